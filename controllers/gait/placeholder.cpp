@@ -1,0 +1,1 @@
+#include "animrt/controllers/motion_source.hpp"

@@ -1,0 +1,26 @@
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+namespace {
+
+std::string format(const Location& where, const std::string& key, const std::string& message) {
+  std::string out = where.file.empty() ? std::string("<input>") : where.file;
+  if (where.line > 0) {
+    out += ':' + std::to_string(where.line);
+    if (where.column > 0) out += ':' + std::to_string(where.column);
+  }
+  out += ": ";
+  if (!key.empty()) out += key + ": ";
+  out += message;
+  return out;
+}
+
+}  // namespace
+
+InputError::InputError(Location where, std::string key, std::string message)
+    : std::runtime_error(format(where, key, message)),
+      where_(std::move(where)),
+      key_(std::move(key)),
+      message_(std::move(message)) {}
+
+}  // namespace animrt

@@ -1,0 +1,221 @@
+#include "animrt/core/yaml_doc.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace animrt {
+namespace {
+
+std::string join_path(const std::string& parent, std::string_view key) {
+  if (parent.empty()) return std::string(key);
+  return parent + "." + std::string(key);
+}
+
+Location location_of(const std::string& file, const YAML::Mark& mark) {
+  if (mark.is_null()) return Location{file, 0, 0};
+  return Location{file, mark.line + 1, mark.column + 1};
+}
+
+}  // namespace
+
+YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std::string path,
+                   YAML::Mark mark)
+    : file_(std::move(file)), node_(std::move(node)), path_(std::move(path)), mark_(mark) {}
+
+YamlNode YamlNode::load_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(Location{path, 0, 0}, "", "cannot open file: " + std::string(std::strerror(errno)));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return load_string(buffer.str(), path);
+}
+
+YamlNode YamlNode::load_string(const std::string& text, const std::string& file_name) {
+  auto file = std::make_shared<const std::string>(file_name);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(location_of(file_name, e.mark), "", "YAML syntax error: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw InputError(Location{file_name, 0, 0}, "", "file is empty");
+  return YamlNode(file, root, "", root.Mark());
+}
+
+Location YamlNode::location() const {
+  YAML::Mark mark = mark_;
+  if (node_ && !node_.Mark().is_null()) mark = node_.Mark();
+  return location_of(*file_, mark);
+}
+
+void YamlNode::fail(const std::string& message) const {
+  throw InputError(location(), path_, message);
+}
+
+YamlNode YamlNode::child(const YAML::Node& node, std::string path) const {
+  return YamlNode(file_, node, std::move(path), node.Mark().is_null() ? mark_ : node.Mark());
+}
+
+std::string YamlNode::describe() const {
+  if (!node_ || node_.IsNull()) return "nothing";
+  if (node_.IsMap()) return "a map";
+  if (node_.IsSequence()) return "a list";
+  return "\"" + node_.Scalar() + "\"";
+}
+
+bool YamlNode::has(std::string_view key) const {
+  return node_.IsMap() && node_[std::string(key)].IsDefined();
+}
+
+std::optional<YamlNode> YamlNode::find(std::string_view key) const {
+  if (!node_.IsMap()) fail("expected a map, found " + describe());
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    if (it->first.IsScalar() && it->first.Scalar() == key) {
+      YAML::Node value = it->second;
+      YAML::Mark mark = value.Mark().is_null() || value.IsNull() ? it->first.Mark() : value.Mark();
+      return YamlNode(file_, value, join_path(path_, key), mark);
+    }
+  }
+  return std::nullopt;
+}
+
+YamlNode YamlNode::at(std::string_view key) const {
+  auto found = find(key);
+  if (!found) throw InputError(location(), join_path(path_, key), "required key is missing");
+  return *found;
+}
+
+void YamlNode::allow_only(std::initializer_list<std::string_view> keys) const {
+  if (!node_.IsMap()) fail("expected a map, found " + describe());
+  std::set<std::string> seen;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string("<complex key>");
+    bool known = false;
+    for (auto k : keys) known = known || (k == key);
+    Location where = location_of(*file_, it->first.Mark());
+    if (!known) {
+      std::string expected;
+      for (auto k : keys) expected += (expected.empty() ? "" : ", ") + std::string(k);
+      throw InputError(where, join_path(path_, key), "unknown key (expected one of: " + expected + ")");
+    }
+    if (!seen.insert(key).second) throw InputError(where, join_path(path_, key), "duplicate key");
+  }
+}
+
+std::vector<std::pair<std::string, YamlNode>> YamlNode::entries() const {
+  if (!node_.IsMap()) fail("expected a map, found " + describe());
+  std::vector<std::pair<std::string, YamlNode>> out;
+  std::set<std::string> seen;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    if (!it->first.IsScalar()) {
+      throw InputError(location_of(*file_, it->first.Mark()), path_, "keys must be plain names");
+    }
+    const std::string key = it->first.Scalar();
+    if (!seen.insert(key).second) {
+      throw InputError(location_of(*file_, it->first.Mark()), join_path(path_, key), "duplicate key");
+    }
+    YAML::Mark mark = it->second.IsNull() ? it->first.Mark() : it->second.Mark();
+    out.emplace_back(key, YamlNode(file_, it->second, join_path(path_, key), mark));
+  }
+  return out;
+}
+
+std::vector<YamlNode> YamlNode::items() const {
+  if (!node_.IsSequence()) fail("expected a list, found " + describe());
+  std::vector<YamlNode> out;
+  std::size_t index = 0;
+  for (auto it = node_.begin(); it != node_.end(); ++it, ++index) {
+    out.push_back(child(*it, path_ + "[" + std::to_string(index) + "]"));
+  }
+  return out;
+}
+
+std::string YamlNode::as_string() const {
+  if (!node_.IsScalar()) fail("expected a string, found " + describe());
+  return node_.Scalar();
+}
+
+double YamlNode::as_double() const {
+  if (!node_.IsScalar()) fail("expected a number, found " + describe());
+  const std::string& s = node_.Scalar();
+  double value = 0.0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) {
+    fail("expected a number, found " + describe());
+  }
+  if (!std::isfinite(value)) fail("expected a finite number, found " + describe());
+  return value;
+}
+
+std::int64_t YamlNode::as_int() const {
+  if (!node_.IsScalar()) fail("expected an integer, found " + describe());
+  const std::string& s = node_.Scalar();
+  std::int64_t value = 0;
+  const char* begin = s.data();
+  int base = 10;
+  if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+    begin += 2;
+    base = 16;
+  }
+  auto [end, ec] = std::from_chars(begin, s.data() + s.size(), value, base);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) {
+    fail("expected an integer, found " + describe());
+  }
+  return value;
+}
+
+bool YamlNode::as_bool() const {
+  if (!node_.IsScalar()) fail("expected true or false, found " + describe());
+  const std::string& s = node_.Scalar();
+  if (s == "true") return true;
+  if (s == "false") return false;
+  fail("expected true or false, found " + describe());
+}
+
+double YamlNode::as_double_in(double lo, double hi) const {
+  double value = as_double();
+  if (value < lo || value > hi) {
+    std::ostringstream msg;
+    msg << "expected a number from " << lo << " to " << hi << ", found " << describe();
+    fail(msg.str());
+  }
+  return value;
+}
+
+std::int64_t YamlNode::as_int_in(std::int64_t lo, std::int64_t hi) const {
+  std::int64_t value = as_int();
+  if (value < lo || value > hi) {
+    fail("expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi) +
+         ", found " + describe());
+  }
+  return value;
+}
+
+double YamlNode::as_positive_double() const {
+  double value = as_double();
+  if (!(value > 0.0)) fail("expected a positive number, found " + describe());
+  return value;
+}
+
+double YamlNode::get_double(std::string_view key, double fallback) const {
+  auto found = find(key);
+  return found ? found->as_double() : fallback;
+}
+
+std::string YamlNode::get_string(std::string_view key, const std::string& fallback) const {
+  auto found = find(key);
+  return found ? found->as_string() : fallback;
+}
+
+bool YamlNode::get_bool(std::string_view key, bool fallback) const {
+  auto found = find(key);
+  return found ? found->as_bool() : fallback;
+}
+
+}  // namespace animrt

@@ -1,0 +1,60 @@
+#pragma once
+// One actuator bus: a protocol spoken over a transport to several devices.
+// The runtime drives every bus through this interface and does not know
+// whether the other end is hardware or a simulated device.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "animrt/bridge/bus_config.hpp"
+
+namespace animrt {
+
+enum class DeviceHealth : std::uint8_t { ok, timeout, protocol_error, hardware_error };
+
+const char* to_string(DeviceHealth health);
+
+// Per device, counted since configure(). Read by the runtime after each cycle.
+struct DeviceStatus {
+  int device_id = 0;
+  DeviceHealth health = DeviceHealth::ok;  // result of the latest transaction
+  bool faulted = false;                    // set by the runtime's watchdog / by hardware error
+  std::uint64_t transactions = 0;
+  std::uint64_t timeouts = 0;
+  std::uint64_t crc_errors = 0;
+  std::uint64_t protocol_errors = 0;  // malformed, truncated, wrong id, unexpected packet
+  std::uint64_t hardware_errors = 0;  // status packets with the alert / error bits set
+  std::uint8_t last_error_byte = 0;   // status error byte of the last status packet
+  std::uint8_t hardware_error_status = 0;  // device's own fault register, when read
+};
+
+class ActuatorBus {
+ public:
+  virtual ~ActuatorBus() = default;
+
+  virtual const BusConfig& config() const = 0;
+
+  // Lifecycle. configure(): open the transport, ping every device, read the
+  // positions; throws DeviceError naming the device on failure.
+  // activate(): torque on. deactivate(): torque off (best effort, never throws).
+  virtual void configure() = 0;
+  virtual void activate() = 0;
+  virtual void deactivate() = 0;
+
+  // One cycle. Indexed like config().actuators. read() updates the entries of
+  // devices that answered and leaves the others unchanged; write() sends the
+  // goal positions (rad). Neither allocates, and neither blocks longer than
+  // the bus timeout. Devices marked `faulted` are skipped.
+  virtual void read(std::span<double> positions) = 0;
+  virtual void write(std::span<const double> positions) = 0;
+
+  // Per device status, indexed like config().actuators.
+  virtual std::span<DeviceStatus> devices() = 0;
+};
+
+// Builds the bus for config.protocol on a transport opened on config.port.
+std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config);
+
+}  // namespace animrt

@@ -1,0 +1,45 @@
+#pragma once
+// What a bus and each device on it need to know, as read from the robot
+// config. Device units (ticks) exist only from here down.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+
+// How a joint maps to one device on a bus.
+struct ActuatorBinding {
+  std::string joint;          // robot joint name
+  int joint_index = -1;       // robot joint index
+  int device_id = 0;          // bus address (Dynamixel id 0..252)
+  double ticks_per_rad = 4096.0 / (2.0 * 3.14159265358979323846);  // native scale
+  std::int32_t zero_ticks = 2048;  // ticks at 0 rad
+  int direction = 1;               // +1 or -1
+
+  std::int32_t to_ticks(double rad) const;
+  double to_rad(std::int32_t ticks) const;
+};
+
+// Simulated-device settings of a bus (used only with --backend sim).
+struct SimBusSettings {
+  double time_constant_s = 0.02;   // first-order lag of each motor
+  double max_speed_rad_s = 6.0;    // rate limit of each motor
+  bool wire_time = false;          // emulate bytes on the wire at the baud rate
+  int return_delay_us = 0;         // device's delay before answering
+};
+
+struct BusConfig {
+  std::string name;
+  std::string protocol;     // "dynamixel2"
+  std::string port;         // e.g. /dev/ttyUSB0
+  int baud = 1'000'000;
+  double timeout_s = 0.004;  // answer timeout for one transaction
+  SimBusSettings sim;
+  std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
+  Location where;                          // where the bus is declared
+};
+
+}  // namespace animrt

@@ -1,0 +1,39 @@
+#pragma once
+// The robot file: joints, buses, actuator bindings, loop rate, safety and the
+// motion source. Loading validates everything; nothing moves until it passes.
+
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+
+struct SafetyConfig {
+  double watchdog_timeout_s = 0.1;  // a device silent this long is faulted
+  double start_ramp_s = 2.0;        // measured pose -> first pose of the motion
+  double stop_ramp_s = 2.0;         // current pose -> home
+};
+
+struct MotionConfig {
+  std::string type;  // "gait"
+  std::string file;  // resolved against the robot file's folder
+  Location where;
+};
+
+struct RobotConfig {
+  std::string file;
+  std::string name;
+  double rate_hz = 200.0;
+  SafetyConfig safety;
+  std::vector<JointSpec> joints;
+  std::vector<BusConfig> buses;  // each with its actuators (joint_index filled in)
+  MotionConfig motion;
+};
+
+// Throws InputError (file, line, column, key) on the first problem found.
+RobotConfig load_robot_config(const std::string& path);
+
+}  // namespace animrt

@@ -1,0 +1,1 @@
+#include "animrt/runtime/robot_config.hpp"

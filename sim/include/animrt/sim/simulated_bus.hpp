@@ -1,0 +1,35 @@
+#pragma once
+// Simulated devices of one bus: firmware that speaks the bus's real wire
+// protocol on the device side of a pseudo-terminal (or other endpoint), so the
+// runtime drives it through exactly the code that drives hardware.
+
+#include <memory>
+#include <string>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/clock.hpp"
+
+namespace animrt {
+
+class SimulatedBus {
+ public:
+  virtual ~SimulatedBus() = default;
+  // Where a client connects, e.g. "/dev/pts/7". Valid after construction.
+  virtual const std::string& endpoint() const = 0;
+  // One line for `animrt sim`, e.g. "serial legs /dev/pts/7".
+  virtual std::string describe() const = 0;
+  // Serve on a background thread until stop() or destruction.
+  virtual void start() = 0;
+  virtual void stop() = 0;
+  // Fault injection: a device that is not responding ignores every packet.
+  virtual void set_device_responding(int device_id, bool responding) = 0;
+  // Position of a device in radians (through its binding), for tests.
+  virtual double device_position(int device_id) const = 0;
+};
+
+// Builds the simulated devices for config.protocol ("dynamixel2": N X-series
+// servos behind one pty). Motor models read time from `clock`, so a lockstep
+// run with a ManualClock is deterministic.
+std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock);
+
+}  // namespace animrt

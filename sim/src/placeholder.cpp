@@ -1,0 +1,1 @@
+#include "animrt/sim/simulated_bus.hpp"
