@@ -3,6 +3,7 @@
 // protocol on the device side of a pseudo-terminal (or other endpoint), so the
 // runtime drives it through exactly the code that drives hardware.
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -23,6 +24,9 @@ class SimulatedBus {
   virtual void stop() = 0;
   // Fault injection: a device that is not responding ignores every packet.
   virtual void set_device_responding(int device_id, bool responding) = 0;
+  // Fault injection: a device with hardware error bits set reports them in its
+  // hardware error register and sets the alert bit of every status packet.
+  virtual void set_device_hardware_error(int device_id, std::uint8_t error_bits) = 0;
   // Position of a device in radians (through its binding), for tests.
   virtual double device_position(int device_id) const = 0;
 };
