@@ -1,0 +1,22 @@
+#pragma once
+// Everything a run needs from files, loaded and validated in one place, so
+// `animrt validate` checks exactly what `animrt run` would use.
+
+#include <memory>
+#include <string>
+
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/runtime/robot_config.hpp"
+
+namespace animrt {
+
+struct LoadedRobot {
+  RobotConfig config;
+  std::unique_ptr<MotionSource> motion;
+};
+
+// Loads the robot file and its motion source. Throws InputError on the first
+// problem in any of the files.
+LoadedRobot load_robot(const std::string& path);
+
+}  // namespace animrt

@@ -1,0 +1,73 @@
+#pragma once
+// What a run reports at its end, as text for people and JSON for tools.
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+
+namespace animrt {
+
+struct TimingSummary {
+  std::uint64_t count = 0;
+  double p50_s = 0.0;
+  double p99_s = 0.0;
+  double max_s = 0.0;
+};
+
+struct JointReport {
+  std::string name;
+  double rms_tracking_error_rad = 0.0;  // commanded (previous cycle) - measured
+  double max_tracking_error_rad = 0.0;
+};
+
+struct DeviceReport {
+  std::string bus;
+  std::string joint;
+  DeviceStatus status;
+};
+
+struct BusReport {
+  std::string name;
+  TimingSummary io;  // read + write time of the bus per cycle
+};
+
+enum class EndReason { duration, signal, fault };
+const char* to_string(EndReason reason);
+
+struct RunSummary {
+  std::string robot;
+  std::string backend;
+  bool lockstep = false;
+  double rate_hz = 0.0;
+  EndReason end_reason = EndReason::duration;
+  std::vector<std::string> faults;  // one line per faulted device
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;
+  double motion_time_s = 0.0;  // time spent playing the motion source
+  TimingSummary period;        // between cycle starts
+  TimingSummary jitter;        // cycle start - deadline
+  TimingSummary busy;          // work per cycle (wake to end of writes)
+  std::vector<BusReport> buses;
+  std::vector<JointReport> joints;
+  std::vector<DeviceReport> devices;
+  bool sched_fifo = false;
+  int sched_priority = 0;
+  std::string sched_note;
+  bool memory_locked = false;
+  std::string mlock_note;
+  std::string telemetry_file;
+  std::uint64_t telemetry_records = 0;
+  std::uint64_t telemetry_dropped = 0;
+
+  // 0 for a clean run, 4 when a device fault ended it.
+  int exit_code() const { return end_reason == EndReason::fault ? 4 : 0; }
+};
+
+std::string format_summary(const RunSummary& summary);
+nlohmann::json to_json(const RunSummary& summary);
+
+}  // namespace animrt

@@ -1,0 +1,52 @@
+#pragma once
+// The lifecycle of a run: configure (open buses, ping every device, read the
+// pose), activate (torque on, ramp from the measured pose to the motion's
+// first pose), run (read -> sample -> filter -> write on absolute deadlines),
+// deactivate (ramp to home, torque off) on the end of the duration, a stop
+// request or a device fault.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/runtime/robot_config.hpp"
+#include "animrt/runtime/run_summary.hpp"
+
+namespace animrt {
+
+struct RunOptions {
+  double duration_s = 0.0;  // seconds of motion; 0 = until a stop request
+  // Lockstep: the loop never sleeps; it advances this clock by one period per
+  // cycle (share it with simulated devices for deterministic runs).
+  ManualClock* lockstep_clock = nullptr;
+  bool request_realtime = true;  // SCHED_FIFO + mlockall (real-time runs only)
+  int realtime_priority = 80;
+  std::string telemetry_path;                      // CSV, empty = none
+  const std::atomic<bool>* stop_request = nullptr;  // e.g. set by SIGINT
+  std::string backend_name = "hardware";           // for the report
+  // Lifecycle messages; never called from inside the cycle.
+  std::function<void(const std::string&)> log;
+};
+
+class Runner {
+ public:
+  Runner(RobotConfig config, std::vector<std::unique_ptr<ActuatorBus>> buses,
+         std::unique_ptr<MotionSource> motion);
+  ~Runner();
+
+  // Runs the whole lifecycle. Throws DeviceError when bring-up fails (after
+  // switching off whatever it had switched on); a fault during the run ends
+  // it through the stop ramp and is reported in the summary.
+  RunSummary run(const RunOptions& options);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace animrt

@@ -1,0 +1,58 @@
+#pragma once
+// Telemetry leaves the real-time cycle through a preallocated
+// single-producer single-consumer ring; a writer thread drains it to CSV.
+// The cycle never blocks: when the ring is full, records are dropped and
+// counted.
+
+#include <atomic>
+#include <cstdint>
+#include <fstream>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace animrt {
+
+class TelemetryRing {
+ public:
+  // `width` doubles per record, `capacity` records.
+  TelemetryRing(std::size_t width, std::size_t capacity);
+  // Producer side (real-time thread). Returns false (and counts) when full.
+  bool push(std::span<const double> record);
+  // Consumer side. Copies the oldest record into `out`; false when empty.
+  bool pop(std::span<double> out);
+  std::size_t width() const { return width_; }
+  std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
+
+ private:
+  std::size_t width_;
+  std::size_t capacity_;
+  std::vector<double> slots_;
+  alignas(64) std::atomic<std::uint64_t> head_{0};  // next write (producer)
+  alignas(64) std::atomic<std::uint64_t> tail_{0};  // next read (consumer)
+  std::atomic<std::uint64_t> dropped_{0};
+};
+
+// Drains a ring into a CSV file: `time_s,<joint>_cmd_rad,<joint>_meas_rad,...`.
+class TelemetryWriter {
+ public:
+  // Opens the file (throws std::runtime_error naming it if it cannot).
+  TelemetryWriter(const std::string& path, std::span<const std::string> joint_names,
+                  TelemetryRing& ring);
+  ~TelemetryWriter();
+  // Drains what is left and closes the file.
+  void finish();
+  std::uint64_t written() const { return written_.load(); }
+
+ private:
+  void drain();
+  std::ofstream out_;
+  TelemetryRing& ring_;
+  std::vector<double> record_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> written_{0};
+  std::thread thread_;
+};
+
+}  // namespace animrt

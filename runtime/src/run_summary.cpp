@@ -1,0 +1,121 @@
+#include "animrt/runtime/run_summary.hpp"
+
+#include <fmt/format.h>
+
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+namespace {
+
+std::string ms(double seconds) { return fmt::format("{:.3f} ms", seconds * 1e3); }
+
+nlohmann::json timing_json(const TimingSummary& t) {
+  return {{"count", t.count}, {"p50_s", t.p50_s}, {"p99_s", t.p99_s}, {"max_s", t.max_s}};
+}
+
+}  // namespace
+
+const char* to_string(EndReason reason) {
+  switch (reason) {
+    case EndReason::duration: return "duration";
+    case EndReason::signal: return "stop request";
+    case EndReason::fault: return "device fault";
+  }
+  return "?";
+}
+
+std::string format_summary(const RunSummary& s) {
+  std::string out;
+  auto line = [&out](const std::string& text) { out += text + '\n'; };
+  line(fmt::format("run: {} on the {} backend, {} clock at {:g} Hz; ended by {} after {:.2f} s of motion",
+                   s.robot, s.backend, s.lockstep ? "lockstep" : "real-time", s.rate_hz,
+                   to_string(s.end_reason), s.motion_time_s));
+  for (const auto& fault : s.faults) line("FAULT " + fault);
+  line(fmt::format("cycles: {}, overruns: {}", s.cycles, s.overruns));
+  line(fmt::format("period: p50 {}, p99 {}, max {}", ms(s.period.p50_s), ms(s.period.p99_s),
+                   ms(s.period.max_s)));
+  line(fmt::format("jitter (start - deadline): p50 {}, p99 {}, max {}", ms(s.jitter.p50_s),
+                   ms(s.jitter.p99_s), ms(s.jitter.max_s)));
+  line(fmt::format("work per cycle: p50 {}, p99 {}, max {}", ms(s.busy.p50_s), ms(s.busy.p99_s),
+                   ms(s.busy.max_s)));
+  if (!s.lockstep) {
+    line(s.sched_fifo ? fmt::format("scheduling: SCHED_FIFO priority {}", s.sched_priority)
+                      : "scheduling: " + s.sched_note);
+    line(s.memory_locked ? "memory: locked" : "memory: " + s.mlock_note);
+  }
+  for (const auto& bus : s.buses) {
+    line(fmt::format("bus {}: I/O per cycle p50 {}, p99 {}, max {}", bus.name, ms(bus.io.p50_s),
+                     ms(bus.io.p99_s), ms(bus.io.max_s)));
+  }
+  line("tracking error, commanded vs measured (deg):");
+  for (const auto& j : s.joints) {
+    line(fmt::format("  {:<14} rms {:7.3f}  max {:7.3f}", j.name,
+                     rad_to_deg(j.rms_tracking_error_rad), rad_to_deg(j.max_tracking_error_rad)));
+  }
+  line("devices:");
+  for (const auto& d : s.devices) {
+    const DeviceStatus& st = d.status;
+    line(fmt::format(
+        "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware {}{}",
+        d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
+        st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
+        st.hardware_error_status ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
+                                 : std::string()));
+  }
+  if (!s.telemetry_file.empty()) {
+    line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
+                     s.telemetry_file, s.telemetry_dropped));
+  }
+  return out;
+}
+
+nlohmann::json to_json(const RunSummary& s) {
+  nlohmann::json j;
+  j["robot"] = s.robot;
+  j["backend"] = s.backend;
+  j["clock"] = s.lockstep ? "lockstep" : "realtime";
+  j["rate_hz"] = s.rate_hz;
+  j["end_reason"] = to_string(s.end_reason);
+  j["exit_code"] = s.exit_code();
+  j["faults"] = s.faults;
+  j["cycles"] = s.cycles;
+  j["overruns"] = s.overruns;
+  j["motion_time_s"] = s.motion_time_s;
+  j["period"] = timing_json(s.period);
+  j["jitter"] = timing_json(s.jitter);
+  j["work_per_cycle"] = timing_json(s.busy);
+  j["realtime"] = {{"sched_fifo", s.sched_fifo},
+                   {"priority", s.sched_priority},
+                   {"sched_note", s.sched_note},
+                   {"memory_locked", s.memory_locked},
+                   {"mlock_note", s.mlock_note}};
+  j["buses"] = nlohmann::json::array();
+  for (const auto& bus : s.buses) j["buses"].push_back({{"name", bus.name}, {"io", timing_json(bus.io)}});
+  j["joints"] = nlohmann::json::array();
+  for (const auto& joint : s.joints) {
+    j["joints"].push_back({{"name", joint.name},
+                           {"rms_tracking_error_rad", joint.rms_tracking_error_rad},
+                           {"max_tracking_error_rad", joint.max_tracking_error_rad}});
+  }
+  j["devices"] = nlohmann::json::array();
+  for (const auto& d : s.devices) {
+    const DeviceStatus& st = d.status;
+    j["devices"].push_back({{"bus", d.bus},
+                            {"id", st.device_id},
+                            {"joint", d.joint},
+                            {"health", to_string(st.health)},
+                            {"faulted", st.faulted},
+                            {"transactions", st.transactions},
+                            {"timeouts", st.timeouts},
+                            {"crc_errors", st.crc_errors},
+                            {"protocol_errors", st.protocol_errors},
+                            {"hardware_errors", st.hardware_errors},
+                            {"hardware_error_status", st.hardware_error_status}});
+  }
+  j["telemetry"] = {{"file", s.telemetry_file},
+                    {"records", s.telemetry_records},
+                    {"dropped", s.telemetry_dropped}};
+  return j;
+}
+
+}  // namespace animrt

@@ -1,0 +1,18 @@
+#pragma once
+// The simulated backend: starts simulated devices for every bus and points
+// the bus configs at their endpoints. From there on the runtime drives them
+// through exactly the code that drives hardware.
+
+#include <memory>
+#include <vector>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/sim/simulated_bus.hpp"
+
+namespace animrt {
+
+std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
+                                                                   const Clock& clock);
+
+}  // namespace animrt

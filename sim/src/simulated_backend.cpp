@@ -1,0 +1,17 @@
+#include "animrt/sim/simulated_backend.hpp"
+
+namespace animrt {
+
+std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
+                                                                   const Clock& clock) {
+  std::vector<std::unique_ptr<SimulatedBus>> simulated;
+  for (auto& bus : buses) {
+    auto sim = make_simulated_bus(bus, clock);
+    sim->start();
+    bus.port = sim->endpoint();
+    simulated.push_back(std::move(sim));
+  }
+  return simulated;
+}
+
+}  // namespace animrt
