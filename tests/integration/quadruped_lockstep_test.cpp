@@ -1,0 +1,319 @@
+// The runtime against simulated Dynamixel servos over a real pseudo-terminal,
+// on a lockstep clock: the whole lifecycle, tracking, determinism, the fault
+// path when a device dies or reports a hardware error, and no allocation in
+// the cycle.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <functional>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/runner.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+
+// Counts allocations per thread, so a test can see whether the loop thread
+// allocates between two cycles.
+namespace {
+thread_local std::uint64_t t_allocations = 0;
+}
+void* operator new(std::size_t size) {
+  ++t_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) {
+  ++t_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace animrt {
+namespace {
+
+const std::string kQuadruped = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml";
+
+// Wraps a motion source to act at given motion times, on the loop thread, so
+// fault injection happens at a deterministic cycle.
+class Probe final : public MotionSource {
+ public:
+  explicit Probe(std::unique_ptr<MotionSource> inner) : inner_(std::move(inner)) {}
+  std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
+  void sample(double t, std::span<double> targets) const override {
+    if (on_sample) on_sample(t);
+    allocations_seen.push_back_noalloc(t_allocations);
+    inner_->sample(t, targets);
+  }
+  std::function<void(double)> on_sample;
+
+  // Preallocated record of the loop thread's allocation counter per sample.
+  struct Record {
+    std::vector<std::uint64_t> values;
+    std::size_t size = 0;
+    void push_back_noalloc(std::uint64_t v) {
+      if (size < values.size()) values[size++] = v;
+    }
+  };
+  mutable Record allocations_seen;
+
+ private:
+  std::unique_ptr<MotionSource> inner_;
+};
+
+struct Rig {
+  ManualClock clock;
+  LoadedRobot robot;
+  std::vector<std::unique_ptr<SimulatedBus>> sims;
+  Probe* probe = nullptr;
+  std::unique_ptr<Runner> runner;
+
+  Rig() {
+    robot = load_robot(kQuadruped);
+    for (auto& bus : robot.config.buses) {
+      bus.timeout_s = 0.05;  // generous: a loaded CI machine must not cause timeouts
+      bus.sim.wire_time = false;
+    }
+    sims = start_simulated_devices(robot.config.buses, clock);
+    std::vector<std::unique_ptr<ActuatorBus>> buses;
+    for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
+    auto probe_owner = std::make_unique<Probe>(std::move(robot.motion));
+    probe = probe_owner.get();
+    probe->allocations_seen.values.assign(100000, 0);
+    runner = std::make_unique<Runner>(robot.config, std::move(buses), std::move(probe_owner));
+  }
+
+  RunSummary run(double duration, const std::string& telemetry = "") {
+    RunOptions options;
+    options.duration_s = duration;
+    options.lockstep_clock = &clock;
+    options.telemetry_path = telemetry;
+    options.backend_name = "sim";
+    return runner->run(options);
+  }
+};
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  int column(const std::string& name) const {
+    for (std::size_t i = 0; i < header.size(); ++i) {
+      if (header[i] == name) return static_cast<int>(i);
+    }
+    ADD_FAILURE() << "no column " << name;
+    return 0;
+  }
+};
+
+Csv read_csv(const std::string& path) {
+  Csv csv;
+  std::ifstream in(path);
+  std::string line, cell;
+  std::getline(in, line);
+  std::stringstream hs(line);
+  while (std::getline(hs, cell, ',')) csv.header.push_back(cell);
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::vector<double> row;
+    while (std::getline(ls, cell, ',')) row.push_back(std::stod(cell));
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(QuadrupedLockstep, WalksTheGaitAndTracksWithinTheServoModel) {
+  Rig rig;
+  const std::string csv_path = ::testing::TempDir() + "/lockstep_walk.csv";
+  RunSummary s = rig.run(3.0, csv_path);
+
+  EXPECT_EQ(s.end_reason, EndReason::duration);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_TRUE(s.faults.empty());
+  EXPECT_NEAR(s.motion_time_s, 3.0, 0.006);
+  ASSERT_EQ(s.devices.size(), 12u);
+  for (const auto& d : s.devices) {
+    EXPECT_FALSE(d.status.faulted) << d.joint;
+    EXPECT_EQ(d.status.timeouts, 0u) << d.joint;
+    EXPECT_EQ(d.status.crc_errors, 0u) << d.joint;
+    EXPECT_EQ(d.status.protocol_errors, 0u) << d.joint;
+    EXPECT_GE(d.status.transactions, s.cycles) << d.joint;
+  }
+  EXPECT_EQ(s.telemetry_dropped, 0u);
+  EXPECT_EQ(s.telemetry_records, s.cycles);
+
+  // A first-order servo with time constant tau lags a command moving at v by
+  // about tau*v, so the RMS error is bounded by tau * RMS(v) plus a margin for
+  // the one-cycle delay and the tick quantisation.
+  const double tau = rig.robot.config.buses[0].sim.time_constant_s;
+  const double dt = 1.0 / rig.robot.config.rate_hz;
+  const double tick = 2 * M_PI / 4096;
+  Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), s.cycles);
+  for (std::size_t j = 0; j < s.joints.size(); ++j) {
+    const auto& name = s.joints[j].name;
+    const int cmd = csv.column(name + "_cmd_rad");
+    double sum_v2 = 0.0;
+    double moved = 0.0;
+    for (std::size_t k = 1; k < csv.rows.size(); ++k) {
+      const double v = (csv.rows[k][cmd] - csv.rows[k - 1][cmd]) / dt;
+      sum_v2 += v * v;
+      moved = std::max(moved, std::abs(csv.rows[k][cmd]));
+    }
+    const double rms_v = std::sqrt(sum_v2 / static_cast<double>(csv.rows.size() - 1));
+    EXPECT_GT(moved, 0.05) << name << " did not move";
+    EXPECT_LE(s.joints[j].rms_tracking_error_rad, 1.5 * (tau + dt) * rms_v + 2 * tick) << name;
+    EXPECT_GT(s.joints[j].rms_tracking_error_rad, 0.0) << name;
+  }
+  // Every servo is back home at the end.
+  for (const auto& bus : rig.robot.config.buses) {
+    for (const auto& a : bus.actuators) {
+      EXPECT_NEAR(rig.sims[0]->device_position(a.device_id), 0.0, 0.02) << a.joint;
+    }
+  }
+}
+
+TEST(QuadrupedLockstep, SameRunSameTelemetry) {
+  const std::string a = ::testing::TempDir() + "/lockstep_a.csv";
+  const std::string b = ::testing::TempDir() + "/lockstep_b.csv";
+  {
+    Rig rig;
+    rig.run(1.0, a);
+  }
+  {
+    Rig rig;
+    rig.run(1.0, b);
+  }
+  const std::string ta = slurp(a), tb = slurp(b);
+  EXPECT_GT(ta.size(), 1000u);
+  EXPECT_EQ(ta, tb);
+}
+
+TEST(QuadrupedLockstep, TheCycleDoesNotAllocate) {
+  Rig rig;
+  rig.run(1.0);
+  const auto& seen = rig.probe->allocations_seen;
+  ASSERT_GT(seen.size, 150u);
+  // The first call plans the start ramp outside the cycle; compare the loop
+  // thread's allocation counter from the 10th motion cycle on.
+  for (std::size_t k = 11; k < seen.size; ++k) {
+    ASSERT_EQ(seen.values[k], seen.values[10]) << "allocation between motion cycles " << k - 1
+                                               << " and " << k;
+  }
+}
+
+// Checks a fault run: the faulted joint is reported, every other joint's
+// command stays continuous and ends at home, and the loop did not stall.
+void expect_safe_fault_stop(const RunSummary& s, const Csv& csv, const RobotConfig& config,
+                            const std::string& faulted_joint) {
+  EXPECT_EQ(s.end_reason, EndReason::fault);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find(faulted_joint), std::string::npos) << s.faults[0];
+  const double dt = 1.0 / config.rate_hz;
+  for (const auto& joint : config.joints) {
+    const int cmd = csv.column(joint.name + "_cmd_rad");
+    for (std::size_t k = 1; k < csv.rows.size(); ++k) {
+      ASSERT_LE(std::abs(csv.rows[k][cmd] - csv.rows[k - 1][cmd]),
+                joint.limits.max_velocity * dt * (1 + 1e-9))
+          << joint.name << " jumped at cycle " << k;
+    }
+    if (joint.name != faulted_joint) {
+      EXPECT_NEAR(csv.rows.back()[cmd], joint.home, 1e-6) << joint.name;
+    }
+  }
+  for (const auto& d : s.devices) EXPECT_EQ(d.status.faulted, d.joint == faulted_joint) << d.joint;
+}
+
+TEST(QuadrupedLockstep, ADeviceThatDiesMidRunFaultsAndTheOthersRampHome) {
+  Rig rig;
+  const int dead_id = 5;  // rf_knee
+  rig.probe->on_sample = [&](double t) {
+    if (t >= 1.0) rig.sims[0]->set_device_responding(dead_id, false);
+  };
+  const std::string csv_path = ::testing::TempDir() + "/lockstep_dead.csv";
+  RunSummary s = rig.run(5.0, csv_path);
+  Csv csv = read_csv(csv_path);
+  expect_safe_fault_stop(s, csv, rig.robot.config, "rf_knee");
+  EXPECT_NE(s.faults[0].find("no valid answer"), std::string::npos) << s.faults[0];
+  EXPECT_LT(s.motion_time_s, 1.5);  // the motion stopped soon after the fault
+  for (const auto& d : s.devices) {
+    if (d.joint == "rf_knee") {
+      // Silent for the watchdog time (0.1 s = 20 cycles), then left out.
+      EXPECT_GE(d.status.timeouts, 20u);
+      EXPECT_LE(d.status.timeouts, 22u);
+    } else {
+      EXPECT_EQ(d.status.timeouts, 0u) << d.joint;
+    }
+  }
+}
+
+TEST(QuadrupedLockstep, AHardwareErrorFaultsTheDeviceAtOnce) {
+  Rig rig;
+  rig.probe->on_sample = [&](double t) {
+    if (t >= 0.5) rig.sims[0]->set_device_hardware_error(9, 0x04);  // lh_ankle overheating
+  };
+  const std::string csv_path = ::testing::TempDir() + "/lockstep_hw.csv";
+  RunSummary s = rig.run(5.0, csv_path);
+  Csv csv = read_csv(csv_path);
+  expect_safe_fault_stop(s, csv, rig.robot.config, "lh_ankle");
+  EXPECT_NE(s.faults[0].find("hardware error"), std::string::npos) << s.faults[0];
+  EXPECT_LT(s.motion_time_s, 0.52);
+  for (const auto& d : s.devices) {
+    if (d.joint == "lh_ankle") {
+      EXPECT_GE(d.status.hardware_errors, 1u);
+    }
+  }
+}
+
+TEST(QuadrupedLockstep, AStopRequestRampsHome) {
+  Rig rig;
+  std::atomic<bool> stop{false};
+  rig.probe->on_sample = [&](double t) {
+    if (t >= 0.7) stop.store(true);
+  };
+  RunOptions options;
+  options.duration_s = 0.0;  // forever, until the stop request
+  options.lockstep_clock = &rig.clock;
+  options.stop_request = &stop;
+  const std::string csv_path = ::testing::TempDir() + "/lockstep_stop.csv";
+  options.telemetry_path = csv_path;
+  RunSummary s = rig.runner->run(options);
+  EXPECT_EQ(s.end_reason, EndReason::signal);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_NEAR(s.motion_time_s, 0.7, 0.011);
+  Csv csv = read_csv(csv_path);
+  for (const auto& joint : rig.robot.config.joints) {
+    EXPECT_NEAR(csv.rows.back()[csv.column(joint.name + "_cmd_rad")], joint.home, 1e-6);
+  }
+}
+
+TEST(QuadrupedLockstep, AMissingDeviceStopsBringUpBeforeAnythingMoves) {
+  Rig rig;
+  rig.sims[0]->set_device_responding(3, false);
+  try {
+    rig.run(1.0);
+    FAIL() << "expected a DeviceError";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("lf_ankle"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace animrt
