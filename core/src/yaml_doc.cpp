@@ -50,7 +50,8 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& file_
 
 Location YamlNode::location() const {
   YAML::Mark mark = mark_;
-  if (node_ && !node_.Mark().is_null()) mark = node_.Mark();
+  // An empty value carries the mark of the next token: keep the key's.
+  if (node_ && !node_.IsNull() && !node_.Mark().is_null()) mark = node_.Mark();
   return location_of(*file_, mark);
 }
 

@@ -61,3 +61,15 @@ TEST(YamlNode, DuplicateKeyIsAnError) {
 
 }  // namespace
 }  // namespace animrt
+
+namespace animrt {
+namespace {
+
+TEST(YamlNode, AnEmptyValueIsReportedAtItsKey) {
+  auto msg = error_of("a: 1\nbuses:\njoints: {}\n",
+                      [](const YamlNode& n) { (void)n.at("buses").entries(); });
+  EXPECT_EQ(msg, "t.yaml:2:1: buses: expected a map, found nothing");
+}
+
+}  // namespace
+}  // namespace animrt

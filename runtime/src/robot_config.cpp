@@ -1,0 +1,370 @@
+#include "animrt/runtime/robot_config.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt {
+namespace {
+
+// What each protocol's devices accept. Adding a protocol means adding a row
+// here and a bus implementation in firmware_bridge.
+struct ProtocolSpec {
+  std::string_view name;
+  int max_device_id;       // ids 0..max_device_id
+  std::int64_t min_ticks;  // position range in device units
+  std::int64_t max_ticks;
+};
+
+// Dynamixel Protocol 2.0: ids 253..255 are reserved (254 is broadcast); an
+// X-series servo in position control mode accepts goal positions 0..4095.
+constexpr ProtocolSpec kProtocols[] = {
+    {"dynamixel2", 252, 0, 4095},
+};
+
+const ProtocolSpec* find_protocol(std::string_view name) {
+  for (const auto& p : kProtocols) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+std::string supported_protocols() {
+  std::string out;
+  for (const auto& p : kProtocols) out += (out.empty() ? "" : ", ") + std::string(p.name);
+  return out;
+}
+
+// Numbers in messages: shortest readable form, as the YAML reader prints them.
+std::string num(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// What a node holds, quoted like YamlNode's own messages.
+std::string found(const YamlNode& node) {
+  const YAML::Node& raw = node.raw();
+  if (!raw || raw.IsNull()) return "nothing";
+  if (raw.IsMap()) return "a map";
+  if (raw.IsSequence()) return "a list";
+  return "\"" + raw.Scalar() + "\"";
+}
+
+// Position of `key` itself inside `map` (the line a user reads as "declared
+// here"), falling back to the map's position.
+Location key_location(const YamlNode& map, std::string_view key) {
+  for (auto it = map.raw().begin(); it != map.raw().end(); ++it) {
+    if (it->first.IsScalar() && it->first.Scalar() == key && !it->first.Mark().is_null()) {
+      return Location{map.file(), it->first.Mark().line + 1, it->first.Mark().column + 1};
+    }
+  }
+  return map.location();
+}
+
+std::string key_path(const YamlNode& parent, std::string_view key) {
+  return parent.path().empty() ? std::string(key) : parent.path() + "." + std::string(key);
+}
+
+SafetyConfig parse_safety(const YamlNode& node) {
+  node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s"});
+  SafetyConfig safety;
+  if (auto n = node.find("watchdog_timeout_s")) {
+    safety.watchdog_timeout_s = n->as_positive_double();
+  }
+  if (auto n = node.find("start_ramp_s")) safety.start_ramp_s = n->as_double_in(0.0, 60.0);
+  if (auto n = node.find("stop_ramp_s")) safety.stop_ramp_s = n->as_double_in(0.0, 60.0);
+  return safety;
+}
+
+SimBusSettings parse_sim(const YamlNode& node) {
+  node.allow_only({"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us"});
+  SimBusSettings sim;
+  if (auto n = node.find("time_constant_s")) sim.time_constant_s = n->as_positive_double();
+  if (auto n = node.find("max_speed_dps")) {
+    sim.max_speed_rad_s = deg_to_rad(n->as_positive_double());
+  }
+  if (auto n = node.find("wire_time")) sim.wire_time = n->as_bool();
+  // Dynamixel's Return Delay Time register counts 2 us units, 0..254.
+  if (auto n = node.find("return_delay_us")) {
+    sim.return_delay_us = static_cast<int>(n->as_int_in(0, 508));
+  }
+  return sim;
+}
+
+BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses) {
+  node.allow_only({"protocol", "port", "baud", "timeout_ms", "sim"});
+  BusConfig bus;
+  bus.name = name;
+  bus.where = key_location(buses, name);
+
+  const YamlNode protocol = node.at("protocol");
+  bus.protocol = protocol.as_string();
+  if (!find_protocol(bus.protocol)) {
+    protocol.fail("unknown protocol " + found(protocol) + " (supported: " + supported_protocols() +
+                  ")");
+  }
+
+  const YamlNode port = node.at("port");
+  bus.port = port.as_string();
+  if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");
+
+  if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(1, 10'500'000));
+
+  if (auto n = node.find("timeout_ms")) {
+    const double ms = n->as_double();
+    if (!(ms > 0.0 && ms < 1000.0)) {
+      n->fail("expected a number greater than 0 and less than 1000, found " + found(*n));
+    }
+    bus.timeout_s = ms / 1000.0;
+  }
+
+  if (auto n = node.find("sim")) bus.sim = parse_sim(*n);
+  return bus;
+}
+
+std::vector<BusConfig> parse_buses(const YamlNode& node) {
+  const auto entries = node.entries();
+  if (entries.empty()) node.fail("expected at least one bus, found an empty map");
+  std::vector<BusConfig> buses;
+  for (const auto& [name, value] : entries) {
+    BusConfig bus = parse_bus(name, value, node);
+    // Two buses on one port would fight over the line.
+    for (const auto& other : buses) {
+      if (other.port == bus.port) {
+        value.at("port").fail("port \"" + bus.port + "\" is already used by bus " + other.name);
+      }
+    }
+    buses.push_back(std::move(bus));
+  }
+  return buses;
+}
+
+JointLimits parse_limits(const YamlNode& node) {
+  node.allow_only({"min_deg", "max_deg", "velocity_dps", "acceleration_dps2"});
+  const double min_deg = node.at("min_deg").as_double();
+  const YamlNode max_node = node.at("max_deg");
+  const double max_deg = max_node.as_double();
+  if (!(max_deg > min_deg)) {
+    max_node.fail("expected a value greater than min_deg (" + num(min_deg) + "), found " +
+                  found(max_node));
+  }
+  JointLimits limits;
+  limits.min_position = deg_to_rad(min_deg);
+  limits.max_position = deg_to_rad(max_deg);
+  limits.max_velocity = deg_to_rad(node.at("velocity_dps").as_positive_double());
+  limits.max_acceleration = deg_to_rad(node.at("acceleration_dps2").as_positive_double());
+  return limits;
+}
+
+double parse_home(const YamlNode& joint, const YamlNode& limits_node) {
+  const double min_deg = limits_node.at("min_deg").as_double();
+  const double max_deg = limits_node.at("max_deg").as_double();
+  const std::string range = num(min_deg) + ".." + num(max_deg);
+  const auto home = joint.find("home_deg");
+  if (!home) {
+    if (min_deg <= 0.0 && 0.0 <= max_deg) return 0.0;
+    throw InputError(joint.location(), key_path(joint, "home_deg"),
+                     "limits contradict the home pose: home_deg defaults to 0, outside "
+                     "min_deg..max_deg (" +
+                         range + "); set home_deg inside the limits");
+  }
+  const double home_deg = home->as_double();
+  if (home_deg < min_deg || home_deg > max_deg) {
+    home->fail("limits contradict the home pose: expected home_deg within min_deg..max_deg (" +
+               range + "), found " + found(*home));
+  }
+  return deg_to_rad(home_deg);
+}
+
+int parse_direction(const YamlNode& node) {
+  if (node.is_scalar()) {
+    const std::string& s = node.raw().Scalar();
+    if (s == "1" || s == "+1") return 1;
+    if (s == "-1") return -1;
+  }
+  node.fail("expected 1 or -1 (-1 for a mirrored servo), found " + found(node));
+}
+
+// A parsed actuator together with what later checks need to point at.
+struct ParsedActuator {
+  ActuatorBinding binding;
+  std::size_t bus_index = 0;
+  std::string scale;  // "4096 ticks/rev", for messages
+};
+
+ParsedActuator parse_actuator(const YamlNode& node, const std::vector<BusConfig>& buses) {
+  node.allow_only({"bus", "id", "ticks_per_rev", "ticks_per_rad", "zero_ticks", "direction"});
+  ParsedActuator out;
+
+  const YamlNode bus_node = node.at("bus");
+  const std::string bus_name = bus_node.as_string();
+  bool known = false;
+  std::string defined;
+  for (std::size_t i = 0; i < buses.size(); ++i) {
+    defined += (defined.empty() ? "" : ", ") + buses[i].name;
+    if (buses[i].name == bus_name) {
+      out.bus_index = i;
+      known = true;
+    }
+  }
+  if (!known) {
+    bus_node.fail("no bus named " + found(bus_node) + " (defined buses: " + defined + ")");
+  }
+  const BusConfig& bus = buses[out.bus_index];
+  const ProtocolSpec& protocol = *find_protocol(bus.protocol);
+
+  const YamlNode id_node = node.at("id");
+  const std::int64_t id = id_node.as_int();
+  if (id < 0 || id > protocol.max_device_id) {
+    id_node.fail("expected a device id from 0 to " + std::to_string(protocol.max_device_id) +
+                 " for " + std::string(protocol.name) + ", found " + found(id_node));
+  }
+  out.binding.device_id = static_cast<int>(id);
+  for (const auto& other : bus.actuators) {
+    if (other.device_id == id) {
+      id_node.fail("device id " + std::to_string(id) + " is already used by joint " + other.joint +
+                   " on bus " + bus.name);
+    }
+  }
+
+  const auto per_rev = node.find("ticks_per_rev");
+  const auto per_rad = node.find("ticks_per_rad");
+  if (per_rev && per_rad) per_rad->fail("give either ticks_per_rev or ticks_per_rad, not both");
+  if (per_rad) {
+    out.binding.ticks_per_rad = per_rad->as_positive_double();
+    out.scale = num(out.binding.ticks_per_rad) + " ticks/rad";
+  } else {
+    const double ticks_per_rev = per_rev ? per_rev->as_positive_double() : 4096.0;
+    out.binding.ticks_per_rad = ticks_per_rev / (2.0 * kPi);
+    out.scale = num(ticks_per_rev) + " ticks/rev";
+  }
+
+  if (auto n = node.find("zero_ticks")) {
+    out.binding.zero_ticks = static_cast<std::int32_t>(n->as_int_in(
+        std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
+  }
+  if (auto n = node.find("direction")) out.binding.direction = parse_direction(*n);
+  return out;
+}
+
+// A position limit must be a position the servo can be commanded to; the
+// mapping is the one ActuatorBinding::to_ticks applies at run time.
+void check_ticks(const YamlNode& limit_node, double rad, const ParsedActuator& actuator,
+                 const ProtocolSpec& protocol) {
+  const ActuatorBinding& b = actuator.binding;
+  // In double, so that absurd scales cannot overflow an integer.
+  const double ticks = std::round(b.zero_ticks + b.direction * rad * b.ticks_per_rad);
+  if (ticks < static_cast<double>(protocol.min_ticks) ||
+      ticks > static_cast<double>(protocol.max_ticks)) {
+    std::ostringstream tick_text;  // whole numbers print plainly, absurd ones in e-notation
+    tick_text.precision(12);
+    tick_text << ticks;
+    limit_node.fail(num(rad_to_deg(rad)) + " deg maps to tick " + tick_text.str() +
+                    " (zero_ticks " + std::to_string(b.zero_ticks) + ", direction " +
+                    std::to_string(b.direction) + ", " + actuator.scale + "), outside the " +
+                    std::string(protocol.name) + " position range " +
+                    std::to_string(protocol.min_ticks) + ".." + std::to_string(protocol.max_ticks));
+  }
+}
+
+void parse_joints(const YamlNode& node, RobotConfig& config) {
+  const auto entries = node.entries();
+  if (entries.empty()) node.fail("expected at least one joint, found an empty map");
+  for (const auto& [name, value] : entries) {
+    value.allow_only({"limits", "home_deg", "actuator"});
+    JointSpec joint;
+    joint.name = name;
+    const YamlNode limits_node = value.at("limits");
+    joint.limits = parse_limits(limits_node);
+    joint.home = parse_home(value, limits_node);
+
+    ParsedActuator actuator = parse_actuator(value.at("actuator"), config.buses);
+    BusConfig& bus = config.buses[actuator.bus_index];
+    const ProtocolSpec& protocol = *find_protocol(bus.protocol);
+    check_ticks(limits_node.at("min_deg"), joint.limits.min_position, actuator, protocol);
+    check_ticks(limits_node.at("max_deg"), joint.limits.max_position, actuator, protocol);
+
+    actuator.binding.joint = name;
+    actuator.binding.joint_index = static_cast<int>(config.joints.size());
+    bus.actuators.push_back(actuator.binding);
+    config.joints.push_back(std::move(joint));
+  }
+}
+
+MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path) {
+  node.allow_only({"type", "file"});
+  MotionConfig motion;
+  const YamlNode type = node.at("type");
+  motion.type = type.as_string();
+  if (motion.type != "gait") type.fail("unknown motion type " + found(type) + " (supported: gait)");
+
+  const YamlNode file = node.at("file");
+  const std::string given = file.as_string();
+  if (given.empty()) file.fail("expected a file path, found \"\"");
+  motion.where = file.location();
+
+  // Not normalised: "a/b/../c" stays correct when b is a symlink.
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(robot_path).parent_path();
+  const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
+  motion.file = resolved.string();
+
+  std::error_code ec;
+  const fs::file_status status = fs::status(resolved, ec);
+  const std::string where =
+      given == motion.file ? "\"" + given + "\""
+                           : "\"" + given + "\" (resolved against the robot file's folder to \"" +
+                                 motion.file + "\")";
+  if (!fs::exists(status)) file.fail("file not found: " + where);
+  if (fs::is_directory(status)) file.fail("expected a file, found a folder: " + where);
+  return motion;
+}
+
+}  // namespace
+
+RobotConfig load_robot_config(const std::string& path) {
+  const YamlNode root = YamlNode::load_file(path);
+  root.allow_only({"name", "loop", "safety", "buses", "joints", "motion"});
+
+  RobotConfig config;
+  config.file = path;
+
+  const YamlNode name = root.at("name");
+  config.name = name.as_string();
+  if (config.name.empty()) name.fail("expected a robot name, found \"\"");
+
+  const YamlNode loop = root.at("loop");
+  loop.allow_only({"rate_hz"});
+  config.rate_hz = loop.at("rate_hz").as_double_in(1.0, 10000.0);
+
+  if (auto safety = root.find("safety")) config.safety = parse_safety(*safety);
+
+  const YamlNode buses = root.at("buses");
+  config.buses = parse_buses(buses);
+  parse_joints(root.at("joints"), config);
+  // A bus without devices is almost always a typo in some actuator.bus, and
+  // opening its port would fail or grab a line for nothing.
+  for (const auto& bus : config.buses) {
+    if (bus.actuators.empty()) {
+      throw InputError(bus.where, key_path(buses, bus.name),
+                       "no joint is bound to this bus (bind joints with actuator.bus: " + bus.name +
+                           ", or remove the bus)");
+    }
+  }
+
+  config.motion = parse_motion(root.at("motion"), path);
+  return config;
+}
+
+}  // namespace animrt

@@ -1,0 +1,722 @@
+#include "animrt/runtime/robot_config.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace animrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSourceDir = ANIMRT_SOURCE_DIR;
+
+void write_file(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Each test gets its own folder holding robots/robot.yaml and gaits/gait.yaml
+// (the loader only checks that the gait file exists).
+class RobotConfigTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("animrt_robot_config_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    write_file(dir_ / "gaits" / "gait.yaml", "# a gait\n");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string robot_path() const { return (dir_ / "robots" / "robot.yaml").string(); }
+
+  RobotConfig load(const std::string& text) {
+    write_file(robot_path(), text);
+    return load_robot_config(robot_path());
+  }
+
+  // The full message of the InputError that loading `text` raises.
+  std::string error_of(const std::string& text) {
+    try {
+      (void)load(text);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+
+  // Expected message: the robot file's path followed by `rest`.
+  std::string at(const std::string& rest) const { return robot_path() + ":" + rest; }
+
+  fs::path dir_;
+};
+
+// A small valid robot; the error tests below are variations of it.
+const char* const kMinimal = R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)";
+
+// ---------------------------------------------------------------- valid files
+
+TEST_F(RobotConfigTest, ShippedQuadrupedHasTheDocumentedValues) {
+  // A copy next to a stand-in gait, so the robot file itself is checked even
+  // before configs/gaits/walk.yaml exists.
+  const fs::path copy = dir_ / "robots" / "quadruped.yaml";
+  write_file(copy, read_file(kSourceDir + "/configs/robots/quadruped.yaml"));
+  write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
+  const RobotConfig c = load_robot_config(copy.string());
+
+  EXPECT_EQ(c.file, copy.string());
+  EXPECT_EQ(c.name, "quadruped");
+  EXPECT_DOUBLE_EQ(c.rate_hz, 200.0);
+  EXPECT_DOUBLE_EQ(c.safety.watchdog_timeout_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.safety.start_ramp_s, 2.0);
+  EXPECT_DOUBLE_EQ(c.safety.stop_ramp_s, 2.0);
+
+  const char* const names[] = {"lf_hip", "lf_knee", "lf_ankle", "rf_hip", "rf_knee", "rf_ankle",
+                               "lh_hip", "lh_knee", "lh_ankle", "rh_hip", "rh_knee", "rh_ankle"};
+  ASSERT_EQ(c.joints.size(), 12u);
+  for (int i = 0; i < 12; ++i) {
+    SCOPED_TRACE(names[i]);
+    const JointSpec& j = c.joints[i];
+    EXPECT_EQ(j.name, names[i]);
+    const double limit_deg = (i % 3 == 0) ? 45.0 : 60.0;  // hips 45, knees and ankles 60
+    EXPECT_DOUBLE_EQ(j.limits.min_position, -limit_deg * kPi / 180.0);
+    EXPECT_DOUBLE_EQ(j.limits.max_position, limit_deg * kPi / 180.0);
+    EXPECT_DOUBLE_EQ(j.limits.max_velocity, 300.0 * kPi / 180.0);
+    EXPECT_DOUBLE_EQ(j.limits.max_acceleration, 3000.0 * kPi / 180.0);
+    EXPECT_DOUBLE_EQ(j.home, 0.0);
+  }
+  EXPECT_NEAR(c.joints[1].limits.min_position, -1.0471975511965976, 1e-15);  // -60 deg
+
+  ASSERT_EQ(c.buses.size(), 1u);
+  const BusConfig& bus = c.buses[0];
+  EXPECT_EQ(bus.name, "legs");
+  EXPECT_EQ(bus.protocol, "dynamixel2");
+  EXPECT_EQ(bus.port, "/dev/ttyUSB0");
+  EXPECT_EQ(bus.baud, 1'000'000);
+  EXPECT_DOUBLE_EQ(bus.timeout_s, 0.004);
+  EXPECT_DOUBLE_EQ(bus.sim.time_constant_s, 0.03);
+  EXPECT_NEAR(bus.sim.max_speed_rad_s, 5.759586531581287, 1e-12);  // 330 deg/s
+  EXPECT_TRUE(bus.sim.wire_time);
+  EXPECT_EQ(bus.sim.return_delay_us, 0);
+  EXPECT_EQ(bus.where.file, copy.string());
+  EXPECT_GT(bus.where.line, 0);
+
+  ASSERT_EQ(bus.actuators.size(), 12u);
+  for (int i = 0; i < 12; ++i) {
+    SCOPED_TRACE(names[i]);
+    const ActuatorBinding& a = bus.actuators[i];
+    EXPECT_EQ(a.joint, names[i]);
+    EXPECT_EQ(a.joint_index, i);
+    EXPECT_EQ(a.device_id, i + 1);
+    EXPECT_NEAR(a.ticks_per_rad, 651.8986469044033, 1e-9);  // 4096 / 2pi
+    EXPECT_EQ(a.zero_ticks, 2048);
+    const bool right = names[i][0] == 'r';
+    EXPECT_EQ(a.direction, right ? -1 : 1);
+  }
+  // +45 deg on a hip: half a quarter turn from the centre, mirrored on the right.
+  EXPECT_EQ(bus.actuators[0].to_ticks(c.joints[0].limits.max_position), 2560);
+  EXPECT_EQ(bus.actuators[3].to_ticks(c.joints[3].limits.max_position), 1536);
+
+  EXPECT_EQ(c.motion.type, "gait");
+  EXPECT_EQ(c.motion.file, (dir_ / "robots" / ".." / "gaits" / "walk.yaml").string());
+  EXPECT_TRUE(fs::exists(c.motion.file));
+  EXPECT_EQ(c.motion.where.file, copy.string());
+  EXPECT_GT(c.motion.where.line, 0);
+}
+
+TEST_F(RobotConfigTest, ShippedQuadrupedLoadsInPlace) {
+  const std::string walk = kSourceDir + "/configs/gaits/walk.yaml";
+  if (!fs::exists(walk)) GTEST_SKIP() << walk << " does not exist yet (another part writes it)";
+  const std::string path = kSourceDir + "/configs/robots/quadruped.yaml";
+  const RobotConfig c = load_robot_config(path);
+  EXPECT_EQ(c.joints.size(), 12u);
+  EXPECT_EQ(c.motion.file, kSourceDir + "/configs/robots/../gaits/walk.yaml");
+  EXPECT_TRUE(fs::equivalent(c.motion.file, walk));
+}
+
+TEST_F(RobotConfigTest, OptionalKeysTakeTheirDefaults) {
+  const RobotConfig c = load(kMinimal);
+  EXPECT_DOUBLE_EQ(c.rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(c.safety.watchdog_timeout_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.safety.start_ramp_s, 2.0);
+  EXPECT_DOUBLE_EQ(c.safety.stop_ramp_s, 2.0);
+  ASSERT_EQ(c.buses.size(), 1u);
+  EXPECT_EQ(c.buses[0].baud, 1'000'000);
+  EXPECT_DOUBLE_EQ(c.buses[0].timeout_s, 0.004);
+  EXPECT_DOUBLE_EQ(c.buses[0].sim.time_constant_s, 0.02);
+  EXPECT_DOUBLE_EQ(c.buses[0].sim.max_speed_rad_s, 6.0);
+  EXPECT_FALSE(c.buses[0].sim.wire_time);
+  EXPECT_EQ(c.buses[0].sim.return_delay_us, 0);
+  ASSERT_EQ(c.buses[0].actuators.size(), 1u);
+  const ActuatorBinding& a = c.buses[0].actuators[0];
+  EXPECT_DOUBLE_EQ(a.ticks_per_rad, 4096.0 / (2.0 * kPi));
+  EXPECT_EQ(a.zero_ticks, 2048);
+  EXPECT_EQ(a.direction, 1);
+  EXPECT_DOUBLE_EQ(c.joints[0].home, 0.0);
+  EXPECT_EQ(c.buses[0].where.line, 4);
+  EXPECT_EQ(c.buses[0].where.column, 3);
+  EXPECT_EQ(c.motion.where.line, 9);
+  EXPECT_EQ(c.motion.where.column, 28);
+}
+
+TEST_F(RobotConfigTest, ActuatorsFollowJointOrderAcrossBuses) {
+  const RobotConfig c = load(R"(name: two buses
+loop: {rate_hz: 500}
+buses:
+  left: {protocol: dynamixel2, port: /dev/ttyUSB0, baud: 4000000, timeout_ms: 2.5}
+  right: {protocol: dynamixel2, port: /dev/ttyUSB1}
+joints:
+  a:
+    limits: {min_deg: 0, max_deg: 90, velocity_dps: 90, acceleration_dps2: 900}
+    home_deg: 30
+    actuator: {bus: right, id: 7, ticks_per_rad: 1000, zero_ticks: 100, direction: 1}
+  b:
+    limits: {min_deg: -20, max_deg: 20, velocity_dps: 90, acceleration_dps2: 900}
+    actuator: {bus: left, id: 7, direction: -1}
+  c:
+    limits: {min_deg: -20, max_deg: 20, velocity_dps: 90, acceleration_dps2: 900}
+    actuator: {bus: right, id: 0, ticks_per_rev: 2048, zero_ticks: 1024}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)");
+  ASSERT_EQ(c.joints.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.joints[0].home, 30.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(c.buses[0].timeout_s, 0.0025);
+  EXPECT_EQ(c.buses[0].baud, 4'000'000);
+  ASSERT_EQ(c.buses[0].actuators.size(), 1u);
+  EXPECT_EQ(c.buses[0].actuators[0].joint, "b");
+  EXPECT_EQ(c.buses[0].actuators[0].joint_index, 1);
+  EXPECT_EQ(c.buses[0].actuators[0].direction, -1);
+  ASSERT_EQ(c.buses[1].actuators.size(), 2u);
+  EXPECT_EQ(c.buses[1].actuators[0].joint, "a");
+  EXPECT_EQ(c.buses[1].actuators[0].joint_index, 0);
+  EXPECT_DOUBLE_EQ(c.buses[1].actuators[0].ticks_per_rad, 1000.0);
+  EXPECT_EQ(c.buses[1].actuators[0].zero_ticks, 100);
+  EXPECT_EQ(c.buses[1].actuators[0].to_ticks(c.joints[0].limits.max_position), 1671);
+  EXPECT_EQ(c.buses[1].actuators[1].joint, "c");
+  EXPECT_EQ(c.buses[1].actuators[1].joint_index, 2);
+  EXPECT_EQ(c.buses[1].actuators[1].device_id, 0);
+  EXPECT_DOUBLE_EQ(c.buses[1].actuators[1].ticks_per_rad, 2048.0 / (2.0 * kPi));
+}
+
+TEST_F(RobotConfigTest, AbsoluteMotionFileIsKeptAsGiven) {
+  const std::string gait = (dir_ / "gaits" / "gait.yaml").string();
+  std::string text = kMinimal;
+  text.replace(text.find("../gaits/gait.yaml"), 18, gait);
+  EXPECT_EQ(load(text).motion.file, gait);
+}
+
+// ------------------------------------------------------------ unknown keys
+
+TEST_F(RobotConfigTest, UnknownKeysAreRejectedAtEveryLevel) {
+  EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"),
+            at("10:1: colour: unknown key (expected one of: name, loop, safety, buses, joints, "
+               "motion)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100, rate: 5}
+)"),
+            at("2:22: loop.rate: unknown key (expected one of: rate_hz)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+safety: {watchdog_s: 1}
+)"),
+            at("3:10: safety.watchdog_s: unknown key (expected one of: watchdog_timeout_s, "
+               "start_ramp_s, stop_ramp_s)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b:
+    protocol: dynamixel2
+    port: /dev/ttyUSB0
+    parity: none
+)"),
+            at("7:5: buses.b.parity: unknown key (expected one of: protocol, port, baud, "
+               "timeout_ms, sim)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b:
+    protocol: dynamixel2
+    port: /dev/ttyUSB0
+    sim: {max_speed_rad_s: 6}
+)"),
+            at("7:11: buses.b.sim.max_speed_rad_s: unknown key (expected one of: "
+               "time_constant_s, max_speed_dps, wire_time, return_delay_us)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    home: 0
+)"),
+            at("8:5: joints.j1.home: unknown key (expected one of: limits, home_deg, actuator)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+)"),
+            at("7:14: joints.j1.limits.min: unknown key (expected one of: min_deg, max_deg, "
+               "velocity_dps, acceleration_dps2)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1, inverted: true}
+)"),
+            at("8:31: joints.j1.actuator.inverted: unknown key (expected one of: bus, id, "
+               "ticks_per_rev, ticks_per_rad, zero_ticks, direction)"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1}
+motion: {type: gait, file: ../gaits/gait.yaml, speed: 2}
+)"),
+            at("9:48: motion.speed: unknown key (expected one of: type, file)"));
+}
+
+// ------------------------------------------------------------- wrong types
+
+TEST_F(RobotConfigTest, WrongTypesNameWhatWasFound) {
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: fast}\n"),
+            at("2:17: loop.rate_hz: expected a number, found \"fast\""));
+  EXPECT_EQ(error_of("name: {first: t}\n"), at("1:7: name: expected a string, found a map"));
+  EXPECT_EQ(error_of("name: t\nloop: 200\n"), at("2:7: loop: expected a map, found \"200\""));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  - {protocol: dynamixel2, port: /dev/ttyUSB0}
+)"),
+            at("4:3: buses: expected a map, found a list"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0, baud: 1e6}
+)"),
+            at("4:55: buses.b.baud: expected an integer, found \"1e6\""));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0, sim: {wire_time: yes}}
+)"),
+            at("4:66: buses.b.sim.wire_time: expected true or false, found \"yes\""));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: one}
+)"),
+            at("8:28: joints.j1.actuator.id: expected an integer, found \"one\""));
+}
+
+// ---------------------------------------------------------- numbers in range
+
+TEST_F(RobotConfigTest, LoopRateOutOfRange) {
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 0}\n"),
+            at("2:17: loop.rate_hz: expected a number from 1 to 10000, found \"0\""));
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 20000}\n"),
+            at("2:17: loop.rate_hz: expected a number from 1 to 10000, found \"20000\""));
+}
+
+TEST_F(RobotConfigTest, SafetyOutOfRange) {
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 0}\n"),
+            at("3:30: safety.watchdog_timeout_s: expected a positive number, found \"0\""));
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\nsafety: {start_ramp_s: 61}\n"),
+            at("3:24: safety.start_ramp_s: expected a number from 0 to 60, found \"61\""));
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\nsafety: {stop_ramp_s: -1}\n"),
+            at("3:23: safety.stop_ramp_s: expected a number from 0 to 60, found \"-1\""));
+}
+
+TEST_F(RobotConfigTest, BusNumbersOutOfRange) {
+  const std::string head =
+      "name: t\nloop: {rate_hz: 100}\nbuses:\n  b:\n    protocol: dynamixel2\n"
+      "    port: /dev/ttyUSB0\n";
+  EXPECT_EQ(error_of(head + "    baud: 0\n"),
+            at("7:11: buses.b.baud: expected an integer from 1 to 10500000, found \"0\""));
+  EXPECT_EQ(error_of(head + "    baud: 12000000\n"),
+            at("7:11: buses.b.baud: expected an integer from 1 to 10500000, found \"12000000\""));
+  EXPECT_EQ(error_of(head + "    timeout_ms: 0\n"),
+            at("7:17: buses.b.timeout_ms: expected a number greater than 0 and less than 1000, "
+               "found \"0\""));
+  EXPECT_EQ(error_of(head + "    timeout_ms: 1000\n"),
+            at("7:17: buses.b.timeout_ms: expected a number greater than 0 and less than 1000, "
+               "found \"1000\""));
+  EXPECT_EQ(error_of(head + "    sim: {time_constant_s: 0}\n"),
+            at("7:28: buses.b.sim.time_constant_s: expected a positive number, found \"0\""));
+  EXPECT_EQ(error_of(head + "    sim: {max_speed_dps: -330}\n"),
+            at("7:26: buses.b.sim.max_speed_dps: expected a positive number, found \"-330\""));
+  EXPECT_EQ(error_of(head + "    sim: {return_delay_us: 600}\n"),
+            at("7:28: buses.b.sim.return_delay_us: expected an integer from 0 to 508, found "
+               "\"600\""));
+}
+
+// ----------------------------------------------------------- missing keys
+
+TEST_F(RobotConfigTest, MissingRequiredKeys) {
+  EXPECT_EQ(error_of("loop: {rate_hz: 100}\n"), at("1:1: name: required key is missing"));
+  EXPECT_EQ(error_of("name: t\n"), at("1:1: loop: required key is missing"));
+  EXPECT_EQ(error_of("name: t\nloop: {}\n"), at("2:7: loop.rate_hz: required key is missing"));
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\n"), at("1:1: buses: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {port: /dev/ttyUSB0}
+)"),
+            at("4:6: buses.b.protocol: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2}
+)"),
+            at("4:6: buses.b.port: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+)"),
+            at("1:1: joints: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    actuator: {bus: b, id: 1}
+)"),
+            at("7:5: joints.j1.limits: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, velocity_dps: 100, acceleration_dps2: 1000}
+)"),
+            at("7:13: joints.j1.limits.max_deg: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+)"),
+            at("7:5: joints.j1.actuator: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {id: 1}
+)"),
+            at("8:15: joints.j1.actuator.bus: required key is missing"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b}
+)"),
+            at("8:15: joints.j1.actuator.id: required key is missing"));
+  std::string no_motion = kMinimal;
+  no_motion.erase(no_motion.find("motion:"));
+  EXPECT_EQ(error_of(no_motion), at("1:1: motion: required key is missing"));
+  std::string no_file = kMinimal;
+  no_file.replace(no_file.find(", file: ../gaits/gait.yaml"), 26, "");
+  EXPECT_EQ(error_of(no_file), at("9:9: motion.file: required key is missing"));
+}
+
+TEST_F(RobotConfigTest, MissingRobotFile) {
+  const std::string path = (dir_ / "nope.yaml").string();
+  try {
+    (void)load_robot_config(path);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": cannot open file: No such file or directory");
+  }
+}
+
+TEST_F(RobotConfigTest, EmptyName) {
+  EXPECT_EQ(error_of("name: \"\"\n"), at("1:7: name: expected a robot name, found \"\""));
+}
+
+// ------------------------------------------------------------ buses, joints
+
+TEST_F(RobotConfigTest, EmptyBusesAndJoints) {
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\nbuses: {}\n"),
+            at("3:8: buses: expected at least one bus, found an empty map"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints: {}
+)"),
+            at("5:9: joints: expected at least one joint, found an empty map"));
+}
+
+TEST_F(RobotConfigTest, UnknownProtocol) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: modbus, port: /dev/ttyUSB0}
+)"),
+            at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2)"));
+}
+
+TEST_F(RobotConfigTest, TwoBusesOnOnePort) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  front: {protocol: dynamixel2, port: /dev/ttyUSB0}
+  back: {protocol: dynamixel2, port: /dev/ttyUSB0}
+)"),
+            at("5:38: buses.back.port: port \"/dev/ttyUSB0\" is already used by bus front"));
+}
+
+TEST_F(RobotConfigTest, DuplicateBusAndJointNames) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+  b: {protocol: dynamixel2, port: /dev/ttyUSB1}
+)"),
+            at("5:3: buses.b: duplicate key"));
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1}
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 2}
+)"),
+            at("9:3: joints.j1: duplicate key"));
+}
+
+TEST_F(RobotConfigTest, DeviceIdOutOfRange) {
+  const std::string head = R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+)";
+  EXPECT_EQ(error_of(head + "    actuator: {bus: b, id: 253}\n"),
+            at("8:28: joints.j1.actuator.id: expected a device id from 0 to 252 for dynamixel2, "
+               "found \"253\""));
+  EXPECT_EQ(error_of(head + "    actuator: {bus: b, id: -1}\n"),
+            at("8:28: joints.j1.actuator.id: expected a device id from 0 to 252 for dynamixel2, "
+               "found \"-1\""));
+}
+
+TEST_F(RobotConfigTest, DuplicateDeviceIdOnABus) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  knee:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 3}
+  ankle:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 3}
+)"),
+            at("11:28: joints.ankle.actuator.id: device id 3 is already used by joint knee on "
+               "bus b"));
+}
+
+TEST_F(RobotConfigTest, JointOnAnUndefinedBus) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  legs: {protocol: dynamixel2, port: /dev/ttyUSB0}
+  neck: {protocol: dynamixel2, port: /dev/ttyUSB1}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: leg, id: 1}
+)"),
+            at("9:21: joints.j1.actuator.bus: no bus named \"leg\" (defined buses: legs, neck)"));
+}
+
+TEST_F(RobotConfigTest, BusWithoutJoints) {
+  EXPECT_EQ(error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  legs: {protocol: dynamixel2, port: /dev/ttyUSB0}
+  neck: {protocol: dynamixel2, port: /dev/ttyUSB1}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: legs, id: 1}
+)"),
+            at("5:3: buses.neck: no joint is bound to this bus (bind joints with actuator.bus: "
+               "neck, or remove the bus)"));
+}
+
+// ----------------------------------------------------------------- limits
+
+const char* const kLimitsHead = R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: dynamixel2, port: /dev/ttyUSB0}
+joints:
+  j1:
+)";
+
+TEST_F(RobotConfigTest, MinNotBelowMax) {
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: 10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"),
+            at("7:36: joints.j1.limits.max_deg: expected a value greater than min_deg (10), "
+               "found \"10\""));
+}
+
+TEST_F(RobotConfigTest, HomeOutsideLimits) {
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    home_deg: 12.5\n"),
+            at("8:15: joints.j1.home_deg: limits contradict the home pose: expected home_deg "
+               "within min_deg..max_deg (-10..10), found \"12.5\""));
+  // Without home_deg the home pose is 0, which these limits exclude.
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: 10, max_deg: 90, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1}\n"),
+            at("7:5: joints.j1.home_deg: limits contradict the home pose: home_deg defaults to 0, "
+               "outside min_deg..max_deg (10..90); set home_deg inside the limits"));
+}
+
+TEST_F(RobotConfigTest, VelocityAndAccelerationMustBePositive) {
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 0, "
+                     "acceleration_dps2: 1000}\n"),
+            at("7:55: joints.j1.limits.velocity_dps: expected a positive number, found \"0\""));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: -5}\n"),
+            at("7:79: joints.j1.limits.acceleration_dps2: expected a positive number, found "
+               "\"-5\""));
+}
+
+TEST_F(RobotConfigTest, LimitsOutsideTheServoRange) {
+  // 200 deg from the centre is past the end of a 0..4095 turn.
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 200, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1}\n"),
+            at("7:37: joints.j1.limits.max_deg: 200 deg maps to tick 4324 (zero_ticks 2048, "
+               "direction 1, 4096 ticks/rev), outside the dynamixel2 position range 0..4095"));
+  // Mirrored with an off-centre zero: the lower limit lands above the top.
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -90, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, zero_ticks: 3500, direction: -1}\n"),
+            at("7:23: joints.j1.limits.min_deg: -90 deg maps to tick 4524 (zero_ticks 3500, "
+               "direction -1, 4096 ticks/rev), outside the dynamixel2 position range 0..4095"));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -90, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, ticks_per_rad: 2000}\n"),
+            at("7:23: joints.j1.limits.min_deg: -90 deg maps to tick -1094 (zero_ticks 2048, "
+               "direction 1, 2000 ticks/rad), outside the dynamixel2 position range 0..4095"));
+}
+
+// --------------------------------------------------------------- actuator
+
+TEST_F(RobotConfigTest, DirectionMustBePlusOrMinusOne) {
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, direction: 0}\n"),
+            at("8:42: joints.j1.actuator.direction: expected 1 or -1 (-1 for a mirrored servo), "
+               "found \"0\""));
+}
+
+TEST_F(RobotConfigTest, TicksPerRevOrPerRadNotBoth) {
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, ticks_per_rev: 4096, ticks_per_rad: 651.9}\n"),
+            at("8:67: joints.j1.actuator.ticks_per_rad: give either ticks_per_rev or "
+               "ticks_per_rad, not both"));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, ticks_per_rev: 0}\n"),
+            at("8:46: joints.j1.actuator.ticks_per_rev: expected a positive number, found \"0\""));
+}
+
+// ----------------------------------------------------------------- motion
+
+TEST_F(RobotConfigTest, UnknownMotionType) {
+  std::string text = kMinimal;
+  text.replace(text.find("type: gait"), 10, "type: keyframes");
+  EXPECT_EQ(error_of(text),
+            at("9:16: motion.type: unknown motion type \"keyframes\" (supported: gait)"));
+}
+
+TEST_F(RobotConfigTest, MotionFileMissing) {
+  std::string text = kMinimal;
+  text.replace(text.find("gait.yaml"), 9, "walk.yaml");
+  const std::string resolved = (dir_ / "robots" / ".." / "gaits" / "walk.yaml").string();
+  EXPECT_EQ(error_of(text),
+            at("9:28: motion.file: file not found: \"../gaits/walk.yaml\" (resolved against the "
+               "robot file's folder to \"" +
+               resolved + "\")"));
+}
+
+TEST_F(RobotConfigTest, MotionFileIsAFolder) {
+  std::string text = kMinimal;
+  text.replace(text.find("../gaits/gait.yaml"), 18, "../gaits");
+  const std::string resolved = (dir_ / "robots" / ".." / "gaits").string();
+  EXPECT_EQ(error_of(text),
+            at("9:28: motion.file: expected a file, found a folder: \"../gaits\" (resolved "
+               "against the robot file's folder to \"" +
+               resolved + "\")"));
+}
+
+}  // namespace
+}  // namespace animrt
