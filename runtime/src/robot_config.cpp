@@ -348,7 +348,18 @@ RobotConfig load_robot_config(const std::string& path) {
   loop.allow_only({"rate_hz"});
   config.rate_hz = loop.at("rate_hz").as_double_in(1.0, 10000.0);
 
-  if (auto safety = root.find("safety")) config.safety = parse_safety(*safety);
+  if (auto safety = root.find("safety")) {
+    config.safety = parse_safety(*safety);
+    // The watchdog counts in cycles: shorter than two periods, one late answer
+    // would already fault a healthy device.
+    if (auto watchdog = safety->find("watchdog_timeout_s");
+        watchdog && config.safety.watchdog_timeout_s < 2.0 / config.rate_hz) {
+      std::ostringstream msg;
+      msg << "expected at least two loop periods (" << 2.0 / config.rate_hz << " s at loop.rate_hz "
+          << config.rate_hz << "), found \"" << watchdog->as_string() << "\"";
+      watchdog->fail(msg.str());
+    }
+  }
 
   const YamlNode buses = root.at("buses");
   config.buses = parse_buses(buses);

@@ -720,3 +720,29 @@ TEST_F(RobotConfigTest, MotionFileIsAFolder) {
 
 }  // namespace
 }  // namespace animrt
+
+namespace animrt {
+namespace {
+
+TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {
+  const std::string dir = ::testing::TempDir() + "/watchdog_test";
+  std::filesystem::create_directories(dir);
+  const std::string gait = std::string(ANIMRT_SOURCE_DIR) + "/configs/gaits/walk.yaml";
+  const std::string path = dir + "/robot.yaml";
+  std::ofstream(path) << "name: r\nloop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 0.015}\n"
+                         "buses: {b: {protocol: dynamixel2, port: /dev/null}}\n"
+                         "joints: {j: {limits: {min_deg: -1, max_deg: 1, velocity_dps: 1, "
+                         "acceleration_dps2: 1}, actuator: {bus: b, id: 1}}}\n"
+                         "motion: {type: gait, file: " + gait + "}\n";
+  try {
+    load_robot_config(path);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path + ":3:30: safety.watchdog_timeout_s: expected at least two loop periods "
+                     "(0.02 s at loop.rate_hz 100), found \"0.015\"");
+  }
+}
+
+}  // namespace
+}  // namespace animrt
