@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -19,25 +18,7 @@
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
-// Counts allocations per thread, so a test can see whether the loop thread
-// allocates between two cycles.
-namespace {
-thread_local std::uint64_t t_allocations = 0;
-}
-void* operator new(std::size_t size) {
-  ++t_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  ++t_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "support/alloc_counter.hpp"
 
 namespace animrt {
 namespace {
@@ -52,7 +33,7 @@ class Probe final : public MotionSource {
   std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
   void sample(double t, std::span<double> targets) const override {
     if (on_sample) on_sample(t);
-    allocations_seen.push_back_noalloc(t_allocations);
+    allocations_seen.push_back_noalloc(test::thread_allocations());
     inner_->sample(t, targets);
   }
   std::function<void(double)> on_sample;
@@ -131,13 +112,6 @@ Csv read_csv(const std::string& path) {
   return csv;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(QuadrupedLockstep, WalksTheGaitAndTracksWithinTheServoModel) {
   Rig rig;
   const std::string csv_path = ::testing::TempDir() + "/lockstep_walk.csv";
@@ -200,9 +174,16 @@ TEST(QuadrupedLockstep, SameRunSameTelemetry) {
     Rig rig;
     rig.run(1.0, b);
   }
-  const std::string ta = slurp(a), tb = slurp(b);
-  EXPECT_GT(ta.size(), 1000u);
-  EXPECT_EQ(ta, tb);
+  std::ifstream fa(a), fb(b);
+  std::string la, lb;
+  int line = 0;
+  while (std::getline(fa, la)) {
+    ++line;
+    ASSERT_TRUE(std::getline(fb, lb)) << "second run is shorter, line " << line;
+    ASSERT_EQ(la, lb) << "runs differ at line " << line;
+  }
+  EXPECT_FALSE(std::getline(fb, lb)) << "second run is longer";
+  EXPECT_GT(line, 200);
 }
 
 TEST(QuadrupedLockstep, TheCycleDoesNotAllocate) {
@@ -255,9 +236,10 @@ TEST(QuadrupedLockstep, ADeviceThatDiesMidRunFaultsAndTheOthersRampHome) {
   EXPECT_LT(s.motion_time_s, 1.5);  // the motion stopped soon after the fault
   for (const auto& d : s.devices) {
     if (d.joint == "rf_knee") {
-      // Silent for the watchdog time (0.1 s = 20 cycles), then left out.
+      // Silent for the watchdog time (0.1 s = 20 cycles), then left out of
+      // the cycle; deactivate tries its torque-off up to three times more.
       EXPECT_GE(d.status.timeouts, 20u);
-      EXPECT_LE(d.status.timeouts, 22u);
+      EXPECT_LE(d.status.timeouts, 25u);
     } else {
       EXPECT_EQ(d.status.timeouts, 0u) << d.joint;
     }

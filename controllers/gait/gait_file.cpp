@@ -1,0 +1,456 @@
+// Reading, checking and writing gait files (format: configs/gaits/walk.yaml).
+
+#include "animrt/controllers/gait/gait_file.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "animrt/controllers/gait/expression.hpp"
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt {
+namespace {
+
+// A curve must be finite over one stride; it is sampled this many times.
+constexpr int kFiniteSamples = 1024;
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out.empty() ? std::string("none") : out;
+}
+
+std::string format_number(double v) {
+  char buf[32];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  (void)ec;  // 32 bytes always hold a double
+  return std::string(buf, end);
+}
+
+// Throws if the compiled curve is not finite somewhere on [0, 1).
+void check_finite(const Expression& curve, const std::function<void(const std::string&)>& fail) {
+  for (int i = 0; i < kFiniteSamples; ++i) {
+    const double t = static_cast<double>(i) / kFiniteSamples;  // exact binary fractions
+    const double v = curve.eval(t);
+    if (!std::isfinite(v)) {
+      fail("curve is not finite at t = " + format_number(t) + " stride cycles (value " +
+           (std::isnan(v) ? std::string("nan") : format_number(v)) +
+           "); it must be finite over the whole stride");
+    }
+  }
+}
+
+// ---- positions of expression characters inside the YAML file ----
+
+// The 0-based offset in `text` of the start of 1-based `line`, or npos.
+std::size_t line_start(const std::string& text, int line) {
+  std::size_t pos = 0;
+  for (int l = 1; l < line; ++l) {
+    pos = text.find('\n', pos);
+    if (pos == std::string::npos) return pos;
+    ++pos;
+  }
+  return pos;
+}
+
+// Where the scalar's characters begin and how to walk them: yaml-cpp marks a
+// quoted scalar at its opening quote.
+struct ScalarSource {
+  std::size_t begin = std::string::npos;  // offset in the file text of the first character
+  char quote = 0;                         // '"', '\'' or 0 (plain)
+  int line = 0;                           // 1-based
+  int column = 0;                         // 1-based column of `begin`
+};
+
+ScalarSource scalar_source(const std::string& text, const Location& mark) {
+  ScalarSource src;
+  const std::size_t ls = line_start(text, mark.line);
+  if (ls == std::string::npos || mark.column <= 0) return src;
+  const std::size_t at = ls + static_cast<std::size_t>(mark.column - 1);
+  if (at >= text.size()) return src;
+  const char c = text[at];
+  if (c == '|' || c == '>') return src;  // block scalars start on the next line
+  src.quote = (c == '"' || c == '\'') ? c : 0;
+  src.begin = src.quote ? at + 1 : at;
+  src.line = mark.line;
+  src.column = mark.column + (src.quote ? 1 : 0);
+  return src;
+}
+
+// The file column of the expression's 1-based `expr_column`, when the
+// scalar's text up to there is on one line and free of escapes (so one
+// expression character is one file character); otherwise nullopt.
+std::optional<int> file_column(const std::string& text, const ScalarSource& src,
+                               const std::string& expression, int expr_column) {
+  if (src.begin == std::string::npos) return std::nullopt;
+  std::size_t pos = src.begin;
+  for (int i = 1; i < expr_column; ++i) {
+    if (pos >= text.size() || text[pos] == '\n' || text[pos] == '\r') return std::nullopt;
+    if (src.quote == '"' && text[pos] == '\\') return std::nullopt;
+    if (src.quote == '\'' && text[pos] == '\'') return std::nullopt;  // '' is one quote
+    if (static_cast<std::size_t>(i - 1) < expression.size() &&
+        text[pos] != expression[static_cast<std::size_t>(i - 1)]) {
+      return std::nullopt;  // folded or otherwise transformed text
+    }
+    ++pos;
+  }
+  return src.column + (expr_column - 1);
+}
+
+[[noreturn]] void throw_expression_error(const ExpressionError& e, const std::string& text,
+                                         const YamlNode& node, const std::string& expression) {
+  const Location mark = node.location();
+  const ScalarSource src = scalar_source(text, mark);
+  const auto col = file_column(text, src, expression, e.column());
+  std::string message = e.detail();
+  if (e.related_column() > 0) {
+    const auto related = file_column(text, src, expression, e.related_column());
+    message += related ? " at column " + std::to_string(*related)
+                       : " at column " + std::to_string(e.related_column()) + " of the expression";
+  }
+  if (col) throw InputError(Location{mark.file, src.line, *col}, node.path(), message);
+  // Multi-line or escaped text: point at the scalar and say where inside.
+  throw InputError(mark, node.path(),
+                   message + " (column " + std::to_string(e.column()) + " of the expression)");
+}
+
+// ---- reading ----
+
+// Marks of a map's keys, in order (YamlNode::entries() gives the values').
+std::vector<Location> key_locations(const YamlNode& map) {
+  std::vector<Location> out;
+  for (auto it = map.raw().begin(); it != map.raw().end(); ++it) {
+    const YAML::Mark m = it->first.Mark();
+    out.push_back(m.is_null() ? map.location() : Location{map.file(), m.line + 1, m.column + 1});
+  }
+  return out;
+}
+
+int read_sign(const YamlNode& node) {
+  const double v = node.as_double();
+  if (v != 1.0 && v != -1.0) node.fail("expected 1 or -1, found \"" + node.as_string() + "\"");
+  return v > 0 ? 1 : -1;
+}
+
+void read_timing(const YamlNode& root, GaitFile& gait) {
+  const auto freq = root.find("stride_frequency_hz");
+  const auto froude = root.find("froude");
+  if (freq && froude) {
+    froude->fail("give exactly one of stride_frequency_hz or froude, not both");
+  }
+  if (!freq && !froude) {
+    throw InputError(root.location(), "",
+                     "missing stride timing: give exactly one of stride_frequency_hz or froude");
+  }
+  if (freq) {
+    gait.stride_frequency_hz = freq->as_positive_double();
+    return;
+  }
+  froude->allow_only({"number", "hip_height_m"});
+  FroudeTiming timing;
+  timing.number = froude->at("number").as_positive_double();
+  timing.hip_height_m = froude->at("hip_height_m").as_positive_double();
+  gait.froude = timing;
+}
+
+void read_curves(const YamlNode& root, const std::string& text, GaitFile& gait) {
+  const YamlNode curves = root.at("curves");
+  const auto entries = curves.entries();
+  for (const auto& entry : entries) {
+    const YamlNode& node = entry.second;  // not a structured binding: lambdas capture it
+    GaitCurve curve;
+    curve.name = entry.first;
+    curve.expression = node.as_string();
+    const ScalarSource src = scalar_source(text, node.location());
+    curve.where = src.begin == std::string::npos ? node.location()
+                                                 : Location{node.file(), src.line, src.column};
+    Expression compiled;
+    try {
+      compiled = Expression::compile(curve.expression);
+    } catch (const ExpressionError& e) {
+      throw_expression_error(e, text, node, curve.expression);
+    }
+    check_finite(compiled, [&](const std::string& message) {
+      throw InputError(curve.where, node.path(), message);
+    });
+    gait.curves.push_back(std::move(curve));
+  }
+}
+
+void read_limbs(const YamlNode& root, GaitFile& gait) {
+  const YamlNode limbs = root.at("limbs");
+  const auto locations = key_locations(limbs);
+  const auto entries = limbs.entries();
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    GaitLimb limb;
+    limb.name = entries[i].first;
+    limb.phase = entries[i].second.as_double_in(0.0, 1.0);
+    limb.where = locations[i];
+    gait.limbs.push_back(std::move(limb));
+  }
+}
+
+std::vector<std::string> curve_names(const GaitFile& gait) {
+  std::vector<std::string> out;
+  for (const auto& c : gait.curves) out.push_back(c.name);
+  return out;
+}
+
+std::vector<std::string> limb_names(const GaitFile& gait) {
+  std::vector<std::string> out;
+  for (const auto& l : gait.limbs) out.push_back(l.name);
+  return out;
+}
+
+void read_joints(const YamlNode& root, GaitFile& gait) {
+  const YamlNode joints = root.at("joints");
+  const auto locations = key_locations(joints);
+  const auto entries = joints.entries();
+  if (entries.empty()) joints.fail("a gait needs at least one joint");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const YamlNode& node = entries[i].second;
+    node.allow_only({"curve", "limb", "sign", "scale", "offset_deg"});
+    GaitJoint joint;
+    joint.name = entries[i].first;
+    joint.where = locations[i];
+    const YamlNode curve = node.at("curve");
+    joint.curve = curve.as_string();
+    if (!gait.find_curve(joint.curve)) {
+      curve.fail("undefined curve '" + joint.curve + "' (curves: " + join_names(curve_names(gait)) +
+                 ")");
+    }
+    const YamlNode limb = node.at("limb");
+    joint.limb = limb.as_string();
+    if (!gait.find_limb(joint.limb)) {
+      limb.fail("undefined limb '" + joint.limb + "' (limbs: " + join_names(limb_names(gait)) +
+                ")");
+    }
+    if (auto sign = node.find("sign")) joint.sign = read_sign(*sign);
+    joint.scale = node.get_double("scale", 1.0);
+    joint.offset_deg = node.get_double("offset_deg", 0.0);
+    gait.joints.push_back(std::move(joint));
+  }
+}
+
+// ---- writing ----
+
+bool needs_quotes(const std::string& s) {
+  if (s.empty()) return true;
+  static const char* const kSpecial[] = {"null", "true", "false", "yes", "no",
+                                         "on",   "off",  "y",     "n"};
+  std::string lower;
+  for (char c : s) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  for (const char* w : kSpecial) {
+    if (lower == w) return true;
+  }
+  const auto plain = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  };
+  if (s[0] >= '0' && s[0] <= '9') return true;
+  for (char c : s) {
+    if (!plain(c)) return true;
+  }
+  return false;
+}
+
+std::string double_quoted(const std::string& s) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out = "\"";
+  for (char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string name_text(const std::string& s) { return needs_quotes(s) ? double_quoted(s) : s; }
+
+}  // namespace
+
+double GaitFile::stride_frequency() const {
+  if (stride_frequency_hz) return *stride_frequency_hz;
+  if (froude) return froude_stride_frequency(froude->number, froude->hip_height_m);
+  return 0.0;
+}
+
+const GaitCurve* GaitFile::find_curve(const std::string& curve_name) const {
+  for (const auto& c : curves) {
+    if (c.name == curve_name) return &c;
+  }
+  return nullptr;
+}
+
+const GaitLimb* GaitFile::find_limb(const std::string& limb_name) const {
+  for (const auto& l : limbs) {
+    if (l.name == limb_name) return &l;
+  }
+  return nullptr;
+}
+
+bool operator==(const GaitCurve& a, const GaitCurve& b) {
+  return a.name == b.name && a.expression == b.expression;
+}
+bool operator==(const GaitLimb& a, const GaitLimb& b) {
+  return a.name == b.name && a.phase == b.phase;
+}
+bool operator==(const GaitJoint& a, const GaitJoint& b) {
+  return a.name == b.name && a.curve == b.curve && a.limb == b.limb && a.sign == b.sign &&
+         a.scale == b.scale && a.offset_deg == b.offset_deg;
+}
+bool operator==(const FroudeTiming& a, const FroudeTiming& b) {
+  return a.number == b.number && a.hip_height_m == b.hip_height_m;
+}
+bool operator==(const GaitFile& a, const GaitFile& b) {
+  return a.name == b.name && a.stride_frequency_hz == b.stride_frequency_hz &&
+         a.froude == b.froude && a.curves == b.curves && a.limbs == b.limbs && a.joints == b.joints;
+}
+
+GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
+  const YamlNode root = YamlNode::load_string(text, file_name);
+  root.allow_only({"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints"});
+  GaitFile gait;
+  gait.file = file_name;
+  const YamlNode name = root.at("name");
+  gait.name = name.as_string();
+  if (gait.name.empty()) name.fail("expected a non-empty name");
+  read_timing(root, gait);
+  read_curves(root, text, gait);
+  read_limbs(root, gait);
+  read_joints(root, gait);
+  return gait;
+}
+
+GaitFile load_gait_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(Location{path, 0, 0}, "",
+                     "cannot open file: " + std::string(std::strerror(errno)));
+  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_gait_file(buffer.str(), path);
+}
+
+void validate_gait(const GaitFile& gait) {
+  const Location top{gait.file, 0, 0};
+  if (gait.name.empty()) throw InputError(top, "name", "expected a non-empty name");
+  if (gait.stride_frequency_hz.has_value() == gait.froude.has_value()) {
+    throw InputError(top, "", "give exactly one of stride_frequency_hz or froude");
+  }
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (gait.stride_frequency_hz && !positive(*gait.stride_frequency_hz)) {
+    throw InputError(
+        top, "stride_frequency_hz",
+        "expected a positive number, found " + format_number(*gait.stride_frequency_hz));
+  }
+  if (gait.froude && !(positive(gait.froude->number) && positive(gait.froude->hip_height_m))) {
+    throw InputError(top, "froude", "number and hip_height_m must be positive");
+  }
+  for (std::size_t i = 0; i < gait.curves.size(); ++i) {
+    const GaitCurve& c = gait.curves[i];
+    const std::string key = "curves." + c.name;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (gait.curves[j].name == c.name) throw InputError(c.where, key, "duplicate curve");
+    }
+    Expression compiled;
+    try {
+      compiled = Expression::compile(c.expression);
+    } catch (const ExpressionError& e) {
+      throw InputError(
+          c.where, key,
+          e.message() + " (column " + std::to_string(e.column()) + " of the expression)");
+    }
+    check_finite(compiled, [&](const std::string& m) { throw InputError(c.where, key, m); });
+  }
+  for (std::size_t i = 0; i < gait.limbs.size(); ++i) {
+    const GaitLimb& l = gait.limbs[i];
+    const std::string key = "limbs." + l.name;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (gait.limbs[j].name == l.name) throw InputError(l.where, key, "duplicate limb");
+    }
+    if (!(l.phase >= 0.0 && l.phase <= 1.0)) {
+      throw InputError(l.where, key,
+                       "expected a phase from 0 to 1, found " + format_number(l.phase));
+    }
+  }
+  if (gait.joints.empty()) throw InputError(top, "joints", "a gait needs at least one joint");
+  for (std::size_t i = 0; i < gait.joints.size(); ++i) {
+    const GaitJoint& j = gait.joints[i];
+    const std::string key = "joints." + j.name;
+    for (std::size_t k = 0; k < i; ++k) {
+      if (gait.joints[k].name == j.name) throw InputError(j.where, key, "duplicate joint");
+    }
+    if (!gait.find_curve(j.curve)) {
+      throw InputError(
+          j.where, key + ".curve",
+          "undefined curve '" + j.curve + "' (curves: " + join_names(curve_names(gait)) + ")");
+    }
+    if (!gait.find_limb(j.limb)) {
+      throw InputError(
+          j.where, key + ".limb",
+          "undefined limb '" + j.limb + "' (limbs: " + join_names(limb_names(gait)) + ")");
+    }
+    if (j.sign != 1 && j.sign != -1) {
+      throw InputError(j.where, key + ".sign", "expected 1 or -1, found " + std::to_string(j.sign));
+    }
+    if (!std::isfinite(j.scale) || !std::isfinite(j.offset_deg)) {
+      throw InputError(j.where, key, "scale and offset_deg must be finite");
+    }
+  }
+}
+
+std::string format_gait_file(const GaitFile& gait) {
+  std::string out;
+  out += "# Gait file written by animrt (format: configs/gaits/walk.yaml).\n";
+  out += "name: " + double_quoted(gait.name) + "\n";
+  if (gait.stride_frequency_hz) {
+    out += "stride_frequency_hz: " + format_number(*gait.stride_frequency_hz) + "\n";
+  }
+  if (gait.froude) {
+    out += "froude: {number: " + format_number(gait.froude->number) +
+           ", hip_height_m: " + format_number(gait.froude->hip_height_m) + "}\n";
+  }
+  out += gait.curves.empty() ? "curves: {}\n" : "curves:\n";
+  for (const auto& c : gait.curves) {
+    out += "  " + name_text(c.name) + ": " + double_quoted(c.expression) + "\n";
+  }
+  out += gait.limbs.empty() ? "limbs: {}\n" : "limbs:\n";
+  for (const auto& l : gait.limbs) {
+    out += "  " + name_text(l.name) + ": " + format_number(l.phase) + "\n";
+  }
+  out += gait.joints.empty() ? "joints: {}\n" : "joints:\n";
+  for (const auto& j : gait.joints) {
+    out += "  " + name_text(j.name) + ": {curve: " + name_text(j.curve) +
+           ", limb: " + name_text(j.limb) + ", sign: " + std::to_string(j.sign) +
+           ", scale: " + format_number(j.scale) + ", offset_deg: " + format_number(j.offset_deg) +
+           "}\n";
+  }
+  return out;
+}
+
+void write_gait_file(const GaitFile& gait, const std::string& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  out << format_gait_file(gait);
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+}
+
+}  // namespace animrt

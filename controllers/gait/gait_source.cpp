@@ -1,0 +1,98 @@
+// A gait bound to a robot's joints: the MotionSource the real-time loop samples.
+
+#include "animrt/controllers/gait/gait_source.hpp"
+
+#include <utility>
+#include <vector>
+
+#include "animrt/controllers/gait/expression.hpp"
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+namespace {
+
+class GaitSource final : public MotionSource {
+ public:
+  // One driven joint, everything resolved to indices and numbers at load.
+  struct Drive {
+    int joint = 0;
+    int curve = 0;
+    double phase = 0.0;  // stride cycles
+    double gain = 1.0;   // sign * scale
+    double offset_deg = 0.0;
+  };
+
+  GaitSource(double frequency, std::vector<Expression> curves, std::vector<Drive> drives)
+      : frequency_(frequency), curves_(std::move(curves)), drives_(std::move(drives)) {
+    for (const Drive& d : drives_) driven_.push_back(d.joint);
+  }
+
+  std::span<const int> driven_joints() const override { return driven_; }
+
+  void sample(double t, std::span<double> targets) const override {
+    const double cycles = frequency_ * t;
+    for (const Drive& d : drives_) {
+      if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
+      const double deg =
+          d.gain * curves_[static_cast<std::size_t>(d.curve)].eval(cycles - d.phase) + d.offset_deg;
+      targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);
+    }
+  }
+
+ private:
+  double frequency_;
+  std::vector<Expression> curves_;
+  std::vector<Drive> drives_;
+  std::vector<int> driven_;
+};
+
+std::string joint_names(std::span<const JointSpec> joints) {
+  std::string out;
+  for (const auto& j : joints) out += (out.empty() ? "" : ", ") + j.name;
+  return out.empty() ? std::string("none") : out;
+}
+
+// `gait` has been validated.
+std::unique_ptr<MotionSource> bind(const GaitFile& gait, std::span<const JointSpec> joints) {
+  std::vector<Expression> curves;
+  curves.reserve(gait.curves.size());
+  for (const auto& c : gait.curves) curves.push_back(Expression::compile(c.expression));
+
+  std::vector<GaitSource::Drive> drives;
+  for (const GaitJoint& gj : gait.joints) {
+    GaitSource::Drive d;
+    d.joint = -1;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      if (joints[i].name == gj.name) d.joint = static_cast<int>(i);
+    }
+    if (d.joint < 0) {
+      throw InputError(gj.where, "joints." + gj.name,
+                       "no joint named '" + gj.name +
+                           "' in the robot (its joints: " + joint_names(joints) + ")");
+    }
+    for (std::size_t i = 0; i < gait.curves.size(); ++i) {
+      if (gait.curves[i].name == gj.curve) d.curve = static_cast<int>(i);
+    }
+    d.phase = gait.find_limb(gj.limb)->phase;
+    d.gain = gj.sign * gj.scale;
+    d.offset_deg = gj.offset_deg;
+    drives.push_back(d);
+  }
+  return std::make_unique<GaitSource>(gait.stride_frequency(), std::move(curves),
+                                      std::move(drives));
+}
+
+}  // namespace
+
+std::unique_ptr<MotionSource> load_gait_source(const std::string& gait_path,
+                                               std::span<const JointSpec> joints) {
+  return bind(load_gait_file(gait_path), joints);
+}
+
+std::unique_ptr<MotionSource> make_gait_source(const GaitFile& gait,
+                                               std::span<const JointSpec> joints) {
+  validate_gait(gait);
+  return bind(gait, joints);
+}
+
+}  // namespace animrt

@@ -1,1 +1,0 @@
-#include "animrt/controllers/motion_source.hpp"

@@ -1,0 +1,115 @@
+#pragma once
+// Master side of a Dynamixel Protocol 2.0 bus (X-series servos in position
+// mode). configure() pings and reads every device; each cycle is then one
+// Sync Read of the present positions and one Sync Write of the goals.
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/dynamixel/protocol2.hpp"
+
+namespace animrt {
+
+class DynamixelBus final : public ActuatorBus {
+ public:
+  // Largest number of devices whose Sync Write fits one packet even after
+  // worst-case byte stuffing.
+  static constexpr std::size_t kMaxDevices = 150;
+  // Attempts per device for the lifecycle transactions (not for the cycle).
+  static constexpr int kTries = 3;
+
+  // Takes an open transport (tests inject one). Allocates every buffer the
+  // cycle needs. Throws DeviceError for ids outside 0..252, duplicate ids, a
+  // bad scale or direction, or more than kMaxDevices devices.
+  DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> transport);
+
+  const BusConfig& config() const override { return config_; }
+
+  // Resets the counters, pings every device (kTries each) and reads its
+  // present position. Throws one DeviceError listing every device that failed.
+  void configure() override;
+  // Per device: goal position = present position, then torque on. On failure
+  // turns torque off again and throws DeviceError naming the device.
+  void activate() override;
+  // Torque off on every device, best effort; never throws.
+  void deactivate() override;
+
+  // One Sync Read / Sync Write. Counters: `transactions` counts instruction
+  // packets that expected an answer from the device (Sync Write expects none).
+  // Both throw DeviceError only if the transport itself is gone.
+  void read(std::span<double> positions) override;
+  void write(std::span<const double> positions) override;
+
+  std::span<DeviceStatus> devices() override { return status_; }
+
+ private:
+  using Deadline = std::chrono::steady_clock::time_point;
+
+  // What became of one device's answer in a transaction.
+  enum class Answer : std::uint8_t {
+    pending,
+    ok,        // status packet with usable data (value_ holds it)
+    rejected,  // status packet with an error number or the wrong data length
+    timeout,   // nothing arrived
+    garbled,   // bad CRC, or junk / truncated / wrong-id packet and nothing better
+  };
+
+  // Sends tx_[0, length) and collects status packets for the devices in
+  // asked_[0, count) (ids in ids_) until each answered or the one deadline
+  // passed. Updates every counter; results land in answer_ and value_.
+  void transact(std::size_t length, std::size_t count, std::size_t data_length, bool diagnostic);
+  // One device, one instruction; kTries attempts while nothing usable came.
+  Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
+                 int tries = kTries, bool diagnostic = false);
+  // Judges one status packet for slot `slot`.
+  void accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
+              bool diagnostic);
+  void blame(std::size_t slot, bool crc);
+  // Pulls bytes until the decoder has something other than need_more.
+  dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
+  // Reads the hardware error register of devices whose alert just appeared.
+  void read_pending_hardware_status();
+  Answer write_register(std::size_t device, std::uint16_t address, std::uint32_t value,
+                        std::uint16_t size, int tries);
+  std::int32_t goal_ticks(std::size_t device, double rad) const;
+
+  // Why a lifecycle transaction failed; for `ok` the hardware error it carried.
+  std::string failure(std::size_t device, Answer answer) const;
+  std::string prefix() const;                      // "bus legs (/dev/pts/4): "
+  std::string describe(std::size_t device) const;  // "id 5 (lf_ankle)"
+
+  BusConfig config_;
+  std::unique_ptr<ByteTransport> transport_;
+  std::chrono::microseconds timeout_;
+
+  std::vector<DeviceStatus> status_;
+  std::vector<std::int32_t> present_ticks_;   // latest known, per device
+  std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
+  std::vector<double> min_rad_, max_rad_;     // goals that stay inside int32 ticks
+  std::vector<std::uint8_t> alert_seen_;      // alert bit in the latest status
+  std::vector<std::uint8_t> status_pending_;  // hardware error register to read
+  bool fresh_ = false;                        // configure() values not yet handed out
+
+  // Per slot of the current transaction.
+  std::vector<std::uint8_t> ids_;
+  std::vector<std::size_t> asked_;
+  std::vector<Answer> answer_;
+  std::vector<std::uint8_t> suspect_;  // blamed for junk or a wrong id, still waited for
+  std::vector<std::uint32_t> value_;
+  std::vector<std::uint8_t> sync_data_;
+
+  std::array<std::uint8_t, dxl::kMaxPacket> tx_{};
+  std::array<std::uint8_t, 256> rx_{};
+  std::size_t rx_begin_ = 0, rx_end_ = 0;
+  dxl::Decoder decoder_;
+};
+
+}  // namespace animrt

@@ -1,0 +1,451 @@
+#include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+namespace {
+
+using std::chrono::steady_clock;
+
+// Any data length is fine (ping: the model number layout is not our business).
+constexpr std::size_t kAnyLength = std::numeric_limits<std::size_t>::max();
+constexpr std::uint8_t kErrorNumberMask = 0x7F;
+
+const char* status_error_name(std::uint8_t number) {
+  switch (static_cast<dxl::StatusError>(number)) {
+    case dxl::StatusError::none:
+      return "none";
+    case dxl::StatusError::result_fail:
+      return "result fail";
+    case dxl::StatusError::instruction:
+      return "instruction error";
+    case dxl::StatusError::crc:
+      return "CRC error";
+    case dxl::StatusError::data_range:
+      return "data range error";
+    case dxl::StatusError::data_length:
+      return "data length error";
+    case dxl::StatusError::data_limit:
+      return "data limit error";
+    case dxl::StatusError::access:
+      return "access error";
+  }
+  return "unknown error";
+}
+
+std::string hex_byte(std::uint8_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", v);
+  return buf;
+}
+
+// X-series hardware error status register (address 70) bits.
+std::string hardware_error_text(std::uint8_t bits) {
+  static constexpr std::pair<std::uint8_t, const char*> kBits[] = {
+      {0x01, "input voltage"},    {0x04, "overheating"}, {0x08, "motor encoder"},
+      {0x10, "electrical shock"}, {0x20, "overload"},
+  };
+  std::string out = "hardware error status " + hex_byte(bits);
+  std::string names;
+  for (const auto& [bit, name] : kBits) {
+    if ((bits & bit) == 0) continue;
+    if (!names.empty()) names += ", ";
+    names += name;
+  }
+  if (!names.empty()) out += ": " + names;
+  return out;
+}
+
+}  // namespace
+
+DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> transport)
+    : config_(std::move(config)),
+      transport_(std::move(transport)),
+      timeout_(std::chrono::ceil<std::chrono::microseconds>(
+          std::chrono::duration<double>(config_.timeout_s))) {
+  const std::string bus = "bus " + config_.name + ": ";
+  if (!transport_) throw DeviceError(bus + "no transport");
+  if (!(config_.timeout_s > 0.0)) throw DeviceError(bus + "timeout must be positive");
+  const std::size_t n = config_.actuators.size();
+  if (n > kMaxDevices) {
+    throw DeviceError(bus + std::to_string(n) + " devices do not fit one Sync Write (at most " +
+                      std::to_string(kMaxDevices) + ")");
+  }
+  bool used[256] = {};
+  for (const ActuatorBinding& b : config_.actuators) {
+    const std::string who = "device id " + std::to_string(b.device_id) + " (" + b.joint + ")";
+    if (b.device_id < 0 || b.device_id > 252) throw DeviceError(bus + who + " is outside 0..252");
+    if (used[b.device_id]) throw DeviceError(bus + who + " is used twice");
+    used[b.device_id] = true;
+    if (b.direction != 1 && b.direction != -1) {
+      throw DeviceError(bus + who + ": direction must be +1 or -1");
+    }
+    if (!(b.ticks_per_rad > 0.0) || !std::isfinite(b.ticks_per_rad)) {
+      throw DeviceError(bus + who + ": ticks per radian must be positive");
+    }
+  }
+
+  status_.resize(n);
+  present_ticks_.resize(n);
+  goal_ticks_.resize(n);
+  min_rad_.resize(n);
+  max_rad_.resize(n);
+  alert_seen_.resize(n);
+  status_pending_.resize(n);
+  ids_.resize(n);
+  asked_.resize(n);
+  answer_.resize(n);
+  suspect_.resize(n);
+  value_.resize(n);
+  sync_data_.resize(4 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const ActuatorBinding& b = config_.actuators[i];
+    status_[i].device_id = b.device_id;
+    present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
+    // One tick inside the int32 range so rounding cannot wrap.
+    const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
+    const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
+    min_rad_[i] = std::min(a, c);
+    max_rad_[i] = std::max(a, c);
+  }
+}
+
+std::string DynamixelBus::prefix() const {
+  return "bus " + config_.name + " (" + transport_->port() + "): ";
+}
+
+std::string DynamixelBus::describe(std::size_t device) const {
+  const ActuatorBinding& b = config_.actuators[device];
+  return "id " + std::to_string(b.device_id) + " (" + b.joint + ")";
+}
+
+// ---- transactions ---------------------------------------------------------
+
+dxl::DecodeResult DynamixelBus::next_event(dxl::Packet& packet, Deadline deadline) {
+  for (;;) {
+    if (rx_begin_ < rx_end_) {
+      rx_begin_ += decoder_.feed({rx_.data() + rx_begin_, rx_end_ - rx_begin_});
+    }
+    const dxl::DecodeResult r = decoder_.next(packet);
+    if (r != dxl::DecodeResult::need_more) return r;
+    if (rx_begin_ < rx_end_) {
+      // Full decoder that still sees no packet: drop its bytes, never stall.
+      decoder_.reset();
+      continue;
+    }
+    const auto now = steady_clock::now();
+    if (now >= deadline) return dxl::DecodeResult::need_more;
+    rx_begin_ = 0;
+    rx_end_ = transport_->read(rx_, std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+  }
+}
+
+void DynamixelBus::blame(std::size_t slot, bool crc) {
+  DeviceStatus& st = status_[asked_[slot]];
+  ++(crc ? st.crc_errors : st.protocol_errors);
+  st.health = DeviceHealth::protocol_error;
+  answer_[slot] = Answer::garbled;
+}
+
+void DynamixelBus::accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
+                          bool diagnostic) {
+  const std::size_t device = asked_[slot];
+  DeviceStatus& st = status_[device];
+  if (packet.params.empty()) {  // a status packet always carries its error byte
+    blame(slot, false);
+    return;
+  }
+  const std::uint8_t error = packet.params[0];
+  const bool alert = (error & dxl::kAlertBit) != 0;
+  st.last_error_byte = error;
+  if (!diagnostic) {
+    if (alert) {
+      ++st.hardware_errors;
+      // Read the fault register once per episode, not on every cycle.
+      if (!alert_seen_[device]) status_pending_[device] = 1;
+    }
+    alert_seen_[device] = alert ? 1 : 0;
+  }
+  const auto data = packet.params.subspan(1);
+  const bool bad_number = (error & kErrorNumberMask) != 0;
+  const bool bad_length = !bad_number && data_length != kAnyLength && data.size() != data_length;
+  if (bad_number || bad_length) {
+    ++st.protocol_errors;
+    st.health = alert ? DeviceHealth::hardware_error : DeviceHealth::protocol_error;
+    answer_[slot] = Answer::rejected;
+    return;
+  }
+  std::uint32_t value = 0;
+  for (std::size_t i = 0; i < std::min<std::size_t>(4, data.size()); ++i) {
+    value |= static_cast<std::uint32_t>(data[i]) << (8 * i);
+  }
+  value_[slot] = value;
+  answer_[slot] = Answer::ok;
+  st.health = alert ? DeviceHealth::hardware_error : DeviceHealth::ok;
+}
+
+void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t data_length,
+                            bool diagnostic) {
+  for (std::size_t s = 0; s < count; ++s) {
+    answer_[s] = Answer::pending;
+    suspect_[s] = 0;
+    ++status_[asked_[s]].transactions;
+  }
+  // Late answers from an earlier transaction must not pass for this one's.
+  transport_->discard_input();
+  decoder_.reset();
+  rx_begin_ = rx_end_ = 0;
+  transport_->write({tx_.data(), length});
+
+  // One deadline for the whole transaction: a dead device costs one timeout.
+  const Deadline deadline = steady_clock::now() + timeout_;
+  std::size_t remaining = count;
+  std::size_t expected = 0;  // first slot still waiting: whose answer comes next
+  dxl::Packet packet;
+  while (remaining > 0) {
+    while (answer_[expected] != Answer::pending) ++expected;
+    const dxl::DecodeResult r = next_event(packet, deadline);
+    if (r == dxl::DecodeResult::need_more) break;
+    if (r == dxl::DecodeResult::bad_crc) {
+      // A whole packet arrived damaged: that was the answer, no other follows.
+      blame(expected, true);
+      --remaining;
+      continue;
+    }
+    std::size_t slot = count;
+    if (r == dxl::DecodeResult::packet) {
+      // Our own instruction, echoed by a half-duplex adapter, is no answer.
+      if (packet.instruction != dxl::inst::status) continue;
+      slot = expected;
+      while (slot < count && !(ids_[slot] == packet.id && answer_[slot] == Answer::pending)) ++slot;
+    }
+    if (slot == count) {
+      // Junk that looked like a header, or a packet from an id not asked (or
+      // answered twice): counted, and the real answer is still waited for.
+      DeviceStatus& st = status_[asked_[expected]];
+      ++st.protocol_errors;
+      st.health = DeviceHealth::protocol_error;
+      suspect_[expected] = 1;
+      continue;
+    }
+    accept(slot, packet, data_length, diagnostic);
+    --remaining;
+  }
+
+  // Bytes of an unfinished packet at the deadline: the next answer was cut short.
+  bool truncated = decoder_.buffered() > 0;
+  for (std::size_t s = 0; s < count; ++s) {
+    if (answer_[s] != Answer::pending) continue;
+    DeviceStatus& st = status_[asked_[s]];
+    answer_[s] = Answer::garbled;
+    if (suspect_[s] != 0) continue;  // already counted as a protocol error
+    if (truncated) {
+      truncated = false;
+      ++st.protocol_errors;
+      st.health = DeviceHealth::protocol_error;
+      continue;
+    }
+    ++st.timeouts;
+    st.health = DeviceHealth::timeout;
+    answer_[s] = Answer::timeout;
+  }
+}
+
+DynamixelBus::Answer DynamixelBus::unicast(std::size_t device, std::size_t length,
+                                           std::size_t data_length, int tries, bool diagnostic) {
+  Answer a = Answer::timeout;
+  if (length == 0) return a;
+  for (int t = 0; t < tries; ++t) {
+    ids_[0] = static_cast<std::uint8_t>(config_.actuators[device].device_id);
+    asked_[0] = device;
+    transact(length, 1, data_length, diagnostic);  // tx_ still holds the instruction
+    a = answer_[0];
+    if (a == Answer::ok || a == Answer::rejected) break;  // retrying will not change a verdict
+  }
+  return a;
+}
+
+DynamixelBus::Answer DynamixelBus::write_register(std::size_t device, std::uint16_t address,
+                                                  std::uint32_t value, std::uint16_t size,
+                                                  int tries) {
+  std::uint8_t data[4];
+  dxl::put_u32(data, value);
+  const auto id = static_cast<std::uint8_t>(config_.actuators[device].device_id);
+  const std::size_t length = dxl::encode_write(id, address, {data, size}, tx_);
+  return unicast(device, length, 0, tries);
+}
+
+void DynamixelBus::read_pending_hardware_status() {
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    if (status_pending_[i] == 0) continue;
+    status_pending_[i] = 0;
+    DeviceStatus& st = status_[i];
+    const auto id = static_cast<std::uint8_t>(st.device_id);
+    const std::size_t length = dxl::encode_read(id, dxl::xreg::hardware_error_status, 1, tx_);
+    // The diagnosis must not overwrite the verdict of the cycle.
+    const DeviceHealth health = st.health;
+    if (unicast(i, length, 1, 1, true) == Answer::ok) {
+      st.hardware_error_status = static_cast<std::uint8_t>(value_[0]);
+    }
+    st.health = health;
+  }
+}
+
+std::string DynamixelBus::failure(std::size_t device, Answer answer) const {
+  const DeviceStatus& st = status_[device];
+  switch (answer) {
+    case Answer::timeout:
+      return "no answer";
+    case Answer::garbled:
+      return "garbled answer";
+    case Answer::rejected: {
+      const std::uint8_t number = st.last_error_byte & kErrorNumberMask;
+      if (number == 0) return "answer with the wrong data length";
+      return "status error " + hex_byte(st.last_error_byte) + " (" + status_error_name(number) +
+             ")";
+    }
+    case Answer::ok:
+    case Answer::pending:
+      break;
+  }
+  return "device reports a hardware error (" + hardware_error_text(st.hardware_error_status) + ")";
+}
+
+// ---- lifecycle --------------------------------------------------------------
+
+void DynamixelBus::configure() {
+  const std::size_t n = status_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    status_[i] = DeviceStatus{};
+    status_[i].device_id = config_.actuators[i].device_id;
+    alert_seen_[i] = status_pending_[i] = 0;
+  }
+  fresh_ = false;
+
+  std::string silent, garbled;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    const Answer a = unicast(i, dxl::encode_ping(id, tx_), kAnyLength);
+    std::string& list = a == Answer::timeout ? silent : garbled;
+    if (a == Answer::ok || a == Answer::rejected) continue;  // it answered: it is there
+    list += (list.empty() ? "" : ", ") + describe(i);
+  }
+  if (!silent.empty() || !garbled.empty()) {
+    std::string message = prefix();
+    if (!silent.empty()) message += "no answer to ping from " + silent;
+    if (!garbled.empty()) {
+      message +=
+          (silent.empty() ? "" : "; ") + std::string("garbled answer to ping from ") + garbled;
+    }
+    throw DeviceError(message);
+  }
+
+  std::string unread;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    const std::size_t length = dxl::encode_read(id, dxl::xreg::present_position, 4, tx_);
+    const Answer a = unicast(i, length, 4);
+    if (a == Answer::ok) {
+      present_ticks_[i] = goal_ticks_[i] = static_cast<std::int32_t>(value_[0]);
+    } else {
+      unread += (unread.empty() ? "" : "; ") + describe(i) + ": " + failure(i, a);
+    }
+  }
+  if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
+  read_pending_hardware_status();
+  fresh_ = true;
+}
+
+void DynamixelBus::activate() {
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    if (status_[i].faulted) continue;
+    // Goal = where the servo is, so torque on cannot jump to a stale goal.
+    const std::int32_t ticks = present_ticks_[i];
+    const auto check = [&](Answer a, const char* action) {
+      if (a == Answer::ok && alert_seen_[i] == 0) return;
+      // A servo in hardware error shutdown would stay limp: refuse to start.
+      if (a == Answer::ok) read_pending_hardware_status();
+      const std::string message =
+          prefix() + "cannot " + action + " of " + describe(i) + ": " + failure(i, a);
+      deactivate();
+      throw DeviceError(message);
+    };
+    check(write_register(i, dxl::xreg::goal_position, static_cast<std::uint32_t>(ticks), 4, kTries),
+          "write goal position");
+    goal_ticks_[i] = ticks;
+    check(write_register(i, dxl::xreg::torque_enable, 1, 1, kTries), "enable torque");
+  }
+}
+
+void DynamixelBus::deactivate() {
+  try {
+    for (std::size_t i = 0; i < status_.size(); ++i) {
+      write_register(i, dxl::xreg::torque_enable, 0, 1, kTries);
+    }
+  } catch (...) {
+    // The line is gone: nothing more can be sent, and deactivate never throws.
+  }
+}
+
+// ---- cycle ----------------------------------------------------------------
+
+void DynamixelBus::read(std::span<double> positions) {
+  const std::size_t n = std::min(status_.size(), positions.size());
+  if (fresh_) {
+    // Hand out what configure() read, so no entry starts undefined.
+    for (std::size_t i = 0; i < n; ++i) {
+      positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
+    }
+    fresh_ = false;
+  }
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    if (status_[i].faulted) continue;
+    ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
+    asked_[count] = i;
+    ++count;
+  }
+  if (count > 0) {
+    const std::size_t length =
+        dxl::encode_sync_read(dxl::xreg::present_position, 4, {ids_.data(), count}, tx_);
+    if (length > 0) {
+      transact(length, count, 4, false);
+      for (std::size_t s = 0; s < count; ++s) {
+        if (answer_[s] != Answer::ok) continue;
+        const std::size_t i = asked_[s];
+        present_ticks_[i] = static_cast<std::int32_t>(value_[s]);
+        if (i < n) positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
+      }
+    }
+  }
+  // Only after an alert appeared: one extra transaction in that failure case.
+  read_pending_hardware_status();
+}
+
+std::int32_t DynamixelBus::goal_ticks(std::size_t device, double rad) const {
+  if (!std::isfinite(rad)) return goal_ticks_[device];  // hold the last goal
+  return config_.actuators[device].to_ticks(std::clamp(rad, min_rad_[device], max_rad_[device]));
+}
+
+void DynamixelBus::write(std::span<const double> positions) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    if (status_[i].faulted) continue;
+    if (i < positions.size()) goal_ticks_[i] = goal_ticks(i, positions[i]);
+    ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
+    dxl::put_u32(sync_data_.data() + 4 * count, static_cast<std::uint32_t>(goal_ticks_[i]));
+    ++count;
+  }
+  if (count == 0) return;
+  const std::size_t length = dxl::encode_sync_write(
+      dxl::xreg::goal_position, 4, {ids_.data(), count}, {sync_data_.data(), 4 * count}, tx_);
+  if (length > 0) transport_->write({tx_.data(), length});
+}
+
+}  // namespace animrt

@@ -1,0 +1,121 @@
+#include "fd_transport.hpp"
+
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <ctime>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::detail {
+namespace {
+
+// A writer that cannot hand bytes to the driver for this long is stuck (the
+// other end stopped reading); better an error than a frozen loop.
+constexpr std::chrono::milliseconds kWriteStall{1000};
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+timespec to_timespec(std::int64_t ns) {
+  if (ns < 0) ns = 0;
+  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+}
+
+// Waits for `events` until the monotonic deadline; returns revents, or 0 on
+// timeout. ppoll rather than poll: the bus timeouts are in microseconds.
+short wait_for(int fd, short events, std::int64_t deadline_ns) {
+  for (;;) {
+    pollfd p{fd, events, 0};
+    const timespec left = to_timespec(deadline_ns - now_ns());
+    const int r = ppoll(&p, 1, &left, nullptr);
+    if (r > 0) return p.revents;
+    if (r == 0) return 0;
+    if (errno != EINTR) return POLLERR;
+  }
+}
+
+}  // namespace
+
+void FdTransport::line_gone(const char* what, int error) const {
+  std::string message = "serial port " + port_ + ": " + what;
+  if (error != 0) message += std::string(": ") + std::strerror(error);
+  throw DeviceError(message);
+}
+
+void FdTransport::write(std::span<const std::uint8_t> bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      const short ev =
+          wait_for(fd_, POLLOUT, now_ns() + std::chrono::nanoseconds(kWriteStall).count());
+      if (ev == 0) line_gone("write stalled (the other end is not reading)", 0);
+      if ((ev & POLLOUT) == 0) line_gone("line is gone (hangup or error)", 0);
+      continue;
+    }
+    line_gone("write failed, line is gone", n < 0 ? errno : 0);
+  }
+}
+
+std::size_t FdTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
+  if (buffer.empty()) return 0;
+  const std::int64_t deadline = now_ns() + std::chrono::nanoseconds(timeout).count();
+  bool waited = false;
+  for (;;) {
+    // Read first: when bytes are already queued this saves the poll.
+    const ssize_t n = ::read(fd_, buffer.data(), buffer.size());
+    if (n > 0) return static_cast<std::size_t>(n);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+      line_gone("read failed, line is gone", errno);
+    }
+    // Nothing queued (EAGAIN, or 0 when the tty has VMIN = 0); a hangup also
+    // reads 0, so poll tells the two apart.
+    if (waited && now_ns() >= deadline) return 0;
+    const short ev = wait_for(fd_, POLLIN, deadline);
+    waited = true;
+    if ((ev & (POLLHUP | POLLERR | POLLNVAL)) != 0) line_gone("line is gone (hangup)", 0);
+    if (ev == 0) return 0;
+  }
+}
+
+void FdTransport::discard_input() {
+  tcflush(fd_, TCIFLUSH);
+  // tcflush leaves bytes that were still in flight in the driver (a pty's
+  // flip buffer); read them away too.
+  std::uint8_t sink[256];
+  for (;;) {
+    const ssize_t n = ::read(fd_, sink, sizeof sink);
+    if (n > 0) continue;
+    if (n < 0 && errno == EINTR) continue;
+    return;
+  }
+}
+
+void throw_open_error(const std::string& port, const std::string& reason, int error) {
+  std::string message = "cannot open serial port " + port + ": " + reason;
+  if (error == EACCES || error == EPERM) {
+    message +=
+        " (is the user in the 'dialout' group? add it with 'sudo usermod -aG dialout "
+        "$USER' and log in again)";
+  } else if (error == EBUSY) {
+    message +=
+        " (another program may be using the port; also check the user is in the "
+        "'dialout' group)";
+  }
+  throw DeviceError(message);
+}
+
+}  // namespace animrt::detail

@@ -1,0 +1,167 @@
+#include "animrt/controllers/gait/gait_source.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "animrt/core/joint.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace {
+
+const char* const kGait = R"yaml(name: test
+stride_frequency_hz: 2.0
+curves:
+  lin: "t"
+  wave: "10 + 5*sin(2*PI*t)"
+limbs:
+  a: 0.0
+  b: 0.25
+joints:
+  j1: {curve: wave, limb: a}
+  j2: {curve: wave, limb: b, sign: -1, scale: 2.0, offset_deg: 3}
+  j3: {curve: lin, limb: b, scale: 0.5, offset_deg: -1}
+)yaml";
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::vector<JointSpec> robot(std::initializer_list<const char*> names) {
+  std::vector<JointSpec> joints;
+  for (const char* n : names) {
+    JointSpec j;
+    j.name = n;
+    j.limits = {-1.0, 1.0, 5.0, 50.0};
+    joints.push_back(j);
+  }
+  return joints;
+}
+
+class GaitSourceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = write_temp("gait_source_test.yaml", kGait);
+    joints_ = robot({"x", "j2", "j1", "j3", "y"});
+    source_ = load_gait_source(path_, joints_);
+  }
+
+  // Targets in degrees at t seconds; unmapped joints keep 99 rad.
+  std::vector<double> sample_deg(double t) const {
+    std::vector<double> targets(joints_.size(), 99.0);
+    source_->sample(t, targets);
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      if (targets[i] != 99.0) targets[i] = rad_to_deg(targets[i]);
+    }
+    return targets;
+  }
+
+  std::string path_;
+  std::vector<JointSpec> joints_;
+  std::unique_ptr<MotionSource> source_;
+};
+
+TEST_F(GaitSourceTest, DrivesTheMappedJointsInFileOrder) {
+  const auto driven = source_->driven_joints();
+  EXPECT_EQ(std::vector<int>(driven.begin(), driven.end()), (std::vector<int>{2, 1, 3}));
+}
+
+// Hand-computed with f = 2 Hz: u = 2 t - phase; wave(u) = 10 + 5 sin(2 pi u).
+//   j1 = wave(u_a)                 j2 = -1 * 2 * wave(u_b) + 3
+//   j3 = 0.5 * u_b - 1
+TEST_F(GaitSourceTest, SamplesHandComputedValues) {
+  struct Row {
+    double t, j1, j2, j3;
+  };
+  const Row rows[] = {
+      // t = 0: u_a = 0, u_b = -0.25 (sin = -1, wave = 5).
+      {0.0, 10.0, -7.0, -1.125},
+      // t = 0.125: u_a = 0.25 (wave 15), u_b = 0 (wave 10).
+      {0.125, 15.0, -17.0, -1.0},
+      // t = 0.25: u_a = 0.5 (wave 10), u_b = 0.25 (wave 15).
+      {0.25, 10.0, -27.0, -0.875},
+      // t = 0.5: u_a = 1 (wave 10), u_b = 0.75 (wave 5).
+      {0.5, 10.0, -7.0, -0.625},
+  };
+  for (const Row& r : rows) {
+    const auto deg = sample_deg(r.t);
+    EXPECT_NEAR(deg[2], r.j1, 1e-9) << "j1 at t = " << r.t;
+    EXPECT_NEAR(deg[1], r.j2, 1e-9) << "j2 at t = " << r.t;
+    EXPECT_NEAR(deg[3], r.j3, 1e-9) << "j3 at t = " << r.t;
+    EXPECT_EQ(deg[0], 99.0);  // not driven: untouched
+    EXPECT_EQ(deg[4], 99.0);
+  }
+}
+
+TEST_F(GaitSourceTest, TargetsAreRadians) {
+  std::vector<double> targets(joints_.size(), 0.0);
+  source_->sample(0.125, targets);
+  EXPECT_NEAR(targets[2], 15.0 * kPi / 180.0, 1e-15);
+}
+
+TEST_F(GaitSourceTest, SampleDoesNotAllocate) {
+  std::vector<double> targets(joints_.size(), 0.0);
+  test::AllocationCounter counter;
+  for (int i = 0; i < 1000; ++i) source_->sample(i * 0.005, targets);
+  EXPECT_EQ(counter.count(), 0);
+}
+
+TEST(GaitSource, JointNotInTheRobot) {
+  const std::string path = write_temp("gait_source_missing_joint.yaml", kGait);
+  try {
+    (void)load_gait_source(path, robot({"x", "j2", "j1", "y"}));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(
+        std::string(e.what()),
+        path + ":12:3: joints.j3: no joint named 'j3' in the robot (its joints: x, j2, j1, y)");
+  }
+}
+
+TEST(GaitSource, FileErrorsPassThrough) {
+  const std::string path = write_temp("gait_source_bad.yaml", std::string(kGait) + "extra: 1\n");
+  try {
+    (void)load_gait_source(path, robot({"j1", "j2", "j3"}));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().line, 13);
+    EXPECT_EQ(e.key(), "extra");
+  }
+}
+
+TEST(GaitSource, FromAGaitInMemory) {
+  GaitFile g;
+  g.name = "evolved";
+  g.froude = FroudeTiming{1.0, 1.0};  // f = sqrt(9.81) / 2.3
+  g.curves.push_back({"c", "t", {}});
+  g.limbs.push_back({"l", 0.5, {}});
+  g.joints.push_back({"q", "c", "l", 1, 1.0, 0.0, {}});
+  const auto joints = robot({"q"});
+  const auto source = make_gait_source(g, joints);
+  std::vector<double> targets(1, 0.0);
+  source->sample(2.3, targets);
+  EXPECT_NEAR(rad_to_deg(targets[0]), 3.1320919526732 - 0.5, 1e-9);
+
+  g.joints[0].name = "p";
+  try {
+    (void)make_gait_source(g, joints);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "<input>: joints.p: no joint named 'p' in the robot (its joints: q)");
+  }
+  g.joints[0].curve = "d";
+  try {
+    (void)make_gait_source(g, joints);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "<input>: joints.p.curve: undefined curve 'd' (curves: c)");
+  }
+}
+
+}  // namespace
+}  // namespace animrt
