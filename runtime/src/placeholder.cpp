@@ -1,1 +1,0 @@
-#include "animrt/runtime/robot_config.hpp"

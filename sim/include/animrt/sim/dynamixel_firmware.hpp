@@ -1,0 +1,82 @@
+#pragma once
+// The servos of one simulated Dynamixel bus answering decoded Protocol 2.0
+// instruction packets, as the firmware of each servo would. No I/O: the
+// status packets go to an Answers list in the order they appear on the wire.
+//
+// Instructions: Ping (broadcast: every servo answers, in id order), Read,
+// Write, Reg Write, Action, Reboot, Sync Read, Sync Write, Bulk Read, Bulk
+// Write. Factory Reset, Clear and unknown instructions answer Instruction
+// Error. A broadcast Read is ignored; broadcast Write/Reg Write/Action/Reboot
+// act without answering.
+// Status Return Level is respected (Ping always answers; a write that
+// changes the level is answered per the level it arrived under). Sync and Bulk
+// instructions are obeyed only with the broadcast id. A servo that is not
+// responding ignores every packet. A write to ID takes effect at once (its
+// status packet already carries the new ID).
+//
+// Simplification: on a real bus each servo of a Sync/Bulk Read waits for the
+// previous one's status packet; here a servo that does not respond is simply
+// skipped and the next one answers at once.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/sim/dynamixel_servo.hpp"
+
+namespace animrt::sim {
+
+// Status packets for one instruction packet, back to back in `bytes`.
+struct Answers {
+  struct Answer {
+    std::size_t offset = 0;
+    std::size_t size = 0;
+    int return_delay_us = 0;  // the answering servo's Return Delay Time
+  };
+  std::vector<std::uint8_t> bytes;
+  std::vector<Answer> list;
+
+  void clear() {
+    bytes.clear();
+    list.clear();
+  }
+  std::span<const std::uint8_t> packet(const Answer& a) const {
+    return {bytes.data() + a.offset, a.size};
+  }
+};
+
+// Whether the protocol lets any servo answer this packet: broadcast packets
+// other than Ping, Sync Read and Bulk Read never get an answer.
+bool may_answer(const dxl::Packet& packet);
+
+class DynamixelFirmware {
+ public:
+  // One servo per actuator of `config`. Throws InputError for a device id
+  // outside 0..252 or used twice.
+  DynamixelFirmware(const BusConfig& config, Nanos now);
+
+  // Handles one instruction packet at time `now` and appends the answers.
+  void handle(const dxl::Packet& packet, Nanos now, Answers& out);
+
+  // By the id configured in the BusConfig (not the ID register, which a
+  // client may change); nullptr if there is none.
+  DynamixelServo* find_configured(int device_id);
+  const DynamixelServo* find_configured(int device_id) const;
+
+  std::size_t size() const { return servos_.size(); }
+
+ private:
+  DynamixelServo* target(std::uint8_t id);  // responding servo with this ID register
+  void answer(const DynamixelServo& servo, dxl::StatusError error,
+              std::span<const std::uint8_t> data, Answers& out) const;
+  void answer_read(const DynamixelServo& servo, std::uint16_t address, std::uint16_t length,
+                   Answers& out) const;
+
+  std::vector<DynamixelServo> servos_;
+  std::vector<DynamixelServo*> by_id_;  // scratch for broadcast ping
+};
+
+}  // namespace animrt::sim

@@ -1,0 +1,129 @@
+#pragma once
+// One simulated Dynamixel X-series servo (identity of an XM430-W210: model
+// 1030, firmware 38): its control table, the firmware's rules for reading and
+// writing it, and a motor model. No I/O; DynamixelFirmware feeds it packets.
+//
+// Control table: the X-series items listed in kItems (dynamixel_servo.cpp);
+// other addresses below 147 read as 0 and cannot be written (Access Error).
+// Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (only 3,
+// position control; other modes answer Data Range Error), Moving Threshold,
+// Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
+// Return Level, Registered Instruction, Hardware Error Status, Goal Position,
+// Realtime Tick, Moving, Present Velocity/Position/Input Voltage/Temperature.
+// Stored but without effect: Model Information, Drive Mode, Temperature
+// Limit, Profile Acceleration, Profile Velocity, Velocity Limit (the rate
+// limit is SimBusSettings::max_speed_rad_s).
+//
+// Motor: with torque on, Present Position follows Goal Position as a first
+// order lag (time constant tau) whose speed is limited to vmax: speed =
+// clamp((goal - position) / tau, -vmax, vmax). The model is integrated in
+// closed form, so the state at time t does not depend on how often it was
+// advanced on the way (packets may arrive at any rate). Torque off: no motion.
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "animrt/core/clock.hpp"
+
+namespace animrt::sim {
+
+// X-series addresses the simulator uses beyond dxl::xreg.
+namespace xreg_sim {
+inline constexpr std::uint16_t model_information = 2;        // 4
+inline constexpr std::uint16_t drive_mode = 10;              // 1
+inline constexpr std::uint16_t moving_threshold = 24;        // 4, unit 0.229 rpm
+inline constexpr std::uint16_t temperature_limit = 31;       // 1
+inline constexpr std::uint16_t shutdown = 63;                // 1
+inline constexpr std::uint16_t registered_instruction = 69;  // 1
+inline constexpr std::uint16_t profile_acceleration = 108;   // 4
+inline constexpr std::uint16_t profile_velocity = 112;       // 4
+inline constexpr std::uint16_t realtime_tick = 120;          // 2, ms modulo 32768
+inline constexpr std::uint16_t present_input_voltage = 144;  // 2, unit 0.1 V
+inline constexpr std::uint16_t eeprom_end = 64;              // first RAM address
+}  // namespace xreg_sim
+
+inline constexpr std::uint16_t kXModelNumber = 1030;  // XM430-W210
+inline constexpr std::uint8_t kXFirmwareVersion = 38;
+inline constexpr double kXTicksPerRev = 4096.0;
+inline constexpr double kXVelocityUnitRpm = 0.229;
+inline constexpr std::uint8_t kXTemperatureC = 36;
+inline constexpr std::uint16_t kXInputVoltage = 120;  // 12.0 V
+
+// Baud Rate register value for a baud (9600 -> 0, 57600 -> 1, 115200 -> 2,
+// 1M -> 3, 2M -> 4, 3M -> 5, 4M -> 6, 4.5M -> 7); the nearest one otherwise.
+std::uint8_t baud_rate_register(int baud);
+
+// Initial position offset of a servo, so the runtime's start ramp has work to
+// do: (2 + id % 3) degrees, positive for odd ids and negative for even ones.
+double initial_offset_rad(int device_id);
+
+class DynamixelServo {
+ public:
+  DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings, int baud,
+                 Nanos now);
+
+  int device_id() const { return binding_.device_id; }       // as configured
+  std::uint8_t id() const { return table_[dxl::xreg::id]; }  // answers to this
+  std::uint8_t status_return_level() const { return table_[dxl::xreg::status_return_level]; }
+  int return_delay_us() const { return 2 * table_[dxl::xreg::return_delay_time]; }
+  bool torque_on() const { return table_[dxl::xreg::torque_enable] != 0; }
+
+  // Brings the motor and the present-value registers to `now` (never back).
+  void advance(Nanos now);
+
+  // Instruction handlers. Each returns the error number for the status
+  // packet; a failed write changes nothing. `out` must hold `length` bytes.
+  dxl::StatusError read(std::uint16_t address, std::uint16_t length,
+                        std::span<std::uint8_t> out) const;
+  dxl::StatusError write(std::uint16_t address, std::span<const std::uint8_t> data);
+  dxl::StatusError reg_write(std::uint16_t address, std::span<const std::uint8_t> data);
+  dxl::StatusError action();
+  void reboot(Nanos now);
+
+  // Error byte of a status packet: the number plus the alert bit while the
+  // hardware error status is non-zero.
+  std::uint8_t status_error(dxl::StatusError error) const;
+
+  // Fault injection. A hardware error in Shutdown(63) (default: overheating,
+  // electrical shock, overload) switches torque off; as on the real servo,
+  // only a Reboot allows torque on again, and it shuts down again if the
+  // fault is still there.
+  bool responding() const { return responding_; }
+  void set_responding(bool responding) { responding_ = responding; }
+  void set_hardware_error(std::uint8_t bits, Nanos now);
+
+  // Present position in radians through the binding, at time `now`, without
+  // changing the state.
+  double position_rad(Nanos now) const;
+
+ private:
+  struct Motor {
+    double position = 0;  // ticks
+    double velocity = 0;  // ticks/s
+  };
+  Motor motor_at(Nanos now) const;
+  dxl::StatusError check_write(std::uint16_t address, std::span<const std::uint8_t> data) const;
+  void reset_ram();
+  void latch_shutdown();
+  void publish(Nanos now);  // motor state -> present-value registers
+  std::int32_t reg32(std::uint16_t address) const;
+
+  ActuatorBinding binding_;
+  double tau_s_;
+  double vmax_ticks_s_;
+  std::array<std::uint8_t, dxl::xreg::table_size> table_{};
+  Motor motor_;
+  Nanos motor_time_;
+  bool responding_ = true;
+  bool shut_down_ = false;
+  std::uint8_t injected_error_ = 0;
+  // Reg Write waiting for Action.
+  std::array<std::uint8_t, dxl::xreg::table_size> pending_{};
+  std::uint16_t pending_address_ = 0;
+  std::uint16_t pending_length_ = 0;
+};
+
+}  // namespace animrt::sim

@@ -1,0 +1,102 @@
+#pragma once
+// Simulated Dynamixel X-series servos of one bus behind a pseudo-terminal:
+// any Protocol 2.0 client that opens endpoint() (raw 8N1) talks to them as it
+// would to hardware. A background thread reads the pty master, decodes with
+// the same codec the runtime uses, lets DynamixelFirmware answer, and writes
+// the status packets back.
+//
+// Time: a packet takes effect at the Clock's time when the thread handles
+// it. In lockstep (the Clock is a ManualClock) that is deterministic for a
+// packet the client waits an answer for, since the clock holds still
+// meanwhile; but a packet that never gets an answer (Sync Write, Bulk Write,
+// broadcast Write...) may be handled only after the client has moved the
+// clock on. So in lockstep such a packet takes effect at the time of the
+// packet before it: the cycle it was sent in, when each cycle starts with an
+// answered transaction (read, then write).
+//
+// Wire time (SimBusSettings::wire_time): each answer is held back (real time)
+// until the instruction's bytes, the servo's Return Delay Time and the
+// answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/sim/dynamixel_firmware.hpp"
+#include "animrt/sim/simulated_bus.hpp"
+
+namespace animrt::sim {
+
+struct DynamixelSimStats {
+  std::uint64_t packets = 0;        // instruction packets handled (any id)
+  std::uint64_t answers = 0;        // status packets sent
+  std::uint64_t crc_errors = 0;     // packets dropped for a bad CRC (never answered)
+  std::uint64_t malformed = 0;      // impossible length or bad stuffing
+  std::uint64_t stray_bytes = 0;    // bytes outside any packet
+  std::uint64_t dropped_bytes = 0;  // answer bytes the client never read (pty full)
+};
+
+class DynamixelSimBus final : public SimulatedBus {
+ public:
+  // Opens the pty and builds the servos; throws DeviceError if no pty can be
+  // opened and InputError for bad device ids.
+  DynamixelSimBus(const BusConfig& config, const Clock& clock);
+  ~DynamixelSimBus() override;
+  DynamixelSimBus(const DynamixelSimBus&) = delete;
+  DynamixelSimBus& operator=(const DynamixelSimBus&) = delete;
+
+  const std::string& endpoint() const override { return endpoint_; }
+  std::string describe() const override;
+  void start() override;
+  void stop() override;
+  // These take the id from the BusConfig; they throw std::out_of_range for
+  // an id that is not on this bus.
+  void set_device_responding(int device_id, bool responding) override;
+  void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  double device_position(int device_id) const override;
+
+  DynamixelSimStats stats() const;
+
+ private:
+  void serve();
+  void process(std::span<const std::uint8_t> bytes, Nanos arrival);
+  void handle(const dxl::Packet& packet, Nanos arrival);
+  void send(std::span<const std::uint8_t> bytes);
+  Nanos wire_ns(std::size_t bytes) const;
+  void close_fds();
+
+  BusConfig config_;
+  const Clock& clock_;
+  std::string endpoint_;
+  int master_ = -1;
+  int slave_ = -1;  // held open so the master never sees a hangup between clients
+  std::array<int, 2> wake_{-1, -1};
+
+  mutable std::mutex mutex_;  // guards firmware_
+  DynamixelFirmware firmware_;
+
+  // Serving thread only.
+  bool lockstep_ = false;
+  Nanos last_time_ = 0;  // when the previous packet took effect
+  dxl::Decoder decoder_;
+  Answers answers_;
+  Nanos bus_free_ = 0;  // wire time: when the emulated line is idle again
+
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> packets_{0};
+  std::atomic<std::uint64_t> answers_sent_{0};
+  std::atomic<std::uint64_t> crc_errors_{0};
+  std::atomic<std::uint64_t> malformed_{0};
+  std::atomic<std::uint64_t> stray_bytes_{0};
+  std::atomic<std::uint64_t> dropped_bytes_{0};
+};
+
+}  // namespace animrt::sim

@@ -1,0 +1,211 @@
+#include "animrt/sim/dynamixel_firmware.hpp"
+
+#include <algorithm>
+#include <array>
+#include <string>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::sim {
+namespace {
+
+using dxl::StatusError;
+namespace inst = dxl::inst;
+
+constexpr int kMaxDeviceId = 252;
+constexpr std::uint8_t kReplyPingAndRead = 1;  // Status Return Level
+constexpr std::uint8_t kReplyAll = 2;
+
+std::uint16_t u16_at(std::span<const std::uint8_t> p, std::size_t i) { return dxl::get_u16(&p[i]); }
+
+}  // namespace
+
+bool may_answer(const dxl::Packet& packet) {
+  if (packet.instruction == inst::status) return false;
+  if (packet.id != dxl::kBroadcastId) return true;
+  return packet.instruction == inst::ping || packet.instruction == inst::sync_read ||
+         packet.instruction == inst::bulk_read;
+}
+
+DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now) {
+  servos_.reserve(config.actuators.size());
+  by_id_.reserve(config.actuators.size());
+  for (const ActuatorBinding& binding : config.actuators) {
+    if (binding.device_id < 0 || binding.device_id > kMaxDeviceId) {
+      throw InputError(config.where, "device_id",
+                       "Dynamixel id " + std::to_string(binding.device_id) + " of joint '" +
+                           binding.joint + "' is outside 0..252");
+    }
+    if (find_configured(binding.device_id) != nullptr) {
+      throw InputError(config.where, "device_id",
+                       "Dynamixel id " + std::to_string(binding.device_id) +
+                           " is used twice on bus '" + config.name + "'");
+    }
+    servos_.emplace_back(binding, config.sim, config.baud, now);
+  }
+}
+
+DynamixelServo* DynamixelFirmware::find_configured(int device_id) {
+  for (DynamixelServo& s : servos_) {
+    if (s.device_id() == device_id) return &s;
+  }
+  return nullptr;
+}
+
+const DynamixelServo* DynamixelFirmware::find_configured(int device_id) const {
+  for (const DynamixelServo& s : servos_) {
+    if (s.device_id() == device_id) return &s;
+  }
+  return nullptr;
+}
+
+DynamixelServo* DynamixelFirmware::target(std::uint8_t id) {
+  for (DynamixelServo& s : servos_) {
+    if (s.id() == id && s.responding()) return &s;
+  }
+  return nullptr;
+}
+
+void DynamixelFirmware::answer(const DynamixelServo& servo, StatusError error,
+                               std::span<const std::uint8_t> data, Answers& out) const {
+  const std::size_t offset = out.bytes.size();
+  out.bytes.resize(offset + dxl::kMaxPacket);
+  const std::size_t n = dxl::encode_status(servo.id(), servo.status_error(error), data,
+                                           {out.bytes.data() + offset, dxl::kMaxPacket});
+  out.bytes.resize(offset + n);
+  if (n > 0) out.list.push_back({offset, n, servo.return_delay_us()});
+}
+
+void DynamixelFirmware::answer_read(const DynamixelServo& servo, std::uint16_t address,
+                                    std::uint16_t length, Answers& out) const {
+  if (servo.status_return_level() < kReplyPingAndRead) return;
+  std::array<std::uint8_t, dxl::xreg::table_size> data{};
+  const StatusError error =
+      length <= data.size() ? servo.read(address, length, data) : StatusError::access;
+  const std::size_t n = error == StatusError::none ? length : 0;
+  answer(servo, error, {data.data(), n}, out);
+}
+
+void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& out) {
+  for (DynamixelServo& s : servos_) s.advance(now);
+  const std::span<const std::uint8_t> p = packet.params;
+  const bool broadcast = packet.id == dxl::kBroadcastId;
+
+  // Unicast instructions: the addressed servo acts and answers per its
+  // Status Return Level; broadcast ones act on every servo, silently.
+  auto each_target = [&](auto&& act) {
+    if (broadcast) {
+      for (DynamixelServo& s : servos_) {
+        if (s.responding()) act(s);
+      }
+    } else if (DynamixelServo* s = target(packet.id)) {
+      act(*s);
+    }
+  };
+  // `level` is the Status Return Level when the packet arrived: a write that
+  // changes it is still answered as before.
+  auto reply = [&](const DynamixelServo& s, std::uint8_t level, StatusError error) {
+    if (!broadcast && level >= kReplyAll) answer(s, error, {}, out);
+  };
+
+  switch (packet.instruction) {
+    case inst::ping: {
+      // Answered whatever the Status Return Level.
+      by_id_.clear();
+      each_target([&](DynamixelServo& s) { by_id_.push_back(&s); });
+      std::sort(by_id_.begin(), by_id_.end(),
+                [](const DynamixelServo* a, const DynamixelServo* b) { return a->id() < b->id(); });
+      for (const DynamixelServo* s : by_id_) {
+        std::array<std::uint8_t, 3> info{};
+        s->read(dxl::xreg::model_number, 2, info);
+        s->read(dxl::xreg::firmware_version, 1, std::span(info).subspan(2));
+        answer(*s, StatusError::none, info, out);
+      }
+      break;
+    }
+    case inst::read:
+      if (broadcast) break;  // the manual: no status for a broadcast Read
+      if (DynamixelServo* s = target(packet.id)) {
+        if (p.size() != 4) {
+          if (s->status_return_level() >= kReplyPingAndRead) {
+            answer(*s, StatusError::data_length, {}, out);
+          }
+        } else {
+          answer_read(*s, u16_at(p, 0), u16_at(p, 2), out);
+        }
+      }
+      break;
+    case inst::write:
+    case inst::reg_write:
+      each_target([&](DynamixelServo& s) {
+        const std::uint8_t level = s.status_return_level();
+        StatusError error = StatusError::data_length;
+        if (p.size() >= 3) {
+          error = packet.instruction == inst::write ? s.write(u16_at(p, 0), p.subspan(2))
+                                                    : s.reg_write(u16_at(p, 0), p.subspan(2));
+        }
+        reply(s, level, error);
+      });
+      break;
+    case inst::action:
+      each_target([&](DynamixelServo& s) {
+        const std::uint8_t level = s.status_return_level();
+        reply(s, level, s.action());
+      });
+      break;
+    case inst::reboot:
+      // The status packet goes out before the servo restarts.
+      each_target([&](DynamixelServo& s) {
+        reply(s, s.status_return_level(), StatusError::none);
+        s.reboot(now);
+      });
+      break;
+    case inst::sync_read:
+      if (!broadcast || p.size() < 5) break;
+      for (std::uint8_t id : p.subspan(4)) {
+        if (DynamixelServo* s = target(id)) answer_read(*s, u16_at(p, 0), u16_at(p, 2), out);
+      }
+      break;
+    case inst::sync_write: {
+      if (!broadcast || p.size() < 4) break;
+      const std::size_t length = u16_at(p, 2);
+      const std::span<const std::uint8_t> blocks = p.subspan(4);
+      if (length == 0 || blocks.size() % (length + 1) != 0) break;  // malformed: ignored
+      for (std::size_t i = 0; i < blocks.size(); i += length + 1) {
+        if (DynamixelServo* s = target(blocks[i])) {
+          s->write(u16_at(p, 0), blocks.subspan(i + 1, length));
+        }
+      }
+      break;
+    }
+    case inst::bulk_read:
+      if (!broadcast || p.empty() || p.size() % 5 != 0) break;
+      for (std::size_t i = 0; i < p.size(); i += 5) {
+        if (DynamixelServo* s = target(p[i]))
+          answer_read(*s, u16_at(p, i + 1), u16_at(p, i + 3), out);
+      }
+      break;
+    case inst::bulk_write: {
+      if (!broadcast) break;
+      // Check the whole layout first: a truncated packet changes nothing.
+      std::size_t i = 0;
+      while (i + 5 <= p.size()) i += 5 + u16_at(p, i + 3);
+      if (i != p.size() || p.empty()) break;
+      for (i = 0; i < p.size(); i += 5 + u16_at(p, i + 3)) {
+        if (DynamixelServo* s = target(p[i])) {
+          s->write(u16_at(p, i + 1), p.subspan(i + 5, u16_at(p, i + 3)));
+        }
+      }
+      break;
+    }
+    case inst::status:
+      break;  // another device's answer: not for us
+    default:
+      // Factory Reset, Clear and anything unknown.
+      each_target(
+          [&](DynamixelServo& s) { reply(s, s.status_return_level(), StatusError::instruction); });
+      break;
+  }
+}
+
+}  // namespace animrt::sim

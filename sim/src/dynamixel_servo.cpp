@@ -1,0 +1,306 @@
+#include "animrt/sim/dynamixel_servo.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <numbers>
+
+namespace animrt::sim {
+namespace {
+
+using dxl::StatusError;
+namespace xreg = dxl::xreg;
+
+struct Item {
+  std::uint16_t address;
+  std::uint8_t size;
+  bool writable;
+  std::int64_t min = 0;
+  std::int64_t max = 0;
+};
+
+// X-series control table (XM430-W210 e-manual), the part the simulator keeps.
+// Goal Position's range is the position limits (checked separately).
+constexpr Item kItems[] = {
+    {xreg::model_number, 2, false},
+    {xreg_sim::model_information, 4, false},
+    {xreg::firmware_version, 1, false},
+    {xreg::id, 1, true, 0, 252},
+    {xreg::baud_rate, 1, true, 0, 7},
+    {xreg::return_delay_time, 1, true, 0, 254},
+    {xreg_sim::drive_mode, 1, true, 0, 5},
+    {xreg::operating_mode, 1, true, 3, 3},  // only position control is modelled
+    {xreg_sim::moving_threshold, 4, true, 0, 1023},
+    {xreg_sim::temperature_limit, 1, true, 0, 100},
+    {xreg::velocity_limit, 4, true, 0, 1023},
+    {xreg::max_position_limit, 4, true, 0, 4095},
+    {xreg::min_position_limit, 4, true, 0, 4095},
+    {xreg_sim::shutdown, 1, true, 0, 255},
+    {xreg::torque_enable, 1, true, 0, 1},
+    {xreg::led, 1, true, 0, 1},
+    {xreg::status_return_level, 1, true, 0, 2},
+    {xreg_sim::registered_instruction, 1, false},
+    {xreg::hardware_error_status, 1, false},
+    {xreg_sim::profile_acceleration, 4, true, 0, 32767},
+    {xreg_sim::profile_velocity, 4, true, 0, 32767},
+    {xreg::goal_position, 4, true, INT32_MIN, INT32_MAX},
+    {xreg_sim::realtime_tick, 2, false},
+    {xreg::moving, 1, false},
+    {xreg::present_velocity, 4, false},
+    {xreg::present_position, 4, false},
+    {xreg_sim::present_input_voltage, 2, false},
+    {xreg::present_temperature, 1, false},
+};
+
+const Item* item_containing(std::size_t address) {
+  for (const Item& item : kItems) {
+    if (address >= item.address && address < item.address + item.size) return &item;
+  }
+  return nullptr;
+}
+
+std::uint32_t get_le(const std::uint8_t* p, std::size_t size) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < size; ++i) v |= static_cast<std::uint32_t>(p[i]) << (8 * i);
+  return v;
+}
+
+constexpr int kBauds[] = {9600,      57600,     115200,    1'000'000,
+                          2'000'000, 3'000'000, 4'000'000, 4'500'000};
+constexpr std::uint8_t kDefaultMovingThreshold = 10;
+constexpr std::uint8_t kDefaultTemperatureLimit = 80;
+constexpr std::uint8_t kDefaultShutdown = 0x34;  // overload, electrical shock, overheating
+
+double ticks_per_s_to_units(double ticks_per_s) {
+  return ticks_per_s / kXTicksPerRev * 60.0 / kXVelocityUnitRpm;
+}
+
+}  // namespace
+
+std::uint8_t baud_rate_register(int baud) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
+    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
+        std::abs(static_cast<long>(kBauds[best]) - baud)) {
+      best = i;
+    }
+  }
+  return static_cast<std::uint8_t>(best);
+}
+
+double initial_offset_rad(int device_id) {
+  const double degrees = (device_id % 2 == 1 ? 1.0 : -1.0) * (2 + device_id % 3);
+  return degrees * std::numbers::pi / 180.0;
+}
+
+DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings,
+                               int baud, Nanos now)
+    : binding_(binding),
+      tau_s_(std::max(0.0, settings.time_constant_s)),
+      vmax_ticks_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
+      motor_time_(now) {
+  // EEPROM at its defaults, shaped by the bus config.
+  dxl::put_u16(&table_[xreg::model_number], kXModelNumber);
+  table_[xreg::firmware_version] = kXFirmwareVersion;
+  table_[xreg::id] = static_cast<std::uint8_t>(binding.device_id);
+  table_[xreg::baud_rate] = baud_rate_register(baud);
+  table_[xreg::return_delay_time] =
+      static_cast<std::uint8_t>(std::clamp(settings.return_delay_us / 2, 0, 254));
+  table_[xreg::operating_mode] = 3;
+  dxl::put_u32(&table_[xreg_sim::moving_threshold], kDefaultMovingThreshold);
+  table_[xreg_sim::temperature_limit] = kDefaultTemperatureLimit;
+  const double limit_units = std::ceil(ticks_per_s_to_units(vmax_ticks_s_));
+  dxl::put_u32(&table_[xreg::velocity_limit],
+               static_cast<std::uint32_t>(std::clamp(limit_units, 0.0, 1023.0)));
+  dxl::put_u32(&table_[xreg::max_position_limit], 4095);
+  dxl::put_u32(&table_[xreg::min_position_limit], 0);
+  table_[xreg_sim::shutdown] = kDefaultShutdown;
+
+  const std::int32_t start =
+      std::clamp(binding.to_ticks(initial_offset_rad(binding.device_id)),
+                 reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
+  motor_.position = start;
+  reset_ram();
+  publish(now);
+}
+
+std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
+  return static_cast<std::int32_t>(dxl::get_u32(&table_[address]));
+}
+
+void DynamixelServo::reset_ram() {
+  std::fill(table_.begin() + xreg_sim::eeprom_end, table_.end(), std::uint8_t{0});
+  table_[xreg::status_return_level] = 2;
+  // Hold still when torque comes on: the goal starts at the present position.
+  dxl::put_u32(&table_[xreg::goal_position],
+               static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+  motor_.velocity = 0;
+  pending_length_ = 0;
+}
+
+void DynamixelServo::latch_shutdown() {
+  shut_down_ = true;
+  table_[xreg::torque_enable] = 0;
+}
+
+DynamixelServo::Motor DynamixelServo::motor_at(Nanos now) const {
+  Motor m = motor_;
+  if (!torque_on() || vmax_ticks_s_ <= 0) {
+    m.velocity = 0;
+    return m;
+  }
+  if (now <= motor_time_) return m;
+  double dt = to_seconds(now - motor_time_);
+  // Limits may have changed while torque was off; the servo never leaves them.
+  const double goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
+                                 reg32(xreg::max_position_limit));
+  const double vmax = vmax_ticks_s_;
+  const double error = goal - m.position;
+  const double dir = error >= 0 ? 1.0 : -1.0;
+  if (tau_s_ <= 0) {  // pure rate limiter
+    const double travel = std::min(std::abs(error), vmax * dt);
+    m.position += dir * travel;
+    m.velocity = m.position == goal ? 0.0 : dir * vmax;
+    return m;
+  }
+  // Closed form of speed = clamp(error / tau, +-vmax): a ramp at vmax until
+  // the error is vmax * tau, then an exponential decay.
+  const double band = vmax * tau_s_;
+  if (std::abs(error) > band) {
+    const double ramp_s = (std::abs(error) - band) / vmax;
+    if (dt <= ramp_s) {
+      m.position += dir * vmax * dt;
+      m.velocity = dir * vmax;
+      return m;
+    }
+    m.position = goal - dir * band;
+    dt -= ramp_s;
+  }
+  const double remaining = (goal - m.position) * std::exp(-dt / tau_s_);
+  m.position = goal - remaining;
+  m.velocity = remaining / tau_s_;
+  return m;
+}
+
+void DynamixelServo::advance(Nanos now) {
+  if (now < motor_time_) return;
+  motor_ = motor_at(now);
+  motor_time_ = now;
+  publish(now);
+}
+
+void DynamixelServo::publish(Nanos now) {
+  const auto position = static_cast<std::int32_t>(std::lround(motor_.position));
+  const auto velocity =
+      static_cast<std::int32_t>(std::lround(ticks_per_s_to_units(motor_.velocity)));
+  dxl::put_u32(&table_[xreg::present_position], static_cast<std::uint32_t>(position));
+  dxl::put_u32(&table_[xreg::present_velocity], static_cast<std::uint32_t>(velocity));
+  table_[xreg::moving] = std::abs(velocity) > reg32(xreg_sim::moving_threshold) ? 1 : 0;
+  const Nanos ms = now / 1'000'000;
+  dxl::put_u16(&table_[xreg_sim::realtime_tick], static_cast<std::uint16_t>(ms % 32768));
+  dxl::put_u16(&table_[xreg_sim::present_input_voltage], kXInputVoltage);
+  table_[xreg::present_temperature] = kXTemperatureC;
+  table_[xreg::hardware_error_status] = injected_error_;
+  table_[xreg_sim::registered_instruction] = pending_length_ > 0 ? 1 : 0;
+}
+
+StatusError DynamixelServo::read(std::uint16_t address, std::uint16_t length,
+                                 std::span<std::uint8_t> out) const {
+  if (length == 0 || out.size() < length) return StatusError::data_length;
+  if (static_cast<std::size_t>(address) + length > table_.size()) return StatusError::access;
+  std::memcpy(out.data(), &table_[address], length);
+  return StatusError::none;
+}
+
+StatusError DynamixelServo::check_write(std::uint16_t address,
+                                        std::span<const std::uint8_t> data) const {
+  if (data.empty()) return StatusError::data_length;
+  const std::size_t end = address + data.size();
+  if (end > table_.size()) return StatusError::access;
+  // Whole writable items only: a gap or read-only item is an Access Error, a
+  // part of an item a Data Length Error (as the Protocol 2.0 page defines).
+  for (std::size_t a = address; a < end;) {
+    const Item* item = item_containing(a);
+    if (item == nullptr) return StatusError::access;
+    if (item->address != a || a + item->size > end) return StatusError::data_length;
+    if (!item->writable) return StatusError::access;
+    a += item->size;
+  }
+  if (address < xreg_sim::eeprom_end && torque_on()) return StatusError::access;  // ROM lock
+
+  std::array<std::uint8_t, dxl::xreg::table_size> after = table_;
+  std::memcpy(&after[address], data.data(), data.size());
+  for (std::size_t a = address; a < end;) {
+    const Item* item = item_containing(a);
+    const std::uint32_t raw = get_le(&after[a], item->size);
+    if (item->address == xreg::goal_position) {
+      const auto goal = static_cast<std::int32_t>(raw);
+      if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
+          goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
+        return StatusError::data_limit;
+      }
+    } else if (raw < item->min || raw > item->max) {
+      return StatusError::data_range;
+    }
+    a += item->size;
+  }
+  // After a shutdown only a Reboot allows torque on again.
+  if (shut_down_ && after[xreg::torque_enable] != 0) return StatusError::result_fail;
+  return StatusError::none;
+}
+
+StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::uint8_t> data) {
+  const StatusError error = check_write(address, data);
+  if (error != StatusError::none) return error;
+  std::memcpy(&table_[address], data.data(), data.size());
+  if (!torque_on()) motor_.velocity = 0;
+  publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
+  return StatusError::none;
+}
+
+StatusError DynamixelServo::reg_write(std::uint16_t address, std::span<const std::uint8_t> data) {
+  const StatusError error = check_write(address, data);
+  if (error != StatusError::none) return error;
+  std::memcpy(pending_.data(), data.data(), data.size());
+  pending_address_ = address;
+  pending_length_ = static_cast<std::uint16_t>(data.size());
+  table_[xreg_sim::registered_instruction] = 1;
+  return StatusError::none;
+}
+
+StatusError DynamixelServo::action() {
+  if (pending_length_ == 0) return StatusError::instruction;  // Action without Reg Write
+  const std::uint16_t length = pending_length_;
+  pending_length_ = 0;
+  table_[xreg_sim::registered_instruction] = 0;
+  return write(pending_address_, {pending_.data(), length});
+}
+
+void DynamixelServo::reboot(Nanos now) {
+  advance(now);
+  shut_down_ = false;
+  reset_ram();
+  if (injected_error_ & table_[xreg_sim::shutdown]) latch_shutdown();
+  publish(motor_time_);
+}
+
+std::uint8_t DynamixelServo::status_error(StatusError error) const {
+  const auto number = static_cast<std::uint8_t>(error);
+  return table_[xreg::hardware_error_status] != 0 ? (dxl::kAlertBit | number) : number;
+}
+
+void DynamixelServo::set_hardware_error(std::uint8_t bits, Nanos now) {
+  advance(now);
+  injected_error_ = bits;
+  if (bits & table_[xreg_sim::shutdown]) latch_shutdown();
+  if (!torque_on()) motor_.velocity = 0;
+  publish(motor_time_);
+}
+
+double DynamixelServo::position_rad(Nanos now) const {
+  const Motor m = motor_at(std::max(now, motor_time_));
+  return binding_.direction * (m.position - binding_.zero_ticks) / binding_.ticks_per_rad;
+}
+
+}  // namespace animrt::sim

@@ -1,0 +1,252 @@
+#include "animrt/sim/dynamixel_sim_bus.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::sim {
+namespace {
+
+constexpr int kWriteStallMs = 200;  // a client that stops reading loses answers after this
+constexpr int kBitsPerByte = 10;    // start + 8 data + stop
+
+[[noreturn]] void fail(const BusConfig& config, const char* what, int error) {
+  throw DeviceError("simulated bus '" + config.name + "': " + what + ": " + std::strerror(error));
+}
+
+// Bytes the packet took on the wire, stuffing included.
+std::size_t wire_size(const dxl::Packet& packet) {
+  std::size_t stuffed = 0;
+  int ff_run = packet.instruction == 0xFF ? 1 : 0;
+  for (std::uint8_t b : packet.params) {
+    if (b == 0xFD && ff_run >= 2) {
+      ++stuffed;
+      ff_run = 0;
+    } else {
+      ff_run = b == 0xFF ? ff_run + 1 : 0;
+    }
+  }
+  return 10 + packet.params.size() + stuffed;  // header, id, len, inst, params, crc
+}
+
+void sleep_until_monotonic(Nanos t) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// By the id of the BusConfig; the ids a test or the CLI knows.
+template <typename Firmware>
+auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id) {
+  auto* servo = firmware.find_configured(device_id);
+  if (servo == nullptr) {
+    throw std::out_of_range("no device " + std::to_string(device_id) + " on simulated bus '" +
+                            config.name + "'");
+  }
+  return *servo;
+}
+
+}  // namespace
+
+DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock)
+    : config_(config),
+      clock_(clock),
+      firmware_(config, clock.now()),
+      lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
+      last_time_(clock.now()) {
+  try {
+    master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
+    if (master_ < 0) fail(config_, "posix_openpt", errno);
+    if (::grantpt(master_) != 0) fail(config_, "grantpt", errno);
+    if (::unlockpt(master_) != 0) fail(config_, "unlockpt", errno);
+    char name[128];
+    if (const int error = ::ptsname_r(master_, name, sizeof(name)); error != 0) {
+      fail(config_, "ptsname", error);
+    }
+    endpoint_ = name;
+    slave_ = ::open(endpoint_.c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC);
+    if (slave_ < 0) fail(config_, "open pty slave", errno);
+    // Raw 8N1 on the line, so no byte is translated or echoed whichever side
+    // configures it first.
+    termios tio{};
+    if (::tcgetattr(slave_, &tio) != 0) fail(config_, "tcgetattr", errno);
+    ::cfmakeraw(&tio);
+    tio.c_cflag |= CLOCAL | CREAD;
+    if (::tcsetattr(slave_, TCSANOW, &tio) != 0) fail(config_, "tcsetattr", errno);
+    if (::fcntl(master_, F_SETFL, O_NONBLOCK) != 0) fail(config_, "fcntl", errno);
+    if (::pipe2(wake_.data(), O_CLOEXEC | O_NONBLOCK) != 0) fail(config_, "pipe", errno);
+  } catch (...) {
+    close_fds();
+    throw;
+  }
+  const std::size_t most = (firmware_.size() + 1) * dxl::kMaxPacket;
+  answers_.bytes.reserve(most);
+  answers_.list.reserve(firmware_.size() + 1);
+}
+
+DynamixelSimBus::~DynamixelSimBus() {
+  stop();
+  close_fds();
+}
+
+void DynamixelSimBus::close_fds() {
+  for (int* fd : {&master_, &slave_, &wake_[0], &wake_[1]}) {
+    if (*fd >= 0) ::close(*fd);
+    *fd = -1;
+  }
+}
+
+std::string DynamixelSimBus::describe() const { return "serial " + config_.name + " " + endpoint_; }
+
+void DynamixelSimBus::start() {
+  if (thread_.joinable()) return;
+  std::uint8_t drain[16];
+  while (::read(wake_[0], drain, sizeof(drain)) > 0) {
+  }
+  stop_ = false;
+  thread_ = std::thread([this] { serve(); });
+}
+
+void DynamixelSimBus::stop() {
+  if (!thread_.joinable()) return;
+  stop_ = true;
+  const std::uint8_t wake = 1;
+  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &wake, 1);
+  thread_.join();
+}
+
+void DynamixelSimBus::serve() {
+  std::array<std::uint8_t, 4096> buffer{};
+  while (!stop_.load()) {
+    pollfd fds[2] = {{master_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
+    if (::poll(fds, 2, -1) < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    if (fds[1].revents != 0) break;
+    if (fds[0].revents & POLLIN) {
+      const ssize_t n = ::read(master_, buffer.data(), buffer.size());
+      if (n > 0) {
+        process({buffer.data(), static_cast<std::size_t>(n)}, MonotonicClock().now());
+        continue;
+      }
+      if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+    }
+    // Hangup or error: not expected while we hold the slave open; do not spin.
+    ::poll(&fds[1], 1, 10);
+  }
+}
+
+void DynamixelSimBus::process(std::span<const std::uint8_t> bytes, Nanos arrival) {
+  std::size_t fed = 0;
+  while (fed < bytes.size()) {
+    fed += decoder_.feed(bytes.subspan(fed));
+    dxl::Packet packet;
+    for (;;) {
+      const dxl::DecodeResult result = decoder_.next(packet);
+      if (result == dxl::DecodeResult::need_more) break;
+      if (result == dxl::DecodeResult::bad_crc) {
+        ++crc_errors_;  // a servo ignores a packet it cannot trust
+      } else if (result == dxl::DecodeResult::malformed) {
+        ++malformed_;
+      } else {
+        handle(packet, arrival);
+      }
+    }
+  }
+  stray_bytes_ = decoder_.stray_bytes();
+}
+
+void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
+  const std::size_t instruction_bytes = wire_size(packet);
+  Nanos now = clock_.now();
+  if (lockstep_ && !may_answer(packet)) now = last_time_;
+  last_time_ = now;
+  answers_.clear();
+  {
+    std::lock_guard lock(mutex_);
+    firmware_.handle(packet, now, answers_);
+  }
+  if (packet.instruction != dxl::inst::status) ++packets_;
+
+  if (!config_.sim.wire_time) {
+    for (const Answers::Answer& a : answers_.list) send(answers_.packet(a));
+  } else {
+    // One line: the instruction, then each servo's delay and answer in turn.
+    Nanos t = std::max(arrival, bus_free_) + wire_ns(instruction_bytes);
+    for (const Answers::Answer& a : answers_.list) {
+      t += static_cast<Nanos>(a.return_delay_us) * 1000 + wire_ns(a.size);
+      sleep_until_monotonic(t);
+      send(answers_.packet(a));
+    }
+    bus_free_ = t;
+  }
+  answers_sent_ += answers_.list.size();
+}
+
+Nanos DynamixelSimBus::wire_ns(std::size_t bytes) const {
+  const int baud = std::max(config_.baud, 1);
+  return static_cast<Nanos>(bytes) * kBitsPerByte * 1'000'000'000 / baud;
+}
+
+void DynamixelSimBus::send(std::span<const std::uint8_t> bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(master_, bytes.data() + done, bytes.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EAGAIN) {
+      // The client is not reading: wait a little, as a line would not.
+      pollfd fds[2] = {{master_, POLLOUT, 0}, {wake_[0], POLLIN, 0}};
+      if (::poll(fds, 2, kWriteStallMs) > 0 && fds[1].revents == 0 && (fds[0].revents & POLLOUT)) {
+        continue;
+      }
+    }
+    break;
+  }
+  dropped_bytes_ += bytes.size() - done;
+}
+
+void DynamixelSimBus::set_device_responding(int device_id, bool responding) {
+  std::lock_guard lock(mutex_);
+  servo_or_throw(firmware_, config_, device_id).set_responding(responding);
+}
+
+void DynamixelSimBus::set_device_hardware_error(int device_id, std::uint8_t error_bits) {
+  std::lock_guard lock(mutex_);
+  servo_or_throw(firmware_, config_, device_id).set_hardware_error(error_bits, clock_.now());
+}
+
+double DynamixelSimBus::device_position(int device_id) const {
+  std::lock_guard lock(mutex_);
+  return servo_or_throw(firmware_, config_, device_id).position_rad(clock_.now());
+}
+
+DynamixelSimStats DynamixelSimBus::stats() const {
+  DynamixelSimStats s;
+  s.packets = packets_;
+  s.answers = answers_sent_;
+  s.crc_errors = crc_errors_;
+  s.malformed = malformed_;
+  s.stray_bytes = stray_bytes_;
+  s.dropped_bytes = dropped_bytes_;
+  return s;
+}
+
+}  // namespace animrt::sim

@@ -1,1 +1,0 @@
-#include "animrt/sim/simulated_bus.hpp"
