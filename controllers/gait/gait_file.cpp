@@ -28,7 +28,7 @@ std::string join_names(const std::vector<std::string>& names) {
   return out.empty() ? std::string("none") : out;
 }
 
-std::string format_number(double v) {
+std::string shortest_exact(double v) {
   char buf[32];
   auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
   (void)ec;  // 32 bytes always hold a double
@@ -41,8 +41,8 @@ void check_finite(const Expression& curve, const std::function<void(const std::s
     const double t = static_cast<double>(i) / kFiniteSamples;  // exact binary fractions
     const double v = curve.eval(t);
     if (!std::isfinite(v)) {
-      fail("curve is not finite at t = " + format_number(t) + " stride cycles (value " +
-           (std::isnan(v) ? std::string("nan") : format_number(v)) +
+      fail("curve is not finite at t = " + shortest_exact(t) + " stride cycles (value " +
+           (std::isnan(v) ? std::string("nan") : shortest_exact(v)) +
            "); it must be finite over the whole stride");
     }
   }
@@ -358,7 +358,7 @@ void validate_gait(const GaitFile& gait) {
   if (gait.stride_frequency_hz && !positive(*gait.stride_frequency_hz)) {
     throw InputError(
         top, "stride_frequency_hz",
-        "expected a positive number, found " + format_number(*gait.stride_frequency_hz));
+        "expected a positive number, found " + shortest_exact(*gait.stride_frequency_hz));
   }
   if (gait.froude && !(positive(gait.froude->number) && positive(gait.froude->hip_height_m))) {
     throw InputError(top, "froude", "number and hip_height_m must be positive");
@@ -387,7 +387,7 @@ void validate_gait(const GaitFile& gait) {
     }
     if (!(l.phase >= 0.0 && l.phase <= 1.0)) {
       throw InputError(l.where, key,
-                       "expected a phase from 0 to 1, found " + format_number(l.phase));
+                       "expected a phase from 0 to 1, found " + shortest_exact(l.phase));
     }
   }
   if (gait.joints.empty()) throw InputError(top, "joints", "a gait needs at least one joint");
@@ -421,11 +421,11 @@ std::string format_gait_file(const GaitFile& gait) {
   out += "# Gait file written by animrt (format: configs/gaits/walk.yaml).\n";
   out += "name: " + double_quoted(gait.name) + "\n";
   if (gait.stride_frequency_hz) {
-    out += "stride_frequency_hz: " + format_number(*gait.stride_frequency_hz) + "\n";
+    out += "stride_frequency_hz: " + shortest_exact(*gait.stride_frequency_hz) + "\n";
   }
   if (gait.froude) {
-    out += "froude: {number: " + format_number(gait.froude->number) +
-           ", hip_height_m: " + format_number(gait.froude->hip_height_m) + "}\n";
+    out += "froude: {number: " + shortest_exact(gait.froude->number) +
+           ", hip_height_m: " + shortest_exact(gait.froude->hip_height_m) + "}\n";
   }
   out += gait.curves.empty() ? "curves: {}\n" : "curves:\n";
   for (const auto& c : gait.curves) {
@@ -433,13 +433,13 @@ std::string format_gait_file(const GaitFile& gait) {
   }
   out += gait.limbs.empty() ? "limbs: {}\n" : "limbs:\n";
   for (const auto& l : gait.limbs) {
-    out += "  " + name_text(l.name) + ": " + format_number(l.phase) + "\n";
+    out += "  " + name_text(l.name) + ": " + shortest_exact(l.phase) + "\n";
   }
   out += gait.joints.empty() ? "joints: {}\n" : "joints:\n";
   for (const auto& j : gait.joints) {
     out += "  " + name_text(j.name) + ": {curve: " + name_text(j.curve) +
            ", limb: " + name_text(j.limb) + ", sign: " + std::to_string(j.sign) +
-           ", scale: " + format_number(j.scale) + ", offset_deg: " + format_number(j.offset_deg) +
+           ", scale: " + shortest_exact(j.scale) + ", offset_deg: " + shortest_exact(j.offset_deg) +
            "}\n";
   }
   return out;

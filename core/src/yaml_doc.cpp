@@ -93,6 +93,10 @@ YamlNode YamlNode::at(std::string_view key) const {
 }
 
 void YamlNode::allow_only(std::initializer_list<std::string_view> keys) const {
+  allow_only(std::span<const std::string_view>(keys.begin(), keys.size()));
+}
+
+void YamlNode::allow_only(std::span<const std::string_view> keys) const {
   if (!node_.IsMap()) fail("expected a map, found " + describe());
   std::set<std::string> seen;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
@@ -217,6 +221,12 @@ std::string YamlNode::get_string(std::string_view key, const std::string& fallba
 bool YamlNode::get_bool(std::string_view key, bool fallback) const {
   auto found = find(key);
   return found ? found->as_bool() : fallback;
+}
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
 }
 
 }  // namespace animrt

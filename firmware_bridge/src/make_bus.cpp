@@ -1,39 +1,40 @@
-// The factory that picks a bus implementation by protocol name.
+// The protocol registry and the bus factory.
 
 #include <memory>
 #include <string>
 
 #include "animrt/bridge/actuator_bus.hpp"
-#include "animrt/bridge/byte_transport.hpp"
-#include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
+#include "animrt/bridge/dynamixel/dynamixel_protocol.hpp"
+#include "animrt/bridge/protocol.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
 namespace {
 
-std::string where(const BusConfig& config) {
-  const Location& at = config.where;
-  if (at.file.empty()) return "";
-  std::string out = at.file;
-  if (at.line > 0) out += ":" + std::to_string(at.line);
-  if (at.line > 0 && at.column > 0) out += ":" + std::to_string(at.column);
-  return out + ": ";
-}
+// Every protocol the runtime can drive. Add a module here to add a device.
+const Protocol* const kProtocols[] = {
+    &dynamixel2_protocol(),
+};
 
 }  // namespace
 
-std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) {
-  if (config.protocol == "dynamixel2") {
-    std::unique_ptr<ByteTransport> transport;
-    try {
-      transport = open_serial(config.port, config.baud);
-    } catch (const DeviceError& e) {
-      throw DeviceError("bus " + config.name + ": " + e.what());
-    }
-    return std::make_unique<DynamixelBus>(config, std::move(transport));
+const Protocol* find_protocol(std::string_view name) {
+  for (const Protocol* p : kProtocols) {
+    if (p->name() == name) return p;
   }
-  throw DeviceError(where(config) + "bus " + config.name + ": unknown protocol '" +
-                    config.protocol + "' (known: dynamixel2)");
+  return nullptr;
+}
+
+std::string supported_protocols() {
+  std::string out;
+  for (const Protocol* p : kProtocols) out += (out.empty() ? "" : ", ") + std::string(p->name());
+  return out;
+}
+
+std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) {
+  if (const Protocol* protocol = find_protocol(config.protocol)) return protocol->make_bus(config);
+  throw DeviceError("bus " + config.name + ": unknown protocol '" + config.protocol +
+                    "' (supported: " + supported_protocols() + ")");
 }
 
 }  // namespace animrt

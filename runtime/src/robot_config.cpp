@@ -12,54 +12,14 @@
 #include <utility>
 #include <vector>
 
+#include "animrt/bridge/protocol.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
 namespace {
 
-// What each protocol's devices accept. Adding a protocol means adding a row
-// here and a bus implementation in firmware_bridge.
-struct ProtocolSpec {
-  std::string_view name;
-  int max_device_id;       // ids 0..max_device_id
-  std::int64_t min_ticks;  // position range in device units
-  std::int64_t max_ticks;
-};
-
-// Dynamixel Protocol 2.0: ids 253..255 are reserved (254 is broadcast); an
-// X-series servo in position control mode accepts goal positions 0..4095.
-constexpr ProtocolSpec kProtocols[] = {
-    {"dynamixel2", 252, 0, 4095},
-};
-
-const ProtocolSpec* find_protocol(std::string_view name) {
-  for (const auto& p : kProtocols) {
-    if (p.name == name) return &p;
-  }
-  return nullptr;
-}
-
-std::string supported_protocols() {
-  std::string out;
-  for (const auto& p : kProtocols) out += (out.empty() ? "" : ", ") + std::string(p.name);
-  return out;
-}
-
-// Numbers in messages: shortest readable form, as the YAML reader prints them.
-std::string num(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-// What a node holds, quoted like YamlNode's own messages.
-std::string found(const YamlNode& node) {
-  const YAML::Node& raw = node.raw();
-  if (!raw || raw.IsNull()) return "nothing";
-  if (raw.IsMap()) return "a map";
-  if (raw.IsSequence()) return "a list";
-  return "\"" + raw.Scalar() + "\"";
-}
+std::string num(double value) { return format_number(value); }
+std::string found(const YamlNode& node) { return node.describe(); }
 
 // Position of `key` itself inside `map` (the line a user reads as "declared
 // here"), falling back to the map's position.
@@ -103,32 +63,23 @@ SimBusSettings parse_sim(const YamlNode& node) {
 }
 
 BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses) {
-  node.allow_only({"protocol", "port", "baud", "timeout_ms", "sim"});
   BusConfig bus;
   bus.name = name;
   bus.where = key_location(buses, name);
 
-  const YamlNode protocol = node.at("protocol");
-  bus.protocol = protocol.as_string();
-  if (!find_protocol(bus.protocol)) {
-    protocol.fail("unknown protocol " + found(protocol) + " (supported: " + supported_protocols() +
-                  ")");
+  const YamlNode protocol_node = node.at("protocol");
+  bus.protocol = protocol_node.as_string();
+  const Protocol* protocol = find_protocol(bus.protocol);
+  if (!protocol) {
+    protocol_node.fail("unknown protocol " + found(protocol_node) +
+                       " (supported: " + supported_protocols() + ")");
   }
+  std::vector<std::string_view> keys{"protocol"};
+  for (auto key : protocol->bus_keys()) keys.push_back(key);
+  keys.push_back("sim");
+  node.allow_only(keys);
 
-  const YamlNode port = node.at("port");
-  bus.port = port.as_string();
-  if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");
-
-  if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(1, 10'500'000));
-
-  if (auto n = node.find("timeout_ms")) {
-    const double ms = n->as_double();
-    if (!(ms > 0.0 && ms < 1000.0)) {
-      n->fail("expected a number greater than 0 and less than 1000, found " + found(*n));
-    }
-    bus.timeout_s = ms / 1000.0;
-  }
-
+  protocol->read_bus(node, bus);
   if (auto n = node.find("sim")) bus.sim = parse_sim(*n);
   return bus;
 }
@@ -187,95 +138,29 @@ double parse_home(const YamlNode& joint, const YamlNode& limits_node) {
   return deg_to_rad(home_deg);
 }
 
-int parse_direction(const YamlNode& node) {
-  if (node.is_scalar()) {
-    const std::string& s = node.raw().Scalar();
-    if (s == "1" || s == "+1") return 1;
-    if (s == "-1") return -1;
-  }
-  node.fail("expected 1 or -1 (-1 for a mirrored servo), found " + found(node));
-}
-
-// A parsed actuator together with what later checks need to point at.
-struct ParsedActuator {
-  ActuatorBinding binding;
-  std::size_t bus_index = 0;
-  std::string scale;  // "4096 ticks/rev", for messages
-};
-
-ParsedActuator parse_actuator(const YamlNode& node, const std::vector<BusConfig>& buses) {
-  node.allow_only({"bus", "id", "ticks_per_rev", "ticks_per_rad", "zero_ticks", "direction"});
-  ParsedActuator out;
-
+// Reads `actuator.bus` and hands the rest to the bus's protocol.
+std::size_t parse_actuator(const YamlNode& node, const JointSpec& joint,
+                           const YamlNode& limits_node, const std::vector<BusConfig>& buses,
+                           ActuatorBinding& binding) {
+  if (!node.is_map()) node.fail("expected a map, found " + found(node));
   const YamlNode bus_node = node.at("bus");
   const std::string bus_name = bus_node.as_string();
-  bool known = false;
+  std::size_t bus_index = buses.size();
   std::string defined;
   for (std::size_t i = 0; i < buses.size(); ++i) {
     defined += (defined.empty() ? "" : ", ") + buses[i].name;
-    if (buses[i].name == bus_name) {
-      out.bus_index = i;
-      known = true;
-    }
+    if (buses[i].name == bus_name) bus_index = i;
   }
-  if (!known) {
+  if (bus_index == buses.size()) {
     bus_node.fail("no bus named " + found(bus_node) + " (defined buses: " + defined + ")");
   }
-  const BusConfig& bus = buses[out.bus_index];
-  const ProtocolSpec& protocol = *find_protocol(bus.protocol);
-
-  const YamlNode id_node = node.at("id");
-  const std::int64_t id = id_node.as_int();
-  if (id < 0 || id > protocol.max_device_id) {
-    id_node.fail("expected a device id from 0 to " + std::to_string(protocol.max_device_id) +
-                 " for " + std::string(protocol.name) + ", found " + found(id_node));
-  }
-  out.binding.device_id = static_cast<int>(id);
-  for (const auto& other : bus.actuators) {
-    if (other.device_id == id) {
-      id_node.fail("device id " + std::to_string(id) + " is already used by joint " + other.joint +
-                   " on bus " + bus.name);
-    }
-  }
-
-  const auto per_rev = node.find("ticks_per_rev");
-  const auto per_rad = node.find("ticks_per_rad");
-  if (per_rev && per_rad) per_rad->fail("give either ticks_per_rev or ticks_per_rad, not both");
-  if (per_rad) {
-    out.binding.ticks_per_rad = per_rad->as_positive_double();
-    out.scale = num(out.binding.ticks_per_rad) + " ticks/rad";
-  } else {
-    const double ticks_per_rev = per_rev ? per_rev->as_positive_double() : 4096.0;
-    out.binding.ticks_per_rad = ticks_per_rev / (2.0 * kPi);
-    out.scale = num(ticks_per_rev) + " ticks/rev";
-  }
-
-  if (auto n = node.find("zero_ticks")) {
-    out.binding.zero_ticks = static_cast<std::int32_t>(n->as_int_in(
-        std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
-  }
-  if (auto n = node.find("direction")) out.binding.direction = parse_direction(*n);
-  return out;
-}
-
-// A position limit must be a position the servo can be commanded to; the
-// mapping is the one ActuatorBinding::to_ticks applies at run time.
-void check_ticks(const YamlNode& limit_node, double rad, const ParsedActuator& actuator,
-                 const ProtocolSpec& protocol) {
-  const ActuatorBinding& b = actuator.binding;
-  // In double, so that absurd scales cannot overflow an integer.
-  const double ticks = std::round(b.zero_ticks + b.direction * rad * b.ticks_per_rad);
-  if (ticks < static_cast<double>(protocol.min_ticks) ||
-      ticks > static_cast<double>(protocol.max_ticks)) {
-    std::ostringstream tick_text;  // whole numbers print plainly, absurd ones in e-notation
-    tick_text.precision(12);
-    tick_text << ticks;
-    limit_node.fail(num(rad_to_deg(rad)) + " deg maps to tick " + tick_text.str() +
-                    " (zero_ticks " + std::to_string(b.zero_ticks) + ", direction " +
-                    std::to_string(b.direction) + ", " + actuator.scale + "), outside the " +
-                    std::string(protocol.name) + " position range " +
-                    std::to_string(protocol.min_ticks) + ".." + std::to_string(protocol.max_ticks));
-  }
+  const BusConfig& bus = buses[bus_index];
+  const Protocol& protocol = *find_protocol(bus.protocol);
+  std::vector<std::string_view> keys{"bus"};
+  for (auto key : protocol.actuator_keys()) keys.push_back(key);
+  node.allow_only(keys);
+  protocol.read_actuator(node, joint, limits_node, bus, binding);
+  return bus_index;
 }
 
 void parse_joints(const YamlNode& node, RobotConfig& config) {
@@ -289,15 +174,12 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
     joint.limits = parse_limits(limits_node);
     joint.home = parse_home(value, limits_node);
 
-    ParsedActuator actuator = parse_actuator(value.at("actuator"), config.buses);
-    BusConfig& bus = config.buses[actuator.bus_index];
-    const ProtocolSpec& protocol = *find_protocol(bus.protocol);
-    check_ticks(limits_node.at("min_deg"), joint.limits.min_position, actuator, protocol);
-    check_ticks(limits_node.at("max_deg"), joint.limits.max_position, actuator, protocol);
-
-    actuator.binding.joint = name;
-    actuator.binding.joint_index = static_cast<int>(config.joints.size());
-    bus.actuators.push_back(actuator.binding);
+    ActuatorBinding binding;
+    binding.joint = name;
+    binding.joint_index = static_cast<int>(config.joints.size());
+    const std::size_t bus_index =
+        parse_actuator(value.at("actuator"), joint, limits_node, config.buses, binding);
+    config.buses[bus_index].actuators.push_back(binding);
     config.joints.push_back(std::move(joint));
   }
 }

@@ -9,6 +9,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -41,6 +42,7 @@ class YamlNode {
   // Rejects any key not listed (reports the first unknown one at its own
   // position) and requires the node to be a map.
   void allow_only(std::initializer_list<std::string_view> keys) const;
+  void allow_only(std::span<const std::string_view> keys) const;
   // Entries of a map in file order; duplicate keys are an error.
   std::vector<std::pair<std::string, YamlNode>> entries() const;
   // Items of a sequence in file order.
@@ -63,17 +65,22 @@ class YamlNode {
 
   // Throws InputError at this node.
   [[noreturn]] void fail(const std::string& message) const;
+  // What the node holds, for messages: "nothing", "a map", "a list" or the
+  // quoted scalar.
+  std::string describe() const;
 
  private:
   YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std::string path,
            YAML::Mark mark);
   YamlNode child(const YAML::Node& node, std::string path) const;
-  std::string describe() const;  // what was found, for messages
 
   std::shared_ptr<const std::string> file_;
   YAML::Node node_;
   std::string path_;
   YAML::Mark mark_;  // where this node (or, if null, its key) is
 };
+
+// Shortest readable form of a number, as messages print them ("0.02", "100").
+std::string format_number(double value);
 
 }  // namespace animrt

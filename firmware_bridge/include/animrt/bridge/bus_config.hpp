@@ -2,6 +2,7 @@
 // What a bus and each device on it need to know, as read from the robot
 // config. Device units (ticks) exist only from here down.
 
+#include <any>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@ struct ActuatorBinding {
   double ticks_per_rad = 4096.0 / (2.0 * 3.14159265358979323846);  // native scale
   std::int32_t zero_ticks = 2048;  // ticks at 0 rad
   int direction = 1;               // +1 or -1
+  // Protocol-specific settings, owned by the protocol module that read them
+  // (for example a register map or a pulse calibration).
+  std::any options;
 
   std::int32_t to_ticks(double rad) const;
   double to_rad(std::int32_t ticks) const;
@@ -33,12 +37,13 @@ struct SimBusSettings {
 
 struct BusConfig {
   std::string name;
-  std::string protocol;     // "dynamixel2"
-  std::string port;         // e.g. /dev/ttyUSB0
+  std::string protocol;     // a registered Protocol's name, e.g. "dynamixel2"
+  std::string port;         // where the bus is: /dev/ttyUSB0, host:port, can0, ...
   int baud = 1'000'000;
   double timeout_s = 0.004;  // answer timeout for one transaction
   SimBusSettings sim;
   std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
+  std::any options;                        // protocol-specific, see ActuatorBinding::options
   Location where;                          // where the bus is declared
 };
 

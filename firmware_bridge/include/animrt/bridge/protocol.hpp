@@ -1,0 +1,49 @@
+#pragma once
+// A protocol module holds everything protocol-specific about a bus, from the
+// robot file to the wire: which keys a bus and an actuator of that protocol
+// take (and their checks), and how the bus is built. The runtime's config
+// reader and bus factory only dispatch here, so adding a device means adding
+// a module (and a simulated device in sim/), not editing the runtime.
+
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/joint.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt {
+
+class Protocol {
+ public:
+  virtual ~Protocol() = default;
+  virtual std::string_view name() const = 0;
+
+  // Bus keys of this protocol besides `protocol` and `sim` (read by the
+  // runtime), in the order error messages list them.
+  virtual std::span<const std::string_view> bus_keys() const = 0;
+  // Reads those keys into `bus` (name, protocol, where and sim are set).
+  virtual void read_bus(const YamlNode& node, BusConfig& bus) const = 0;
+
+  // Actuator keys besides `bus`, in message order.
+  virtual std::span<const std::string_view> actuator_keys() const = 0;
+  // Reads an actuator binding of `joint` on `bus` (whose actuators so far are
+  // in bus.actuators) and checks that the joint's limits, given in
+  // `limits_node`, are positions the device can take.
+  virtual void read_actuator(const YamlNode& node, const JointSpec& joint,
+                             const YamlNode& limits_node, const BusConfig& bus,
+                             ActuatorBinding& out) const = 0;
+
+  // Opens the bus (transport included). Throws DeviceError.
+  virtual std::unique_ptr<ActuatorBus> make_bus(const BusConfig& bus) const = 0;
+};
+
+// The registered protocols; nullptr for an unknown name.
+const Protocol* find_protocol(std::string_view name);
+// "dynamixel2, ..." for messages.
+std::string supported_protocols();
+
+}  // namespace animrt

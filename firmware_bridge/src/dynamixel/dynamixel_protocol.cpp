@@ -1,0 +1,127 @@
+#include "animrt/bridge/dynamixel/dynamixel_protocol.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+
+#include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
+
+namespace animrt {
+namespace {
+
+// Ids 253..255 are reserved (254 is broadcast); an X-series servo in position
+// control mode takes goal positions 0..4095.
+constexpr int kMaxDeviceId = 252;
+constexpr std::int64_t kMinTicks = 0;
+constexpr std::int64_t kMaxTicks = 4095;
+
+constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms"};
+constexpr std::string_view kActuatorKeys[] = {"id", "ticks_per_rev", "ticks_per_rad", "zero_ticks",
+                                              "direction"};
+
+int parse_direction(const YamlNode& node) {
+  if (node.is_scalar()) {
+    const std::string& s = node.raw().Scalar();
+    if (s == "1" || s == "+1") return 1;
+    if (s == "-1") return -1;
+  }
+  node.fail("expected 1 or -1 (-1 for a mirrored servo), found " + node.describe());
+}
+
+// A position limit must be a position the servo can be commanded to; the
+// mapping is the one ActuatorBinding::to_ticks applies at run time.
+void check_ticks(const YamlNode& limit_node, double rad, const ActuatorBinding& b,
+                 const std::string& scale) {
+  // In double, so that absurd scales cannot overflow an integer.
+  const double ticks = std::round(b.zero_ticks + b.direction * rad * b.ticks_per_rad);
+  if (ticks < static_cast<double>(kMinTicks) || ticks > static_cast<double>(kMaxTicks)) {
+    std::ostringstream tick_text;  // whole numbers print plainly, absurd ones in e-notation
+    tick_text.precision(12);
+    tick_text << ticks;
+    limit_node.fail(format_number(rad_to_deg(rad)) + " deg maps to tick " + tick_text.str() +
+                    " (zero_ticks " + std::to_string(b.zero_ticks) + ", direction " +
+                    std::to_string(b.direction) + ", " + scale +
+                    "), outside the dynamixel2 position range " + std::to_string(kMinTicks) +
+                    ".." + std::to_string(kMaxTicks));
+  }
+}
+
+class Dynamixel2 final : public Protocol {
+ public:
+  std::string_view name() const override { return "dynamixel2"; }
+  std::span<const std::string_view> bus_keys() const override { return kBusKeys; }
+  std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+
+  void read_bus(const YamlNode& node, BusConfig& bus) const override {
+    const YamlNode port = node.at("port");
+    bus.port = port.as_string();
+    if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");
+    if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(1, 10'500'000));
+    if (auto n = node.find("timeout_ms")) {
+      const double ms = n->as_double();
+      if (!(ms > 0.0 && ms < 1000.0)) {
+        n->fail("expected a number greater than 0 and less than 1000, found " + n->describe());
+      }
+      bus.timeout_s = ms / 1000.0;
+    }
+  }
+
+  void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,
+                     const BusConfig& bus, ActuatorBinding& out) const override {
+    const YamlNode id_node = node.at("id");
+    const std::int64_t id = id_node.as_int();
+    if (id < 0 || id > kMaxDeviceId) {
+      id_node.fail("expected a device id from 0 to " + std::to_string(kMaxDeviceId) +
+                   " for dynamixel2, found " + id_node.describe());
+    }
+    out.device_id = static_cast<int>(id);
+    for (const auto& other : bus.actuators) {
+      if (other.device_id == id) {
+        id_node.fail("device id " + std::to_string(id) + " is already used by joint " +
+                     other.joint + " on bus " + bus.name);
+      }
+    }
+
+    const auto per_rev = node.find("ticks_per_rev");
+    const auto per_rad = node.find("ticks_per_rad");
+    if (per_rev && per_rad) per_rad->fail("give either ticks_per_rev or ticks_per_rad, not both");
+    std::string scale;  // for messages
+    if (per_rad) {
+      out.ticks_per_rad = per_rad->as_positive_double();
+      scale = format_number(out.ticks_per_rad) + " ticks/rad";
+    } else {
+      const double ticks_per_rev = per_rev ? per_rev->as_positive_double() : 4096.0;
+      out.ticks_per_rad = ticks_per_rev / (2.0 * kPi);
+      scale = format_number(ticks_per_rev) + " ticks/rev";
+    }
+    if (auto n = node.find("zero_ticks")) {
+      out.zero_ticks = static_cast<std::int32_t>(n->as_int_in(
+          std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
+    }
+    if (auto n = node.find("direction")) out.direction = parse_direction(*n);
+
+    check_ticks(limits_node.at("min_deg"), joint.limits.min_position, out, scale);
+    check_ticks(limits_node.at("max_deg"), joint.limits.max_position, out, scale);
+  }
+
+  std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
+    std::unique_ptr<ByteTransport> transport;
+    try {
+      transport = open_serial(config.port, config.baud);
+    } catch (const DeviceError& e) {
+      throw DeviceError("bus " + config.name + ": " + e.what());
+    }
+    return std::make_unique<DynamixelBus>(config, std::move(transport));
+  }
+};
+
+}  // namespace
+
+const Protocol& dynamixel2_protocol() {
+  static const Dynamixel2 protocol;
+  return protocol;
+}
+
+}  // namespace animrt
