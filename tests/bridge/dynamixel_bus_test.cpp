@@ -681,7 +681,7 @@ TEST(MakeBus, UnknownProtocolIsADeviceError) {
   config.protocol = "dynamixel1";
   config.where = Location{"robot.yaml", 12, 5};
   EXPECT_EQ(error_of([&] { make_bus(config); }),
-            "robot.yaml:12:5: bus legs: unknown protocol 'dynamixel1' (known: dynamixel2)");
+            "bus legs: unknown protocol 'dynamixel1' (supported: dynamixel2)");
 }
 
 TEST(MakeBus, MissingPortNamesTheBusAndThePort) {
