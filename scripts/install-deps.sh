@@ -8,6 +8,7 @@ packages=(
   libserialport-dev libyaml-cpp-dev libeigen3-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-serial
+  libsndfile1-dev libsamplerate0-dev libaubio-dev libasound2-dev espeak-ng praat sptk sox
 )
 
 missing=()
