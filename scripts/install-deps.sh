@@ -7,8 +7,9 @@ packages=(
   build-essential cmake make pkg-config
   libserialport-dev libyaml-cpp-dev libeigen3-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-serial
+  python3 python3-serial rt-tests
   libsndfile1-dev libsamplerate0-dev libaubio-dev libasound2-dev espeak-ng praat sptk sox
+  libmodbus-dev mbpoll python3-pymodbus
 )
 
 missing=()
