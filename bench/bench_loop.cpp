@@ -49,8 +49,9 @@ void loop_case(double rate_hz, bool wire_time, int baud, double seconds) {
   std::printf(
       "%6.0f Hz  %-22s  period p50 %6.3f p99 %6.3f max %6.3f ms | jitter p50 %5.0f p99 %5.0f max "
       "%6.0f us | overruns %5llu/%-6llu | bus I/O p50 %6.3f p99 %6.3f ms | %s\n",
-      rate_hz, wire_time ? ("wire time at " + std::to_string(baud / 1000) + " kbaud").c_str()
-                         : "pty speed (no wire time)",
+      rate_hz,
+      wire_time ? ("wire time at " + std::to_string(baud / 1000) + " kbaud").c_str()
+                : "pty speed (no wire time)",
       ms(s.period.p50_s), ms(s.period.p99_s), ms(s.period.max_s), us(s.jitter.p50_s),
       us(s.jitter.p99_s), us(s.jitter.max_s), static_cast<unsigned long long>(s.overruns),
       static_cast<unsigned long long>(s.cycles), ms(s.buses[0].io.p50_s), ms(s.buses[0].io.p99_s),

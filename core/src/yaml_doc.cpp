@@ -1,10 +1,10 @@
 #include "animrt/core/yaml_doc.hpp"
 
 #include <cerrno>
-#include <cstring>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -30,7 +30,9 @@ YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std
 
 YamlNode YamlNode::load_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(Location{path, 0, 0}, "", "cannot open file: " + std::string(std::strerror(errno)));
+  if (!in)
+    throw InputError(Location{path, 0, 0}, "",
+                     "cannot open file: " + std::string(std::strerror(errno)));
   std::stringstream buffer;
   buffer << in.rdbuf();
   return load_string(buffer.str(), path);
@@ -100,14 +102,16 @@ void YamlNode::allow_only(std::span<const std::string_view> keys) const {
   if (!node_.IsMap()) fail("expected a map, found " + describe());
   std::set<std::string> seen;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string("<complex key>");
+    const std::string key =
+        it->first.IsScalar() ? it->first.Scalar() : std::string("<complex key>");
     bool known = false;
     for (auto k : keys) known = known || (k == key);
     Location where = location_of(*file_, it->first.Mark());
     if (!known) {
       std::string expected;
       for (auto k : keys) expected += (expected.empty() ? "" : ", ") + std::string(k);
-      throw InputError(where, join_path(path_, key), "unknown key (expected one of: " + expected + ")");
+      throw InputError(where, join_path(path_, key),
+                       "unknown key (expected one of: " + expected + ")");
     }
     if (!seen.insert(key).second) throw InputError(where, join_path(path_, key), "duplicate key");
   }
@@ -123,7 +127,8 @@ std::vector<std::pair<std::string, YamlNode>> YamlNode::entries() const {
     }
     const std::string key = it->first.Scalar();
     if (!seen.insert(key).second) {
-      throw InputError(location_of(*file_, it->first.Mark()), join_path(path_, key), "duplicate key");
+      throw InputError(location_of(*file_, it->first.Mark()), join_path(path_, key),
+                       "duplicate key");
     }
     YAML::Mark mark = it->second.IsNull() ? it->first.Mark() : it->second.Mark();
     out.emplace_back(key, YamlNode(file_, it->second, join_path(path_, key), mark));

@@ -11,7 +11,8 @@ LoadedRobot load_robot(const std::string& path) {
   if (motion.type == "gait") {
     robot.motion = load_gait_source(motion.file, robot.config.joints);
   } else {
-    throw InputError(motion.where, "motion.type", "unsupported motion type \"" + motion.type + "\"");
+    throw InputError(motion.where, "motion.type",
+                     "unsupported motion type \"" + motion.type + "\"");
   }
   return robot;
 }

@@ -17,9 +17,12 @@ nlohmann::json timing_json(const TimingSummary& t) {
 
 const char* to_string(EndReason reason) {
   switch (reason) {
-    case EndReason::duration: return "duration";
-    case EndReason::signal: return "stop request";
-    case EndReason::fault: return "device fault";
+    case EndReason::duration:
+      return "duration";
+    case EndReason::signal:
+      return "stop request";
+    case EndReason::fault:
+      return "device fault";
   }
   return "?";
 }
@@ -27,9 +30,10 @@ const char* to_string(EndReason reason) {
 std::string format_summary(const RunSummary& s) {
   std::string out;
   auto line = [&out](const std::string& text) { out += text + '\n'; };
-  line(fmt::format("run: {} on the {} backend, {} clock at {:g} Hz; ended by {} after {:.2f} s of motion",
-                   s.robot, s.backend, s.lockstep ? "lockstep" : "real-time", s.rate_hz,
-                   to_string(s.end_reason), s.motion_time_s));
+  line(fmt::format(
+      "run: {} on the {} backend, {} clock at {:g} Hz; ended by {} after {:.2f} s of motion",
+      s.robot, s.backend, s.lockstep ? "lockstep" : "real-time", s.rate_hz, to_string(s.end_reason),
+      s.motion_time_s));
   for (const auto& fault : s.faults) line("FAULT " + fault);
   line(fmt::format("cycles: {}, overruns: {}", s.cycles, s.overruns));
   line(fmt::format("period: p50 {}, p99 {}, max {}", ms(s.period.p50_s), ms(s.period.p99_s),
@@ -59,8 +63,9 @@ std::string format_summary(const RunSummary& s) {
         "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware {}{}",
         d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
         st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
-        st.hardware_error_status ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
-                                 : std::string()));
+        st.hardware_error_status
+            ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
+            : std::string()));
   }
   if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
@@ -90,7 +95,8 @@ nlohmann::json to_json(const RunSummary& s) {
                    {"memory_locked", s.memory_locked},
                    {"mlock_note", s.mlock_note}};
   j["buses"] = nlohmann::json::array();
-  for (const auto& bus : s.buses) j["buses"].push_back({{"name", bus.name}, {"io", timing_json(bus.io)}});
+  for (const auto& bus : s.buses)
+    j["buses"].push_back({{"name", bus.name}, {"io", timing_json(bus.io)}});
   j["joints"] = nlohmann::json::array();
   for (const auto& joint : s.joints) {
     j["joints"].push_back({{"name", joint.name},

@@ -1,6 +1,7 @@
+#include "animrt/core/error.hpp"
+
 #include <gtest/gtest.h>
 
-#include "animrt/core/error.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {

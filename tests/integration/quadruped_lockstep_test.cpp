@@ -6,10 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <functional>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,7 +17,6 @@
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
-
 #include "support/alloc_counter.hpp"
 
 namespace animrt {
@@ -194,8 +193,8 @@ TEST(QuadrupedLockstep, TheCycleDoesNotAllocate) {
   // The first call plans the start ramp outside the cycle; compare the loop
   // thread's allocation counter from the 10th motion cycle on.
   for (std::size_t k = 11; k < seen.size; ++k) {
-    ASSERT_EQ(seen.values[k], seen.values[10]) << "allocation between motion cycles " << k - 1
-                                               << " and " << k;
+    ASSERT_EQ(seen.values[k], seen.values[10])
+        << "allocation between motion cycles " << k - 1 << " and " << k;
   }
 }
 

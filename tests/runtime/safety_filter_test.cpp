@@ -1,3 +1,5 @@
+#include "animrt/runtime/safety_filter.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -5,7 +7,6 @@
 #include <vector>
 
 #include "animrt/runtime/pose_ramp.hpp"
-#include "animrt/runtime/safety_filter.hpp"
 
 namespace animrt {
 namespace {
@@ -23,7 +24,8 @@ struct Checker {
   double last_v = 0.0;
   double max_step = 0.0;
 
-  explicit Checker(double start, JointLimits limits = kLimits) : filter({limits}, kDt), last_p(start) {
+  explicit Checker(double start, JointLimits limits = kLimits)
+      : filter({limits}, kDt), last_p(start) {
     filter.reset(std::vector<double>{start});
   }
 

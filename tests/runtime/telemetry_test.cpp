@@ -1,3 +1,5 @@
+#include "animrt/runtime/telemetry.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -8,7 +10,6 @@
 #include <vector>
 
 #include "animrt/runtime/loop_stats.hpp"
-#include "animrt/runtime/telemetry.hpp"
 
 namespace animrt {
 namespace {

@@ -43,8 +43,8 @@ void check_ticks(const YamlNode& limit_node, double rad, const ActuatorBinding& 
     limit_node.fail(format_number(rad_to_deg(rad)) + " deg maps to tick " + tick_text.str() +
                     " (zero_ticks " + std::to_string(b.zero_ticks) + ", direction " +
                     std::to_string(b.direction) + ", " + scale +
-                    "), outside the dynamixel2 position range " + std::to_string(kMinTicks) +
-                    ".." + std::to_string(kMaxTicks));
+                    "), outside the dynamixel2 position range " + std::to_string(kMinTicks) + ".." +
+                    std::to_string(kMaxTicks));
   }
 }
 

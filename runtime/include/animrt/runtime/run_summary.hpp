@@ -1,9 +1,8 @@
 #pragma once
 // What a run reports at its end, as text for people and JSON for tools.
 
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
