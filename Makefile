@@ -3,7 +3,7 @@ BUILD ?= build
 ASAN_BUILD ?= build-asan
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize bench clean
+.PHONY: deps build demo test test-release test-sanitize test-hil bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -19,8 +19,10 @@ demo: build
 	  --telemetry $(BUILD)/demo_telemetry.csv --summary-json $(BUILD)/demo_summary.json
 
 # Every test tier: unit and integration on the warnings-as-errors build, then
-# again under AddressSanitizer and UndefinedBehaviorSanitizer.
+# again under AddressSanitizer and UndefinedBehaviorSanitizer, then the
+# hardware-in-the-loop tier in a QEMU guest.
 test: test-release test-sanitize
+	$(MAKE) test-hil
 
 test-release: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
@@ -30,6 +32,11 @@ test-sanitize: deps
 	  -DANIMRT_BENCH=OFF
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS)
+
+# Hardware-in-the-loop: the release build's animrt in a Linux guest under
+# QEMU, on a real 8250 UART and on SocketCAN (vcan0); results in $(BUILD)/hil.
+test-hil: build
+	tests/hil/run $(BUILD)
 
 bench: build
 	scripts/run-benchmarks.sh $(BUILD)

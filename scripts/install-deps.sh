@@ -9,7 +9,9 @@ packages=(
   nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-serial rt-tests
   libsndfile1-dev libsamplerate0-dev libaubio-dev libasound2-dev espeak-ng praat sptk sox
-  libmodbus-dev mbpoll python3-pymodbus
+  libmodbus-dev mbpoll python3-pymodbus python3-serial-asyncio
+  libmujoco-dev libqhull-dev libopenmpi-dev openmpi-bin gnuplot-nox
+  can-utils qemu-system-x86 busybox-static cpio  # HIL tier (tests/hil/run)
 )
 
 missing=()

@@ -4,7 +4,10 @@
 #include <string>
 
 #include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/can/can_protocols.hpp"
 #include "animrt/bridge/dynamixel/dynamixel_protocol.hpp"
+#include "animrt/bridge/maestro/maestro_protocol.hpp"
+#include "animrt/bridge/modbus/modbus_protocol.hpp"
 #include "animrt/bridge/protocol.hpp"
 #include "animrt/core/error.hpp"
 
@@ -14,6 +17,11 @@ namespace {
 // Every protocol the runtime can drive. Add a module here to add a device.
 const Protocol* const kProtocols[] = {
     &dynamixel2_protocol(),
+    &mit_protocol(),
+    &cia402_protocol(),
+    &maestro_protocol(),
+    &modbus_tcp_protocol(),
+    &modbus_rtu_protocol(),
 };
 
 }  // namespace

@@ -17,7 +17,10 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
+#include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "evolve_command.hpp"
+#include "head_command.hpp"
 
 namespace {
 
@@ -104,6 +107,8 @@ int cmd_run(const RunArgs& args) {
 int cmd_sim(const std::string& path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
   animrt::MonotonicClock clock;
+  // Served for other programs: CAN devices go on the real interfaces.
+  animrt::sim::set_can_sim_attach(animrt::sim::CanSimAttach::socketcan);
   auto simulated = animrt::start_simulated_devices(robot.config.buses, clock);
   for (const auto& sim : simulated) std::cout << sim->describe() << '\n';
   std::cout << std::flush;
@@ -143,6 +148,8 @@ int main(int argc, char** argv) {
   auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");
   sim->add_option("CONFIG", sim_path, "robot file (YAML)")->required();
 
+  animrt::cli::add_evolve_command(app);
+  animrt::cli::add_head_command(app);
   CLI11_PARSE(app, argc, argv);
   install_signal_handlers();
   try {

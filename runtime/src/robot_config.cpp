@@ -92,7 +92,8 @@ std::vector<BusConfig> parse_buses(const YamlNode& node) {
     BusConfig bus = parse_bus(name, value, node);
     // Two buses on one port would fight over the line.
     for (const auto& other : buses) {
-      if (other.port == bus.port) {
+      if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
+                                      find_protocol(bus.protocol)->shares_port())) {
         value.at("port").fail("port \"" + bus.port + "\" is already used by bus " + other.name);
       }
     }
@@ -184,12 +185,35 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
   }
 }
 
-MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path) {
+MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path, bool in_layers = false) {
+  // Layers: sources applied in order; later ones win on the joints they drive.
+  if (auto t = node.find("type"); t && t->is_scalar() && t->as_string() == "layers") {
+    if (in_layers) t->fail("layers cannot be nested");
+    node.allow_only({"type", "layers"});
+    MotionConfig motion;
+    motion.type = "layers";
+    motion.where = node.location();
+    const YamlNode list = node.at("layers");
+    const auto items = list.items();
+    if (items.empty()) list.fail("expected at least one motion source, found an empty list");
+    for (const YamlNode& item : items) motion.layers.push_back(parse_motion(item, robot_path, true));
+    return motion;
+  }
+  if (auto t = node.find("type"); t && t->is_scalar() && t->as_string() == "head") {
+    MotionConfig motion;
+    motion.type = "head";
+    motion.where = node.location();
+    motion.head = std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, robot_path));
+    motion.file = motion.head->model;
+    return motion;
+  }
   node.allow_only({"type", "file"});
   MotionConfig motion;
   const YamlNode type = node.at("type");
   motion.type = type.as_string();
-  if (motion.type != "gait") type.fail("unknown motion type " + found(type) + " (supported: gait)");
+  if (motion.type != "gait" && motion.type != "show") {
+    type.fail("unknown motion type " + found(type) + " (supported: gait, head, show, layers)");
+  }
 
   const YamlNode file = node.at("file");
   const std::string given = file.as_string();

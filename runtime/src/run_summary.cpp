@@ -48,8 +48,8 @@ std::string format_summary(const RunSummary& s) {
     line(s.memory_locked ? "memory: locked" : "memory: " + s.mlock_note);
   }
   for (const auto& bus : s.buses) {
-    line(fmt::format("bus {}: I/O per cycle p50 {}, p99 {}, max {}", bus.name, ms(bus.io.p50_s),
-                     ms(bus.io.p99_s), ms(bus.io.max_s)));
+    line(fmt::format("bus {}: cycle time (read + write) p50 {}, p99 {}, max {}; late cycles {}",
+                     bus.name, ms(bus.io.p50_s), ms(bus.io.p99_s), ms(bus.io.max_s), bus.late_cycles));
   }
   line("tracking error, commanded vs measured (deg):");
   for (const auto& j : s.joints) {
@@ -65,7 +65,11 @@ std::string format_summary(const RunSummary& s) {
         st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
         st.hardware_error_status
             ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
-            : std::string()));
+            : std::string()) +
+        (st.exceptions ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
+                       : std::string()) +
+        (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
+                      : std::string()));
   }
   if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
@@ -96,7 +100,8 @@ nlohmann::json to_json(const RunSummary& s) {
                    {"mlock_note", s.mlock_note}};
   j["buses"] = nlohmann::json::array();
   for (const auto& bus : s.buses)
-    j["buses"].push_back({{"name", bus.name}, {"io", timing_json(bus.io)}});
+    j["buses"].push_back(
+        {{"name", bus.name}, {"io", timing_json(bus.io)}, {"late_cycles", bus.late_cycles}});
   j["joints"] = nlohmann::json::array();
   for (const auto& joint : s.joints) {
     j["joints"].push_back({{"name", joint.name},
@@ -116,7 +121,9 @@ nlohmann::json to_json(const RunSummary& s) {
                             {"crc_errors", st.crc_errors},
                             {"protocol_errors", st.protocol_errors},
                             {"hardware_errors", st.hardware_errors},
-                            {"hardware_error_status", st.hardware_error_status}});
+                            {"hardware_error_status", st.hardware_error_status},
+                            {"exceptions", st.exceptions},
+                            {"open_loop", st.open_loop}});
   }
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},

@@ -14,6 +14,7 @@
 #include "animrt/runtime/realtime.hpp"
 #include "animrt/runtime/safety_filter.hpp"
 #include "animrt/runtime/telemetry.hpp"
+#include "bus_worker.hpp"
 
 namespace animrt {
 namespace {
@@ -21,6 +22,10 @@ namespace {
 constexpr std::size_t kTelemetryCapacity = 1 << 14;  // records (~80 s at 200 Hz)
 constexpr double kSettledVelocity = 1e-3;            // rad/s: the stop ramp has ended
 constexpr double kMaxSettleTime = 2.0;               // s after the stop ramp, at most
+// Real time: how long the loop waits for the buses' reads, as a fraction of
+// the period. A bus that has not answered by then keeps its last measurement
+// this cycle, and the others go on without it.
+constexpr double kReadBudget = 0.6;
 
 enum class Phase { start_ramp, motion, stop_ramp, done };
 
@@ -58,9 +63,10 @@ struct Runner::Impl {
   void log(const RunOptions& options, const std::string& message) const {
     if (options.log) options.log(message);
   }
-  bool joint_faulted(std::size_t j) const {
-    return buses[slots[j].bus]->devices()[slots[j].device].faulted;
-  }
+  // The loop's own record of faulted devices; a bus's DeviceStatus::faulted
+  // follows it whenever the bus's I/O thread is idle.
+  std::vector<std::vector<std::uint8_t>> faulted;
+  bool joint_faulted(std::size_t j) const { return faulted[slots[j].bus][slots[j].device] != 0; }
   // Reads every bus; io_time gets each bus's read time (wall clock).
   void read_all(std::vector<double>& measured, const MonotonicClock& wall,
                 std::vector<Nanos>& io_time) {
@@ -155,9 +161,21 @@ RunSummary Runner::run(const RunOptions& options) {
   std::vector<double> sq_error(n, 0.0), max_error(n, 0.0);
   std::uint64_t error_samples = 0;
   std::vector<std::vector<Nanos>> last_ok(m.buses.size());
+  m.faulted.assign(m.buses.size(), {});
   for (std::size_t b = 0; b < m.buses.size(); ++b) {
     last_ok[b].assign(m.buses[b]->devices().size(), clock.now());
+    m.faulted[b].assign(m.buses[b]->devices().size(), 0);
   }
+  // One I/O thread per bus (started below, after the real-time request).
+  std::atomic<std::uint32_t> io_done{0};
+  std::vector<std::unique_ptr<BusWorker>> workers;
+  for (std::size_t b = 0; b < m.buses.size(); ++b) {
+    workers.push_back(std::make_unique<BusWorker>(*m.buses[b], m.bus_positions[b], io_done));
+  }
+  std::vector<std::uint8_t> fresh(m.buses.size(), 0);    // a read to use this cycle
+  std::vector<std::uint8_t> pending(m.buses.size(), 0);  // a read posted, not yet used
+  std::vector<std::uint64_t> late_cycles(m.buses.size(), 0);
+  std::vector<std::uint64_t> io_seen(m.buses.size(), 0);
   MicrosHistogram period_hist, jitter_hist, busy_hist;
   std::vector<MicrosHistogram> bus_hist(m.buses.size());
   std::vector<std::string> fault_lines;
@@ -193,6 +211,23 @@ RunSummary Runner::run(const RunOptions& options) {
     summary.sched_note = options.lockstep_clock ? "lockstep: not requested" : "not requested";
     summary.mlock_note = summary.sched_note;
   }
+  for (auto& w : workers) w->start(summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0);
+  // Waits until every bus with a posted request of the kind is done, or
+  // until `deadline` (wall clock; < 0: no limit, as in lockstep).
+  auto wait_for = [&](bool reads, Nanos deadline) {
+    for (;;) {
+      const std::uint32_t seen = io_done.load(std::memory_order_acquire);
+      bool all = true;
+      for (auto& w : workers) all = all && (reads ? w->read_done() : w->write_done());
+      if (all) return;
+      Nanos timeout = -1;
+      if (deadline >= 0) {
+        timeout = deadline - wall.now();
+        if (timeout <= 0) return;
+      }
+      futex_wait(io_done, seen, timeout);
+    }
+  };
 
   // --- run -----------------------------------------------------------------
   const Nanos watchdog = from_seconds(m.config.safety.watchdog_timeout_s);
@@ -228,22 +263,62 @@ RunSummary Runner::run(const RunOptions& options) {
     previous_wake = wake;
     const double now_s = to_seconds(deadline - start);  // nominal time: smooth motion
 
-    // read
-    m.read_all(measured, wall, io_time);
+    // read: every idle bus reads on its own thread; a bus still busy from an
+    // earlier cycle is late and keeps its last measurement.
+    // A read that finished after an earlier cycle's budget is used now (and
+    // its bus writes this cycle); an idle bus gets a new read.
+    for (std::size_t b = 0; b < workers.size(); ++b) {
+      fresh[b] = 0;
+      if (pending[b]) {
+        if (workers[b]->read_done()) {
+          pending[b] = 0;
+          fresh[b] = 1;
+        }
+      } else if (workers[b]->idle()) {
+        if (workers[b]->io_cycles() != io_seen[b]) {
+          io_seen[b] = workers[b]->io_cycles();
+          bus_hist[b].add(to_seconds(workers[b]->last_io_ns()));
+        }
+        // Faults decided while the bus was busy reach its status now.
+        auto devices = m.buses[b]->devices();
+        for (std::size_t d = 0; d < devices.size(); ++d) devices[d].faulted = m.faulted[b][d] != 0;
+        workers[b]->post_read();
+        pending[b] = 1;
+      }
+    }
+    wait_for(true, options.lockstep_clock ? Nanos{-1}
+                                          : wake_wall + static_cast<Nanos>(kReadBudget * static_cast<double>(period)));
+    for (std::size_t b = 0; b < workers.size(); ++b) {
+      if (pending[b] && workers[b]->read_done()) {
+        pending[b] = 0;
+        fresh[b] = 1;
+      }
+      if (!fresh[b]) ++late_cycles[b];
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      if (fresh[m.slots[j].bus]) measured[j] = workers[m.slots[j].bus]->positions()[m.slots[j].device];
+    }
 
     // watchdog: a device silent (or answering garbage) for too long, or one
-    // reporting a hardware error, is faulted.
+    // reporting a hardware error, is faulted. A late bus is judged by its
+    // answers once its I/O thread is done (every transaction is bounded by
+    // the bus timeout); only a bus stuck for ten watchdog times (a thread
+    // that never returns) is faulted without them. A descheduled I/O thread
+    // on a loaded machine is therefore not mistaken for silent devices.
     for (std::size_t b = 0; b < m.buses.size(); ++b) {
+      const std::size_t count = m.faulted[b].size();
       auto devices = m.buses[b]->devices();
-      for (std::size_t d = 0; d < devices.size(); ++d) {
-        DeviceStatus& status = devices[d];
-        if (status.faulted) continue;
-        if (status.health == DeviceHealth::ok) {
+      for (std::size_t d = 0; d < count; ++d) {
+        if (m.faulted[b][d]) continue;
+        if (!fresh[b] && wake - last_ok[b][d] <= 10 * watchdog) continue;
+        const DeviceHealth health = fresh[b] ? devices[d].health : DeviceHealth::timeout;
+        if (health == DeviceHealth::ok) {
           last_ok[b][d] = wake;
-        } else if (status.health == DeviceHealth::hardware_error || wake - last_ok[b][d] > watchdog) {
-          status.faulted = true;
+        } else if (health == DeviceHealth::hardware_error || wake - last_ok[b][d] > watchdog) {
+          m.faulted[b][d] = 1;
+          if (fresh[b]) devices[d].faulted = true;
           fault = true;
-          fault_events.push_back(FaultEvent{b, d, status.health, now_s});
+          fault_events.push_back(FaultEvent{b, d, health, now_s});
         }
       }
     }
@@ -294,13 +369,13 @@ RunSummary Runner::run(const RunOptions& options) {
     // filter, write
     filter.step(targets, commands);
     for (std::size_t j = 0; j < n; ++j) {
-      m.bus_commands[m.slots[j].bus][m.slots[j].device] = commands[j];
+      if (fresh[m.slots[j].bus]) workers[m.slots[j].bus]->commands()[m.slots[j].device] = commands[j];
     }
-    for (std::size_t b = 0; b < m.buses.size(); ++b) {
-      const Nanos t0 = wall.now();
-      m.buses[b]->write(m.bus_commands[b]);
-      bus_hist[b].add(to_seconds(io_time[b] + wall.now() - t0));
+    for (std::size_t b = 0; b < workers.size(); ++b) {
+      if (fresh[b]) workers[b]->post_write();
     }
+    // Lockstep: the writes land before the clock moves on (deterministic).
+    if (options.lockstep_clock) wait_for(false, -1);
     std::copy(commands.begin(), commands.end(), previous_commands.begin());
 
     // telemetry
@@ -332,6 +407,12 @@ RunSummary Runner::run(const RunOptions& options) {
       sleep_until(deadline);
     }
   }
+  for (auto& w : workers) w->stop();
+  for (std::size_t b = 0; b < m.buses.size(); ++b) {
+    if (workers[b]->io_cycles() != io_seen[b]) bus_hist[b].add(to_seconds(workers[b]->last_io_ns()));
+    auto devices = m.buses[b]->devices();
+    for (std::size_t d = 0; d < devices.size(); ++d) devices[d].faulted = m.faulted[b][d] != 0;
+  }
   if (realtime) release_realtime();
 
   // --- deactivate --------------------------------------------------------------
@@ -346,7 +427,7 @@ RunSummary Runner::run(const RunOptions& options) {
   summary.jitter = summarize(jitter_hist);
   summary.busy = summarize(busy_hist);
   for (std::size_t b = 0; b < m.buses.size(); ++b) {
-    summary.buses.push_back(BusReport{m.buses[b]->config().name, summarize(bus_hist[b])});
+    summary.buses.push_back(BusReport{m.buses[b]->config().name, summarize(bus_hist[b]), late_cycles[b]});
     const auto& actuators = m.buses[b]->config().actuators;
     auto devices = m.buses[b]->devices();
     for (std::size_t d = 0; d < devices.size(); ++d) {

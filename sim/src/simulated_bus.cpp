@@ -5,12 +5,20 @@
 #include <memory>
 
 #include "animrt/core/error.hpp"
+#include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/dynamixel_sim_bus.hpp"
+#include "animrt/sim/maestro/maestro_sim_bus.hpp"
+#include "animrt/sim/modbus/modbus_sim_bus.hpp"
 
 namespace animrt {
 
 std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock) {
   if (config.protocol == "dynamixel2") return std::make_unique<sim::DynamixelSimBus>(config, clock);
+  if (config.protocol == "mit" || config.protocol == "cia402") return sim::make_can_sim_bus(config, clock);
+  if (config.protocol == "maestro") return std::make_unique<sim::MaestroSimBus>(config, clock);
+  if (config.protocol == "modbus-tcp" || config.protocol == "modbus-rtu") {
+    return std::make_unique<sim::ModbusSimBus>(config, clock);
+  }
   throw InputError(config.where, "protocol",
                    "no simulated devices for protocol '" + config.protocol + "' on bus '" +
                        config.name + "' (expected dynamixel2)");

@@ -496,7 +496,7 @@ loop: {rate_hz: 100}
 buses:
   b: {protocol: modbus, port: /dev/ttyUSB0}
 )"),
-            at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2)"));
+            at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2, mit, cia402, maestro, modbus-tcp, modbus-rtu)"));
 }
 
 TEST_F(RobotConfigTest, TwoBusesOnOnePort) {
@@ -695,7 +695,7 @@ TEST_F(RobotConfigTest, UnknownMotionType) {
   std::string text = kMinimal;
   text.replace(text.find("type: gait"), 10, "type: keyframes");
   EXPECT_EQ(error_of(text),
-            at("9:16: motion.type: unknown motion type \"keyframes\" (supported: gait)"));
+            at("9:16: motion.type: unknown motion type \"keyframes\" (supported: gait, head, show, layers)"));
 }
 
 TEST_F(RobotConfigTest, MotionFileMissing) {

@@ -22,6 +22,11 @@ class Protocol {
   virtual ~Protocol() = default;
   virtual std::string_view name() const = 0;
 
+  // Whether buses of this protocol may share their port with other buses
+  // that say so too (a CAN interface carries several protocols, told apart
+  // by frame ids); a serial line belongs to one bus.
+  virtual bool shares_port() const { return false; }
+
   // Bus keys of this protocol besides `protocol` and `sim` (read by the
   // runtime), in the order error messages list them.
   virtual std::span<const std::string_view> bus_keys() const = 0;

@@ -5,7 +5,10 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
 #include "animrt/bridge/bus_config.hpp"
+#include "animrt/controllers/head/head_source.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
 
@@ -21,6 +24,8 @@ struct MotionConfig {
   std::string type;  // "gait"
   std::string file;  // resolved against the robot file's folder
   Location where;
+  std::shared_ptr<const head::HeadMotionConfig> head;  // type "head" (parsed in controllers/head)
+  std::vector<MotionConfig> layers;  // type "layers": applied in order, later layers win
 };
 
 struct RobotConfig {

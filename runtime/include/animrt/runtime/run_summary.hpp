@@ -31,7 +31,10 @@ struct DeviceReport {
 
 struct BusReport {
   std::string name;
-  TimingSummary io;  // read + write time of the bus per cycle
+  TimingSummary io;  // read + write time of the bus per cycle (on its I/O thread)
+  // Cycles in which the bus had not answered within the loop's read budget
+  // (its joints kept their last measurement, the other buses went on).
+  std::uint64_t late_cycles = 0;
 };
 
 enum class EndReason { duration, signal, fault };

@@ -1,0 +1,258 @@
+// The head MotionSource: a worker thread streams audio through the
+// synthesizer at real time and publishes poses into a preallocated ring;
+// sample() only reads the ring (no allocation, no lock, no I/O).
+
+#include "animrt/controllers/head/head_source.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#include "animrt/controllers/head/alsa_audio.hpp"
+#include "animrt/controllers/head/streaming.hpp"
+
+namespace animrt::head {
+namespace {
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
+
+struct Drive {
+  int joint = -1;
+  double gain = 1.0, offset_deg = 0.0, lo = 0.0, hi = 0.0;  // lo/hi in rad
+};
+
+class HeadSource final : public MotionSource {
+ public:
+  HeadSource(const HeadMotionConfig& c, HeadModel model, Audio audio, Drive axes[3], Drive jaw,
+             HeadJawMap jaw_map)
+      : config_(c),
+        model_(std::move(model)),
+        audio_(std::move(audio)),
+        jaw_(jaw),
+        jaw_map_(std::move(jaw_map)) {
+    for (int i = 0; i < 3; ++i) axes_[i] = axes[i];
+    for (const Drive& d : axes_) {
+      if (d.joint >= 0) driven_.push_back(d.joint);
+    }
+    if (jaw_.joint >= 0) driven_.push_back(jaw_.joint);
+    StreamOptions so;
+    so.input_rate = audio_.sample_rate;
+    so.decoder_lag_s = c.decoder_lag_s;
+    so.max_gap_s = c.max_gap_s;
+    stream_options_ = so;
+    block_ = std::max<std::size_t>(1, static_cast<std::size_t>(c.block_s * audio_.sample_rate));
+    // One cycle: the utterance, then the pause.
+    if (c.capture.empty()) {
+      cycle_ = audio_.samples;
+      cycle_.resize(cycle_.size() + static_cast<std::size_t>(c.pause_s * audio_.sample_rate), 0.0f);
+    }
+    {
+      StreamingSynthesizer probe(model_, so);
+      latency_s_ = probe.worst_case_latency_s() + c.block_s;
+    }
+    rate_ = model_.smoothing.output_rate_hz;
+    if (c.precomputed) {
+      StreamingSynthesizer s(model_, so);
+      std::vector<StreamPose> out;
+      for (std::size_t i = 0; i < cycle_.size(); i += block_) {
+        s.push(std::span<const float>(cycle_.data() + i, std::min(block_, cycle_.size() - i)), out);
+      }
+      s.finish(out);
+      ring_ = std::vector<Slot>(out.size());
+      for (std::size_t i = 0; i < out.size(); ++i) store(i, out[i]);
+      written_.store(out.size());
+    } else {
+      ring_ = std::vector<Slot>(static_cast<std::size_t>(rate_ * 60.0));
+      worker_ = std::thread([this] { run(); });
+    }
+  }
+
+  ~HeadSource() override {
+    stop_.store(true);
+    if (worker_.joinable()) worker_.join();
+  }
+
+  std::span<const int> driven_joints() const override { return driven_; }
+
+  void sample(double t, std::span<double> targets) const override {
+    if (t > 0 && start_ns_.load(std::memory_order_relaxed) == 0) {
+      start_ns_.store(now_ns() - static_cast<std::int64_t>(t * 1e9), std::memory_order_release);
+    }
+    double pose[4] = {0, 0, 0, 0};  // yaw, pitch, roll, energy
+    const double audio_t = t - latency_s_;
+    const std::uint64_t written = written_.load(std::memory_order_acquire);
+    if (audio_t >= 0 && written > 0) {
+      std::uint64_t idx = static_cast<std::uint64_t>(audio_t * rate_);
+      if (config_.precomputed) {
+        idx = config_.repeat ? idx % written : std::min<std::uint64_t>(idx, written - 1);
+      } else {
+        idx =
+            std::min<std::uint64_t>(idx, written - 1);  // the stream is late: hold the newest pose
+      }
+      const Slot& s = ring_[static_cast<std::size_t>(idx % ring_.size())];
+      for (int k = 0; k < 4; ++k) pose[k] = s.v[k].load(std::memory_order_relaxed);
+    }
+    for (int k = 0; k < 3; ++k) {
+      const Drive& d = axes_[k];
+      if (d.joint < 0 || static_cast<std::size_t>(d.joint) >= targets.size()) continue;
+      targets[static_cast<std::size_t>(d.joint)] =
+          std::clamp(deg_to_rad(d.gain * pose[k] + d.offset_deg), d.lo, d.hi);
+    }
+    if (jaw_.joint >= 0 && static_cast<std::size_t>(jaw_.joint) < targets.size()) {
+      const double open = std::clamp(
+          (pose[3] - jaw_map_.energy_floor) / (jaw_map_.energy_full - jaw_map_.energy_floor), 0.0,
+          1.0);
+      const double deg = jaw_map_.closed_deg + open * (jaw_map_.open_deg - jaw_map_.closed_deg);
+      targets[static_cast<std::size_t>(jaw_.joint)] = std::clamp(deg_to_rad(deg), jaw_.lo, jaw_.hi);
+    }
+  }
+
+ private:
+  struct Slot {
+    std::atomic<double> v[4];
+  };
+
+  void store(std::size_t i, const StreamPose& p) {
+    Slot& s = ring_[i % ring_.size()];
+    s.v[0].store(p.pose.yaw, std::memory_order_relaxed);
+    s.v[1].store(p.pose.pitch, std::memory_order_relaxed);
+    s.v[2].store(p.pose.roll, std::memory_order_relaxed);
+    s.v[3].store(p.energy, std::memory_order_relaxed);
+  }
+
+  // Worker: waits for the motion to start, then feeds one block per block
+  // period (audio "arrives" in real time), playing it to ALSA when asked.
+  void run() {
+    while (!stop_.load() && start_ns_.load(std::memory_order_acquire) == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    if (stop_.load()) return;
+    std::unique_ptr<AlsaPlayback> playback;
+    std::unique_ptr<AlsaCapture> capture;
+    try {
+      if (!config_.capture.empty())
+        capture = std::make_unique<AlsaCapture>(config_.capture, audio_.sample_rate);
+      if (config_.audio_device != "none" && config_.capture.empty()) {
+        const std::string dev = config_.audio_device == "auto" ? "default" : config_.audio_device;
+        if (config_.audio_device != "auto" || alsa_playback_available(dev)) {
+          playback = std::make_unique<AlsaPlayback>(dev, audio_.sample_rate);
+          // Delay the sound by the synthesis latency so head and voice match.
+          std::vector<float> lead(static_cast<std::size_t>(latency_s_ * audio_.sample_rate), 0.0f);
+          playback->write(lead);
+        }
+      }
+    } catch (const std::exception&) {
+      return;  // no device: the head stays at rest (the run still works)
+    }
+    StreamingSynthesizer stream(model_, stream_options_);
+    std::vector<StreamPose> out;
+    std::vector<float> block(block_);
+    const std::int64_t start = start_ns_.load();
+    std::uint64_t fed = 0, next = 0;
+    std::size_t pos = 0;
+    while (!stop_.load()) {
+      if (capture) {
+        capture->read(block);
+      } else {
+        if (pos >= cycle_.size()) {
+          if (!config_.repeat) break;
+          pos = 0;
+        }
+        const std::size_t n = std::min(block_, cycle_.size() - pos);
+        std::copy_n(cycle_.begin() + static_cast<std::ptrdiff_t>(pos), n, block.begin());
+        std::fill(block.begin() + static_cast<std::ptrdiff_t>(n), block.end(), 0.0f);
+        pos += n;
+        // This block has "arrived" once its last sample has been spoken.
+        const std::int64_t due =
+            start +
+            static_cast<std::int64_t>(static_cast<double>(fed + block_) * 1e9 / audio_.sample_rate);
+        timespec ts{static_cast<time_t>(due / 1000000000LL), static_cast<long>(due % 1000000000LL)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+        if (playback) playback->write(block);
+      }
+      fed += block_;
+      out.clear();
+      stream.push(block, out);
+      for (const StreamPose& p : out) store(static_cast<std::size_t>(next++), p);
+      written_.store(next, std::memory_order_release);
+    }
+    if (!stop_.load()) {
+      out.clear();
+      stream.finish(out);
+      for (const StreamPose& p : out) store(static_cast<std::size_t>(next++), p);
+      written_.store(next, std::memory_order_release);
+    }
+  }
+
+  HeadMotionConfig config_;
+  HeadModel model_;
+  Audio audio_;
+  Drive axes_[3];
+  Drive jaw_;
+  HeadJawMap jaw_map_;
+  std::vector<int> driven_;
+  StreamOptions stream_options_;
+  std::size_t block_ = 1;
+  std::vector<float> cycle_;
+  double latency_s_ = 0, rate_ = 120;
+  std::vector<Slot> ring_;
+  std::atomic<std::uint64_t> written_{0};
+  mutable std::atomic<std::int64_t> start_ns_{0};
+  std::atomic<bool> stop_{false};
+  std::thread worker_;
+};
+
+Drive bind_joint(const std::string& name, const Location& where, const std::string& key,
+                 std::span<const JointSpec> joints) {
+  Drive d;
+  if (name.empty()) return d;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    if (joints[i].name == name) {
+      d.joint = static_cast<int>(i);
+      d.lo = joints[i].limits.min_position;
+      d.hi = joints[i].limits.max_position;
+    }
+  }
+  if (d.joint < 0) {
+    std::string have;
+    for (const auto& j : joints) have += (have.empty() ? "" : ", ") + j.name;
+    throw InputError(where, key,
+                     "no joint named '" + name + "' in the robot (its joints: " + have + ")");
+  }
+  return d;
+}
+
+}  // namespace
+
+std::unique_ptr<MotionSource> make_head_source(const HeadMotionConfig& c,
+                                               std::span<const JointSpec> joints) {
+  HeadModel model = load_model(c.model);
+  if (c.noise_deg) model.smoothing.noise_deg = *c.noise_deg;
+  Audio audio;
+  if (!c.audio.empty()) {
+    audio = load_audio(c.audio);
+  } else {
+    audio.sample_rate = model.features.sample_rate;
+  }
+  Drive axes[3];
+  const HeadAxisMap* maps[3] = {&c.yaw, &c.pitch, &c.roll};
+  const char* keys[3] = {"motion.axes.yaw.joint", "motion.axes.pitch.joint",
+                         "motion.axes.roll.joint"};
+  for (int k = 0; k < 3; ++k) {
+    axes[k] = bind_joint(maps[k]->joint, maps[k]->where, keys[k], joints);
+    axes[k].gain = maps[k]->sign * maps[k]->scale;
+    axes[k].offset_deg = maps[k]->offset_deg;
+  }
+  const Drive jaw = bind_joint(c.jaw.joint, c.jaw.where, "motion.jaw.joint", joints);
+  return std::make_unique<HeadSource>(c, std::move(model), std::move(audio), axes, jaw, c.jaw);
+}
+
+}  // namespace animrt::head

@@ -1,0 +1,171 @@
+// Pitch through aubio's YIN family, RMS energy on the same window, spline
+// fill of unvoiced F0, regression derivatives.
+
+#include "animrt/controllers/head/prosody.hpp"
+
+#include <aubio/aubio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "animrt/controllers/head/spline.hpp"
+
+namespace animrt::head {
+
+int FeatureConfig::hop_samples() const {
+  return static_cast<int>(std::lround(sample_rate / frame_rate_hz));
+}
+int FeatureConfig::window_samples() const {
+  return static_cast<int>(std::lround(window_s * sample_rate));
+}
+double FeatureConfig::first_frame_time_s() const {
+  return static_cast<double>(window_samples()) / 2.0 / sample_rate;
+}
+void FeatureConfig::validate() const {
+  if (sample_rate < 8000 || sample_rate > 192000)
+    throw std::invalid_argument("sample_rate out of range");
+  if (!(frame_rate_hz > 0)) throw std::invalid_argument("frame_rate_hz must be positive");
+  if (std::abs(sample_rate / frame_rate_hz - hop_samples()) > 1e-6) {
+    throw std::invalid_argument("sample_rate / frame_rate_hz must be a whole number of samples");
+  }
+  if (window_samples() < hop_samples()) throw std::invalid_argument("window shorter than the hop");
+  if (!(f0_min_hz > 0 && f0_max_hz > f0_min_hz)) throw std::invalid_argument("bad F0 range");
+  if (delta_window < 1) throw std::invalid_argument("delta_window must be >= 1");
+  if (method != "yin" && method != "yinfast" && method != "yinfft") {
+    throw std::invalid_argument("pitch method must be yin, yinfast or yinfft");
+  }
+}
+
+struct PitchEnergyTracker::Impl {
+  FeatureConfig config;
+  int hop = 0, window = 0;
+  aubio_pitch_t* pitch = nullptr;
+  fvec_t* in = nullptr;
+  fvec_t* out = nullptr;
+  std::vector<float> ring;  // last `window` samples for the RMS
+  std::size_t ring_pos = 0;
+  std::size_t fill = 0;     // samples in the current hop block
+  std::uint64_t total = 0;  // samples pushed
+};
+
+PitchEnergyTracker::PitchEnergyTracker(const FeatureConfig& config)
+    : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  Impl& m = *impl_;
+  m.config = config;
+  m.hop = config.hop_samples();
+  m.window = config.window_samples();
+  m.pitch = new_aubio_pitch(config.method.c_str(), static_cast<uint_t>(m.window),
+                            static_cast<uint_t>(m.hop), static_cast<uint_t>(config.sample_rate));
+  if (m.pitch == nullptr) throw std::runtime_error("aubio: cannot create pitch detector");
+  aubio_pitch_set_unit(m.pitch, "Hz");
+  aubio_pitch_set_silence(m.pitch, static_cast<smpl_t>(config.silence_db));
+  m.in = new_fvec(static_cast<uint_t>(m.hop));
+  m.out = new_fvec(1);
+  m.ring.assign(static_cast<std::size_t>(m.window), 0.0f);
+}
+
+PitchEnergyTracker::~PitchEnergyTracker() {
+  if (impl_->pitch) del_aubio_pitch(impl_->pitch);
+  if (impl_->in) del_fvec(impl_->in);
+  if (impl_->out) del_fvec(impl_->out);
+}
+
+void PitchEnergyTracker::push(std::span<const float> samples, std::vector<RawFrame>& frames) {
+  Impl& m = *impl_;
+  for (float s : samples) {
+    m.in->data[m.fill++] = s;
+    m.ring[m.ring_pos] = s;
+    m.ring_pos = (m.ring_pos + 1) % m.ring.size();
+    ++m.total;
+    if (m.fill < static_cast<std::size_t>(m.hop)) continue;
+    m.fill = 0;
+    aubio_pitch_do(m.pitch, m.in, m.out);
+    // Until a whole window has arrived the analysis sees leading zeros.
+    if (m.total < static_cast<std::uint64_t>(m.window)) continue;
+    RawFrame f;
+    double sum = 0.0;
+    for (float v : m.ring) sum += static_cast<double>(v) * v;
+    f.energy = std::sqrt(sum / static_cast<double>(m.ring.size()));
+    f.confidence = aubio_pitch_get_confidence(m.pitch);
+    const double hz = m.out->data[0];
+    const double level_db = f.energy > 0 ? 20.0 * std::log10(f.energy) : -200.0;
+    f.voiced = hz >= m.config.f0_min_hz && hz <= m.config.f0_max_hz &&
+               f.confidence >= m.config.voicing_threshold && level_db > m.config.silence_db;
+    f.f0_hz = f.voiced ? hz : 0.0;
+    frames.push_back(f);
+  }
+}
+
+Eigen::MatrixXd deltas(const Eigen::MatrixXd& x, int window, double frame_rate_hz) {
+  const Eigen::Index n = x.rows();
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, x.cols());
+  double norm = 0.0;
+  for (int k = 1; k <= window; ++k) norm += 2.0 * k * k;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    for (int k = 1; k <= window; ++k) {
+      const Eigen::Index a = std::min<Eigen::Index>(t + k, n - 1);
+      const Eigen::Index b = std::max<Eigen::Index>(t - k, 0);
+      d.row(t) += k * (x.row(a) - x.row(b));
+    }
+  }
+  return d * (frame_rate_hz / norm);
+}
+
+FeatureTrack extract_features(const Audio& audio_in, const FeatureConfig& config) {
+  config.validate();
+  const Audio audio = resample(audio_in, config.sample_rate);
+  FeatureTrack track;
+  track.frame_rate_hz = config.frame_rate_hz;
+  track.t0_s = config.first_frame_time_s();
+  PitchEnergyTracker tracker(config);
+  tracker.push(audio.samples, track.raw);
+
+  const std::size_t n = track.raw.size();
+  std::vector<double> f0(n);
+  std::unique_ptr<bool[]> known(new bool[n > 0 ? n : 1]);
+  for (std::size_t i = 0; i < n; ++i) {
+    f0[i] = track.raw[i].f0_hz;
+    known[i] = track.raw[i].voiced;
+  }
+  track.f0_filled = fill_gaps_spline(f0, std::span<const bool>(known.get(), n), config.f0_min_hz,
+                                     config.f0_max_hz);
+  // No voiced frame at all: a flat contour at the bottom of the range.
+  if (std::none_of(known.get(), known.get() + n, [](bool b) { return b; })) {
+    std::fill(track.f0_filled.begin(), track.f0_filled.end(), config.f0_min_hz);
+  }
+  Eigen::MatrixXd base(static_cast<Eigen::Index>(n), 2);
+  for (std::size_t i = 0; i < n; ++i) {
+    base(static_cast<Eigen::Index>(i), 0) = track.f0_filled[i];
+    base(static_cast<Eigen::Index>(i), 1) = track.raw[i].energy;
+  }
+  const Eigen::MatrixXd d1 = deltas(base, config.delta_window, config.frame_rate_hz);
+  const Eigen::MatrixXd d2 = deltas(d1, config.delta_window, config.frame_rate_hz);
+  track.features.resize(static_cast<Eigen::Index>(n), kFeatureDim);
+  track.features << base, d1, d2;
+  return track;
+}
+
+FeatureTrack extract_features_file(const std::string& wav_path, const FeatureConfig& config) {
+  return extract_features(load_audio(wav_path, config.sample_rate), config);
+}
+
+void write_features_csv(const std::string& path, const FeatureTrack& track) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out << "time_s,f0_hz,energy,voiced,f0_filled_hz,d_f0,d_energy,dd_f0,dd_energy\n";
+  char line[512];
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    const RawFrame& f = track.raw[i];
+    std::snprintf(line, sizeof line, "%.6f,%.3f,%.6g,%d,%.3f,%.6g,%.6g,%.6g,%.6g\n", track.time(i),
+                  f.f0_hz, f.energy, f.voiced ? 1 : 0, track.features(r, 0), track.features(r, 2),
+                  track.features(r, 3), track.features(r, 4), track.features(r, 5));
+    out << line;
+  }
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace animrt::head

@@ -1,0 +1,92 @@
+#include "animrt/controllers/head/trainer.hpp"
+
+#include <stdexcept>
+
+namespace animrt::head {
+
+HeadModel train_model(const std::vector<PreparedUtterance>& train, const FeatureConfig& config,
+                      const TrainOptions& options) {
+  if (train.empty()) throw std::invalid_argument("training needs at least one utterance");
+  auto log = [&](const std::string& s) {
+    if (options.log) options.log(s);
+  };
+  HeadModel model;
+  model.features = config;
+  model.states = options.states;
+  model.mixtures = options.mixtures;
+  model.topology = options.topology;
+  model.decode = options.decode;
+  model.smoothing = options.smoothing;
+
+  Eigen::Index frames = 0;
+  for (const auto& u : train) {
+    frames += u.track.features.rows();
+    model.training_utterances.push_back(u.name);
+  }
+  Eigen::MatrixXd all_features(frames, kFeatureDim), all_poses(frames, 3);
+  Eigen::Index row = 0;
+  for (const auto& u : train) {
+    all_features.middleRows(row, u.track.features.rows()) = u.track.features;
+    all_poses.middleRows(row, u.poses.rows()) = u.poses;
+    row += u.track.features.rows();
+  }
+  if (frames < options.clusters)
+    throw std::invalid_argument("training data has fewer frames than clusters");
+  model.feature_mean = all_features.colwise().mean().transpose();
+  model.feature_std = ((all_features.rowwise() - model.feature_mean.transpose())
+                           .array()
+                           .square()
+                           .colwise()
+                           .mean()
+                           .sqrt())
+                          .transpose()
+                          .cwiseMax(1e-9);
+
+  log("vector quantisation: " + std::to_string(frames) + " pose frames into " +
+      std::to_string(options.clusters) + " clusters");
+  model.codebook = train_lbg(all_poses, options.clusters, options.lbg);
+
+  // The known segmentation: every frame's cluster, runs of one cluster as
+  // that cluster's training sequences.
+  std::vector<std::vector<int>> labels;
+  std::vector<std::vector<Eigen::MatrixXd>> sequences(static_cast<std::size_t>(options.clusters));
+  for (const auto& u : train) {
+    const Eigen::MatrixXd obs = model.normalise(u.track.features);
+    std::vector<int> l(static_cast<std::size_t>(obs.rows()));
+    for (Eigen::Index t = 0; t < obs.rows(); ++t)
+      l[static_cast<std::size_t>(t)] = model.codebook.nearest(u.poses.row(t).transpose());
+    Eigen::Index start = 0;
+    for (Eigen::Index t = 1; t <= obs.rows(); ++t) {
+      if (t == obs.rows() || l[static_cast<std::size_t>(t)] != l[static_cast<std::size_t>(start)]) {
+        sequences[static_cast<std::size_t>(l[static_cast<std::size_t>(start)])].push_back(
+            obs.middleRows(start, t - start));
+        start = t;
+      }
+    }
+    labels.push_back(std::move(l));
+  }
+
+  HmmTrainOptions ho;
+  ho.states = options.states;
+  ho.mixtures = options.mixtures;
+  ho.topology = options.topology;
+  ho.max_iterations = options.iterations;
+  ho.variance_floor = Eigen::VectorXd::Constant(kFeatureDim, options.variance_floor);
+  for (int k = 0; k < options.clusters; ++k) {
+    auto& seqs = sequences[static_cast<std::size_t>(k)];
+    if (seqs.empty()) {
+      // An empty cell (possible with duplicate poses): model it on everything,
+      // the bigram will rarely choose it.
+      seqs.push_back(model.normalise(all_features));
+    }
+    Hmm hmm = init_hmm(seqs, ho);
+    baum_welch(hmm, seqs, ho);
+    model.hmms.push_back(std::move(hmm));
+  }
+  log("trained " + std::to_string(options.clusters) + " HMMs (S=" + std::to_string(options.states) +
+      ", M=" + std::to_string(options.mixtures) + ", " + topology_name(options.topology) + ")");
+  model.bigram = train_bigram(labels, options.clusters, options.bigram_discount);
+  return model;
+}
+
+}  // namespace animrt::head

@@ -1,0 +1,56 @@
+#pragma once
+// The seam between the evolver and a physics engine: a simulator walks a
+// model with a gait for some stride cycles and reports what happened. The
+// MuJoCo implementation lives in sim/mujoco; the evolver never sees it.
+//
+// A simulator is used by one thread at a time; a factory makes one per
+// worker thread (they may share the read-only model).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/gait/gait_file.hpp"
+
+namespace animrt::evolve {
+
+struct WalkSettings {
+  double settle_s = 0.5;   // standing still in the gait's first pose before walking
+  int warmup_cycles = 1;   // stride cycles walked but not measured
+  int measure_cycles = 3;  // stride cycles measured
+};
+
+struct GaitMeasures {
+  bool fell = false;              // torso too low, flipped, or the physics went unstable
+  double speed = 0.0;             // m/s, forward (+x) displacement of the torso / time
+  double distance = 0.0;          // m, forward displacement over the measured cycles
+  double stride_length = 0.0;     // m, mean forward advance of a foot between its touchdowns
+  double duty_factor = 0.0;       // mean fraction of the stride each foot is on the ground
+  double energy_per_cycle = 0.0;  // J, sum |actuator force x joint velocity| dt per cycle
+  double sim_time = 0.0;          // s simulated
+  long steps = 0;                 // physics steps taken
+};
+
+// What a model looks like to the fitness function.
+struct ModelInfo {
+  std::vector<std::string> joints;  // actuated joints, by name
+  double hip_height_m = 0.0;        // standing hip height
+  double mass_kg = 0.0;
+};
+
+class GaitSimulator {
+ public:
+  virtual ~GaitSimulator() = default;
+  virtual const ModelInfo& info() const = 0;
+  // Walks `gait` (validated; its joints are model joints) from a standing
+  // start. Never throws for a bad gait: a gait that breaks the model falls.
+  virtual GaitMeasures walk(const GaitFile& gait, const WalkSettings& settings) = 0;
+};
+
+class GaitSimulatorFactory {
+ public:
+  virtual ~GaitSimulatorFactory() = default;
+  virtual std::unique_ptr<GaitSimulator> make() const = 0;
+};
+
+}  // namespace animrt::evolve

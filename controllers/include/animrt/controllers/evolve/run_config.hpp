@@ -1,0 +1,53 @@
+#pragma once
+// The evolve run file (configs/evolve/*.yaml, format in docs/evolve.md):
+// grammar, model, seed gait, GE parameters, walk and fitness settings.
+// Relative paths are resolved against the run file's folder.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/evolve/fitness.hpp"
+#include "animrt/controllers/evolve/gait_simulator.hpp"
+#include "animrt/controllers/evolve/operators.hpp"
+
+namespace animrt::evolve {
+
+struct SearchSettings {
+  std::uint64_t seed = 1;
+  int population = 75;
+  int generations = 50;  // after the initial one (generations 0..N are evaluated)
+  int elites = 7;
+  int tournament = 3;
+  double crossover = 0.9;
+  double mutation = 0.02;
+  int max_wraps = 3;
+  InitSettings init;
+};
+
+// Curves free to move from a generation on (the paper's Table 3); the other
+// curves are held at their seed mean.
+struct FreedomStage {
+  int from_generation = 0;
+  std::vector<std::string> free;  // curve names of the seed gait
+  Location where;
+};
+
+struct RunConfig {
+  std::string file;
+  std::string name;
+  std::string grammar;  // path
+  std::string model;    // path (MJCF)
+  std::string
+      seed_gait;  // path: timing (froude), limbs, joint mapping, curve names in grammar order
+  SearchSettings search;
+  WalkSettings walk;
+  std::vector<WeightStage> weights;   // at least one, the first from generation 0
+  std::vector<FreedomStage> freedom;  // empty: every curve free all the time
+  int threads = 0;                    // 0: all cores
+};
+
+RunConfig load_run_config(const std::string& path);
+RunConfig parse_run_config(const std::string& text, const std::string& file_name);
+
+}  // namespace animrt::evolve

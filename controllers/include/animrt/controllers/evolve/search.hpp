@@ -1,0 +1,73 @@
+#pragma once
+// The GE search: ramped full/grow initial population, then per generation
+// elites (copied unchanged), tournament selection, fixed-point crossover and
+// int-flip mutation, generational replacement. Invalid individuals (mapping
+// ran out of wraps, or the phenotype is not a usable gait) score
+// kWorstFitness and are counted. Everything random comes from one Rng
+// seeded by the run file, and evaluation results do not depend on how they
+// were computed, so a seed always gives the same run.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/evolve/evaluator.hpp"
+#include "animrt/controllers/evolve/grammar.hpp"
+#include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/controllers/evolve/run_config.hpp"
+
+namespace animrt::evolve {
+
+struct GenerationStats {
+  int generation = 0;
+  double best = 0.0;     // lowest fitness
+  double average = 0.0;  // over the whole population, invalid and fallen included
+  double stddev = 0.0;
+  int invalid = 0;       // individuals that did not map to a usable gait
+  int fell = 0;          // valid individuals whose walk fell
+  int evaluations = 0;   // walks simulated this generation
+  double seconds = 0.0;  // wall time of this generation's evaluations
+  std::string best_phenotype;
+  GaitMeasures best_measures;
+};
+
+struct Individual {
+  Genome genome;
+  bool mapped = false;  // the genome mapped to a complete phenotype
+  bool valid = false;   // ... and that phenotype is a usable gait
+  std::string phenotype;
+  GaitFile gait;          // when valid
+  GaitMeasures measures;  // of the last walk
+  int stage = -1;         // freedom stage it was walked under (-1: not yet)
+  double fitness = kWorstFitness;
+};
+
+struct SearchResult {
+  std::vector<GenerationStats> history;
+  Individual best;  // best of the last generation
+  long evaluations = 0;
+  long invalid = 0;
+};
+
+class Search {
+ public:
+  // Checks the seed gait against the grammar's run file (freedom names,
+  // froude timing) and throws InputError on a mismatch.
+  Search(RunConfig config, Grammar grammar, GaitFile seed, ModelInfo model, Evaluator& evaluator);
+
+  SearchResult run(const std::function<void(const GenerationStats&)>& progress = {});
+
+ private:
+  int stage_at(int generation) const;
+  void evaluate(std::vector<Individual>& pop, int generation, GenerationStats& stats);
+
+  RunConfig config_;
+  Grammar grammar_;
+  GaitFile seed_;
+  ModelInfo model_;
+  Evaluator& evaluator_;
+  GaitTargets targets_;
+  std::vector<std::vector<std::string>> held_;  // per freedom stage
+};
+
+}  // namespace animrt::evolve

@@ -1,0 +1,31 @@
+#pragma once
+// Mono audio in memory, and WAV (or any libsndfile format) input/output.
+
+#include <string>
+#include <vector>
+
+namespace animrt::head {
+
+struct Audio {
+  int sample_rate = 0;
+  std::vector<float> samples;  // mono, nominally in [-1, 1]
+  double duration_s() const {
+    return sample_rate > 0 ? static_cast<double>(samples.size()) / sample_rate : 0.0;
+  }
+};
+
+// Reads an audio file through libsndfile, mixes it down to mono and, when
+// `target_rate` > 0 and differs, resamples it with libsamplerate. Throws
+// InputError naming the file for a missing, empty, truncated or non-audio
+// file.
+Audio load_audio(const std::string& path, int target_rate = 0);
+
+// Resamples with libsamplerate (band-limited sinc). Returns `in` unchanged
+// when the rates match.
+Audio resample(const Audio& in, int target_rate);
+
+// Writes 16-bit PCM WAV. Throws std::runtime_error when the file cannot be
+// written.
+void write_wav(const std::string& path, const Audio& audio);
+
+}  // namespace animrt::head

@@ -1,0 +1,80 @@
+#pragma once
+// The head as a MotionSource: speech (a bundled WAV played at real time, or
+// live ALSA capture) goes through the streaming synthesizer in blocks; the
+// Euler angles drive the neck joints (axis mapping, signs, scale, offsets,
+// clamped to the joint limits) and the speech energy opens the jaw.
+//
+// Timing: motion time t shows the pose of audio time t - latency_s, where
+// latency_s is the synthesizer's worst-case latency plus one block. When a
+// file is played, its sound is delayed by the same amount, so what is heard
+// and what moves stay in step; with live capture the head trails the voice
+// by latency_s.
+//
+// Robot file (motion section), see docs/head.md:
+//   motion:
+//     type: head
+//     model: ../head/model.txt
+//     audio: ../head/utterance.wav   # or  capture: default  (ALSA, live)
+//     playback: realtime             # or precomputed (same stream, run at load)
+//     repeat: true
+//     pause_s: 1.0
+//     audio_device: none             # ALSA playback: none, auto or a device name
+//     decoder_lag_s: 0.2
+//     axes:
+//       yaw:   {joint: neck_yaw, sign: 1, scale: 1.0, offset_deg: 0}
+//       pitch: {joint: neck_pitch, sign: 1}
+//       roll:  {joint: neck_roll, sign: 1}
+//     jaw: {joint: jaw, closed_deg: 0, open_deg: 20, energy_floor: 0.01, energy_full: 0.12}
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/core/joint.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt::head {
+
+struct HeadAxisMap {
+  std::string joint;  // empty: axis not driven
+  double sign = 1.0, scale = 1.0, offset_deg = 0.0;
+  Location where;
+};
+
+struct HeadJawMap {
+  std::string joint;  // empty: no jaw
+  double closed_deg = 0.0, open_deg = 20.0;
+  double energy_floor = 0.01, energy_full = 0.12;  // RMS energy: closed below, fully open above
+  Location where;
+};
+
+struct HeadMotionConfig {
+  std::string model;    // resolved path
+  std::string audio;    // resolved path, or empty with capture
+  std::string capture;  // ALSA capture device for live use, or empty
+  bool precomputed = false;
+  bool repeat = true;
+  double pause_s = 1.0;
+  std::string audio_device = "none";
+  double decoder_lag_s = 0.2;
+  double max_gap_s = 0.15;
+  double block_s = 0.01;
+  std::optional<double> noise_deg;
+  HeadAxisMap yaw, pitch, roll;
+  HeadJawMap jaw;
+  Location where;
+};
+
+// Reads the motion node of a robot file (type: head); paths are resolved
+// against the robot file's folder and must exist. InputError on any problem.
+HeadMotionConfig parse_head_motion(const YamlNode& motion, const std::string& robot_path);
+
+// Loads the model and audio (InputError naming the file on any problem) and
+// binds the axes to the robot's joints by name.
+std::unique_ptr<MotionSource> make_head_source(const HeadMotionConfig& config,
+                                               std::span<const JointSpec> joints);
+
+}  // namespace animrt::head

@@ -1,0 +1,80 @@
+#pragma once
+// Keyframe shows: per joint, keys (time, value) with an interpolation per
+// segment, a loop flag and an optional audio track with its start offset.
+//
+//   name: hello
+//   loop: true
+//   duration_s: 4          # default: the last key's time
+//   audio: {file: hello.wav, offset_s: 0.25}
+//   joints:
+//     jaw:
+//       interpolation: cubic        # default of this joint's segments
+//       keys:
+//         - [0.0, 0]                # [time_s, degrees]
+//         - [0.3, 14]
+//         - {t: 0.6, value: 2, interpolation: step}   # segment from this key on
+//
+// Interpolation of the segment that starts at a key: step (hold the key's
+// value), linear, or cubic: a Hermite cubic whose slope at each key is the
+// slope between its neighbours (zero at the ends of a non-looping show), so
+// velocity is continuous across consecutive cubic segments. A looping show
+// wraps from its last key to its first at duration_s.
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+
+enum class Interpolation { step, linear, cubic };
+
+struct ShowKey {
+  double t = 0.0;                                      // s
+  double value = 0.0;                                  // rad (file: degrees)
+  Interpolation interpolation = Interpolation::cubic;  // of the segment from this key
+  Location where;
+};
+
+struct ShowTrack {
+  std::string joint;
+  std::vector<ShowKey> keys;  // strictly increasing t, at least one
+  Location where;
+};
+
+struct ShowAudio {
+  std::string file;       // resolved against the show file's folder
+  double offset_s = 0.0;  // show time at which the audio starts
+};
+
+struct ShowFile {
+  std::string file;
+  std::string name;
+  bool loop = false;
+  double duration_s = 0.0;
+  bool has_audio = false;
+  ShowAudio audio;
+  std::vector<ShowTrack> tracks;
+};
+
+// Loads and validates a show file (InputError with file, line, column, key).
+ShowFile load_show_file(const std::string& path);
+
+// Binds a show to the robot's joints (an unknown joint, or a key outside the
+// joint's limits, is an InputError at the key). sample() is allocation-free.
+std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
+                                               std::span<const JointSpec> joints);
+std::unique_ptr<MotionSource> load_show_source(const std::string& path,
+                                               std::span<const JointSpec> joints);
+
+// Layers: each source in order writes the joints it drives, so a later layer
+// overrides an earlier one on the joints they share (e.g. a show for eyes and
+// jaw on top of a gait or head motion for the neck).
+std::unique_ptr<MotionSource> make_layered_source(
+    std::vector<std::unique_ptr<MotionSource>> layers);
+
+}  // namespace animrt

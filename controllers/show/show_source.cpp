@@ -1,0 +1,193 @@
+// A show bound to a robot's joints, and layers of motion sources.
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "animrt/controllers/show/show_file.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt {
+namespace {
+
+class ShowSource final : public MotionSource {
+ public:
+  struct Track {
+    int joint = 0;
+    std::vector<ShowKey> keys;
+    std::vector<double> slope;  // rad/s at each key (cubic tangents)
+  };
+
+  ShowSource(std::vector<Track> tracks, bool loop, double duration)
+      : tracks_(std::move(tracks)), loop_(loop), duration_(duration) {
+    for (const Track& t : tracks_) driven_.push_back(t.joint);
+  }
+
+  std::span<const int> driven_joints() const override { return driven_; }
+
+  void sample(double t, std::span<double> targets) const override {
+    if (loop_) {
+      t = std::fmod(t, duration_);
+      if (t < 0) t += duration_;
+    }
+    for (const Track& track : tracks_) {
+      if (static_cast<std::size_t>(track.joint) < targets.size()) {
+        targets[static_cast<std::size_t>(track.joint)] = eval(track, t);
+      }
+    }
+  }
+
+ private:
+  double eval(const Track& tr, double t) const {
+    const auto& k = tr.keys;
+    const std::size_t n = k.size();
+    if (n == 1) return k[0].value;
+    // Segment [i, i+1); before the first key: hold it (or, looping, the wrap
+    // segment from the last key); after the last: hold it or wrap.
+    std::size_t i;
+    double t0, t1, v0, v1, s0, s1;
+    if (t < k[0].t || t >= k[n - 1].t) {
+      if (!loop_) return t < k[0].t ? k[0].value : k[n - 1].value;
+      i = n - 1;
+      t0 = k[n - 1].t;
+      t1 = k[0].t + duration_;
+      if (t < k[0].t) t += duration_;
+      v0 = k[n - 1].value;
+      v1 = k[0].value;
+      s0 = tr.slope[n - 1];
+      s1 = tr.slope[0];
+    } else {
+      // Last key with k.t <= t (binary search, no allocation).
+      i = static_cast<std::size_t>(
+              std::upper_bound(k.begin(), k.end(), t,
+                               [](double x, const ShowKey& key) { return x < key.t; }) -
+              k.begin()) -
+          1;
+      t0 = k[i].t;
+      t1 = k[i + 1].t;
+      v0 = k[i].value;
+      v1 = k[i + 1].value;
+      s0 = tr.slope[i];
+      s1 = tr.slope[i + 1];
+    }
+    const double h = t1 - t0;
+    if (!(h > 0)) return v0;
+    const double u = (t - t0) / h;
+    switch (k[i].interpolation) {
+      case Interpolation::step:
+        return v0;
+      case Interpolation::linear:
+        return v0 + (v1 - v0) * u;
+      case Interpolation::cubic: {
+        const double u2 = u * u, u3 = u2 * u;
+        return (2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * h * s0 + (-2 * u3 + 3 * u2) * v1 +
+               (u3 - u2) * h * s1;
+      }
+    }
+    return v0;
+  }
+
+  std::vector<Track> tracks_;
+  bool loop_;
+  double duration_;
+  std::vector<int> driven_;
+};
+
+// Slopes for cubic segments: the slope between the neighbours of each key
+// (so consecutive cubic segments share it: continuous velocity); zero at the
+// ends of a non-looping show; wrapping for a looping one.
+std::vector<double> slopes(const std::vector<ShowKey>& k, bool loop, double duration) {
+  const std::size_t n = k.size();
+  std::vector<double> s(n, 0.0);
+  if (n < 2) return s;
+  for (std::size_t i = 0; i < n; ++i) {
+    double tp, vp, tn, vn;
+    if (i > 0) {
+      tp = k[i - 1].t;
+      vp = k[i - 1].value;
+    } else if (loop) {
+      tp = k[n - 1].t - duration;
+      vp = k[n - 1].value;
+    } else {
+      continue;
+    }
+    if (i + 1 < n) {
+      tn = k[i + 1].t;
+      vn = k[i + 1].value;
+    } else if (loop) {
+      tn = k[0].t + duration;
+      vn = k[0].value;
+    } else {
+      continue;
+    }
+    s[i] = tn > tp ? (vn - vp) / (tn - tp) : 0.0;
+  }
+  return s;
+}
+
+class LayeredSource final : public MotionSource {
+ public:
+  explicit LayeredSource(std::vector<std::unique_ptr<MotionSource>> layers)
+      : layers_(std::move(layers)) {
+    for (const auto& l : layers_) {
+      for (int j : l->driven_joints()) {
+        if (std::find(driven_.begin(), driven_.end(), j) == driven_.end()) driven_.push_back(j);
+      }
+    }
+  }
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double t, std::span<double> targets) const override {
+    for (const auto& l : layers_) l->sample(t, targets);
+  }
+
+ private:
+  std::vector<std::unique_ptr<MotionSource>> layers_;
+  std::vector<int> driven_;
+};
+
+}  // namespace
+
+std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
+                                               std::span<const JointSpec> joints) {
+  std::vector<ShowSource::Track> tracks;
+  for (const ShowTrack& st : show.tracks) {
+    ShowSource::Track t;
+    t.joint = -1;
+    std::string names;
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      names += (names.empty() ? "" : ", ") + joints[j].name;
+      if (joints[j].name == st.joint) t.joint = static_cast<int>(j);
+    }
+    if (t.joint < 0) {
+      throw InputError(
+          st.where, "joints." + st.joint,
+          "no joint named '" + st.joint + "' in the robot (its joints: " + names + ")");
+    }
+    const JointLimits& lim = joints[static_cast<std::size_t>(t.joint)].limits;
+    for (const ShowKey& k : st.keys) {
+      if (k.value < lim.min_position - 1e-9 || k.value > lim.max_position + 1e-9) {
+        throw InputError(
+            k.where, "joints." + st.joint + ".keys",
+            "key at " + format_number(k.t) + " s is " + format_number(rad_to_deg(k.value)) +
+                " deg, outside the joint's limits " + format_number(rad_to_deg(lim.min_position)) +
+                ".." + format_number(rad_to_deg(lim.max_position)) + " deg");
+      }
+    }
+    t.keys = st.keys;
+    t.slope = slopes(st.keys, show.loop, show.duration_s);
+    tracks.push_back(std::move(t));
+  }
+  return std::make_unique<ShowSource>(std::move(tracks), show.loop, show.duration_s);
+}
+
+std::unique_ptr<MotionSource> load_show_source(const std::string& path,
+                                               std::span<const JointSpec> joints) {
+  return make_show_source(load_show_file(path), joints);
+}
+
+std::unique_ptr<MotionSource> make_layered_source(
+    std::vector<std::unique_ptr<MotionSource>> layers) {
+  return std::make_unique<LayeredSource>(std::move(layers));
+}
+
+}  // namespace animrt

@@ -1,0 +1,111 @@
+#pragma once
+// Master side of CANopen CiA 402 drives in cyclic synchronous position mode.
+//
+// configure(): per drive, expedited SDOs check the device type (402), set the
+// heartbeat producer time, the mode (CSP) and the PDO mapping (RPDO1:
+// controlword + target position; TPDO1: statusword + position actual, both
+// synchronous), read the position, then NMT start. activate(): walks the
+// controlword state machine to Operation Enabled (fault reset first if the
+// drive is in Fault) with the target held at the actual position.
+// Each cycle read() produces SYNC and collects every TPDO (one deadline);
+// write() sends each RPDO, applied by the drives at the next SYNC.
+// deactivate(): back down to Switch On Disabled, NMT pre-operational.
+//
+// Supervision: the heartbeat consumer marks a drive timed out when no
+// heartbeat came for heartbeat_timeout_ms (bus time). A boot-up message in
+// the middle of a run (the drive rebooted), an EMCY with a non-zero code, a
+// statusword in Fault, or a drive that left Operation Enabled by itself make
+// the device a hardware error, which the runtime's safety filter answers by
+// ramping every other joint home.
+
+#include <chrono>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/can/can_options.hpp"
+#include "animrt/bridge/can/can_transport.hpp"
+#include "animrt/bridge/can/canopen.hpp"
+#include "animrt/bridge/can/cia402.hpp"
+
+namespace animrt {
+
+class Cia402Bus final : public ActuatorBus {
+ public:
+  static constexpr int kTries = 3;              // per SDO
+  static constexpr int kStateMachineSteps = 8;  // SYNC cycles to reach a state
+
+  Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transport);
+
+  const BusConfig& config() const override { return config_; }
+  void configure() override;
+  void activate() override;
+  void deactivate() override;
+  void read(std::span<double> positions) override;
+  void write(std::span<const double> positions) override;
+  std::span<DeviceStatus> devices() override { return status_; }
+
+  // What the runtime knows about each drive.
+  struct DriveReport {
+    cia402::State state = cia402::State::not_ready_to_switch_on;
+    std::uint16_t statusword = 0;
+    canopen::NmtState nmt = canopen::NmtState::pre_operational;
+    canopen::Emcy last_emcy;  // code 0 if none
+    std::uint64_t emcy_count = 0;
+    std::uint64_t reboots = 0;  // boot-up messages after configure()
+    std::uint64_t heartbeats = 0;
+    bool heartbeat_lost = false;
+  };
+  const DriveReport& drive(std::size_t device) const { return drive_[device]; }
+  const CanFrameTransport& transport() const { return *transport_; }
+  // "EMCY 0x2310 (current), error register 0x03" or "" for one device.
+  std::string fault_text(std::size_t device) const;
+
+  // One SDO transaction (configuration; not for the cycle). Returns the
+  // uploaded value; throws DeviceError naming the object and the abort code.
+  std::uint32_t sdo_read(std::size_t device, std::uint16_t index, std::uint8_t sub);
+  void sdo_write(std::size_t device, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
+                 std::uint8_t size);
+  void nmt(canopen::NmtCommand command, std::size_t device);
+
+ private:
+  // Sends SYNC and collects TPDOs of the drives in expect_ (one deadline).
+  void sync_cycle();
+  void handle(const can_frame& frame);
+  void supervise();
+  void send_rpdo(std::size_t device, std::uint16_t controlword, std::int32_t target);
+  // Runs SYNC cycles until every non-faulted drive is in `goal` (or steps
+  // run out); returns the drives that did not get there.
+  std::string walk_to(cia402::State goal);
+  int slot_of(canid_t cob, canid_t base) const;
+  std::string prefix() const;
+  std::string describe(std::size_t device) const;
+
+  BusConfig config_;
+  Cia402BusOptions options_;
+  std::unique_ptr<CanFrameTransport> transport_;
+  std::chrono::microseconds timeout_;
+  Nanos heartbeat_timeout_ns_;
+
+  std::vector<DeviceStatus> status_;
+  std::vector<DriveReport> drive_;
+  std::vector<std::int32_t> actual_counts_;
+  std::vector<std::int32_t> target_counts_;
+  std::vector<std::uint16_t> controlword_;
+  std::vector<Nanos> last_heartbeat_;
+  std::vector<std::uint8_t> expect_;       // TPDO awaited this cycle
+  std::vector<std::uint8_t> hw_fault_;     // sticky hardware error (EMCY, reboot, fault state)
+  std::vector<int> slot_of_node_;          // node id -> device index
+  std::vector<double> min_rad_, max_rad_;  // goals that stay inside int32 counts
+  bool running_ = false;                   // between activate() and deactivate(): OE expected
+  bool fresh_ = false;
+
+  // SDO exchange in flight (configuration only).
+  int sdo_slot_ = -1;
+  bool sdo_done_ = false;
+  canopen::Sdo sdo_answer_;
+};
+
+}  // namespace animrt

@@ -1,0 +1,123 @@
+#pragma once
+// Master side of Modbus drives (RTU over serial or TCP, through libmodbus),
+// each joint described by a register map.
+//
+// Per cycle: read() sends, per slave and register table, ONE Read Holding /
+// Read Input Registers request covering every present and status register
+// of that slave's joints; write() sends, per slave, one Write Multiple
+// Registers per contiguous run of goal registers (one request when the goals
+// are contiguous). Exceptions, CRC errors and timeouts are counted per
+// device; a status register with fault bits set is a hardware error.
+//
+// A TCP connection that drops is closed and reopened with exponential
+// backoff (reconnect_min_s doubling to reconnect_max_s); in between, every
+// device counts a timeout per cycle and nothing blocks, so the watchdog
+// faults the devices only if the connection stays down.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/modbus/register_map.hpp"
+
+struct _modbus;
+
+namespace animrt {
+
+// BusConfig::options of a modbus-tcp or modbus-rtu bus.
+struct ModbusBusOptions {
+  bool tcp = true;
+  char parity = 'N';  // RTU: N, E or O
+  int stop_bits = 1;  // RTU
+  double reconnect_min_s = 0.1;
+  double reconnect_max_s = 2.0;
+};
+
+// ActuatorBinding::options of a Modbus joint:
+//   map value (SI, map->unit) = zero + per_rad * joint angle (rad).
+struct ModbusJointOptions {
+  int slave = 1;
+  std::shared_ptr<const modbus::RegisterMap> map;
+  double per_rad = 1.0;  // 1 for maps in rad; metres per radian for a linear actuator on a lever
+  double zero = 0.0;
+};
+
+class ModbusBus final : public ActuatorBus {
+ public:
+  // Plans the requests. Throws DeviceError for joints without a register
+  // map, registers of one slave that overlap or span more than one request.
+  explicit ModbusBus(BusConfig config);
+  ~ModbusBus() override;
+  ModbusBus(const ModbusBus&) = delete;
+  ModbusBus& operator=(const ModbusBus&) = delete;
+
+  const BusConfig& config() const override { return config_; }
+  // Connects and reads every slave; throws DeviceError listing each slave
+  // that did not answer (and why).
+  void configure() override;
+  // Goal = present, then the enable coil/register on; throws on failure.
+  void activate() override;
+  // Enable off, best effort.
+  void deactivate() override;
+  void read(std::span<double> positions) override;
+  void write(std::span<const double> positions) override;
+  std::span<DeviceStatus> devices() override { return status_; }
+
+  std::uint64_t reconnects() const { return reconnects_; }
+  bool connected() const { return connected_; }
+  // Requests sent so far (for tests that count them).
+  std::uint64_t requests() const { return requests_; }
+
+ private:
+  struct Read {
+    modbus::Table table;
+    int begin = 0, count = 0;
+    std::vector<std::uint16_t> words;
+  };
+  struct Write {
+    int begin = 0, count = 0;
+    std::vector<std::uint16_t> words;
+  };
+  struct Slave {
+    int id = 0;
+    std::vector<std::size_t> devices;
+    std::vector<Read> reads;
+    std::vector<Write> writes;
+  };
+  enum class Failure : std::uint8_t { none, timeout, exception, crc, protocol, connection };
+
+  bool ensure_connected(bool blocking);
+  void disconnect();
+  Failure classify(int error) const;
+  // Counts a failed request against the slave's devices; returns the failure.
+  Failure fail_slave(const Slave& slave, int error);
+  bool read_slave(Slave& slave, bool count);
+  const std::uint16_t* words_of(const Slave& slave, const modbus::Register& r) const;
+  bool write_slave(Slave& slave);
+  bool set_enable(Slave& slave, bool on, int* error);
+  std::string prefix() const;
+
+  BusConfig config_;
+  ModbusBusOptions options_;
+  std::vector<ModbusJointOptions> joints_;
+  std::vector<Slave> slaves_;
+  std::vector<DeviceStatus> status_;
+  std::vector<double> present_rad_;
+  std::vector<double> goal_rad_;
+  std::vector<std::uint8_t> answered_;
+  _modbus* ctx_ = nullptr;
+  bool connected_ = false;
+  bool fresh_ = false;
+  std::chrono::steady_clock::time_point next_attempt_{};
+  double backoff_s_ = 0.0;
+  std::uint64_t reconnects_ = 0;
+  std::uint64_t requests_ = 0;
+  std::string host_;
+  int tcp_port_ = 0;
+};
+
+}  // namespace animrt

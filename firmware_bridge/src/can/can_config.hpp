@@ -1,0 +1,16 @@
+#pragma once
+// Robot-file keys both CAN protocol modules share.
+
+#include <string_view>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt::can_config {
+
+// interface (required), bitrate, timeout_ms.
+void read_common_bus(const YamlNode& node, BusConfig& bus);
+// 1 or -1.
+int read_direction(const YamlNode& node);
+
+}  // namespace animrt::can_config

@@ -1,0 +1,97 @@
+// "cia402": CANopen CiA 402 drives (cyclic synchronous position) as a
+// protocol module.
+
+#include <cmath>
+#include <limits>
+
+#include "animrt/bridge/can/can_options.hpp"
+#include "animrt/bridge/can/can_protocols.hpp"
+#include "animrt/bridge/can/canopen.hpp"
+#include "animrt/bridge/can/cia402_bus.hpp"
+#include "can_config.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr std::string_view kBusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
+                                         "heartbeat_timeout_ms"};
+constexpr std::string_view kActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
+                                              "direction"};
+
+class Cia402 final : public Protocol {
+ public:
+  std::string_view name() const override { return "cia402"; }
+  bool shares_port() const override { return true; }
+  std::span<const std::string_view> bus_keys() const override { return kBusKeys; }
+  std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+
+  void read_bus(const YamlNode& node, BusConfig& bus) const override {
+    can_config::read_common_bus(node, bus);
+    Cia402BusOptions options;
+    if (auto n = node.find("heartbeat_ms"))
+      options.heartbeat_ms = static_cast<int>(n->as_int_in(1, 65535));
+    options.heartbeat_timeout_ms = 3 * options.heartbeat_ms;
+    if (auto n = node.find("heartbeat_timeout_ms")) {
+      options.heartbeat_timeout_ms = static_cast<int>(n->as_int_in(1, 655350));
+      if (options.heartbeat_timeout_ms <= options.heartbeat_ms) {
+        n->fail("expected more than heartbeat_ms (" + std::to_string(options.heartbeat_ms) +
+                "), found " + n->describe());
+      }
+    }
+    bus.options = options;
+  }
+
+  void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,
+                     const BusConfig& bus, ActuatorBinding& out) const override {
+    const YamlNode id_node = node.at("node_id");
+    const std::int64_t id = id_node.as_int();
+    if (id < 1 || id > canopen::kMaxNodeId) {
+      id_node.fail("expected a CANopen node id from 1 to 127, found " + id_node.describe());
+    }
+    for (const auto& other : bus.actuators) {
+      if (other.device_id == id) {
+        id_node.fail("node id " + std::to_string(id) + " is already used by joint " + other.joint +
+                     " on bus " + bus.name);
+      }
+    }
+    out.device_id = static_cast<int>(id);
+    double counts_per_rev = 4096.0;
+    if (auto n = node.find("counts_per_rev")) counts_per_rev = n->as_positive_double();
+    out.ticks_per_rad = counts_per_rev / (2.0 * kPi);
+    out.zero_ticks = 0;
+    if (auto n = node.find("zero_counts")) {
+      out.zero_ticks = static_cast<std::int32_t>(n->as_int_in(
+          std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
+    }
+    if (auto n = node.find("direction")) out.direction = can_config::read_direction(*n);
+    const auto check = [&](const char* key, double rad) {
+      const double counts = std::round(out.zero_ticks + out.direction * rad * out.ticks_per_rad);
+      if (counts < std::numeric_limits<std::int32_t>::min() ||
+          counts > std::numeric_limits<std::int32_t>::max()) {
+        limits_node.at(key).fail(format_number(rad_to_deg(rad)) +
+                                 " deg maps outside the 32-bit target position range");
+      }
+    };
+    check("min_deg", joint.limits.min_position);
+    check("max_deg", joint.limits.max_position);
+  }
+
+  std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
+    std::unique_ptr<CanFrameTransport> transport;
+    try {
+      transport = open_can(config.port);
+    } catch (const DeviceError& e) {
+      throw DeviceError("bus " + config.name + ": " + e.what());
+    }
+    return std::make_unique<Cia402Bus>(config, std::move(transport));
+  }
+};
+
+}  // namespace
+
+const Protocol& cia402_protocol() {
+  static const Cia402 protocol;
+  return protocol;
+}
+
+}  // namespace animrt

@@ -1,0 +1,439 @@
+#include "animrt/bridge/modbus/modbus_bus.hpp"
+
+#include <modbus.h>
+
+#include <algorithm>
+#include <any>
+#include <cerrno>
+#include <cmath>
+#include <utility>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+namespace {
+
+using std::chrono::steady_clock;
+constexpr int kMaxReadWords = 125;   // Read (Holding|Input) Registers
+constexpr int kMaxWriteWords = 123;  // Write Multiple Registers
+constexpr int kTries = 3;            // lifecycle requests only
+
+std::string exception_name(int code) {
+  switch (code) {
+    case MODBUS_EXCEPTION_ILLEGAL_FUNCTION:
+      return "illegal function";
+    case MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS:
+      return "illegal data address";
+    case MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE:
+      return "illegal data value";
+    case MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE:
+      return "slave device failure";
+    case MODBUS_EXCEPTION_SLAVE_OR_SERVER_BUSY:
+      return "slave device busy";
+    case MODBUS_EXCEPTION_GATEWAY_TARGET:
+      return "gateway target failed to respond";
+    default:
+      return "exception " + std::to_string(code);
+  }
+}
+
+}  // namespace
+
+ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
+  const std::string bus = "bus " + config_.name + ": ";
+  if (const auto* o = std::any_cast<ModbusBusOptions>(&config_.options)) options_ = *o;
+  const std::size_t n = config_.actuators.size();
+  joints_.resize(n);
+  status_.resize(n);
+  present_rad_.assign(n, 0.0);
+  goal_rad_.assign(n, 0.0);
+  answered_.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const ActuatorBinding& b = config_.actuators[i];
+    const auto* j = std::any_cast<ModbusJointOptions>(&b.options);
+    if (j == nullptr || !j->map) throw DeviceError(bus + b.joint + " has no register map");
+    joints_[i] = *j;
+    auto slave = std::find_if(slaves_.begin(), slaves_.end(),
+                              [&](const Slave& s) { return s.id == j->slave; });
+    if (slave == slaves_.end()) {
+      slaves_.push_back(Slave{});
+      slaves_.back().id = j->slave;
+      slave = slaves_.end() - 1;
+    }
+    slave->devices.push_back(i);
+  }
+  // Requests per slave: one read per table over every present/status
+  // register, one write per contiguous run of goal registers.
+  for (Slave& s : slaves_) {
+    for (modbus::Table table : {modbus::Table::holding, modbus::Table::input}) {
+      int lo = 1 << 20, hi = -1;
+      for (std::size_t d : s.devices) {
+        const modbus::RegisterMap& m = *joints_[d].map;
+        auto cover = [&](const modbus::Register& r) {
+          if (r.table != table) return;
+          lo = std::min(lo, r.address);
+          hi = std::max(hi, r.end());
+        };
+        cover(m.present);
+        if (m.has_status) cover(m.status);
+      }
+      if (hi < 0) continue;
+      if (hi - lo > kMaxReadWords) {
+        throw DeviceError(bus + "the " + std::string(modbus::to_string(table)) +
+                          " registers read from slave " + std::to_string(s.id) + " span " +
+                          std::to_string(hi - lo) + " registers, more than one request can read (" +
+                          std::to_string(kMaxReadWords) + ")");
+      }
+      Read r;
+      r.table = table;
+      r.begin = lo;
+      r.count = hi - lo;
+      r.words.assign(static_cast<std::size_t>(r.count), 0);
+      s.reads.push_back(std::move(r));
+    }
+    std::vector<std::pair<int, int>> goals;
+    for (std::size_t d : s.devices)
+      goals.push_back({joints_[d].map->goal.address, joints_[d].map->goal.end()});
+    std::sort(goals.begin(), goals.end());
+    for (std::size_t k = 0; k < goals.size(); ++k) {
+      if (k > 0 && goals[k].first < goals[k - 1].second) {
+        throw DeviceError(bus + "two joints on slave " + std::to_string(s.id) +
+                          " write the same goal register " + std::to_string(goals[k].first));
+      }
+      if (!s.writes.empty() && s.writes.back().begin + s.writes.back().count == goals[k].first &&
+          s.writes.back().count + (goals[k].second - goals[k].first) <= kMaxWriteWords) {
+        s.writes.back().count += goals[k].second - goals[k].first;
+      } else {
+        Write w;
+        w.begin = goals[k].first;
+        w.count = goals[k].second - goals[k].first;
+        s.writes.push_back(std::move(w));
+      }
+    }
+    for (Write& w : s.writes) w.words.assign(static_cast<std::size_t>(w.count), 0);
+  }
+
+  if (options_.tcp) {
+    const auto colon = config_.port.rfind(':');
+    if (colon == std::string::npos)
+      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+    host_ = config_.port.substr(0, colon);
+    try {
+      tcp_port_ = std::stoi(config_.port.substr(colon + 1));
+    } catch (...) {
+      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+    }
+    ctx_ = modbus_new_tcp(host_.c_str(), tcp_port_);
+  } else {
+    ctx_ =
+        modbus_new_rtu(config_.port.c_str(), config_.baud, options_.parity, 8, options_.stop_bits);
+  }
+  if (ctx_ == nullptr) throw DeviceError(bus + "libmodbus: " + modbus_strerror(errno));
+  // We reconnect ourselves, with backoff; libmodbus's own recovery sleeps.
+  modbus_set_error_recovery(ctx_, MODBUS_ERROR_RECOVERY_NONE);
+  const auto us = static_cast<std::uint32_t>(std::ceil(config_.timeout_s * 1e6));
+  modbus_set_response_timeout(ctx_, us / 1'000'000, us % 1'000'000);
+  modbus_set_byte_timeout(ctx_, us / 1'000'000, us % 1'000'000);
+}
+
+ModbusBus::~ModbusBus() {
+  if (ctx_ != nullptr) {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+  }
+}
+
+std::string ModbusBus::prefix() const {
+  return "bus " + config_.name + " (" + config_.port + "): ";
+}
+
+void ModbusBus::disconnect() {
+  if (connected_) modbus_close(ctx_);
+  connected_ = false;
+}
+
+bool ModbusBus::ensure_connected(bool blocking) {
+  if (connected_) return true;
+  const auto now = steady_clock::now();
+  if (!blocking && now < next_attempt_) return false;
+  if (modbus_connect(ctx_) == 0) {
+    connected_ = true;
+    backoff_s_ = 0.0;
+    ++reconnects_;
+    return true;
+  }
+  modbus_close(ctx_);
+  backoff_s_ = backoff_s_ == 0.0 ? options_.reconnect_min_s
+                                 : std::min(2 * backoff_s_, options_.reconnect_max_s);
+  next_attempt_ = now + std::chrono::duration_cast<steady_clock::duration>(
+                            std::chrono::duration<double>(backoff_s_));
+  return false;
+}
+
+ModbusBus::Failure ModbusBus::classify(int error) const {
+  if (error > MODBUS_ENOBASE && error <= EMBXGTAR) return Failure::exception;
+  if (error == EMBBADCRC) return Failure::crc;
+  if (error == ETIMEDOUT) return Failure::timeout;
+  if (error == EMBBADDATA || error == EMBBADEXC || error == EMBUNKEXC || error == EMBMDATA ||
+      error == EMBBADSLAVE) {
+    return Failure::protocol;
+  }
+  return Failure::connection;  // ECONNRESET, EPIPE, EBADF, ...: the link is gone
+}
+
+ModbusBus::Failure ModbusBus::fail_slave(const Slave& slave, int error) {
+  const Failure f = classify(error);
+  for (std::size_t d : slave.devices) {
+    DeviceStatus& st = status_[d];
+    if (st.faulted) continue;
+    switch (f) {
+      case Failure::exception:
+        ++st.exceptions;
+        st.last_error_byte = static_cast<std::uint8_t>(error - MODBUS_ENOBASE);
+        st.health = DeviceHealth::protocol_error;
+        break;
+      case Failure::crc:
+        ++st.crc_errors;
+        st.health = DeviceHealth::protocol_error;
+        break;
+      case Failure::protocol:
+        ++st.protocol_errors;
+        st.health = DeviceHealth::protocol_error;
+        break;
+      case Failure::timeout:
+      case Failure::connection:
+      case Failure::none:
+        ++st.timeouts;
+        st.health = DeviceHealth::timeout;
+        break;
+    }
+  }
+  if (f == Failure::connection && options_.tcp) {
+    disconnect();
+    next_attempt_ =
+        steady_clock::now() + std::chrono::duration_cast<steady_clock::duration>(
+                                  std::chrono::duration<double>(options_.reconnect_min_s));
+    backoff_s_ = options_.reconnect_min_s;
+  }
+  return f;
+}
+
+const std::uint16_t* ModbusBus::words_of(const Slave& slave, const modbus::Register& r) const {
+  for (const Read& rd : slave.reads) {
+    if (rd.table == r.table && r.address >= rd.begin && r.end() <= rd.begin + rd.count) {
+      return rd.words.data() + (r.address - rd.begin);
+    }
+  }
+  return nullptr;
+}
+
+bool ModbusBus::read_slave(Slave& slave, bool count) {
+  bool any = false;
+  for (std::size_t d : slave.devices) {
+    answered_[d] = 0;
+    if (status_[d].faulted) continue;
+    any = true;
+    if (count) ++status_[d].transactions;
+  }
+  if (!any) return true;
+  for (Read& r : slave.reads) {
+    if (!connected_) return false;
+    modbus_set_slave(ctx_, slave.id);
+    ++requests_;
+    const int rc = r.table == modbus::Table::holding
+                       ? modbus_read_registers(ctx_, r.begin, r.count, r.words.data())
+                       : modbus_read_input_registers(ctx_, r.begin, r.count, r.words.data());
+    if (rc != r.count) {
+      const int error = rc < 0 ? errno : EMBMDATA;
+      if (count) {
+        fail_slave(slave, error);
+      } else if (classify(error) == Failure::connection && options_.tcp) {
+        disconnect();
+      }
+      if (!count)
+        status_[slave.devices[0]].last_error_byte =
+            classify(error) == Failure::exception
+                ? static_cast<std::uint8_t>(error - MODBUS_ENOBASE)
+                : 0;
+      return false;
+    }
+  }
+  for (std::size_t d : slave.devices) {
+    if (status_[d].faulted) continue;
+    const modbus::RegisterMap& m = *joints_[d].map;
+    const ModbusJointOptions& j = joints_[d];
+    DeviceStatus& st = status_[d];
+    present_rad_[d] = (m.present.decode(words_of(slave, m.present)) - j.zero) / j.per_rad;
+    answered_[d] = 1;
+    st.health = DeviceHealth::ok;
+    if (m.has_status) {
+      const std::uint16_t value = *words_of(slave, m.status);
+      const std::uint16_t faults = value & m.fault_mask;
+      st.hardware_error_status = static_cast<std::uint8_t>(faults & 0xFF);
+      if (faults != 0) {
+        if (count) ++st.hardware_errors;
+        st.health = DeviceHealth::hardware_error;
+      }
+    }
+  }
+  return true;
+}
+
+bool ModbusBus::write_slave(Slave& slave) {
+  for (std::size_t d : slave.devices) {
+    if (status_[d].faulted) return true;  // a faulted drive is left alone
+  }
+  for (std::size_t d : slave.devices) {
+    const modbus::RegisterMap& m = *joints_[d].map;
+    const ModbusJointOptions& j = joints_[d];
+    for (Write& w : slave.writes) {
+      if (m.goal.address >= w.begin && m.goal.end() <= w.begin + w.count) {
+        m.goal.encode(j.zero + j.per_rad * goal_rad_[d],
+                      w.words.data() + (m.goal.address - w.begin));
+      }
+    }
+  }
+  for (Write& w : slave.writes) {
+    if (!connected_) return false;
+    modbus_set_slave(ctx_, slave.id);
+    ++requests_;
+    if (modbus_write_registers(ctx_, w.begin, w.count, w.words.data()) != w.count) {
+      fail_slave(slave, errno);
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
+  for (std::size_t d : slave.devices) {
+    const modbus::Enable& e = joints_[d].map->enable;
+    if (!e.configured) continue;
+    modbus_set_slave(ctx_, slave.id);
+    const std::uint16_t value = on ? e.on : e.off;
+    const int rc = e.coil ? modbus_write_bit(ctx_, e.address, value)
+                          : modbus_write_register(ctx_, e.address, value);
+    if (rc != 1) {
+      *error = errno;
+      return false;
+    }
+  }
+  return true;
+}
+
+// ---- lifecycle --------------------------------------------------------------
+
+void ModbusBus::configure() {
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    status_[i] = DeviceStatus{};
+    status_[i].device_id = joints_[i].slave;
+  }
+  if (!ensure_connected(true)) {
+    throw DeviceError(prefix() + "cannot connect: " + modbus_strerror(errno));
+  }
+  std::string failed;
+  for (Slave& s : slaves_) {
+    bool ok = false;
+    int tries = 0;
+    for (; tries < kTries && !ok; ++tries) {
+      if (!connected_) ensure_connected(true);
+      ok = read_slave(s, false);
+    }
+    if (ok) continue;
+    const std::uint8_t code = status_[s.devices[0]].last_error_byte;
+    std::string joints;
+    for (std::size_t d : s.devices)
+      joints += (joints.empty() ? "" : ", ") + config_.actuators[d].joint;
+    failed += (failed.empty() ? "" : "; ") + std::string("slave ") + std::to_string(s.id) + " (" +
+              joints + "): " +
+              (code ? "exception " + std::to_string(code) + " (" + exception_name(code) + ")"
+                    : std::string("no answer"));
+  }
+  if (!failed.empty()) throw DeviceError(prefix() + "cannot read " + failed);
+  for (Slave& s : slaves_) {
+    for (std::size_t d : s.devices) {
+      if (status_[d].health == DeviceHealth::hardware_error) {
+        const auto& m = *joints_[d].map;
+        throw DeviceError(prefix() + "slave " + std::to_string(s.id) + " (" +
+                          config_.actuators[d].joint +
+                          ") reports faults: " + m.fault_text(status_[d].hardware_error_status));
+      }
+    }
+  }
+  goal_rad_ = present_rad_;
+  fresh_ = true;
+}
+
+void ModbusBus::activate() {
+  for (Slave& s : slaves_) {
+    bool ok = false;
+    int error = 0;
+    for (int t = 0; t < kTries && !ok; ++t) {
+      if (!connected_) ensure_connected(true);
+      ok = write_slave(s);  // goal = present: enabling cannot make it jump
+      if (ok) ok = set_enable(s, true, &error);
+      if (!ok && error == 0) error = errno;
+    }
+    if (!ok) {
+      const std::string why = classify(error) == Failure::exception
+                                  ? exception_name(error - MODBUS_ENOBASE)
+                                  : std::string(modbus_strerror(error));
+      deactivate();
+      throw DeviceError(prefix() + "cannot enable slave " + std::to_string(s.id) + ": " + why);
+    }
+  }
+}
+
+void ModbusBus::deactivate() {
+  if (!connected_ && !ensure_connected(true)) return;
+  for (Slave& s : slaves_) {
+    int error = 0;
+    if (!set_enable(s, false, &error) && classify(error) == Failure::connection) return;
+  }
+}
+
+// ---- cycle ----------------------------------------------------------------
+
+void ModbusBus::read(std::span<double> positions) {
+  const std::size_t n = std::min(positions.size(), status_.size());
+  if (fresh_) {
+    for (std::size_t i = 0; i < n; ++i) positions[i] = present_rad_[i];
+    fresh_ = false;
+  }
+  if (!ensure_connected(false)) {
+    // Down and waiting for the next attempt: no answer this cycle.
+    for (DeviceStatus& st : status_) {
+      if (st.faulted) continue;
+      ++st.transactions;
+      ++st.timeouts;
+      st.health = DeviceHealth::timeout;
+    }
+    return;
+  }
+  modbus_flush(ctx_);  // late answers of timed-out requests must not pass for these
+  for (Slave& s : slaves_) {
+    if (!connected_) {
+      for (std::size_t d : s.devices) {
+        if (status_[d].faulted) continue;
+        ++status_[d].transactions;
+        ++status_[d].timeouts;
+        status_[d].health = DeviceHealth::timeout;
+      }
+      continue;
+    }
+    read_slave(s, true);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (answered_[i]) positions[i] = present_rad_[i];
+  }
+}
+
+void ModbusBus::write(std::span<const double> positions) {
+  for (std::size_t i = 0; i < std::min(positions.size(), goal_rad_.size()); ++i) {
+    if (std::isfinite(positions[i])) goal_rad_[i] = positions[i];
+  }
+  if (!connected_) return;  // read() reconnects; nothing to say to a dead link
+  for (Slave& s : slaves_) write_slave(s);
+}
+
+}  // namespace animrt

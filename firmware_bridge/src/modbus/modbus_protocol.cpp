@@ -1,0 +1,166 @@
+#include "animrt/bridge/modbus/modbus_protocol.hpp"
+
+#include <any>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "animrt/bridge/modbus/modbus_bus.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr std::string_view kTcpKeys[] = {"port", "timeout_ms", "reconnect_ms"};
+constexpr std::string_view kRtuKeys[] = {"port", "baud", "parity", "stop_bits", "timeout_ms"};
+constexpr std::string_view kActuatorKeys[] = {"slave", "map", "m_per_rad", "zero_m"};
+
+void read_timeout(const YamlNode& node, BusConfig& bus) {
+  bus.timeout_s = 0.02;
+  if (auto n = node.find("timeout_ms")) {
+    const double ms = n->as_double();
+    if (!(ms > 0.0 && ms < 10000.0)) {
+      n->fail("expected a number greater than 0 and less than 10000, found " + n->describe());
+    }
+    bus.timeout_s = ms / 1000.0;
+  }
+}
+
+class ModbusProtocol final : public Protocol {
+ public:
+  explicit ModbusProtocol(bool tcp) : tcp_(tcp) {}
+  std::string_view name() const override { return tcp_ ? "modbus-tcp" : "modbus-rtu"; }
+  std::span<const std::string_view> bus_keys() const override {
+    return tcp_ ? std::span<const std::string_view>(kTcpKeys)
+                : std::span<const std::string_view>(kRtuKeys);
+  }
+  std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+
+  void read_bus(const YamlNode& node, BusConfig& bus) const override {
+    const YamlNode port = node.at("port");
+    bus.port = port.as_string();
+    ModbusBusOptions options;
+    options.tcp = tcp_;
+    if (tcp_) {
+      const auto colon = bus.port.rfind(':');
+      bool ok = colon != std::string::npos && colon > 0 && colon + 1 < bus.port.size();
+      if (ok) {
+        const std::string p = bus.port.substr(colon + 1);
+        ok = p.find_first_not_of("0123456789") == std::string::npos && p.size() <= 5 &&
+             std::stoi(p) >= 1 && std::stoi(p) <= 65535;
+      }
+      if (!ok) port.fail("expected HOST:PORT (e.g. 192.168.1.20:502), found " + port.describe());
+      if (auto n = node.find("reconnect_ms"))
+        options.reconnect_min_s = n->as_double_in(1, 60000) / 1000.0;
+      options.reconnect_max_s = std::max(options.reconnect_max_s, options.reconnect_min_s);
+    } else {
+      if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");
+      bus.baud = 19200;
+      if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(300, 4'000'000));
+      if (auto n = node.find("parity")) {
+        const std::string p = n->as_string();
+        if (p == "none") {
+          options.parity = 'N';
+        } else if (p == "even") {
+          options.parity = 'E';
+        } else if (p == "odd") {
+          options.parity = 'O';
+        } else {
+          n->fail("expected none, even or odd, found " + n->describe());
+        }
+      } else {
+        options.parity = 'E';  // the Modbus serial line default
+      }
+      if (auto n = node.find("stop_bits")) options.stop_bits = static_cast<int>(n->as_int_in(1, 2));
+    }
+    read_timeout(node, bus);
+    bus.options = options;
+  }
+
+  void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,
+                     const BusConfig& bus, ActuatorBinding& out) const override {
+    ModbusJointOptions j;
+    const YamlNode slave = node.at("slave");
+    j.slave = static_cast<int>(slave.as_int());
+    if (j.slave < 1 || j.slave > 247) {
+      slave.fail("expected a slave id from 1 to 247, found " + slave.describe());
+    }
+    const YamlNode map_node = node.at("map");
+    const std::string given = map_node.as_string();
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::path(node.file()).parent_path();
+    const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
+    if (!fs::is_regular_file(resolved)) {
+      map_node.fail("register map not found: \"" + given + "\" (resolved to \"" +
+                    resolved.string() + "\")");
+    }
+    j.map = modbus::load_register_map(resolved.string());
+    const modbus::RegisterMap& m = *j.map;
+    const auto per = node.find("m_per_rad");
+    const auto zero = node.find("zero_m");
+    if (m.unit == "m") {
+      if (!per) {
+        node.fail("missing key m_per_rad: the map " + given +
+                  " is in metres, so the joint needs the stroke per radian (negative to reverse)");
+      }
+      j.per_rad = per->as_double();
+      if (!(std::isfinite(j.per_rad) && j.per_rad != 0.0))
+        per->fail("expected a non-zero number, found " + per->describe());
+      if (zero) j.zero = zero->as_double();
+    } else if (per || zero) {
+      (per ? *per : *zero)
+          .fail("the map " + given +
+                " is in radians; m_per_rad and zero_m apply to maps in metres");
+    }
+    // Two joints of one slave must not share a register.
+    for (const auto& other : bus.actuators) {
+      const auto& o = std::any_cast<const ModbusJointOptions&>(other.options);
+      if (o.slave != j.slave) continue;
+      for (const auto& a : m.spans()) {
+        for (const auto& b : o.map->spans()) {
+          if (a.first == b.first && a.second.first < b.second.second &&
+              b.second.first < a.second.second) {
+            slave.fail("registers overlap: joint " + joint.name + " and joint " + other.joint +
+                       " on slave " + std::to_string(j.slave) + " both use " +
+                       modbus::to_string(a.first) + " register " +
+                       std::to_string(std::max(a.second.first, b.second.first)));
+          }
+        }
+      }
+    }
+    if (m.has_range) {
+      for (const char* key : {"min_deg", "max_deg"}) {
+        const double rad = key[1] == 'i' ? joint.limits.min_position : joint.limits.max_position;
+        const double si = j.zero + j.per_rad * rad;
+        if (si < m.range_min - 1e-12 || si > m.range_max + 1e-12) {
+          limits_node.at(key).fail(format_number(rad_to_deg(rad)) + " deg maps to " +
+                                   format_number(si) + " " + m.unit + ", outside the range of " +
+                                   given + " (" + format_number(m.range_min) + ".." +
+                                   format_number(m.range_max) + " " + m.unit + ")");
+        }
+      }
+    }
+    out.device_id = j.slave;
+    out.options = j;
+  }
+
+  std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
+    return std::make_unique<ModbusBus>(config);
+  }
+
+ private:
+  bool tcp_;
+};
+
+}  // namespace
+
+const Protocol& modbus_tcp_protocol() {
+  static const ModbusProtocol protocol(true);
+  return protocol;
+}
+
+const Protocol& modbus_rtu_protocol() {
+  static const ModbusProtocol protocol(false);
+  return protocol;
+}
+
+}  // namespace animrt

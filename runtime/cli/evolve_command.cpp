@@ -1,0 +1,151 @@
+// The evolve subcommand: load the run file, grammar, seed gait and model,
+// run the search (threads, optionally MPI ranks), write gait, CSV and plot.
+
+#include "evolve_command.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "animrt/controllers/evolve/mpi_evaluator.hpp"
+#include "animrt/controllers/evolve/report.hpp"
+#include "animrt/controllers/evolve/search.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct EvolveArgs {
+  std::string run_file;
+  std::string out;
+  std::optional<int> threads;
+  std::optional<std::uint64_t> seed;
+  std::optional<int> population;
+  std::optional<int> generations;
+  std::string csv;
+  std::string plot;
+  bool mpi = false;
+  bool quiet = false;
+};
+
+std::string with_extension(const std::string& path, const std::string& ext) {
+  return std::filesystem::path(path).replace_extension(ext).string();
+}
+
+int run_evolve(const EvolveArgs& a) {
+  evolve::RunConfig config = evolve::load_run_config(a.run_file);
+  if (a.seed) config.search.seed = *a.seed;
+  if (a.population) config.search.population = *a.population;
+  if (a.generations) config.search.generations = *a.generations;
+  if (a.threads) config.threads = *a.threads;
+  if (config.search.elites >= config.search.population) {
+    config.search.elites = std::max(0, config.search.population - 1);
+  }
+  evolve::Grammar grammar = evolve::Grammar::load_file(config.grammar);
+  GaitFile seed = load_gait_file(config.seed_gait);
+  sim::MujocoGaitSimulatorFactory factory(config.model);
+  // The seed gait must drive joints the model has (errors name the gait file).
+  {
+    std::vector<JointSpec> specs;
+    for (const auto& j : factory.model().actuated_joints) {
+      JointSpec s;
+      s.name = j;
+      s.limits = {-kPi, kPi, 100.0, 10000.0};
+      specs.push_back(s);
+    }
+    (void)make_gait_source(seed, specs);
+  }
+  evolve::ModelInfo info{factory.model().actuated_joints, factory.model().hip_height_m,
+                         factory.model().mass_kg};
+
+  std::unique_ptr<evolve::MpiSession> session;
+  if (a.mpi) session = std::make_unique<evolve::MpiSession>(nullptr, nullptr);
+  const bool lead = !session || session->rank() == 0;
+  const int threads = config.threads > 0
+                          ? config.threads
+                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  evolve::ThreadEvaluator local(factory, threads);
+  std::unique_ptr<evolve::MpiEvaluator> distributed;
+  if (session) distributed = std::make_unique<evolve::MpiEvaluator>(*session, local);
+  evolve::Evaluator& evaluator =
+      distributed ? static_cast<evolve::Evaluator&>(*distributed) : local;
+
+  const int workers = evaluator.workers();
+  if (lead && !a.quiet) {
+    std::cout << "evolve " << config.name << ": grammar " << config.grammar << ", model "
+              << config.model << " (" << info.joints.size() << " actuators, " << info.mass_kg
+              << " kg), population " << config.search.population << ", "
+              << config.search.generations << " generations, seed " << config.search.seed << ", "
+              << workers << " worker" << (workers == 1 ? "" : "s")
+              << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
+              << std::flush;
+  }
+  const int generations = config.search.generations;
+  evolve::Search search(config, std::move(grammar), seed, info, evaluator);
+  const evolve::SearchResult result = search.run([&](const evolve::GenerationStats& s) {
+    if (lead && !a.quiet)
+      std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
+  });
+  if (!lead) return 0;
+
+  const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
+  const std::string plot = a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
+  evolve::write_history_csv(result.history, csv);
+  evolve::write_history_svg(result.history, config.name, plot);
+  const auto& best = result.best;
+  if (!best.valid) {
+    std::cerr << "error: no valid individual in the last generation; no gait written\n";
+    return 4;
+  }
+  write_gait_file(best.gait, a.out);
+  const auto& m = best.measures;
+  std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
+            << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
+            << ", energy " << m.energy_per_cycle << " J/cycle\n"
+            << "evaluations " << result.evaluations << ", invalid " << result.invalid << '\n'
+            << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
+  return 0;
+}
+
+}  // namespace
+
+void add_evolve_command(CLI::App& app) {
+  auto args = std::make_shared<EvolveArgs>();
+  auto* cmd = app.add_subcommand("evolve",
+                                 "Evolve a gait with Grammatical Evolution against a MuJoCo model");
+  cmd->add_option("RUN", args->run_file, "evolve run file (YAML)")->required();
+  cmd->add_option("--out", args->out, "gait file to write (best of the last generation)")
+      ->required();
+  cmd->add_option("--threads", args->threads, "evaluation threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--seed", args->seed, "random seed (overrides the run file)");
+  cmd->add_option("--population", args->population, "population size")
+      ->check(CLI::Range(2, 1000000));
+  cmd->add_option("--generations", args->generations, "generations after the initial one")
+      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--csv", args->csv, "per-generation statistics (default: OUT with .csv)");
+  cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
+  cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
+  cmd->add_flag("--quiet", args->quiet, "no progress lines");
+  cmd->callback([args] {
+    int code = 0;
+    try {
+      code = run_evolve(*args);
+    } catch (const InputError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 2;
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 1;
+    }
+    if (code != 0) throw CLI::RuntimeError(code);
+    throw CLI::Success();  // main() dispatches only its own subcommands
+  });
+}
+
+}  // namespace animrt::cli

@@ -1,0 +1,123 @@
+#include "bus_worker.hpp"
+
+#include <linux/futex.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <climits>
+
+namespace animrt {
+
+static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) &&
+              std::atomic<std::uint32_t>::is_always_lock_free);
+
+void futex_wait(std::atomic<std::uint32_t>& word, std::uint32_t expected, Nanos timeout_ns) {
+  timespec ts{};
+  timespec* tp = nullptr;
+  if (timeout_ns >= 0) {
+    ts.tv_sec = static_cast<time_t>(timeout_ns / 1'000'000'000);
+    ts.tv_nsec = static_cast<long>(timeout_ns % 1'000'000'000);
+    tp = &ts;
+  }
+  ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, expected, tp,
+            nullptr, 0);
+}
+
+void futex_wake_all(std::atomic<std::uint32_t>& word) {
+  ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, INT_MAX,
+            nullptr, nullptr, 0);
+}
+
+BusWorker::BusWorker(ActuatorBus& bus, std::span<const double> initial_positions,
+                     std::atomic<std::uint32_t>& done)
+    : bus_(bus),
+      done_(done),
+      positions_(initial_positions.begin(), initial_positions.end()),
+      commands_(initial_positions.begin(), initial_positions.end()) {}
+
+BusWorker::~BusWorker() { stop(); }
+
+void BusWorker::start(int realtime_priority) {
+  if (thread_.joinable()) return;
+  stop_ = false;
+  thread_ = std::thread([this] { run(); });
+  if (realtime_priority > 0) {
+    sched_param param{};
+    param.sched_priority = realtime_priority;
+    pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param);  // best effort
+  }
+}
+
+void BusWorker::stop() {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  wake_.fetch_add(1, std::memory_order_release);
+  futex_wake_all(wake_);
+  thread_.join();
+}
+
+void BusWorker::post_read() {
+  read_req_.fetch_add(1, std::memory_order_release);
+  wake_.fetch_add(1, std::memory_order_release);
+  futex_wake_all(wake_);
+}
+
+void BusWorker::post_write() {
+  write_req_.fetch_add(1, std::memory_order_release);
+  wake_.fetch_add(1, std::memory_order_release);
+  futex_wake_all(wake_);
+}
+
+void BusWorker::signal_done() {
+  done_.fetch_add(1, std::memory_order_release);
+  futex_wake_all(done_);
+}
+
+template <typename F>
+void BusWorker::guarded(F&& io) {
+  try {
+    io();
+  } catch (...) {
+    // The transport is gone (e.g. the adapter was unplugged): no answers,
+    // which the loop's watchdog turns into a fault.
+    for (DeviceStatus& st : bus_.devices()) {
+      if (st.faulted) continue;
+      ++st.timeouts;
+      st.health = DeviceHealth::timeout;
+    }
+  }
+}
+
+void BusWorker::run() {
+  const MonotonicClock wall;
+  for (;;) {
+    const std::uint32_t seen = wake_.load(std::memory_order_acquire);
+    if (stop_.load(std::memory_order_acquire)) return;
+    bool worked = false;
+    const std::uint32_t rr = read_req_.load(std::memory_order_acquire);
+    if (rr != read_done_.load(std::memory_order_relaxed)) {
+      const Nanos t0 = wall.now();
+      guarded([this] { bus_.read(positions_); });
+      read_ns_ = wall.now() - t0;
+      read_done_.store(rr, std::memory_order_release);
+      signal_done();
+      worked = true;
+    }
+    const std::uint32_t wr = write_req_.load(std::memory_order_acquire);
+    if (wr != write_done_.load(std::memory_order_relaxed)) {
+      const Nanos t0 = wall.now();
+      guarded([this] { bus_.write(commands_); });
+      io_ns_.store(read_ns_ + (wall.now() - t0), std::memory_order_relaxed);
+      io_cycles_.fetch_add(1, std::memory_order_release);
+      write_done_.store(wr, std::memory_order_release);
+      signal_done();
+      worked = true;
+    }
+    if (!worked) futex_wait(wake_, seen, -1);
+  }
+}
+
+}  // namespace animrt

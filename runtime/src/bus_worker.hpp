@@ -1,0 +1,80 @@
+#pragma once
+// One I/O thread per bus, so a slow or dead bus never holds up the others.
+// The loop posts a read (and later a write) and waits for the reads with a
+// deadline; a bus that misses it keeps its last measurement and is skipped
+// until its thread is idle again. Hand-over is lock-free: sequence counters
+// with release/acquire ordering, and futex waits on them (no mutex, no
+// allocation after start()).
+//
+// Ownership: positions() and commands() belong to the worker thread while a
+// request is pending, and to the loop thread while idle().
+
+#include <atomic>
+#include <cstdint>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/core/clock.hpp"
+
+namespace animrt {
+
+// Futex wait/wake on a 32-bit atomic. timeout_ns < 0 waits without limit.
+void futex_wait(std::atomic<std::uint32_t>& word, std::uint32_t expected, Nanos timeout_ns);
+void futex_wake_all(std::atomic<std::uint32_t>& word);
+
+class BusWorker {
+ public:
+  // `done` is bumped (and woken) after every completed request of any worker.
+  BusWorker(ActuatorBus& bus, std::span<const double> initial_positions,
+            std::atomic<std::uint32_t>& done);
+  ~BusWorker();
+  BusWorker(const BusWorker&) = delete;
+  BusWorker& operator=(const BusWorker&) = delete;
+
+  void start(int realtime_priority);  // 0: inherit the default policy
+  void stop();
+
+  bool idle() const {
+    return read_done_.load(std::memory_order_acquire) ==
+               read_req_.load(std::memory_order_relaxed) &&
+           write_done_.load(std::memory_order_acquire) ==
+               write_req_.load(std::memory_order_relaxed);
+  }
+  bool read_done() const {
+    return read_done_.load(std::memory_order_acquire) == read_req_.load(std::memory_order_relaxed);
+  }
+  bool write_done() const {
+    return write_done_.load(std::memory_order_acquire) ==
+           write_req_.load(std::memory_order_relaxed);
+  }
+  void post_read();
+  void post_write();
+
+  std::span<double> positions() { return positions_; }
+  std::span<double> commands() { return commands_; }
+  // Read + write time of the last completed cycle, and how many have completed.
+  Nanos last_io_ns() const { return io_ns_.load(std::memory_order_acquire); }
+  std::uint64_t io_cycles() const { return io_cycles_.load(std::memory_order_acquire); }
+
+ private:
+  void run();
+  void signal_done();
+  template <typename F>
+  void guarded(F&& io);
+
+  ActuatorBus& bus_;
+  std::atomic<std::uint32_t>& done_;
+  std::vector<double> positions_;
+  std::vector<double> commands_;
+  std::atomic<std::uint32_t> wake_{0};
+  std::atomic<std::uint32_t> read_req_{0}, read_done_{0}, write_req_{0}, write_done_{0};
+  std::atomic<bool> stop_{false};
+  std::atomic<Nanos> io_ns_{0};
+  std::atomic<std::uint64_t> io_cycles_{0};
+  Nanos read_ns_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace animrt

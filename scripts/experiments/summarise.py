@@ -1,0 +1,83 @@
+#!/usr/bin/python3
+"""Summarises evolve runs written by table5.sh: OUT/table.md and plots.
+
+    summarise.py OUT_DIR RUNS GRAMMAR...
+"""
+import csv
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+PAPER = {  # Murphy, O'Neill and Carr, Tables 4 and 5 (30 runs, 75 x 50)
+    "hybrid": (95.3, 5.2729, 138.8273, 57.2904),
+    "concatenating": (100.333, 8.5231, 140.9203, 43.1542),
+    "sinusoidal": (100.4333, 6.0039, 150.2595, 44.2394),
+    "numerical": (101.3333, 8.5715, 132.6506, 37.6833),
+    "free": (106.3, 19.05, 279.1248, 81.3519),
+    "concatenating_varying_weights": (102.7, 5.3572, 154.5484, 50.3666),
+    "concatenating_varying_freedom": (104.0333, 7.8892, 112.2726, 8.4968),
+}
+NAMES = {
+    "hybrid": "Numerical & concatenating functions",
+    "concatenating": "Concatenating functions",
+    "sinusoidal": "Sinusoidal grammar",
+    "numerical": "Numerical only",
+    "free": "Free",
+    "concatenating_varying_weights": "Concatenating, varying fitness weights",
+    "concatenating_varying_freedom": "Concatenating, varying joint freedom",
+}
+
+
+def mean_sd(xs):
+    m = sum(xs) / len(xs)
+    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else 0.0
+    return m, sd
+
+
+def main():
+    out, runs, grammars = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
+    rows = ["| Grammar | Avg. best | Std. dev. | Avg. avg. | Std. dev. | invalid (last gen, mean) "
+            "| paper: avg. best (sd) | paper: avg. avg. (sd) |",
+            "|---|---|---|---|---|---|---|---|"]
+    curves = {}
+    for g in grammars:
+        best, avg, invalid, per_gen = [], [], [], []
+        for r in range(1, runs + 1):
+            with open(os.path.join(out, f"{g}_{r}.csv")) as f:
+                data = list(csv.DictReader(f))
+            best.append(float(data[-1]["best"]))
+            avg.append(float(data[-1]["average"]))
+            invalid.append(float(data[-1]["invalid"]))
+            per_gen.append([(float(d["best"]), float(d["average"])) for d in data])
+        b, bsd = mean_sd(best)
+        a, asd = mean_sd(avg)
+        p = PAPER.get(g)
+        paper = (f"{p[0]} ({p[1]}) | {p[2]} ({p[3]})" if p else "- | -")
+        rows.append(f"| {NAMES.get(g, g)} | {b:.1f} | {bsd:.1f} | {a:.1f} | {asd:.1f} | "
+                    f"{sum(invalid) / len(invalid):.1f} | {paper} |")
+        gens = len(per_gen[0])
+        curves[g] = [(i, sum(run[i][0] for run in per_gen) / runs,
+                      sum(run[i][1] for run in per_gen) / runs) for i in range(gens)]
+    table = "\n".join(rows) + "\n"
+    with open(os.path.join(out, "table.md"), "w") as f:
+        f.write(table)
+    print(table)
+    for g, pts in curves.items():
+        with open(os.path.join(out, f"mean_{g}.dat"), "w") as f:
+            for i, b, a in pts:
+                f.write(f"{i} {b} {a}\n")
+    if shutil.which("gnuplot"):
+        for col, name in ((2, "best"), (3, "average")):
+            plots = ", ".join(f"'{out}/mean_{g}.dat' using 1:{col} with lines lw 2 title '{g}'"
+                              for g in curves)
+            script = (f"set terminal svg size 800,500; set output '{out}/{name}.svg';"
+                      f"set logscale y; set xlabel 'generation'; set ylabel '{name} fitness';"
+                      f"set key outside; plot {plots}")
+            subprocess.run(["gnuplot", "-e", script], check=True)
+        print(f"plots: {out}/best.svg {out}/average.svg")
+
+
+if __name__ == "__main__":
+    main()

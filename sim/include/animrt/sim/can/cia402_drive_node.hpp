@@ -1,0 +1,124 @@
+#pragma once
+// A simulated CANopen CiA 402 servo drive: the device side of the protocol
+// the runtime's Cia402Bus speaks.
+//
+// - NMT: start, stop, enter pre-operational, reset node (object dictionary
+//   back to defaults), reset communication (1000h-1FFFh back to defaults);
+//   a boot-up message after power-on and after either reset.
+// - Object dictionary subset: 1000h device type (0x00020192), 1001h error
+//   register, 1017h heartbeat producer time, 1018h identity, RPDO1 (1400h,
+//   1600h) and TPDO1 (1800h, 1A00h) communication and mapping, 603Fh error
+//   code, 6040h controlword, 6041h statusword, 6060h/6061h modes of
+//   operation (8, cyclic synchronous position, only), 6064h position actual,
+//   606Ch velocity actual, 607Ah target position.
+// - Expedited SDO upload and download with the CiA 301 abort codes (object
+//   or sub-index missing, read-only, write-only, length mismatch, value
+//   range, mapping rules); segmented transfers are answered with an abort.
+// - PDOs: mapping as configured through 1600h/1A00h (rules: disable the PDO
+//   by COB-ID bit 31 and set sub-index 0 to 0 before changing entries; only
+//   mappable objects; at most 64 bits). Transmission types 1-240 act on
+//   SYNC (an RPDO received is applied at the next SYNC; a TPDO goes out
+//   every n-th SYNC), 254/255 immediately (RPDO) / never on SYNC (TPDO).
+// - The controlword / statusword state machine of CiA 402, with fault
+//   reaction, fault reset and quick stop.
+// - EMCY on a fault (error code per injected condition, error register),
+//   and "error reset" (code 0) when a fault reset clears it; EMCY 8210h when
+//   an RPDO is shorter than its mapping.
+// - Heartbeat producer at the 1017h period.
+// - Motor: in Operation Enabled the position follows the target (LagMotor,
+//   in counts); otherwise it holds.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/can/canopen.hpp"
+#include "animrt/bridge/can/cia402.hpp"
+#include "animrt/sim/can/can_node.hpp"
+#include "animrt/sim/can/motor_model.hpp"
+
+namespace animrt::sim {
+
+inline constexpr std::uint32_t kDriveDeviceType = 0x00020192;  // servo drive, profile 402
+inline constexpr std::uint32_t kDriveVendorId = 0x000000A5;
+inline constexpr std::uint32_t kDriveProductCode = 0x00000402;
+
+class Cia402DriveNode final : public CanNode {
+ public:
+  Cia402DriveNode(const ActuatorBinding& binding, const SimBusSettings& settings, Nanos now);
+
+  int device_id() const override { return binding_.device_id; }
+  std::vector<canid_t> listens_to() const override;
+  void handle(const can_frame& frame, Nanos now, FrameList& out) override;
+  void poll(Nanos now, FrameList& out) override;
+  double joint_position(Nanos now) const override;
+  void set_fault(std::uint8_t bits, Nanos now, FrameList& out) override;
+  void reboot(Nanos now, FrameList& out) override;
+
+  cia402::State state() const { return state_; }
+  canopen::NmtState nmt_state() const { return nmt_; }
+  std::uint16_t statusword(Nanos now) const;
+  // The EMCY error code an injected fault condition produces.
+  static std::uint16_t emcy_code_for(std::uint8_t bits);
+
+ private:
+  enum class Access : std::uint8_t { ro, rw, wo };
+  struct Entry {
+    std::uint16_t index;
+    std::uint8_t sub;
+    std::uint8_t size;  // bytes
+    Access access;
+    bool rx_mappable;  // may be mapped into an RPDO
+    bool tx_mappable;  // may be mapped into a TPDO
+    std::uint32_t value;
+  };
+  struct Pdo {
+    std::uint16_t comm;  // 1400h / 1800h
+    std::uint16_t map;   // 1600h / 1A00h
+    bool receive;
+  };
+
+  void reset_application(Nanos now);
+  void reset_communication();
+  void boot(FrameList& out);
+  Entry* find(std::uint16_t index, std::uint8_t sub);
+  bool index_exists(std::uint16_t index) const;
+  std::uint32_t read_value(const Entry& e, Nanos now) const;
+  // Checks and performs a write (SDO or PDO); returns an abort code or 0.
+  std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size,
+                      bool from_pdo, Nanos now, FrameList& out);
+  std::uint32_t check_mapping(const Pdo& pdo, std::uint8_t sub, std::uint32_t value) const;
+  std::uint32_t mapped_bits(const Pdo& pdo, std::uint8_t count) const;
+  void handle_sdo(const can_frame& frame, Nanos now, FrameList& out);
+  void handle_nmt(const can_frame& frame, Nanos now, FrameList& out);
+  void handle_rpdo(const can_frame& frame, Nanos now, FrameList& out);
+  void apply_rpdo(Nanos now, FrameList& out);
+  void on_sync(Nanos now, FrameList& out);
+  void send_tpdo(Nanos now, FrameList& out);
+  void controlword(std::uint16_t value, Nanos now, FrameList& out);
+  void enter_state(cia402::State state, Nanos now);
+  void emit_emcy(std::uint16_t code, FrameList& out);
+  std::uint32_t cob_id(const Pdo& pdo) const;
+  std::uint8_t transmission_type(const Pdo& pdo) const;
+
+  ActuatorBinding binding_;
+  SimBusSettings settings_;
+  std::uint8_t node_;
+  std::vector<Entry> od_;
+  canopen::NmtState nmt_ = canopen::NmtState::pre_operational;
+  cia402::State state_ = cia402::State::switch_on_disabled;
+  std::uint16_t last_controlword_ = 0;
+  LagMotor motor_;              // counts
+  std::uint8_t condition_ = 0;  // injected fault condition (0: none)
+  bool boot_pending_ = true;
+  Nanos next_heartbeat_ = 0;
+  // RPDO received, waiting for SYNC.
+  std::array<std::uint8_t, 8> rpdo_data_{};
+  bool rpdo_pending_ = false;
+  std::uint32_t sync_count_ = 0;
+  static constexpr Pdo kRpdo{0x1400, 0x1600, true};
+  static constexpr Pdo kTpdo{0x1800, 0x1A00, false};
+};
+
+}  // namespace animrt::sim

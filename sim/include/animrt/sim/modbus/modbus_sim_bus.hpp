@@ -1,0 +1,97 @@
+#pragma once
+// Simulated Modbus drives of one bus, served by libmodbus: on a loopback TCP
+// port (modbus-tcp) or on a pty speaking RTU (modbus-rtu). Each slave id of
+// the bus is one drive holding the registers of its joints' register maps
+// (libmodbus answers exception 2 outside them, and 3 for a bad quantity);
+// the drive itself answers exception 3 to a goal outside the map's range or
+// an enable value that is neither on nor off. Motor per joint: first-order
+// lag (SimBusSettings::time_constant_s) with a speed limit (max_speed), moving
+// only while enabled (or always, when the map has no enable). Any standard
+// Modbus master can talk to it (mbpoll, pymodbus).
+//
+// RTU: frames are delimited by their function code's length, CRC-checked
+// (a bad CRC is dropped unanswered and counted), and dispatched by slave id.
+// SimBusSettings::return_delay_us delays every answer (real time), to model
+// a slow drive or gateway.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/modbus/modbus_bus.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/sim/simulated_bus.hpp"
+
+struct _modbus;
+struct _modbus_mapping_t;
+
+namespace animrt::sim {
+
+class PtyPair;
+class WakePipe;
+
+struct ModbusSimStats {
+  std::uint64_t requests = 0;     // answered or not, valid frames
+  std::uint64_t exceptions = 0;   // exception 3 answers of the drive's own value checks
+  std::uint64_t crc_errors = 0;   // RTU frames dropped for a bad CRC
+  std::uint64_t dropped = 0;      // RTU bytes of unknown or cut frames
+  std::uint64_t connections = 0;  // TCP connections accepted
+};
+
+class ModbusSimBus final : public SimulatedBus {
+ public:
+  ModbusSimBus(const BusConfig& config, const Clock& clock);
+  ~ModbusSimBus() override;
+  ModbusSimBus(const ModbusSimBus&) = delete;
+  ModbusSimBus& operator=(const ModbusSimBus&) = delete;
+
+  const std::string& endpoint() const override { return endpoint_; }
+  std::string describe() const override;
+  void start() override;
+  void stop() override;
+  // device_id = slave id. A drive that is not responding ignores requests.
+  void set_device_responding(int device_id, bool responding) override;
+  // Sets bits in the drive's status register (and disables its motors).
+  void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  double device_position(int device_id) const override;
+
+  // TCP: closes every open client connection (the server keeps listening).
+  void drop_connections();
+  ModbusSimStats stats() const;
+
+ private:
+  struct Joint;
+  struct Drive;
+  void serve_tcp();
+  void serve_rtu();
+  // Handles one request (ADU) at `offset` (header length); replies unless the
+  // slave is absent or silent.
+  void handle(const std::uint8_t* req, int length, int offset);
+  Drive* drive(int slave);
+  void advance(Drive& d, Nanos now);
+  void publish(Drive& d);
+
+  BusConfig config_;
+  const Clock& clock_;
+  bool tcp_;
+  std::string endpoint_;
+  int listen_fd_ = -1;
+  std::unique_ptr<PtyPair> pty_;
+  std::unique_ptr<WakePipe> wake_;
+  _modbus* ctx_ = nullptr;
+  std::vector<std::unique_ptr<Drive>> drives_;
+  mutable std::mutex mutex_;  // guards drives_ state
+  std::vector<int> clients_;
+  std::atomic<bool> drop_{false};
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> requests_{0}, exceptions_{0}, crc_errors_{0}, dropped_{0},
+      connections_{0};
+};
+
+}  // namespace animrt::sim

@@ -1,0 +1,195 @@
+// Walking a gait on a MuJoCo model and measuring it (see mujoco_gait_sim.hpp).
+
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/core/joint.hpp"
+
+namespace animrt::sim {
+namespace {
+
+// A foot must be off the ground this long before its next contact counts as
+// a touchdown (contacts chatter for a few steps when a foot lands).
+constexpr double kDebounceS = 0.02;
+
+std::vector<JointSpec> joint_specs(const MujocoModel& mm) {
+  const mjModel* m = mm.model.get();
+  std::vector<JointSpec> specs;
+  for (std::size_t a = 0; a < mm.actuated_joints.size(); ++a) {
+    const int j = m->actuator_trnid[2 * a];
+    JointSpec s;
+    s.name = mm.actuated_joints[a];
+    s.limits.min_position = m->jnt_limited[j] ? m->jnt_range[2 * j] : -kPi;
+    s.limits.max_position = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : kPi;
+    s.limits.max_velocity = 100.0;
+    s.limits.max_acceleration = 10000.0;
+    specs.push_back(s);
+  }
+  return specs;
+}
+
+int root_qpos(const mjModel* m, int torso) {
+  const int j = m->body_jntadr[torso];
+  return (j >= 0 && m->jnt_type[j] == mjJNT_FREE) ? m->jnt_qposadr[j] : -1;
+}
+
+}  // namespace
+
+void place_standing(const MujocoModel& mm, mjData* d, const double* targets) {
+  const mjModel* m = mm.model.get();
+  mj_resetData(m, d);
+  for (std::size_t a = 0; a < mm.actuator_qpos.size(); ++a) {
+    const int j = m->actuator_trnid[2 * a];
+    double q = targets[a];
+    if (m->jnt_limited[j]) q = std::clamp(q, m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
+    d->qpos[mm.actuator_qpos[a]] = q;
+    d->ctrl[a] = q;
+  }
+  mj_kinematics(m, d);
+  double lowest = 1e9;
+  for (int g : mm.foot_geoms) {
+    // Feet are spheres or boxes standing level: the bottom is centre - (radius | half height).
+    const double below =
+        m->geom_type[g] == mjGEOM_BOX ? m->geom_size[3 * g + 2] : m->geom_size[3 * g];
+    lowest = std::min(lowest, d->geom_xpos[3 * g + 2] - below);
+  }
+  const int root = root_qpos(m, mm.torso_body);
+  if (root >= 0) d->qpos[root + 2] -= lowest - 0.001;
+  mj_forward(m, d);
+}
+
+bool has_fallen(const MujocoModel& mm, const mjData* d, double standing_z) {
+  const double z = d->xpos[3 * mm.torso_body + 2];
+  const double up = d->xmat[9 * mm.torso_body + 8];  // z component of the torso's z axis
+  if (!std::isfinite(z) || !std::isfinite(up)) return true;
+  if (d->warning[mjWARN_BADQACC].number > 0 || d->warning[mjWARN_BADQPOS].number > 0 ||
+      d->warning[mjWARN_BADQVEL].number > 0) {
+    return true;
+  }
+  return z < 0.5 * standing_z || up < 0.5;
+}
+
+MujocoGaitSimulator::MujocoGaitSimulator(std::shared_ptr<const MujocoModel> model)
+    : model_(std::move(model)), data_(make_mujoco_data(*model_)) {
+  info_.joints = model_->actuated_joints;
+  info_.hip_height_m = model_->hip_height_m;
+  info_.mass_kg = model_->mass_kg;
+}
+
+evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
+                                               const evolve::WalkSettings& settings) {
+  const MujocoModel& mm = *model_;
+  const mjModel* m = mm.model.get();
+  mjData* d = data_.get();
+  const auto specs = joint_specs(mm);
+  const auto source = make_gait_source(gait, specs);
+  std::vector<double> targets(specs.size(), 0.0);
+  evolve::GaitMeasures out;
+
+  // Standing pose: every joint at its mean over one stride (all feet down).
+  const double f = gait.stride_frequency();
+  std::vector<double> stand(specs.size(), 0.0);
+  constexpr int kMeanSamples = 64;
+  for (int i = 0; i < kMeanSamples; ++i) {
+    source->sample(static_cast<double>(i) / (kMeanSamples * f), targets);
+    for (std::size_t a = 0; a < targets.size(); ++a) stand[a] += targets[a] / kMeanSamples;
+  }
+  place_standing(mm, d, stand.data());
+  const double dt = m->opt.timestep;
+  const auto steps_for = [dt](double s) { return static_cast<long>(std::llround(s / dt)); };
+  const long settle = steps_for(settings.settle_s);
+  const long warmup = steps_for(settings.warmup_cycles / f);
+  const long measure = steps_for(settings.measure_cycles / f);
+  // From standing into the gait: blended in over the first cycle (smoothstep).
+  const long blend = std::max(1L, std::min(warmup, steps_for(1.0 / f)));
+  const double standing_z = d->xpos[3 * mm.torso_body + 2];
+
+  const std::size_t feet = mm.foot_geoms.size();
+  std::vector<int> foot_of(static_cast<std::size_t>(m->ngeom), -1);
+  for (std::size_t i = 0; i < feet; ++i)
+    foot_of[static_cast<std::size_t>(mm.foot_geoms[i])] = static_cast<int>(i);
+  std::vector<char> contact(feet, 0);
+  std::vector<long> air_steps(feet, 1 << 30);
+  std::vector<long> contact_steps(feet, 0);
+  std::vector<std::vector<double>> touchdowns(feet);
+  const long debounce = std::max(1L, steps_for(kDebounceS));
+  double energy = 0.0;
+  double x0 = 0.0;
+
+  const long total = settle + warmup + measure;
+  for (long step = 0; step < total; ++step) {
+    const bool walking = step >= settle;
+    if (walking) {
+      const long k = step - settle;
+      source->sample(static_cast<double>(k) * dt, targets);
+      const double u = std::min(1.0, static_cast<double>(k) / static_cast<double>(blend));
+      const double s = u * u * (3.0 - 2.0 * u);
+      for (std::size_t a = 0; a < targets.size(); ++a) {
+        d->ctrl[a] = stand[a] + s * (targets[a] - stand[a]);
+      }
+    }
+    mj_step(m, d);
+    ++out.steps;
+    if (has_fallen(mm, d, standing_z)) {
+      out.fell = true;
+      break;
+    }
+    if (step == settle + warmup - 1) x0 = d->xpos[3 * mm.torso_body];
+    if (step < settle + warmup) continue;
+
+    std::fill(contact.begin(), contact.end(), 0);
+    for (int c = 0; c < d->ncon; ++c) {
+      for (int g : {d->contact[c].geom1, d->contact[c].geom2}) {
+        const int foot = foot_of[static_cast<std::size_t>(g)];
+        if (foot >= 0) contact[static_cast<std::size_t>(foot)] = 1;
+      }
+    }
+    for (std::size_t i = 0; i < feet; ++i) {
+      if (contact[i]) {
+        if (air_steps[i] >= debounce) {
+          touchdowns[i].push_back(d->geom_xpos[3 * mm.foot_geoms[i]]);
+        }
+        air_steps[i] = 0;
+        ++contact_steps[i];
+      } else {
+        ++air_steps[i];
+      }
+    }
+    for (int a = 0; a < m->nu; ++a) {
+      energy += std::fabs(d->actuator_force[a] * d->actuator_velocity[a]) * dt;
+    }
+  }
+  out.sim_time = static_cast<double>(out.steps) * dt;
+  if (out.fell) return out;
+
+  const double window = static_cast<double>(measure) * dt;
+  out.distance = d->xpos[3 * mm.torso_body] - x0;
+  out.speed = out.distance / window;
+  double contact_sum = 0;
+  for (long c : contact_steps) contact_sum += static_cast<double>(c);
+  out.duty_factor = contact_sum / (static_cast<double>(feet) * static_cast<double>(measure));
+  double stride_sum = 0;
+  int strides = 0;
+  for (const auto& td : touchdowns) {
+    for (std::size_t k = 1; k < td.size(); ++k) {
+      stride_sum += td[k] - td[k - 1];
+      ++strides;
+    }
+  }
+  out.stride_length = strides > 0 ? stride_sum / strides : 0.0;
+  out.energy_per_cycle = energy / settings.measure_cycles;
+  return out;
+}
+
+MujocoGaitSimulatorFactory::MujocoGaitSimulatorFactory(const std::string& model_path)
+    : model_(std::make_shared<const MujocoModel>(load_mujoco_model(model_path))) {}
+
+std::unique_ptr<evolve::GaitSimulator> MujocoGaitSimulatorFactory::make() const {
+  return std::make_unique<MujocoGaitSimulator>(model_);
+}
+
+}  // namespace animrt::sim

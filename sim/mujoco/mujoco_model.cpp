@@ -1,0 +1,78 @@
+// Loading and checking MJCF models (see mujoco_model.hpp).
+
+#include "animrt/sim/mujoco/mujoco_model.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::sim {
+
+int MujocoModel::actuator_of(const std::string& joint) const {
+  for (std::size_t i = 0; i < actuated_joints.size(); ++i) {
+    if (actuated_joints[i] == joint) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+MujocoModel load_mujoco_model(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError({path, 0, 0}, "", "cannot open model file");
+  char error[1024] = "";
+  mjModel* raw = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+  if (!raw) {
+    std::string message = error;
+    // MuJoCo's parser errors say "... line N ..."; take N for the location.
+    int line = 0;
+    if (const auto at = message.find("line "); at != std::string::npos) {
+      line = std::atoi(message.c_str() + at + 5);
+    }
+    for (auto& c : message) {
+      if (c == '\n') c = ' ';
+    }
+    throw InputError({path, line, 0}, "", "invalid MJCF model: " + message);
+  }
+  MujocoModel out;
+  out.model = std::shared_ptr<const mjModel>(
+      raw, [](const mjModel* m) { mj_deleteModel(const_cast<mjModel*>(m)); });
+  out.file = path;
+  const mjModel* m = raw;
+  out.torso_body = mj_name2id(m, mjOBJ_BODY, "torso");
+  if (out.torso_body < 0)
+    throw InputError({path, 0, 0}, "torso", "the model needs a body named torso");
+  for (int g = 0; g < m->ngeom; ++g) {
+    const char* name = mj_id2name(m, mjOBJ_GEOM, g);
+    if (!name) continue;
+    const std::string n = name;
+    if (n.size() >= 4 && n.compare(n.size() - 4, 4, "foot") == 0) out.foot_geoms.push_back(g);
+  }
+  if (out.foot_geoms.empty()) {
+    throw InputError({path, 0, 0}, "foot", "the model needs geoms whose names end in 'foot'");
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT) {
+      throw InputError({path, 0, 0}, "actuator", "every actuator must drive a joint");
+    }
+    const int j = m->actuator_trnid[2 * a];
+    if (m->jnt_type[j] != mjJNT_HINGE) {
+      throw InputError({path, 0, 0}, "actuator", "every actuator must drive a hinge joint");
+    }
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    out.actuated_joints.push_back(name ? name : "");
+    out.actuator_qpos.push_back(m->jnt_qposadr[j]);
+    out.actuator_dof.push_back(m->jnt_dofadr[j]);
+  }
+  const int hh = mj_name2id(m, mjOBJ_NUMERIC, "hip_height");
+  out.hip_height_m =
+      hh >= 0 ? m->numeric_data[m->numeric_adr[hh]] : m->body_pos[3 * out.torso_body + 2];
+  out.mass_kg = mj_getTotalmass(m);
+  return out;
+}
+
+MujocoData make_mujoco_data(const MujocoModel& model) {
+  mjData* d = mj_makeData(model.model.get());
+  if (!d) throw std::runtime_error("mj_makeData failed for " + model.file);
+  return MujocoData(d, mj_deleteData);
+}
+
+}  // namespace animrt::sim

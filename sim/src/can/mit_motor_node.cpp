@@ -1,0 +1,100 @@
+#include "animrt/sim/can/mit_motor_node.hpp"
+
+#include <algorithm>
+
+#include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
+
+namespace animrt::sim {
+namespace {
+constexpr std::uint8_t kTemperatureC = 40;
+}
+
+MitMotorNode::MitMotorNode(const ActuatorBinding& binding, canid_t master_id,
+                           const SimBusSettings& settings, Nanos now)
+    : binding_(binding),
+      options_(options_of<MitMotorOptions>(binding.options)),
+      master_id_(master_id),
+      motor_(0.0, settings.time_constant_s, settings.max_speed_rad_s, now) {
+  // Start a little away from the home pose, so the start ramp has work to do.
+  const double start = options_.to_motor(initial_offset_rad(binding.device_id), binding.direction);
+  motor_ = LagMotor(start, settings.time_constant_s, settings.max_speed_rad_s, now);
+}
+
+std::vector<canid_t> MitMotorNode::listens_to() const {
+  return {static_cast<canid_t>(binding_.device_id)};
+}
+
+double MitMotorNode::joint_position(Nanos now) const {
+  return options_.to_joint(motor_position(now), binding_.direction);
+}
+
+can_frame MitMotorNode::reply(Nanos now) const {
+  mit::Reply r;
+  r.motor_id = static_cast<std::uint8_t>(binding_.device_id);
+  r.position = motor_position(now);
+  r.velocity = motor_.velocity(now);
+  r.torque = 0.0;
+  if (motor_mode_) {
+    r.torque = command_.kp * (command_.position - r.position) +
+               command_.kd * (command_.velocity - r.velocity) + command_.torque;
+  }
+  r.extended = true;
+  r.temperature = kTemperatureC;
+  r.error = error_;
+  return mit::pack_reply(master_id_, r, options_.ranges);
+}
+
+void MitMotorNode::handle(const can_frame& frame, Nanos now, FrameList& out) {
+  if (!responding()) return;
+  if ((frame.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG)) != 0) return;
+  if ((frame.can_id & CAN_SFF_MASK) != static_cast<canid_t>(binding_.device_id)) return;
+  if (frame.len != 8) return;  // the firmware ignores anything but 8 bytes
+  switch (mit::special_of(frame)) {
+    case mit::Special::enter_motor_mode:
+      if (error_ == 0) {
+        motor_mode_ = true;
+        command_ = mit::Command{};  // limp until the first command
+        motor_.hold(now);
+      }
+      break;
+    case mit::Special::exit_motor_mode:
+      motor_mode_ = false;
+      motor_.hold(now);
+      break;
+    case mit::Special::set_zero:
+      motor_.hold(now);
+      zero_ = motor_.position(now);
+      break;
+    case mit::Special::none: {
+      mit::Command c;
+      if (!mit::unpack_command(frame, options_.ranges, c)) return;
+      if (motor_mode_) {
+        command_ = c;
+        if (c.kp > 0.0) {
+          motor_.set_goal(c.position + zero_, now);
+        } else {
+          motor_.hold(now);
+        }
+      }
+      break;
+    }
+  }
+  out.push_back(reply(now));
+}
+
+void MitMotorNode::set_fault(std::uint8_t bits, Nanos now, FrameList&) {
+  error_ = bits;
+  if (bits != 0) {
+    motor_mode_ = false;
+    motor_.hold(now);
+  }
+}
+
+void MitMotorNode::reboot(Nanos now, FrameList&) {
+  motor_mode_ = false;
+  command_ = mit::Command{};
+  zero_ = 0.0;
+  motor_.hold(now);
+}
+
+}  // namespace animrt::sim

@@ -1,0 +1,475 @@
+#include "animrt/sim/modbus/modbus_sim_bus.hpp"
+
+#include <arpa/inet.h>
+#include <modbus.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <any>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "animrt/core/error.hpp"
+#include "animrt/sim/dynamixel_servo.hpp"
+#include "animrt/sim/maestro/pty_pair.hpp"
+
+namespace animrt::sim {
+namespace {
+
+constexpr Nanos kStep = 1'000'000;  // motor integration step: 1 ms
+
+std::uint16_t get16(const std::uint8_t* p) {
+  return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
+}
+
+std::uint16_t crc16(const std::uint8_t* p, std::size_t n) {
+  std::uint16_t crc = 0xFFFF;
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= p[i];
+    for (int b = 0; b < 8; ++b)
+      crc = (crc & 1) ? static_cast<std::uint16_t>((crc >> 1) ^ 0xA001) : crc >> 1;
+  }
+  return crc;
+}
+
+// Length of an RTU request from its first bytes; 0 = not known yet, -1 =
+// unknown function.
+int rtu_length(const std::uint8_t* b, std::size_t have) {
+  if (have < 2) return 0;
+  switch (b[1]) {
+    case 1:
+    case 2:
+    case 3:
+    case 4:
+    case 5:
+    case 6:
+      return 8;
+    case 15:
+    case 16:
+      return have < 7 ? 0 : 9 + b[6];
+    case 23:
+      return have < 11 ? 0 : 13 + b[10];
+    case 22:
+      return 10;
+    case 17:
+      return 4;
+    default:
+      return -1;
+  }
+}
+
+void sleep_us(int us) {
+  if (us <= 0) return;
+  timespec ts{us / 1'000'000, static_cast<long>(us % 1'000'000) * 1000};
+  while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+  }
+}
+
+}  // namespace
+
+struct ModbusSimBus::Joint {
+  const ActuatorBinding* binding = nullptr;
+  ModbusJointOptions options;
+  double position = 0.0;  // joint rad
+  double goal = 0.0;
+};
+
+struct ModbusSimBus::Drive {
+  int slave = 0;
+  std::vector<Joint> joints;
+  modbus_mapping_t* mapping = nullptr;
+  bool responding = true;
+  std::uint16_t faults = 0;
+  bool enabled = false;
+  Nanos time = 0;
+  ~Drive() {
+    if (mapping) modbus_mapping_free(mapping);
+  }
+};
+
+ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
+    : config_(config), clock_(clock), wake_(std::make_unique<WakePipe>()) {
+  const auto* bus_options = std::any_cast<ModbusBusOptions>(&config_.options);
+  tcp_ = bus_options == nullptr || bus_options->tcp;
+  const Nanos now = clock.now();
+  for (const ActuatorBinding& b : config_.actuators) {
+    const auto& o = std::any_cast<const ModbusJointOptions&>(b.options);
+    Drive* d = drive(o.slave);
+    if (d == nullptr) {
+      drives_.push_back(std::make_unique<Drive>());
+      d = drives_.back().get();
+      d->slave = o.slave;
+      d->time = now;
+    }
+    Joint j;
+    j.binding = &b;
+    j.options = o;
+    j.position = j.goal = initial_offset_rad(o.slave + static_cast<int>(d->joints.size()));
+    d->joints.push_back(j);
+  }
+  for (auto& dp : drives_) {
+    Drive& d = *dp;
+    int hold_lo = 1 << 20, hold_hi = 0, in_lo = 1 << 20, in_hi = 0, coil_lo = 1 << 20, coil_hi = 0;
+    bool any_enable = false;
+    for (const Joint& j : d.joints) {
+      for (const auto& [table, span] : j.options.map->spans()) {
+        int& lo = table == modbus::Table::holding ? hold_lo : in_lo;
+        int& hi = table == modbus::Table::holding ? hold_hi : in_hi;
+        lo = std::min(lo, span.first);
+        hi = std::max(hi, span.second);
+      }
+      const modbus::Enable& e = j.options.map->enable;
+      if (e.configured) any_enable = true;
+      if (e.configured && e.coil) {
+        coil_lo = std::min(coil_lo, e.address);
+        coil_hi = std::max(coil_hi, e.address + 1);
+      }
+    }
+    d.enabled = !any_enable;
+    const auto n = [](int lo, int hi) { return hi > lo ? hi - lo : 0; };
+    d.mapping = modbus_mapping_new_start_address(
+        static_cast<unsigned>(n(coil_lo, coil_hi) ? coil_lo : 0),
+        static_cast<unsigned>(n(coil_lo, coil_hi)), 0, 0,
+        static_cast<unsigned>(n(hold_lo, hold_hi) ? hold_lo : 0),
+        static_cast<unsigned>(n(hold_lo, hold_hi)),
+        static_cast<unsigned>(n(in_lo, in_hi) ? in_lo : 0), static_cast<unsigned>(n(in_lo, in_hi)));
+    if (d.mapping == nullptr)
+      throw DeviceError("simulated bus '" + config_.name + "': modbus mapping");
+    for (Joint& j : d.joints) {
+      const modbus::RegisterMap& m = *j.options.map;
+      j.options.map->goal.encode(
+          j.options.zero + j.options.per_rad * j.goal,
+          d.mapping->tab_registers + (m.goal.address - d.mapping->start_registers));
+      if (m.enable.configured) {
+        if (m.enable.coil) {
+          d.mapping->tab_bits[m.enable.address - d.mapping->start_bits] =
+              static_cast<std::uint8_t>(m.enable.off);
+        } else {
+          d.mapping->tab_registers[m.enable.address - d.mapping->start_registers] = m.enable.off;
+        }
+      }
+    }
+    publish(d);
+  }
+
+  if (tcp_) {
+    ctx_ = modbus_new_tcp("127.0.0.1", 0);
+    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const int yes = 1;
+    ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    addr.sin_port = 0;
+    socklen_t len = sizeof addr;
+    if (listen_fd_ < 0 ||
+        ::bind(listen_fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
+        ::listen(listen_fd_, 8) != 0 ||
+        ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) != 0) {
+      const int error = errno;
+      if (listen_fd_ >= 0) ::close(listen_fd_);
+      if (ctx_) modbus_free(ctx_);
+      throw DeviceError("simulated bus '" + config_.name +
+                        "': cannot listen on 127.0.0.1: " + std::strerror(error));
+    }
+    endpoint_ = "127.0.0.1:" + std::to_string(ntohs(addr.sin_port));
+  } else {
+    pty_ = std::make_unique<PtyPair>("simulated bus '" + config_.name + "'");
+    endpoint_ = pty_->path();
+    ctx_ = modbus_new_rtu("/dev/null", std::max(config_.baud, 300), 'N', 8, 1);
+    if (ctx_) modbus_set_socket(ctx_, pty_->master());
+  }
+  if (ctx_ == nullptr) throw DeviceError("simulated bus '" + config_.name + "': libmodbus context");
+}
+
+ModbusSimBus::~ModbusSimBus() {
+  stop();
+  if (listen_fd_ >= 0) ::close(listen_fd_);
+  if (ctx_) {
+    if (tcp_) modbus_set_socket(ctx_, -1);
+    modbus_free(ctx_);  // the pty's fd belongs to PtyPair; free does not close it
+  }
+}
+
+std::string ModbusSimBus::describe() const {
+  return std::string(tcp_ ? "modbus-tcp " : "modbus-rtu ") + config_.name + " " + endpoint_;
+}
+
+void ModbusSimBus::start() {
+  if (thread_.joinable()) return;
+  wake_->drain();
+  stop_ = false;
+  thread_ = std::thread([this] { tcp_ ? serve_tcp() : serve_rtu(); });
+}
+
+void ModbusSimBus::stop() {
+  if (!thread_.joinable()) return;
+  stop_ = true;
+  wake_->wake();
+  thread_.join();
+  for (int fd : clients_) ::close(fd);
+  clients_.clear();
+}
+
+ModbusSimBus::Drive* ModbusSimBus::drive(int slave) {
+  for (auto& d : drives_) {
+    if (d->slave == slave) return d.get();
+  }
+  return nullptr;
+}
+
+void ModbusSimBus::advance(Drive& d, Nanos now) {
+  const double tau = config_.sim.time_constant_s;
+  const double vmax = config_.sim.max_speed_rad_s;
+  for (; d.time + kStep <= now; d.time += kStep) {
+    if (!d.enabled || d.faults) continue;
+    const double dt = to_seconds(kStep);
+    for (Joint& j : d.joints) {
+      const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
+      j.position += v * dt;
+    }
+  }
+}
+
+void ModbusSimBus::publish(Drive& d) {
+  for (Joint& j : d.joints) {
+    const modbus::RegisterMap& m = *j.options.map;
+    std::uint16_t* tab =
+        m.present.table == modbus::Table::holding
+            ? d.mapping->tab_registers + (m.present.address - d.mapping->start_registers)
+            : d.mapping->tab_input_registers +
+                  (m.present.address - d.mapping->start_input_registers);
+    m.present.encode(j.options.zero + j.options.per_rad * j.position, tab);
+    if (m.has_status) {
+      std::uint16_t* st =
+          m.status.table == modbus::Table::holding
+              ? d.mapping->tab_registers + (m.status.address - d.mapping->start_registers)
+              : d.mapping->tab_input_registers +
+                    (m.status.address - d.mapping->start_input_registers);
+      *st = d.faults;
+    }
+  }
+}
+
+void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
+  ++requests_;
+  std::lock_guard lock(mutex_);
+  Drive* d = drive(req[offset - 1]);
+  if (d == nullptr || !d->responding) return;  // nobody home: the master times out
+  const Nanos now = clock_.now();
+  advance(*d, now);
+  publish(*d);
+
+  // The drive's own checks of written values, before libmodbus stores them.
+  const std::uint8_t* pdu = req + offset;
+  const int function = pdu[0];
+  int write_addr = -1, write_count = 0;
+  const std::uint8_t* values = nullptr;
+  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
+    write_addr = get16(pdu + 1);
+    write_count = 1;
+    values = pdu + 3;
+  } else if (function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
+    write_addr = get16(pdu + 1);
+    write_count = get16(pdu + 3);
+    values = pdu + 6;
+  } else if (function == MODBUS_FC_WRITE_AND_READ_REGISTERS) {
+    write_addr = get16(pdu + 5);
+    write_count = get16(pdu + 7);
+    values = pdu + 10;
+  }
+  bool bad_value = false;
+  if (write_addr >= 0 && length >= offset + 1) {
+    for (const Joint& j : d->joints) {
+      const modbus::RegisterMap& m = *j.options.map;
+      const int g0 = m.goal.address, g1 = m.goal.end();
+      if (write_addr < g1 && g0 < write_addr + write_count) {
+        std::uint16_t words[2] = {0, 0};
+        for (int a = g0; a < g1; ++a) {
+          const int rel = a - d->mapping->start_registers;
+          words[a - g0] =
+              (a >= write_addr && a < write_addr + write_count)
+                  ? get16(values + 2 * (a - write_addr))
+                  : (rel >= 0 && rel < d->mapping->nb_registers ? d->mapping->tab_registers[rel]
+                                                                : 0);
+        }
+        const double si = m.goal.decode(words);
+        if (!std::isfinite(si) || (m.has_range && (si < m.range_min || si > m.range_max)))
+          bad_value = true;
+      }
+      if (m.enable.configured && !m.enable.coil && m.enable.address >= write_addr &&
+          m.enable.address < write_addr + write_count) {
+        const std::uint16_t v = get16(values + 2 * (m.enable.address - write_addr));
+        if (v != m.enable.on && v != m.enable.off) bad_value = true;
+      }
+    }
+  }
+  const int delay = config_.sim.return_delay_us;
+  if (bad_value) {
+    sleep_us(delay);
+    modbus_reply_exception(ctx_, req, MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE);
+    ++exceptions_;
+    return;
+  }
+  if (!tcp_) modbus_set_slave(ctx_, d->slave);
+  sleep_us(delay);
+  // libmodbus answers exceptions 2 (illegal address) and 3 (bad quantity) itself.
+  modbus_reply(ctx_, req, length, d->mapping);
+  // Read back what was written: goals and enables.
+  bool enabled = true, any_enable = false;
+  for (Joint& j : d->joints) {
+    const modbus::RegisterMap& m = *j.options.map;
+    const std::uint16_t* g =
+        d->mapping->tab_registers + (m.goal.address - d->mapping->start_registers);
+    j.goal = (m.goal.decode(g) - j.options.zero) / j.options.per_rad;
+    if (m.enable.configured) {
+      any_enable = true;
+      const std::uint16_t v =
+          m.enable.coil ? d->mapping->tab_bits[m.enable.address - d->mapping->start_bits]
+                        : d->mapping->tab_registers[m.enable.address - d->mapping->start_registers];
+      enabled = enabled && v == m.enable.on;
+    }
+  }
+  d->enabled = !any_enable || enabled;
+}
+
+void ModbusSimBus::serve_tcp() {
+  std::array<std::uint8_t, MODBUS_TCP_MAX_ADU_LENGTH> req{};
+  std::vector<pollfd> fds;
+  while (!stop_.load()) {
+    if (drop_.exchange(false)) {
+      for (int fd : clients_) ::close(fd);
+      clients_.clear();
+    }
+    fds.clear();
+    fds.push_back({wake_->read_fd(), POLLIN, 0});
+    fds.push_back({listen_fd_, POLLIN, 0});
+    for (int fd : clients_) fds.push_back({fd, POLLIN, 0});
+    if (::poll(fds.data(), fds.size(), -1) < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    if (fds[0].revents != 0) {
+      wake_->drain();
+      continue;  // stop or drop: checked at the top
+    }
+    if (fds[1].revents & POLLIN) {
+      const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+      if (fd >= 0) {
+        clients_.push_back(fd);
+        ++connections_;
+      }
+    }
+    for (std::size_t i = 2; i < fds.size(); ++i) {
+      if (fds[i].revents == 0) continue;
+      modbus_set_socket(ctx_, fds[i].fd);
+      const int rc = modbus_receive(ctx_, req.data());
+      if (rc > 0) {
+        handle(req.data(), rc, modbus_get_header_length(ctx_));
+      } else if (rc < 0) {
+        ::close(fds[i].fd);
+        clients_.erase(std::find(clients_.begin(), clients_.end(), fds[i].fd));
+      }
+    }
+  }
+  modbus_set_socket(ctx_, -1);
+}
+
+void ModbusSimBus::serve_rtu() {
+  std::array<std::uint8_t, 512> buf{};
+  std::size_t have = 0;
+  const int master = pty_->master();
+  // Silence that ends a cut frame: 3.5 characters, at least a few ms here.
+  const int gap_ms = 5;
+  while (!stop_.load()) {
+    pollfd fds[2] = {{master, POLLIN, 0}, {wake_->read_fd(), POLLIN, 0}};
+    const int r = ::poll(fds, 2, have > 0 ? gap_ms : -1);
+    if (r < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    if (fds[1].revents != 0) break;
+    if (r == 0) {  // silence inside a frame: drop it
+      dropped_ += have;
+      have = 0;
+      continue;
+    }
+    if (!(fds[0].revents & POLLIN)) {
+      ::poll(&fds[1], 1, 10);
+      continue;
+    }
+    const ssize_t n = ::read(master, buf.data() + have, buf.size() - have);
+    if (n <= 0) continue;
+    have += static_cast<std::size_t>(n);
+    for (;;) {
+      const int want = rtu_length(buf.data(), have);
+      if (want == 0 || (want > 0 && have < static_cast<std::size_t>(want))) break;
+      if (want < 0) {  // unknown function: wait for the silence after it
+        break;
+      }
+      const std::size_t len = static_cast<std::size_t>(want);
+      const std::uint16_t crc = crc16(buf.data(), len - 2);
+      if ((buf[len - 2] | (buf[len - 1] << 8)) != crc) {
+        ++crc_errors_;  // a drive ignores a frame it cannot trust
+      } else {
+        handle(buf.data(), static_cast<int>(len), 1);
+      }
+      std::memmove(buf.data(), buf.data() + len, have - len);
+      have -= len;
+    }
+    if (have == buf.size()) {
+      dropped_ += have;
+      have = 0;
+    }
+  }
+}
+
+void ModbusSimBus::set_device_responding(int device_id, bool responding) {
+  std::lock_guard lock(mutex_);
+  Drive* d = drive(device_id);
+  if (!d)
+    throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
+                            config_.name + "'");
+  d->responding = responding;
+}
+
+void ModbusSimBus::set_device_hardware_error(int device_id, std::uint8_t error_bits) {
+  std::lock_guard lock(mutex_);
+  Drive* d = drive(device_id);
+  if (!d)
+    throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
+                            config_.name + "'");
+  advance(*d, clock_.now());
+  d->faults = static_cast<std::uint16_t>(d->faults | error_bits);
+  publish(*d);
+}
+
+double ModbusSimBus::device_position(int device_id) const {
+  std::lock_guard lock(mutex_);
+  auto* self = const_cast<ModbusSimBus*>(this);
+  Drive* d = self->drive(device_id);
+  if (!d)
+    throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
+                            config_.name + "'");
+  self->advance(*d, clock_.now());
+  return d->joints.front().position;
+}
+
+void ModbusSimBus::drop_connections() {
+  drop_ = true;
+  wake_->wake();
+}
+
+ModbusSimStats ModbusSimBus::stats() const {
+  return ModbusSimStats{requests_.load(), exceptions_.load(), crc_errors_.load(), dropped_.load(),
+                        connections_.load()};
+}
+
+}  // namespace animrt::sim

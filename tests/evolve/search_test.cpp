@@ -1,0 +1,186 @@
+// The GE search: reproducible from its seed, threads agree with a serial run,
+// invalid individuals score worst and are counted, a falling phenotype gets
+// the worst score, the run file is checked.
+
+#include "animrt/controllers/evolve/search.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "animrt/controllers/evolve/evaluator.hpp"
+#include "animrt/controllers/evolve/phenotype.hpp"
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+
+namespace animrt::evolve {
+namespace {
+
+const std::string kRoot = ANIMRT_SOURCE_DIR;
+
+// A tiny run on the demo quadruped: short walks, few individuals.
+RunConfig tiny_run() {
+  RunConfig c = load_run_config(kRoot + "/configs/evolve/quadruped_concatenating.yaml");
+  c.search.population = 8;
+  c.search.generations = 2;
+  c.search.elites = 2;
+  c.search.init.max_depth = 6;
+  c.walk.settle_s = 0.1;
+  c.walk.warmup_cycles = 1;
+  c.walk.measure_cycles = 1;
+  return c;
+}
+
+SearchResult run_with(const RunConfig& c, Evaluator& evaluator, const ModelInfo& info) {
+  Search search(c, Grammar::load_file(c.grammar), load_gait_file(c.seed_gait), info, evaluator);
+  return search.run();
+}
+
+void expect_same(const SearchResult& a, const SearchResult& b) {
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (std::size_t g = 0; g < a.history.size(); ++g) {
+    EXPECT_EQ(a.history[g].best, b.history[g].best) << "generation " << g;
+    EXPECT_EQ(a.history[g].average, b.history[g].average) << "generation " << g;
+    EXPECT_EQ(a.history[g].invalid, b.history[g].invalid) << "generation " << g;
+    EXPECT_EQ(a.history[g].best_phenotype, b.history[g].best_phenotype) << "generation " << g;
+  }
+  EXPECT_EQ(a.best.phenotype, b.best.phenotype);
+  EXPECT_EQ(format_gait_file(a.best.gait), format_gait_file(b.best.gait));
+}
+
+TEST(Search, SameSeedSameRunAndThreadsAgreeWithSerial) {
+  const RunConfig c = tiny_run();
+  sim::MujocoGaitSimulatorFactory factory(c.model);
+  const ModelInfo info{factory.model().actuated_joints, factory.model().hip_height_m,
+                       factory.model().mass_kg};
+  ThreadEvaluator serial(factory, 1);
+  ThreadEvaluator threads(factory, 2);
+  const SearchResult a = run_with(c, serial, info);
+  const SearchResult b = run_with(c, serial, info);
+  const SearchResult t = run_with(c, threads, info);
+  expect_same(a, b);
+  expect_same(a, t);
+  ASSERT_EQ(a.history.size(), 3u);  // generations 0, 1, 2
+  // Elitism: with fixed weights the best never gets worse.
+  EXPECT_LE(a.history[2].best, a.history[0].best);
+  EXPECT_TRUE(a.best.valid);
+  EXPECT_LT(a.best.fitness, kWorstFitness);
+}
+
+TEST(Search, FallingPhenotypeGetsTheWorstScore) {
+  const RunConfig c = tiny_run();
+  sim::MujocoGaitSimulatorFactory factory(c.model);
+  auto sim = factory.make();
+  const GaitFile seed = load_gait_file(c.seed_gait);
+  const PhenotypeGait flail =
+      make_phenotype_gait(seed, "200*sin(2*PI*t); 200*sin(2*PI*t); 200*sin(2*PI*t)");
+  ASSERT_TRUE(flail.valid) << flail.error;
+  const GaitMeasures m = sim->walk(flail.gait, c.walk);
+  EXPECT_TRUE(m.fell);
+  const GaitTargets t = froude_targets(seed.froude->number, seed.froude->hip_height_m);
+  EXPECT_EQ(score(m, t, {}, sim->info().mass_kg), kWorstFitness);
+  // The seed itself scores better than worst.
+  EXPECT_LT(score(sim->walk(seed, c.walk), t, {}, sim->info().mass_kg), kWorstFitness);
+}
+
+// Walks nothing: every valid gait gets the same measures.
+class FakeEvaluator final : public Evaluator {
+ public:
+  void walk_all(std::span<const GaitFile* const> gaits, const WalkSettings&,
+                std::span<GaitMeasures> out) override {
+    for (std::size_t i = 0; i < gaits.size(); ++i) {
+      out[i] = GaitMeasures{};
+      out[i].speed = 0.05;
+      out[i].stride_length = 0.05;
+      out[i].duty_factor = 0.7;
+      ++walked;
+    }
+  }
+  int workers() const override { return 1; }
+  int walked = 0;
+};
+
+TEST(Search, InvalidIndividualsScoreWorstAndAreCounted) {
+  RunConfig c = tiny_run();
+  c.search.population = 20;
+  c.search.generations = 0;
+  // A curve that is infinite makes the phenotype an unusable gait.
+  const Grammar g = Grammar::parse(
+      "<p> ::= <c>;<c>;<c>\n<c> ::= 1e308*1e308 | sin(2*PI*t) | 2*sin(2*PI*t)\n", "inv.bnf");
+  Rng rng(c.search.seed);
+  int expected_invalid = 0;
+  for (const auto& genome : ramped_full_grow(g, c.search.population, c.search.init, rng)) {
+    const MapResult r = map_genome(g, genome);
+    expected_invalid += r.phenotype.find("1e308") != std::string::npos;
+  }
+  ASSERT_GT(expected_invalid, 0);
+  ASSERT_LT(expected_invalid, c.search.population);
+  FakeEvaluator fake;
+  Search search(c, g, load_gait_file(c.seed_gait), {{}, 0.18, 1.6}, fake);
+  const SearchResult r = search.run();
+  EXPECT_EQ(r.history[0].invalid, expected_invalid);
+  EXPECT_EQ(fake.walked, c.search.population - expected_invalid);
+  const double valid_score = r.history[0].best;
+  EXPECT_LT(valid_score, kWorstFitness);
+  const double n = c.search.population;
+  EXPECT_NEAR(r.history[0].average,
+              ((n - expected_invalid) * valid_score + expected_invalid * kWorstFitness) / n, 1e-6);
+}
+
+TEST(Phenotype, WrongCurveCountOrBadExpressionIsInvalid) {
+  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/quadruped_seed.yaml");
+  EXPECT_FALSE(make_phenotype_gait(seed, "1;2").valid);
+  EXPECT_FALSE(make_phenotype_gait(seed, "1;2;(3").valid);
+  const PhenotypeGait ok = make_phenotype_gait(seed, "1 + 2*t; 2; 3", {"", "7", ""});
+  ASSERT_TRUE(ok.valid) << ok.error;
+  EXPECT_EQ(ok.gait.curves[1].expression, "7");  // held still
+  EXPECT_EQ(ok.gait.joints.size(), seed.joints.size());
+}
+
+TEST(RunConfig, ErrorsNameFileLineAndKey) {
+  const auto error_of = [](const std::string& text) {
+    try {
+      parse_run_config(text, "run.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string head = "name: x\ngrammar: g.bnf\nmodel: m.xml\nseed_gait: s.yaml\n";
+  EXPECT_EQ(error_of(head + "search: {population: 1}\n"),
+            "run.yaml:5:22: search.population: expected an integer from 2 to 1000000, found \"1\"");
+  EXPECT_EQ(error_of(head + "bogus: 1\n"),
+            "run.yaml:5:1: bogus: unknown key (expected one of: name, grammar, model, seed_gait, "
+            "search, walk, fitness, threads)");
+  EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 3}]}\n"),
+            "run.yaml:5:39: fitness.weights[0].from_generation: the first stage must start at "
+            "generation 0");
+  const RunConfig ok = parse_run_config(head, "/a/b/run.yaml");
+  EXPECT_EQ(ok.grammar, "/a/b/g.bnf");
+  EXPECT_EQ(ok.search.population, 75);
+  EXPECT_EQ(ok.search.elites, 7);
+  ASSERT_EQ(ok.weights.size(), 1u);
+}
+
+TEST(RunConfig, ShippedRunFilesLoad) {
+  for (const char* f : {"horse_numerical", "horse_concatenating", "horse_hybrid",
+                        "horse_sinusoidal", "horse_free", "horse_concatenating_varying_weights",
+                        "horse_concatenating_varying_freedom", "quadruped_concatenating"}) {
+    const RunConfig c = load_run_config(kRoot + "/configs/evolve/" + f + ".yaml");
+    EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
+    EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;
+  }
+  const RunConfig w =
+      load_run_config(kRoot + "/configs/evolve/horse_concatenating_varying_weights.yaml");
+  ASSERT_EQ(w.weights.size(), 5u);
+  EXPECT_EQ(weights_at(w.weights, 15).distance, 2.0);
+  EXPECT_EQ(weights_at(w.weights, 25).duty_factor, 2.0);
+  EXPECT_EQ(weights_at(w.weights, 50).stride_length, 1.0);
+  const RunConfig f =
+      load_run_config(kRoot + "/configs/evolve/horse_concatenating_varying_freedom.yaml");
+  ASSERT_EQ(f.freedom.size(), 4u);
+  EXPECT_EQ(f.freedom[0].free.size(), 3u);
+  EXPECT_EQ(f.freedom[3].free.size(), 12u);
+}
+
+}  // namespace
+}  // namespace animrt::evolve

@@ -1,0 +1,95 @@
+#!/bin/busybox sh
+# /init of the HIL guest (see tests/hil/run). Runs the guest tests, sends
+# the results to the host on /dev/ttyS2 (files framed by "=== BEGIN name ==="
+# and "=== END ===" lines), then powers off. Every test prints one line,
+# "PASS name" or "FAIL name: why", into results.txt.
+/bin/busybox --install -s /bin
+export PATH=/bin:/sbin
+mount -t proc proc /proc
+mount -t sysfs sys /sys
+mount -t devtmpfs dev /dev
+mkdir -p /tmp
+R=/tmp/results.txt
+: > $R
+pass() { echo "PASS $1" >> $R; echo "hil-guest: PASS $1"; }
+fail() { echo "FAIL $1: $2" >> $R; echo "hil-guest: FAIL $1: $2"; }
+
+# -- kernel CAN --------------------------------------------------------------
+ok=1
+for m in can can-raw can-dev vcan; do
+  insmod /lib/modules/$m.ko 2>/tmp/insmod.err || { ok=0; fail kernel_can "insmod $m: $(cat /tmp/insmod.err)"; }
+done
+if [ $ok = 1 ] && ip link add dev vcan0 type vcan && ip link set vcan0 up; then
+  pass kernel_can
+fi
+
+# -- serial: libserialport on the 8250 UART, host-side simulated servos --------
+if [ -e /sys/class/tty/ttyS1/device/driver ]; then
+  animrt run /configs/robots/quadruped_ttyS1.yaml --backend hardware --duration 3 --no-realtime \
+    --summary-json /tmp/serial_summary.json > /tmp/serial_run.txt 2>&1
+  rc=$?
+  if [ $rc = 0 ] && grep -q '"end_reason": "duration"' /tmp/serial_summary.json; then
+    pass serial_quadruped
+  else
+    fail serial_quadruped "animrt run exited $rc: $(grep -m1 error /tmp/serial_run.txt)"
+  fi
+else
+  fail serial_quadruped "no 8250 driver behind /dev/ttyS1"
+fi
+
+# -- CAN: SocketCAN on vcan0, simulated motors and drive in another process ------
+candump -L vcan0 > /tmp/vcan0.log 2>/tmp/candump.err &
+dump=$!
+animrt sim /configs/robots/quadruped_can_vcan0.yaml > /tmp/can_sim.txt 2>&1 &
+sim=$!
+n=0
+while [ "$(grep -c '^can ' /tmp/can_sim.txt)" -lt 3 ] && [ $n -lt 100 ]; do sleep 0.1; n=$((n + 1)); done
+if [ "$(grep -c '^can ' /tmp/can_sim.txt)" -lt 3 ]; then
+  fail can_sim "animrt sim did not come up on vcan0: $(head -c 300 /tmp/can_sim.txt)"
+else
+  pass can_sim
+fi
+animrt run /configs/robots/quadruped_can_vcan0.yaml --backend hardware --duration 3 --no-realtime \
+  --summary-json /tmp/can_summary.json > /tmp/can_run.txt 2>&1
+rc=$?
+if [ $rc = 0 ] && grep -q '"end_reason": "duration"' /tmp/can_summary.json; then
+  pass can_quadruped
+else
+  fail can_quadruped "animrt run exited $rc: $(grep -m1 error /tmp/can_run.txt)"
+fi
+kill $sim 2>/dev/null; wait $sim 2>/dev/null
+# With nobody answering, bring-up names every silent device (exit 3).
+animrt run /configs/robots/quadruped_can_vcan0.yaml --backend hardware --duration 1 --no-realtime \
+  > /tmp/can_missing_run.txt 2>&1
+rc=$?
+if [ $rc = 3 ] && grep -q 'no answer to exit motor mode from motor id 1 (lf_hip)' /tmp/can_missing_run.txt; then
+  pass can_missing_devices
+else
+  fail can_missing_devices "expected exit 3 naming the motors, got $rc: $(head -c 300 /tmp/can_missing_run.txt)"
+fi
+sleep 0.2
+kill $dump 2>/dev/null; wait $dump 2>/dev/null
+# The recording holds each protocol's traffic (candump -L: "(time) vcan0 ID#DATA").
+check() { grep -q " vcan0 $2\$" /tmp/vcan0.log && pass "candump_$1" || fail "candump_$1" "no $2 in vcan0.log"; }
+check mit_enter_motor_mode '001#FFFFFFFFFFFFFFFC'
+check mit_reply '000#01.*'
+check nmt_start_node32 '000#0120'
+check sync '080#'
+check sdo_device_type '5A0#4300100092010200'
+check heartbeat_operational '720#05'
+check tpdo '1A0#.*'
+
+echo DONE >> $R
+# -- results to the host --------------------------------------------------------
+stty -F /dev/ttyS2 raw -echo 2>/dev/null
+{
+  for f in results.txt vcan0.log serial_summary.json serial_run.txt can_summary.json can_run.txt \
+           can_sim.txt can_missing_run.txt; do
+    [ -f /tmp/$f ] || continue
+    echo "=== BEGIN $f ==="
+    cat /tmp/$f
+    echo "=== END ==="
+  done
+} > /dev/ttyS2
+sync
+poweroff -f

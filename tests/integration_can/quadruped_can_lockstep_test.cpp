@@ -1,0 +1,267 @@
+// The runtime against the simulated MIT motors and CiA 402 drive of
+// configs/robots/quadruped_can.yaml on the in-process virtual CAN bus, on a
+// lockstep clock: the whole lifecycle, tracking, determinism, no allocation
+// in the cycle, and the fault paths: a drive that reboots mid-run, an EMCY,
+// a silent drive (heartbeat consumer), an interface going bus-off, and a
+// device missing at bring-up.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/can/cia402_bus.hpp"
+#include "animrt/bridge/can/mit_bus.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/runner.hpp"
+#include "animrt/sim/can/can_sim_bus.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace {
+
+const std::string kRobot = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped_can.yaml";
+
+class Probe final : public MotionSource {
+ public:
+  explicit Probe(std::unique_ptr<MotionSource> inner) : inner_(std::move(inner)) {
+    allocations.assign(100000, 0);
+  }
+  std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
+  void sample(double t, std::span<double> targets) const override {
+    if (on_sample) on_sample(t);
+    if (samples < allocations.size()) allocations[samples++] = test::thread_allocations();
+    inner_->sample(t, targets);
+  }
+  std::function<void(double)> on_sample;
+  mutable std::vector<std::uint64_t> allocations;
+  mutable std::size_t samples = 0;
+
+ private:
+  std::unique_ptr<MotionSource> inner_;
+};
+
+struct Rig {
+  ManualClock clock;
+  LoadedRobot robot;
+  std::vector<std::unique_ptr<SimulatedBus>> sims;
+  MitBus* left = nullptr;
+  Cia402Bus* drive = nullptr;
+  Probe* probe = nullptr;
+  std::unique_ptr<Runner> runner;
+
+  explicit Rig(const std::function<void(Rig&)>& before_buses = {}) {
+    robot = load_robot(kRobot);
+    for (auto& bus : robot.config.buses) bus.timeout_s = 0.05;  // a loaded CI machine is no fault
+    sims = start_simulated_devices(robot.config.buses, clock);
+    if (before_buses) before_buses(*this);
+    std::vector<std::unique_ptr<ActuatorBus>> buses;
+    for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
+    left = dynamic_cast<MitBus*>(buses[0].get());
+    drive = dynamic_cast<Cia402Bus*>(buses[2].get());
+    auto owner = std::make_unique<Probe>(std::move(robot.motion));
+    probe = owner.get();
+    runner = std::make_unique<Runner>(robot.config, std::move(buses), std::move(owner));
+  }
+  sim::CanSimBus& sim(std::size_t i) { return dynamic_cast<sim::CanSimBus&>(*sims[i]); }
+
+  RunSummary run(double duration, const std::string& telemetry = "") {
+    RunOptions options;
+    options.duration_s = duration;
+    options.lockstep_clock = &clock;
+    options.telemetry_path = telemetry;
+    options.backend_name = "sim";
+    return runner->run(options);
+  }
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(QuadrupedCanLockstep, WalksOnMitMotorsAndACia402Drive) {
+  Rig rig;
+  ASSERT_NE(rig.left, nullptr);
+  ASSERT_NE(rig.drive, nullptr);
+  const RunSummary s = rig.run(2.0);
+  EXPECT_EQ(s.end_reason, EndReason::duration);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_TRUE(s.faults.empty());
+  ASSERT_EQ(s.devices.size(), 12u);
+  for (const auto& d : s.devices) {
+    EXPECT_FALSE(d.status.faulted) << d.joint;
+    EXPECT_EQ(d.status.timeouts, 0u) << d.joint;
+    EXPECT_EQ(d.status.protocol_errors, 0u) << d.joint;
+    EXPECT_GE(d.status.transactions, s.cycles) << d.joint;
+  }
+  // First-order motors (tau 20 ms) behind a gait of at most ~140 deg/s.
+  for (const auto& j : s.joints) {
+    EXPECT_LT(j.max_tracking_error_rad, deg_to_rad(6.0)) << j.name;
+    EXPECT_GT(j.rms_tracking_error_rad, 0.0) << j.name;
+  }
+  // The drive went through the state machine and back, with heartbeats.
+  EXPECT_EQ(rig.drive->drive(0).state, cia402::State::switch_on_disabled);
+  EXPECT_GT(rig.drive->drive(0).heartbeats, 50u);  // 20 ms producer over > 6 s
+  EXPECT_EQ(rig.drive->drive(0).reboots, 0u);
+  EXPECT_EQ(rig.left->transport().errors().error_frames, 0u);
+  // Everything ramped home.
+  for (int id : {1, 2, 3, 4, 5, 6}) EXPECT_NEAR(rig.sims[0]->device_position(id), 0.0, 0.01);
+  EXPECT_NEAR(rig.sims[2]->device_position(32), 0.0, 0.01);
+}
+
+TEST(QuadrupedCanLockstep, DeterministicAndAllocationFreeCycle) {
+  const std::string a = ::testing::TempDir() + "/can_a.csv";
+  const std::string b = ::testing::TempDir() + "/can_b.csv";
+  std::size_t samples = 0;
+  {
+    Rig rig;
+    rig.run(1.0, a);
+    samples = rig.probe->samples;
+    ASSERT_GT(samples, 100u);
+    // Between two samples the loop thread ran a whole cycle: read, filter,
+    // write (both CAN protocols, virtual bus included), telemetry push.
+    for (std::size_t i = 2; i + 1 < samples; ++i) {
+      ASSERT_EQ(rig.probe->allocations[i + 1], rig.probe->allocations[i]) << "sample " << i;
+    }
+  }
+  {
+    Rig rig;
+    rig.run(1.0, b);
+  }
+  const std::string ta = read_file(a), tb = read_file(b);
+  EXPECT_GT(ta.size(), 1000u);
+  EXPECT_EQ(ta, tb);
+}
+
+TEST(QuadrupedCanLockstep, RebootedDriveFaultsAndTheRestRampsHome) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.5) {
+      rig.sim(2).reboot_device(32);
+      done = true;
+    }
+  };
+  const RunSummary s = rig.run(2.0);
+  EXPECT_EQ(s.end_reason, EndReason::fault);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("bus hip_drive id 32 (rh_hip): hardware error reported"),
+            std::string::npos)
+      << s.faults[0];
+  EXPECT_EQ(rig.drive->drive(0).reboots, 1u);
+  EXPECT_NE(rig.drive->fault_text(0).find("drive rebooted"), std::string::npos);
+  EXPECT_LT(s.motion_time_s, 0.6);
+  for (int id : {1, 2, 3, 4, 5, 6}) EXPECT_NEAR(rig.sims[0]->device_position(id), 0.0, 0.01);
+  for (int id : {7, 8, 9, 11, 12}) EXPECT_NEAR(rig.sims[1]->device_position(id), 0.0, 0.01);
+}
+
+TEST(QuadrupedCanLockstep, EmcyBecomesTheDevicesFaultReport) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.3) {
+      rig.sims[2]->set_device_hardware_error(32, 0x20);  // overload
+      done = true;
+    }
+  };
+  const RunSummary s = rig.run(2.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("id 32 (rh_hip): hardware error reported"), std::string::npos);
+  EXPECT_EQ(rig.drive->fault_text(0).substr(0, 46),
+            "EMCY 0x2310 (current), error register 0x03; st");
+  const auto& d = s.devices.back();
+  EXPECT_EQ(d.joint, "rh_hip");
+  EXPECT_EQ(d.status.hardware_error_status, 0x03);
+  EXPECT_GE(d.status.hardware_errors, 1u);
+}
+
+TEST(QuadrupedCanLockstep, SilentDriveTimesOutThroughTheHeartbeatConsumer) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.3) {
+      rig.sims[2]->set_device_responding(32, false);
+      done = true;
+    }
+  };
+  const RunSummary s = rig.run(2.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("id 32 (rh_hip): no valid answer for more than 0.1 s (last: timeout)"),
+            std::string::npos)
+      << s.faults[0];
+  EXPECT_TRUE(rig.drive->drive(0).heartbeat_lost);
+}
+
+TEST(QuadrupedCanLockstep, BusOffFaultsEveryDeviceOnThatInterface) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.3) {
+      rig.sim(0).virtual_bus()->set_bus_off(true);
+      done = true;
+    }
+  };
+  const RunSummary s = rig.run(2.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  EXPECT_EQ(s.faults.size(), 6u);
+  for (const auto& line : s.faults)
+    EXPECT_NE(line.find("bus legs_left"), std::string::npos) << line;
+  EXPECT_EQ(rig.left->transport().errors().bus_off, 1u);
+  EXPECT_TRUE(rig.left->transport().bus_off());
+  EXPECT_GT(rig.left->transport().errors().tx_dropped, 0u);
+  // The other interface's joints ramped home.
+  for (int id : {7, 8, 9, 11, 12}) EXPECT_NEAR(rig.sims[1]->device_position(id), 0.0, 0.01);
+  EXPECT_NEAR(rig.sims[2]->device_position(32), 0.0, 0.01);
+  rig.sim(0).virtual_bus()->set_bus_off(false);
+}
+
+TEST(QuadrupedCanLockstep, MissingDevicesAreNamedAtBringUp) {
+  {
+    Rig rig([](Rig& r) { r.sims[1]->set_device_responding(8, false); });
+    try {
+      rig.run(1.0);
+      FAIL() << "expected DeviceError";
+    } catch (const DeviceError& e) {
+      EXPECT_STREQ(
+          e.what(),
+          "bus legs_right (virtual:can1): no answer to exit motor mode from motor id 8 (rf_knee)");
+    }
+  }
+  {
+    Rig rig([](Rig& r) { r.sims[2]->set_device_responding(32, false); });
+    try {
+      rig.run(1.0);
+      FAIL() << "expected DeviceError";
+    } catch (const DeviceError& e) {
+      EXPECT_STREQ(
+          e.what(),
+          "bus hip_drive (virtual:can1): no answer to SDO upload 0x1000:00 (device type) from "
+          "node 32 (rh_hip)");
+    }
+  }
+}
+
+TEST(QuadrupedCanLockstep, DriveInFaultIsResetAtActivation) {
+  Rig rig([](Rig& r) {
+    r.sims[2]->set_device_hardware_error(32, 0x04);
+    r.sims[2]->set_device_hardware_error(32, 0);  // cause gone, drive still in fault
+  });
+  const RunSummary s = rig.run(0.5);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_TRUE(s.faults.empty());
+}
+
+}  // namespace
+}  // namespace animrt

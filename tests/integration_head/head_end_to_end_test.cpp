@@ -1,0 +1,153 @@
+// End to end: the CLI (corpus, train, synth, eval, features), the head
+// motion source on the bundled model and utterance, and the pitch tracker's
+// gross pitch error against Praat.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "animrt/controllers/head/head_source.hpp"
+#include "animrt/controllers/head/pose_io.hpp"
+#include "animrt/controllers/head/prosody.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt::head {
+namespace {
+
+const std::string kBin = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
+const std::string kSrc = ANIMRT_SOURCE_DIR;
+
+std::string tmp(const std::string& tag) {
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("animrt_head_it_" + tag + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d.string();
+}
+
+int run(const std::string& cmd) {
+  const int rc = std::system((cmd + " > /dev/null 2>&1").c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TEST(HeadCli, CorpusTrainSynthEvalFeatures) {
+  const std::string d = tmp("cli");
+  ASSERT_EQ(run(kBin + " head corpus --out " + d + "/corpus --utterances 5 --speakers 1 --quiet"),
+            0);
+  ASSERT_EQ(run(kBin + " head train " + d + "/corpus --out " + d +
+                "/m.txt -K 4 -S 2 -M 1 --iterations 2 --quiet"),
+            0);
+  ASSERT_EQ(run(kBin + " head synth " + d + "/m.txt " + kSrc +
+                "/configs/head/utterance.wav --out " + d + "/p.csv"),
+            0);
+  const PoseTrack p = load_euler_csv(d + "/p.csv");
+  EXPECT_GT(p.size(), 120u);
+  EXPECT_EQ(run(kBin + " head eval " + d + "/m.txt " + d + "/corpus"), 0);
+  ASSERT_EQ(
+      run(kBin + " head features " + kSrc + "/configs/head/utterance.wav --out " + d + "/f.csv"),
+      0);
+  std::ifstream f(d + "/f.csv");
+  std::string header;
+  std::getline(f, header);
+  EXPECT_EQ(header, "time_s,f0_hz,energy,voiced,f0_filled_hz,d_f0,d_energy,dd_f0,dd_energy");
+  // Bad input: exit code 2.
+  std::ofstream(d + "/bad.txt") << "animrt-head-model 7\n";
+  EXPECT_EQ(run(kBin + " head synth " + d + "/bad.txt " + kSrc +
+                "/configs/head/utterance.wav --out " + d + "/x.csv"),
+            2);
+  EXPECT_EQ(run(kBin + " head features " + d + "/bad.txt --out " + d + "/x.csv"), 2);
+  std::filesystem::remove_all(d);
+}
+
+TEST(HeadSource, BundledModelMovesNeckAndJawWithinLimits) {
+  HeadMotionConfig c;
+  c.model = kSrc + "/configs/head/model.txt";
+  c.audio = kSrc + "/configs/head/utterance.wav";
+  c.precomputed = true;  // the same streaming pipeline, run at load (lockstep-friendly)
+  c.yaw.joint = "yaw";
+  c.pitch.joint = "pitch";
+  c.pitch.sign = -1;
+  c.roll.joint = "roll";
+  c.jaw.joint = "jaw";
+  std::vector<JointSpec> joints(4);
+  const char* names[] = {"yaw", "pitch", "roll", "jaw"};
+  for (int i = 0; i < 4; ++i) {
+    joints[static_cast<std::size_t>(i)].name = names[i];
+    joints[static_cast<std::size_t>(i)].limits = {deg_to_rad(-15), deg_to_rad(15), 1, 1};
+  }
+  joints[3].limits = {0, deg_to_rad(20), 1, 1};
+  auto src = make_head_source(c, joints);
+  EXPECT_EQ(src->driven_joints().size(), 4u);
+  std::vector<double> t(4, 0.0), lo(4, 1e9), hi(4, -1e9);
+  const auto before = test::thread_allocations();
+  for (int i = 0; i < 800; ++i) {
+    src->sample(i * 0.01, t);
+    for (int k = 0; k < 4; ++k) {
+      lo[static_cast<std::size_t>(k)] =
+          std::min(lo[static_cast<std::size_t>(k)], t[static_cast<std::size_t>(k)]);
+      hi[static_cast<std::size_t>(k)] =
+          std::max(hi[static_cast<std::size_t>(k)], t[static_cast<std::size_t>(k)]);
+    }
+  }
+  EXPECT_EQ(test::thread_allocations(), before);  // sample() never allocates
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GE(lo[static_cast<std::size_t>(k)],
+              joints[static_cast<std::size_t>(k)].limits.min_position - 1e-12);
+    EXPECT_LE(hi[static_cast<std::size_t>(k)],
+              joints[static_cast<std::size_t>(k)].limits.max_position + 1e-12);
+    EXPECT_GT(hi[static_cast<std::size_t>(k)] - lo[static_cast<std::size_t>(k)], deg_to_rad(1.0))
+        << names[k];
+  }
+  // A joint the robot does not have.
+  c.roll.joint = "tail";
+  EXPECT_THROW(make_head_source(c, joints), InputError);
+}
+
+// Gross pitch error of our YIN features against Praat's autocorrelation
+// tracker on espeak-ng speech: frames voiced in both, |error| > 20 %.
+TEST(PitchTracker, GrossPitchErrorAgainstPraat) {
+  if (std::system("command -v praat > /dev/null 2>&1") != 0) GTEST_SKIP() << "praat not installed";
+  const std::string d = tmp("gpe");
+  const std::string wav = kSrc + "/configs/head/utterance.wav";
+  std::ofstream(d + "/pitch.praat") << "form args\n  sentence wav\n  sentence out\nendform\n"
+                                       "s = Read from file: wav$\np = To Pitch: 0.005, 75, 500\n"
+                                       "n = Get number of frames\nwriteFileLine: out$, \"t f\"\n"
+                                       "for i to n\n  t = Get time from frame number: i\n"
+                                       "  f = Get value in frame: i, \"Hertz\"\n"
+                                       "  appendFileLine: out$, fixed$(t, 5), \" \", f\nendfor\n";
+  ASSERT_EQ(run("praat --run " + d + "/pitch.praat " + wav + " " + d + "/ref.txt"), 0);
+  std::ifstream in(d + "/ref.txt");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::pair<double, double>> ref;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string t, f;
+    ls >> t >> f;
+    ref.push_back({std::stod(t), f.find("undefined") == std::string::npos ? std::stod(f) : 0.0});
+  }
+  ASSERT_GT(ref.size(), 100u);
+  const FeatureTrack ours = extract_features_file(wav, FeatureConfig{});
+  int both = 0, gross = 0;
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    const double t = ours.time(i);
+    auto it = std::lower_bound(ref.begin(), ref.end(), std::make_pair(t, -1.0));
+    if (it == ref.end()) break;
+    if (!ours.raw[i].voiced || it->second <= 0) continue;
+    ++both;
+    gross += std::abs(ours.raw[i].f0_hz - it->second) > 0.2 * it->second;
+  }
+  ASSERT_GT(both, 50);
+  const double gpe = static_cast<double>(gross) / both;
+  std::cout << "gross pitch error vs Praat: " << 100 * gpe << " % of " << both
+            << " frames voiced in both\n";
+  EXPECT_LT(gpe, 0.10);
+  std::filesystem::remove_all(d);
+}
+
+}  // namespace
+}  // namespace animrt::head

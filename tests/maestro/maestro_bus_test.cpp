@@ -1,0 +1,223 @@
+// The Maestro bus driver against simulated boards over a real pty, and the
+// robot-file checks of the maestro protocol.
+
+#include "animrt/bridge/maestro/maestro_bus.hpp"
+
+#include <gtest/gtest.h>
+
+#include <any>
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "animrt/core/joint.hpp"
+#include "animrt/runtime/robot_config.hpp"
+#include "animrt/sim/maestro/maestro_sim_bus.hpp"
+
+namespace animrt {
+namespace {
+
+std::string write_robot(const std::string& name, const std::string& text) {
+  const std::string path =
+      ::testing::TempDir() + "/" +
+      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Three servos: eyes on channels 0 and 1 (a block), jaw on 4 (mirrored).
+std::string robot_text(const std::string& bus_extra = "", const std::string& jaw_extra = "") {
+  return R"(name: face
+loop: {rate_hz: 100}
+buses:
+  face:
+    protocol: maestro
+    port: /dev/null
+)" + bus_extra +
+         R"(joints:
+  eye_pan:
+    limits: {min_deg: -30, max_deg: 30, velocity_dps: 300, acceleration_dps2: 3000}
+    actuator: {bus: face, channel: 0, deg_per_us: 0.09}
+  eye_tilt:
+    limits: {min_deg: -20, max_deg: 20, velocity_dps: 300, acceleration_dps2: 3000}
+    actuator: {bus: face, channel: 1, deg_per_us: 0.09}
+  jaw:
+    limits: {min_deg: 0, max_deg: 25, velocity_dps: 200, acceleration_dps2: 2000}
+    actuator: {bus: face, channel: 4, deg_per_us: -0.09, neutral_us: 1700)" +
+         jaw_extra + R"(}
+motion: {type: gait, file: )" +
+         std::string(ANIMRT_SOURCE_DIR) + R"(/configs/gaits/walk.yaml}
+)";
+}
+
+RobotConfig load(const std::string& text, const std::string& name = "robot.yaml") {
+  return load_robot_config(write_robot(name, text));
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    load(text, "bad.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+struct Rig {
+  ManualClock clock;
+  RobotConfig config;
+  std::unique_ptr<sim::MaestroSimBus> sim;
+  std::unique_ptr<ActuatorBus> bus;
+  explicit Rig(const std::string& bus_extra = "") {
+    config = load(robot_text(bus_extra));
+    BusConfig& b = config.buses[0];
+    b.timeout_s = 0.05;
+    sim = std::make_unique<sim::MaestroSimBus>(b, clock);
+    sim->start();
+    b.port = sim->endpoint();
+    bus = make_bus(b);
+  }
+};
+
+TEST(MaestroConfig, CalibrationMapsToQuarterMicroseconds) {
+  const RobotConfig c = load(robot_text());
+  const auto& jaw = c.buses[0].actuators[2];
+  EXPECT_EQ(jaw.device_id, 4);
+  EXPECT_EQ(jaw.zero_ticks, 6800);  // 1700 us
+  EXPECT_EQ(jaw.direction, -1);
+  // 10 deg of jaw = 111.1 us less pulse = 444.4 quarter-us.
+  EXPECT_EQ(jaw.to_ticks(deg_to_rad(10)), 6800 - 444);
+}
+
+TEST(MaestroConfig, ErrorsNameFileLineAndKey) {
+  // The jaw's 25 deg maps to 1700 - 277.8 = 1422 us: fine. Its 0 deg at
+  // neutral is fine. Now make the range too narrow.
+  EXPECT_NE(error_of(robot_text("", ", max_us: 1600")).find("neutral_us"), std::string::npos);
+  const std::string narrow = error_of(robot_text("", ", min_us: 1500"));
+  EXPECT_NE(narrow.find("bad.yaml:15:"), std::string::npos) << narrow;
+  EXPECT_NE(narrow.find("joints.jaw.limits.max_deg: 25 deg maps to 1422.2"), std::string::npos)
+      << narrow;
+  EXPECT_NE(narrow.find("outside min_us..max_us (1500..2000)"), std::string::npos) << narrow;
+
+  std::string text = robot_text();
+  text.replace(text.find("channel: 4"), 10, "channel: 12");
+  const std::string channel = error_of(text);
+  EXPECT_NE(channel.find("joints.jaw.actuator.channel: expected a channel from 0 to 11"),
+            std::string::npos)
+      << channel;
+
+  text = robot_text();
+  text.replace(text.find("channel: 1,"), 11, "channel: 0,");
+  EXPECT_NE(error_of(text).find("channel 0 is already used by joint eye_pan"), std::string::npos);
+
+  text = robot_text();
+  text.replace(text.find("deg_per_us: 0.09}"), 17, "speed: 5}");
+  EXPECT_NE(error_of(text).find("joints.eye_pan.actuator: missing key rad_per_us or deg_per_us"),
+            std::string::npos)
+      << error_of(text);
+
+  EXPECT_NE(error_of(robot_text("    device_number: 3\n"))
+                .find("buses.face.device_number: device_number needs serial_protocol: pololu"),
+            std::string::npos);
+  EXPECT_NE(error_of(robot_text("    board: maxi\n")).find("expected micro6, mini12"),
+            std::string::npos);
+}
+
+TEST(MaestroBus, ReadsTheBoardsOutputAndWritesBlocksOfTargets) {
+  Rig r;
+  r.bus->configure();
+  std::vector<double> pos(3, 99.0);
+  r.bus->read(pos);
+  // Off channels are reported at their neutral pulse.
+  EXPECT_DOUBLE_EQ(pos[0], 0.0);
+  EXPECT_DOUBLE_EQ(pos[2], 0.0);
+  for (const auto& d : r.bus->devices()) EXPECT_TRUE(d.open_loop);
+  r.bus->activate();
+  EXPECT_EQ(r.sim->pulse(0), 6000);
+  EXPECT_EQ(r.sim->pulse(4), 6800);
+
+  const std::vector<double> goal{deg_to_rad(9), deg_to_rad(-4.5), deg_to_rad(18)};
+  r.bus->write(goal);
+  r.clock.advance(10'000'000);
+  r.bus->read(pos);
+  EXPECT_EQ(r.sim->pulse(0), 6400);  // +100 us
+  EXPECT_EQ(r.sim->pulse(1), 5800);
+  EXPECT_EQ(r.sim->pulse(4), 6000);  // 18 deg at -0.09 deg/us = -200 us
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(pos[i], goal[i], deg_to_rad(0.025)) << i;
+  for (const auto& d : r.bus->devices()) {
+    EXPECT_EQ(d.health, DeviceHealth::ok);
+    EXPECT_EQ(d.timeouts, 0u);
+    EXPECT_GE(d.transactions, 2u);
+  }
+  r.bus->deactivate();
+  r.bus->read(pos);               // answered: the board has handled everything before it
+  EXPECT_EQ(r.sim->pulse(0), 0);  // pulses off
+}
+
+TEST(MaestroBus, BoardErrorsAreHardwareErrorsOfEveryChannel) {
+  Rig r;
+  r.bus->configure();
+  r.bus->activate();
+  std::vector<double> pos(3);
+  r.sim->set_device_hardware_error(4, 0x20);  // serial timeout
+  r.bus->read(pos);
+  for (const auto& d : r.bus->devices()) {
+    EXPECT_EQ(d.health, DeviceHealth::hardware_error);
+    EXPECT_EQ(d.hardware_error_status, 0x20);
+    EXPECT_EQ(d.hardware_errors, 1u);
+  }
+  r.bus->read(pos);  // Get Errors cleared the register
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+}
+
+TEST(MaestroBus, ASilentBoardTimesOutAndIsReportedAtBringUp) {
+  Rig r;
+  r.sim->set_device_responding(0, false);
+  try {
+    r.bus->configure();
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("no answer to Get Position/Get Errors"), std::string::npos)
+        << e.what();
+  }
+  r.sim->set_device_responding(0, true);
+  r.bus->configure();
+  r.sim->set_device_responding(0, false);
+  std::vector<double> pos(3);
+  r.bus->read(pos);
+  for (const auto& d : r.bus->devices()) {
+    EXPECT_EQ(d.health, DeviceHealth::timeout);
+    EXPECT_EQ(d.timeouts, 1u);
+  }
+}
+
+TEST(MaestroBus, PololuFormAddressesDaisyChainedBoards) {
+  const std::string bus_extra = "    serial_protocol: pololu\n    device_number: 12\n";
+  std::string text = robot_text(bus_extra);
+  text.replace(text.find("channel: 4,"), 11, "channel: 4, device_number: 13,");
+  ManualClock clock;
+  RobotConfig config = load(text);
+  BusConfig& b = config.buses[0];
+  EXPECT_EQ(b.actuators[2].device_id, 1304);
+  auto sim = std::make_unique<sim::MaestroSimBus>(b, clock);
+  sim->start();
+  b.port = sim->endpoint();
+  auto bus = make_bus(b);
+  bus->configure();
+  bus->activate();
+  bus->write(std::vector<double>{deg_to_rad(9), 0.0, deg_to_rad(18)});
+  clock.advance(10'000'000);
+  std::vector<double> pos(3);
+  bus->read(pos);
+  EXPECT_EQ(sim->pulse(1200), 6400);
+  EXPECT_EQ(sim->pulse(1304), 6000);
+  // Only board 13 stops answering: only the jaw times out.
+  sim->set_device_responding(1304, false);
+  bus->read(pos);
+  EXPECT_EQ(bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_EQ(bus->devices()[2].health, DeviceHealth::timeout);
+}
+
+}  // namespace
+}  // namespace animrt

@@ -1,0 +1,229 @@
+// The Modbus bus driver against the simulated drives (a real libmodbus
+// server) over loopback TCP and over a pty in RTU, and the robot-file checks.
+
+#include "animrt/bridge/modbus/modbus_bus.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "animrt/core/joint.hpp"
+#include "animrt/runtime/robot_config.hpp"
+#include "animrt/sim/dynamixel_servo.hpp"
+#include "animrt/sim/modbus/modbus_sim_bus.hpp"
+
+namespace animrt {
+namespace {
+
+const std::string kMaps = std::string(ANIMRT_SOURCE_DIR) + "/configs/modbus/";
+
+// Two joints: a rotary drive on slave 1 and a linear actuator (on a 0.1 m
+// lever) on slave 2.
+std::string robot_text(const std::string& protocol, const std::string& extra_joint = "") {
+  const std::string port = protocol == "modbus-tcp" ? "127.0.0.1:1502" : "/dev/null";
+  return "name: drives\nloop: {rate_hz: 100}\nbuses:\n  drives:\n    protocol: " + protocol +
+         "\n    port: " + port + "\n    timeout_ms: 200\n" +
+         "joints:\n"
+         "  pan:\n"
+         "    limits: {min_deg: -90, max_deg: 90, velocity_dps: 100, acceleration_dps2: 500}\n"
+         "    actuator: {bus: drives, slave: 1, map: " +
+         kMaps +
+         "position_drive.yaml}\n"
+         "  lean:\n"
+         "    limits: {min_deg: -20, max_deg: 20, velocity_dps: 20, acceleration_dps2: 100}\n"
+         "    actuator: {bus: drives, slave: 2, map: " +
+         kMaps + "linear_actuator.yaml, m_per_rad: 0.1, zero_m: 0.05}\n" + extra_joint +
+         "motion: {type: gait, file: " + std::string(ANIMRT_SOURCE_DIR) +
+         "/configs/gaits/walk.yaml}\n";
+}
+
+RobotConfig load(const std::string& text, const std::string& name = "robot.yaml") {
+  // Per test (parameterised names contain '/'), so parallel tests never share a file.
+  std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::replace(test.begin(), test.end(), '/', '_');
+  const std::string path = ::testing::TempDir() + "/" + test + "_" + name;
+  std::ofstream(path) << text;
+  return load_robot_config(path);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    load(text, "bad.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+struct Rig {
+  ManualClock clock;
+  RobotConfig config;
+  std::unique_ptr<sim::ModbusSimBus> sim;
+  std::unique_ptr<ModbusBus> bus;
+  explicit Rig(const std::string& protocol) {
+    config = load(robot_text(protocol));
+    BusConfig& b = config.buses[0];
+    sim = std::make_unique<sim::ModbusSimBus>(b, clock);
+    sim->start();
+    b.port = sim->endpoint();
+    auto* options = std::any_cast<ModbusBusOptions>(&b.options);
+    options->reconnect_min_s = 0.01;
+    options->reconnect_max_s = 0.05;
+    bus = std::make_unique<ModbusBus>(b);
+  }
+  std::vector<double> step(const std::vector<double>& goal, int cycles = 1) {
+    std::vector<double> pos(2, 0.0);
+    for (int k = 0; k < cycles; ++k) {
+      bus->write(goal);
+      clock.advance(10'000'000);
+      bus->read(pos);
+    }
+    return pos;
+  }
+};
+
+class ModbusTransports : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ModbusTransports, TracksGoalsWithOneRequestPerSlaveAndDirection) {
+  Rig r(GetParam());
+  r.bus->configure();
+  std::vector<double> pos(2, 99.0);
+  r.bus->read(pos);
+  // The simulated drives start a few degrees off zero.
+  EXPECT_NEAR(pos[0], sim::initial_offset_rad(1), 1e-4);
+  EXPECT_NEAR(pos[1], sim::initial_offset_rad(2), 1e-3);
+  r.bus->activate();
+  const std::uint64_t before = r.bus->requests();
+  const std::vector<double> goal{deg_to_rad(30), deg_to_rad(-10)};
+  pos = r.step(goal, 100);  // 1 s
+  // One read (each map keeps present and status in one table) and one write
+  // per slave and cycle.
+  EXPECT_EQ(r.bus->requests() - before, 100u * 2 * 2);
+  EXPECT_NEAR(pos[0], goal[0], 1e-3);
+  EXPECT_NEAR(pos[1], goal[1], 2e-4 / 0.1);  // 0.01 mm counts on a 0.1 m lever
+  EXPECT_NEAR(r.sim->device_position(1), goal[0], 1e-3);
+  for (const auto& d : r.bus->devices()) {
+    EXPECT_EQ(d.health, DeviceHealth::ok);
+    EXPECT_EQ(d.timeouts + d.exceptions + d.crc_errors + d.protocol_errors, 0u);
+  }
+  r.bus->deactivate();
+  const double held = r.sim->device_position(1);
+  r.step(std::vector<double>{0.0, 0.0}, 10);  // disabled: the drive ignores goals
+  EXPECT_DOUBLE_EQ(r.sim->device_position(1), held);
+}
+
+TEST_P(ModbusTransports, ExceptionsTimeoutsAndFaultsAreCountedPerDevice) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  // A goal past the actuator's stroke: the drive answers exception 3.
+  r.step({0.0, deg_to_rad(60)});
+  EXPECT_EQ(r.bus->devices()[1].exceptions, 1u);
+  EXPECT_EQ(r.bus->devices()[1].last_error_byte, 3);
+  EXPECT_EQ(r.bus->devices()[0].exceptions, 0u);
+  // A silent slave times out; the other is unaffected.
+  r.sim->set_device_responding(2, false);
+  auto pos = r.step({0.0, 0.0});
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::timeout);
+  EXPECT_GE(r.bus->devices()[1].timeouts, 1u);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  r.sim->set_device_responding(2, true);
+  // Fault bits in the status register are a hardware error.
+  r.sim->set_device_hardware_error(1, 0x04);
+  r.step({0.0, 0.0});
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::hardware_error);
+  EXPECT_EQ(r.bus->devices()[0].hardware_error_status, 0x04);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+INSTANTIATE_TEST_SUITE_P(TcpAndRtu, ModbusTransports, ::testing::Values("modbus-tcp", "modbus-rtu"),
+                         [](const auto& p) { return p.param == "modbus-tcp" ? "tcp" : "rtu"; });
+
+TEST(ModbusBus, IllegalAddressIsExceptionTwoAtBringUp) {
+  // The runtime thinks slave 1 is a linear actuator; the drive has the rotary map.
+  ManualClock clock;
+  RobotConfig drive = load(robot_text("modbus-tcp"));
+  sim::ModbusSimBus sim(drive.buses[0], clock);
+  sim.start();
+  std::string text = robot_text("modbus-tcp");
+  text.replace(text.find("slave: 2"), 8, "slave: 3");
+  text.replace(text.find("slave: 1"), 8, "slave: 2");
+  RobotConfig wrong = load(text, "wrong.yaml");
+  wrong.buses[0].port = sim.endpoint();
+  ModbusBus bus(wrong.buses[0]);
+  try {
+    bus.configure();
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("slave 2 (pan): exception 2 (illegal data address)"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("slave 3 (lean): no answer"), std::string::npos) << what;
+  }
+}
+
+TEST(ModbusBus, ADroppedConnectionIsReopenedWithBackoff) {
+  Rig r("modbus-tcp");
+  r.bus->configure();
+  r.bus->activate();
+  EXPECT_EQ(r.bus->reconnects(), 1u);
+  r.sim->drop_connections();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::vector<double> pos(2);
+  r.bus->read(pos);  // the request meets a closed socket
+  EXPECT_FALSE(r.bus->connected());
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::timeout);
+  // Within the backoff nothing is attempted and nothing blocks.
+  const auto t0 = std::chrono::steady_clock::now();
+  r.bus->read(pos);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(5));
+  bool back = false;
+  for (int i = 0; i < 200 && !back; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    r.bus->read(pos);
+    back = r.bus->devices()[0].health == DeviceHealth::ok;
+  }
+  EXPECT_TRUE(back);
+  EXPECT_EQ(r.bus->reconnects(), 2u);
+  EXPECT_GE(r.sim->stats().connections, 2u);
+}
+
+TEST(ModbusConfig, ErrorsNameFileLineAndKey) {
+  EXPECT_EQ(load(robot_text("modbus-tcp")).buses[0].actuators[1].device_id, 2);
+  std::string text = robot_text("modbus-tcp");
+  text.replace(text.find("m_per_rad: 0.1"), 14, "m_per_rad: 0.5");
+  const std::string range = error_of(text);
+  EXPECT_NE(range.find("bad.yaml:13:"), std::string::npos) << range;
+  EXPECT_NE(range.find("joints.lean.limits.min_deg: -20 deg maps to -0.124533"), std::string::npos)
+      << range;
+  EXPECT_NE(range.find("outside the range of"), std::string::npos) << range;
+
+  text = robot_text("modbus-tcp");
+  text.replace(text.find(", m_per_rad: 0.1, zero_m: 0.05"), 30, "");
+  EXPECT_NE(error_of(text).find("joints.lean.actuator: missing key m_per_rad"), std::string::npos)
+      << error_of(text);
+
+  const std::string twice = error_of(robot_text(
+      "modbus-tcp",
+      "  tilt:\n    limits: {min_deg: -9, max_deg: 9, velocity_dps: 9, acceleration_dps2: 9}\n"
+      "    actuator: {bus: drives, slave: 1, map: " +
+          kMaps + "position_drive.yaml}\n"));
+  EXPECT_NE(
+      twice.find(
+          "joints.tilt.actuator.slave: registers overlap: joint tilt and joint pan on slave 1"),
+      std::string::npos)
+      << twice;
+
+  text = robot_text("modbus-tcp");
+  text.replace(text.find("port: 127.0.0.1:1502"), 20, "port: localhost");
+  EXPECT_NE(error_of(text).find("buses.drives.port: expected HOST:PORT"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace animrt

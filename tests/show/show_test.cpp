@@ -1,0 +1,181 @@
+// Keyframe shows: interpolation, continuity, looping, layering, validation,
+// and no allocation in sample().
+
+#include <gtest/gtest.h>
+#include <sndfile.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/show/show_file.hpp"
+#include "animrt/core/joint.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace {
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path =
+      ::testing::TempDir() + "/" +
+      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::vector<JointSpec> joints() {
+  std::vector<JointSpec> j(3);
+  const char* names[] = {"neck", "jaw", "eye"};
+  for (int i = 0; i < 3; ++i) {
+    j[i].name = names[i];
+    j[i].limits = {deg_to_rad(-45), deg_to_rad(45), 3.0, 30.0};
+  }
+  return j;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    load_show_source(write("bad_show.yaml", text), joints());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+double deg_at(const MotionSource& s, double t, int joint) {
+  std::vector<double> targets(3, -99.0);
+  s.sample(t, targets);
+  return rad_to_deg(targets[static_cast<std::size_t>(joint)]);
+}
+
+const std::string kShow = R"(name: test
+joints:
+  jaw:
+    interpolation: linear
+    keys:
+      - [0, 0]
+      - {t: 1, value: 10, interpolation: step}
+      - [2, 20]
+      - [3, 0]
+  eye:
+    keys:
+      - [0, 0]
+      - [1, 10]
+      - [2, 0]
+      - [4, 30]
+)";
+
+TEST(Show, StepLinearAndCubicSegments) {
+  auto s = load_show_source(write("show.yaml", kShow), joints());
+  ASSERT_EQ(s->driven_joints().size(), 2u);
+  EXPECT_DOUBLE_EQ(deg_at(*s, 0.5, 1), 5.0);                // linear
+  EXPECT_DOUBLE_EQ(deg_at(*s, 1.5, 1), 10.0);               // step holds the key
+  EXPECT_DOUBLE_EQ(deg_at(*s, 2.5, 1), 10.0);               // linear 20 -> 0
+  EXPECT_DOUBLE_EQ(deg_at(*s, 9.0, 1), 0.0);                // past the end: hold the last key
+  EXPECT_DOUBLE_EQ(deg_at(*s, 0.5, 0), rad_to_deg(-99.0));  // a joint the show does not drive
+  // Cubic through the keys, zero slope at the ends, slope (0-0)/2 = 0 at t=1.
+  EXPECT_NEAR(deg_at(*s, 1.0, 2), 10.0, 1e-12);
+  EXPECT_NEAR(deg_at(*s, 0.5, 2), 5.0, 1e-12);  // both slopes 0: the midpoint
+  EXPECT_NEAR(deg_at(*s, 4.0, 2), 30.0, 1e-12);
+}
+
+TEST(Show, CubicVelocityIsContinuousAcrossKeys) {
+  auto s = load_show_source(write("show.yaml", kShow), joints());
+  const double h = 1e-6;
+  for (double key : {1.0, 2.0}) {
+    const double left = (deg_at(*s, key, 2) - deg_at(*s, key - h, 2)) / h;
+    const double right = (deg_at(*s, key + h, 2) - deg_at(*s, key, 2)) / h;
+    EXPECT_NEAR(left, right, 1e-3) << "at t=" << key;
+  }
+  // Slope at t=2 is (30 - 10) / (4 - 1) deg/s.
+  EXPECT_NEAR((deg_at(*s, 2.0 + h, 2) - deg_at(*s, 2.0 - h, 2)) / (2 * h), 20.0 / 3.0, 1e-3);
+}
+
+TEST(Show, LoopingWrapsSmoothly) {
+  std::string text = kShow;
+  text.replace(text.find("name: test\n"), 11, "name: test\nloop: true\nduration_s: 5\n");
+  auto s = load_show_source(write("loop.yaml", text), joints());
+  EXPECT_NEAR(deg_at(*s, 5.5, 2), deg_at(*s, 0.5, 2), 1e-9);
+  EXPECT_NEAR(deg_at(*s, 10.0, 2), 0.0, 1e-9);
+  // Wrap segment 4 s (30) -> 5 s (0): continuous at the wrap and at t=4.
+  const double h = 1e-6;
+  EXPECT_NEAR(deg_at(*s, 5.0 - h, 2), deg_at(*s, 5.0, 2), 1e-3);
+  const double left = (deg_at(*s, 4.0, 2) - deg_at(*s, 4.0 - h, 2)) / h;
+  const double right = (deg_at(*s, 4.0 + h, 2) - deg_at(*s, 4.0, 2)) / h;
+  EXPECT_NEAR(left, right, 1e-3);
+}
+
+TEST(Show, SampleDoesNotAllocate) {
+  auto s = load_show_source(write("show.yaml", kShow), joints());
+  std::vector<double> targets(3);
+  test::AllocationCounter counter;
+  for (int k = 0; k < 1000; ++k) s->sample(k * 0.01, targets);
+  EXPECT_EQ(counter.count(), 0);
+}
+
+TEST(Show, LayersLetTheLaterSourceWin) {
+  auto under = load_show_source(
+      write("under.yaml", "joints:\n  neck: {keys: [[0, 5]]}\n  jaw: {keys: [[0, 7]]}\n"),
+      joints());
+  auto over = load_show_source(write("over.yaml", "joints:\n  jaw: {keys: [[0, 3]]}\n"), joints());
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  layers.push_back(std::move(under));
+  layers.push_back(std::move(over));
+  auto s = make_layered_source(std::move(layers));
+  EXPECT_EQ(s->driven_joints().size(), 2u);
+  EXPECT_DOUBLE_EQ(deg_at(*s, 1.0, 0), 5.0);
+  EXPECT_DOUBLE_EQ(deg_at(*s, 1.0, 1), 3.0);
+}
+
+TEST(Show, AudioTrackWithOffset) {
+  const std::string wav = ::testing::TempDir() + "/hello.wav";
+  SF_INFO info{};
+  info.samplerate = 8000;
+  info.channels = 1;
+  info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+  SNDFILE* f = sf_open(wav.c_str(), SFM_WRITE, &info);
+  ASSERT_NE(f, nullptr);
+  std::vector<short> samples(800, 0);
+  sf_write_short(f, samples.data(), static_cast<sf_count_t>(samples.size()));
+  sf_close(f);
+  const ShowFile show = load_show_file(
+      write("audio.yaml",
+            "audio: {file: hello.wav, offset_s: 0.25}\njoints:\n  jaw: {keys: [[0, 1]]}\n"));
+  EXPECT_TRUE(show.has_audio);
+  EXPECT_TRUE(std::filesystem::equivalent(show.audio.file, wav));
+  EXPECT_DOUBLE_EQ(show.audio.offset_s, 0.25);
+  std::ofstream(::testing::TempDir() + "/not_audio.wav") << "garbage";
+  const std::string e =
+      error_of("audio: {file: not_audio.wav}\njoints:\n  jaw: {keys: [[0, 1]]}\n");
+  EXPECT_NE(e.find("bad_show.yaml:1:15: audio.file: cannot open audio file"), std::string::npos)
+      << e;
+}
+
+TEST(Show, ErrorsNameFileLineAndKey) {
+  EXPECT_NE(error_of("joints:\n  jaw:\n    keys:\n      - [0, 0]\n      - [0, 5]\n")
+                .find("bad_show.yaml:5:10: joints.jaw.keys[1][0]: expected a time after the "
+                      "previous key's 0 s"),
+            std::string::npos)
+      << error_of("joints:\n  jaw:\n    keys:\n      - [0, 0]\n      - [0, 5]\n");
+  EXPECT_NE(error_of("joints:\n  jaw: {interpolation: spline, keys: [[0, 0]]}\n")
+                .find("joints.jaw.interpolation: expected step, linear or cubic, found \"spline\""),
+            std::string::npos);
+  EXPECT_NE(
+      error_of("joints:\n  tail: {keys: [[0, 0]]}\n").find("no joint named 'tail' in the robot"),
+      std::string::npos);
+  EXPECT_NE(error_of("joints:\n  jaw: {keys: [[0, 0], [1, 50]]}\n")
+                .find("key at 1 s is 50 deg, outside the joint's limits -45..45 deg"),
+            std::string::npos)
+      << error_of("joints:\n  jaw: {keys: [[0, 0], [1, 50]]}\n");
+  EXPECT_NE(error_of("joints:\n  jaw: {unit: m, keys: [[0, 0]]}\n")
+                .find("joints.jaw.unit: joint values in metres"),
+            std::string::npos);
+  EXPECT_NE(error_of("duration_s: 1\njoints:\n  jaw: {keys: [[0, 0], [2, 1]]}\n")
+                .find("duration_s: expected at least the last key's time (2 s)"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace animrt
