@@ -66,12 +66,12 @@ Audio load_audio(const std::string& path, int target_rate) {
   if (fs::is_directory(path, ec)) fail(path, "expected an audio file, found a folder");
   if (fs::file_size(path, ec) == 0) fail(path, "empty file (0 bytes), expected audio");
 
+  check_riff_length(path);  // before sf_open: a throw here leaves nothing open
   SF_INFO info{};
   SNDFILE* file = sf_open(path.c_str(), SFM_READ, &info);
   if (file == nullptr) {
     fail(path, std::string("not a readable audio file (libsndfile: ") + sf_strerror(nullptr) + ")");
   }
-  check_riff_length(path);
   if (info.frames <= 0 || info.channels <= 0) {
     sf_close(file);
     fail(path, "the audio file holds no samples");

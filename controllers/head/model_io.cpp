@@ -187,6 +187,7 @@ void save_model(const std::string& path, const HeadModel& m) {
       .word("seed")
       .num(static_cast<double>(m.smoothing.seed))
       .end();
+  w.key("shrink").word("factor").num(m.smoothing.shrink).word("toward").nums(m.pose_mean).end();
   w.key("decode")
       .word("lm_scale")
       .num(m.decode.lm_scale)
@@ -306,6 +307,12 @@ HeadModel load_model(const std::string& path) {
   r.check(
       m.smoothing.key_rate_hz > 0 && m.smoothing.output_rate_hz > 0 && m.smoothing.noise_deg >= 0,
       "rates must be positive and noise_deg >= 0");
+  r.done();
+  r.line("shrink");
+  m.smoothing.shrink = r.named_num("factor");
+  r.check(m.smoothing.shrink >= 0 && m.smoothing.shrink <= 1, "factor must be in [0, 1]");
+  r.check(r.word() == "toward", "expected \"toward\"");
+  m.pose_mean = r.nums(3);
   r.done();
   r.line("decode");
   m.decode.lm_scale = r.named_num("lm_scale");

@@ -14,6 +14,13 @@
 
 namespace animrt::head {
 
+double f0_semitones(double f0_hz) {
+  return 12.0 * std::log2(std::max(f0_hz, 1.0) / kF0ReferenceHz);
+}
+double energy_db(double rms) {
+  return rms > 0 ? std::max(kEnergyFloorDb, 20.0 * std::log10(rms)) : kEnergyFloorDb;
+}
+
 int FeatureConfig::hop_samples() const {
   return static_cast<int>(std::lround(sample_rate / frame_rate_hz));
 }
@@ -138,8 +145,8 @@ FeatureTrack extract_features(const Audio& audio_in, const FeatureConfig& config
   }
   Eigen::MatrixXd base(static_cast<Eigen::Index>(n), 2);
   for (std::size_t i = 0; i < n; ++i) {
-    base(static_cast<Eigen::Index>(i), 0) = track.f0_filled[i];
-    base(static_cast<Eigen::Index>(i), 1) = track.raw[i].energy;
+    base(static_cast<Eigen::Index>(i), 0) = f0_semitones(track.f0_filled[i]);
+    base(static_cast<Eigen::Index>(i), 1) = energy_db(track.raw[i].energy);
   }
   const Eigen::MatrixXd d1 = deltas(base, config.delta_window, config.frame_rate_hz);
   const Eigen::MatrixXd d2 = deltas(d1, config.delta_window, config.frame_rate_hz);
@@ -155,13 +162,15 @@ FeatureTrack extract_features_file(const std::string& wav_path, const FeatureCon
 void write_features_csv(const std::string& path, const FeatureTrack& track) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << "time_s,f0_hz,energy,voiced,f0_filled_hz,d_f0,d_energy,dd_f0,dd_energy\n";
+  out << "time_s,f0_hz,energy,voiced,f0_filled_hz,f0_st,energy_db,d_f0_st,d_energy_db,dd_f0_st,"
+         "dd_energy_db\n";
   char line[512];
   for (std::size_t i = 0; i < track.size(); ++i) {
     const auto r = static_cast<Eigen::Index>(i);
     const RawFrame& f = track.raw[i];
-    std::snprintf(line, sizeof line, "%.6f,%.3f,%.6g,%d,%.3f,%.6g,%.6g,%.6g,%.6g\n", track.time(i),
-                  f.f0_hz, f.energy, f.voiced ? 1 : 0, track.features(r, 0), track.features(r, 2),
+    std::snprintf(line, sizeof line, "%.6f,%.3f,%.6g,%d,%.3f,%.4f,%.3f,%.6g,%.6g,%.6g,%.6g\n",
+                  track.time(i), f.f0_hz, f.energy, f.voiced ? 1 : 0, track.f0_filled[i],
+                  track.features(r, 0), track.features(r, 1), track.features(r, 2),
                   track.features(r, 3), track.features(r, 4), track.features(r, 5));
     out << line;
   }

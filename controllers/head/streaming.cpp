@@ -87,7 +87,7 @@ struct StreamingSynthesizer::Impl {
 
   void release(long index, double f0, double energy, std::vector<StreamPose>& out) {
     (void)index;
-    base.push_back(Eigen::Vector2d(f0, energy));
+    base.push_back(Eigen::Vector2d(f0_semitones(f0), energy_db(energy)));
     ++base_count;
     complete_features(out);
   }
@@ -131,7 +131,7 @@ struct StreamingSynthesizer::Impl {
       const double key_t = static_cast<double>(k) / kr;
       const long key_frame = std::max(0L, std::lround((key_t - t0) * fr));
       if (key_frame != frame) break;
-      const auto m = model.codebook.means.row(cluster);
+      const Eigen::Vector3d m = model.cluster_pose(cluster);
       Eigen::Quaterniond q = euler_to_quat({m(0), m(1), m(2)});
       if (!keys.empty() && keys.back().dot(q) < 0) q.coeffs() = -q.coeffs();
       keys.push_back(q);

@@ -32,7 +32,7 @@ PoseTrack smooth_clusters(const HeadModel& model, const std::vector<int>& cluste
     const double idx = std::round((t - t0_s) * frame_rate_hz);
     const auto i =
         static_cast<std::size_t>(std::clamp(idx, 0.0, static_cast<double>(clusters.size() - 1)));
-    const auto m = model.codebook.means.row(clusters[i]);
+    const Eigen::Vector3d m = model.cluster_pose(clusters[i]);
     return euler_to_quat({m(0), m(1), m(2)});
   };
   const double end_t = t0_s + static_cast<double>(clusters.size() - 1) / frame_rate_hz;

@@ -1,8 +1,52 @@
 #include "animrt/controllers/head/trainer.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
+#include "animrt/controllers/head/synthesis.hpp"
+
 namespace animrt::head {
+namespace {
+
+// The shrink factor (0, 0.05, ..., 1) with the smallest mean Euclidean
+// distance between the decoded output poses and the original poses, over a
+// 4-fold cross-validation of the training utterances: each quarter is decoded
+// by a model trained on the other three.
+double choose_shrink(const std::vector<PreparedUtterance>& train, const FeatureConfig& config,
+                     const TrainOptions& options) {
+  constexpr int kFolds = 4;
+  constexpr int kSteps = 20;
+  if (train.size() < static_cast<std::size_t>(kFolds)) return 1.0;
+  std::vector<double> total(kSteps + 1, 0.0);
+  for (int fold = 0; fold < kFolds; ++fold) {
+    std::vector<PreparedUtterance> fit, check;
+    for (std::size_t i = 0; i < train.size(); ++i)
+      (static_cast<int>(i % kFolds) == fold ? check : fit).push_back(train[i]);
+    TrainOptions o = options;
+    o.shrink = 1.0;
+    o.log = nullptr;
+    const HeadModel inner = train_model(fit, config, o);
+    for (const auto& u : check) {
+      const std::vector<int> clusters = decode_track(inner, u.track);
+      const auto n =
+          std::min<Eigen::Index>(static_cast<Eigen::Index>(clusters.size()), u.poses.rows());
+      for (Eigen::Index t = 0; t < n; ++t) {
+        const Eigen::Vector3d d =
+            inner.codebook.means.row(clusters[static_cast<std::size_t>(t)]).transpose() -
+            inner.pose_mean;
+        const Eigen::Vector3d y = u.poses.row(t).transpose() - inner.pose_mean;
+        for (int s = 0; s <= kSteps; ++s)
+          total[static_cast<std::size_t>(s)] += (y - (static_cast<double>(s) / kSteps) * d).norm();
+      }
+    }
+  }
+  int best = kSteps;
+  for (int s = 0; s <= kSteps; ++s)
+    if (total[static_cast<std::size_t>(s)] < total[static_cast<std::size_t>(best)]) best = s;
+  return static_cast<double>(best) / kSteps;
+}
+
+}  // namespace
 
 HeadModel train_model(const std::vector<PreparedUtterance>& train, const FeatureConfig& config,
                       const TrainOptions& options) {
@@ -45,6 +89,7 @@ HeadModel train_model(const std::vector<PreparedUtterance>& train, const Feature
   log("vector quantisation: " + std::to_string(frames) + " pose frames into " +
       std::to_string(options.clusters) + " clusters");
   model.codebook = train_lbg(all_poses, options.clusters, options.lbg);
+  model.pose_mean = all_poses.colwise().mean().transpose();
 
   // The known segmentation: every frame's cluster, runs of one cluster as
   // that cluster's training sequences.
@@ -86,6 +131,13 @@ HeadModel train_model(const std::vector<PreparedUtterance>& train, const Feature
   log("trained " + std::to_string(options.clusters) + " HMMs (S=" + std::to_string(options.states) +
       ", M=" + std::to_string(options.mixtures) + ", " + topology_name(options.topology) + ")");
   model.bigram = train_bigram(labels, options.clusters, options.bigram_discount);
+  if (options.shrink >= 0) {
+    model.smoothing.shrink = std::min(options.shrink, 1.0);
+  } else {
+    model.smoothing.shrink = choose_shrink(train, config, options);
+    log("output poses shrunk toward the mean pose by " + std::to_string(model.smoothing.shrink) +
+        " (chosen by 4-fold cross-validation on the training utterances)");
+  }
   return model;
 }
 

@@ -42,12 +42,14 @@ ShowFile load_show_file(const std::string& path) {
     track.where = node.location();
     if (auto u = node.find("unit")) {
       const std::string unit = u->as_string();
-      if (unit == "m") {
-        u->fail(
-            "joint values in metres need a prismatic joint, and robot joints are revolute "
-            "(limits in degrees); use unit: deg");
+      if (unit == "deg") {
+        track.unit = ShowUnit::deg;
+      } else if (unit == "m") {
+        track.unit = ShowUnit::m;
+      } else {
+        u->fail("expected deg (revolute joint) or m (prismatic joint), found " + u->describe());
       }
-      if (unit != "deg") u->fail("expected deg, found " + u->describe());
+      track.unit_where = u->location();
     }
     Interpolation fallback = Interpolation::cubic;
     if (auto i = node.find("interpolation")) fallback = parse_interpolation(*i);
@@ -77,7 +79,7 @@ ShowFile load_show_file(const std::string& path) {
                   item.describe());
       }
       key.t = t_node->as_double_in(0.0, 1e6);
-      key.value = deg_to_rad(v_node->as_double());
+      key.value = v_node->as_double();
       if (!track.keys.empty() && !(key.t > track.keys.back().t)) {
         t_node->fail("expected a time after the previous key's " +
                      format_number(track.keys.back().t) + " s, found " + t_node->describe());
@@ -106,12 +108,23 @@ ShowFile load_show_file(const std::string& path) {
     show.has_audio = true;
     show.audio.file = resolved.string();
     if (auto o = a->find("offset_s")) show.audio.offset_s = o->as_double_in(-1e6, 1e6);
+    std::error_code ec;
+    if (!fs::is_regular_file(resolved, ec)) {
+      file.fail("audio file not found: \"" + given +
+                "\" (resolved against the show file's folder to \"" + show.audio.file + "\")");
+    }
     SF_INFO info{};
     SNDFILE* sf = sf_open(show.audio.file.c_str(), SFM_READ, &info);
     if (sf == nullptr) {
       file.fail("cannot open audio file \"" + show.audio.file + "\": " + sf_strerror(nullptr));
     }
     sf_close(sf);
+    if (info.frames <= 0 || info.samplerate <= 0) {
+      file.fail("audio file \"" + show.audio.file + "\" holds no sound");
+    }
+    show.audio.sample_rate = info.samplerate;
+    show.audio.channels = info.channels;
+    show.audio.length_s = static_cast<double>(info.frames) / info.samplerate;
   }
   return show;
 }

@@ -163,18 +163,31 @@ std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
           st.where, "joints." + st.joint,
           "no joint named '" + st.joint + "' in the robot (its joints: " + names + ")");
     }
-    const JointLimits& lim = joints[static_cast<std::size_t>(t.joint)].limits;
-    for (const ShowKey& k : st.keys) {
+    const JointSpec& joint = joints[static_cast<std::size_t>(t.joint)];
+    const bool prismatic = joint.type == JointType::prismatic;
+    if (st.unit == (prismatic ? ShowUnit::deg : ShowUnit::m)) {
+      throw InputError(st.unit_where, "joints." + st.joint + ".unit",
+                       prismatic ? "unit deg, but joint '" + st.joint +
+                                       "' is prismatic (its limits are in metres); use unit: m"
+                                 : "unit m, but joint '" + st.joint +
+                                       "' is revolute (its limits are in degrees); use unit: deg");
+    }
+    const char* unit = prismatic ? " m" : " deg";
+    auto as_written = [prismatic](double si) { return prismatic ? si : rad_to_deg(si); };
+    const JointLimits& lim = joint.limits;
+    t.keys = st.keys;
+    for (ShowKey& k : t.keys) {
+      const double written = k.value;
+      k.value = prismatic ? written : deg_to_rad(written);
       if (k.value < lim.min_position - 1e-9 || k.value > lim.max_position + 1e-9) {
-        throw InputError(
-            k.where, "joints." + st.joint + ".keys",
-            "key at " + format_number(k.t) + " s is " + format_number(rad_to_deg(k.value)) +
-                " deg, outside the joint's limits " + format_number(rad_to_deg(lim.min_position)) +
-                ".." + format_number(rad_to_deg(lim.max_position)) + " deg");
+        throw InputError(k.where, "joints." + st.joint + ".keys",
+                         "key at " + format_number(k.t) + " s is " + format_number(written) + unit +
+                             ", outside the joint's limits " +
+                             format_number(as_written(lim.min_position)) + ".." +
+                             format_number(as_written(lim.max_position)) + unit);
       }
     }
-    t.keys = st.keys;
-    t.slope = slopes(st.keys, show.loop, show.duration_s);
+    t.slope = slopes(t.keys, show.loop, show.duration_s);
     tracks.push_back(std::move(t));
   }
   return std::make_unique<ShowSource>(std::move(tracks), show.loop, show.duration_s);

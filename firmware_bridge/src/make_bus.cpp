@@ -16,12 +16,8 @@ namespace {
 
 // Every protocol the runtime can drive. Add a module here to add a device.
 const Protocol* const kProtocols[] = {
-    &dynamixel2_protocol(),
-    &mit_protocol(),
-    &cia402_protocol(),
-    &maestro_protocol(),
-    &modbus_tcp_protocol(),
-    &modbus_rtu_protocol(),
+    &dynamixel2_protocol(), &mit_protocol(),        &cia402_protocol(),
+    &maestro_protocol(),    &modbus_tcp_protocol(), &modbus_rtu_protocol(),
 };
 
 }  // namespace

@@ -29,6 +29,7 @@ struct HeadArgs {
   std::uint64_t seed = 1;
   double train_fraction = 0.8;
   double noise_deg = -1;
+  double shrink = -1;
   bool quiet = false;
 };
 
@@ -55,6 +56,7 @@ TrainOptions train_options(const HeadArgs& a) {
   o.states = a.states;
   o.mixtures = a.mixtures;
   o.iterations = a.iterations;
+  o.shrink = a.shrink;
   o.topology = a.topology == "EG" ? Topology::kErgodic : Topology::kLeftToRight;
   if (!a.quiet) o.log = [](const std::string& s) { std::cerr << s << '\n'; };
   return o;
@@ -106,9 +108,10 @@ int run_synth(const HeadArgs& a) {
 void print_eval(const Evaluation& e) {
   std::printf(
       "test utterances %d\nmean distance  %.2f deg (std %.2f)\nfirst CCA      %.3f (std %.3f)\n"
-      "mean-pose baseline distance %.2f deg (std %.2f)\n",
+      "mean-pose baseline distance %.2f deg (std %.2f), first CCA %.3f (std %.3f)\n",
       e.utterances, e.distance_deg.mean, e.distance_deg.std, e.cca.mean, e.cca.std,
-      e.baseline_distance_deg.mean, e.baseline_distance_deg.std);
+      e.baseline_distance_deg.mean, e.baseline_distance_deg.std, e.baseline_cca.mean,
+      e.baseline_cca.std);
 }
 
 int run_eval(const HeadArgs& a) {
@@ -164,6 +167,10 @@ void add_train_options(CLI::App* c, HeadArgs& a) {
       ->check(CLI::Range(0, 200));
   c->add_option("--train-fraction", a.train_fraction, "share of the corpus for training")
       ->check(CLI::Range(0.05, 1.0));
+  c->add_option("--shrink", a.shrink,
+                 "output poses toward the mean pose: factor in [0, 1] (1: the paper), "
+                 "negative: chosen on the training data")
+      ->check(CLI::Range(-1.0, 1.0));
   c->add_option("--seed", a.seed, "split seed");
   c->add_flag("--quiet", a.quiet, "no progress lines");
 }

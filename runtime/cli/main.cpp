@@ -2,22 +2,25 @@
 // serve simulated devices for another program.
 
 #include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
 #include <iostream>
+#include <string>
 #include <thread>
 
-#include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/spdlog.h>
-
+#include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
+#include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
 #include "head_command.hpp"
@@ -29,6 +32,7 @@ constexpr int kExitOk = 0;
 constexpr int kExitUsage = 1;
 constexpr int kExitInvalidInput = 2;
 constexpr int kExitDeviceError = 3;
+constexpr double kLockstepMinTimeoutS = 0.25;  // bus timeout floor with --lockstep
 
 std::atomic<bool> g_stop{false};
 
@@ -42,14 +46,23 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+// "gait FILE", or for layers "layers [gait FILE, show FILE]".
+std::string describe_motion(const animrt::MotionConfig& motion) {
+  if (motion.type != "layers") return motion.type + " " + motion.file;
+  std::string text = "layers [";
+  for (std::size_t i = 0; i < motion.layers.size(); ++i) {
+    text += (i ? ", " : "") + describe_motion(motion.layers[i]);
+  }
+  return text + "]";
+}
+
 int cmd_validate(const std::string& path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
   std::size_t devices = 0;
   for (const auto& bus : robot.config.buses) devices += bus.actuators.size();
   std::cout << path << ": ok (" << robot.config.joints.size() << " joints, "
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
-            << ", " << devices << " devices, " << robot.config.motion.type << " "
-            << robot.config.motion.file << ")\n";
+            << ", " << devices << " devices, " << describe_motion(robot.config.motion) << ")\n";
   return kExitOk;
 }
 
@@ -61,7 +74,15 @@ struct RunArgs {
   std::string summary_json;
   bool lockstep = false;
   bool no_realtime = false;
+  bool no_audio = false;
+  std::string physics;  // MJCF model behind the simulated servos
 };
+
+// The show files a motion plays (a show, or show layers).
+void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>& out) {
+  if (motion.type == "show") out.push_back(motion.file);
+  for (const auto& layer : motion.layers) collect_shows(layer, out);
+}
 
 int cmd_run(const RunArgs& args) {
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
@@ -69,14 +90,31 @@ int cmd_run(const RunArgs& args) {
     spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
     return kExitUsage;
   }
+  if (!args.physics.empty() && args.backend != "sim") {
+    spdlog::error("--physics needs --backend sim (it replaces the simulated servos' motors)");
+    return kExitUsage;
+  }
   animrt::ManualClock lockstep_clock;
   animrt::MonotonicClock wall_clock;
+  std::unique_ptr<animrt::sim::MujocoJointPhysics> physics;  // outlives the devices below
   std::vector<std::unique_ptr<animrt::SimulatedBus>> simulated;
   if (args.backend == "sim") {
     const animrt::Clock& clock = args.lockstep ? static_cast<const animrt::Clock&>(lockstep_clock)
                                                : static_cast<const animrt::Clock&>(wall_clock);
-    simulated = animrt::start_simulated_devices(robot.config.buses, clock);
+    if (!args.physics.empty()) {
+      physics = std::make_unique<animrt::sim::MujocoJointPhysics>(args.physics, robot.config.joints,
+                                                                  robot.config.file, clock.now());
+      spdlog::info("physics: {} drives the simulated servos", args.physics);
+    }
+    simulated = animrt::start_simulated_devices(robot.config.buses, clock, physics.get());
     for (const auto& sim : simulated) spdlog::info("simulated devices: {}", sim->describe());
+  }
+  if (args.lockstep) {
+    // Simulated devices answer in no simulated time, so in lockstep a bus
+    // timeout measures only how busy the host is: a loaded machine must not
+    // make a device look silent.
+    for (auto& bus : robot.config.buses)
+      bus.timeout_s = std::max(bus.timeout_s, kLockstepMinTimeoutS);
   }
   std::vector<std::unique_ptr<animrt::ActuatorBus>> buses;
   for (const auto& bus : robot.config.buses) buses.push_back(animrt::make_bus(bus));
@@ -90,8 +128,41 @@ int cmd_run(const RunArgs& args) {
   options.backend_name = args.backend;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
 
+  // A show's sound track plays on its own thread, started with the motion.
+  std::vector<std::unique_ptr<animrt::ShowAudioPlayer>> audio;
+  if (!args.no_audio) {
+    std::vector<std::string> shows;
+    collect_shows(robot.config.motion, shows);
+    audio = animrt::open_show_audio(
+        shows, args.lockstep, [](int rate) { return animrt::open_alsa_sink("default", rate); },
+        wall_clock, [](const std::string& message) { spdlog::warn("{}", message); });
+  }
+  options.on_motion_start = [&audio, p = physics.get()](animrt::Nanos t0) {
+    for (auto& player : audio) player->start(t0);
+    if (p) p->mark_motion_start();
+  };
+  options.on_motion_end = [&audio, p = physics.get()] {
+    for (auto& player : audio) player->stop();
+    if (p) p->mark_motion_end();
+  };
+
   animrt::Runner runner(std::move(robot.config), std::move(buses), std::move(robot.motion));
   animrt::RunSummary summary = runner.run(options);
+  if (physics) {
+    const animrt::sim::PhysicsMeasures m = physics->measures();
+    animrt::PhysicsReport report;
+    report.model = m.model_file;
+    report.timestep_s = m.timestep_s;
+    report.simulated_s = m.simulated_s;
+    report.forward_m = m.forward_m;
+    report.sideways_m = m.sideways_m;
+    report.motion_s = m.motion_s;
+    report.motion_forward_m = m.motion_forward_m;
+    report.average_speed_m_s = m.motion_s > 0 ? m.motion_forward_m / m.motion_s : 0.0;
+    report.falls = m.falls;
+    report.first_fall_s = m.first_fall_s;
+    summary.physics = report;
+  }
   std::cout << animrt::format_summary(summary) << std::flush;
   if (!args.summary_json.empty()) {
     std::ofstream out(args.summary_json);
@@ -136,13 +207,18 @@ int main(int argc, char** argv) {
   run->add_option("--backend", run_args.backend, "sim (simulated devices on ptys) or hardware")
       ->check(CLI::IsMember({"sim", "hardware"}))
       ->capture_default_str();
-  run->add_option("--duration", run_args.duration, "seconds of motion, then ramp home (0 = until Ctrl-C)")
+  run->add_option("--duration", run_args.duration,
+                  "seconds of motion, then ramp home (0 = until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
   run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file");
   run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON");
   run->add_flag("--lockstep", run_args.lockstep,
                 "simulated clock: run as fast as the devices answer (sim backend only)");
   run->add_flag("--no-realtime", run_args.no_realtime, "do not request SCHED_FIFO or mlockall");
+  run->add_flag("--no-audio", run_args.no_audio, "do not play the show's sound track");
+  run->add_option("--physics", run_args.physics,
+                  "MuJoCo model (MJCF) behind the simulated servos; the summary reports distance, "
+                  "speed and falls (sim backend, dynamixel2 buses)");
 
   std::string sim_path;
   auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");

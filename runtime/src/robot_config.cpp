@@ -102,41 +102,65 @@ std::vector<BusConfig> parse_buses(const YamlNode& node) {
   return buses;
 }
 
-JointLimits parse_limits(const YamlNode& node) {
-  node.allow_only({"min_deg", "max_deg", "velocity_dps", "acceleration_dps2"});
-  const double min_deg = node.at("min_deg").as_double();
-  const YamlNode max_node = node.at("max_deg");
-  const double max_deg = max_node.as_double();
-  if (!(max_deg > min_deg)) {
-    max_node.fail("expected a value greater than min_deg (" + num(min_deg) + "), found " +
-                  found(max_node));
+// The keys of a joint's limits and home in its unit: degrees for a revolute
+// joint, metres for a prismatic one.
+struct UnitKeys {
+  const char *min, *max, *velocity, *acceleration, *home;
+  double to_si;
+};
+UnitKeys unit_keys(JointType type) {
+  if (type == JointType::prismatic)
+    return {"min_m", "max_m", "velocity_mps", "acceleration_mps2", "home_m", 1.0};
+  return {"min_deg", "max_deg", "velocity_dps", "acceleration_dps2", "home_deg", deg_to_rad(1.0)};
+}
+
+JointType parse_joint_type(const YamlNode& joint) {
+  const auto node = joint.find("type");
+  if (!node) return JointType::revolute;
+  const std::string type = node->as_string();
+  if (type == "revolute") return JointType::revolute;
+  if (type == "prismatic") return JointType::prismatic;
+  node->fail("expected revolute or prismatic, found " + found(*node));
+}
+
+JointLimits parse_limits(const YamlNode& node, JointType type) {
+  const UnitKeys k = unit_keys(type);
+  node.allow_only({k.min, k.max, k.velocity, k.acceleration});
+  const double min_v = node.at(k.min).as_double();
+  const YamlNode max_node = node.at(k.max);
+  const double max_v = max_node.as_double();
+  if (!(max_v > min_v)) {
+    max_node.fail("expected a value greater than " + std::string(k.min) + " (" + num(min_v) +
+                  "), found " + found(max_node));
   }
   JointLimits limits;
-  limits.min_position = deg_to_rad(min_deg);
-  limits.max_position = deg_to_rad(max_deg);
-  limits.max_velocity = deg_to_rad(node.at("velocity_dps").as_positive_double());
-  limits.max_acceleration = deg_to_rad(node.at("acceleration_dps2").as_positive_double());
+  limits.min_position = min_v * k.to_si;
+  limits.max_position = max_v * k.to_si;
+  limits.max_velocity = node.at(k.velocity).as_positive_double() * k.to_si;
+  limits.max_acceleration = node.at(k.acceleration).as_positive_double() * k.to_si;
   return limits;
 }
 
-double parse_home(const YamlNode& joint, const YamlNode& limits_node) {
-  const double min_deg = limits_node.at("min_deg").as_double();
-  const double max_deg = limits_node.at("max_deg").as_double();
-  const std::string range = num(min_deg) + ".." + num(max_deg);
-  const auto home = joint.find("home_deg");
+double parse_home(const YamlNode& joint, const YamlNode& limits_node, JointType type) {
+  const UnitKeys k = unit_keys(type);
+  const double min_v = limits_node.at(k.min).as_double();
+  const double max_v = limits_node.at(k.max).as_double();
+  const std::string range = num(min_v) + ".." + num(max_v);
+  const std::string bounds = std::string(k.min) + ".." + k.max;
+  const auto home = joint.find(k.home);
   if (!home) {
-    if (min_deg <= 0.0 && 0.0 <= max_deg) return 0.0;
-    throw InputError(joint.location(), key_path(joint, "home_deg"),
-                     "limits contradict the home pose: home_deg defaults to 0, outside "
-                     "min_deg..max_deg (" +
-                         range + "); set home_deg inside the limits");
+    if (min_v <= 0.0 && 0.0 <= max_v) return 0.0;
+    throw InputError(joint.location(), key_path(joint, k.home),
+                     "limits contradict the home pose: " + std::string(k.home) +
+                         " defaults to 0, outside " + bounds + " (" + range + "); set " + k.home +
+                         " inside the limits");
   }
-  const double home_deg = home->as_double();
-  if (home_deg < min_deg || home_deg > max_deg) {
-    home->fail("limits contradict the home pose: expected home_deg within min_deg..max_deg (" +
-               range + "), found " + found(*home));
+  const double home_v = home->as_double();
+  if (home_v < min_v || home_v > max_v) {
+    home->fail("limits contradict the home pose: expected " + std::string(k.home) + " within " +
+               bounds + " (" + range + "), found " + found(*home));
   }
-  return deg_to_rad(home_deg);
+  return home_v * k.to_si;
 }
 
 // Reads `actuator.bus` and hands the rest to the bus's protocol.
@@ -157,6 +181,10 @@ std::size_t parse_actuator(const YamlNode& node, const JointSpec& joint,
   }
   const BusConfig& bus = buses[bus_index];
   const Protocol& protocol = *find_protocol(bus.protocol);
+  if (joint.type == JointType::prismatic && !protocol.drives_prismatic()) {
+    bus_node.fail("joint " + joint.name + " is prismatic, and bus " + bus.name + " (" +
+                  bus.protocol + ") drives revolute joints only");
+  }
   std::vector<std::string_view> keys{"bus"};
   for (auto key : protocol.actuator_keys()) keys.push_back(key);
   node.allow_only(keys);
@@ -168,12 +196,13 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
   const auto entries = node.entries();
   if (entries.empty()) node.fail("expected at least one joint, found an empty map");
   for (const auto& [name, value] : entries) {
-    value.allow_only({"limits", "home_deg", "actuator"});
     JointSpec joint;
     joint.name = name;
+    joint.type = parse_joint_type(value);
+    value.allow_only({"type", "limits", unit_keys(joint.type).home, "actuator"});
     const YamlNode limits_node = value.at("limits");
-    joint.limits = parse_limits(limits_node);
-    joint.home = parse_home(value, limits_node);
+    joint.limits = parse_limits(limits_node, joint.type);
+    joint.home = parse_home(value, limits_node, joint.type);
 
     ActuatorBinding binding;
     binding.joint = name;
@@ -185,7 +214,8 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
   }
 }
 
-MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path, bool in_layers = false) {
+MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
+                          bool in_layers = false) {
   // Layers: sources applied in order; later ones win on the joints they drive.
   if (auto t = node.find("type"); t && t->is_scalar() && t->as_string() == "layers") {
     if (in_layers) t->fail("layers cannot be nested");
@@ -196,14 +226,16 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path, b
     const YamlNode list = node.at("layers");
     const auto items = list.items();
     if (items.empty()) list.fail("expected at least one motion source, found an empty list");
-    for (const YamlNode& item : items) motion.layers.push_back(parse_motion(item, robot_path, true));
+    for (const YamlNode& item : items)
+      motion.layers.push_back(parse_motion(item, robot_path, true));
     return motion;
   }
   if (auto t = node.find("type"); t && t->is_scalar() && t->as_string() == "head") {
     MotionConfig motion;
     motion.type = "head";
     motion.where = node.location();
-    motion.head = std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, robot_path));
+    motion.head =
+        std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, robot_path));
     motion.file = motion.head->model;
     return motion;
   }

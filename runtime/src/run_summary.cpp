@@ -49,10 +49,16 @@ std::string format_summary(const RunSummary& s) {
   }
   for (const auto& bus : s.buses) {
     line(fmt::format("bus {}: cycle time (read + write) p50 {}, p99 {}, max {}; late cycles {}",
-                     bus.name, ms(bus.io.p50_s), ms(bus.io.p99_s), ms(bus.io.max_s), bus.late_cycles));
+                     bus.name, ms(bus.io.p50_s), ms(bus.io.p99_s), ms(bus.io.max_s),
+                     bus.late_cycles));
   }
   line("tracking error, commanded vs measured (deg):");
   for (const auto& j : s.joints) {
+    if (j.prismatic) {  // metres, printed in mm
+      line(fmt::format("  {:<14} rms {:7.3f}  max {:7.3f} mm", j.name,
+                       1e3 * j.rms_tracking_error_rad, 1e3 * j.max_tracking_error_rad));
+      continue;
+    }
     line(fmt::format("  {:<14} rms {:7.3f}  max {:7.3f}", j.name,
                      rad_to_deg(j.rms_tracking_error_rad), rad_to_deg(j.max_tracking_error_rad)));
   }
@@ -60,16 +66,28 @@ std::string format_summary(const RunSummary& s) {
   for (const auto& d : s.devices) {
     const DeviceStatus& st = d.status;
     line(fmt::format(
-        "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware {}{}",
-        d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
-        st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
-        st.hardware_error_status
-            ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
-            : std::string()) +
-        (st.exceptions ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
-                       : std::string()) +
-        (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
-                      : std::string()));
+             "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware "
+             "{}{}",
+             d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
+             st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
+             st.hardware_error_status
+                 ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
+                 : std::string()) +
+         (st.exceptions
+              ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
+              : std::string()) +
+         (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
+                       : std::string()));
+  }
+  if (s.physics) {
+    const PhysicsReport& p = *s.physics;
+    line(fmt::format(
+        "physics: {} ({:g} ms steps), {:.2f} s simulated: forward {:.3f} m, sideways {:.3f} m, "
+        "falls {}{}",
+        p.model, p.timestep_s * 1e3, p.simulated_s, p.forward_m, p.sideways_m, p.falls,
+        p.falls > 0 ? fmt::format(" (first at {:.2f} s)", p.first_fall_s) : std::string()));
+    line(fmt::format("physics, motion only: forward {:.3f} m in {:.2f} s, average speed {:.3f} m/s",
+                     p.motion_forward_m, p.motion_s, p.average_speed_m_s));
   }
   if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
@@ -128,6 +146,19 @@ nlohmann::json to_json(const RunSummary& s) {
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},
                     {"dropped", s.telemetry_dropped}};
+  if (s.physics) {
+    const PhysicsReport& p = *s.physics;
+    j["physics"] = {{"model", p.model},
+                    {"timestep_s", p.timestep_s},
+                    {"simulated_s", p.simulated_s},
+                    {"forward_m", p.forward_m},
+                    {"sideways_m", p.sideways_m},
+                    {"motion_s", p.motion_s},
+                    {"motion_forward_m", p.motion_forward_m},
+                    {"average_speed_m_s", p.average_speed_m_s},
+                    {"falls", p.falls},
+                    {"first_fall_s", p.first_fall_s}};
+  }
   return j;
 }
 

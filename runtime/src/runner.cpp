@@ -1,12 +1,11 @@
 #include "animrt/runtime/runner.hpp"
 
+#include <fmt/format.h>
 #include <time.h>
 
 #include <algorithm>
 #include <cmath>
 #include <optional>
-
-#include <fmt/format.h>
 
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/loop_stats.hpp"
@@ -131,7 +130,7 @@ RunSummary Runner::run(const RunOptions& options) {
   // --- configure -----------------------------------------------------------
   for (auto& bus : m.buses) {
     m.log(options, fmt::format("configure: bus {} ({}, {} devices)", bus->config().name,
-                             bus->config().port, bus->config().actuators.size()));
+                               bus->config().port, bus->config().actuators.size()));
     bus->configure();
   }
   std::vector<double> measured(n, 0.0);
@@ -211,7 +210,8 @@ RunSummary Runner::run(const RunOptions& options) {
     summary.sched_note = options.lockstep_clock ? "lockstep: not requested" : "not requested";
     summary.mlock_note = summary.sched_note;
   }
-  for (auto& w : workers) w->start(summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0);
+  for (auto& w : workers)
+    w->start(summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0);
   // Waits until every bus with a posted request of the kind is done, or
   // until `deadline` (wall clock; < 0: no limit, as in lockstep).
   auto wait_for = [&](bool reads, Nanos deadline) {
@@ -249,7 +249,10 @@ RunSummary Runner::run(const RunOptions& options) {
       ramp_to[j] = m.joint_faulted(j) ? position[j] : m.home[j];
     }
     ramp.plan(ramp_from, ramp_to, m.limits, m.config.safety.stop_ramp_s);
-    if (phase == Phase::motion) summary.motion_time_s = now_s - motion_start;
+    if (phase == Phase::motion) {
+      summary.motion_time_s = now_s - motion_start;
+      if (options.on_motion_end) options.on_motion_end();
+    }
     phase = Phase::stop_ramp;
     phase_start = now_s;
   };
@@ -286,8 +289,9 @@ RunSummary Runner::run(const RunOptions& options) {
         pending[b] = 1;
       }
     }
-    wait_for(true, options.lockstep_clock ? Nanos{-1}
-                                          : wake_wall + static_cast<Nanos>(kReadBudget * static_cast<double>(period)));
+    wait_for(true, options.lockstep_clock
+                       ? Nanos{-1}
+                       : wake_wall + static_cast<Nanos>(kReadBudget * static_cast<double>(period)));
     for (std::size_t b = 0; b < workers.size(); ++b) {
       if (pending[b] && workers[b]->read_done()) {
         pending[b] = 0;
@@ -296,7 +300,8 @@ RunSummary Runner::run(const RunOptions& options) {
       if (!fresh[b]) ++late_cycles[b];
     }
     for (std::size_t j = 0; j < n; ++j) {
-      if (fresh[m.slots[j].bus]) measured[j] = workers[m.slots[j].bus]->positions()[m.slots[j].device];
+      if (fresh[m.slots[j].bus])
+        measured[j] = workers[m.slots[j].bus]->positions()[m.slots[j].device];
     }
 
     // watchdog: a device silent (or answering garbage) for too long, or one
@@ -346,6 +351,7 @@ RunSummary Runner::run(const RunOptions& options) {
       } else if (phase == Phase::start_ramp && now_s - phase_start >= ramp.duration()) {
         phase = Phase::motion;
         motion_start = now_s;
+        if (options.on_motion_start) options.on_motion_start(deadline);
       }
     }
 
@@ -369,7 +375,8 @@ RunSummary Runner::run(const RunOptions& options) {
     // filter, write
     filter.step(targets, commands);
     for (std::size_t j = 0; j < n; ++j) {
-      if (fresh[m.slots[j].bus]) workers[m.slots[j].bus]->commands()[m.slots[j].device] = commands[j];
+      if (fresh[m.slots[j].bus])
+        workers[m.slots[j].bus]->commands()[m.slots[j].device] = commands[j];
     }
     for (std::size_t b = 0; b < workers.size(); ++b) {
       if (fresh[b]) workers[b]->post_write();
@@ -409,7 +416,8 @@ RunSummary Runner::run(const RunOptions& options) {
   }
   for (auto& w : workers) w->stop();
   for (std::size_t b = 0; b < m.buses.size(); ++b) {
-    if (workers[b]->io_cycles() != io_seen[b]) bus_hist[b].add(to_seconds(workers[b]->last_io_ns()));
+    if (workers[b]->io_cycles() != io_seen[b])
+      bus_hist[b].add(to_seconds(workers[b]->last_io_ns()));
     auto devices = m.buses[b]->devices();
     for (std::size_t d = 0; d < devices.size(); ++d) devices[d].faulted = m.faulted[b][d] != 0;
   }
@@ -420,35 +428,39 @@ RunSummary Runner::run(const RunOptions& options) {
   m.log(options, "deactivate: torque off");
   if (writer) writer->finish();
 
-  summary.end_reason = fault ? EndReason::fault
-                             : (stop_requested ? EndReason::signal : EndReason::duration);
+  summary.end_reason =
+      fault ? EndReason::fault : (stop_requested ? EndReason::signal : EndReason::duration);
   summary.cycles = cycle;
   summary.period = summarize(period_hist);
   summary.jitter = summarize(jitter_hist);
   summary.busy = summarize(busy_hist);
   for (std::size_t b = 0; b < m.buses.size(); ++b) {
-    summary.buses.push_back(BusReport{m.buses[b]->config().name, summarize(bus_hist[b]), late_cycles[b]});
+    summary.buses.push_back(
+        BusReport{m.buses[b]->config().name, summarize(bus_hist[b]), late_cycles[b]});
     const auto& actuators = m.buses[b]->config().actuators;
     auto devices = m.buses[b]->devices();
     for (std::size_t d = 0; d < devices.size(); ++d) {
-      summary.devices.push_back(DeviceReport{m.buses[b]->config().name, actuators[d].joint, devices[d]});
+      summary.devices.push_back(
+          DeviceReport{m.buses[b]->config().name, actuators[d].joint, devices[d]});
     }
   }
   for (const auto& event : fault_events) {
     const auto& bus = m.buses[event.bus]->config();
     const auto& actuator = bus.actuators[event.device];
-    summary.faults.push_back(fmt::format(
-        "bus {} id {} ({}): {} at t={:.3f} s; other joints ramped to home", bus.name,
-        actuator.device_id, actuator.joint,
-        event.health == DeviceHealth::hardware_error ? "hardware error reported"
-                                                     : fmt::format("no valid answer for more than {} s (last: {})",
-                                                                   m.config.safety.watchdog_timeout_s,
-                                                                   to_string(event.health)),
-        event.at));
+    summary.faults.push_back(
+        fmt::format("bus {} id {} ({}): {} at t={:.3f} s; other joints ramped to home", bus.name,
+                    actuator.device_id, actuator.joint,
+                    event.health == DeviceHealth::hardware_error
+                        ? "hardware error reported"
+                        : fmt::format("no valid answer for more than {} s (last: {})",
+                                      m.config.safety.watchdog_timeout_s, to_string(event.health)),
+                    event.at));
   }
   for (std::size_t j = 0; j < n; ++j) {
-    const double rms = error_samples ? std::sqrt(sq_error[j] / static_cast<double>(error_samples)) : 0.0;
-    summary.joints.push_back(JointReport{m.config.joints[j].name, rms, max_error[j]});
+    const double rms =
+        error_samples ? std::sqrt(sq_error[j] / static_cast<double>(error_samples)) : 0.0;
+    summary.joints.push_back(JointReport{m.config.joints[j].name, rms, max_error[j],
+                                         m.config.joints[j].type == JointType::prismatic});
   }
   if (writer) {
     summary.telemetry_file = options.telemetry_path;

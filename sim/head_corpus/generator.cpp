@@ -113,10 +113,10 @@ const std::vector<SpeakerStyle>& speaker_styles() {
   static const std::vector<SpeakerStyle> styles = {
       // voice, pitch, rate, rest y/p/r, nod, f0->pitch, f0->roll, energy->pitch, sway, sway_hz,
       // drift
-      {"en-us+m3", 40, 160, 2.0, -1.0, 0.5, 10.0, 1.5, 0.8, 8.0, 8.0, 0.30, 1.5},
-      {"en-gb+f3", 60, 170, -3.0, 1.0, -1.0, 8.0, 1.2, 1.0, 6.0, 6.0, 0.40, 1.2},
-      {"en-us+m1", 30, 145, 0.0, 2.0, 1.5, 12.0, 1.8, 0.6, 9.0, 10.0, 0.25, 1.8},
-      {"en-gb-scotland+f2", 55, 180, 4.0, -2.0, 0.0, 9.0, 1.0, 0.9, 7.0, 7.0, 0.45, 1.4},
+      {"en-us+m3", 48, 160, 2.0, -1.0, 0.5, 10.0, 1.5, 0.8, 8.0, 3.2, 0.30, 1.0},
+      {"en-gb+f3", 60, 170, -3.0, 1.0, -1.0, 8.0, 1.2, 1.0, 6.0, 2.4, 0.40, 0.8},
+      {"en-us+m1", 45, 145, 0.0, 2.0, 1.5, 12.0, 1.8, 0.6, 9.0, 4.0, 0.25, 1.2},
+      {"en-gb-scotland+f2", 55, 180, 4.0, -2.0, 0.0, 9.0, 1.0, 0.9, 7.0, 2.8, 0.45, 1.0},
   };
   return styles;
 }
@@ -171,12 +171,18 @@ Motion head_motion(const GeneratorProsody& pr, const SpeakerStyle& st, double du
                      voiced.begin() + static_cast<std::ptrdiff_t>(voiced.size() / 2), voiced.end());
     median = voiced[voiced.size() / 2];
   }
+  // Frames more than 10 semitones from the median are the tracker's octave
+  // errors, not intonation: treat them as unvoiced.
+  std::vector<double> f0 = pr.f0_hz;
+  for (double& f : f0) {
+    if (f > 0 && std::abs(12.0 * std::log2(f / median)) > 10.0) f = 0.0;
+  }
   std::vector<double> semis(n, 0.0), active(n, 0.0);
   double hold = 0;
   const double peak_energy = std::max(1e-6, *std::max_element(pr.energy.begin(), pr.energy.end()));
   std::vector<double> energy(n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (pr.f0_hz[i] > 0) hold = 12.0 * std::log2(pr.f0_hz[i] / median);
+    if (f0[i] > 0) hold = 12.0 * std::log2(f0[i] / median);
     semis[i] = hold;
     energy[i] = pr.energy[i] / peak_energy;
     active[i] = energy[i] > 0.05 ? 1.0 : 0.0;
@@ -192,7 +198,7 @@ Motion head_motion(const GeneratorProsody& pr, const SpeakerStyle& st, double du
   const auto look = static_cast<std::size_t>(0.25 * fr);
   std::vector<std::pair<double, double>> accents;  // time, strength
   for (std::size_t i = look; i + 1 < n; ++i) {
-    if (pr.f0_hz[i] <= 0 || semis[i] < semis[i - 1] || semis[i] < semis[i + 1]) continue;
+    if (f0[i] <= 0 || semis[i] < semis[i - 1] || semis[i] < semis[i + 1]) continue;
     const double lo = *std::min_element(semis.begin() + static_cast<std::ptrdiff_t>(i - look),
                                         semis.begin() + static_cast<std::ptrdiff_t>(i));
     const double prominence = semis[i] - lo;
@@ -230,8 +236,9 @@ Motion head_motion(const GeneratorProsody& pr, const SpeakerStyle& st, double du
     const double e = sample(energy_lp, t);
     double nod = 0;
     for (std::size_t a = 0; a < accents.size(); ++a) {
-      // A nod: raised-cosine dip of 0.4 s starting 50 ms after the accent.
-      const double u = (t - accents[a].first - 0.05) / 0.4;
+      // A nod: a raised-cosine dip of 0.4 s, deepest 50 ms after the accent's
+      // F0 peak (the head's nod lands on the accented syllable).
+      const double u = (t - accents[a].first + 0.15) / 0.4;
       if (u > 0 && u < 1)
         nod += accent_gain[a] * accents[a].second * 0.5 * (1 - std::cos(2 * std::numbers::pi * u));
     }

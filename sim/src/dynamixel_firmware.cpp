@@ -27,7 +27,7 @@ bool may_answer(const dxl::Packet& packet) {
          packet.instruction == inst::bulk_read;
 }
 
-DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now) {
+DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now, JointPhysics* physics) {
   servos_.reserve(config.actuators.size());
   by_id_.reserve(config.actuators.size());
   for (const ActuatorBinding& binding : config.actuators) {
@@ -41,7 +41,7 @@ DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now) {
                        "Dynamixel id " + std::to_string(binding.device_id) +
                            " is used twice on bus '" + config.name + "'");
     }
-    servos_.emplace_back(binding, config.sim, config.baud, now);
+    servos_.emplace_back(binding, config.sim, config.baud, now, physics);
   }
 }
 

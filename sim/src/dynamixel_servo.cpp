@@ -6,6 +6,8 @@
 #include <cstring>
 #include <numbers>
 
+#include "animrt/core/error.hpp"
+
 namespace animrt::sim {
 namespace {
 
@@ -95,11 +97,19 @@ double initial_offset_rad(int device_id) {
 }
 
 DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings,
-                               int baud, Nanos now)
+                               int baud, Nanos now, JointPhysics* physics)
     : binding_(binding),
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_ticks_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
-      motor_time_(now) {
+      motor_time_(now),
+      physics_(physics) {
+  if (physics_ != nullptr) {
+    physics_joint_ = physics_->joint_index(binding.joint);
+    if (physics_joint_ < 0) {
+      throw InputError({}, "actuator",
+                       "joint '" + binding.joint + "' is not driven by the physics model");
+    }
+  }
   // EEPROM at its defaults, shaped by the bus config.
   dxl::put_u16(&table_[xreg::model_number], kXModelNumber);
   table_[xreg::firmware_version] = kXFirmwareVersion;
@@ -121,8 +131,17 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
       std::clamp(binding.to_ticks(initial_offset_rad(binding.device_id)),
                  reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
   motor_.position = start;
+  if (physics_ != nullptr) motor_ = motor_at(now);  // where the physics put the joint
   reset_ram();
   publish(now);
+  command_physics();
+}
+
+void DynamixelServo::command_physics() {
+  if (physics_ == nullptr) return;
+  const std::int32_t goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
+                                       reg32(xreg::max_position_limit));
+  physics_->command(physics_joint_, binding_.to_rad(goal), torque_on());
 }
 
 std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
@@ -146,6 +165,12 @@ void DynamixelServo::latch_shutdown() {
 
 DynamixelServo::Motor DynamixelServo::motor_at(Nanos now) const {
   Motor m = motor_;
+  if (physics_ != nullptr) {
+    const double scale = binding_.direction * binding_.ticks_per_rad;
+    m.position = binding_.zero_ticks + scale * physics_->position(physics_joint_);
+    m.velocity = scale * physics_->velocity(physics_joint_);
+    return m;
+  }
   if (!torque_on() || vmax_ticks_s_ <= 0) {
     m.velocity = 0;
     return m;
@@ -185,6 +210,7 @@ DynamixelServo::Motor DynamixelServo::motor_at(Nanos now) const {
 
 void DynamixelServo::advance(Nanos now) {
   if (now < motor_time_) return;
+  if (physics_ != nullptr) physics_->advance(now);
   motor_ = motor_at(now);
   motor_time_ = now;
   publish(now);
@@ -254,8 +280,9 @@ StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::ui
   const StatusError error = check_write(address, data);
   if (error != StatusError::none) return error;
   std::memcpy(&table_[address], data.data(), data.size());
-  if (!torque_on()) motor_.velocity = 0;
+  if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
+  command_physics();
   return StatusError::none;
 }
 
@@ -283,6 +310,7 @@ void DynamixelServo::reboot(Nanos now) {
   reset_ram();
   if (injected_error_ & table_[xreg_sim::shutdown]) latch_shutdown();
   publish(motor_time_);
+  command_physics();
 }
 
 std::uint8_t DynamixelServo::status_error(StatusError error) const {
@@ -294,8 +322,9 @@ void DynamixelServo::set_hardware_error(std::uint8_t bits, Nanos now) {
   advance(now);
   injected_error_ = bits;
   if (bits & table_[xreg_sim::shutdown]) latch_shutdown();
-  if (!torque_on()) motor_.velocity = 0;
+  if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);
+  command_physics();
 }
 
 double DynamixelServo::position_rad(Nanos now) const {

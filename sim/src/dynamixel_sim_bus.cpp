@@ -61,10 +61,10 @@ auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id)
 
 }  // namespace
 
-DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock)
+DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics)
     : config_(config),
       clock_(clock),
-      firmware_(config, clock.now()),
+      firmware_(config, clock.now(), physics),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
   try {

@@ -3,10 +3,11 @@
 namespace animrt {
 
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
-                                                                   const Clock& clock) {
+                                                                   const Clock& clock,
+                                                                   sim::JointPhysics* physics) {
   std::vector<std::unique_ptr<SimulatedBus>> simulated;
   for (auto& bus : buses) {
-    auto sim = make_simulated_bus(bus, clock);
+    auto sim = make_simulated_bus(bus, clock, physics);
     sim->start();
     bus.port = sim->endpoint();
     simulated.push_back(std::move(sim));

@@ -12,9 +12,18 @@
 
 namespace animrt {
 
-std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock) {
-  if (config.protocol == "dynamixel2") return std::make_unique<sim::DynamixelSimBus>(config, clock);
-  if (config.protocol == "mit" || config.protocol == "cia402") return sim::make_can_sim_bus(config, clock);
+std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock,
+                                                 sim::JointPhysics* physics) {
+  if (config.protocol == "dynamixel2") {
+    return std::make_unique<sim::DynamixelSimBus>(config, clock, physics);
+  }
+  if (physics != nullptr) {
+    throw InputError(
+        config.where, "protocol",
+        "physics drives only dynamixel2 buses; bus '" + config.name + "' is " + config.protocol);
+  }
+  if (config.protocol == "mit" || config.protocol == "cia402")
+    return sim::make_can_sim_bus(config, clock);
   if (config.protocol == "maestro") return std::make_unique<sim::MaestroSimBus>(config, clock);
   if (config.protocol == "modbus-tcp" || config.protocol == "modbus-rtu") {
     return std::make_unique<sim::ModbusSimBus>(config, clock);

@@ -681,7 +681,8 @@ TEST(MakeBus, UnknownProtocolIsADeviceError) {
   config.protocol = "dynamixel1";
   config.where = Location{"robot.yaml", 12, 5};
   EXPECT_EQ(error_of([&] { make_bus(config); }),
-            "bus legs: unknown protocol 'dynamixel1' (supported: dynamixel2, mit, cia402, maestro, modbus-tcp, modbus-rtu)");
+            "bus legs: unknown protocol 'dynamixel1' (supported: dynamixel2, mit, cia402, maestro, "
+            "modbus-tcp, modbus-rtu)");
 }
 
 TEST(MakeBus, MissingPortNamesTheBusAndThePort) {

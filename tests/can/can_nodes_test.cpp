@@ -163,6 +163,85 @@ TEST(Cia402Drive, SyncRpdoTpdoAndTheStateMachineToOperationEnabled) {
   EXPECT_EQ(d.node->state(), cia402::State::operation_enabled);
 }
 
+// The drive's firmware through every transition of the CiA 402 state
+// machine, each commanded by an RPDO and applied at the next SYNC, checked
+// in the statusword of the TPDO that SYNC produces (transitions 0 and 1 are
+// the boot into Switch On Disabled; 13 and 14 follow a fault).
+TEST(Cia402Drive, EveryTransitionThroughRpdoAndSync) {
+  using cia402::State;
+  namespace cw = cia402::cw;
+  Drive d;
+  d.map_csp();
+  EXPECT_EQ(d.node->state(), State::switch_on_disabled);  // 0 and 1 at boot
+  const auto actual = static_cast<std::int32_t>(d.read(obj::position_actual));
+  d.send(nmt(NmtCommand::start, kNode));
+  std::uint16_t last = 0;
+  // Sends one controlword, SYNCs, and returns the state the TPDO reports.
+  auto step = [&](std::uint16_t controlword) {
+    d.send(d.rpdo(controlword, actual));
+    last = controlword;
+    const FrameList r = d.send(sync());
+    for (const can_frame& f : r) {
+      if (f.can_id == 0x180u + kNode) {
+        return cia402::decode_statusword(static_cast<std::uint16_t>(get_le(f.data, 2)));
+      }
+    }
+    ADD_FAILURE() << "no TPDO after SYNC";
+    return State::not_ready_to_switch_on;
+  };
+  struct Expect {
+    std::uint16_t controlword;
+    State state;
+    const char* transition;
+  };
+  const Expect path[] = {
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::disable_voltage, State::switch_on_disabled, "7 (disable voltage)"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::quick_stop, State::switch_on_disabled, "7 (quick stop)"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::switch_on, State::switched_on, "3"},
+      {cw::shutdown, State::ready_to_switch_on, "6"},
+      {cw::switch_on, State::switched_on, "3"},
+      {cw::disable_voltage, State::switch_on_disabled, "10 (disable voltage)"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::switch_on, State::switched_on, "3"},
+      {cw::quick_stop, State::switch_on_disabled, "10 (quick stop)"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::switch_on, State::switched_on, "3"},
+      {cw::enable_operation, State::operation_enabled, "4"},
+      {cw::switch_on, State::switched_on, "5"},
+      {cw::enable_operation, State::operation_enabled, "4"},
+      {cw::shutdown, State::ready_to_switch_on, "8"},
+      {cw::enable_operation, State::operation_enabled, "3+4 in one command"},
+      {cw::disable_voltage, State::switch_on_disabled, "9"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::enable_operation, State::operation_enabled, "3+4 in one command"},
+      {cw::quick_stop, State::quick_stop_active, "11"},
+      {cw::enable_operation, State::operation_enabled, "16"},
+      {cw::quick_stop, State::quick_stop_active, "11"},
+      {cw::disable_voltage, State::switch_on_disabled, "12"},
+      {cw::shutdown, State::ready_to_switch_on, "2"},
+      {cw::enable_operation, State::operation_enabled, "3+4 in one command"},
+  };
+  for (const Expect& e : path) {
+    EXPECT_EQ(step(e.controlword), e.state) << "transition " << e.transition;
+  }
+  // 13 and 14: a fault in Operation Enabled; the drive reports Fault.
+  FrameList emcy_out;
+  d.node->set_fault(0x04, d.now, emcy_out);
+  EXPECT_EQ(step(last), State::fault) << "transitions 13, 14";
+  // Commands other than fault reset leave Fault.
+  EXPECT_EQ(step(cw::shutdown), State::fault);
+  EXPECT_EQ(step(cw::enable_operation), State::fault);
+  // 15: the cause gone, a rising edge of bit 7.
+  d.node->set_fault(0, d.now, emcy_out);
+  EXPECT_EQ(step(cw::fault_reset), State::switch_on_disabled) << "transition 15";
+  // Bit 7 held high is no new reset and no other command: nothing changes.
+  EXPECT_EQ(step(cw::fault_reset), State::switch_on_disabled);
+  EXPECT_EQ(step(cw::shutdown), State::ready_to_switch_on);
+}
+
 TEST(Cia402Drive, HeartbeatProducer) {
   Drive d;
   ASSERT_EQ(d.write_abort(obj::heartbeat_time, 0, 20, 2), 0u);

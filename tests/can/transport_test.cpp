@@ -91,6 +91,50 @@ TEST(VirtualCan, ErrorFramesAreCountedNotDelivered) {
   EXPECT_EQ(describe_errors(rx->errors()), "2 error frames (1 error passive, 1 arbitration lost)");
 }
 
+// Error frames as the kernel's CAN drivers send them (linux/can/error.h:
+// the class in can_id, controller status in data[1], length CAN_ERR_DLC):
+// every class is counted, bus-off and restart are told apart, and the end of
+// run report names each count.
+TEST(CanErrors, EveryKernelErrorClassIsCounted) {
+  auto error = [](canid_t cls, std::uint8_t controller = 0) {
+    can_frame f{};
+    f.can_id = CAN_ERR_FLAG | cls;
+    f.len = CAN_ERR_DLC;
+    f.data[1] = controller;
+    return f;
+  };
+  CanErrorCounters c;
+  EXPECT_EQ(describe_errors(c), "");
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_CRTL, CAN_ERR_CRTL_TX_WARNING), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_CRTL, CAN_ERR_CRTL_TX_PASSIVE), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_CRTL, CAN_ERR_CRTL_RX_OVERFLOW), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_PROT), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_ACK), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_LOSTARB), c), 0);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_BUSOFF), c), 1);
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_RESTARTED), c), -1);
+  EXPECT_EQ(c.error_frames, 8u);
+  EXPECT_EQ(c.error_warning, 1u);
+  EXPECT_EQ(c.error_passive, 1u);
+  EXPECT_EQ(c.rx_overflows, 1u);
+  EXPECT_EQ(c.protocol_violations, 1u);
+  EXPECT_EQ(c.no_ack, 1u);
+  EXPECT_EQ(c.arbitration_lost, 1u);
+  EXPECT_EQ(c.bus_off, 1u);
+  EXPECT_EQ(c.restarts, 1u);
+  // One frame may carry several classes (a bit error that sent the
+  // controller to error passive): each is counted, the frame once.
+  EXPECT_EQ(count_error_frame(error(CAN_ERR_PROT | CAN_ERR_CRTL, CAN_ERR_CRTL_RX_PASSIVE), c), 0);
+  EXPECT_EQ(c.error_frames, 9u);
+  EXPECT_EQ(c.protocol_violations, 2u);
+  EXPECT_EQ(c.error_passive, 2u);
+  c.tx_dropped = 4;
+  EXPECT_EQ(describe_errors(c),
+            "9 error frames (1 bus-off, 1 restarted, 2 error passive, 1 error warning, "
+            "1 arbitration lost, 2 protocol violation, 1 no ack, 1 receive overflow), "
+            "4 frames not sent");
+}
+
 TEST(VirtualCan, BusOffStopsTrafficUntilRestart) {
   auto bus = std::make_shared<VirtualCanBus>("t5");
   auto tx = bus->attach();

@@ -68,7 +68,7 @@ TEST(Corpus, MissingPoseFileIsAnError) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(Training, BeatsTheMeanPoseBaseline) {
+TEST(Training, OneSpeakerBeatsTheMeanPoseBaseline) {
   const Trained& t = trained();
   EXPECT_EQ(t.model.clusters(), 8);
   EXPECT_EQ(t.model.hmms.size(), 8u);
@@ -178,11 +178,16 @@ TEST(ModelFile, CorruptMismatchedAndMissingFilesAreClearErrors) {
   EXPECT_NE(load_error(dir + "/none.txt").find("not found"), std::string::npos);
   EXPECT_NE(load_error(write("magic.txt", "hello\n")).find("not an animrt head model"),
             std::string::npos);
+  const std::string magic = "animrt-head-model " + std::to_string(kModelFormatVersion);
+  const std::string other = std::to_string(kModelFormatVersion + 1);
   std::string v2 = text;
-  v2.replace(v2.find("animrt-head-model 1"), 19, "animrt-head-model 2");
-  EXPECT_NE(load_error(write("v2.txt", v2)).find("version 2 is not supported"), std::string::npos);
-  EXPECT_NE(load_error(write("cut.txt", text.substr(0, text.size() / 2))).find(""),
+  v2.replace(v2.find(magic), magic.size(), "animrt-head-model " + other);
+  EXPECT_NE(load_error(write("v2.txt", v2)).find("version " + other + " is not supported"),
             std::string::npos);
+  // Cut after a whole line, half way through: the file ends early.
+  const std::string cut = text.substr(0, text.rfind('\n', text.size() / 2) + 1);
+  const std::string cut_msg = load_error(write("cut.txt", cut));
+  EXPECT_NE(cut_msg.find("truncated"), std::string::npos) << cut_msg;
   std::string bad = text;
   const auto pos = bad.find("mix ");
   bad.replace(pos, 8, "mix oops");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -61,9 +62,18 @@ TEST(Features, SilenceIsUnvoicedAndGapsAreFilled) {
   EXPECT_EQ(t.raw[mid].f0_hz, 0.0);
   EXPECT_GT(t.f0_filled[mid], 140.0);
   EXPECT_LT(t.f0_filled[mid], 210.0);
+  // The observation is F0 in semitones above 100 Hz and energy in dB:
+  // 150 Hz is 7.02 st, 200 Hz is 12 st; silence sits at the -60 dB floor.
+  const auto row = [&](double t_s) { return static_cast<Eigen::Index>((t_s - t.t0_s) * 120); };
+  EXPECT_NEAR(t.features(row(0.2), 0), 12.0 * std::log2(1.5), 0.15);
+  EXPECT_NEAR(t.features(row(0.9), 0), 12.0, 0.15);
+  EXPECT_NEAR(t.features(row(0.2), 1),
+              20.0 * std::log10(t.raw[static_cast<std::size_t>(row(0.2))].energy), 1e-9);
+  EXPECT_EQ(t.features(row(0.55), 1), kEnergyFloorDb);
   for (std::size_t i = 0; i < t.size(); ++i) {
-    EXPECT_GE(t.features(static_cast<Eigen::Index>(i), 0), 80.0);
-    EXPECT_LE(t.features(static_cast<Eigen::Index>(i), 0), 500.0);
+    EXPECT_NEAR(t.features(static_cast<Eigen::Index>(i), 0), f0_semitones(t.f0_filled[i]), 1e-9);
+    EXPECT_GE(t.f0_filled[i], 80.0);
+    EXPECT_LE(t.f0_filled[i], 500.0);
   }
 }
 

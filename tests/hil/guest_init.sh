@@ -1,6 +1,6 @@
 #!/bin/busybox sh
 # /init of the HIL guest (see tests/hil/run). Runs the guest tests, sends
-# the results to the host on /dev/ttyS2 (files framed by "=== BEGIN name ==="
+# the results to the host on /dev/ttyS3 (files framed by "=== BEGIN name ==="
 # and "=== END ===" lines), then powers off. Every test prints one line,
 # "PASS name" or "FAIL name: why", into results.txt.
 /bin/busybox --install -s /bin
@@ -35,6 +35,21 @@ if [ -e /sys/class/tty/ttyS1/device/driver ]; then
   fi
 else
   fail serial_quadruped "no 8250 driver behind /dev/ttyS1"
+fi
+
+# -- Modbus RTU: libmodbus on the second 8250 UART, host-side simulated drive ---
+# (tests/hil/run checks in the summary that the drive tracked.)
+if [ -e /sys/class/tty/ttyS2/device/driver ]; then
+  animrt run /configs/robots/modbus_rtu.yaml --backend hardware --duration 3 --no-realtime \
+    --summary-json /tmp/modbus_summary.json > /tmp/modbus_run.txt 2>&1
+  rc=$?
+  if [ $rc = 0 ] && grep -q '"end_reason": "duration"' /tmp/modbus_summary.json; then
+    pass modbus_rtu_drive
+  else
+    fail modbus_rtu_drive "animrt run exited $rc: $(grep -m1 error /tmp/modbus_run.txt)"
+  fi
+else
+  fail modbus_rtu_drive "no 8250 driver behind /dev/ttyS2"
 fi
 
 # -- CAN: SocketCAN on vcan0, simulated motors and drive in another process ------
@@ -81,15 +96,15 @@ check tpdo '1A0#.*'
 
 echo DONE >> $R
 # -- results to the host --------------------------------------------------------
-stty -F /dev/ttyS2 raw -echo 2>/dev/null
+stty -F /dev/ttyS3 raw -echo 2>/dev/null
 {
-  for f in results.txt vcan0.log serial_summary.json serial_run.txt can_summary.json can_run.txt \
-           can_sim.txt can_missing_run.txt; do
+  for f in results.txt vcan0.log serial_summary.json serial_run.txt modbus_summary.json \
+           modbus_run.txt can_summary.json can_run.txt can_sim.txt can_missing_run.txt; do
     [ -f /tmp/$f ] || continue
     echo "=== BEGIN $f ==="
     cat /tmp/$f
     echo "=== END ==="
   done
-} > /dev/ttyS2
+} > /dev/ttyS3
 sync
 poweroff -f

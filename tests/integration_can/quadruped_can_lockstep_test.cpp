@@ -6,6 +6,7 @@
 // device missing at bring-up.
 
 #include <gtest/gtest.h>
+#include <linux/can/error.h>
 
 #include <cmath>
 #include <fstream>
@@ -225,6 +226,40 @@ TEST(QuadrupedCanLockstep, BusOffFaultsEveryDeviceOnThatInterface) {
   for (int id : {7, 8, 9, 11, 12}) EXPECT_NEAR(rig.sims[1]->device_position(id), 0.0, 0.01);
   EXPECT_NEAR(rig.sims[2]->device_position(32), 0.0, 0.01);
   rig.sim(0).virtual_bus()->set_bus_off(false);
+}
+
+// Error frames that do not stop the bus (error passive, lost arbitration)
+// are counted on the interface that saw them, not on the robot's other
+// interface, and named at the end of the run; the run goes on.
+TEST(QuadrupedCanLockstep, ErrorFramesAreCountedPerInterfaceAndReported) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.3) {
+      can_frame passive{};
+      passive.can_id = CAN_ERR_CRTL;
+      passive.data[1] = CAN_ERR_CRTL_TX_PASSIVE;
+      rig.sim(0).virtual_bus()->inject_error(passive);
+      can_frame lost{};
+      lost.can_id = CAN_ERR_LOSTARB;
+      rig.sim(0).virtual_bus()->inject_error(lost);
+      done = true;
+    }
+  };
+  ::testing::internal::CaptureStderr();
+  const RunSummary s = rig.run(1.0);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_TRUE(s.faults.empty());
+  EXPECT_EQ(rig.left->transport().errors().error_frames, 2u);
+  EXPECT_EQ(rig.left->transport().errors().error_passive, 1u);
+  EXPECT_EQ(rig.left->transport().errors().arbitration_lost, 1u);
+  EXPECT_EQ(rig.drive->transport().errors().error_frames, 0u);
+  EXPECT_NE(err.find("bus legs_left (virtual:can0): CAN errors: 2 error frames (1 error passive, "
+                     "1 arbitration lost)"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("bus hip_drive (virtual:can1): CAN errors"), std::string::npos) << err;
 }
 
 TEST(QuadrupedCanLockstep, MissingDevicesAreNamedAtBringUp) {

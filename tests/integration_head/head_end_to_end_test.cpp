@@ -53,7 +53,9 @@ TEST(HeadCli, CorpusTrainSynthEvalFeatures) {
   std::ifstream f(d + "/f.csv");
   std::string header;
   std::getline(f, header);
-  EXPECT_EQ(header, "time_s,f0_hz,energy,voiced,f0_filled_hz,d_f0,d_energy,dd_f0,dd_energy");
+  EXPECT_EQ(header,
+            "time_s,f0_hz,energy,voiced,f0_filled_hz,f0_st,energy_db,d_f0_st,d_energy_db,dd_f0_st,"
+            "dd_energy_db");
   // Bad input: exit code 2.
   std::ofstream(d + "/bad.txt") << "animrt-head-model 7\n";
   EXPECT_EQ(run(kBin + " head synth " + d + "/bad.txt " + kSrc +

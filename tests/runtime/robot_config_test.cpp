@@ -260,7 +260,8 @@ buses:
 )"),
             at("7:11: buses.b.sim.max_speed_rad_s: unknown key (expected one of: "
                "time_constant_s, max_speed_dps, wire_time, return_delay_us)"));
-  EXPECT_EQ(error_of(R"(name: t
+  EXPECT_EQ(
+      error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
   b: {protocol: dynamixel2, port: /dev/ttyUSB0}
@@ -269,7 +270,7 @@ joints:
     limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
     home: 0
 )"),
-            at("8:5: joints.j1.home: unknown key (expected one of: limits, home_deg, actuator)"));
+      at("8:5: joints.j1.home: unknown key (expected one of: type, limits, home_deg, actuator)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -496,7 +497,8 @@ loop: {rate_hz: 100}
 buses:
   b: {protocol: modbus, port: /dev/ttyUSB0}
 )"),
-            at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2, mit, cia402, maestro, modbus-tcp, modbus-rtu)"));
+            at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2, mit, "
+               "cia402, maestro, modbus-tcp, modbus-rtu)"));
 }
 
 TEST_F(RobotConfigTest, TwoBusesOnOnePort) {
@@ -694,8 +696,8 @@ TEST_F(RobotConfigTest, TicksPerRevOrPerRadNotBoth) {
 TEST_F(RobotConfigTest, UnknownMotionType) {
   std::string text = kMinimal;
   text.replace(text.find("type: gait"), 10, "type: keyframes");
-  EXPECT_EQ(error_of(text),
-            at("9:16: motion.type: unknown motion type \"keyframes\" (supported: gait, head, show, layers)"));
+  EXPECT_EQ(error_of(text), at("9:16: motion.type: unknown motion type \"keyframes\" (supported: "
+                               "gait, head, show, layers)"));
 }
 
 TEST_F(RobotConfigTest, MotionFileMissing) {
@@ -733,14 +735,16 @@ TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {
                          "buses: {b: {protocol: dynamixel2, port: /dev/null}}\n"
                          "joints: {j: {limits: {min_deg: -1, max_deg: 1, velocity_dps: 1, "
                          "acceleration_dps2: 1}, actuator: {bus: b, id: 1}}}\n"
-                         "motion: {type: gait, file: " + gait + "}\n";
+                         "motion: {type: gait, file: " +
+                             gait + "}\n";
   try {
     load_robot_config(path);
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              path + ":3:30: safety.watchdog_timeout_s: expected at least two loop periods "
-                     "(0.02 s at loop.rate_hz 100), found \"0.015\"");
+              path +
+                  ":3:30: safety.watchdog_timeout_s: expected at least two loop periods "
+                  "(0.02 s at loop.rate_hz 100), found \"0.015\"");
   }
 }
 

@@ -153,6 +153,50 @@ TEST(Show, AudioTrackWithOffset) {
       << e;
 }
 
+// Values are in the joint's unit: metres for a prismatic joint, degrees for
+// a revolute one, in the same show.
+TEST(Show, PrismaticJointKeysAreMetres) {
+  std::vector<JointSpec> j = joints();
+  JointSpec slide;
+  slide.name = "slide";
+  slide.type = JointType::prismatic;
+  slide.limits = {0.0, 0.1, 0.05, 0.5};
+  j.push_back(slide);
+  const std::string text =
+      "joints:\n"
+      "  slide: {interpolation: linear, keys: [[0, 0.02], [1, 0.08]]}\n"
+      "  jaw: {unit: deg, interpolation: linear, keys: [[0, 0], [1, 10]]}\n";
+  auto source = load_show_source(write("metres.yaml", text), j);
+  std::vector<double> targets(4, -1.0);
+  source->sample(0.5, targets);
+  EXPECT_NEAR(targets[3], 0.05, 1e-12);
+  EXPECT_NEAR(targets[1], deg_to_rad(5.0), 1e-12);
+  // The same track stated in metres explicitly.
+  auto explicit_unit =
+      load_show_source(write("unit_m.yaml", "joints:\n  slide: {unit: m, keys: [[0, 0.07]]}\n"), j);
+  explicit_unit->sample(0.0, targets);
+  EXPECT_NEAR(targets[3], 0.07, 1e-12);
+
+  auto error_with = [&](const std::string& show) {
+    try {
+      load_show_source(write("bad_metres.yaml", show), j);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string e = error_with("joints:\n  slide: {unit: deg, keys: [[0, 0.05]]}\n");
+  EXPECT_NE(e.find("bad_metres.yaml:2:17: joints.slide.unit: unit deg, but joint 'slide' is "
+                   "prismatic (its limits are in metres); use unit: m"),
+            std::string::npos)
+      << e;
+  // Degrees written for a slide are far outside its stroke, and said in metres.
+  e = error_with("joints:\n  slide: {keys: [[0, 0.05], [1, 30]]}\n");
+  EXPECT_NE(e.find("joints.slide.keys: key at 1 s is 30 m, outside the joint's limits 0..0.1 m"),
+            std::string::npos)
+      << e;
+}
+
 TEST(Show, ErrorsNameFileLineAndKey) {
   EXPECT_NE(error_of("joints:\n  jaw:\n    keys:\n      - [0, 0]\n      - [0, 5]\n")
                 .find("bad_show.yaml:5:10: joints.jaw.keys[1][0]: expected a time after the "
@@ -170,7 +214,12 @@ TEST(Show, ErrorsNameFileLineAndKey) {
             std::string::npos)
       << error_of("joints:\n  jaw: {keys: [[0, 0], [1, 50]]}\n");
   EXPECT_NE(error_of("joints:\n  jaw: {unit: m, keys: [[0, 0]]}\n")
-                .find("joints.jaw.unit: joint values in metres"),
+                .find("bad_show.yaml:2:15: joints.jaw.unit: unit m, but joint 'jaw' is revolute "
+                      "(its limits are in degrees); use unit: deg"),
+            std::string::npos)
+      << error_of("joints:\n  jaw: {unit: m, keys: [[0, 0]]}\n");
+  EXPECT_NE(error_of("joints:\n  jaw: {unit: inch, keys: [[0, 0]]}\n")
+                .find("joints.jaw.unit: expected deg (revolute joint) or m (prismatic joint)"),
             std::string::npos);
   EXPECT_NE(error_of("duration_s: 1\njoints:\n  jaw: {keys: [[0, 0], [2, 1]]}\n")
                 .find("duration_s: expected at least the last key's time (2 s)"),

@@ -232,45 +232,25 @@ void Cia402Bus::nmt(canopen::NmtCommand command, std::size_t device) {
 
 std::uint32_t Cia402Bus::sdo_read(std::size_t device, std::uint16_t index, std::uint8_t sub) {
   const auto node = static_cast<std::uint8_t>(config_.actuators[device].device_id);
-  const std::string what = "SDO upload " + object_name(index, sub);
-  for (int t = 0; t < kTries; ++t) {
-    sdo_slot_ = static_cast<int>(device);
-    sdo_done_ = false;
-    transport_->send(canopen::sdo_upload(node, index, sub));
-    const auto deadline = std::chrono::steady_clock::now() + timeout_;
-    can_frame frame;
-    while (!sdo_done_) {
-      const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
-          deadline - std::chrono::steady_clock::now());
-      if (!transport_->receive(frame, std::max(left, std::chrono::microseconds(0)))) break;
-      handle(frame);
-    }
-    sdo_slot_ = -1;
-    if (!sdo_done_) continue;
-    const canopen::Sdo& a = sdo_answer_;
-    if (a.kind == canopen::SdoKind::abort) {
-      throw DeviceError(prefix() + describe(device) + ": " + what + " aborted: " + hex(a.value, 8) +
-                        " (" + canopen::sdo_abort_text(a.value) + ")");
-    }
-    if (a.kind != canopen::SdoKind::upload_response || !a.expedited || a.index != index ||
-        a.subindex != sub) {
-      ++status_[device].protocol_errors;
-      throw DeviceError(prefix() + describe(device) + ": " + what + ": unexpected answer");
-    }
-    return a.value;
-  }
-  ++status_[device].timeouts;
-  throw DeviceError(prefix() + describe(device) + ": no answer to " + what);
+  return sdo_exchange(device, canopen::sdo_upload(node, index, sub), index, sub,
+                      "SDO upload " + object_name(index, sub), canopen::SdoKind::upload_response);
 }
 
 void Cia402Bus::sdo_write(std::size_t device, std::uint16_t index, std::uint8_t sub,
                           std::uint32_t value, std::uint8_t size) {
   const auto node = static_cast<std::uint8_t>(config_.actuators[device].device_id);
-  const std::string what = "SDO download " + object_name(index, sub) + " = " + hex(value, 2 * size);
+  sdo_exchange(device, canopen::sdo_download(node, index, sub, value, size), index, sub,
+               "SDO download " + object_name(index, sub) + " = " + hex(value, 2 * size),
+               canopen::SdoKind::download_response);
+}
+
+std::uint32_t Cia402Bus::sdo_exchange(std::size_t device, const can_frame& request,
+                                      std::uint16_t index, std::uint8_t sub,
+                                      const std::string& what, canopen::SdoKind expected) {
   for (int t = 0; t < kTries; ++t) {
     sdo_slot_ = static_cast<int>(device);
     sdo_done_ = false;
-    transport_->send(canopen::sdo_download(node, index, sub, value, size));
+    transport_->send(request);
     const auto deadline = std::chrono::steady_clock::now() + timeout_;
     can_frame frame;
     while (!sdo_done_) {
@@ -286,11 +266,13 @@ void Cia402Bus::sdo_write(std::size_t device, std::uint16_t index, std::uint8_t 
       throw DeviceError(prefix() + describe(device) + ": " + what + " aborted: " + hex(a.value, 8) +
                         " (" + canopen::sdo_abort_text(a.value) + ")");
     }
-    if (a.kind != canopen::SdoKind::download_response || a.index != index || a.subindex != sub) {
+    // Uploads are expedited only: a segmented answer is not understood.
+    const bool expedited_if_upload = expected != canopen::SdoKind::upload_response || a.expedited;
+    if (a.kind != expected || !expedited_if_upload || a.index != index || a.subindex != sub) {
       ++status_[device].protocol_errors;
       throw DeviceError(prefix() + describe(device) + ": " + what + ": unexpected answer");
     }
-    return;
+    return a.value;
   }
   ++status_[device].timeouts;
   throw DeviceError(prefix() + describe(device) + ": no answer to " + what);

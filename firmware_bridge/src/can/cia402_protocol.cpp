@@ -77,13 +77,7 @@ class Cia402 final : public Protocol {
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
-    std::unique_ptr<CanFrameTransport> transport;
-    try {
-      transport = open_can(config.port);
-    } catch (const DeviceError& e) {
-      throw DeviceError("bus " + config.name + ": " + e.what());
-    }
-    return std::make_unique<Cia402Bus>(config, std::move(transport));
+    return std::make_unique<Cia402Bus>(config, open_bus_can(config));
   }
 };
 

@@ -104,13 +104,7 @@ class Mit final : public Protocol {
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
-    std::unique_ptr<CanFrameTransport> transport;
-    try {
-      transport = open_can(config.port);
-    } catch (const DeviceError& e) {
-      throw DeviceError("bus " + config.name + ": " + e.what());
-    }
-    return std::make_unique<MitBus>(config, std::move(transport));
+    return std::make_unique<MitBus>(config, open_bus_can(config));
   }
 };
 

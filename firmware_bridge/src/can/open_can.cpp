@@ -3,6 +3,7 @@
 
 #include <linux/can/error.h>
 
+#include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/can/can_transport.hpp"
 #include "animrt/bridge/can/socketcan.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
@@ -14,6 +15,14 @@ std::unique_ptr<CanFrameTransport> open_can(const std::string& port) {
     return VirtualCanBus::named(port.substr(kVirtualCanPrefix.size()))->attach();
   }
   return open_socketcan(port);
+}
+
+std::unique_ptr<CanFrameTransport> open_bus_can(const BusConfig& bus) {
+  try {
+    return open_can(bus.port);
+  } catch (const DeviceError& e) {
+    throw DeviceError("bus " + bus.name + ": " + e.what());
+  }
 }
 
 int count_error_frame(const can_frame& frame, CanErrorCounters& c) {

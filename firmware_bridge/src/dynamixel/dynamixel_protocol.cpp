@@ -107,13 +107,7 @@ class Dynamixel2 final : public Protocol {
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
-    std::unique_ptr<ByteTransport> transport;
-    try {
-      transport = open_serial(config.port, config.baud);
-    } catch (const DeviceError& e) {
-      throw DeviceError("bus " + config.name + ": " + e.what());
-    }
-    return std::make_unique<DynamixelBus>(config, std::move(transport));
+    return std::make_unique<DynamixelBus>(config, open_bus_serial(config));
   }
 };
 

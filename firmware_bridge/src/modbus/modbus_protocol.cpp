@@ -29,6 +29,7 @@ class ModbusProtocol final : public Protocol {
  public:
   explicit ModbusProtocol(bool tcp) : tcp_(tcp) {}
   std::string_view name() const override { return tcp_ ? "modbus-tcp" : "modbus-rtu"; }
+  bool drives_prismatic() const override { return true; }
   std::span<const std::string_view> bus_keys() const override {
     return tcp_ ? std::span<const std::string_view>(kTcpKeys)
                 : std::span<const std::string_view>(kRtuKeys);
@@ -97,7 +98,21 @@ class ModbusProtocol final : public Protocol {
     const modbus::RegisterMap& m = *j.map;
     const auto per = node.find("m_per_rad");
     const auto zero = node.find("zero_m");
-    if (m.unit == "m") {
+    const bool prismatic = joint.type == JointType::prismatic;
+    if (prismatic) {
+      // The joint is the actuator's stroke itself: metres in, metres out.
+      if (m.unit != "m") {
+        map_node.fail("joint " + joint.name + " is prismatic (metres) but the map " + given +
+                      " is in radians; use a map in metres");
+      }
+      if (per) {
+        per->fail("joint " + joint.name +
+                  " is prismatic: the actuator moves it directly, so there is no stroke per "
+                  "radian (zero_m alone sets the actuator position at joint 0 m)");
+      }
+      j.per_rad = 1.0;
+      if (zero) j.zero = zero->as_double();
+    } else if (m.unit == "m") {
       if (!per) {
         node.fail("missing key m_per_rad: the map " + given +
                   " is in metres, so the joint needs the stroke per radian (negative to reverse)");
@@ -128,14 +143,17 @@ class ModbusProtocol final : public Protocol {
       }
     }
     if (m.has_range) {
-      for (const char* key : {"min_deg", "max_deg"}) {
+      static constexpr const char* kDegKeys[] = {"min_deg", "max_deg"};
+      static constexpr const char* kMetreKeys[] = {"min_m", "max_m"};
+      for (const char* key : prismatic ? kMetreKeys : kDegKeys) {
         const double rad = key[1] == 'i' ? joint.limits.min_position : joint.limits.max_position;
         const double si = j.zero + j.per_rad * rad;
         if (si < m.range_min - 1e-12 || si > m.range_max + 1e-12) {
-          limits_node.at(key).fail(format_number(rad_to_deg(rad)) + " deg maps to " +
-                                   format_number(si) + " " + m.unit + ", outside the range of " +
-                                   given + " (" + format_number(m.range_min) + ".." +
-                                   format_number(m.range_max) + " " + m.unit + ")");
+          limits_node.at(key).fail(
+              (prismatic ? format_number(rad) + " m" : format_number(rad_to_deg(rad)) + " deg") +
+              " maps to " + format_number(si) + " " + m.unit + ", outside the range of " + given +
+              " (" + format_number(m.range_min) + ".." + format_number(m.range_max) + " " + m.unit +
+              ")");
         }
       }
     }

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <memory>
 
+#include "animrt/bridge/bus_config.hpp"
+#include "animrt/core/error.hpp"
 #include "fd_transport.hpp"
 
 namespace animrt {
@@ -33,6 +35,14 @@ std::unique_ptr<ByteTransport> open_serial(const std::string& port, int baud) {
   }
   if (detail::is_pseudo_terminal(device)) return detail::open_pty(port, device, baud);
   return detail::open_libserialport(port, device, baud);
+}
+
+std::unique_ptr<ByteTransport> open_bus_serial(const BusConfig& bus) {
+  try {
+    return open_serial(bus.port, bus.baud);
+  } catch (const DeviceError& e) {
+    throw DeviceError("bus " + bus.name + ": " + e.what());
+  }
 }
 
 }  // namespace animrt

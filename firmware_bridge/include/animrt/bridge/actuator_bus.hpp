@@ -24,10 +24,10 @@ struct DeviceStatus {
   std::uint64_t transactions = 0;
   std::uint64_t timeouts = 0;
   std::uint64_t crc_errors = 0;
-  std::uint64_t protocol_errors = 0;  // malformed, truncated, wrong id, unexpected packet
-  std::uint64_t hardware_errors = 0;  // status packets with the alert / error bits set
-  std::uint64_t exceptions = 0;       // Modbus exception responses (code in last_error_byte)
-  std::uint8_t last_error_byte = 0;   // status error byte of the last status packet
+  std::uint64_t protocol_errors = 0;       // malformed, truncated, wrong id, unexpected packet
+  std::uint64_t hardware_errors = 0;       // status packets with the alert / error bits set
+  std::uint64_t exceptions = 0;            // Modbus exception responses (code in last_error_byte)
+  std::uint8_t last_error_byte = 0;        // status error byte of the last status packet
   std::uint8_t hardware_error_status = 0;  // device's own fault register, when read
   // The measured position is the controller's own output (e.g. a Maestro's
   // ramped pulse for a hobby servo), not a sensor reading.

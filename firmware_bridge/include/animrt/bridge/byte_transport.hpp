@@ -30,4 +30,9 @@ class ByteTransport {
 // through libserialport. Throws DeviceError with the port and the reason.
 std::unique_ptr<ByteTransport> open_serial(const std::string& port, int baud);
 
+struct BusConfig;
+// open_serial for a serial-line bus (its port and baud rate); the error
+// names the bus.
+std::unique_ptr<ByteTransport> open_bus_serial(const BusConfig& bus);
+
 }  // namespace animrt

@@ -27,6 +27,10 @@ class Protocol {
   // by frame ids); a serial line belongs to one bus.
   virtual bool shares_port() const { return false; }
 
+  // Whether its actuators can be bound to prismatic joints (positions in
+  // metres); the others drive revolute joints only.
+  virtual bool drives_prismatic() const { return false; }
+
   // Bus keys of this protocol besides `protocol` and `sim` (read by the
   // runtime), in the order error messages list them.
   virtual std::span<const std::string_view> bus_keys() const = 0;

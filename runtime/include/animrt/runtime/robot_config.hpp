@@ -2,10 +2,9 @@
 // The robot file: joints, buses, actuator bindings, loop rate, safety and the
 // motion source. Loading validates everything; nothing moves until it passes.
 
+#include <memory>
 #include <string>
 #include <vector>
-
-#include <memory>
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/controllers/head/head_source.hpp"

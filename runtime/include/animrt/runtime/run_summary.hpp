@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,8 @@ struct TimingSummary {
 struct JointReport {
   std::string name;
   double rms_tracking_error_rad = 0.0;  // commanded (previous cycle) - measured
-  double max_tracking_error_rad = 0.0;
+  double max_tracking_error_rad = 0.0;  // (a prismatic joint's errors are in m)
+  bool prismatic = false;
 };
 
 struct DeviceReport {
@@ -35,6 +37,20 @@ struct BusReport {
   // Cycles in which the bus had not answered within the loop's read budget
   // (its joints kept their last measurement, the other buses went on).
   std::uint64_t late_cycles = 0;
+};
+
+// What the physics behind simulated servos saw (`animrt run --physics`).
+struct PhysicsReport {
+  std::string model;
+  double timestep_s = 0.0;
+  double simulated_s = 0.0;        // physics time from the devices' start to the end
+  double forward_m = 0.0;          // torso's +x displacement over that time (ramps included)
+  double sideways_m = 0.0;         // torso's +y displacement
+  double motion_s = 0.0;           // physics time of the motion proper (0: it never started)
+  double motion_forward_m = 0.0;   // torso's +x displacement during the motion
+  double average_speed_m_s = 0.0;  // motion_forward_m / motion_s
+  int falls = 0;                   // upright -> fallen transitions (the gait fitness's criterion)
+  double first_fall_s = -1.0;      // physics time of the first fall, -1 if none
 };
 
 enum class EndReason { duration, signal, fault };
@@ -64,6 +80,7 @@ struct RunSummary {
   std::string telemetry_file;
   std::uint64_t telemetry_records = 0;
   std::uint64_t telemetry_dropped = 0;
+  std::optional<PhysicsReport> physics;  // set by whoever ran the physics
 
   // 0 for a clean run, 4 when a device fault ended it.
   int exit_code() const { return end_reason == EndReason::fault ? 4 : 0; }

@@ -26,11 +26,16 @@ struct RunOptions {
   ManualClock* lockstep_clock = nullptr;
   bool request_realtime = true;  // SCHED_FIFO + mlockall (real-time runs only)
   int realtime_priority = 80;
-  std::string telemetry_path;                      // CSV, empty = none
+  std::string telemetry_path;                       // CSV, empty = none
   const std::atomic<bool>* stop_request = nullptr;  // e.g. set by SIGINT
-  std::string backend_name = "hardware";           // for the report
+  std::string backend_name = "hardware";            // for the report
   // Lifecycle messages; never called from inside the cycle.
   std::function<void(const std::string&)> log;
+  // Called from inside the cycle when the motion starts (with the time of its
+  // t = 0 on the run's clock) and when it ends (stop, fault or duration), so
+  // a show's sound track can follow it. Must not block, lock or allocate.
+  std::function<void(Nanos)> on_motion_start;
+  std::function<void()> on_motion_end;
 };
 
 class Runner {

@@ -55,8 +55,9 @@ bool may_answer(const dxl::Packet& packet);
 class DynamixelFirmware {
  public:
   // One servo per actuator of `config`. Throws InputError for a device id
-  // outside 0..252 or used twice.
-  DynamixelFirmware(const BusConfig& config, Nanos now);
+  // outside 0..252 or used twice. With `physics`, every servo takes its
+  // motor state from it (see DynamixelServo).
+  DynamixelFirmware(const BusConfig& config, Nanos now, JointPhysics* physics = nullptr);
 
   // Handles one instruction packet at time `now` and appends the answers.
   void handle(const dxl::Packet& packet, Nanos now, Answers& out);

@@ -19,6 +19,11 @@
 // clamp((goal - position) / tau, -vmax, vmax). The model is integrated in
 // closed form, so the state at time t does not depend on how often it was
 // advanced on the way (packets may arrive at any rate). Torque off: no motion.
+//
+// With a JointPhysics the motor model is the physics instead: the servo hands
+// it the goal (within the position limits) and the torque state whenever
+// they change, steps it on to each packet's time, and publishes the joint's
+// position and velocity (a limp joint can be moved by the physics).
 
 #include <array>
 #include <cstdint>
@@ -27,6 +32,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/joint_physics.hpp"
 
 namespace animrt::sim {
 
@@ -62,8 +68,10 @@ double initial_offset_rad(int device_id);
 
 class DynamixelServo {
  public:
+  // `physics` (optional, outlives the servo) replaces the motor model; it
+  // must drive binding.joint (InputError otherwise).
   DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings, int baud,
-                 Nanos now);
+                 Nanos now, JointPhysics* physics = nullptr);
 
   int device_id() const { return binding_.device_id; }       // as configured
   std::uint8_t id() const { return table_[dxl::xreg::id]; }  // answers to this
@@ -96,7 +104,7 @@ class DynamixelServo {
   void set_hardware_error(std::uint8_t bits, Nanos now);
 
   // Present position in radians through the binding, at time `now`, without
-  // changing the state.
+  // changing the state (with physics: where the physics is now).
   double position_rad(Nanos now) const;
 
  private:
@@ -109,6 +117,7 @@ class DynamixelServo {
   void reset_ram();
   void latch_shutdown();
   void publish(Nanos now);  // motor state -> present-value registers
+  void command_physics();   // goal and torque -> physics
   std::int32_t reg32(std::uint16_t address) const;
 
   ActuatorBinding binding_;
@@ -117,6 +126,8 @@ class DynamixelServo {
   std::array<std::uint8_t, dxl::xreg::table_size> table_{};
   Motor motor_;
   Nanos motor_time_;
+  JointPhysics* physics_ = nullptr;
+  int physics_joint_ = -1;
   bool responding_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;

@@ -46,8 +46,9 @@ struct DynamixelSimStats {
 class DynamixelSimBus final : public SimulatedBus {
  public:
   // Opens the pty and builds the servos; throws DeviceError if no pty can be
-  // opened and InputError for bad device ids.
-  DynamixelSimBus(const BusConfig& config, const Clock& clock);
+  // opened and InputError for bad device ids. `physics` (optional, outlives
+  // the bus) replaces the servos' motor model.
+  DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics = nullptr);
   ~DynamixelSimBus() override;
   DynamixelSimBus(const DynamixelSimBus&) = delete;
   DynamixelSimBus& operator=(const DynamixelSimBus&) = delete;

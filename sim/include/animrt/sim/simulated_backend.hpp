@@ -12,7 +12,9 @@
 
 namespace animrt {
 
-std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
-                                                                   const Clock& clock);
+// With `physics` (optional, outlives the devices) the simulated servos take
+// their motor state from it (see make_simulated_bus).
+std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(
+    std::vector<BusConfig>& buses, const Clock& clock, sim::JointPhysics* physics = nullptr);
 
 }  // namespace animrt

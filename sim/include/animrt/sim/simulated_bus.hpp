@@ -31,9 +31,15 @@ class SimulatedBus {
   virtual double device_position(int device_id) const = 0;
 };
 
+namespace sim {
+class JointPhysics;
+}
+
 // Builds the simulated devices for config.protocol ("dynamixel2": N X-series
 // servos behind one pty). Motor models read time from `clock`, so a lockstep
-// run with a ManualClock is deterministic.
-std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock);
+// run with a ManualClock is deterministic. With `physics` (dynamixel2 only;
+// InputError for other protocols) the servos take their motor state from it.
+std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock,
+                                                 sim::JointPhysics* physics = nullptr);
 
 }  // namespace animrt

@@ -30,6 +30,9 @@ struct Evaluation {
   Score distance_deg;  // per utterance mean distance, then mean and std over utterances
   Score cca;
   Score baseline_distance_deg;  // always the training mean pose
+  // The mean pose through the same output stage (plus the model's seeded
+  // noise, without which a constant has no correlation to measure).
+  Score baseline_cca;
   int utterances = 0;
 };
 

@@ -21,6 +21,16 @@ namespace animrt::head {
 
 constexpr int kFeatureDim = 6;  // f0, energy, d f0, d energy, dd f0, dd energy
 
+// The observation's pitch and energy are on logarithmic scales: F0 in
+// semitones above 100 Hz and energy in dB relative to full scale (floored at
+// -60 dB). An accent raises F0 by about the same number of semitones in a low
+// and a high voice, so the HMMs learn intonation that carries across
+// speakers, while the absolute level still tells voices apart.
+constexpr double kF0ReferenceHz = 100.0;
+constexpr double kEnergyFloorDb = -60.0;
+double f0_semitones(double f0_hz);
+double energy_db(double rms);
+
 struct FeatureConfig {
   int sample_rate = 24000;       // analysis rate; audio is resampled to it
   double window_s = 0.025;       // analysis window
@@ -71,7 +81,9 @@ struct FeatureTrack {
   double t0_s = 0.0;  // time of frame 0
   std::vector<RawFrame> raw;
   std::vector<double> f0_filled;  // Hz, spline through voiced frames
-  Eigen::MatrixXd features;       // frames x 6: f0, energy, df0, denergy, ddf0, ddenergy
+  // frames x 6: f0 (semitones of f0_filled), energy (dB), and their first and
+  // second derivatives per second.
+  Eigen::MatrixXd features;
   std::size_t size() const { return raw.size(); }
   double time(std::size_t i) const { return t0_s + static_cast<double>(i) / frame_rate_hz; }
 };
@@ -83,8 +95,9 @@ FeatureTrack extract_features_file(const std::string& wav_path, const FeatureCon
 //   d_t = rate * sum_k k (c_{t+k} - c_{t-k}) / (2 sum_k k^2),  k = 1..window.
 Eigen::MatrixXd deltas(const Eigen::MatrixXd& x, int window, double frame_rate_hz);
 
-// Writes the features CSV: time_s, f0_hz (0 unvoiced), energy, voiced,
-// f0_filled_hz, d_f0, d_energy, dd_f0, dd_energy.
+// Writes the features CSV: time_s, f0_hz (0 unvoiced), energy (RMS), voiced,
+// f0_filled_hz, then the observation: f0_st, energy_db, d_f0_st, d_energy_db,
+// dd_f0_st, dd_energy_db.
 void write_features_csv(const std::string& path, const FeatureTrack& track);
 
 }  // namespace animrt::head

@@ -10,7 +10,7 @@
 //     jaw:
 //       interpolation: cubic        # default of this joint's segments
 //       keys:
-//         - [0.0, 0]                # [time_s, degrees]
+//         - [0.0, 0]                # [time_s, value]
 //         - [0.3, 14]
 //         - {t: 0.6, value: 2, interpolation: step}   # segment from this key on
 //
@@ -19,6 +19,11 @@
 // slope between its neighbours (zero at the ends of a non-looping show), so
 // velocity is continuous across consecutive cubic segments. A looping show
 // wraps from its last key to its first at duration_s.
+//
+// Values are in the unit of the robot joint they drive: degrees for a
+// revolute joint, metres for a prismatic one. A track may state its unit
+// (`unit: deg` or `unit: m`); a unit that contradicts the joint's type is an
+// error, so a show written for another robot is not silently misread.
 
 #include <memory>
 #include <span>
@@ -34,21 +39,28 @@ namespace animrt {
 enum class Interpolation { step, linear, cubic };
 
 struct ShowKey {
-  double t = 0.0;                                      // s
-  double value = 0.0;                                  // rad (file: degrees)
+  double t = 0.0;      // s
+  double value = 0.0;  // as written: degrees or metres (SI once bound to a joint)
   Interpolation interpolation = Interpolation::cubic;  // of the segment from this key
   Location where;
 };
 
+enum class ShowUnit { from_joint, deg, m };
+
 struct ShowTrack {
   std::string joint;
   std::vector<ShowKey> keys;  // strictly increasing t, at least one
+  ShowUnit unit = ShowUnit::from_joint;
+  Location unit_where;
   Location where;
 };
 
 struct ShowAudio {
   std::string file;       // resolved against the show file's folder
   double offset_s = 0.0;  // show time at which the audio starts
+  int sample_rate = 0;    // Hz, read from the file on load
+  int channels = 0;
+  double length_s = 0.0;
 };
 
 struct ShowFile {
@@ -64,8 +76,10 @@ struct ShowFile {
 // Loads and validates a show file (InputError with file, line, column, key).
 ShowFile load_show_file(const std::string& path);
 
-// Binds a show to the robot's joints (an unknown joint, or a key outside the
-// joint's limits, is an InputError at the key). sample() is allocation-free.
+// Binds a show to the robot's joints, converting its values to SI by each
+// joint's type (an unknown joint, a unit that contradicts the joint's type,
+// or a key outside the joint's limits, is an InputError at the key).
+// sample() is allocation-free.
 std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
                                                std::span<const JointSpec> joints);
 std::unique_ptr<MotionSource> load_show_source(const std::string& path,

@@ -61,6 +61,10 @@ class CanFrameTransport {
 // DeviceError naming the interface and the reason.
 std::unique_ptr<CanFrameTransport> open_can(const std::string& port);
 
+struct BusConfig;
+// open_can for a CAN bus of the robot file; the error names the bus.
+std::unique_ptr<CanFrameTransport> open_bus_can(const BusConfig& bus);
+
 inline constexpr std::string_view kVirtualCanPrefix = "virtual:";
 
 // Counts one error frame into `counters`; returns +1 if it reports bus-off,

@@ -71,6 +71,9 @@ class Cia402Bus final : public ActuatorBus {
   void nmt(canopen::NmtCommand command, std::size_t device);
 
  private:
+  // Sends `request` (retried on silence) and returns the answer's value.
+  std::uint32_t sdo_exchange(std::size_t device, const can_frame& request, std::uint16_t index,
+                             std::uint8_t sub, const std::string& what, canopen::SdoKind expected);
   // Sends SYNC and collects TPDOs of the drives in expect_ (one deadline).
   void sync_cycle();
   void handle(const can_frame& frame);

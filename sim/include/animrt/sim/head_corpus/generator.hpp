@@ -27,7 +27,7 @@ struct SpeakerStyle {
   double f0_pitch_deg = 1.2;      // head up per semitone above the speaker's median F0
   double f0_roll_deg = 0.6;       // roll per semitone
   double energy_pitch_deg = 4.0;  // head up at full loudness
-  double sway_deg = 5.0;          // yaw sway amplitude at full loudness
+  double sway_deg = 3.0;          // yaw sway amplitude at full loudness
   double sway_hz = 0.35;
   double drift_deg = 1.0;  // std of the slow random drift
 };

@@ -1,0 +1,109 @@
+#pragma once
+// A show's sound track, played in step with the show. The schedule says which
+// sample of the track sounds at which show time (pure arithmetic on frame
+// counts, tested without a sound card); the player is a normal-priority
+// thread that feeds ALSA from that schedule once the show has started.
+//
+// Show frame f is show time f / rate. Track frame (f - offset) sounds at show
+// frame f: silence before the offset and after the track's end. A looping
+// show restarts its track on every pass (show frames wrap at the show's
+// duration), so a track longer than a pass is cut at the wrap.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "animrt/controllers/show/show_file.hpp"
+#include "animrt/core/clock.hpp"
+
+namespace animrt {
+
+// The sound of a file, mixed down to one channel (libsndfile).
+struct AudioTrack {
+  int rate = 0;  // Hz
+  std::vector<float> samples;
+};
+// Throws InputError (file and key unknown here: the show file validated it).
+AudioTrack load_audio_track(const std::string& path);
+
+class ShowAudioSchedule {
+ public:
+  ShowAudioSchedule(const ShowAudio& audio, bool loop, double show_duration_s, int rate,
+                    std::int64_t track_frames);
+  // The track frame that sounds at show frame `show_frame`, or -1 (silence).
+  std::int64_t track_frame(std::int64_t show_frame) const;
+  // Fills `out` with the sound of show frames first_show_frame, +1, ...
+  void render(std::span<const float> track, std::int64_t first_show_frame,
+              std::span<float> out) const;
+  int rate() const { return rate_; }
+
+ private:
+  int rate_;
+  std::int64_t offset_;  // frames
+  std::int64_t period_;  // frames per pass of a looping show, 0 = not looping
+  std::int64_t length_;  // frames in the track
+};
+
+// Where the sound goes. The ALSA sink is the real one; tests may use others.
+class AudioSink {
+ public:
+  virtual ~AudioSink() = default;
+  // Frames written but not yet heard (the output's latency right now).
+  virtual std::int64_t queued_frames() = 0;
+  // Blocks until the frames are queued.
+  virtual void write(std::span<const float> mono) = 0;
+};
+// Opens an ALSA playback device (e.g. "default") for mono float at `rate`.
+// Throws DeviceError with ALSA's reason (no sound card, busy, ...); ALSA's
+// own diagnostics are kept off stderr, so the caller reports it once.
+std::unique_ptr<AudioSink> open_alsa_sink(const std::string& device, int rate);
+
+class ShowAudioPlayer {
+ public:
+  // The sink is opened by the caller (so a missing sound card is reported
+  // before the run starts); `clock` is the clock of the origin given to
+  // start() (CLOCK_MONOTONIC in a real-time run).
+  ShowAudioPlayer(const ShowFile& show, AudioTrack track, std::unique_ptr<AudioSink> sink,
+                  const Clock& clock);
+  ~ShowAudioPlayer();
+  ShowAudioPlayer(const ShowAudioPlayer&) = delete;
+  ShowAudioPlayer& operator=(const ShowAudioPlayer&) = delete;
+
+  // From the control loop: no lock, no allocation, no blocking.
+  void start(Nanos show_origin) { origin_.store(show_origin, std::memory_order_release); }
+  void stop() { stopped_.store(true, std::memory_order_release); }
+
+  // Show frames written to the sink so far (for tests and the report).
+  std::int64_t frames_played() const { return played_.load(std::memory_order_acquire); }
+
+ private:
+  void run();
+
+  AudioTrack track_;
+  ShowAudioSchedule schedule_;
+  std::unique_ptr<AudioSink> sink_;
+  const Clock& clock_;
+  static constexpr Nanos kNotStarted = INT64_MIN;
+  std::atomic<Nanos> origin_{kNotStarted};
+  std::atomic<bool> stopped_{false};
+  std::atomic<bool> quit_{false};
+  std::atomic<std::int64_t> played_{0};
+  std::thread thread_;
+};
+
+// The players for the sound tracks of `show_files` (shows without one are
+// skipped). A track that cannot be played, for instance on a machine without
+// a sound card, is reported through `log` once and left out: the run goes on
+// without sound. A lockstep run is not in real time, so it plays nothing
+// (and says so).
+using AudioSinkFactory = std::function<std::unique_ptr<AudioSink>(int rate)>;
+std::vector<std::unique_ptr<ShowAudioPlayer>> open_show_audio(
+    const std::vector<std::string>& show_files, bool lockstep, const AudioSinkFactory& open_sink,
+    const Clock& clock, const std::function<void(const std::string&)>& log);
+
+}  // namespace animrt

@@ -1,0 +1,135 @@
+// A show's sound track: the schedule (which track frame sounds at which show
+// frame) and the player thread that feeds it to a sink.
+
+#include "animrt/controllers/show/show_audio.hpp"
+
+#include <sndfile.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+
+#include "animrt/core/error.hpp"
+#include "animrt/core/yaml_doc.hpp"
+
+namespace animrt {
+
+AudioTrack load_audio_track(const std::string& path) {
+  SF_INFO info{};
+  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
+  if (f == nullptr) {
+    throw InputError(Location{path, 0, 0}, "audio",
+                     "cannot open audio file: " + std::string(sf_strerror(nullptr)));
+  }
+  const int channels = std::max(1, info.channels);
+  std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
+                                 static_cast<std::size_t>(channels));
+  const sf_count_t got = sf_readf_float(f, interleaved.data(), info.frames);
+  sf_close(f);
+  AudioTrack track;
+  track.rate = info.samplerate;
+  track.samples.resize(static_cast<std::size_t>(std::max<sf_count_t>(got, 0)));
+  for (std::size_t i = 0; i < track.samples.size(); ++i) {
+    float sum = 0.0f;
+    for (int c = 0; c < channels; ++c) {
+      sum += interleaved[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)];
+    }
+    track.samples[i] = sum / static_cast<float>(channels);
+  }
+  return track;
+}
+
+ShowAudioSchedule::ShowAudioSchedule(const ShowAudio& audio, bool loop, double show_duration_s,
+                                     int rate, std::int64_t track_frames)
+    : rate_(rate),
+      offset_(std::llround(audio.offset_s * rate)),
+      period_(loop ? std::llround(show_duration_s * rate) : 0),
+      length_(track_frames) {}
+
+std::int64_t ShowAudioSchedule::track_frame(std::int64_t show_frame) const {
+  if (show_frame < 0) return -1;
+  if (period_ > 0) show_frame %= period_;
+  const std::int64_t k = show_frame - offset_;
+  return k >= 0 && k < length_ ? k : -1;
+}
+
+void ShowAudioSchedule::render(std::span<const float> track, std::int64_t first_show_frame,
+                               std::span<float> out) const {
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::int64_t k = track_frame(first_show_frame + static_cast<std::int64_t>(i));
+    out[i] = k >= 0 && k < static_cast<std::int64_t>(track.size())
+                 ? track[static_cast<std::size_t>(k)]
+                 : 0.0f;
+  }
+}
+
+ShowAudioPlayer::ShowAudioPlayer(const ShowFile& show, AudioTrack track,
+                                 std::unique_ptr<AudioSink> sink, const Clock& clock)
+    : track_(std::move(track)),
+      schedule_(show.audio, show.loop, show.duration_s, track_.rate,
+                static_cast<std::int64_t>(track_.samples.size())),
+      sink_(std::move(sink)),
+      clock_(clock) {
+  thread_ = std::thread([this] { run(); });
+}
+
+ShowAudioPlayer::~ShowAudioPlayer() {
+  quit_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+}
+
+void ShowAudioPlayer::run() {
+  const int rate = schedule_.rate();
+  const std::int64_t block = std::max(1, rate / 100);  // 10 ms per write
+  std::vector<float> buffer(static_cast<std::size_t>(block));
+  std::int64_t next = -1;  // show frame of the next block; -1: not playing yet
+  while (!quit_.load(std::memory_order_acquire)) {
+    const Nanos origin = origin_.load(std::memory_order_acquire);
+    if (origin == kNotStarted || stopped_.load(std::memory_order_acquire)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      continue;
+    }
+    // The show frame that will be heard when the next written frame plays:
+    // now, plus what the output still holds.
+    const std::int64_t queued = sink_->queued_frames();
+    const Nanos since = clock_.now() - origin;
+    const std::int64_t heard =
+        static_cast<std::int64_t>(std::floor(static_cast<double>(since) * 1e-9 * rate)) + queued;
+    // Continuous blocks while in step; a jump when more than 20 ms apart (the
+    // start, a stall of this thread, or drift between the clocks).
+    if (next < 0 || std::llabs(heard - next) > rate / 50) next = heard;
+    schedule_.render(track_.samples, next, buffer);
+    sink_->write(buffer);
+    next += block;
+    played_.fetch_add(block, std::memory_order_acq_rel);
+  }
+}
+
+std::vector<std::unique_ptr<ShowAudioPlayer>> open_show_audio(
+    const std::vector<std::string>& show_files, bool lockstep, const AudioSinkFactory& open_sink,
+    const Clock& clock, const std::function<void(const std::string&)>& log) {
+  std::vector<std::unique_ptr<ShowAudioPlayer>> players;
+  for (const std::string& file : show_files) {
+    const ShowFile show = load_show_file(file);
+    if (!show.has_audio) continue;
+    if (lockstep) {
+      log("audio: " + show.audio.file + " not played (a lockstep run is not in real time)");
+      continue;
+    }
+    AudioTrack track = load_audio_track(show.audio.file);
+    try {
+      std::unique_ptr<AudioSink> sink = open_sink(track.rate);
+      players.push_back(
+          std::make_unique<ShowAudioPlayer>(show, std::move(track), std::move(sink), clock));
+      log("audio: " + show.audio.file + " starts at show time " +
+          format_number(show.audio.offset_s) + " s");
+    } catch (const DeviceError& e) {
+      log("audio: cannot play " + show.audio.file + " (" + e.what() +
+          "); the show runs without sound");
+    }
+  }
+  return players;
+}
+
+}  // namespace animrt

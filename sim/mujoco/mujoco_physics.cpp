@@ -1,0 +1,152 @@
+// MuJoCo physics behind the simulated servos (see mujoco_physics.hpp).
+
+#include "animrt/sim/mujoco/mujoco_physics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "animrt/core/error.hpp"
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+
+namespace animrt::sim {
+namespace {
+
+std::string listed(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+}  // namespace
+
+MujocoJointPhysics::MujocoJointPhysics(const std::string& model_path,
+                                       const std::vector<JointSpec>& joints,
+                                       const std::string& robot_file, Nanos start)
+    : meta_(load_mujoco_model(model_path)),
+      model_(mj_copyModel(nullptr, meta_.model.get()), mj_deleteModel),
+      data_(make_mujoco_data(meta_)),
+      start_(start) {
+  if (!model_) throw std::runtime_error("mj_copyModel failed for " + model_path);
+  const mjModel* m = model_.get();
+  for (const JointSpec& joint : joints) {
+    const int a = meta_.actuator_of(joint.name);
+    if (a < 0) {
+      throw InputError({model_path, 0, 0}, "actuator",
+                       "joint '" + joint.name + "' of " + robot_file +
+                           " has no position actuator on a hinge joint of that name in this "
+                           "model (it has: " +
+                           listed(meta_.actuated_joints) + ")");
+    }
+    names_.push_back(joint.name);
+    actuator_.push_back(a);
+  }
+  step_ns_ = std::max<Nanos>(1, std::llround(m->opt.timestep * 1e9));
+  for (int a = 0; a < m->nu; ++a) {
+    gain_.push_back(m->actuator_gainprm[a * mjNGAIN]);
+    bias1_.push_back(m->actuator_biasprm[a * mjNBIAS + 1]);
+    bias2_.push_back(m->actuator_biasprm[a * mjNBIAS + 2]);
+  }
+  std::vector<double> pose(static_cast<std::size_t>(m->nu), 0.0);
+  for (std::size_t j = 0; j < joints.size(); ++j) pose[actuator_[j]] = joints[j].home;
+  place_standing(meta_, data_.get(), pose.data());
+  const int torso = meta_.torso_body;
+  standing_z_ = data_->xpos[3 * torso + 2];
+  x0_ = data_->xpos[3 * torso];
+  y0_ = data_->xpos[3 * torso + 1];
+}
+
+MujocoJointPhysics::~MujocoJointPhysics() = default;
+
+int MujocoJointPhysics::joint_index(const std::string& joint) const {
+  const auto it = std::find(names_.begin(), names_.end(), joint);
+  return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());
+}
+
+void MujocoJointPhysics::advance(Nanos now) {
+  std::lock_guard lock(mutex_);
+  if (now <= start_) return;
+  const auto due = static_cast<std::uint64_t>((now - start_) / step_ns_);
+  while (steps_ < due) step();
+}
+
+void MujocoJointPhysics::step() {
+  mj_step(model_.get(), data_.get());
+  ++steps_;
+  const bool fallen = has_fallen(meta_, data_.get(), standing_z_);
+  if (fallen && !fallen_) {
+    if (falls_ == 0) first_fall_s_ = static_cast<double>(steps_) * model_->opt.timestep;
+    ++falls_;
+  }
+  fallen_ = fallen;
+  const double t = static_cast<double>(steps_) * model_->opt.timestep;
+  const double x = data_->xpos[3 * meta_.torso_body];
+  int requested = kRequested;
+  if (start_mark_.compare_exchange_strong(requested, kRecorded)) {
+    motion_x0_ = x;
+    motion_t0_ = t;
+  }
+  requested = kRequested;
+  if (end_mark_.compare_exchange_strong(requested, kRecorded)) {
+    motion_x1_ = x;
+    motion_t1_ = t;
+  }
+}
+
+void MujocoJointPhysics::mark_motion_start() {
+  int none = kNone;
+  start_mark_.compare_exchange_strong(none, kRequested);
+}
+
+void MujocoJointPhysics::mark_motion_end() {
+  int none = kNone;
+  end_mark_.compare_exchange_strong(none, kRequested);
+}
+
+void MujocoJointPhysics::command(int index, double goal_rad, bool torque_on) {
+  std::lock_guard lock(mutex_);
+  const auto a = static_cast<std::size_t>(actuator_.at(static_cast<std::size_t>(index)));
+  mjModel* m = model_.get();
+  // A position actuator's force is gain * ctrl + bias1 * q + bias2 * qdot:
+  // all three at zero leave the joint limp.
+  m->actuator_gainprm[a * mjNGAIN] = torque_on ? gain_[a] : 0.0;
+  m->actuator_biasprm[a * mjNBIAS + 1] = torque_on ? bias1_[a] : 0.0;
+  m->actuator_biasprm[a * mjNBIAS + 2] = torque_on ? bias2_[a] : 0.0;
+  data_->ctrl[a] = goal_rad;
+}
+
+double MujocoJointPhysics::position(int index) const {
+  std::lock_guard lock(mutex_);
+  const auto a = static_cast<std::size_t>(actuator_.at(static_cast<std::size_t>(index)));
+  return data_->qpos[meta_.actuator_qpos[a]];
+}
+
+double MujocoJointPhysics::velocity(int index) const {
+  std::lock_guard lock(mutex_);
+  const auto a = static_cast<std::size_t>(actuator_.at(static_cast<std::size_t>(index)));
+  return data_->qvel[meta_.actuator_dof[a]];
+}
+
+PhysicsMeasures MujocoJointPhysics::measures() const {
+  std::lock_guard lock(mutex_);
+  PhysicsMeasures out;
+  out.model_file = meta_.file;
+  out.timestep_s = model_->opt.timestep;
+  out.steps = steps_;
+  out.simulated_s = static_cast<double>(steps_) * model_->opt.timestep;
+  const int torso = meta_.torso_body;
+  out.forward_m = data_->xpos[3 * torso] - x0_;
+  out.sideways_m = data_->xpos[3 * torso + 1] - y0_;
+  if (start_mark_ == kRecorded) {
+    // Not ended yet (or no step since the end mark): up to now.
+    const bool ended = end_mark_ == kRecorded;
+    out.motion_s = (ended ? motion_t1_ : out.simulated_s) - motion_t0_;
+    out.motion_forward_m = (ended ? motion_x1_ : data_->xpos[3 * torso]) - motion_x0_;
+  }
+  out.falls = falls_;
+  out.first_fall_s = first_fall_s_;
+  out.fallen = fallen_;
+  return out;
+}
+
+}  // namespace animrt::sim

@@ -1,0 +1,289 @@
+// The simulated servos backed by MuJoCo physics, driven by the runtime in
+// lockstep: the evolved quadruped gait carries the figure forward without a
+// fall, holding the home pose does not, the physics follows the clock
+// deterministically, and a robot joint the model lacks gets a clear error.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/runner.hpp"
+#include "animrt/sim/mujoco/mujoco_physics.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+
+namespace animrt {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kRoot = ANIMRT_SOURCE_DIR;
+const std::string kModel = kRoot + "/configs/models/quadruped.xml";
+const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+}
+
+// The demo quadruped playing `gait`, without wire-time emulation (lockstep
+// needs no real-time pacing) and with a generous answer timeout.
+std::string write_robot(const std::string& name, const std::string& gait) {
+  std::string robot = read(kRoot + "/configs/robots/quadruped.yaml");
+  replace_once(robot, "file: ../gaits/walk.yaml", "file: " + gait);
+  replace_once(robot, "wire_time: true", "wire_time: false");
+  // Bus timeouts are wall-clock time even in lockstep; a loaded machine must not hit them.
+  replace_once(robot, "timeout_ms: 4 ", "timeout_ms: 50 ");
+  const fs::path path = fs::temp_directory_path() /
+                        ("animrt_physics_" + std::to_string(getpid()) + "_" + name + ".yaml");
+  std::ofstream(path) << robot;
+  return path.string();
+}
+
+// Holds every joint at its home pose.
+class HoldHome final : public MotionSource {
+ public:
+  explicit HoldHome(const std::vector<JointSpec>& joints) {
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      driven_.push_back(static_cast<int>(j));
+      home_.push_back(joints[j].home);
+    }
+  }
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double, std::span<double> targets) const override {
+    for (std::size_t j = 0; j < home_.size(); ++j) targets[j] = home_[j];
+  }
+
+ private:
+  std::vector<int> driven_;
+  std::vector<double> home_;
+};
+
+struct Outcome {
+  sim::PhysicsMeasures physics;
+  RunSummary summary;
+  std::vector<double> joints_at_end;    // the physics' joint angles after the run
+  std::vector<double> measured_at_end;  // the runtime's last measurement over the wire
+};
+
+// The last row's *_meas_rad columns of a telemetry CSV.
+std::vector<double> last_measured(const std::string& csv) {
+  std::istringstream in(read(csv));
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line)) last = line;
+  std::vector<std::string> names, cells;
+  std::stringstream hs(header), ls(last);
+  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
+  for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+  std::vector<double> out;
+  for (std::size_t i = 0; i < names.size() && i < cells.size(); ++i) {
+    if (names[i].ends_with("_meas_rad")) out.push_back(std::stod(cells[i]));
+  }
+  return out;
+}
+
+// A lockstep run of `robot_file` for `duration` s of motion with the servos
+// on the physics; `hold_home` replaces the robot's gait.
+Outcome run_on_physics(const std::string& robot_file, double duration, bool hold_home) {
+  ManualClock clock;
+  LoadedRobot robot = load_robot(robot_file);
+  sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, clock.now());
+  auto sims = start_simulated_devices(robot.config.buses, clock, &physics);
+  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
+  std::unique_ptr<MotionSource> motion =
+      hold_home ? std::make_unique<HoldHome>(robot.config.joints) : std::move(robot.motion);
+  Runner runner(robot.config, std::move(buses), std::move(motion));
+  RunOptions options;
+  options.duration_s = duration;
+  options.lockstep_clock = &clock;
+  options.backend_name = "sim";
+  options.telemetry_path = robot_file + ".csv";
+  options.on_motion_start = [&physics](Nanos) { physics.mark_motion_start(); };
+  options.on_motion_end = [&physics] { physics.mark_motion_end(); };
+  Outcome out;
+  out.summary = runner.run(options);
+  out.physics = physics.measures();
+  for (int j = 0; j < static_cast<int>(robot.config.joints.size()); ++j) {
+    out.joints_at_end.push_back(physics.position(j));
+  }
+  out.measured_at_end = last_measured(options.telemetry_path);
+  fs::remove(options.telemetry_path);
+  return out;
+}
+
+class PhysicsBackend : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    for (const auto& f : files_) fs::remove(f);
+  }
+  std::string robot(const std::string& name, const std::string& gait) {
+    files_.push_back(write_robot(name, gait));
+    return files_.back();
+  }
+  std::vector<std::string> files_;
+};
+
+constexpr double kMotionS = 6.0;
+
+TEST_F(PhysicsBackend, EvolvedGaitCarriesTheFigureForwardWithoutFalling) {
+  const Outcome walk = run_on_physics(
+      robot("evolved", kRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, false);
+  EXPECT_EQ(walk.summary.exit_code(), 0);
+  EXPECT_EQ(walk.summary.end_reason, EndReason::duration);
+  // The physics ran for the whole run: start ramp, motion, stop ramp.
+  EXPECT_GT(walk.physics.simulated_s, kMotionS + 1.0);
+  EXPECT_EQ(walk.physics.falls, 0);
+  EXPECT_FALSE(walk.physics.fallen);
+  EXPECT_GT(walk.physics.forward_m, 0.10) << "sideways " << walk.physics.sideways_m;
+  // The motion proper: its length within a cycle (5 ms) and most of the distance.
+  EXPECT_NEAR(walk.physics.motion_s, kMotionS, 0.006);
+  EXPECT_GT(walk.physics.motion_forward_m, 0.5 * walk.physics.forward_m);
+  EXPECT_LE(walk.physics.motion_forward_m, walk.physics.forward_m + 0.02);
+  // What the runtime measured over the wire is the physics' joint angle
+  // (zero and direction of each binding applied), within a tick.
+  ASSERT_EQ(walk.measured_at_end.size(), walk.joints_at_end.size());
+  for (std::size_t j = 0; j < walk.joints_at_end.size(); ++j) {
+    EXPECT_NEAR(walk.measured_at_end[j], walk.joints_at_end[j], 2 * kPi / 4096) << j;
+  }
+}
+
+TEST_F(PhysicsBackend, HoldingTheHomePoseGoesNowhere) {
+  const Outcome still = run_on_physics(
+      robot("home", kRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, true);
+  EXPECT_EQ(still.summary.exit_code(), 0);
+  EXPECT_GT(still.physics.simulated_s, kMotionS);
+  EXPECT_EQ(still.physics.falls, 0);
+  EXPECT_LT(std::abs(still.physics.forward_m), 0.01);
+  EXPECT_LT(std::abs(still.physics.sideways_m), 0.01);
+  EXPECT_NEAR(still.physics.motion_s, kMotionS, 0.006);
+  EXPECT_LT(std::abs(still.physics.motion_forward_m), 0.01);
+}
+
+TEST_F(PhysicsBackend, LockstepRunsAreIdentical) {
+  const std::string file = robot("twice", kRoot + "/configs/gaits/quadruped_evolved.yaml");
+  const Outcome a = run_on_physics(file, 1.0, false);
+  const Outcome b = run_on_physics(file, 1.0, false);
+  EXPECT_EQ(a.physics.steps, b.physics.steps);
+  EXPECT_EQ(a.physics.forward_m, b.physics.forward_m);
+  EXPECT_EQ(a.physics.motion_s, b.physics.motion_s);
+  EXPECT_EQ(a.physics.motion_forward_m, b.physics.motion_forward_m);
+  EXPECT_EQ(a.physics.sideways_m, b.physics.sideways_m);
+  ASSERT_EQ(a.summary.joints.size(), b.summary.joints.size());
+  for (std::size_t j = 0; j < a.summary.joints.size(); ++j) {
+    EXPECT_EQ(a.summary.joints[j].rms_tracking_error_rad,
+              b.summary.joints[j].rms_tracking_error_rad);
+  }
+}
+
+TEST(PhysicsModel, StepsAtItsOwnTimestepAsTheClockMoves) {
+  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 1'000'000'000);
+  physics.advance(1'000'000'000 + 4'999'999);  // 2 ms steps: two are due, the third is not
+  EXPECT_EQ(physics.measures().steps, 2u);
+  physics.advance(1'000'000'000);  // never back
+  EXPECT_EQ(physics.measures().steps, 2u);
+  physics.advance(1'000'000'000 + 6'000'000);
+  EXPECT_EQ(physics.measures().steps, 3u);
+  EXPECT_DOUBLE_EQ(physics.measures().timestep_s, 0.002);
+}
+
+TEST(PhysicsModel, TorqueOffLetsTheFigureSagAndTorqueOnHoldsIt) {
+  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  const int n = static_cast<int>(robot.config.joints.size());
+  // A crouch (knees and ankles bent) held for 1 s, then 1 s with torque on or off.
+  std::vector<double> crouch(static_cast<std::size_t>(n), 0.0);
+  for (int j = 0; j < n; ++j) {
+    const std::string& name = robot.config.joints[j].name;
+    if (name.ends_with("knee")) crouch[j] = -0.5;
+    if (name.ends_with("ankle")) crouch[j] = 0.5;
+  }
+  auto drift_after = [&](bool torque) {
+    sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
+    for (int j = 0; j < n; ++j) physics.command(j, crouch[j], true);
+    physics.advance(1'000'000'000);
+    for (int j = 0; j < n; ++j) physics.command(j, crouch[j], torque);
+    physics.advance(2'000'000'000);
+    double sum = 0;
+    for (int j = 0; j < n; ++j) sum += std::abs(physics.position(j) - crouch[j]);
+    return sum / n;
+  };
+  EXPECT_LT(drift_after(true), 0.1);   // rad, mean over joints: held near the crouch
+  EXPECT_GT(drift_after(false), 0.2);  // limp legs fold under the body's weight
+}
+
+TEST(PhysicsModel, AJointTheModelLacksNamesTheModelFileAndTheJoint) {
+  LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  robot.config.joints[4].name = "rf_knee_x";
+  try {
+    sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, kModel);
+    EXPECT_EQ(std::string(e.what()),
+              kModel + ": actuator: joint 'rf_knee_x' of " + robot.config.file +
+                  " has no position actuator on a hinge joint of that name in this model (it "
+                  "has: lf_hip, lf_knee, lf_ankle, rf_hip, rf_knee, rf_ankle, lh_hip, lh_knee, "
+                  "lh_ankle, rh_hip, rh_knee, rh_ankle)");
+  }
+}
+
+int sh(const std::string& cmd) {
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST_F(PhysicsBackend, CliReportsDistanceSpeedAndFalls) {
+  const std::string file = robot("cli", kRoot + "/configs/gaits/quadruped_evolved.yaml");
+  const std::string base =
+      fs::temp_directory_path() / ("animrt_physics_cli_" + std::to_string(getpid()));
+  files_.push_back(base + ".json");
+  files_.push_back(base + ".log");
+  ASSERT_EQ(sh(kAnimrt + " run " + file + " --lockstep --no-realtime --duration 2 --physics " +
+               kModel + " --summary-json " + base + ".json > " + base + ".log 2>&1"),
+            0)
+      << read(base + ".log");
+  const std::string log = read(base + ".log");
+  EXPECT_NE(log.find("physics: " + kModel + " (2 ms steps)"), std::string::npos) << log;
+  EXPECT_NE(log.find("falls 0"), std::string::npos) << log;
+  const std::string json = read(base + ".json");
+  EXPECT_NE(log.find("physics, motion only: forward "), std::string::npos) << log;
+  EXPECT_NE(log.find(" in 2.00 s, average speed "), std::string::npos) << log;
+  for (const char* key :
+       {"\"forward_m\"", "\"motion_forward_m\"", "\"average_speed_m_s\"", "\"falls\": 0"}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+  }
+
+  // A model without one of the robot's joints: exit 2, one line naming both.
+  std::string xml = read(kModel);
+  replace_once(xml, "<position name=\"lh_ankle\" joint=\"lh_ankle\" class=\"ankle\"/>", "");
+  const std::string bad = base + "_bad.xml";
+  files_.push_back(bad);
+  std::ofstream(bad) << xml;
+  EXPECT_EQ(sh(kAnimrt + " run " + file + " --lockstep --duration 1 --physics " + bad + " 2> " +
+               base + ".log"),
+            2);
+  const std::string err = read(base + ".log");
+  EXPECT_EQ(err.rfind("error: " + bad + ": actuator: joint 'lh_ankle' of " + file, 0), 0u) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+}  // namespace
+}  // namespace animrt
