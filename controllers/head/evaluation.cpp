@@ -146,7 +146,8 @@ std::string format_table(const std::vector<TableRow>& rows) {
   for (const auto& r : rows) {
     std::snprintf(
         line, sizeof line,
-        "| K=%d S=%d M=%d %s | %.1f | %.1f | %.2f | %.2f | %.1f +- %.1f | %.2f +- %.2f | %.1f | %.2f "
+        "| K=%d S=%d M=%d %s | %.1f | %.1f | %.2f | %.2f | %.1f +- %.1f | %.2f +- %.2f | %.1f | "
+        "%.2f "
         "|\n",
         r.config.clusters, r.config.states, r.config.mixtures, topology_name(r.config.topology),
         r.result.distance_deg.mean, r.result.distance_deg.std, r.result.cca.mean, r.result.cca.std,

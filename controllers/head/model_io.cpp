@@ -187,7 +187,7 @@ void save_model(const std::string& path, const HeadModel& m) {
       .word("seed")
       .num(static_cast<double>(m.smoothing.seed))
       .end();
-  w.key("shrink").word("factor").num(m.smoothing.shrink).word("toward").nums(m.pose_mean).end();
+  w.key("shrink").word("factor").nums(m.smoothing.shrink).word("toward").nums(m.pose_mean).end();
   w.key("decode")
       .word("lm_scale")
       .num(m.decode.lm_scale)
@@ -309,8 +309,10 @@ HeadModel load_model(const std::string& path) {
       "rates must be positive and noise_deg >= 0");
   r.done();
   r.line("shrink");
-  m.smoothing.shrink = r.named_num("factor");
-  r.check(m.smoothing.shrink >= 0 && m.smoothing.shrink <= 1, "factor must be in [0, 1]");
+  r.check(r.word() == "factor", "expected \"factor\"");
+  m.smoothing.shrink = r.nums(3);
+  r.check((m.smoothing.shrink.array() >= 0).all() && (m.smoothing.shrink.array() <= 1).all(),
+          "factors must be in [0, 1]");
   r.check(r.word() == "toward", "expected \"toward\"");
   m.pose_mean = r.nums(3);
   r.done();

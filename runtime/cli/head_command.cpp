@@ -168,8 +168,8 @@ void add_train_options(CLI::App* c, HeadArgs& a) {
   c->add_option("--train-fraction", a.train_fraction, "share of the corpus for training")
       ->check(CLI::Range(0.05, 1.0));
   c->add_option("--shrink", a.shrink,
-                 "output poses toward the mean pose: factor in [0, 1] (1: the paper), "
-                 "negative: chosen on the training data")
+                "output poses toward the mean pose: factor in [0, 1] (1: the paper), "
+                "negative: chosen on the training data")
       ->check(CLI::Range(-1.0, 1.0));
   c->add_option("--seed", a.seed, "split seed");
   c->add_flag("--quiet", a.quiet, "no progress lines");

@@ -149,6 +149,8 @@ TEST(ModelFile, RoundTripDecodesTheSame) {
   EXPECT_EQ(back.clusters(), t.model.clusters());
   EXPECT_EQ(back.training_utterances, t.model.training_utterances);
   EXPECT_EQ(decode_track(back, t.test[0].track), decode_track(t.model, t.test[0].track));
+  for (int k = 0; k < t.model.clusters(); ++k)
+    EXPECT_LT((back.cluster_pose(k) - t.model.cluster_pose(k)).norm(), 1e-9) << "cluster " << k;
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,8 @@
 // Head-pose loaders: BVH (channel order from the file, head relative to the
 // torso) and marker sets (rotation recovered per frame by SVD).
 
+#include "animrt/controllers/head/pose_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -9,7 +11,6 @@
 #include <numbers>
 #include <random>
 
-#include "animrt/controllers/head/pose_io.hpp"
 #include "animrt/core/error.hpp"
 #include "head_test_util.hpp"
 
@@ -32,7 +33,8 @@ void expect_same_rotation(const Euler& got, const Eigen::Matrix3d& want) {
 
 // Hips (root, 6 channels) -> Spine -> Neck -> Head, the head's rotation
 // channels in `head_order` (e.g. "YXZ").
-std::string bvh_text(const std::string& head_order, const std::vector<std::vector<double>>& frames) {
+std::string bvh_text(const std::string& head_order,
+                     const std::vector<std::vector<double>>& frames) {
   std::string rot;
   for (char c : head_order) rot += std::string(" ") + c + "rotation";
   std::string s =
@@ -69,8 +71,7 @@ TEST(Bvh, RotationChannelsAreAppliedInTheFilesOrder) {
     const PoseTrack t = load_bvh(write_file(dir, order + ".bvh", bvh_text(order, frames)));
     ASSERT_EQ(t.size(), 1u);
     const Eigen::Matrix3d want = our_axis_rotation(order[0], 20) *
-                                 our_axis_rotation(order[1], -15) *
-                                 our_axis_rotation(order[2], 10);
+                                 our_axis_rotation(order[1], -15) * our_axis_rotation(order[2], 10);
     SCOPED_TRACE(order);
     expect_same_rotation(t.poses[0], want);
   }
@@ -143,8 +144,8 @@ TEST(Markers, SvdRecoversRotationsOfAMovingMarkerSet) {
   const std::vector<std::string> names = {"nose", "forehead", "left_ear", "right_ear", "chin"};
   Eigen::MatrixX3d ref(5, 3);
   ref << 0.10, 0.0, 0.0, 0.08, 0.0, 0.08, 0.0, 0.07, 0.0, 0.0, -0.07, 0.0, 0.07, 0.0, -0.08;
-  const std::vector<Euler> truth = {
-      {0, 0, 0}, {10, 0, 0}, {0, 15, 0}, {0, 0, -12}, {25, -10, 5}, {-30, 20, 8}};
+  const std::vector<Euler> truth = {{0, 0, 0},   {10, 0, 0},   {0, 15, 0},
+                                    {0, 0, -12}, {25, -10, 5}, {-30, 20, 8}};
   std::mt19937_64 rng(3);
   std::normal_distribution<double> noise(0.0, 0.0002);  // 0.2 mm
   std::string csv = "time_s";

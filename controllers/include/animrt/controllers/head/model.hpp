@@ -24,10 +24,10 @@ struct SmoothingOptions {
   double output_rate_hz = 120.0;  // poses per second out of SQUAD
   double noise_deg = 0.5;         // half-width of the uniform noise on each angle
   std::uint64_t seed = 1;
-  // Output pose of cluster k = pose_mean + shrink * (cluster mean - pose_mean).
-  // 1 outputs the cluster means as the paper does; below 1 a wrongly decoded
-  // cluster costs less (see docs/head.md).
-  double shrink = 1.0;
+  // Output pose of cluster k = pose_mean + shrink * (cluster mean - pose_mean),
+  // per axis (yaw, pitch, roll). 1 outputs the cluster means as the paper
+  // does; below 1 a wrongly decoded cluster costs less (see docs/head.md).
+  Eigen::Vector3d shrink = Eigen::Vector3d::Ones();
 };
 
 struct HeadModel {
@@ -46,7 +46,7 @@ struct HeadModel {
   int clusters() const { return codebook.size(); }
   // The pose (yaw, pitch, roll in degrees) that synthesis shows for cluster k.
   Eigen::Vector3d cluster_pose(int k) const {
-    return pose_mean + smoothing.shrink * (codebook.means.row(k).transpose() - pose_mean);
+    return pose_mean + smoothing.shrink.cwiseProduct(codebook.means.row(k).transpose() - pose_mean);
   }
   // Normalised observations for the HMMs.
   Eigen::MatrixXd normalise(const Eigen::MatrixXd& raw) const;

@@ -25,9 +25,8 @@ struct TrainOptions {
   DecodeOptions decode;
   SmoothingOptions smoothing;
   // Shrink of the output poses toward the mean pose (SmoothingOptions::shrink):
-  // a value in [0, 1], or negative to choose it on the training data (a model
-  // trained on three quarters of the utterances decodes the rest; the factor
-  // with the smallest mean pose distance there is kept). 1 is the paper.
+  // a value in [0, 1] for all axes, or negative to choose one per axis on the
+  // training data by 4-fold cross-validation (see docs/head.md). 1 is the paper.
   double shrink = -1.0;
   std::function<void(const std::string&)> log;  // progress, may be empty
 };
