@@ -7,10 +7,21 @@
 namespace animrt::head {
 namespace {
 
+// ALSA prints its own diagnostics on stderr (several lines on a machine
+// without a sound card); the caller reports a failure once instead.
+void quiet(const char*, int, const char*, int, const char*, ...) {}
+
+int open_quietly(snd_pcm_t** pcm, const std::string& device, snd_pcm_stream_t stream, int mode) {
+  snd_lib_error_set_handler(quiet);
+  const int err = snd_pcm_open(pcm, device.c_str(), stream, mode);
+  snd_lib_error_set_handler(nullptr);
+  return err;
+}
+
 snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream) {
   snd_pcm_t* pcm = nullptr;
   const char* what = stream == SND_PCM_STREAM_PLAYBACK ? "playback" : "capture";
-  int err = snd_pcm_open(&pcm, device.c_str(), stream, 0);
+  int err = open_quietly(&pcm, device, stream, 0);
   if (err < 0) {
     throw DeviceError("ALSA " + std::string(what) + " device \"" + device +
                       "\": " + snd_strerror(err));
@@ -66,8 +77,7 @@ void AlsaCapture::read(std::span<float> out) {
 
 bool alsa_playback_available(const std::string& device) {
   snd_pcm_t* pcm = nullptr;
-  if (snd_pcm_open(&pcm, device.c_str(), SND_PCM_STREAM_PLAYBACK, SND_PCM_NONBLOCK) < 0)
-    return false;
+  if (open_quietly(&pcm, device, SND_PCM_STREAM_PLAYBACK, SND_PCM_NONBLOCK) < 0) return false;
   snd_pcm_close(pcm);
   return true;
 }
