@@ -17,6 +17,17 @@ struct SafetyConfig {
   double watchdog_timeout_s = 0.1;  // a device silent this long is faulted
   double start_ramp_s = 2.0;        // measured pose -> first pose of the motion
   double stop_ramp_s = 2.0;         // current pose -> home
+  // A start ramp that would need longer than this (the measured pose far from
+  // the first pose, slow limits) is refused before torque goes on.
+  double start_ramp_max_s = 20.0;
+  // From a stop request (signal, duration, fault) to torque off, at most:
+  // the stop ramp is cut short and torque switched off when it runs over.
+  double stop_deadline_s = 6.0;
+  // Following-error watch: a joint whose measured position stays further
+  // than this from its command for the whole window is faulted.
+  double following_error_rad = 0.3490658503988659;  // 20 deg (revolute joints)
+  double following_error_m = 0.02;                  // prismatic joints
+  double following_error_window_s = 0.5;
 };
 
 struct MotionConfig {
