@@ -18,6 +18,7 @@
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
@@ -34,9 +35,14 @@ constexpr int kExitInvalidInput = 2;
 constexpr int kExitDeviceError = 3;
 constexpr double kLockstepMinTimeoutS = 0.25;  // bus timeout floor with --lockstep
 
-std::atomic<bool> g_stop{false};
+animrt::RunControls g_controls;
 
-void on_signal(int) { g_stop.store(true); }
+// The first SIGINT or SIGTERM ramps home; a second one switches torque off at
+// once. Both are lock-free atomic stores, safe in a signal handler.
+void on_signal(int) {
+  if (g_controls.stop.load()) g_controls.abort.store(true);
+  g_controls.stop.store(true);
+}
 
 void install_signal_handlers() {
   struct sigaction action {};
@@ -46,23 +52,14 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
-// "gait FILE", or for layers "layers [gait FILE, show FILE]".
-std::string describe_motion(const animrt::MotionConfig& motion) {
-  if (motion.type != "layers") return motion.type + " " + motion.file;
-  std::string text = "layers [";
-  for (std::size_t i = 0; i < motion.layers.size(); ++i) {
-    text += (i ? ", " : "") + describe_motion(motion.layers[i]);
-  }
-  return text + "]";
-}
-
 int cmd_validate(const std::string& path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
   std::size_t devices = 0;
   for (const auto& bus : robot.config.buses) devices += bus.actuators.size();
   std::cout << path << ": ok (" << robot.config.joints.size() << " joints, "
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
-            << ", " << devices << " devices, " << describe_motion(robot.config.motion) << ")\n";
+            << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
+            << ")\n";
   return kExitOk;
 }
 
@@ -124,7 +121,7 @@ int cmd_run(const RunArgs& args) {
   options.lockstep_clock = args.lockstep ? &lockstep_clock : nullptr;
   options.request_realtime = !args.no_realtime;
   options.telemetry_path = args.telemetry;
-  options.stop_request = &g_stop;
+  options.controls = &g_controls;
   options.backend_name = args.backend;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
 
@@ -183,7 +180,7 @@ int cmd_sim(const std::string& path) {
   auto simulated = animrt::start_simulated_devices(robot.config.buses, clock);
   for (const auto& sim : simulated) std::cout << sim->describe() << '\n';
   std::cout << std::flush;
-  while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (!g_controls.stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   return kExitOk;
 }
 

@@ -22,7 +22,7 @@ const char* to_string(EndReason reason) {
     case EndReason::signal:
       return "stop request";
     case EndReason::fault:
-      return "device fault";
+      return "fault";
   }
   return "?";
 }
@@ -35,7 +35,9 @@ std::string format_summary(const RunSummary& s) {
       s.robot, s.backend, s.lockstep ? "lockstep" : "real-time", s.rate_hz, to_string(s.end_reason),
       s.motion_time_s));
   for (const auto& fault : s.faults) line("FAULT " + fault);
-  line(fmt::format("cycles: {}, overruns: {}", s.cycles, s.overruns));
+  if (!s.torque_cut.empty()) line("TORQUE CUT " + s.torque_cut);
+  line(fmt::format("cycles: {}, overruns: {}, skipped cycles: {}", s.cycles, s.overruns,
+                   s.skipped_cycles));
   line(fmt::format("period: p50 {}, p99 {}, max {}", ms(s.period.p50_s), ms(s.period.p99_s),
                    ms(s.period.max_s)));
   line(fmt::format("jitter (start - deadline): p50 {}, p99 {}, max {}", ms(s.jitter.p50_s),
@@ -107,6 +109,8 @@ nlohmann::json to_json(const RunSummary& s) {
   j["faults"] = s.faults;
   j["cycles"] = s.cycles;
   j["overruns"] = s.overruns;
+  j["skipped_cycles"] = s.skipped_cycles;
+  j["torque_cut"] = s.torque_cut;
   j["motion_time_s"] = s.motion_time_s;
   j["period"] = timing_json(s.period);
   j["jitter"] = timing_json(s.jitter);

@@ -32,13 +32,21 @@ void SafetyFilter::reset(std::span<const double> measured) {
   have_last_target_ = false;
 }
 
-void SafetyFilter::step(std::span<const double> targets, std::span<double> commands) {
+void SafetyFilter::step(std::span<const double> targets, std::span<double> commands,
+                        std::span<const std::uint8_t> active) {
   for (std::size_t i = 0; i < limits_.size(); ++i) {
     const JointLimits& lim = limits_[i];
     const double accel_step = lim.max_acceleration * dt_;
     const double p = position_[i];
     const double v = velocity_[i];
 
+    const bool finite = std::isfinite(targets[i]);
+    if ((!active.empty() && !active[i]) || !finite) {
+      velocity_[i] = 0.0;
+      if (finite) last_target_[i] = std::clamp(targets[i], lim.min_position, lim.max_position);
+      commands[i] = p;
+      continue;
+    }
     const double target = std::clamp(targets[i], lim.min_position, lim.max_position);
     // Feed-forward the target's own velocity so a smooth motion is tracked
     // without lag, plus a correction that can always brake onto the target.
@@ -64,6 +72,10 @@ void SafetyFilter::step(std::span<const double> targets, std::span<double> comma
     if (p_next > hi || p_next < lo) {
       p_next = std::clamp(p_next, lo, hi);
       v_next = (p_next - p) / dt_;
+    }
+    if (!std::isfinite(p_next) || !std::isfinite(v_next)) {  // degenerate limits: hold
+      p_next = p;
+      v_next = 0.0;
     }
     position_[i] = p_next;
     velocity_[i] = v_next;

@@ -265,14 +265,14 @@ TEST(QuadrupedLockstep, AHardwareErrorFaultsTheDeviceAtOnce) {
 
 TEST(QuadrupedLockstep, AStopRequestRampsHome) {
   Rig rig;
-  std::atomic<bool> stop{false};
+  RunControls controls;
   rig.probe->on_sample = [&](double t) {
-    if (t >= 0.7) stop.store(true);
+    if (t >= 0.7) controls.stop.store(true);
   };
   RunOptions options;
   options.duration_s = 0.0;  // forever, until the stop request
   options.lockstep_clock = &rig.clock;
-  options.stop_request = &stop;
+  options.controls = &controls;
   const std::string csv_path = ::testing::TempDir() + "/lockstep_stop.csv";
   options.telemetry_path = csv_path;
   RunSummary s = rig.runner->run(options);

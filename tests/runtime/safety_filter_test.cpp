@@ -152,5 +152,39 @@ TEST(PoseRamp, KeepsTheMinimumDurationForShortMoves) {
   EXPECT_DOUBLE_EQ(ramp.duration(), 2.0);
 }
 
+TEST(SafetyFilter, NonFiniteTargetsHoldTheJointAndNeverReachTheState) {
+  SafetyFilter filter({kLimits, kLimits}, kDt);
+  filter.reset(std::vector<double>{0.2, 0.2});
+  std::vector<double> command(2);
+  for (int i = 0; i < 20; ++i) filter.step(std::vector<double>{0.8, 0.8}, command);
+  const double held = command[0];
+  const double bad[] = {std::nan(""), INFINITY, -INFINITY};
+  for (double b : bad) {
+    filter.step(std::vector<double>{b, 0.8}, command);
+    EXPECT_EQ(command[0], held);
+    EXPECT_TRUE(std::isfinite(filter.position()[0]));
+    EXPECT_EQ(filter.velocity()[0], 0.0);
+  }
+  EXPECT_GT(command[1], held);  // the other joint went on
+}
+
+TEST(SafetyFilter, AnInactiveJointHoldsAndResumesFromRest) {
+  SafetyFilter filter({kLimits}, kDt);
+  filter.reset(std::vector<double>{0.0});
+  std::vector<double> command(1);
+  const std::vector<std::uint8_t> on{1}, off{0};
+  double t = 0.0;
+  for (int i = 0; i < 50; ++i, t += kDt)
+    filter.step(std::vector<double>{0.9 * std::sin(4 * t)}, command, on);
+  const double held = command[0];
+  for (int i = 0; i < 10; ++i, t += kDt) {
+    filter.step(std::vector<double>{0.9 * std::sin(4 * t)}, command, off);
+    EXPECT_EQ(command[0], held);
+  }
+  filter.step(std::vector<double>{0.9 * std::sin(4 * t)}, command, on);
+  // From rest, the first move is at most one acceleration step.
+  EXPECT_LE(std::abs(command[0] - held), kLimits.max_acceleration * kDt * kDt + kTol);
+}
+
 }  // namespace
 }  // namespace animrt

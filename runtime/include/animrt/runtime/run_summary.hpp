@@ -64,7 +64,10 @@ struct RunSummary {
   EndReason end_reason = EndReason::duration;
   std::vector<std::string> faults;  // one line per faulted device
   std::uint64_t cycles = 0;
-  std::uint64_t overruns = 0;
+  std::uint64_t overruns = 0;        // cycles that ended after the next deadline
+  std::uint64_t skipped_cycles = 0;  // whole cycles left out after an overrun
+  // Torque went off without the stop ramp finishing: why (empty otherwise).
+  std::string torque_cut;
   double motion_time_s = 0.0;  // time spent playing the motion source
   TimingSummary period;        // between cycle starts
   TimingSummary jitter;        // cycle start - deadline
@@ -82,8 +85,12 @@ struct RunSummary {
   std::uint64_t telemetry_dropped = 0;
   std::optional<PhysicsReport> physics;  // set by whoever ran the physics
 
-  // 0 for a clean run, 4 when a device fault ended it.
-  int exit_code() const { return end_reason == EndReason::fault ? 4 : 0; }
+  // 0 for a clean run, 4 when a fault ended it, 5 when torque had to be cut
+  // without the stop ramp (stop deadline, second stop request).
+  int exit_code() const {
+    if (end_reason == EndReason::fault) return 4;
+    return torque_cut.empty() ? 0 : 5;
+  }
 };
 
 std::string format_summary(const RunSummary& summary);

@@ -3,7 +3,8 @@
 // pose), activate (torque on, ramp from the measured pose to the motion's
 // first pose), run (read -> sample -> filter -> write on absolute deadlines),
 // deactivate (ramp to home, torque off) on the end of the duration, a stop
-// request or a device fault.
+// request or a fault. The runner is the shell around the cycle (cycle.hpp):
+// threads, clock and lifecycle; what happens in a cycle is step()'s.
 
 #include <atomic>
 #include <functional>
@@ -15,6 +16,7 @@
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "animrt/runtime/run_controls.hpp"
 #include "animrt/runtime/run_summary.hpp"
 
 namespace animrt {
@@ -26,9 +28,11 @@ struct RunOptions {
   ManualClock* lockstep_clock = nullptr;
   bool request_realtime = true;  // SCHED_FIFO + mlockall (real-time runs only)
   int realtime_priority = 80;
-  std::string telemetry_path;                       // CSV, empty = none
-  const std::atomic<bool>* stop_request = nullptr;  // e.g. set by SIGINT
-  std::string backend_name = "hardware";            // for the report
+  std::string telemetry_path;  // CSV, empty = none
+  // Stop, abort, steering and jogs from other threads (a signal handler, a
+  // dashboard, a herd); none when null.
+  RunControls* controls = nullptr;
+  std::string backend_name = "hardware";  // for the report
   // Lifecycle messages; never called from inside the cycle.
   std::function<void(const std::string&)> log;
   // Called from inside the cycle when the motion starts (with the time of its
@@ -44,9 +48,11 @@ class Runner {
          std::unique_ptr<MotionSource> motion);
   ~Runner();
 
-  // Runs the whole lifecycle. Throws DeviceError when bring-up fails (after
-  // switching off whatever it had switched on); a fault during the run ends
-  // it through the stop ramp and is reported in the summary.
+  // Runs the whole lifecycle. Throws DeviceError when bring-up fails or the
+  // start ramp would take longer than safety.start_ramp_max_s; a fault during
+  // the run ends it through the stop ramp and is reported in the summary.
+  // Whatever ends the run (return, exception), every bus that was activated
+  // is deactivated.
   RunSummary run(const RunOptions& options);
 
  private:

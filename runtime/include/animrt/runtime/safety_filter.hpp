@@ -7,6 +7,7 @@
 // so a jump in the target (a new motion, a fault, a stop) never becomes a
 // jump in the command. Allocation-free after construction.
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -24,8 +25,14 @@ class SafetyFilter {
   void reset(std::span<const double> measured);
 
   // One cycle: moves the command toward `targets` (rad) within the limits and
-  // writes it to `commands`.
-  void step(std::span<const double> targets, std::span<double> commands);
+  // writes it to `commands`. A joint whose entry in `active` is 0 (its bus is
+  // late and takes no write this cycle) holds its last command and comes to
+  // rest there: the device, which keeps its last goal, has stopped too, so
+  // the joint resumes from standstill instead of jumping ahead. A target that
+  // is not finite holds the joint as well; the filter's state never becomes
+  // non-finite.
+  void step(std::span<const double> targets, std::span<double> commands,
+            std::span<const std::uint8_t> active = {});
 
   std::span<const double> position() const { return position_; }
   std::span<const double> velocity() const { return velocity_; }

@@ -1,0 +1,153 @@
+#pragma once
+// One cycle of the run as a plain function: step(model, motion, state,
+// inputs) maps the cycle state, this cycle's I/O results and the time to the
+// commands for the buses and the events of the cycle. No threads, no clock,
+// no I/O: the runner is a thin shell around it, and every edge of the safety
+// path (a late bus, a NaN from the motion, a silent device, a joint that does
+// not follow, a stop that runs over) is a deterministic unit test.
+//
+// Everything step() touches is allocated when the CycleState is built;
+// step() itself never allocates.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/runtime/pose_ramp.hpp"
+#include "animrt/runtime/robot_model.hpp"
+#include "animrt/runtime/run_controls.hpp"
+#include "animrt/runtime/safety_filter.hpp"
+
+namespace animrt {
+
+enum class Phase { start_ramp, motion, stop_ramp, done };
+
+// One bus's results for this cycle.
+struct BusIo {
+  // Its read came back in time: positions and health are this cycle's, and
+  // the bus takes a write. A late bus (fresh = false) keeps its last
+  // measurement and its joints hold the last command it was sent.
+  bool fresh = false;
+  std::span<const double> positions;     // per device
+  std::span<const DeviceHealth> health;  // per device, of the latest transaction
+};
+
+struct CycleInputs {
+  double t = 0.0;  // seconds since the run began, at this cycle's deadline
+  std::span<const BusIo> buses;
+  double motion_duration_s = 0.0;        // seconds of motion, then ramp home; 0 = until a stop
+  bool stop = false;                     // ramp home and end
+  bool abort = false;                    // torque off at once
+  const MotionCommand* steer = nullptr;  // a new steering command, if one arrived
+  const JogCommand* jog = nullptr;       // a new jog, if one arrived
+};
+
+enum class EventKind : std::uint8_t {
+  motion_started,
+  motion_ended,
+  device_fault,     // watchdog or hardware error: bus, device, health
+  motion_fault,     // non-finite target: joint, value
+  following_error,  // joint, value = error (rad or m)
+  stop_deadline,    // the stop ramp ran over safety.stop_deadline_s: torque off now
+  aborted,          // torque off now on request
+};
+
+struct CycleEvent {
+  EventKind kind = EventKind::motion_started;
+  double t = 0.0;
+  int joint = -1;
+  std::size_t bus = 0;
+  std::size_t device = 0;
+  DeviceHealth health = DeviceHealth::ok;
+  double value = 0.0;
+};
+
+struct CycleOutputs {
+  std::vector<double> commands;                   // per joint: the filter's output
+  std::vector<std::vector<double>> bus_commands;  // per bus, per device: goals to write
+  std::vector<std::uint8_t> write;                // per bus: write bus_commands this cycle
+  std::vector<CycleEvent> events;                 // this cycle's
+  bool torque_off_now = false;                    // end without a ramp (deadline, abort)
+};
+
+// What ended the run, as far as the cycle knows.
+struct CycleEnd {
+  bool fault = false;       // a device, motion or following-error fault
+  bool stopped = false;     // a stop request
+  bool torque_cut = false;  // stop deadline or abort: torque went off without a ramp
+};
+
+class CycleState {
+ public:
+  explicit CycleState(const RobotModel& model);
+
+  // Before activation: the measured pose and the motion's first pose. Returns
+  // the start ramp's duration (the runner refuses one that is too long).
+  double begin(const RobotModel& model, std::span<const double> measured,
+               std::span<const double> first_pose);
+
+  Phase phase() const { return phase_; }
+  bool done() const { return phase_ == Phase::done; }
+  double motion_time() const { return motion_time_; }
+  const CycleEnd& end() const { return end_; }
+  std::span<const double> measured() const { return measured_; }
+  // The watchdog's record, per bus and device (1 = faulted).
+  const std::vector<std::vector<std::uint8_t>>& faulted() const { return faulted_; }
+  bool joint_faulted(std::size_t j) const;
+  // Every event of the run (bounded: the first ones are kept).
+  std::span<const CycleEvent> log() const { return log_; }
+  std::span<const std::uint64_t> late_cycles() const { return late_cycles_; }
+  // Tracking error of the last command a joint's bus was sent against what
+  // was measured after it: rms and max per joint.
+  double rms_error(std::size_t j) const;
+  double max_error(std::size_t j) const { return max_error_[j]; }
+  std::uint64_t cycles() const { return cycles_; }
+
+ private:
+  friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
+                                  const CycleInputs&);
+  void emit(const CycleEvent& event);
+  void begin_stop(const RobotModel& model, double t);
+
+  Phase phase_ = Phase::start_ramp;
+  double phase_start_ = 0.0;
+  double motion_start_ = 0.0;
+  double stop_start_ = 0.0;
+  double motion_time_ = 0.0;
+  CycleEnd end_;
+  std::uint64_t cycles_ = 0;
+
+  SafetyFilter filter_;
+  PoseRamp ramp_;
+  std::vector<JointSlot> slots_;
+  std::vector<double> measured_, targets_, ramp_from_, ramp_to_, jog_;
+  std::vector<std::uint8_t> active_;            // per joint: its bus takes a write
+  std::vector<std::vector<double>> last_sent_;  // per bus, per device
+  std::vector<std::vector<std::uint8_t>> faulted_;
+  std::vector<std::vector<double>> last_ok_;  // per bus, per device: time of last good answer
+  std::vector<std::uint64_t> late_cycles_;
+  std::vector<double> over_since_;  // per joint: when the following error went over (< 0: not)
+  std::vector<double> sq_error_, max_error_;
+  std::vector<std::uint64_t> error_samples_;
+  std::vector<CycleEvent> log_;
+  CycleOutputs out_;
+};
+
+// One cycle: read the controls, take the measurements, watch the devices and
+// the following error, change phase, sample, filter, and say what to write.
+const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleState& state,
+                         const CycleInputs& in);
+
+// The next deadline after a cycle that ended at `now`: one period on, or,
+// when the cycle overran by whole periods, the first deadline still ahead
+// (missed cycles are skipped, not caught up in a burst).
+struct NextDeadline {
+  Nanos deadline = 0;
+  bool overrun = false;       // the cycle ended after its successor's deadline
+  std::uint64_t skipped = 0;  // whole cycles left out
+};
+NextDeadline next_deadline(Nanos deadline, Nanos now, Nanos period);
+
+}  // namespace animrt

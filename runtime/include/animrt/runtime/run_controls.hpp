@@ -1,0 +1,32 @@
+#pragma once
+// How commands from outside the cycle reach it: a signal handler, a
+// dashboard or a herd writes here from its own thread; the cycle reads every
+// control once, at its start, as part of its inputs. Nothing here blocks
+// either side.
+
+#include <atomic>
+
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/mailbox.hpp"
+
+namespace animrt {
+
+// Moves one joint away from what the motion asks, by `offset` (rad, or m for
+// a prismatic joint), through the same safety filter as every other target.
+// A new jog of the same joint replaces the old one; offset 0 ends it.
+struct JogCommand {
+  int joint = -1;  // robot joint index
+  double offset = 0.0;
+};
+
+struct RunControls {
+  // Ramp home and end the run (SIGINT, SIGTERM, a dashboard's stop).
+  std::atomic<bool> stop{false};
+  // Switch torque off at once, without a ramp (a second SIGINT).
+  std::atomic<bool> abort{false};
+  // Speed and turn of a steered motion source.
+  Mailbox<MotionCommand> steer;
+  Mailbox<JogCommand> jog;
+};
+
+}  // namespace animrt

@@ -1,0 +1,275 @@
+#include "animrt/runtime/cycle.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace animrt {
+namespace {
+
+constexpr double kSettledVelocity = 1e-3;  // rad/s: the stop ramp has ended
+constexpr double kMaxSettleTime = 2.0;     // s after the stop ramp, at most
+// A late bus is judged by its answers once its I/O thread is done (every
+// transaction is bounded by the bus timeout); only a bus stuck this many
+// watchdog times (a thread that never returns) is faulted without them, so
+// a descheduled I/O thread on a loaded machine is not taken for silent
+// devices.
+constexpr double kLateBusGrace = 10.0;
+constexpr std::size_t kEventLogCapacity = 256;
+// Times are seconds in doubles; comparisons allow for their rounding, so
+// "more than 0.1 s" means what it says at 2.4 - 2.3 too.
+constexpr double kTimeEps = 1e-9;
+
+}  // namespace
+
+CycleState::CycleState(const RobotModel& model)
+    : filter_(model.limits, model.dt), ramp_(model.joint_count()), slots_(model.slots) {
+  const std::size_t n = model.joint_count();
+  const std::size_t buses = model.buses.size();
+  measured_.assign(n, 0.0);
+  targets_.assign(n, 0.0);
+  ramp_from_.assign(n, 0.0);
+  ramp_to_.assign(n, 0.0);
+  jog_.assign(n, 0.0);
+  active_.assign(n, 0);
+  over_since_.assign(n, -1.0);
+  sq_error_.assign(n, 0.0);
+  max_error_.assign(n, 0.0);
+  error_samples_.assign(n, 0);
+  late_cycles_.assign(buses, 0);
+  for (const BusModel& bus : model.buses) {
+    last_sent_.emplace_back(bus.joint.size(), 0.0);
+    faulted_.emplace_back(bus.joint.size(), 0);
+    last_ok_.emplace_back(bus.joint.size(), 0.0);
+    out_.bus_commands.emplace_back(bus.joint.size(), 0.0);
+  }
+  out_.commands.assign(n, 0.0);
+  out_.write.assign(buses, 0);
+  // A cycle emits at most a few events per joint and device.
+  out_.events.reserve(4 * n + 8);
+  log_.reserve(kEventLogCapacity);
+}
+
+bool CycleState::joint_faulted(std::size_t j) const {
+  return faulted_[slots_[j].bus][slots_[j].device] != 0;
+}
+
+double CycleState::rms_error(std::size_t j) const {
+  return error_samples_[j] ? std::sqrt(sq_error_[j] / static_cast<double>(error_samples_[j])) : 0.0;
+}
+
+double CycleState::begin(const RobotModel& model, std::span<const double> measured,
+                         std::span<const double> first_pose) {
+  std::copy(measured.begin(), measured.end(), measured_.begin());
+  filter_.reset(measured);
+  // Until the first write, every device holds the goal it got at activation:
+  // where it was measured.
+  for (std::size_t j = 0; j < slots_.size(); ++j) {
+    last_sent_[slots_[j].bus][slots_[j].device] = measured[j];
+  }
+  phase_ = Phase::start_ramp;
+  phase_start_ = 0.0;
+  ramp_.plan(measured, first_pose, model.limits, model.safety.start_ramp_s);
+  return ramp_.duration();
+}
+
+void CycleState::emit(const CycleEvent& event) {
+  if (out_.events.size() < out_.events.capacity()) out_.events.push_back(event);
+  if (log_.size() < log_.capacity()) log_.push_back(event);
+}
+
+void CycleState::begin_stop(const RobotModel& model, double t) {
+  const auto position = filter_.position();
+  for (std::size_t j = 0; j < slots_.size(); ++j) {
+    ramp_from_[j] = position[j];
+    // A faulted joint cannot be commanded: it is held where it was.
+    ramp_to_[j] = joint_faulted(j) ? position[j] : model.home[j];
+  }
+  ramp_.plan(ramp_from_, ramp_to_, model.limits, model.safety.stop_ramp_s);
+  if (phase_ == Phase::motion) {
+    motion_time_ = t - motion_start_;
+    emit(CycleEvent{EventKind::motion_ended, t});
+  }
+  phase_ = Phase::stop_ramp;
+  phase_start_ = t;
+  stop_start_ = t;
+}
+
+const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleState& s,
+                         const CycleInputs& in) {
+  const std::size_t n = model.joint_count();
+  const double t = in.t;
+  CycleOutputs& out = s.out_;
+  out.events.clear();
+  std::fill(out.write.begin(), out.write.end(), 0);
+  if (s.phase_ == Phase::done) return out;
+
+  // Controls from outside, read once at the start of the cycle.
+  if (in.steer) motion.steer(*in.steer);
+  if (in.jog && in.jog->joint >= 0 && static_cast<std::size_t>(in.jog->joint) < n &&
+      std::isfinite(in.jog->offset)) {
+    s.jog_[static_cast<std::size_t>(in.jog->joint)] = in.jog->offset;
+  }
+
+  // Measurements: a late bus keeps its last ones.
+  for (std::size_t b = 0; b < in.buses.size(); ++b) {
+    if (!in.buses[b].fresh) ++s.late_cycles_[b];
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const JointSlot slot = s.slots_[j];
+    const BusIo& io = in.buses[slot.bus];
+    s.active_[j] = io.fresh ? 1 : 0;
+    if (io.fresh && std::isfinite(io.positions[slot.device])) {
+      s.measured_[j] = io.positions[slot.device];
+    }
+  }
+
+  // Watchdog: a device silent (or answering garbage) for longer than the
+  // watchdog, or one reporting a hardware error, is faulted.
+  if (s.cycles_ == 0) {
+    for (auto& bus : s.last_ok_) std::fill(bus.begin(), bus.end(), t);
+  }
+  const double watchdog = model.safety.watchdog_timeout_s;
+  bool fault = false;
+  for (std::size_t b = 0; b < in.buses.size(); ++b) {
+    const BusIo& io = in.buses[b];
+    for (std::size_t d = 0; d < s.faulted_[b].size(); ++d) {
+      if (s.faulted_[b][d]) continue;
+      double& last_ok = s.last_ok_[b][d];
+      if (!io.fresh && t - last_ok <= kLateBusGrace * watchdog + kTimeEps) continue;
+      const DeviceHealth health = io.fresh ? io.health[d] : DeviceHealth::timeout;
+      if (health == DeviceHealth::ok) {
+        last_ok = t;
+      } else if (health == DeviceHealth::hardware_error || t - last_ok > watchdog + kTimeEps) {
+        s.faulted_[b][d] = 1;
+        fault = true;
+        s.emit(CycleEvent{EventKind::device_fault, t, model.buses[b].joint[d], b, d, health});
+      }
+    }
+  }
+
+  // Following error: the last command a device was sent against what it
+  // measured since. A joint that stays too far for the whole window is
+  // faulted like a silent device (it is held, the others ramp home).
+  if (s.cycles_ > 0) {
+    for (std::size_t j = 0; j < n; ++j) {
+      const JointSlot slot = s.slots_[j];
+      if (!s.active_[j] || s.joint_faulted(j)) continue;
+      const double e = std::abs(s.last_sent_[slot.bus][slot.device] - s.measured_[j]);
+      s.sq_error_[j] += e * e;
+      s.max_error_[j] = std::max(s.max_error_[j], e);
+      ++s.error_samples_[j];
+      if (e <= model.following_error[j]) {
+        s.over_since_[j] = -1.0;
+        continue;
+      }
+      if (s.over_since_[j] < 0.0) s.over_since_[j] = t;
+      if (t - s.over_since_[j] >= model.safety.following_error_window_s - kTimeEps) {
+        s.faulted_[slot.bus][slot.device] = 1;
+        fault = true;
+        s.emit(CycleEvent{EventKind::following_error, t, static_cast<int>(j), slot.bus, slot.device,
+                          DeviceHealth::ok, e});
+      }
+    }
+  }
+  if (fault) s.end_.fault = true;
+
+  // Torque off at once: a second stop request, or a stop that ran over.
+  if (in.abort) {
+    s.emit(CycleEvent{EventKind::aborted, t});
+  } else if (s.phase_ == Phase::stop_ramp &&
+             t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps) {
+    s.emit(CycleEvent{EventKind::stop_deadline, t, -1, 0, 0, DeviceHealth::ok,
+                      model.safety.stop_deadline_s});
+  }
+  if (in.abort || (s.phase_ == Phase::stop_ramp &&
+                   t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps)) {
+    if (s.phase_ == Phase::motion) {
+      s.motion_time_ = t - s.motion_start_;
+      s.emit(CycleEvent{EventKind::motion_ended, t});
+    }
+    s.end_.torque_cut = true;
+    s.end_.stopped = s.end_.stopped || in.abort;
+    s.phase_ = Phase::done;
+    out.torque_off_now = true;
+    ++s.cycles_;
+    return out;
+  }
+
+  // Phase changes.
+  if (s.phase_ != Phase::stop_ramp) {
+    if (fault) {
+      s.begin_stop(model, t);
+    } else if (in.stop) {
+      s.end_.stopped = true;
+      s.begin_stop(model, t);
+    } else if (s.phase_ == Phase::motion && in.motion_duration_s > 0.0 &&
+               t - s.motion_start_ >= in.motion_duration_s - kTimeEps) {
+      s.begin_stop(model, t);
+    } else if (s.phase_ == Phase::start_ramp &&
+               t - s.phase_start_ >= s.ramp_.duration() - kTimeEps) {
+      s.phase_ = Phase::motion;
+      s.motion_start_ = t;
+      s.emit(CycleEvent{EventKind::motion_started, t});
+    }
+  }
+
+  // Sample.
+  if (s.phase_ == Phase::motion) {
+    std::copy(model.home.begin(), model.home.end(), s.targets_.begin());
+    motion.sample(t - s.motion_start_, s.targets_);
+    bool bad = false;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (std::isfinite(s.targets_[j])) continue;
+      // A motion fault: the joint holds its last command, the run ramps home.
+      s.emit(CycleEvent{EventKind::motion_fault, t, static_cast<int>(j), s.slots_[j].bus,
+                        s.slots_[j].device, DeviceHealth::ok, s.targets_[j]});
+      bad = true;
+    }
+    if (bad) {
+      s.end_.fault = true;
+      s.begin_stop(model, t);
+    } else {
+      for (std::size_t j = 0; j < n; ++j) s.targets_[j] += s.jog_[j];
+    }
+  }
+  if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
+  const auto position = s.filter_.position();
+  for (std::size_t j = 0; j < n; ++j) {
+    if (s.joint_faulted(j)) s.targets_[j] = position[j];
+  }
+
+  // Filter; a late bus's joints hold the last command it was sent.
+  s.filter_.step(s.targets_, out.commands, s.active_);
+  for (std::size_t b = 0; b < in.buses.size(); ++b) out.write[b] = in.buses[b].fresh ? 1 : 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const JointSlot slot = s.slots_[j];
+    if (!s.active_[j]) continue;
+    out.bus_commands[slot.bus][slot.device] = out.commands[j];
+    s.last_sent_[slot.bus][slot.device] = out.commands[j];
+  }
+
+  if (s.phase_ == Phase::stop_ramp && t - s.phase_start_ >= s.ramp_.duration()) {
+    double fastest = 0.0;
+    for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
+    if (fastest < kSettledVelocity || t - s.phase_start_ >= s.ramp_.duration() + kMaxSettleTime) {
+      s.phase_ = Phase::done;
+    }
+  }
+  ++s.cycles_;
+  return out;
+}
+
+NextDeadline next_deadline(Nanos deadline, Nanos now, Nanos period) {
+  NextDeadline next{deadline + period, false, 0};
+  const Nanos late = now - next.deadline;
+  if (late > 0) {
+    next.overrun = true;
+    if (late >= period) {
+      next.skipped = static_cast<std::uint64_t>(late / period);
+      next.deadline += static_cast<Nanos>(next.skipped) * period;
+    }
+  }
+  return next;
+}
+
+}  // namespace animrt

@@ -1,0 +1,394 @@
+// The cycle as a plain function: every edge of the safety path, without
+// threads, clocks or devices. The "devices" here are the test's own vectors:
+// each follows the goal it was last written, unless a test says otherwise.
+
+#include "animrt/runtime/cycle.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr double kRate = 100.0;
+
+class LambdaSource : public MotionSource {
+ public:
+  explicit LambdaSource(std::size_t joints) {
+    for (std::size_t j = 0; j < joints; ++j) driven_.push_back(static_cast<int>(j));
+  }
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double t, std::span<double> targets) const override {
+    for (std::size_t j = 0; j < targets.size(); ++j) targets[j] = fn(j, t);
+  }
+  void steer(const MotionCommand& command) override { steered = command; }
+
+  std::function<double(std::size_t, double)> fn = [](std::size_t, double) { return 0.0; };
+  MotionCommand steered{-1.0, -1.0};
+
+ private:
+  std::vector<int> driven_;
+};
+
+// Two buses of two joints each: bus 0 drives joints 0 and 1, bus 1 drives 2 and 3.
+RobotModel two_bus_model() {
+  RobotModel m;
+  m.name = "test";
+  m.rate_hz = kRate;
+  m.period = from_seconds(1.0 / kRate);
+  m.dt = 1.0 / kRate;
+  m.safety.start_ramp_s = 0.5;
+  m.safety.stop_ramp_s = 0.5;
+  m.motion = "gait test.yaml";
+  for (int j = 0; j < 4; ++j) {
+    m.joint_names.push_back("j" + std::to_string(j));
+    m.limits.push_back(JointLimits{-1.5, 1.5, 2.0, 20.0});
+    m.home.push_back(0.0);
+    m.prismatic.push_back(0);
+    m.following_error.push_back(m.safety.following_error_rad);
+    m.slots.push_back(JointSlot{static_cast<std::size_t>(j / 2), static_cast<std::size_t>(j % 2)});
+  }
+  m.buses.push_back(BusModel{"a", {0, 1}, {1, 2}});
+  m.buses.push_back(BusModel{"b", {2, 3}, {3, 4}});
+  return m;
+}
+
+// Runs cycles of a model against ideal devices (measured = last goal written).
+struct Bench {
+  explicit Bench(RobotModel m) : model(std::move(m)), motion(model.joint_count()), state(model) {
+    for (const BusModel& bus : model.buses) {
+      positions.emplace_back(bus.joint.size(), 0.0);
+      health.emplace_back(bus.joint.size(), DeviceHealth::ok);
+    }
+    io.resize(model.buses.size());
+    fresh.assign(model.buses.size(), 1);
+  }
+  void begin() {
+    std::vector<double> measured(model.joint_count(), 0.0);
+    std::vector<double> first(model.home);
+    motion.sample(0.0, first);
+    state.begin(model, measured, first);
+  }
+  const CycleOutputs& cycle() {
+    for (std::size_t b = 0; b < io.size(); ++b) {
+      io[b] = BusIo{fresh[b] != 0, positions[b], health[b]};
+    }
+    in.t = static_cast<double>(count) / kRate;
+    in.buses = io;
+    const CycleOutputs& out = step(model, motion, state, in);
+    for (std::size_t b = 0; b < io.size(); ++b) {
+      if (!out.write[b]) continue;
+      if (follow) positions[b] = out.bus_commands[b];
+      written[b].push_back(out.bus_commands[b]);
+    }
+    for (const CycleEvent& e : out.events) events.push_back(e);
+    ++count;
+    return out;
+  }
+  // Runs until the phase is reached (or `limit` cycles).
+  void run_until(Phase phase, int limit = 10000) {
+    for (int i = 0; i < limit && state.phase() != phase && !state.done(); ++i) cycle();
+  }
+  bool has(EventKind kind) const {
+    for (const auto& e : events)
+      if (e.kind == kind) return true;
+    return false;
+  }
+  const CycleEvent* first(EventKind kind) const {
+    for (const auto& e : events)
+      if (e.kind == kind) return &e;
+    return nullptr;
+  }
+
+  RobotModel model;
+  LambdaSource motion;
+  CycleState state;
+  std::vector<std::vector<double>> positions;
+  std::vector<std::vector<DeviceHealth>> health;
+  std::vector<BusIo> io;
+  std::vector<std::uint8_t> fresh;
+  CycleInputs in;
+  bool follow = true;
+  int count = 0;
+  std::vector<CycleEvent> events;
+  std::map<std::size_t, std::vector<std::vector<double>>> written;
+};
+
+TEST(Cycle, ASmoothMotionPlaysAfterTheStartRampAndEndsAtHome) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t j, double t) { return 0.3 * std::sin(2.0 * t + j); };
+  bench.in.motion_duration_s = 1.0;
+  bench.begin();
+  bench.run_until(Phase::done);
+  ASSERT_TRUE(bench.state.done());
+  EXPECT_TRUE(bench.has(EventKind::motion_started));
+  EXPECT_TRUE(bench.has(EventKind::motion_ended));
+  EXPECT_FALSE(bench.state.end().fault);
+  EXPECT_NEAR(bench.state.motion_time(), 1.0, 0.011);
+  for (std::size_t b = 0; b < 2; ++b) {
+    for (double goal : bench.written[b].back()) EXPECT_NEAR(goal, 0.0, 1e-3);
+  }
+}
+
+TEST(Cycle, ANonFiniteTargetIsAMotionFaultThatHoldsTheJointAndRampsHome) {
+  Bench bench(two_bus_model());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  bench.motion.fn = [nan](std::size_t j, double t) {
+    if (j == 1 && t >= 0.3) return nan;
+    return 0.5 * std::sin(3.0 * t);
+  };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  bench.run_until(Phase::stop_ramp);
+  const CycleEvent* fault = bench.first(EventKind::motion_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->joint, 1);
+  EXPECT_TRUE(std::isnan(fault->value));
+  EXPECT_TRUE(bench.state.end().fault);
+  // From the cycle of the fault, joint 1 brakes from its last command: its
+  // steps shrink, it never jumps toward anything.
+  const auto& goals = bench.written[0];
+  ASSERT_GE(goals.size(), 3u);
+  const std::size_t k = goals.size() - 1;
+  EXPECT_LE(std::abs(goals[k][1] - goals[k - 1][1]), std::abs(goals[k - 1][1] - goals[k - 2][1]));
+  bench.run_until(Phase::done);
+  ASSERT_TRUE(bench.state.done());
+  for (const auto& cycle : bench.written[0]) {
+    for (double goal : cycle) EXPECT_TRUE(std::isfinite(goal));
+  }
+  EXPECT_NEAR(bench.written[0].back()[1], 0.0, 1e-3);
+}
+
+TEST(Cycle, AnInfiniteTargetIsAMotionFaultToo) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t j, double t) {
+    return j == 3 && t > 0.2 ? std::numeric_limits<double>::infinity() : 0.0;
+  };
+  bench.begin();
+  bench.run_until(Phase::done);
+  const CycleEvent* fault = bench.first(EventKind::motion_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->joint, 3);
+}
+
+// The goals a device receives: consecutive ones never further apart than one
+// filter step at the velocity limit, however many cycles lie between them.
+void expect_no_jump(const std::vector<std::vector<double>>& goals, double max_step) {
+  for (std::size_t k = 1; k < goals.size(); ++k) {
+    for (std::size_t d = 0; d < goals[k].size(); ++d) {
+      EXPECT_LE(std::abs(goals[k][d] - goals[k - 1][d]), max_step + 1e-9)
+          << "write " << k << " device " << d;
+    }
+  }
+}
+
+TEST(Cycle, ALateBusHoldsItsLastCommandAndResumesWithoutAJump) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double t) { return 1.2 * std::sin(1.5 * t); };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  std::vector<std::vector<double>> goals_b;
+  for (int i = 0; i < 300; ++i) {
+    // Bus b is late for 8 cycles out of every 20.
+    bench.fresh[1] = (i % 20) < 12 ? 1 : 0;
+    const CycleOutputs& out = bench.cycle();
+    EXPECT_EQ(out.write[0], 1);
+    EXPECT_EQ(out.write[1], bench.fresh[1]);
+    if (out.write[1]) {
+      goals_b.push_back(out.bus_commands[1]);
+    }
+  }
+  ASSERT_GT(goals_b.size(), 100u);
+  // The late bus's goals never jump (velocity limit 2 rad/s), and its joints
+  // in the cycle state's own commands were held while it was late.
+  expect_no_jump(goals_b, 2.0 / kRate);
+  EXPECT_EQ(bench.state.late_cycles()[1], 120u);
+  EXPECT_EQ(bench.state.late_cycles()[0], 0u);
+  EXPECT_FALSE(bench.state.end().fault);
+}
+
+TEST(Cycle, ASilentDeviceIsFaultedAfterTheWatchdogAndTheOthersRampHome) {
+  Bench bench(two_bus_model());
+  bench.model.safety.watchdog_timeout_s = 0.1;
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * std::sin(t); };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  const double silent_from = static_cast<double>(bench.count) / kRate;
+  bench.health[1][0] = DeviceHealth::timeout;
+  bench.run_until(Phase::stop_ramp, 100);
+  const CycleEvent* fault = bench.first(EventKind::device_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->bus, 1u);
+  EXPECT_EQ(fault->device, 0u);
+  EXPECT_EQ(fault->joint, 2);
+  // More than the watchdog after the last good answer (one cycle before).
+  EXPECT_GE(fault->t - silent_from, 0.09 - 1e-9);
+  EXPECT_LE(fault->t - silent_from, 0.1 + 0.02);
+  EXPECT_TRUE(bench.state.joint_faulted(2));
+  EXPECT_FALSE(bench.state.joint_faulted(3));
+  bench.run_until(Phase::done);
+  EXPECT_NEAR(bench.written[1].back()[1], 0.0, 1e-3);  // the healthy one went home
+}
+
+TEST(Cycle, AHardwareErrorFaultsTheDeviceAtOnce) {
+  Bench bench(two_bus_model());
+  bench.begin();
+  bench.run_until(Phase::motion);
+  bench.health[0][1] = DeviceHealth::hardware_error;
+  bench.cycle();
+  const CycleEvent* fault = bench.first(EventKind::device_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->health, DeviceHealth::hardware_error);
+  EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
+}
+
+TEST(Cycle, ABusThatNeverComesBackIsFaultedOnlyAfterTenWatchdogs) {
+  Bench bench(two_bus_model());
+  bench.model.safety.watchdog_timeout_s = 0.1;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  const double late_from = static_cast<double>(bench.count) / kRate;
+  bench.fresh[1] = 0;
+  bench.run_until(Phase::stop_ramp, 300);
+  const CycleEvent* fault = bench.first(EventKind::device_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->bus, 1u);
+  EXPECT_GT(fault->t - late_from, 1.0 - 0.02);
+  EXPECT_LT(fault->t - late_from, 1.0 + 0.03);
+}
+
+TEST(Cycle, AJointThatDoesNotFollowIsAFaultAfterTheWindow) {
+  Bench bench(two_bus_model());
+  bench.model.safety.following_error_window_s = 0.2;
+  bench.motion.fn = [](std::size_t, double t) { return 0.5 * std::sin(2.0 * t); };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  // Device 1 of bus a reports another servo's position: 0.6 rad away.
+  bench.follow = false;
+  double over_from = -1.0;
+  for (int i = 0; i < 200 && !bench.has(EventKind::following_error); ++i) {
+    const CycleOutputs& out = bench.cycle();
+    for (std::size_t b = 0; b < 2; ++b) bench.positions[b] = out.bus_commands[b];
+    bench.positions[0][1] = out.bus_commands[0][1] + 0.6;
+    if (over_from < 0.0) over_from = static_cast<double>(bench.count) / kRate;
+  }
+  const CycleEvent* fault = bench.first(EventKind::following_error);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->joint, 1);
+  EXPECT_NEAR(fault->value, 0.6, 0.05);
+  EXPECT_GE(fault->t - over_from, 0.2 - 1e-9);
+  EXPECT_LE(fault->t - over_from, 0.2 + 0.03);
+  EXPECT_TRUE(bench.state.end().fault);
+  EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
+  EXPECT_EQ(bench.events.size(), 3u);  // started, following error, ended
+}
+
+TEST(Cycle, AFollowingErrorBelowTheThresholdOrShorterThanTheWindowIsNoFault) {
+  Bench bench(two_bus_model());
+  bench.model.safety.following_error_window_s = 0.2;
+  bench.in.motion_duration_s = 2.0;
+  bench.begin();
+  bench.follow = false;
+  for (int i = 0; i < 400 && !bench.state.done(); ++i) {
+    const CycleOutputs& out = bench.cycle();
+    for (std::size_t b = 0; b < 2; ++b) bench.positions[b] = out.bus_commands[b];
+    bench.positions[0][0] += 0.3;                   // under 20 deg, always
+    if (i % 30 < 15) bench.positions[1][0] += 1.0;  // over, for 0.15 s at a time
+  }
+  EXPECT_FALSE(bench.has(EventKind::following_error));
+  EXPECT_NEAR(bench.state.max_error(0), 0.3, 1e-6);
+}
+
+TEST(Cycle, AStopThatRunsOverItsDeadlineCutsTorque) {
+  RobotModel model = two_bus_model();
+  model.limits[0].max_velocity = 0.05;  // 1.5 rad home at 0.05 rad/s: too slow to make it
+  model.safety.stop_deadline_s = 3.0;
+  model.safety.start_ramp_max_s = 1000.0;
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double) { return 0.0; };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  // Jog joint 0 far from home, then stop.
+  JogCommand jog{0, 1.4};
+  bench.in.jog = &jog;
+  bench.cycle();
+  bench.in.jog = nullptr;
+  for (int i = 0; i < 3000; ++i) bench.cycle();
+  EXPECT_GT(bench.written[0].back()[0], 1.0);  // the jog went through the filter
+  bench.in.stop = true;
+  const double stop_at = static_cast<double>(bench.count) / kRate;
+  bench.run_until(Phase::done);
+  const CycleEvent* cut = bench.first(EventKind::stop_deadline);
+  ASSERT_NE(cut, nullptr);
+  EXPECT_NEAR(cut->t - stop_at, 3.0, 0.011);
+  EXPECT_TRUE(bench.state.end().torque_cut);
+  EXPECT_TRUE(bench.state.end().stopped);
+}
+
+TEST(Cycle, AnAbortCutsTorqueAtOnce) {
+  Bench bench(two_bus_model());
+  bench.begin();
+  bench.run_until(Phase::motion);
+  bench.in.stop = true;
+  bench.cycle();
+  EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
+  bench.in.abort = true;
+  const CycleOutputs& out = bench.cycle();
+  EXPECT_TRUE(out.torque_off_now);
+  EXPECT_TRUE(bench.state.done());
+  EXPECT_TRUE(bench.has(EventKind::aborted));
+}
+
+TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {
+  Bench bench(two_bus_model());
+  bench.begin();
+  MotionCommand command{0.25, -0.5};
+  bench.in.steer = &command;
+  bench.cycle();
+  EXPECT_EQ(bench.motion.steered.speed_m_s, 0.25);
+  EXPECT_EQ(bench.motion.steered.turn_rad_s, -0.5);
+}
+
+TEST(Cycle, StepDoesNotAllocate) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t j, double t) {
+    return j == 2 && t > 1.0 ? std::numeric_limits<double>::quiet_NaN() : std::sin(t);
+  };
+  bench.begin();
+  std::vector<BusIo> io(2);
+  for (std::size_t b = 0; b < 2; ++b) io[b] = BusIo{true, bench.positions[b], bench.health[b]};
+  bench.in.buses = io;
+  test::AllocationCounter counter;
+  for (int i = 0; i < 600 && !bench.state.done(); ++i) {
+    bench.in.t = i / kRate;
+    io[1].fresh = i % 7 != 0;
+    step(bench.model, bench.motion, bench.state, bench.in);
+  }
+  EXPECT_EQ(counter.count(), 0);
+  EXPECT_TRUE(bench.state.end().fault);  // the NaN path ran
+}
+
+TEST(NextDeadline, CountsOverrunsAndSkipsWholeMissedCycles) {
+  const Nanos period = 5'000'000;
+  NextDeadline on_time = next_deadline(0, 3'000'000, period);
+  EXPECT_EQ(on_time.deadline, period);
+  EXPECT_FALSE(on_time.overrun);
+  NextDeadline late = next_deadline(0, 6'000'000, period);
+  EXPECT_TRUE(late.overrun);
+  EXPECT_EQ(late.skipped, 0u);
+  EXPECT_EQ(late.deadline, period);
+  NextDeadline very_late = next_deadline(0, 23'000'000, period);
+  EXPECT_TRUE(very_late.overrun);
+  EXPECT_EQ(very_late.skipped, 3u);
+  EXPECT_EQ(very_late.deadline, 20'000'000);
+  EXPECT_GT(very_late.deadline + period, 23'000'000);
+}
+
+}  // namespace
+}  // namespace animrt

@@ -1,0 +1,244 @@
+// The runner as a shell: activation is owned whatever ends the run, nothing
+// is switched on when setup fails, and on the wall clock a bus that answers
+// late never receives a goal that jumps. The buses here are in-process
+// devices with ideal motors that log every goal they receive.
+
+#include "animrt/runtime/runner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt {
+namespace {
+
+struct Goal {
+  double t;  // device's wall clock, s
+  std::vector<double> positions;
+};
+
+// A bus whose devices follow the last goal at once. Can answer late on
+// purpose (read sleeps), throw, and report what it received.
+class FakeBus : public ActuatorBus {
+ public:
+  FakeBus(std::string name, std::vector<int> joints, double start = 0.0) {
+    config_.name = std::move(name);
+    config_.protocol = "fake";
+    config_.port = "memory";
+    for (std::size_t d = 0; d < joints.size(); ++d) {
+      ActuatorBinding a;
+      a.joint = "j" + std::to_string(joints[d]);
+      a.joint_index = joints[d];
+      a.device_id = static_cast<int>(d) + 1;
+      config_.actuators.push_back(a);
+      DeviceStatus st;
+      st.device_id = a.device_id;
+      status_.push_back(st);
+    }
+    positions_.assign(joints.size(), start);
+    goals_.reserve(100000);
+  }
+  const BusConfig& config() const override { return config_; }
+  void configure() override { ++configured; }
+  void activate() override {
+    ++activations;
+    if (throw_on_activate) throw DeviceError("bus " + config_.name + ": cannot enable");
+    torque_on = true;
+  }
+  void deactivate() override {
+    ++deactivations;
+    torque_on = false;
+  }
+  void read(std::span<double> positions) override {
+    const int late_ms = late_every > 0 && ++reads % late_every == 0 ? late_by_ms : 0;
+    if (late_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(late_ms));
+    for (std::size_t d = 0; d < positions.size(); ++d) {
+      positions[d] = positions_[d];
+      ++status_[d].transactions;
+      status_[d].health = DeviceHealth::ok;
+    }
+  }
+  void write(std::span<const double> positions) override {
+    positions_.assign(positions.begin(), positions.end());
+    if (goals_.size() < goals_.capacity()) {
+      goals_.push_back(Goal{to_seconds(wall_.now()), positions_});
+    }
+  }
+  std::span<DeviceStatus> devices() override { return status_; }
+
+  const std::vector<Goal>& goals() const { return goals_; }
+
+  int configured = 0, activations = 0, deactivations = 0;
+  bool torque_on = false;
+  bool throw_on_activate = false;
+  int late_every = 0;  // every n-th read is late
+  int late_by_ms = 0;
+
+ private:
+  BusConfig config_;
+  std::vector<DeviceStatus> status_;
+  std::vector<double> positions_;
+  std::vector<Goal> goals_;
+  int reads = 0;
+  MonotonicClock wall_;
+};
+
+class SineSource : public MotionSource {
+ public:
+  explicit SineSource(std::size_t n, double amplitude = 1.0, double rate = 2.0)
+      : amplitude_(amplitude), rate_(rate) {
+    for (std::size_t j = 0; j < n; ++j) driven_.push_back(static_cast<int>(j));
+  }
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double t, std::span<double> targets) const override {
+    for (std::size_t j = 0; j < targets.size(); ++j) targets[j] = amplitude_ * std::sin(rate_ * t);
+  }
+
+ private:
+  double amplitude_, rate_;
+  std::vector<int> driven_;
+};
+
+RobotConfig two_bus_config(double velocity = 2.0) {
+  RobotConfig c;
+  c.file = "test.yaml";
+  c.name = "test";
+  c.rate_hz = 200.0;
+  c.safety.start_ramp_s = 0.2;
+  c.safety.stop_ramp_s = 0.2;
+  c.motion.type = "gait";
+  c.motion.file = "test_gait.yaml";
+  for (int j = 0; j < 4; ++j) {
+    JointSpec s;
+    s.name = "j" + std::to_string(j);
+    s.limits = JointLimits{-1.5, 1.5, velocity, 40.0};
+    c.joints.push_back(s);
+  }
+  return c;
+}
+
+struct Rig {
+  explicit Rig(RobotConfig config = two_bus_config(), double start = 0.0) {
+    auto a = std::make_unique<FakeBus>("a", std::vector<int>{0, 1}, start);
+    auto b = std::make_unique<FakeBus>("b", std::vector<int>{2, 3}, start);
+    bus_a = a.get();
+    bus_b = b.get();
+    std::vector<std::unique_ptr<ActuatorBus>> buses;
+    buses.push_back(std::move(a));
+    buses.push_back(std::move(b));
+    runner = std::make_unique<Runner>(config, std::move(buses),
+                                      std::make_unique<SineSource>(config.joints.size()));
+  }
+  FakeBus* bus_a;
+  FakeBus* bus_b;
+  std::unique_ptr<Runner> runner;
+  ManualClock clock;
+};
+
+RunOptions lockstep(Rig& rig, double duration) {
+  RunOptions o;
+  o.duration_s = duration;
+  o.lockstep_clock = &rig.clock;
+  return o;
+}
+
+TEST(Runner, AnExceptionInTheLoopStillSwitchesEveryBusOff) {
+  Rig rig;
+  RunOptions o = lockstep(rig, 1.0);
+  o.on_motion_start = [](Nanos) { throw std::runtime_error("sound card gone"); };
+  EXPECT_THROW(rig.runner->run(o), std::runtime_error);
+  EXPECT_EQ(rig.bus_a->activations, 1);
+  EXPECT_FALSE(rig.bus_a->torque_on);
+  EXPECT_FALSE(rig.bus_b->torque_on);
+  EXPECT_EQ(rig.bus_b->deactivations, 1);
+}
+
+TEST(Runner, ABusThatFailsToActivateIsSwitchedOffWithTheOnesBeforeIt) {
+  Rig rig;
+  rig.bus_b->throw_on_activate = true;
+  EXPECT_THROW(rig.runner->run(lockstep(rig, 1.0)), DeviceError);
+  EXPECT_EQ(rig.bus_a->deactivations, 1);
+  EXPECT_EQ(rig.bus_b->deactivations, 1);  // it may have enabled some devices
+  EXPECT_FALSE(rig.bus_a->torque_on);
+  EXPECT_TRUE(rig.bus_a->goals().empty());
+}
+
+TEST(Runner, AnUnwritableTelemetryFileStopsTheRunBeforeAnythingIsSwitchedOn) {
+  Rig rig;
+  RunOptions o = lockstep(rig, 1.0);
+  o.telemetry_path = "/nonexistent-folder/telemetry.csv";
+  EXPECT_THROW(rig.runner->run(o), std::runtime_error);
+  EXPECT_EQ(rig.bus_a->activations, 0);
+  EXPECT_EQ(rig.bus_b->activations, 0);
+}
+
+TEST(Runner, AStartRampLongerThanItsLimitIsRefusedBeforeTorqueGoesOn) {
+  RobotConfig config = two_bus_config(0.01);  // rad/s: 1.2 rad takes minutes
+  config.safety.start_ramp_max_s = 20.0;
+  Rig rig(config, 1.2);
+  try {
+    rig.runner->run(lockstep(rig, 1.0));
+    FAIL() << "expected a DeviceError";
+  } catch (const DeviceError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("start ramp: joint j0 is measured at 68.8 deg and the motion starts at "
+                        "0.0 deg"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("safety.start_ramp_max_s (20 s)"), std::string::npos) << what;
+  }
+  EXPECT_EQ(rig.bus_a->activations, 0);
+}
+
+TEST(Runner, ASecondStopRequestCutsTorqueWithExitCodeFive) {
+  Rig rig;
+  RunControls controls;
+  RunOptions o = lockstep(rig, 0.0);
+  o.controls = &controls;
+  o.on_motion_start = [&](Nanos) { controls.stop = true; };
+  o.on_motion_end = [&] { controls.abort = true; };
+  const RunSummary s = rig.runner->run(o);
+  EXPECT_EQ(s.end_reason, EndReason::signal);
+  EXPECT_EQ(s.exit_code(), 5);
+  EXPECT_NE(s.torque_cut.find("second stop request"), std::string::npos) << s.torque_cut;
+  EXPECT_NE(format_summary(s).find("TORQUE CUT second stop request"), std::string::npos);
+  EXPECT_FALSE(rig.bus_a->torque_on);
+}
+
+// Wall clock: bus b answers 12 ms late on every fourth read (the period is
+// 5 ms, the read budget 3 ms after the deadline), so it misses cycles. On
+// the device side no goal may be further from the one before than the
+// velocity limit allows over the time between them.
+TEST(Runner, OnTheWallClockALateBusNeverReceivesAJump) {
+  Rig rig(two_bus_config(2.0));
+  rig.bus_b->late_every = 4;
+  rig.bus_b->late_by_ms = 12;
+  RunOptions o;
+  o.duration_s = 1.5;
+  o.request_realtime = false;
+  const RunSummary s = rig.runner->run(o);
+  EXPECT_EQ(s.exit_code(), 0) << format_summary(s);
+  ASSERT_EQ(s.buses.size(), 2u);
+  EXPECT_GT(s.buses[1].late_cycles, 20u) << format_summary(s);
+  const auto& goals = rig.bus_b->goals();
+  ASSERT_GT(goals.size(), 50u);
+  // Between two goals the device received lies at most one filter step
+  // (2 rad/s * 5 ms), however many cycles the bus missed in between: its
+  // joints held while it was late. (Wall-clock gaps between writes depend on
+  // the machine's load, so the bound is per write, not per second.)
+  for (std::size_t k = 1; k < goals.size(); ++k) {
+    for (std::size_t d = 0; d < 2; ++d) {
+      EXPECT_LE(std::abs(goals[k].positions[d] - goals[k - 1].positions[d]), 2.0 * 0.005 + 1e-9)
+          << "goal " << k << " device " << d;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace animrt
