@@ -361,6 +361,7 @@ void ModbusBus::configure() {
     }
   }
   goal_rad_ = present_rad_;
+  for (Slave& s : slaves_) s.silent = false;
   fresh_ = true;
 }
 
@@ -402,6 +403,7 @@ void ModbusBus::read(std::span<double> positions) {
   }
   if (!ensure_connected(false)) {
     // Down and waiting for the next attempt: no answer this cycle.
+    for (Slave& s : slaves_) s.silent = true;
     for (DeviceStatus& st : status_) {
       if (st.faulted) continue;
       ++st.transactions;
@@ -413,6 +415,7 @@ void ModbusBus::read(std::span<double> positions) {
   modbus_flush(ctx_);  // late answers of timed-out requests must not pass for these
   for (Slave& s : slaves_) {
     if (!connected_) {
+      s.silent = true;
       for (std::size_t d : s.devices) {
         if (status_[d].faulted) continue;
         ++status_[d].transactions;
@@ -421,7 +424,7 @@ void ModbusBus::read(std::span<double> positions) {
       }
       continue;
     }
-    read_slave(s, true);
+    s.silent = !read_slave(s, true);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (answered_[i]) positions[i] = present_rad_[i];
@@ -430,10 +433,12 @@ void ModbusBus::read(std::span<double> positions) {
 
 void ModbusBus::write(std::span<const double> positions) {
   for (std::size_t i = 0; i < std::min(positions.size(), goal_rad_.size()); ++i) {
-    if (std::isfinite(positions[i])) goal_rad_[i] = positions[i];
+    goal_rad_[i] = config_.actuators[i].safe_goal(positions[i], goal_rad_[i]);
   }
   if (!connected_) return;  // read() reconnects; nothing to say to a dead link
-  for (Slave& s : slaves_) write_slave(s);
+  for (Slave& s : slaves_) {
+    if (!s.silent) write_slave(s);
+  }
 }
 
 }  // namespace animrt
