@@ -100,8 +100,11 @@ std::size_t FdTransport::read(std::span<std::uint8_t> buffer, std::chrono::micro
     if (waited && now_ns() >= deadline) return 0;
     const short ev = wait_for(fd_, POLLIN, deadline);
     waited = true;
-    if ((ev & (POLLHUP | POLLERR | POLLNVAL)) != 0 && (ev & POLLIN) == 0) {
-      line_gone("line is gone (hangup)", 0);
+    if ((ev & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
+      // Bytes that came before the hangup are still handed out.
+      const ssize_t last = ::read(fd_, buffer.data(), buffer.size());
+      if (last > 0) return static_cast<std::size_t>(last);
+      line_gone("line is gone (hangup)", last < 0 ? errno : 0);
       return 0;
     }
     if (ev == 0) return 0;
