@@ -108,6 +108,7 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
+    device_of_id_[static_cast<std::size_t>(b.device_id)] = static_cast<std::int16_t>(i);
     present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
     // One tick inside the int32 range so rounding cannot wrap.
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
@@ -240,6 +241,13 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
       ++st.protocol_errors;
       st.health = DeviceHealth::protocol_error;
       suspect_[slot] = 1;
+      continue;
+    }
+    if (slot == count && r == dxl::DecodeResult::packet && device_of_id_[packet.id] >= 0) {
+      // A late answer of another device on this bus (to an earlier request):
+      // its own fault, not the fault of the device whose answer is awaited.
+      DeviceStatus& st = status_[static_cast<std::size_t>(device_of_id_[packet.id])];
+      ++st.protocol_errors;
       continue;
     }
     if (slot == count) {

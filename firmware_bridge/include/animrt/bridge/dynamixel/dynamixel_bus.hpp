@@ -100,6 +100,12 @@ class DynamixelBus final : public ActuatorBus {
   std::chrono::microseconds timeout_;
 
   std::vector<DeviceStatus> status_;
+  std::array<std::int16_t, 256> device_of_id_ = filled_minus_one();  // bus id -> device
+  static std::array<std::int16_t, 256> filled_minus_one() {
+    std::array<std::int16_t, 256> a{};
+    a.fill(-1);
+    return a;
+  }
   std::vector<std::int32_t> present_ticks_;   // latest known, per device
   std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
   std::vector<double> min_rad_, max_rad_;     // goals that stay inside int32 ticks
