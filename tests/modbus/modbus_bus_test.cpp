@@ -120,6 +120,11 @@ TEST_P(ModbusTransports, TracksGoalsWithOneRequestPerSlaveAndDirection) {
 
 TEST_P(ModbusTransports, ExceptionsTimeoutsAndFaultsAreCountedPerDevice) {
   Rig r(GetParam());
+  // Without joint limits in the binding the bus would clamp the goal below.
+  BusConfig unlimited = r.config.buses[0];
+  unlimited.actuators[1].min_position = -HUGE_VAL;
+  unlimited.actuators[1].max_position = HUGE_VAL;
+  r.bus = std::make_unique<ModbusBus>(unlimited);
   r.bus->configure();
   r.bus->activate();
   // A goal past the actuator's stroke: the drive answers exception 3.
@@ -140,6 +145,38 @@ TEST_P(ModbusTransports, ExceptionsTimeoutsAndFaultsAreCountedPerDevice) {
   EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::hardware_error);
   EXPECT_EQ(r.bus->devices()[0].hardware_error_status, 0x04);
   EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+TEST_P(ModbusTransports, ADeadSlaveCostsOneRequestAndOneTimeoutPerCycle) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  r.step({0.0, 0.0});
+  r.sim->set_device_responding(2, false);
+  r.step({0.0, 0.0});  // the first cycle still writes: the slave answered last time
+  const std::uint64_t requests = r.bus->requests();
+  const std::uint64_t timeouts = r.bus->devices()[1].timeouts;
+  r.step({0.1, 0.0}, 5);
+  // Per cycle: slave 1 read + write, slave 2 read only.
+  EXPECT_EQ(r.bus->requests() - requests, 5u * 3);
+  EXPECT_EQ(r.bus->devices()[1].timeouts - timeouts, 5u);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  // Back: its goals are written again.
+  r.sim->set_device_responding(2, true);
+  r.step({0.1, 0.0}, 2);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+TEST_P(ModbusTransports, GoalsAreClampedIntoTheJointLimitsAndNaNHolds) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  // pan is limited to +-90 degrees by the robot file.
+  r.step({deg_to_rad(170), 0.0}, 150);
+  EXPECT_NEAR(r.sim->device_position(1), deg_to_rad(90), 1e-3);
+  r.step({std::nan(""), 0.0}, 20);
+  EXPECT_NEAR(r.sim->device_position(1), deg_to_rad(90), 1e-3);
+  EXPECT_EQ(r.bus->devices()[0].exceptions, 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(TcpAndRtu, ModbusTransports, ::testing::Values("modbus-tcp", "modbus-rtu"),
