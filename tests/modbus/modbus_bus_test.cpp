@@ -3,7 +3,11 @@
 
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -203,6 +207,29 @@ TEST(ModbusBus, IllegalAddressIsExceptionTwoAtBringUp) {
         << what;
     EXPECT_NE(what.find("slave 3 (lean): no answer"), std::string::npos) << what;
   }
+}
+
+TEST(ModbusBus, AClientHoldingHalfAHeaderStallsNoOtherClient) {
+  Rig r("modbus-tcp");
+  r.bus->configure();
+  const auto colon = r.sim->endpoint().rfind(':');
+  const int port = std::stoi(r.sim->endpoint().substr(colon + 1));
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::uint8_t half[3] = {0x00, 0x01, 0x00};  // transaction id and half the protocol id
+  ASSERT_EQ(::send(fd, half, sizeof half, 0), 3);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::uint64_t timeouts = r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts;
+  r.step({0.0, 0.0}, 5);
+  EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+  ::close(fd);
 }
 
 TEST(ModbusBus, ADroppedConnectionIsReopenedWithBackoff) {
