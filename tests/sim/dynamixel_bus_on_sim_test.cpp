@@ -38,24 +38,25 @@ BusConfig two_servos(double timeout_s) {
 }
 
 TEST(DynamixelBusOnSim, LateAnswersAreNeverTakenForTheNextRequest) {
-  // Timeout T = 100 ms, servo 3's first two answers 150 ms late: the first
-  // ping times out and the retry takes the late answer; the second ping's
-  // answer then arrives while the position is being read. A 3-byte ping
-  // answer of the right id must not pass for the 4-byte position.
-  const BusConfig config = two_servos(0.1);
+  // Timeout T = 100 ms, the servo's first two answers 150 ms late. The first
+  // ping times out and its retry takes the late answer (t = 150 ms); the
+  // answer to the retry then comes at 300 ms, while the present position is
+  // being read for the second time. That 3-byte ping answer, from the right
+  // id, must not pass for (or spoil) the 4-byte position that follows it.
+  BusConfig config = two_servos(0.1);
+  config.actuators.pop_back();  // one servo: the timeline above is exact
   ManualClock clock{0};
   sim::DynamixelSimBus sim(config, clock);
   sim.start();
   sim.set_device_answer_delay(3, 150'000'000, 2);
   DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
   ASSERT_NO_THROW(bus.configure());
-  std::vector<double> q(2, 99.0);
+  std::vector<double> q(1, 99.0);
   bus.read(q);
   EXPECT_NEAR(q[0], sim.device_position(3), 1e-3);
-  EXPECT_NEAR(q[1], sim.device_position(4), 1e-3);
-  // The late packet was counted against servo 3, never against servo 4.
-  EXPECT_GE(bus.devices()[0].protocol_errors + bus.devices()[0].timeouts, 1u);
-  EXPECT_EQ(bus.devices()[1].protocol_errors, 0u);
+  // The late answers cost timeouts (whether the stale packet was discarded
+  // before a request or seen and counted during one depends on scheduling).
+  EXPECT_GE(bus.devices()[0].timeouts, 1u);
 }
 
 TEST(DynamixelBusOnSim, ServoRefusesGoalsOutsideTheJointLimitsTheBusWrote) {
