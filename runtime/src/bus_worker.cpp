@@ -119,8 +119,9 @@ void BusWorker::guarded(F&& io) {
   try {
     io();
   } catch (...) {
-    // The transport is gone (e.g. the adapter was unplugged): no answers,
-    // which the loop's watchdog turns into a fault.
+    // Last line of defence only: the buses report a gone line as timeouts
+    // and never throw in read()/write(). Should one still throw, its devices
+    // count a timeout and the loop's watchdog turns that into a fault.
     for (DeviceStatus& st : bus_.devices()) {
       if (st.faulted) continue;
       ++st.timeouts;

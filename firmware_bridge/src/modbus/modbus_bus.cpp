@@ -1,6 +1,7 @@
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
 #include <modbus.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <any>
@@ -17,6 +18,7 @@ using std::chrono::steady_clock;
 constexpr int kMaxReadWords = 125;   // Read (Holding|Input) Registers
 constexpr int kMaxWriteWords = 123;  // Write Multiple Registers
 constexpr int kTries = 3;            // lifecycle requests only
+constexpr int kMaxFlushReads = 16;   // bounded input flush before a cycle's requests
 
 std::string exception_name(int code) {
   switch (code) {
@@ -168,6 +170,22 @@ bool ModbusBus::ensure_connected(bool blocking) {
   next_attempt_ = now + std::chrono::duration_cast<steady_clock::duration>(
                             std::chrono::duration<double>(backoff_s_));
   return false;
+}
+
+void ModbusBus::flush_input() {
+  if (!options_.tcp) {
+    modbus_flush(ctx_);  // RTU: tcflush, bounded
+    return;
+  }
+  // TCP: what is queued now, at most a few ADUs; a peer that keeps sending
+  // must not keep the cycle here (libmodbus's flush reads while data comes).
+  const int fd = modbus_get_socket(ctx_);
+  if (fd < 0) return;
+  std::uint8_t sink[MODBUS_TCP_MAX_ADU_LENGTH];
+  for (int k = 0; k < kMaxFlushReads; ++k) {
+    const ssize_t n = ::recv(fd, sink, sizeof sink, MSG_DONTWAIT);
+    if (n <= 0) return;
+  }
 }
 
 ModbusBus::Failure ModbusBus::classify(int error) const {
@@ -412,7 +430,7 @@ void ModbusBus::read(std::span<double> positions) {
     }
     return;
   }
-  modbus_flush(ctx_);  // late answers of timed-out requests must not pass for these
+  flush_input();  // late answers of timed-out requests must not pass for these
   for (Slave& s : slaves_) {
     if (!connected_) {
       s.silent = true;

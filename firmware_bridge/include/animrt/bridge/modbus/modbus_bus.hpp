@@ -103,6 +103,7 @@ class ModbusBus final : public ActuatorBus {
 
   bool ensure_connected(bool blocking);
   void disconnect();
+  void flush_input();
   Failure classify(int error) const;
   // Counts a failed request against the slave's devices; returns the failure.
   Failure fail_slave(const Slave& slave, int error);
