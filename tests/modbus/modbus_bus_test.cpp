@@ -4,6 +4,7 @@
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -229,6 +230,24 @@ TEST(ModbusBus, AClientHoldingHalfAHeaderStallsNoOtherClient) {
   EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
   EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
   EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+  ::close(fd);
+}
+
+TEST(ModbusBus, RtuFrameCutOffBySilenceDoesNotSwallowTheNextRequest) {
+  Rig r("modbus-rtu");
+  r.bus->configure();
+  // Another writer on the line sends the start of a Read Holding Registers
+  // frame to slave 1 and falls silent.
+  const int fd = ::open(r.sim->endpoint().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(fd, 0);
+  const std::uint8_t cut[4] = {0x01, 0x03, 0x00, 0x10};
+  ASSERT_EQ(::write(fd, cut, sizeof cut), 4);
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  const std::uint64_t timeouts = r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts;
+  r.step({0.0, 0.0}, 3);
+  EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_GE(r.sim->stats().dropped, 4u);
   ::close(fd);
 }
 
