@@ -8,6 +8,9 @@
 #include <unistd.h>
 
 #include <climits>
+#include <cstring>
+#include <string>
+#include <system_error>
 
 namespace animrt {
 
@@ -40,23 +43,58 @@ BusWorker::BusWorker(ActuatorBus& bus, std::span<const double> initial_positions
 
 BusWorker::~BusWorker() { stop(); }
 
-void BusWorker::start(int realtime_priority) {
-  if (thread_.joinable()) return;
+namespace {
+
+void* thread_main(void* worker) {
+  static_cast<BusWorker*>(worker)->run_for_thread();
+  return nullptr;
+}
+
+}  // namespace
+
+void BusWorker::run_for_thread() { run(); }
+
+bool BusWorker::start(int realtime_priority) {
+  if (running_) return realtime_ || realtime_priority <= 0;
   stop_ = false;
-  thread_ = std::thread([this] { run(); });
+  realtime_ = false;
+  priority_note_.clear();
+  int rc = -1;
   if (realtime_priority > 0) {
+    pthread_attr_t attr;
+    pthread_attr_init(&attr);
     sched_param param{};
     param.sched_priority = realtime_priority;
-    pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param);  // best effort
+    int why = pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+    if (why == 0) why = pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+    if (why == 0) why = pthread_attr_setschedparam(&attr, &param);
+    if (why == 0) why = pthread_create(&thread_, &attr, thread_main, this);
+    pthread_attr_destroy(&attr);
+    rc = why;
+    if (rc == 0) {
+      realtime_ = true;
+      priority_note_ = "SCHED_FIFO " + std::to_string(realtime_priority);
+    } else {
+      priority_note_ = "SCHED_FIFO " + std::to_string(realtime_priority) + " not permitted (" +
+                       std::strerror(rc) + "), normal thread";
+    }
   }
+  if (rc != 0) {
+    rc = pthread_create(&thread_, nullptr, thread_main, this);
+    if (rc != 0) throw std::system_error(rc, std::generic_category(), "bus I/O thread");
+    if (priority_note_.empty()) priority_note_ = "default scheduling";
+  }
+  running_ = true;
+  return realtime_ || realtime_priority <= 0;
 }
 
 void BusWorker::stop() {
-  if (!thread_.joinable()) return;
+  if (!running_) return;
   stop_.store(true, std::memory_order_release);
   wake_.fetch_add(1, std::memory_order_release);
   futex_wake_all(wake_);
-  thread_.join();
+  pthread_join(thread_, nullptr);
+  running_ = false;
 }
 
 void BusWorker::post_read() {
@@ -81,8 +119,9 @@ void BusWorker::guarded(F&& io) {
   try {
     io();
   } catch (...) {
-    // The transport is gone (e.g. the adapter was unplugged): no answers,
-    // which the loop's watchdog turns into a fault.
+    // Last line of defence only: the buses report a gone line as timeouts
+    // and never throw in read()/write(). Should one still throw, its devices
+    // count a timeout and the loop's watchdog turns that into a fault.
     for (DeviceStatus& st : bus_.devices()) {
       if (st.faulted) continue;
       ++st.timeouts;

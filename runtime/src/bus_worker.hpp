@@ -9,10 +9,12 @@
 // Ownership: positions() and commands() belong to the worker thread while a
 // request is pending, and to the loop thread while idle().
 
+#include <pthread.h>
+
 #include <atomic>
 #include <cstdint>
 #include <span>
-#include <thread>
+#include <string>
 #include <vector>
 
 #include "animrt/bridge/actuator_bus.hpp"
@@ -33,8 +35,16 @@ class BusWorker {
   BusWorker(const BusWorker&) = delete;
   BusWorker& operator=(const BusWorker&) = delete;
 
-  void start(int realtime_priority);  // 0: inherit the default policy
+  // Starts the I/O thread. realtime_priority > 0: the thread is created with
+  // SCHED_FIFO at that priority (PTHREAD_EXPLICIT_SCHED, so it never runs a
+  // single instruction at the default policy). When that is not permitted
+  // it starts as a normal thread instead, never fatal. Returns whether the
+  // requested priority took effect (true when none was asked); the note
+  // says what happened, for the run summary.
+  bool start(int realtime_priority);  // 0: inherit the default policy
   void stop();
+  bool realtime() const { return realtime_; }
+  const std::string& priority_note() const { return priority_note_; }
 
   bool idle() const {
     return read_done_.load(std::memory_order_acquire) ==
@@ -58,6 +68,9 @@ class BusWorker {
   Nanos last_io_ns() const { return io_ns_.load(std::memory_order_acquire); }
   std::uint64_t io_cycles() const { return io_cycles_.load(std::memory_order_acquire); }
 
+  // Entry of the I/O thread (public only for the pthread trampoline).
+  void run_for_thread();
+
  private:
   void run();
   void signal_done();
@@ -74,7 +87,10 @@ class BusWorker {
   std::atomic<Nanos> io_ns_{0};
   std::atomic<std::uint64_t> io_cycles_{0};
   Nanos read_ns_ = 0;
-  std::thread thread_;
+  pthread_t thread_{};
+  bool running_ = false;
+  bool realtime_ = false;
+  std::string priority_note_;
 };
 
 }  // namespace animrt

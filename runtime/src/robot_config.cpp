@@ -207,6 +207,8 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
     ActuatorBinding binding;
     binding.joint = name;
     binding.joint_index = static_cast<int>(config.joints.size());
+    binding.min_position = joint.limits.min_position;
+    binding.max_position = joint.limits.max_position;
     const std::size_t bus_index =
         parse_actuator(value.at("actuator"), joint, limits_node, config.buses, binding);
     config.buses[bus_index].actuators.push_back(binding);

@@ -73,7 +73,7 @@ void DynamixelFirmware::answer(const DynamixelServo& servo, StatusError error,
   const std::size_t n = dxl::encode_status(servo.id(), servo.status_error(error), data,
                                            {out.bytes.data() + offset, dxl::kMaxPacket});
   out.bytes.resize(offset + n);
-  if (n > 0) out.list.push_back({offset, n, servo.return_delay_us()});
+  if (n > 0) out.list.push_back({offset, n, servo.return_delay_us(), servo.take_answer_delay()});
 }
 
 void DynamixelFirmware::answer_read(const DynamixelServo& servo, std::uint16_t address,

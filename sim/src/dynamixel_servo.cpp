@@ -278,6 +278,7 @@ StatusError DynamixelServo::check_write(std::uint16_t address,
 
 StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::uint8_t> data) {
   const StatusError error = check_write(address, data);
+  log_goal(address, data, error == StatusError::none);
   if (error != StatusError::none) return error;
   std::memcpy(&table_[address], data.data(), data.size());
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
@@ -325,6 +326,42 @@ void DynamixelServo::set_hardware_error(std::uint8_t bits, Nanos now) {
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);
   command_physics();
+}
+
+void DynamixelServo::log_goal(std::uint16_t address, std::span<const std::uint8_t> data,
+                              bool accepted) {
+  const std::size_t goal = xreg::goal_position;
+  if (address > goal || address + data.size() < goal + 4) return;
+  if (goal_ring_.empty()) goal_ring_.resize(kGoalLogCapacity);
+  GoalRecord& r = goal_ring_[goals_received_ % kGoalLogCapacity];
+  r.time = motor_time_;
+  r.ticks = static_cast<std::int32_t>(dxl::get_u32(data.data() + (goal - address)));
+  r.rad = binding_.to_rad(r.ticks);
+  r.accepted = accepted;
+  ++goals_received_;
+}
+
+std::vector<GoalRecord> DynamixelServo::goal_log() const {
+  const std::uint64_t kept = std::min<std::uint64_t>(goals_received_, kGoalLogCapacity);
+  std::vector<GoalRecord> out;
+  out.reserve(kept);
+  for (std::uint64_t k = goals_received_ - kept; k < goals_received_; ++k) {
+    out.push_back(goal_ring_[k % kGoalLogCapacity]);
+  }
+  return out;
+}
+
+void DynamixelServo::clear_goal_log() { goals_received_ = 0; }
+
+void DynamixelServo::set_answer_delay(Nanos delay_ns, int answers) {
+  answer_delay_ns_ = std::max<Nanos>(0, delay_ns);
+  delayed_answers_left_ = answers;
+}
+
+Nanos DynamixelServo::take_answer_delay() const {
+  if (answer_delay_ns_ == 0 || delayed_answers_left_ == 0) return 0;
+  if (delayed_answers_left_ > 0) --delayed_answers_left_;
+  return answer_delay_ns_;
 }
 
 double DynamixelServo::position_rad(Nanos now) const {

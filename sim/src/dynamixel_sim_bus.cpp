@@ -20,6 +20,9 @@ namespace {
 
 constexpr int kWriteStallMs = 200;  // a client that stops reading loses answers after this
 constexpr int kBitsPerByte = 10;    // start + 8 data + stop
+// Silence after which the firmware drops a packet it has only partly
+// received, as a servo's receive timeout does.
+constexpr int kPacketSilenceMs = 5;
 
 [[noreturn]] void fail(const BusConfig& config, const char* what, int error) {
   throw DeviceError("simulated bus '" + config.name + "': " + what + ": " + std::strerror(error));
@@ -130,17 +133,28 @@ void DynamixelSimBus::stop() {
 
 void DynamixelSimBus::serve() {
   std::array<std::uint8_t, 4096> buffer{};
+  const MonotonicClock wall;
+  Nanos last_byte = 0;
   while (!stop_.load()) {
     pollfd fds[2] = {{master_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
+    // With a packet half received, wait only for the inter-byte silence.
+    const int wait_ms = decoder_.buffered() > 0 ? kPacketSilenceMs : -1;
+    const int ready = ::poll(fds, 2, wait_ms);
+    if (ready < 0) {
       if (errno == EINTR) continue;
       break;
+    }
+    if (ready == 0 ||
+        (decoder_.buffered() > 0 && wall.now() - last_byte > Nanos{kPacketSilenceMs} * 1'000'000)) {
+      drop_partial_packet();
+      if (ready == 0) continue;
     }
     if (fds[1].revents != 0) break;
     if (fds[0].revents & POLLIN) {
       const ssize_t n = ::read(master_, buffer.data(), buffer.size());
       if (n > 0) {
-        process({buffer.data(), static_cast<std::size_t>(n)}, MonotonicClock().now());
+        last_byte = wall.now();
+        process({buffer.data(), static_cast<std::size_t>(n)}, last_byte);
         continue;
       }
       if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
@@ -148,6 +162,12 @@ void DynamixelSimBus::serve() {
     // Hangup or error: not expected while we hold the slave open; do not spin.
     ::poll(&fds[1], 1, 10);
   }
+}
+
+void DynamixelSimBus::drop_partial_packet() {
+  if (decoder_.buffered() == 0) return;
+  dropped_partial_ += decoder_.buffered();
+  decoder_.reset();
 }
 
 void DynamixelSimBus::process(std::span<const std::uint8_t> bytes, Nanos arrival) {
@@ -183,12 +203,15 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   if (packet.instruction != dxl::inst::status) ++packets_;
 
   if (!config_.sim.wire_time) {
-    for (const Answers::Answer& a : answers_.list) send(answers_.packet(a));
+    for (const Answers::Answer& a : answers_.list) {
+      if (a.late_ns > 0) sleep_until_monotonic(MonotonicClock().now() + a.late_ns);
+      send(answers_.packet(a));
+    }
   } else {
     // One line: the instruction, then each servo's delay and answer in turn.
     Nanos t = std::max(arrival, bus_free_) + wire_ns(instruction_bytes);
     for (const Answers::Answer& a : answers_.list) {
-      t += static_cast<Nanos>(a.return_delay_us) * 1000 + wire_ns(a.size);
+      t += static_cast<Nanos>(a.return_delay_us) * 1000 + a.late_ns + wire_ns(a.size);
       sleep_until_monotonic(t);
       send(answers_.packet(a));
     }
@@ -233,6 +256,21 @@ void DynamixelSimBus::set_device_hardware_error(int device_id, std::uint8_t erro
   servo_or_throw(firmware_, config_, device_id).set_hardware_error(error_bits, clock_.now());
 }
 
+void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int answers) {
+  std::lock_guard lock(mutex_);
+  servo_or_throw(firmware_, config_, device_id).set_answer_delay(delay_ns, answers);
+}
+
+std::vector<GoalRecord> DynamixelSimBus::device_goal_log(int device_id) const {
+  std::lock_guard lock(mutex_);
+  return servo_or_throw(firmware_, config_, device_id).goal_log();
+}
+
+std::uint64_t DynamixelSimBus::device_goals_received(int device_id) const {
+  std::lock_guard lock(mutex_);
+  return servo_or_throw(firmware_, config_, device_id).goals_received();
+}
+
 double DynamixelSimBus::device_position(int device_id) const {
   std::lock_guard lock(mutex_);
   return servo_or_throw(firmware_, config_, device_id).position_rad(clock_.now());
@@ -246,6 +284,7 @@ DynamixelSimStats DynamixelSimBus::stats() const {
   s.malformed = malformed_;
   s.stray_bytes = stray_bytes_;
   s.dropped_bytes = dropped_bytes_;
+  s.partial_packet_bytes = dropped_partial_;
   return s;
 }
 

@@ -48,7 +48,8 @@ struct FakeServo {
   std::int32_t present = 2048;
   std::int32_t goal = 0;
   std::uint8_t torque = 0;
-  std::uint8_t hardware_error = 0;  // register 70; nonzero sets the alert bit
+  std::uint32_t max_limit = 0, min_limit = 0;  // registers 48 and 52
+  std::uint8_t hardware_error = 0;             // register 70; nonzero sets the alert bit
   Fault fault = Fault::none;
 };
 
@@ -70,10 +71,16 @@ class FakeDevices {
     thread_ = std::thread([this] { serve(); });
   }
   ~FakeDevices() {
+    unplug();
+    ::close(slave_);
+  }
+  // The adapter is pulled: the device side closes, the bus sees EIO.
+  void unplug() {
+    if (master_ < 0) return;
     stop_ = true;
     thread_.join();
     ::close(master_);
-    ::close(slave_);
+    master_ = -1;
   }
 
   const std::string& port() const { return port_; }
@@ -144,6 +151,8 @@ class FakeDevices {
           if (address == dxl::xreg::goal_position)
             s.goal = static_cast<std::int32_t>(dxl::get_u32(&p[2]));
           if (address == dxl::xreg::torque_enable) s.torque = p[2];
+          if (address == dxl::xreg::max_position_limit) s.max_limit = dxl::get_u32(&p[2]);
+          if (address == dxl::xreg::min_position_limit) s.min_limit = dxl::get_u32(&p[2]);
           answer(packet.id, {});
         }
         break;
@@ -176,6 +185,11 @@ class FakeDevices {
       dxl::put_u32(data.data(), static_cast<std::uint32_t>(s.present));
     }
     if (address == dxl::xreg::hardware_error_status && length == 1) data[0] = s.hardware_error;
+    if (address == dxl::xreg::torque_enable && length == 1) data[0] = s.torque;
+    if (address == dxl::xreg::max_position_limit && length == 4)
+      dxl::put_u32(data.data(), s.max_limit);
+    if (address == dxl::xreg::min_position_limit && length == 4)
+      dxl::put_u32(data.data(), s.min_limit);
     return data;
   }
 
@@ -653,6 +667,80 @@ TEST_F(DynamixelBusTest, CycleNeverAllocates) {
   EXPECT_EQ(status(0).crc_errors, 3u);
   EXPECT_EQ(status(1).hardware_error_status, 0x01);
   EXPECT_EQ(status(2).timeouts, 3u);
+}
+
+TEST_F(DynamixelBusTest, WriteClampsIntoTheJointLimits) {
+  auto config = make_config(fake_.port());
+  config.actuators[0].min_position = -0.5;
+  config.actuators[0].max_position = 0.25;
+  config.actuators[2].min_position = -0.1;  // mirrored joint: limits swap in ticks
+  config.actuators[2].max_position = 0.2;
+  DynamixelBus bus(config, open_serial(fake_.port(), 1'000'000));
+  // The fake answers 0 to the limit registers, so configure writes them.
+  bus.configure();
+  fake_.clear_log();
+  bus.write(std::vector<double>{3.0, 0.1, -3.0});
+  bus.write(std::vector<double>{std::nan(""), 0.1, 0.0});
+  std::vector<double> measured(3, 0.0);
+  bus.read(measured);  // a round trip: the fake has handled the writes
+  const auto writes = fake_.log_of(dxl::inst::sync_write);
+  ASSERT_EQ(writes.size(), 2u);
+  const auto tick = [&](std::size_t w, std::size_t i) {
+    return static_cast<std::int32_t>(dxl::get_u32(&writes[w].params[5 + 5 * i]));
+  };
+  EXPECT_EQ(tick(0, 0), config.actuators[0].to_ticks(0.25));
+  EXPECT_EQ(tick(0, 1), config.actuators[1].to_ticks(0.1));
+  EXPECT_EQ(tick(0, 2), config.actuators[2].to_ticks(-0.1));
+  EXPECT_EQ(tick(1, 0), tick(0, 0));  // NaN: the previous goal again
+}
+
+TEST_F(DynamixelBusTest, PositionLimitsAreWrittenWithTorqueOffOnlyWhenTheyDiffer) {
+  auto config = make_config(fake_.port());
+  config.actuators[0].min_position = -0.5;
+  config.actuators[0].max_position = 0.25;
+  DynamixelBus bus(config, open_serial(fake_.port(), 1'000'000));
+  fake_.edit([](auto& s) { s[1].torque = 1; });
+  bus.configure();
+  const auto writes = fake_.log_of(dxl::inst::write);
+  ASSERT_EQ(writes.size(), 3u);  // torque off, max, min; nothing for the unlimited joints
+  EXPECT_EQ(writes[0].address(), dxl::xreg::torque_enable);
+  EXPECT_EQ(writes[0].params[2], 0);
+  EXPECT_EQ(writes[1].address(), dxl::xreg::max_position_limit);
+  EXPECT_EQ(dxl::get_u32(&writes[1].params[2]),
+            static_cast<std::uint32_t>(config.actuators[0].to_ticks(0.25)));
+  EXPECT_EQ(writes[2].address(), dxl::xreg::min_position_limit);
+  EXPECT_EQ(dxl::get_u32(&writes[2].params[2]),
+            static_cast<std::uint32_t>(config.actuators[0].to_ticks(-0.5)));
+  // Read back equal: the EEPROM is left alone.
+  fake_.clear_log();
+  bus.configure();
+  EXPECT_TRUE(fake_.log_of(dxl::inst::write).empty());
+}
+
+TEST_F(DynamixelBusTest, UnpluggedLineCountsTimeoutsWithoutThrowingOrAllocating) {
+  configured();
+  bus_.activate();
+  std::vector<double> q(3, 0.0);
+  bus_.read(q);
+  bus_.write(q);
+  fake_.unplug();
+  long allocations = 0;
+  {
+    test::AllocationCounter counter;
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_NO_THROW(bus_.read(q));
+      EXPECT_NO_THROW(bus_.write(q));
+    }
+    allocations = counter.count();
+  }
+  EXPECT_EQ(allocations, 0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_GE(status(i).timeouts, 5u) << i;
+    EXPECT_EQ(status(i).health, DeviceHealth::timeout) << i;
+  }
+  // Bringing the bus up again says why, once.
+  const std::string error = error_of([&] { bus_.configure(); });
+  EXPECT_NE(error.find("line is gone"), std::string::npos) << error;
 }
 
 TEST(DynamixelBus, RejectsBadBindings) {

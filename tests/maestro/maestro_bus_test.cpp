@@ -155,6 +155,22 @@ TEST(MaestroBus, ReadsTheBoardsOutputAndWritesBlocksOfTargets) {
   EXPECT_EQ(r.sim->pulse(0), 0);  // pulses off
 }
 
+TEST(MaestroBus, GoalsAreClampedIntoTheJointLimitsAndNaNHolds) {
+  Rig r;
+  r.bus->configure();
+  r.bus->activate();
+  std::vector<double> pos(3, 0.0);
+  // eye_pan is limited to +-30 degrees: 30 / 0.09 = 333.3 us past neutral.
+  r.bus->write(std::vector<double>{deg_to_rad(80), deg_to_rad(-4.5), deg_to_rad(18)});
+  r.clock.advance(10'000'000);
+  r.bus->read(pos);
+  EXPECT_EQ(r.sim->pulse(0), 6000 + 1333);
+  r.bus->write(std::vector<double>{std::nan(""), deg_to_rad(-4.5), deg_to_rad(18)});
+  r.clock.advance(10'000'000);
+  r.bus->read(pos);
+  EXPECT_EQ(r.sim->pulse(0), 6000 + 1333);
+}
+
 TEST(MaestroBus, BoardErrorsAreHardwareErrorsOfEveryChannel) {
   Rig r;
   r.bus->configure();

@@ -3,7 +3,12 @@
 
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
+#include <arpa/inet.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -120,6 +125,11 @@ TEST_P(ModbusTransports, TracksGoalsWithOneRequestPerSlaveAndDirection) {
 
 TEST_P(ModbusTransports, ExceptionsTimeoutsAndFaultsAreCountedPerDevice) {
   Rig r(GetParam());
+  // Without joint limits in the binding the bus would clamp the goal below.
+  BusConfig unlimited = r.config.buses[0];
+  unlimited.actuators[1].min_position = -HUGE_VAL;
+  unlimited.actuators[1].max_position = HUGE_VAL;
+  r.bus = std::make_unique<ModbusBus>(unlimited);
   r.bus->configure();
   r.bus->activate();
   // A goal past the actuator's stroke: the drive answers exception 3.
@@ -140,6 +150,38 @@ TEST_P(ModbusTransports, ExceptionsTimeoutsAndFaultsAreCountedPerDevice) {
   EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::hardware_error);
   EXPECT_EQ(r.bus->devices()[0].hardware_error_status, 0x04);
   EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+TEST_P(ModbusTransports, ADeadSlaveCostsOneRequestAndOneTimeoutPerCycle) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  r.step({0.0, 0.0});
+  r.sim->set_device_responding(2, false);
+  r.step({0.0, 0.0});  // the first cycle still writes: the slave answered last time
+  const std::uint64_t requests = r.bus->requests();
+  const std::uint64_t timeouts = r.bus->devices()[1].timeouts;
+  r.step({0.1, 0.0}, 5);
+  // Per cycle: slave 1 read + write, slave 2 read only.
+  EXPECT_EQ(r.bus->requests() - requests, 5u * 3);
+  EXPECT_EQ(r.bus->devices()[1].timeouts - timeouts, 5u);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  // Back: its goals are written again.
+  r.sim->set_device_responding(2, true);
+  r.step({0.1, 0.0}, 2);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+TEST_P(ModbusTransports, GoalsAreClampedIntoTheJointLimitsAndNaNHolds) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  // pan is limited to +-90 degrees by the robot file.
+  r.step({deg_to_rad(170), 0.0}, 150);
+  EXPECT_NEAR(r.sim->device_position(1), deg_to_rad(90), 1e-3);
+  r.step({std::nan(""), 0.0}, 20);
+  EXPECT_NEAR(r.sim->device_position(1), deg_to_rad(90), 1e-3);
+  EXPECT_EQ(r.bus->devices()[0].exceptions, 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(TcpAndRtu, ModbusTransports, ::testing::Values("modbus-tcp", "modbus-rtu"),
@@ -166,6 +208,47 @@ TEST(ModbusBus, IllegalAddressIsExceptionTwoAtBringUp) {
         << what;
     EXPECT_NE(what.find("slave 3 (lean): no answer"), std::string::npos) << what;
   }
+}
+
+TEST(ModbusBus, AClientHoldingHalfAHeaderStallsNoOtherClient) {
+  Rig r("modbus-tcp");
+  r.bus->configure();
+  const auto colon = r.sim->endpoint().rfind(':');
+  const int port = std::stoi(r.sim->endpoint().substr(colon + 1));
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::uint8_t half[3] = {0x00, 0x01, 0x00};  // transaction id and half the protocol id
+  ASSERT_EQ(::send(fd, half, sizeof half, 0), 3);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::uint64_t timeouts = r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts;
+  r.step({0.0, 0.0}, 5);
+  EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+  ::close(fd);
+}
+
+TEST(ModbusBus, RtuFrameCutOffBySilenceDoesNotSwallowTheNextRequest) {
+  Rig r("modbus-rtu");
+  r.bus->configure();
+  // Another writer on the line sends the start of a Read Holding Registers
+  // frame to slave 1 and falls silent.
+  const int fd = ::open(r.sim->endpoint().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(fd, 0);
+  const std::uint8_t cut[4] = {0x01, 0x03, 0x00, 0x10};
+  ASSERT_EQ(::write(fd, cut, sizeof cut), 4);
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  const std::uint64_t timeouts = r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts;
+  r.step({0.0, 0.0}, 3);
+  EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_GE(r.sim->stats().dropped, 4u);
+  ::close(fd);
 }
 
 TEST(ModbusBus, ADroppedConnectionIsReopenedWithBackoff) {

@@ -201,15 +201,20 @@ void Cia402Bus::sync_cycle() {
   transport_->send(canopen::sync());
   const auto deadline = std::chrono::steady_clock::now() + timeout_;
   can_frame frame;
+  // A node that floods the bus must not keep the cycle here: past the
+  // deadline at most this many more frames are taken.
+  std::size_t budget = frame_budget();
   while (waiting > 0) {
     const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
         deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 && budget-- == 0) break;
     if (!transport_->receive(frame, std::max(left, std::chrono::microseconds(0)))) break;
     handle(frame);
     waiting = static_cast<std::size_t>(std::count(expect_.begin(), expect_.end(), 1));
   }
   // Whatever else already arrived (heartbeats, EMCY) without waiting for more.
-  while (transport_->receive(frame, std::chrono::microseconds(0))) handle(frame);
+  budget = frame_budget();
+  while (budget-- > 0 && transport_->receive(frame, std::chrono::microseconds(0))) handle(frame);
   supervise();
 }
 
@@ -253,9 +258,11 @@ std::uint32_t Cia402Bus::sdo_exchange(std::size_t device, const can_frame& reque
     transport_->send(request);
     const auto deadline = std::chrono::steady_clock::now() + timeout_;
     can_frame frame;
+    std::size_t budget = frame_budget();
     while (!sdo_done_) {
       const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
           deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0 && budget-- == 0) break;
       if (!transport_->receive(frame, std::max(left, std::chrono::microseconds(0)))) break;
       handle(frame);
     }
@@ -425,8 +432,8 @@ void Cia402Bus::write(std::span<const double> positions) {
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
     if (i < positions.size() && std::isfinite(positions[i])) {
-      target_counts_[i] =
-          config_.actuators[i].to_ticks(std::clamp(positions[i], min_rad_[i], max_rad_[i]));
+      const double goal = config_.actuators[i].safe_goal(positions[i], positions[i]);
+      target_counts_[i] = config_.actuators[i].to_ticks(std::clamp(goal, min_rad_[i], max_rad_[i]));
     }
     send_rpdo(i, cia402::cw::enable_operation, target_counts_[i]);
   }

@@ -72,9 +72,12 @@ std::size_t MitBus::exchange() {
   const auto deadline = std::chrono::steady_clock::now() + timeout_;
   can_frame frame;
   mit::Reply reply;
+  // Past the deadline at most this many more frames: a flood cannot hold the cycle.
+  std::size_t budget = 64 + 8 * pending_.size();
   while (waiting > 0) {
     const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
         deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 && budget-- == 0) break;
     if (!transport_->receive(frame, std::max(left, std::chrono::microseconds(0)))) break;
     if ((frame.can_id & CAN_SFF_MASK) != bus_options_.master_id) continue;
     const int slot = frame.len >= 1 ? slot_of_id_[frame.data[0]] : -1;
@@ -209,7 +212,8 @@ void MitBus::write(std::span<const double> positions) {
     if (status_[i].faulted) continue;
     const MitMotorOptions& m = motor_[i];
     if (i < positions.size() && std::isfinite(positions[i])) {
-      const double motor = m.to_motor(positions[i], config_.actuators[i].direction);
+      const double goal = config_.actuators[i].safe_goal(positions[i], positions[i]);
+      const double motor = m.to_motor(goal, config_.actuators[i].direction);
       goal_motor_rad_[i] = std::clamp(motor, m.min_motor_rad, m.max_motor_rad);
     }
     frames_[i] = mit::pack_command(static_cast<canid_t>(config_.actuators[i].device_id),

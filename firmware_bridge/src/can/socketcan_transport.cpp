@@ -51,6 +51,8 @@ class SocketCanTransport final : public CanFrameTransport {
         const int change = count_error_frame(frame, errors_);
         if (change > 0) bus_off_ = true;
         if (change < 0) bus_off_ = false;
+        // A flood of error frames must not hold the caller past its timeout.
+        if (std::chrono::steady_clock::now() >= deadline) return false;
         continue;
       }
       if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {

@@ -72,6 +72,7 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   const std::string bus = "bus " + config_.name + ": ";
   if (!transport_) throw DeviceError(bus + "no transport");
   if (!(config_.timeout_s > 0.0)) throw DeviceError(bus + "timeout must be positive");
+  transport_->set_timeout(timeout_);
   const std::size_t n = config_.actuators.size();
   if (n > kMaxDevices) {
     throw DeviceError(bus + std::to_string(n) + " devices do not fit one Sync Write (at most " +
@@ -107,12 +108,17 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
+    device_of_id_[static_cast<std::size_t>(b.device_id)] = static_cast<std::int16_t>(i);
     present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
     // One tick inside the int32 range so rounding cannot wrap.
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
     const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
     min_rad_[i] = std::min(a, c);
     max_rad_[i] = std::max(a, c);
+    if (b.has_limits()) {  // defence in depth: never a goal outside the joint
+      min_rad_[i] = std::max(min_rad_[i], b.min_position);
+      max_rad_[i] = std::min(max_rad_[i], b.max_position);
+    }
   }
 }
 
@@ -143,6 +149,8 @@ dxl::DecodeResult DynamixelBus::next_event(dxl::Packet& packet, Deadline deadlin
     if (now >= deadline) return dxl::DecodeResult::need_more;
     rx_begin_ = 0;
     rx_end_ = transport_->read(rx_, std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+    // A failed line answers nothing, at once: no point waiting for the deadline.
+    if (rx_end_ == 0 && transport_->failure() != nullptr) return dxl::DecodeResult::need_more;
   }
 }
 
@@ -225,6 +233,23 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
       slot = expected;
       while (slot < count && !(ids_[slot] == packet.id && answer_[slot] == Answer::pending)) ++slot;
     }
+    if (slot < count && stale(packet, data_length)) {
+      // Right id, but no answer to this instruction (a late answer to an
+      // earlier one, e.g. a ping's 3 bytes when 4 are read): the real answer
+      // may still come.
+      DeviceStatus& st = status_[asked_[slot]];
+      ++st.protocol_errors;
+      st.health = DeviceHealth::protocol_error;
+      suspect_[slot] = 1;
+      continue;
+    }
+    if (slot == count && r == dxl::DecodeResult::packet && device_of_id_[packet.id] >= 0) {
+      // A late answer of another device on this bus (to an earlier request):
+      // its own fault, not the fault of the device whose answer is awaited.
+      DeviceStatus& st = status_[static_cast<std::size_t>(device_of_id_[packet.id])];
+      ++st.protocol_errors;
+      continue;
+    }
     if (slot == count) {
       // Junk that looked like a header, or a packet from an id not asked (or
       // answered twice): counted, and the real answer is still waited for.
@@ -255,6 +280,13 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
     st.health = DeviceHealth::timeout;
     answer_[s] = Answer::timeout;
   }
+}
+
+bool DynamixelBus::stale(const dxl::Packet& packet, std::size_t data_length) {
+  if (data_length == kAnyLength || packet.params.empty()) return false;
+  // An error number is a verdict on this instruction whatever its length.
+  if ((packet.params[0] & kErrorNumberMask) != 0) return false;
+  return packet.params.size() - 1 != data_length;
 }
 
 DynamixelBus::Answer DynamixelBus::unicast(std::size_t device, std::size_t length,
@@ -336,6 +368,9 @@ void DynamixelBus::configure() {
     if (a == Answer::ok || a == Answer::rejected) continue;  // it answered: it is there
     list += (list.empty() ? "" : ", ") + describe(i);
   }
+  if (transport_->failure() != nullptr) {
+    throw DeviceError(prefix() + describe_failure(*transport_));
+  }
   if (!silent.empty() || !garbled.empty()) {
     std::string message = prefix();
     if (!silent.empty()) message += "no answer to ping from " + silent;
@@ -358,8 +393,44 @@ void DynamixelBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
+  for (std::size_t i = 0; i < n; ++i) write_position_limits(i);
   read_pending_hardware_status();
   fresh_ = true;
+}
+
+void DynamixelBus::write_position_limits(std::size_t device) {
+  const ActuatorBinding& b = config_.actuators[device];
+  if (!b.has_limits()) return;
+  // The joint's limits in ticks, inside the range X-series position mode
+  // accepts (0..4095).
+  const std::int32_t a = b.to_ticks(b.min_position);
+  const std::int32_t c = b.to_ticks(b.max_position);
+  const auto lo = static_cast<std::uint32_t>(std::clamp(std::min(a, c), 0, kXMaxTicks));
+  const auto hi = static_cast<std::uint32_t>(std::clamp(std::max(a, c), 0, kXMaxTicks));
+  const auto id = static_cast<std::uint8_t>(b.device_id);
+  const auto fail = [&](Answer answer, const std::string& what) {
+    throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +
+                      failure(device, answer));
+  };
+  std::uint32_t now_lo = 0, now_hi = 0;
+  Answer r = unicast(device, dxl::encode_read(id, dxl::xreg::max_position_limit, 4, tx_), 4);
+  if (r != Answer::ok) fail(r, "read Max Position Limit");
+  now_hi = value_[0];
+  r = unicast(device, dxl::encode_read(id, dxl::xreg::min_position_limit, 4, tx_), 4);
+  if (r != Answer::ok) fail(r, "read Min Position Limit");
+  now_lo = value_[0];
+  if (now_lo == lo && now_hi == hi) return;  // EEPROM: written only when it differs
+  // EEPROM items are locked while torque is on.
+  r = unicast(device, dxl::encode_read(id, dxl::xreg::torque_enable, 1, tx_), 1);
+  if (r != Answer::ok) fail(r, "read Torque Enable");
+  if (value_[0] != 0) {
+    r = write_register(device, dxl::xreg::torque_enable, 0, 1, kTries);
+    if (r != Answer::ok) fail(r, "turn torque off to write the position limits");
+  }
+  r = write_register(device, dxl::xreg::max_position_limit, hi, 4, kTries);
+  if (r != Answer::ok) fail(r, "write Max Position Limit " + std::to_string(hi));
+  r = write_register(device, dxl::xreg::min_position_limit, lo, 4, kTries);
+  if (r != Answer::ok) fail(r, "write Min Position Limit " + std::to_string(lo));
 }
 
 void DynamixelBus::activate() {

@@ -49,6 +49,7 @@ MaestroBus::MaestroBus(BusConfig config, std::unique_ptr<ByteTransport> transpor
           std::chrono::duration<double>(config_.timeout_s))) {
   const std::string bus = "bus " + config_.name + ": ";
   if (!transport_) throw DeviceError(bus + "no transport");
+  transport_->set_timeout(timeout_);
   if (const auto* o = std::any_cast<MaestroBusOptions>(&config_.options)) options_ = *o;
   const std::size_t n = config_.actuators.size();
   channels_.resize(n);
@@ -105,8 +106,11 @@ std::size_t MaestroBus::receive(std::size_t want, std::chrono::microseconds time
   while (got < want) {
     const auto now = steady_clock::now();
     if (now >= deadline) break;
-    got += transport_->read({rx_.data() + got, want - got},
-                            std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+    const std::size_t n =
+        transport_->read({rx_.data() + got, want - got},
+                         std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+    if (n == 0 && transport_->failure() != nullptr) break;  // line gone: nothing will come
+    got += n;
   }
   return got;
 }
@@ -171,6 +175,7 @@ std::uint16_t MaestroBus::target_of(std::size_t device, double rad) const {
   const double lo = std::ceil(ch.min_us * 4.0);
   const double hi = std::floor(ch.max_us * 4.0);
   const ActuatorBinding& b = config_.actuators[device];
+  rad = b.safe_goal(rad, rad);  // into the joint's limits (finite here)
   const double ticks = std::round(b.zero_ticks + b.direction * rad * b.ticks_per_rad);
   return static_cast<std::uint16_t>(std::clamp(ticks, lo, hi));
 }
@@ -206,6 +211,7 @@ void MaestroBus::configure() {
                         " again after clearing");
     }
   }
+  if (transport_->failure() != nullptr) throw DeviceError(prefix() + describe_failure(*transport_));
   if (!silent.empty())
     throw DeviceError(prefix() + "no answer to Get Position/Get Errors from " + silent);
   for (std::size_t i = 0; i < present_.size(); ++i) {

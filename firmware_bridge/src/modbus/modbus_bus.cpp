@@ -1,6 +1,7 @@
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
 #include <modbus.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <any>
@@ -17,6 +18,7 @@ using std::chrono::steady_clock;
 constexpr int kMaxReadWords = 125;   // Read (Holding|Input) Registers
 constexpr int kMaxWriteWords = 123;  // Write Multiple Registers
 constexpr int kTries = 3;            // lifecycle requests only
+constexpr int kMaxFlushReads = 16;   // bounded input flush before a cycle's requests
 
 std::string exception_name(int code) {
   switch (code) {
@@ -168,6 +170,22 @@ bool ModbusBus::ensure_connected(bool blocking) {
   next_attempt_ = now + std::chrono::duration_cast<steady_clock::duration>(
                             std::chrono::duration<double>(backoff_s_));
   return false;
+}
+
+void ModbusBus::flush_input() {
+  if (!options_.tcp) {
+    modbus_flush(ctx_);  // RTU: tcflush, bounded
+    return;
+  }
+  // TCP: what is queued now, at most a few ADUs; a peer that keeps sending
+  // must not keep the cycle here (libmodbus's flush reads while data comes).
+  const int fd = modbus_get_socket(ctx_);
+  if (fd < 0) return;
+  std::uint8_t sink[MODBUS_TCP_MAX_ADU_LENGTH];
+  for (int k = 0; k < kMaxFlushReads; ++k) {
+    const ssize_t n = ::recv(fd, sink, sizeof sink, MSG_DONTWAIT);
+    if (n <= 0) return;
+  }
 }
 
 ModbusBus::Failure ModbusBus::classify(int error) const {
@@ -361,6 +379,7 @@ void ModbusBus::configure() {
     }
   }
   goal_rad_ = present_rad_;
+  for (Slave& s : slaves_) s.silent = false;
   fresh_ = true;
 }
 
@@ -402,6 +421,7 @@ void ModbusBus::read(std::span<double> positions) {
   }
   if (!ensure_connected(false)) {
     // Down and waiting for the next attempt: no answer this cycle.
+    for (Slave& s : slaves_) s.silent = true;
     for (DeviceStatus& st : status_) {
       if (st.faulted) continue;
       ++st.transactions;
@@ -410,9 +430,10 @@ void ModbusBus::read(std::span<double> positions) {
     }
     return;
   }
-  modbus_flush(ctx_);  // late answers of timed-out requests must not pass for these
+  flush_input();  // late answers of timed-out requests must not pass for these
   for (Slave& s : slaves_) {
     if (!connected_) {
+      s.silent = true;
       for (std::size_t d : s.devices) {
         if (status_[d].faulted) continue;
         ++status_[d].transactions;
@@ -421,7 +442,7 @@ void ModbusBus::read(std::span<double> positions) {
       }
       continue;
     }
-    read_slave(s, true);
+    s.silent = !read_slave(s, true);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (answered_[i]) positions[i] = present_rad_[i];
@@ -430,10 +451,12 @@ void ModbusBus::read(std::span<double> positions) {
 
 void ModbusBus::write(std::span<const double> positions) {
   for (std::size_t i = 0; i < std::min(positions.size(), goal_rad_.size()); ++i) {
-    if (std::isfinite(positions[i])) goal_rad_[i] = positions[i];
+    goal_rad_[i] = config_.actuators[i].safe_goal(positions[i], goal_rad_[i]);
   }
   if (!connected_) return;  // read() reconnects; nothing to say to a dead link
-  for (Slave& s : slaves_) write_slave(s);
+  for (Slave& s : slaves_) {
+    if (!s.silent) write_slave(s);
+  }
 }
 
 }  // namespace animrt

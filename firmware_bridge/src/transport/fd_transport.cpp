@@ -13,10 +13,6 @@
 namespace animrt::detail {
 namespace {
 
-// A writer that cannot hand bytes to the driver for this long is stuck (the
-// other end stopped reading); better an error than a frozen loop.
-constexpr std::chrono::milliseconds kWriteStall{1000};
-
 std::int64_t now_ns() {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -43,13 +39,18 @@ short wait_for(int fd, short events, std::int64_t deadline_ns) {
 
 }  // namespace
 
-void FdTransport::line_gone(const char* what, int error) const {
-  std::string message = "serial port " + port_ + ": " + what;
-  if (error != 0) message += std::string(": ") + std::strerror(error);
-  throw DeviceError(message);
+void FdTransport::line_gone(const char* how, int error) {
+  if (failure_ != nullptr) return;
+  failure_ = how;
+  failure_errno_ = error;
 }
 
-void FdTransport::write(std::span<const std::uint8_t> bytes) {
+bool FdTransport::write(std::span<const std::uint8_t> bytes) {
+  if (failure_ != nullptr) {
+    ++write_failures_;
+    return false;
+  }
+  const std::int64_t deadline = now_ns() + std::chrono::nanoseconds(timeout_).count();
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
@@ -59,18 +60,30 @@ void FdTransport::write(std::span<const std::uint8_t> bytes) {
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      const short ev =
-          wait_for(fd_, POLLOUT, now_ns() + std::chrono::nanoseconds(kWriteStall).count());
-      if (ev == 0) line_gone("write stalled (the other end is not reading)", 0);
-      if ((ev & POLLOUT) == 0) line_gone("line is gone (hangup or error)", 0);
+      // The other end is not reading: wait no longer than one bus timeout,
+      // then give up on this packet (the device drops the partial packet
+      // after its inter-byte silence).
+      const short ev = wait_for(fd_, POLLOUT, deadline);
+      if (ev == 0) {
+        ++write_failures_;
+        return false;
+      }
+      if ((ev & POLLOUT) == 0) {
+        line_gone("line is gone (hangup or error)", 0);
+        ++write_failures_;
+        return false;
+      }
       continue;
     }
     line_gone("write failed, line is gone", n < 0 ? errno : 0);
+    ++write_failures_;
+    return false;
   }
+  return true;
 }
 
 std::size_t FdTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
-  if (buffer.empty()) return 0;
+  if (buffer.empty() || failure_ != nullptr) return 0;
   const std::int64_t deadline = now_ns() + std::chrono::nanoseconds(timeout).count();
   bool waited = false;
   for (;;) {
@@ -80,29 +93,62 @@ std::size_t FdTransport::read(std::span<std::uint8_t> buffer, std::chrono::micro
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
       line_gone("read failed, line is gone", errno);
+      return 0;
     }
     // Nothing queued (EAGAIN, or 0 when the tty has VMIN = 0); a hangup also
     // reads 0, so poll tells the two apart.
     if (waited && now_ns() >= deadline) return 0;
     const short ev = wait_for(fd_, POLLIN, deadline);
     waited = true;
-    if ((ev & (POLLHUP | POLLERR | POLLNVAL)) != 0) line_gone("line is gone (hangup)", 0);
+    if ((ev & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
+      // Bytes that came before the hangup are still handed out.
+      const ssize_t last = ::read(fd_, buffer.data(), buffer.size());
+      if (last > 0) return static_cast<std::size_t>(last);
+      line_gone("line is gone (hangup)", last < 0 ? errno : 0);
+      return 0;
+    }
     if (ev == 0) return 0;
   }
 }
 
 void FdTransport::discard_input() {
+  if (failure_ != nullptr) return;
   tcflush(fd_, TCIFLUSH);
   // tcflush leaves bytes that were still in flight in the driver (a pty's
-  // flip buffer); read them away too.
+  // flip buffer); read them away too, but never for longer than the timeout
+  // or more than kMaxDiscard bytes: a device that keeps sending must not
+  // keep us here.
+  const std::int64_t deadline = now_ns() + std::chrono::nanoseconds(timeout_).count();
   std::uint8_t sink[256];
-  for (;;) {
+  std::size_t dropped = 0;
+  while (dropped < kMaxDiscard && now_ns() < deadline) {
     const ssize_t n = ::read(fd_, sink, sizeof sink);
-    if (n > 0) continue;
+    if (n > 0) {
+      dropped += static_cast<std::size_t>(n);
+      continue;
+    }
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK)
+      line_gone("read failed, line is gone", errno);
     return;
   }
 }
+
+}  // namespace animrt::detail
+
+namespace animrt {
+
+std::string describe_failure(const ByteTransport& transport) {
+  std::string message = "serial port " + transport.port() + ": ";
+  message += transport.failure() != nullptr ? transport.failure() : "working";
+  if (transport.failure_errno() != 0)
+    message += std::string(": ") + std::strerror(transport.failure_errno());
+  return message;
+}
+
+}  // namespace animrt
+
+namespace animrt::detail {
 
 void throw_open_error(const std::string& port, const std::string& reason, int error) {
   std::string message = "cannot open serial port " + port + ": " + reason;

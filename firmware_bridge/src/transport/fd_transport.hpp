@@ -17,9 +17,13 @@ namespace animrt::detail {
 
 class FdTransport : public ByteTransport {
  public:
-  void write(std::span<const std::uint8_t> bytes) override;
+  void set_timeout(std::chrono::microseconds timeout) override { timeout_ = timeout; }
+  bool write(std::span<const std::uint8_t> bytes) override;
   std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) override;
   void discard_input() override;
+  const char* failure() const override { return failure_; }
+  int failure_errno() const override { return failure_errno_; }
+  std::uint64_t write_failures() const override { return write_failures_; }
   const std::string& port() const override { return port_; }
 
  protected:
@@ -28,10 +32,15 @@ class FdTransport : public ByteTransport {
   int fd() const { return fd_; }
 
  private:
-  [[noreturn]] void line_gone(const char* what, int error) const;
+  // Marks the line failed (first reason kept); no allocation.
+  void line_gone(const char* how, int error);
 
   std::string port_;
   int fd_ = -1;
+  std::chrono::microseconds timeout_{1'000'000};
+  const char* failure_ = nullptr;
+  int failure_errno_ = 0;
+  std::uint64_t write_failures_ = 0;
 };
 
 // "cannot open serial port PORT: REASON", with a hint for the usual causes.

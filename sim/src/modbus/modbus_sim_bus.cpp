@@ -216,6 +216,7 @@ void ModbusSimBus::stop() {
   thread_.join();
   for (int fd : clients_) ::close(fd);
   clients_.clear();
+  client_rx_.clear();
 }
 
 ModbusSimBus::Drive* ModbusSimBus::drive(int slave) {
@@ -340,19 +341,31 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
   d->enabled = !any_enable || enabled;
 }
 
+void ModbusSimBus::close_client(std::size_t i) {
+  ::close(clients_[i]);
+  clients_.erase(clients_.begin() + static_cast<std::ptrdiff_t>(i));
+  client_rx_.erase(client_rx_.begin() + static_cast<std::ptrdiff_t>(i));
+}
+
+// Each connection has its own receive buffer: a request is handled once its
+// whole ADU (MBAP length) arrived, so a client that sends half a header
+// holds up nobody else; one that stays incomplete for kTcpStallMs is closed.
 void ModbusSimBus::serve_tcp() {
-  std::array<std::uint8_t, MODBUS_TCP_MAX_ADU_LENGTH> req{};
   std::vector<pollfd> fds;
+  const MonotonicClock wall;
   while (!stop_.load()) {
     if (drop_.exchange(false)) {
-      for (int fd : clients_) ::close(fd);
-      clients_.clear();
+      while (!clients_.empty()) close_client(clients_.size() - 1);
     }
     fds.clear();
     fds.push_back({wake_->read_fd(), POLLIN, 0});
     fds.push_back({listen_fd_, POLLIN, 0});
-    for (int fd : clients_) fds.push_back({fd, POLLIN, 0});
-    if (::poll(fds.data(), fds.size(), -1) < 0) {
+    bool partial = false;
+    for (std::size_t i = 0; i < clients_.size(); ++i) {
+      fds.push_back({clients_[i], POLLIN, 0});
+      partial = partial || client_rx_[i].have > 0;
+    }
+    if (::poll(fds.data(), fds.size(), partial ? kTcpStallMs : -1) < 0) {
       if (errno == EINTR) continue;
       break;
     }
@@ -360,22 +373,55 @@ void ModbusSimBus::serve_tcp() {
       wake_->drain();
       continue;  // stop or drop: checked at the top
     }
+    const Nanos now = wall.now();
     if (fds[1].revents & POLLIN) {
       const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
       if (fd >= 0) {
         clients_.push_back(fd);
+        client_rx_.emplace_back();
+        fds.push_back({fd, 0, 0});  // nothing to read from it in this round
         ++connections_;
       }
     }
-    for (std::size_t i = 2; i < fds.size(); ++i) {
-      if (fds[i].revents == 0) continue;
-      modbus_set_socket(ctx_, fds[i].fd);
-      const int rc = modbus_receive(ctx_, req.data());
-      if (rc > 0) {
-        handle(req.data(), rc, modbus_get_header_length(ctx_));
-      } else if (rc < 0) {
-        ::close(fds[i].fd);
-        clients_.erase(std::find(clients_.begin(), clients_.end(), fds[i].fd));
+    // Clients that keep a request half sent for too long are dropped.
+    for (std::size_t i = clients_.size(); i-- > 0;) {
+      if (client_rx_[i].have > 0 && fds[i + 2].revents == 0 &&
+          now - client_rx_[i].since > Nanos{kTcpStallMs} * 1'000'000) {
+        ++dropped_;
+        close_client(i);
+        fds.erase(fds.begin() + static_cast<std::ptrdiff_t>(i + 2));
+      }
+    }
+    for (std::size_t i = clients_.size(); i-- > 0;) {
+      if (fds[i + 2].revents == 0) continue;
+      ClientRx& rx = client_rx_[i];
+      const ssize_t n =
+          ::recv(clients_[i], rx.buf.data() + rx.have, rx.buf.size() - rx.have, MSG_DONTWAIT);
+      if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR)) {
+        close_client(i);
+        continue;
+      }
+      if (n < 0) continue;
+      if (rx.have == 0) rx.since = now;
+      rx.have += static_cast<std::size_t>(n);
+      bool bad = false;
+      while (rx.have >= kMbapLength) {
+        const std::size_t length = get16(rx.buf.data() + 4);  // unit id + PDU
+        const std::size_t total = 6 + length;
+        if (length < 2 || total > rx.buf.size()) {
+          bad = true;
+          break;
+        }
+        if (rx.have < total) break;
+        modbus_set_socket(ctx_, clients_[i]);
+        handle(rx.buf.data(), static_cast<int>(total), static_cast<int>(kMbapLength));
+        std::memmove(rx.buf.data(), rx.buf.data() + total, rx.have - total);
+        rx.have -= total;
+        rx.since = now;
+      }
+      if (bad) {
+        ++dropped_;
+        close_client(i);
       }
     }
   }

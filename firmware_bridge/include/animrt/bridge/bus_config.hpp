@@ -4,6 +4,7 @@
 
 #include <any>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -13,32 +14,42 @@ namespace animrt {
 
 // How a joint maps to one device on a bus.
 struct ActuatorBinding {
-  std::string joint;          // robot joint name
-  int joint_index = -1;       // robot joint index
-  int device_id = 0;          // bus address (Dynamixel id 0..252)
+  std::string joint;     // robot joint name
+  int joint_index = -1;  // robot joint index
+  int device_id = 0;     // bus address (Dynamixel id 0..252)
   double ticks_per_rad = 4096.0 / (2.0 * 3.14159265358979323846);  // native scale
-  std::int32_t zero_ticks = 2048;  // ticks at 0 rad
-  int direction = 1;               // +1 or -1
+  std::int32_t zero_ticks = 2048;                                  // ticks at 0 rad
+  int direction = 1;                                               // +1 or -1
+  // The joint's position limits (rad, or m for a prismatic joint), copied
+  // from the robot file: every bus clamps its goals into them before they
+  // reach the wire, whatever the layers above did. Unbounded by default.
+  double min_position = -std::numeric_limits<double>::infinity();
+  double max_position = std::numeric_limits<double>::infinity();
   // Protocol-specific settings, owned by the protocol module that read them
   // (for example a register map or a pulse calibration).
   std::any options;
 
   std::int32_t to_ticks(double rad) const;
+  // The goal a bus may send for `goal`: clamped into the joint's limits; a
+  // NaN or infinite goal never reaches the wire, `held` (the previous goal)
+  // is sent again instead.
+  double safe_goal(double goal, double held) const;
+  bool has_limits() const;
   double to_rad(std::int32_t ticks) const;
 };
 
 // Simulated-device settings of a bus (used only with --backend sim).
 struct SimBusSettings {
-  double time_constant_s = 0.02;   // first-order lag of each motor
-  double max_speed_rad_s = 6.0;    // rate limit of each motor
-  bool wire_time = false;          // emulate bytes on the wire at the baud rate
-  int return_delay_us = 0;         // device's delay before answering
+  double time_constant_s = 0.02;  // first-order lag of each motor
+  double max_speed_rad_s = 6.0;   // rate limit of each motor
+  bool wire_time = false;         // emulate bytes on the wire at the baud rate
+  int return_delay_us = 0;        // device's delay before answering
 };
 
 struct BusConfig {
   std::string name;
-  std::string protocol;     // a registered Protocol's name, e.g. "dynamixel2"
-  std::string port;         // where the bus is: /dev/ttyUSB0, host:port, can0, ...
+  std::string protocol;  // a registered Protocol's name, e.g. "dynamixel2"
+  std::string port;      // where the bus is: /dev/ttyUSB0, host:port, can0, ...
   int baud = 1'000'000;
   double timeout_s = 0.004;  // answer timeout for one transaction
   SimBusSettings sim;

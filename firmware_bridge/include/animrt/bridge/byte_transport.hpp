@@ -14,16 +14,35 @@ namespace animrt {
 class ByteTransport {
  public:
   virtual ~ByteTransport() = default;
-  // Writes all bytes (blocking until handed to the driver). Throws DeviceError
-  // if the line is gone.
-  virtual void write(std::span<const std::uint8_t> bytes) = 0;
+  // Bounds write() and discard_input(); a bus sets its answer timeout here
+  // when it is built. Until then one second.
+  virtual void set_timeout(std::chrono::microseconds timeout) = 0;
+  // Writes all bytes, waiting at most the timeout for the driver to take
+  // them. False when the line stalled (nobody reads) or is gone. Never
+  // throws, never allocates.
+  virtual bool write(std::span<const std::uint8_t> bytes) = 0;
   // Reads what is available, waiting at most `timeout` for the first byte.
-  // Returns the number of bytes read (0 on timeout). Never allocates.
+  // Returns the number of bytes read (0 on timeout, or at once when the line
+  // is gone). Never throws, never allocates.
   virtual std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) = 0;
-  // Drops bytes received but not yet read.
+  // Drops bytes received but not yet read; stops after the timeout or
+  // kMaxDiscard bytes, even if the other end keeps sending.
   virtual void discard_input() = 0;
+  // nullptr while the line works; once it failed (hangup, EIO: the adapter
+  // was unplugged) a fixed text saying how, and the line stays failed.
+  virtual const char* failure() const = 0;
+  // errno of that failure (0 when none, or none was given).
+  virtual int failure_errno() const = 0;
+  // Writes that did not complete (stalled or failed), since opening.
+  virtual std::uint64_t write_failures() const = 0;
   virtual const std::string& port() const = 0;
+
+  static constexpr std::size_t kMaxDiscard = 4096;
 };
+
+// "serial port PORT: HOW: STRERROR" for a failed transport (allocates; for
+// lifecycle messages only).
+std::string describe_failure(const ByteTransport& transport);
 
 // Opens `port` at `baud` (8N1, no flow control). A pseudo-terminal
 // (/dev/pts/N or a symlink to one) is opened through termios, anything else

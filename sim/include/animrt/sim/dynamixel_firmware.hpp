@@ -35,6 +35,7 @@ struct Answers {
     std::size_t offset = 0;
     std::size_t size = 0;
     int return_delay_us = 0;  // the answering servo's Return Delay Time
+    Nanos late_ns = 0;        // injected lateness (DynamixelServo::set_answer_delay)
   };
   std::vector<std::uint8_t> bytes;
   std::vector<Answer> list;

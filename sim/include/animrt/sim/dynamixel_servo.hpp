@@ -28,6 +28,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
@@ -66,8 +67,20 @@ std::uint8_t baud_rate_register(int baud);
 // do: (2 + id % 3) degrees, positive for odd ids and negative for even ones.
 double initial_offset_rad(int device_id);
 
+// One Goal Position the servo received (Write, Reg Write + Action, Sync or
+// Bulk Write), as it arrived.
+struct GoalRecord {
+  Nanos time = 0;          // the servo's time when the packet took effect
+  std::int32_t ticks = 0;  // the value written
+  double rad = 0.0;        // the same through the binding
+  bool accepted = false;   // false: refused (e.g. outside Min/Max Position Limit)
+};
+
 class DynamixelServo {
  public:
+  // The goal log keeps the latest this many goals (a ring, allocated once).
+  static constexpr std::size_t kGoalLogCapacity = 16384;
+
   // `physics` (optional, outlives the servo) replaces the motor model; it
   // must drive binding.joint (InputError otherwise).
   DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings, int baud,
@@ -103,6 +116,19 @@ class DynamixelServo {
   void set_responding(bool responding) { responding_ = responding; }
   void set_hardware_error(std::uint8_t bits, Nanos now);
 
+  // Fault injection: the next `answers` status packets (every one while
+  // answers < 0) leave `delay_ns` of real time late, so a client sees late
+  // answers as from a slow or overloaded servo. delay_ns 0 switches it off.
+  void set_answer_delay(Nanos delay_ns, int answers = -1);
+  // The delay for the status packet about to be sent (consumes one count).
+  Nanos take_answer_delay() const;
+
+  // Goals received so far, oldest first (at most kGoalLogCapacity; older
+  // ones are dropped), and how many were received in all.
+  std::vector<GoalRecord> goal_log() const;
+  std::uint64_t goals_received() const { return goals_received_; }
+  void clear_goal_log();
+
   // Present position in radians through the binding, at time `now`, without
   // changing the state (with physics: where the physics is now).
   double position_rad(Nanos now) const;
@@ -135,6 +161,12 @@ class DynamixelServo {
   std::array<std::uint8_t, dxl::xreg::table_size> pending_{};
   std::uint16_t pending_address_ = 0;
   std::uint16_t pending_length_ = 0;
+  // Fault injection and the goal log.
+  Nanos answer_delay_ns_ = 0;
+  mutable int delayed_answers_left_ = 0;  // < 0: every answer
+  std::vector<GoalRecord> goal_ring_;
+  std::uint64_t goals_received_ = 0;
+  void log_goal(std::uint16_t address, std::span<const std::uint8_t> data, bool accepted);
 };
 
 }  // namespace animrt::sim

@@ -14,6 +14,9 @@
 // packet before it: the cycle it was sent in, when each cycle starts with an
 // answered transaction (read, then write).
 //
+// A packet cut off by 5 ms of silence is dropped (as a servo's receive
+// timeout does), so a truncated packet never swallows the next one.
+//
 // Wire time (SimBusSettings::wire_time): each answer is held back (real time)
 // until the instruction's bytes, the servo's Return Delay Time and the
 // answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
@@ -25,6 +28,7 @@
 #include <span>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
@@ -35,12 +39,13 @@
 namespace animrt::sim {
 
 struct DynamixelSimStats {
-  std::uint64_t packets = 0;        // instruction packets handled (any id)
-  std::uint64_t answers = 0;        // status packets sent
-  std::uint64_t crc_errors = 0;     // packets dropped for a bad CRC (never answered)
-  std::uint64_t malformed = 0;      // impossible length or bad stuffing
-  std::uint64_t stray_bytes = 0;    // bytes outside any packet
-  std::uint64_t dropped_bytes = 0;  // answer bytes the client never read (pty full)
+  std::uint64_t packets = 0;               // instruction packets handled (any id)
+  std::uint64_t answers = 0;               // status packets sent
+  std::uint64_t crc_errors = 0;            // packets dropped for a bad CRC (never answered)
+  std::uint64_t malformed = 0;             // impossible length or bad stuffing
+  std::uint64_t stray_bytes = 0;           // bytes outside any packet
+  std::uint64_t dropped_bytes = 0;         // answer bytes the client never read (pty full)
+  std::uint64_t partial_packet_bytes = 0;  // bytes of packets cut off by a silence
 };
 
 class DynamixelSimBus final : public SimulatedBus {
@@ -62,6 +67,10 @@ class DynamixelSimBus final : public SimulatedBus {
   void set_device_responding(int device_id, bool responding) override;
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   double device_position(int device_id) const override;
+  // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
+  void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
+  std::vector<GoalRecord> device_goal_log(int device_id) const;
+  std::uint64_t device_goals_received(int device_id) const;
 
   DynamixelSimStats stats() const;
 
@@ -72,6 +81,7 @@ class DynamixelSimBus final : public SimulatedBus {
   void send(std::span<const std::uint8_t> bytes);
   Nanos wire_ns(std::size_t bytes) const;
   void close_fds();
+  void drop_partial_packet();
 
   BusConfig config_;
   const Clock& clock_;
@@ -98,6 +108,7 @@ class DynamixelSimBus final : public SimulatedBus {
   std::atomic<std::uint64_t> malformed_{0};
   std::atomic<std::uint64_t> stray_bytes_{0};
   std::atomic<std::uint64_t> dropped_bytes_{0};
+  std::atomic<std::uint64_t> dropped_partial_{0};
 };
 
 }  // namespace animrt::sim

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "animrt/bridge/bus_config.hpp"
@@ -27,6 +28,16 @@ class SimulatedBus {
   // Fault injection: a device with hardware error bits set reports them in its
   // hardware error register and sets the alert bit of every status packet.
   virtual void set_device_hardware_error(int device_id, std::uint8_t error_bits) = 0;
+  // Fault injection: the device's next `answers` answers (every one while
+  // answers < 0) leave `delay_ns` of real time late; 0 switches it off.
+  // Throws std::logic_error where the devices do not model it (only the
+  // Dynamixel servos do).
+  virtual void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) {
+    (void)device_id;
+    (void)delay_ns;
+    (void)answers;
+    throw std::logic_error("simulated bus " + endpoint() + ": answer delay is not modelled");
+  }
   // Position of a device in radians (through its binding), for tests.
   virtual double device_position(int device_id) const = 0;
 };

@@ -71,6 +71,8 @@ class Cia402Bus final : public ActuatorBus {
   void nmt(canopen::NmtCommand command, std::size_t device);
 
  private:
+  // Frames taken past a deadline before giving up (a flooding node).
+  std::size_t frame_budget() const { return 64 + 8 * status_.size(); }
   // Sends `request` (retried on silence) and returns the answer's value.
   std::uint32_t sdo_exchange(std::size_t device, const can_frame& request, std::uint16_t index,
                              std::uint8_t sub, const std::string& what, canopen::SdoKind expected);

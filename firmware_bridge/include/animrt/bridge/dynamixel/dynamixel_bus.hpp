@@ -25,6 +25,8 @@ class DynamixelBus final : public ActuatorBus {
   static constexpr std::size_t kMaxDevices = 150;
   // Attempts per device for the lifecycle transactions (not for the cycle).
   static constexpr int kTries = 3;
+  // Largest position an X-series servo takes in position mode.
+  static constexpr std::int32_t kXMaxTicks = 4095;
 
   // Takes an open transport (tests inject one). Allocates every buffer the
   // cycle needs. Throws DeviceError for ids outside 0..252, duplicate ids, a
@@ -35,6 +37,9 @@ class DynamixelBus final : public ActuatorBus {
 
   // Resets the counters, pings every device (kTries each) and reads its
   // present position. Throws one DeviceError listing every device that failed.
+  // Then, for joints with limits, writes Min/Max Position Limit (52/48) from
+  // them when the values read back differ (torque off first: EEPROM), so the
+  // servo itself refuses goals outside the joint.
   void configure() override;
   // Per device: goal position = present position, then torque on. On failure
   // turns torque off again and throws DeviceError naming the device.
@@ -44,7 +49,8 @@ class DynamixelBus final : public ActuatorBus {
 
   // One Sync Read / Sync Write. Counters: `transactions` counts instruction
   // packets that expected an answer from the device (Sync Write expects none).
-  // Both throw DeviceError only if the transport itself is gone.
+  // Neither throws: a line that is gone (adapter unplugged) shows as timeouts
+  // of every device. Goals are clamped into the joint limits; NaN holds.
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
 
@@ -73,6 +79,9 @@ class DynamixelBus final : public ActuatorBus {
   void accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
               bool diagnostic);
   void blame(std::size_t slot, bool crc);
+  // A status packet from the right id that cannot answer this instruction.
+  static bool stale(const dxl::Packet& packet, std::size_t data_length);
+  void write_position_limits(std::size_t device);
   // Pulls bytes until the decoder has something other than need_more.
   dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
   // Reads the hardware error register of devices whose alert just appeared.
@@ -91,6 +100,12 @@ class DynamixelBus final : public ActuatorBus {
   std::chrono::microseconds timeout_;
 
   std::vector<DeviceStatus> status_;
+  std::array<std::int16_t, 256> device_of_id_ = filled_minus_one();  // bus id -> device
+  static std::array<std::int16_t, 256> filled_minus_one() {
+    std::array<std::int16_t, 256> a{};
+    a.fill(-1);
+    return a;
+  }
   std::vector<std::int32_t> present_ticks_;   // latest known, per device
   std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
   std::vector<double> min_rad_, max_rad_;     // goals that stay inside int32 ticks

@@ -13,6 +13,14 @@
 // backoff (reconnect_min_s doubling to reconnect_max_s); in between, every
 // device counts a timeout per cycle and nothing blocks, so the watchdog
 // faults the devices only if the connection stays down.
+//
+// Bounded I/O: libmodbus retries nothing (error recovery off). A dead slave
+// gets one request per cycle: the read; its write is skipped in that cycle.
+// A dropped link is only marked down inside a request; the reconnect
+// happens at the start of a later read() (on the bus's I/O thread, before
+// any request of that cycle), and libmodbus bounds its connect by the
+// response timeout (= the bus timeout). Goals are clamped into the joint
+// limits; a NaN goal keeps the previous one.
 
 #include <chrono>
 #include <cstdint>
@@ -87,11 +95,15 @@ class ModbusBus final : public ActuatorBus {
     std::vector<std::size_t> devices;
     std::vector<Read> reads;
     std::vector<Write> writes;
+    // Did not answer this cycle's read: its write is skipped, so a dead
+    // slave costs one timeout per cycle, not two.
+    bool silent = false;
   };
   enum class Failure : std::uint8_t { none, timeout, exception, crc, protocol, connection };
 
   bool ensure_connected(bool blocking);
   void disconnect();
+  void flush_input();
   Failure classify(int error) const;
   // Counts a failed request against the slave's devices; returns the failure.
   Failure fail_slave(const Slave& slave, int error);

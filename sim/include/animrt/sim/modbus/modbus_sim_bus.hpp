@@ -9,11 +9,15 @@
 // only while enabled (or always, when the map has no enable). Any standard
 // Modbus master can talk to it (mbpoll, pymodbus).
 //
+// TCP: every connection has its own receive buffer, so a client that sends
+// half a request stalls nobody else; it is closed after 1 s incomplete.
+//
 // RTU: frames are delimited by their function code's length, CRC-checked
 // (a bad CRC is dropped unanswered and counted), and dispatched by slave id.
 // SimBusSettings::return_delay_us delays every answer (real time), to model
 // a slow drive or gateway.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -87,6 +91,16 @@ class ModbusSimBus final : public SimulatedBus {
   std::vector<std::unique_ptr<Drive>> drives_;
   mutable std::mutex mutex_;  // guards drives_ state
   std::vector<int> clients_;
+  // Per TCP connection: bytes of a request not complete yet.
+  static constexpr std::size_t kMbapLength = 7;
+  static constexpr int kTcpStallMs = 1000;
+  struct ClientRx {
+    std::array<std::uint8_t, 260> buf{};  // MODBUS_TCP_MAX_ADU_LENGTH
+    std::size_t have = 0;
+    Nanos since = 0;  // when the pending bytes began
+  };
+  std::vector<ClientRx> client_rx_;
+  void close_client(std::size_t i);
   std::atomic<bool> drop_{false};
   std::thread thread_;
   std::atomic<bool> stop_{false};
