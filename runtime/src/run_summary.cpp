@@ -48,6 +48,7 @@ std::string format_summary(const RunSummary& s) {
     line(s.sched_fifo ? fmt::format("scheduling: SCHED_FIFO priority {}", s.sched_priority)
                       : "scheduling: " + s.sched_note);
     line(s.memory_locked ? "memory: locked" : "memory: " + s.mlock_note);
+    for (const auto& note : s.io_thread_notes) line("I/O thread: " + note);
   }
   for (const auto& bus : s.buses) {
     line(fmt::format("bus {}: cycle time (read + write) p50 {}, p99 {}, max {}; late cycles {}",
@@ -119,7 +120,8 @@ nlohmann::json to_json(const RunSummary& s) {
                    {"priority", s.sched_priority},
                    {"sched_note", s.sched_note},
                    {"memory_locked", s.memory_locked},
-                   {"mlock_note", s.mlock_note}};
+                   {"mlock_note", s.mlock_note},
+                   {"io_thread_notes", s.io_thread_notes}};
   j["buses"] = nlohmann::json::array();
   for (const auto& bus : s.buses)
     j["buses"].push_back(

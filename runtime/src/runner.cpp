@@ -238,7 +238,11 @@ RunSummary Runner::run(const RunOptions& options) {
   std::vector<std::unique_ptr<BusWorker>> workers;
   for (std::size_t b = 0; b < bus_count; ++b) {
     workers.push_back(std::make_unique<BusWorker>(*m.buses[b], bus_positions[b], io_done));
-    workers.back()->start(summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0);
+    const int priority = summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0;
+    if (!workers.back()->start(priority) && priority > 0) {
+      summary.io_thread_notes.push_back(
+          fmt::format("bus {}: {}", m.buses[b]->config().name, workers.back()->priority_note()));
+    }
   }
   // Waits until every bus with a posted request of the kind is done, or
   // until `deadline` (CLOCK_MONOTONIC; < 0: no limit, as in lockstep).

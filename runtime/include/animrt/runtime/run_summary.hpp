@@ -80,6 +80,7 @@ struct RunSummary {
   std::string sched_note;
   bool memory_locked = false;
   std::string mlock_note;
+  std::vector<std::string> io_thread_notes;  // per bus I/O thread not at SCHED_FIFO: why
   std::string telemetry_file;
   std::uint64_t telemetry_records = 0;
   std::uint64_t telemetry_dropped = 0;
