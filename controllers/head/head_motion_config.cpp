@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "animrt/controllers/head/head_source.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::head {
 namespace {
@@ -13,9 +14,10 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
   if (given.empty()) node.fail("expected a file path, found \"\"");
   const fs::path p =
       fs::path(given).is_absolute() ? fs::path(given) : fs::path(robot_path).parent_path() / given;
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
+  const std::string problem = input_file_problem(p.string(), kMaxMediaFileBytes);
+  if (problem == kFileMissing)
     node.fail("file not found: \"" + given + "\" (resolved to \"" + p.string() + "\")");
+  if (!problem.empty()) node.fail("\"" + p.string() + "\" " + problem);
   return p.string();
 }
 
