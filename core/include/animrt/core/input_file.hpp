@@ -16,8 +16,9 @@ inline constexpr const char* kFileMissing = "does not exist";
 
 // Text inputs: YAML, BNF, model files.
 inline constexpr std::uintmax_t kMaxInputFileBytes = std::uintmax_t{64} << 20;  // 64 MiB
-// Binary inputs that are legitimately larger (WAV sound tracks, MJCF meshes).
-inline constexpr std::uintmax_t kMaxMediaFileBytes = std::uintmax_t{1} << 30;  // 1 GiB
+// Inputs that may be larger (WAV sound tracks, MJCF models). A sound file is
+// decoded whole into floats, up to 4x its size in memory.
+inline constexpr std::uintmax_t kMaxMediaFileBytes = std::uintmax_t{256} << 20;  // 256 MiB
 
 // What is wrong with `path` as an input file, or "" when it is a readable
 // regular file of at most `max_bytes`: "does not exist", "is a directory",
