@@ -163,28 +163,23 @@ std::vector<BusConfig> parse_buses(const YamlNode& node) {
 
 // The keys of a joint's limits and home in its unit: degrees for a revolute
 // joint, metres for a prismatic one.
-// With the plausible range of each: a position within +-position, a velocity
-// and an acceleration within their lo..hi (in the file's unit).
 struct UnitKeys {
   const char *min, *max, *velocity, *acceleration, *home;
   double to_si;
-  double position, velocity_lo, velocity_hi, acceleration_lo, acceleration_hi;
 };
 UnitKeys unit_keys(JointType type) {
   if (type == JointType::prismatic)
-    return {"min_m", "max_m", "velocity_mps", "acceleration_mps2", "home_m", 1.0, 10.0, 1e-5,
-            10.0,    1e-5,    1000.0};
-  return {"min_deg",
-          "max_deg",
-          "velocity_dps",
-          "acceleration_dps2",
-          "home_deg",
-          deg_to_rad(1.0),
-          3600.0,
-          0.01,
-          5000.0,
-          0.01,
-          1e6};
+    return {"min_m", "max_m", "velocity_mps", "acceleration_mps2", "home_m", 1.0};
+  return {"min_deg", "max_deg", "velocity_dps", "acceleration_dps2", "home_deg", deg_to_rad(1.0)};
+}
+
+// Plausible limits in the file's unit: positions within +-position.
+struct UnitRanges {
+  double position, velocity_lo, velocity_hi, acceleration_lo, acceleration_hi;
+};
+UnitRanges unit_ranges(JointType type) {
+  if (type == JointType::prismatic) return {10.0, 1e-5, 10.0, 1e-5, 1000.0};
+  return {3600.0, 0.01, 5000.0, 0.01, 1e6};
 }
 
 JointType parse_joint_type(const YamlNode& joint) {
@@ -198,10 +193,11 @@ JointType parse_joint_type(const YamlNode& joint) {
 
 JointLimits parse_limits(const YamlNode& node, JointType type) {
   const UnitKeys k = unit_keys(type);
+  const UnitRanges r = unit_ranges(type);
   node.allow_only({k.min, k.max, k.velocity, k.acceleration});
-  const double min_v = node.at(k.min).as_double_in(-k.position, k.position);
+  const double min_v = node.at(k.min).as_double_in(-r.position, r.position);
   const YamlNode max_node = node.at(k.max);
-  const double max_v = max_node.as_double_in(-k.position, k.position);
+  const double max_v = max_node.as_double_in(-r.position, r.position);
   if (!(max_v > min_v)) {
     max_node.fail("expected a value greater than " + std::string(k.min) + " (" + num(min_v) +
                   "), found " + found(max_node));
@@ -209,9 +205,9 @@ JointLimits parse_limits(const YamlNode& node, JointType type) {
   JointLimits limits;
   limits.min_position = min_v * k.to_si;
   limits.max_position = max_v * k.to_si;
-  limits.max_velocity = node.at(k.velocity).as_double_in(k.velocity_lo, k.velocity_hi) * k.to_si;
+  limits.max_velocity = node.at(k.velocity).as_double_in(r.velocity_lo, r.velocity_hi) * k.to_si;
   limits.max_acceleration =
-      node.at(k.acceleration).as_double_in(k.acceleration_lo, k.acceleration_hi) * k.to_si;
+      node.at(k.acceleration).as_double_in(r.acceleration_lo, r.acceleration_hi) * k.to_si;
   return limits;
 }
 
