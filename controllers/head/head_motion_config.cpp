@@ -78,8 +78,8 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
     j->allow_only({"joint", "closed_deg", "open_deg", "energy_floor", "energy_full"});
     c.jaw.where = j->location();
     c.jaw.joint = j->at("joint").as_string();
-    c.jaw.closed_deg = j->get_double("closed_deg", 0.0);
-    c.jaw.open_deg = j->get_double("open_deg", 20.0);
+    if (auto d = j->find("closed_deg")) c.jaw.closed_deg = d->as_double_in(-360.0, 360.0);
+    if (auto d = j->find("open_deg")) c.jaw.open_deg = d->as_double_in(-360.0, 360.0);
     if (auto e = j->find("energy_floor")) c.jaw.energy_floor = e->as_double_in(0.0, 1.0);
     if (auto e = j->find("energy_full")) {
       c.jaw.energy_full = e->as_double_in(0.0, 1.0);
