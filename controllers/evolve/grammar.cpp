@@ -9,9 +9,14 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
+
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::evolve {
 namespace {
+
+constexpr int kInfiniteDepth = INT_MAX / 2;  // no complete derivation (yet)
 
 struct RawProduction {
   std::string text;
@@ -129,13 +134,7 @@ std::vector<Symbol> split_symbols(const RawProduction& p, const RawRule& rule,
 
 }  // namespace
 
-Grammar Grammar::load_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError({path, 0, 0}, "", "cannot open grammar file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path);
-}
+Grammar Grammar::load_file(const std::string& path) { return parse(read_input_file(path), path); }
 
 int Grammar::find(const std::string& name) const {
   for (std::size_t i = 0; i < rules_.size(); ++i) {
@@ -146,6 +145,7 @@ int Grammar::find(const std::string& name) const {
 
 Grammar Grammar::parse(const std::string& text, const std::string& file_name) {
   std::vector<RawRule> raw;
+  std::unordered_map<std::string, std::size_t> index;  // rule name -> position in raw
   std::istringstream in(text);
   std::string line;
   int line_no = 0;
@@ -170,13 +170,12 @@ Grammar Grammar::parse(const std::string& text, const std::string& file_name) {
         throw InputError({file_name, line_no, static_cast<int>(lead) + 1}, "",
                          "expected '<name> ::= ...'");
       }
-      for (const auto& r : raw) {
-        if (r.name == name) {
-          throw InputError(
-              {file_name, line_no, static_cast<int>(lead) + 1}, "<" + name + ">",
-              "rule defined twice (first at line " + std::to_string(r.where.line) + ")");
-        }
+      if (const auto it = index.find(name); it != index.end()) {
+        throw InputError({file_name, line_no, static_cast<int>(lead) + 1}, "<" + name + ">",
+                         "rule defined twice (first at line " +
+                             std::to_string(raw[it->second].where.line) + ")");
       }
+      index.emplace(name, raw.size());
       raw.push_back({name, {file_name, line_no, static_cast<int>(lead) + 1}, {}});
       rest_at = def + 3;
     } else if (body[0] == '|') {
@@ -233,7 +232,8 @@ Grammar Grammar::parse(const std::string& text, const std::string& file_name) {
     for (auto& prod : rule.productions) {
       for (auto& sym : prod.symbols) {
         if (sym.terminal) continue;
-        sym.rule = g.find(sym.text);
+        const auto it = index.find(sym.text);
+        sym.rule = it == index.end() ? -1 : static_cast<int>(it->second);
         if (sym.rule < 0) {
           throw InputError(uses[use].where, "<" + rule.name + ">",
                            "undefined non-terminal <" + sym.text + ">");
@@ -270,58 +270,133 @@ void Grammar::link_and_check() {
                        "unreachable from the start rule <" + rules_[0].name + ">");
     }
   }
-  // Shallowest complete derivation of each rule (fixpoint); a rule left at
-  // infinity recurses with no way to finish.
-  constexpr int kInf = INT_MAX / 2;
-  for (auto& r : rules_) r.min_depth = kInf;
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (auto& r : rules_) {
-      for (auto& p : r.productions) {
-        int d = 1;
-        for (const auto& s : p.symbols) {
-          if (!s.terminal) d = std::max(d, rules_[static_cast<std::size_t>(s.rule)].min_depth + 1);
-        }
-        p.min_depth = std::min(d, kInf);
-        if (p.min_depth < r.min_depth) {
-          r.min_depth = p.min_depth;
-          changed = true;
-        }
-      }
-    }
-  }
+  // Every step below is linear in the grammar's size, so a huge grammar is
+  // checked (and rejected) quickly.
+  compute_min_depths();
   for (const auto& r : rules_) {
-    if (r.min_depth >= kInf) {
+    if (r.min_depth >= kInfiniteDepth) {
       throw InputError(r.where, "<" + r.name + ">",
                        "recursion with no terminal exit: every production leads back to it");
     }
   }
-  // reach[a][b]: rule a can derive rule b.
-  std::vector<std::vector<char>> reach(n, std::vector<char>(n, 0));
+  mark_recursion();
+}
+
+// Shallowest complete derivation of each rule: a production's depth is one
+// more than the deepest rule it uses, a rule's the least of its productions'.
+// Rules are settled in order of depth (a breadth-first form of Knuth's
+// generalisation of Dijkstra's algorithm): a production is complete once
+// every rule it uses is settled. A rule never settled recurses without exit.
+void Grammar::compute_min_depths() {
+  const std::size_t n = rules_.size();
+  struct Occurrence {
+    std::size_t rule, production;
+  };
+  std::vector<std::vector<Occurrence>> used_by(n);
+  std::vector<std::vector<int>> pending(n);  // unsettled non-terminals per production
+  std::vector<int> queue;                    // rules in order of (non-decreasing) depth
+  std::vector<char> settled(n, 0);
   for (std::size_t a = 0; a < n; ++a) {
-    std::vector<int> stack;
-    for (const auto& p : rules_[a].productions) {
-      for (const auto& s : p.symbols) {
-        if (!s.terminal) stack.push_back(s.rule);
+    Rule& rule = rules_[a];
+    rule.min_depth = kInfiniteDepth;
+    pending[a].assign(rule.productions.size(), 0);
+    for (std::size_t p = 0; p < rule.productions.size(); ++p) {
+      rule.productions[p].min_depth = kInfiniteDepth;
+      for (const auto& sym : rule.productions[p].symbols) {
+        if (sym.terminal) continue;
+        used_by[static_cast<std::size_t>(sym.rule)].push_back({a, p});
+        ++pending[a][p];
+      }
+      if (pending[a][p] == 0) {
+        rule.productions[p].min_depth = 1;
+        if (rule.min_depth > 1) {
+          rule.min_depth = 1;
+          queue.push_back(static_cast<int>(a));
+        }
       }
     }
-    while (!stack.empty()) {
-      const auto b = static_cast<std::size_t>(stack.back());
-      stack.pop_back();
-      if (reach[a][b]) continue;
-      reach[a][b] = 1;
-      for (const auto& p : rules_[b].productions) {
-        for (const auto& s : p.symbols) {
-          if (!s.terminal && !reach[a][static_cast<std::size_t>(s.rule)]) stack.push_back(s.rule);
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const auto b = static_cast<std::size_t>(queue[head]);
+    if (settled[b]) continue;
+    settled[b] = 1;
+    const int depth = rules_[b].min_depth + 1;
+    for (const Occurrence& o : used_by[b]) {
+      if (--pending[o.rule][o.production] != 0) continue;
+      // b is the deepest rule this production uses: rules settle in order.
+      Rule& user = rules_[o.rule];
+      user.productions[o.production].min_depth = depth;
+      if (depth < user.min_depth) {
+        user.min_depth = depth;
+        queue.push_back(static_cast<int>(o.rule));
+      }
+    }
+  }
+}
+
+// A production is recursive when it uses a rule that can derive the rule it
+// belongs to: the two are in one strongly connected component of the
+// rule graph (Tarjan's algorithm, iterative).
+void Grammar::mark_recursion() {
+  const std::size_t n = rules_.size();
+  constexpr int kUnvisited = -1;
+  std::vector<int> order(n, kUnvisited), low(n, 0), component(n, -1);
+  std::vector<char> on_stack(n, 0);
+  std::vector<int> stack;
+  struct Frame {
+    std::size_t rule, production, symbol;
+  };
+  std::vector<Frame> frames;
+  int counter = 0, components = 0;
+  for (std::size_t root = 0; root < n; ++root) {
+    if (order[root] != kUnvisited) continue;
+    frames.push_back({root, 0, 0});
+    order[root] = low[root] = counter++;
+    stack.push_back(static_cast<int>(root));
+    on_stack[root] = 1;
+    while (!frames.empty()) {
+      Frame& f = frames.back();
+      const auto& prods = rules_[f.rule].productions;
+      if (f.production < prods.size()) {
+        const auto& syms = prods[f.production].symbols;
+        if (f.symbol >= syms.size()) {
+          ++f.production;
+          f.symbol = 0;
+          continue;
         }
+        const auto& sym = syms[f.symbol++];
+        if (sym.terminal) continue;
+        const auto next = static_cast<std::size_t>(sym.rule);
+        if (order[next] == kUnvisited) {
+          order[next] = low[next] = counter++;
+          stack.push_back(static_cast<int>(next));
+          on_stack[next] = 1;
+          frames.push_back({next, 0, 0});
+        } else if (on_stack[next]) {
+          low[f.rule] = std::min(low[f.rule], order[next]);
+        }
+        continue;
+      }
+      const std::size_t done = f.rule;
+      frames.pop_back();
+      if (!frames.empty()) low[frames.back().rule] = std::min(low[frames.back().rule], low[done]);
+      if (low[done] == order[done]) {
+        while (true) {
+          const auto member = static_cast<std::size_t>(stack.back());
+          stack.pop_back();
+          on_stack[member] = 0;
+          component[member] = components;
+          if (member == done) break;
+        }
+        ++components;
       }
     }
   }
   for (std::size_t a = 0; a < n; ++a) {
     for (auto& p : rules_[a].productions) {
-      for (const auto& s : p.symbols) {
-        const auto b = static_cast<std::size_t>(s.rule);
-        if (!s.terminal && (b == a || reach[b][a])) p.recursive = true;
+      for (const auto& sym : p.symbols) {
+        if (!sym.terminal && component[static_cast<std::size_t>(sym.rule)] == component[a])
+          p.recursive = true;
       }
       if (p.recursive) rules_[a].recursive = true;
     }

@@ -4,7 +4,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <utility>
 
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt::evolve {
@@ -110,7 +112,21 @@ RunConfig from_root(const YamlNode& root) {
 
 }  // namespace
 
-RunConfig load_run_config(const std::string& path) { return from_root(YamlNode::load_file(path)); }
+RunConfig load_run_config(const std::string& path) {
+  const YamlNode root = YamlNode::load_file(path);
+  RunConfig c = from_root(root);
+  // The files it names are checked here, so that a missing one is reported
+  // at its key in the run file rather than later by the loader alone.
+  const std::pair<const char*, const std::string*> files[] = {
+      {"grammar", &c.grammar}, {"model", &c.model}, {"seed_gait", &c.seed_gait}};
+  for (const auto& [key, file] : files) {
+    if (const std::string problem = input_file_problem(*file, kMaxMediaFileBytes);
+        !problem.empty()) {
+      root.at(key).fail("\"" + *file + "\" " + problem);
+    }
+  }
+  return c;
+}
 
 RunConfig parse_run_config(const std::string& text, const std::string& file_name) {
   return from_root(YamlNode::load_string(text, file_name));

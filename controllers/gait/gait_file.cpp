@@ -14,10 +14,14 @@
 
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/controllers/gait/froude.hpp"
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
 namespace {
+
+constexpr double kMaxScale = 100.0;
+constexpr double kMaxOffsetDeg = 3600.0;
 
 // A curve must be finite over one stride; it is sampled this many times.
 constexpr int kFiniteSamples = 1024;
@@ -234,8 +238,11 @@ void read_joints(const YamlNode& root, GaitFile& gait) {
                 ")");
     }
     if (auto sign = node.find("sign")) joint.sign = read_sign(*sign);
-    joint.scale = node.get_double("scale", 1.0);
-    joint.offset_deg = node.get_double("offset_deg", 0.0);
+    // A curve is in degrees already: a scale beyond 100 or an offset beyond
+    // ten turns is a typo, not a gait.
+    if (auto n = node.find("scale")) joint.scale = n->as_double_in(-kMaxScale, kMaxScale);
+    if (auto n = node.find("offset_deg"))
+      joint.offset_deg = n->as_double_in(-kMaxOffsetDeg, kMaxOffsetDeg);
     gait.joints.push_back(std::move(joint));
   }
 }
@@ -338,14 +345,7 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
 }
 
 GaitFile load_gait_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(Location{path, 0, 0}, "",
-                     "cannot open file: " + std::string(std::strerror(errno)));
-  }
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_gait_file(buffer.str(), path);
+  return parse_gait_file(read_input_file(path), path);
 }
 
 void validate_gait(const GaitFile& gait) {
@@ -412,6 +412,15 @@ void validate_gait(const GaitFile& gait) {
     }
     if (!std::isfinite(j.scale) || !std::isfinite(j.offset_deg)) {
       throw InputError(j.where, key, "scale and offset_deg must be finite");
+    }
+    if (std::abs(j.scale) > kMaxScale) {
+      throw InputError(j.where, key + ".scale",
+                       "expected a number from -100 to 100, found " + format_number(j.scale));
+    }
+    if (std::abs(j.offset_deg) > kMaxOffsetDeg) {
+      throw InputError(
+          j.where, key + ".offset_deg",
+          "expected a number from -3600 to 3600, found " + format_number(j.offset_deg));
     }
   }
 }

@@ -6,12 +6,15 @@
 #include <sndfile.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
+#include "animrt/core/yaml_doc.hpp"
 
 namespace animrt::head {
 namespace {
@@ -61,9 +64,9 @@ void check_riff_length(const std::string& path) {
 
 Audio load_audio(const std::string& path, int target_rate) {
   namespace fs = std::filesystem;
+  if (const std::string problem = input_file_problem(path, kMaxMediaFileBytes); !problem.empty())
+    fail(path, problem == kFileMissing ? "audio file not found" : problem);
   std::error_code ec;
-  if (!fs::exists(path, ec)) fail(path, "audio file not found");
-  if (fs::is_directory(path, ec)) fail(path, "expected an audio file, found a folder");
   if (fs::file_size(path, ec) == 0) fail(path, "empty file (0 bytes), expected audio");
 
   check_riff_length(path);  // before sf_open: a throw here leaves nothing open
@@ -75,6 +78,18 @@ Audio load_audio(const std::string& path, int target_rate) {
   if (info.frames <= 0 || info.channels <= 0) {
     sf_close(file);
     fail(path, "the audio file holds no samples");
+  }
+  // Before anything is allocated: a header claiming 1 Hz or 200 channels
+  // would otherwise size buffers from nonsense.
+  if (info.samplerate < kMinAudioRate || info.samplerate > kMaxAudioRate) {
+    sf_close(file);
+    fail(path, "sample rate " + std::to_string(info.samplerate) + " Hz in the header, expected " +
+                   std::to_string(kMinAudioRate) + ".." + std::to_string(kMaxAudioRate) + " Hz");
+  }
+  if (info.channels > kMaxAudioChannels) {
+    sf_close(file);
+    fail(path, std::to_string(info.channels) + " channels in the header, expected 1.." +
+                   std::to_string(kMaxAudioChannels));
   }
   std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
                                  static_cast<std::size_t>(info.channels));
@@ -92,8 +107,20 @@ Audio load_audio(const std::string& path, int target_rate) {
     float sum = 0.0f;
     for (std::size_t c = 0; c < channels; ++c) sum += interleaved[i * channels + c];
     audio.samples[i] = sum / static_cast<float>(channels);
+    if (!std::isfinite(audio.samples[i])) {
+      fail(path, "sample " + std::to_string(i) + " (at " +
+                     format_number(static_cast<double>(i) / info.samplerate) +
+                     " s) is not a finite number (NaN or infinity)");
+    }
   }
-  if (target_rate > 0) audio = resample(audio, target_rate);
+  if (target_rate > 0) {
+    try {
+      audio = resample(audio, target_rate);
+    } catch (const std::exception& e) {
+      fail(path,
+           std::string("cannot resample to ") + std::to_string(target_rate) + " Hz: " + e.what());
+    }
+  }
   return audio;
 }
 

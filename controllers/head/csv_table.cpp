@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::head {
 namespace {
@@ -46,11 +47,7 @@ int CsvTable::require(const std::string& name) const {
 }
 
 CsvTable read_csv_table(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw InputError(Location{path, 0, 0}, "",
-                     std::filesystem::exists(path) ? "cannot read file" : "file not found");
-  }
+  std::istringstream in(read_input_file(path));
   CsvTable table;
   table.file = path;
   std::string line;

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "animrt/controllers/head/head_source.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::head {
 namespace {
@@ -13,9 +14,10 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
   if (given.empty()) node.fail("expected a file path, found \"\"");
   const fs::path p =
       fs::path(given).is_absolute() ? fs::path(given) : fs::path(robot_path).parent_path() / given;
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
+  const std::string problem = input_file_problem(p.string(), kMaxMediaFileBytes);
+  if (problem == kFileMissing)
     node.fail("file not found: \"" + given + "\" (resolved to \"" + p.string() + "\")");
+  if (!problem.empty()) node.fail("\"" + p.string() + "\" " + problem);
   return p.string();
 }
 
@@ -76,8 +78,8 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
     j->allow_only({"joint", "closed_deg", "open_deg", "energy_floor", "energy_full"});
     c.jaw.where = j->location();
     c.jaw.joint = j->at("joint").as_string();
-    c.jaw.closed_deg = j->get_double("closed_deg", 0.0);
-    c.jaw.open_deg = j->get_double("open_deg", 20.0);
+    if (auto d = j->find("closed_deg")) c.jaw.closed_deg = d->as_double_in(-360.0, 360.0);
+    if (auto d = j->find("open_deg")) c.jaw.open_deg = d->as_double_in(-360.0, 360.0);
     if (auto e = j->find("energy_floor")) c.jaw.energy_floor = e->as_double_in(0.0, 1.0);
     if (auto e = j->find("energy_full")) {
       c.jaw.energy_full = e->as_double_in(0.0, 1.0);

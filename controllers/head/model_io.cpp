@@ -13,6 +13,7 @@
 
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt::head {
@@ -63,13 +64,15 @@ class Writer {
   std::string path_;
 };
 
+std::string read_model_file(const std::string& path) {
+  if (input_file_problem(path) == kFileMissing)
+    throw InputError(Location{path, 0, 0}, "", "model file not found");
+  return read_input_file(path);
+}
+
 class Reader {
  public:
-  explicit Reader(const std::string& path) : path_(path), in_(path) {
-    if (!std::filesystem::exists(path))
-      throw InputError(Location{path, 0, 0}, "", "model file not found");
-    if (!in_) throw InputError(Location{path, 0, 0}, "", "cannot read model file");
-  }
+  explicit Reader(const std::string& path) : path_(path), in_(read_model_file(path)) {}
   // Reads the next non-comment line and checks its keyword.
   void line(const std::string& keyword) {
     std::string text;
@@ -79,6 +82,12 @@ class Reader {
                          "unexpected end of file (truncated model?), expected \"" + keyword + "\"");
       }
       ++line_no_;
+      // strtod and the word splitter would stop at a NUL and quietly accept
+      // what came before it.
+      if (const auto nul = text.find('\0'); nul != std::string::npos) {
+        throw InputError(Location{path_, line_no_, static_cast<int>(nul) + 1}, keyword,
+                         "NUL byte in the line (a corrupted or binary file?)");
+      }
       if (!text.empty() && text[0] != '#') break;
     }
     tokens_.clear();
@@ -143,7 +152,7 @@ class Reader {
 
  private:
   std::string path_;
-  std::ifstream in_;
+  std::istringstream in_;
   std::vector<std::string> tokens_;
   std::size_t pos_ = 0;
   int line_no_ = 0;
@@ -258,7 +267,7 @@ HeadModel load_model(const std::string& path) {
   Reader r(path);
   HeadModel m;
   {
-    std::ifstream probe(path, std::ios::binary);
+    std::istringstream probe(read_input_file(path));
     std::string first;
     std::getline(probe, first);
     if (first.rfind(kMagic, 0) != 0) {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/joint.hpp"
 #include "csv_table.hpp"
 
@@ -86,9 +87,7 @@ struct BvhJoint {
 
 class BvhLexer {
  public:
-  explicit BvhLexer(const std::string& path) : path_(path), in_(path) {
-    if (!in_) throw InputError(Location{path, 0, 0}, "", "file not found or unreadable");
-  }
+  explicit BvhLexer(const std::string& path) : path_(path), in_(read_input_file(path)) {}
   bool next(std::string& token) {
     while (true) {
       if (pos_ < words_.size()) {
@@ -123,7 +122,7 @@ class BvhLexer {
 
  private:
   std::string path_;
-  std::ifstream in_;
+  std::istringstream in_;
   std::vector<std::string> words_;
   std::size_t pos_ = 0;
   int line_ = 0;

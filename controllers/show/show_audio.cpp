@@ -11,16 +11,25 @@
 #include <cstdlib>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
 
 AudioTrack load_audio_track(const std::string& path) {
+  check_input_file(path, kMaxMediaFileBytes);
   SF_INFO info{};
   SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
   if (f == nullptr) {
     throw InputError(Location{path, 0, 0}, "audio",
                      "cannot open audio file: " + std::string(sf_strerror(nullptr)));
+  }
+  if (info.samplerate < kMinShowAudioRate || info.samplerate > kMaxShowAudioRate) {
+    sf_close(f);
+    throw InputError(Location{path, 0, 0}, "audio",
+                     "sample rate " + std::to_string(info.samplerate) + " Hz, expected " +
+                         std::to_string(kMinShowAudioRate) + ".." +
+                         std::to_string(kMaxShowAudioRate) + " Hz");
   }
   const int channels = std::max(1, info.channels);
   std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
@@ -36,6 +45,10 @@ AudioTrack load_audio_track(const std::string& path) {
       sum += interleaved[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)];
     }
     track.samples[i] = sum / static_cast<float>(channels);
+    if (!std::isfinite(track.samples[i])) {
+      throw InputError(Location{path, 0, 0}, "audio",
+                       "sample " + std::to_string(i) + " is not a finite number (NaN or infinity)");
+    }
   }
   return track;
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
@@ -109,9 +110,13 @@ ShowFile load_show_file(const std::string& path) {
     show.audio.file = resolved.string();
     if (auto o = a->find("offset_s")) show.audio.offset_s = o->as_double_in(-1e6, 1e6);
     std::error_code ec;
-    if (!fs::is_regular_file(resolved, ec)) {
+    if (!fs::exists(resolved, ec)) {
       file.fail("audio file not found: \"" + given +
                 "\" (resolved against the show file's folder to \"" + show.audio.file + "\")");
+    }
+    if (const std::string problem = input_file_problem(show.audio.file, kMaxMediaFileBytes);
+        !problem.empty()) {
+      file.fail("audio file \"" + show.audio.file + "\" " + problem);
     }
     SF_INFO info{};
     SNDFILE* sf = sf_open(show.audio.file.c_str(), SFM_READ, &info);
@@ -121,6 +126,12 @@ ShowFile load_show_file(const std::string& path) {
     sf_close(sf);
     if (info.frames <= 0 || info.samplerate <= 0) {
       file.fail("audio file \"" + show.audio.file + "\" holds no sound");
+    }
+    if (info.samplerate < kMinShowAudioRate || info.samplerate > kMaxShowAudioRate) {
+      file.fail("audio file \"" + show.audio.file + "\" declares a sample rate of " +
+                std::to_string(info.samplerate) + " Hz, expected " +
+                std::to_string(kMinShowAudioRate) + ".." + std::to_string(kMaxShowAudioRate) +
+                " Hz");
     }
     show.audio.sample_rate = info.samplerate;
     show.audio.channels = info.channels;

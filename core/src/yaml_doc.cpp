@@ -9,6 +9,8 @@
 #include <set>
 #include <sstream>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt {
 namespace {
 
@@ -29,13 +31,7 @@ YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std
     : file_(std::move(file)), node_(std::move(node)), path_(std::move(path)), mark_(mark) {}
 
 YamlNode YamlNode::load_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw InputError(Location{path, 0, 0}, "",
-                     "cannot open file: " + std::string(std::strerror(errno)));
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return load_string(buffer.str(), path);
+  return load_string(read_input_file(path), path);
 }
 
 YamlNode YamlNode::load_string(const std::string& text, const std::string& file_name) {

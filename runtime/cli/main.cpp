@@ -9,7 +9,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -61,6 +63,27 @@ int cmd_validate(const std::string& path) {
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
   return kExitOk;
+}
+
+// Longest --duration accepted: a year, far past any show.
+constexpr double kMaxDurationS = 365.0 * 24 * 3600;
+
+// --duration: a finite number of seconds, 0 (until Ctrl-C) up to a year.
+// The message quotes the argument as given, not CLI11's conversion of it.
+CLI::Validator duration_validator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        const char* end = text.data() + text.size();
+        const auto [stop, ec] = std::from_chars(text.data(), end, value);
+        const std::string expected = "expected seconds from 0 (until Ctrl-C) to " +
+                                     std::to_string(static_cast<long long>(kMaxDurationS)) +
+                                     ", found \"" + text + "\"";
+        if (ec != std::errc() || stop != end || text.empty()) return expected;
+        if (!std::isfinite(value) || value < 0.0 || value > kMaxDurationS) return expected;
+        return "";
+      },
+      "SECONDS");
 }
 
 struct RunArgs {
@@ -206,7 +229,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->add_option("--duration", run_args.duration,
                   "seconds of motion, then ramp home (0 = until Ctrl-C)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(duration_validator());
   run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file");
   run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON");
   run->add_flag("--lockstep", run_args.lockstep,
@@ -223,7 +246,15 @@ int main(int argc, char** argv) {
 
   animrt::cli::add_evolve_command(app);
   animrt::cli::add_head_command(app);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // evolve and head report their own result this way
+  } catch (const CLI::ParseError& e) {
+    // Help and version print and succeed; every other parse error is a usage
+    // error (CLI11's own exit codes, 100 and up, are not ours).
+    return app.exit(e) == static_cast<int>(CLI::ExitCodes::Success) ? kExitOk : kExitUsage;
+  }
   install_signal_handlers();
   try {
     if (*validate) return cmd_validate(validate_path);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "animrt/bridge/protocol.hpp"
+#include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
@@ -36,23 +37,81 @@ std::string key_path(const YamlNode& parent, std::string_view key) {
   return parent.path().empty() ? std::string(key) : parent.path() + "." + std::string(key);
 }
 
-SafetyConfig parse_safety(const YamlNode& node) {
-  node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s"});
+// Plausible ranges of the robot file's numbers (docs/config.md lists them).
+constexpr double kMaxWatchdogS = 5.0;
+constexpr double kMaxStartRampMaxS = 120.0;
+constexpr double kMaxStopDeadlineS = 30.0;
+constexpr double kMaxFollowingWindowS = 5.0;
+
+std::string seconds(double s) { return format_number(s) + " s"; }
+
+// The watchdog and the following-error window count in cycles: shorter
+// than two periods, one late answer would already fault a healthy device.
+void check_two_periods(const YamlNode& n, double value, double rate_hz) {
+  if (value < 2.0 / rate_hz) {
+    std::ostringstream msg;
+    msg << "expected at least two loop periods (" << 2.0 / rate_hz << " s at loop.rate_hz "
+        << rate_hz << "), found \"" << n.as_string() << "\"";
+    n.fail(msg.str());
+  }
+}
+
+SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
+  node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s", "start_ramp_max_s",
+                   "stop_deadline_s", "following_error_deg", "following_error_mm",
+                   "following_error_window_s"});
   SafetyConfig safety;
   if (auto n = node.find("watchdog_timeout_s")) {
     safety.watchdog_timeout_s = n->as_positive_double();
+    if (safety.watchdog_timeout_s > kMaxWatchdogS) {
+      n->fail("expected at most " + seconds(kMaxWatchdogS) + ", found " + n->describe());
+    }
+    check_two_periods(*n, safety.watchdog_timeout_s, rate_hz);
   }
   if (auto n = node.find("start_ramp_s")) safety.start_ramp_s = n->as_double_in(0.0, 60.0);
   if (auto n = node.find("stop_ramp_s")) safety.stop_ramp_s = n->as_double_in(0.0, 60.0);
+  if (auto n = node.find("start_ramp_max_s")) {
+    safety.start_ramp_max_s = n->as_double_in(0.0, kMaxStartRampMaxS);
+    if (!(safety.start_ramp_max_s > safety.start_ramp_s)) {
+      n->fail("expected more than start_ramp_s (" + seconds(safety.start_ramp_s) + "), found " +
+              n->describe());
+    }
+  } else if (!(safety.start_ramp_max_s > safety.start_ramp_s)) {
+    node.at("start_ramp_s")
+        .fail("expected less than start_ramp_max_s (" + seconds(safety.start_ramp_max_s) +
+              " by default); set start_ramp_max_s too");
+  }
+  if (auto n = node.find("stop_deadline_s")) {
+    safety.stop_deadline_s = n->as_double_in(0.0, kMaxStopDeadlineS);
+    if (safety.stop_deadline_s < safety.stop_ramp_s) {
+      n->fail("expected at least stop_ramp_s (" + seconds(safety.stop_ramp_s) + "), found " +
+              n->describe());
+    }
+  } else if (safety.stop_deadline_s < safety.stop_ramp_s) {
+    node.at("stop_ramp_s")
+        .fail("expected at most stop_deadline_s (" + seconds(safety.stop_deadline_s) +
+              " by default); set stop_deadline_s too");
+  }
+  if (auto n = node.find("following_error_deg"))
+    safety.following_error_rad = deg_to_rad(n->as_double_in(0.5, 180.0));
+  if (auto n = node.find("following_error_mm"))
+    safety.following_error_m = n->as_double_in(0.1, 1000.0) / 1000.0;
+  if (auto n = node.find("following_error_window_s")) {
+    safety.following_error_window_s = n->as_double_in(0.0, kMaxFollowingWindowS);
+    check_two_periods(*n, safety.following_error_window_s, rate_hz);
+  } else if (safety.following_error_window_s < 2.0 / rate_hz) {
+    node.fail("the default following_error_window_s (" + seconds(safety.following_error_window_s) +
+              ") is shorter than two loop periods; set following_error_window_s");
+  }
   return safety;
 }
 
 SimBusSettings parse_sim(const YamlNode& node) {
   node.allow_only({"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us"});
   SimBusSettings sim;
-  if (auto n = node.find("time_constant_s")) sim.time_constant_s = n->as_positive_double();
+  if (auto n = node.find("time_constant_s")) sim.time_constant_s = n->as_double_in(1e-4, 10.0);
   if (auto n = node.find("max_speed_dps")) {
-    sim.max_speed_rad_s = deg_to_rad(n->as_positive_double());
+    sim.max_speed_rad_s = deg_to_rad(n->as_double_in(0.01, 100000.0));
   }
   if (auto n = node.find("wire_time")) sim.wire_time = n->as_bool();
   // Dynamixel's Return Delay Time register counts 2 us units, 0..254.
@@ -114,6 +173,15 @@ UnitKeys unit_keys(JointType type) {
   return {"min_deg", "max_deg", "velocity_dps", "acceleration_dps2", "home_deg", deg_to_rad(1.0)};
 }
 
+// Plausible limits in the file's unit: positions within +-position.
+struct UnitRanges {
+  double position, velocity_lo, velocity_hi, acceleration_lo, acceleration_hi;
+};
+UnitRanges unit_ranges(JointType type) {
+  if (type == JointType::prismatic) return {10.0, 1e-5, 10.0, 1e-5, 1000.0};
+  return {3600.0, 0.01, 5000.0, 0.01, 1e6};
+}
+
 JointType parse_joint_type(const YamlNode& joint) {
   const auto node = joint.find("type");
   if (!node) return JointType::revolute;
@@ -125,10 +193,11 @@ JointType parse_joint_type(const YamlNode& joint) {
 
 JointLimits parse_limits(const YamlNode& node, JointType type) {
   const UnitKeys k = unit_keys(type);
+  const UnitRanges r = unit_ranges(type);
   node.allow_only({k.min, k.max, k.velocity, k.acceleration});
-  const double min_v = node.at(k.min).as_double();
+  const double min_v = node.at(k.min).as_double_in(-r.position, r.position);
   const YamlNode max_node = node.at(k.max);
-  const double max_v = max_node.as_double();
+  const double max_v = max_node.as_double_in(-r.position, r.position);
   if (!(max_v > min_v)) {
     max_node.fail("expected a value greater than " + std::string(k.min) + " (" + num(min_v) +
                   "), found " + found(max_node));
@@ -136,8 +205,9 @@ JointLimits parse_limits(const YamlNode& node, JointType type) {
   JointLimits limits;
   limits.min_position = min_v * k.to_si;
   limits.max_position = max_v * k.to_si;
-  limits.max_velocity = node.at(k.velocity).as_positive_double() * k.to_si;
-  limits.max_acceleration = node.at(k.acceleration).as_positive_double() * k.to_si;
+  limits.max_velocity = node.at(k.velocity).as_double_in(r.velocity_lo, r.velocity_hi) * k.to_si;
+  limits.max_acceleration =
+      node.at(k.acceleration).as_double_in(r.acceleration_lo, r.acceleration_hi) * k.to_si;
   return limits;
 }
 
@@ -216,6 +286,58 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
   }
 }
 
+// A bus that may take longer for one answer than the watchdog allows would
+// fault its devices before it ever reported a timeout.
+void check_bus_timeouts(const YamlNode& buses, const RobotConfig& config,
+                        const std::optional<YamlNode>& safety) {
+  const double watchdog = config.safety.watchdog_timeout_s;
+  for (const BusConfig& bus : config.buses) {
+    if (bus.timeout_s < watchdog) continue;
+    const std::string limit = "the watchdog (safety.watchdog_timeout_s " + seconds(watchdog) +
+                              (safety && safety->has("watchdog_timeout_s") ? "" : ", the default") +
+                              ")";
+    const YamlNode node = buses.at(bus.name);
+    if (auto t = node.find("timeout_ms")) {
+      t->fail("expected a bus timeout below " + limit + ", found " + t->describe() + " ms");
+    }
+    throw InputError(bus.where, key_path(buses, bus.name),
+                     "the default bus timeout (" + seconds(bus.timeout_s) + ") is not below " +
+                         limit + "; set timeout_ms");
+  }
+}
+
+// The loop cannot run faster than the slowest bus carries one cycle's
+// traffic. Buses sharing a port (CAN) add up.
+void check_bus_load(const YamlNode& rate_node, const RobotConfig& config) {
+  const double period = 1.0 / config.rate_hz;
+  std::vector<bool> counted(config.buses.size(), false);
+  for (std::size_t i = 0; i < config.buses.size(); ++i) {
+    if (counted[i]) continue;
+    double wire_s = 0.0;
+    std::string names;
+    for (std::size_t j = i; j < config.buses.size(); ++j) {
+      const BusConfig& bus = config.buses[j];
+      if (bus.port != config.buses[i].port) continue;
+      counted[j] = true;
+      const double bits = find_protocol(bus.protocol)->wire_bits_per_cycle(bus);
+      if (bits <= 0.0) continue;  // not estimated (a network link)
+      wire_s += bits / bus.baud;
+      names += (names.empty() ? "" : " + ") + bus.name + " (" + bus.protocol + ", " +
+               std::to_string(bus.actuators.size()) + " devices at " + std::to_string(bus.baud) +
+               (bus.protocol == "mit" || bus.protocol == "cia402" ? " bit/s)" : " baud)");
+    }
+    if (wire_s > period) {
+      std::ostringstream msg;
+      msg.precision(3);
+      msg << "bus " << names << " needs about " << wire_s * 1000.0
+          << " ms of wire time per cycle, longer than the " << period * 1000.0
+          << " ms loop period; expected at most " << std::floor(1.0 / wire_s) << " Hz, found "
+          << rate_node.describe();
+      rate_node.fail(msg.str());
+    }
+  }
+}
+
 MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
                           bool in_layers = false) {
   // Layers: sources applied in order; later ones win on the joints they drive.
@@ -236,6 +358,7 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
     MotionConfig motion;
     motion.type = "head";
     motion.where = node.location();
+    motion.key = node.path();
     motion.head =
         std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, robot_path));
     motion.file = motion.head->model;
@@ -253,6 +376,7 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
   const std::string given = file.as_string();
   if (given.empty()) file.fail("expected a file path, found \"\"");
   motion.where = file.location();
+  motion.key = file.path();
 
   // Not normalised: "a/b/../c" stays correct when b is a symlink.
   namespace fs = std::filesystem;
@@ -260,14 +384,13 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
   const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
   motion.file = resolved.string();
 
-  std::error_code ec;
-  const fs::file_status status = fs::status(resolved, ec);
+  const std::string problem = input_file_problem(motion.file);
   const std::string where =
       given == motion.file ? "\"" + given + "\""
                            : "\"" + given + "\" (resolved against the robot file's folder to \"" +
                                  motion.file + "\")";
-  if (!fs::exists(status)) file.fail("file not found: " + where);
-  if (fs::is_directory(status)) file.fail("expected a file, found a folder: " + where);
+  if (problem == kFileMissing) file.fail("file not found: " + where);
+  if (!problem.empty()) file.fail(where + " " + problem);
   return motion;
 }
 
@@ -288,22 +411,14 @@ RobotConfig load_robot_config(const std::string& path) {
   loop.allow_only({"rate_hz"});
   config.rate_hz = loop.at("rate_hz").as_double_in(1.0, 10000.0);
 
-  if (auto safety = root.find("safety")) {
-    config.safety = parse_safety(*safety);
-    // The watchdog counts in cycles: shorter than two periods, one late answer
-    // would already fault a healthy device.
-    if (auto watchdog = safety->find("watchdog_timeout_s");
-        watchdog && config.safety.watchdog_timeout_s < 2.0 / config.rate_hz) {
-      std::ostringstream msg;
-      msg << "expected at least two loop periods (" << 2.0 / config.rate_hz << " s at loop.rate_hz "
-          << config.rate_hz << "), found \"" << watchdog->as_string() << "\"";
-      watchdog->fail(msg.str());
-    }
-  }
+  const auto safety = root.find("safety");
+  if (safety) config.safety = parse_safety(*safety, config.rate_hz);
 
   const YamlNode buses = root.at("buses");
   config.buses = parse_buses(buses);
+  check_bus_timeouts(buses, config, safety);
   parse_joints(root.at("joints"), config);
+  check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and
   // opening its port would fail or grab a line for nothing.
   for (const auto& bus : config.buses) {

@@ -1,23 +1,55 @@
 #include "animrt/runtime/robot_loader.hpp"
 
+#include <algorithm>
+#include <string>
+
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
+#include "animrt/runtime/motion_check.hpp"
 
 namespace animrt {
 
 namespace {
 
-std::unique_ptr<MotionSource> make_source(const MotionConfig& motion,
-                                          const std::vector<JointSpec>& joints) {
+// "file:line:column" of a location in a motion file.
+std::string at(const Location& where) {
+  std::string text = where.file;
+  if (where.line > 0) text += ":" + std::to_string(where.line);
+  if (where.column > 0) text += ":" + std::to_string(where.column);
+  return text;
+}
+
+std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const RobotConfig& config) {
+  const std::vector<JointSpec>& joints = config.joints;
   if (motion.type == "layers") {
     std::vector<std::unique_ptr<MotionSource>> layers;
-    for (const MotionConfig& layer : motion.layers) layers.push_back(make_source(layer, joints));
+    for (const MotionConfig& layer : motion.layers) layers.push_back(make_source(layer, config));
     return make_layered_source(std::move(layers));
   }
-  if (motion.type == "show") return load_show_source(motion.file, joints);
+  if (motion.type == "show") {
+    const ShowFile show = load_show_file(motion.file);
+    auto source = make_show_source(show, joints);
+    double length = show.duration_s;
+    for (const ShowTrack& track : show.tracks) length = std::max(length, track.keys.back().t);
+    MotionCheck check{source.get(), length, motion.where, motion.key, {}};
+    check.joint_where = [&show, &joints](int j) {
+      for (const ShowTrack& track : show.tracks) {
+        if (track.joint == joints[static_cast<std::size_t>(j)].name) return at(track.where);
+      }
+      return std::string();
+    };
+    check_motion(config, check);
+    return source;
+  }
   if (motion.type == "gait" || motion.type == "head") {
-    auto source = motion.type == "gait" ? load_gait_source(motion.file, joints)
-                                        : head::make_head_source(*motion.head, joints);
+    std::unique_ptr<GaitFile> gait;
+    std::unique_ptr<MotionSource> source;
+    if (motion.type == "gait") {
+      gait = std::make_unique<GaitFile>(load_gait_file(motion.file));
+      source = make_gait_source(*gait, joints);
+    } else {
+      source = head::make_head_source(*motion.head, joints);
+    }
     // Gaits and head motion produce angles; only a show states metres.
     for (int j : source->driven_joints()) {
       const JointSpec& joint = joints[static_cast<std::size_t>(j)];
@@ -26,6 +58,24 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion,
                          "a " + motion.type + " drives angles, and joint " + joint.name +
                              " is prismatic (metres); drive it with a show");
       }
+    }
+    // Head motion follows speech known only as it plays (live capture, or a
+    // file streamed through the decoder), and its targets are clamped to the
+    // joints' limits as they are made, so it is not sampled here.
+    if (gait) {
+      MotionCheck check{source.get(),
+                        gait_check_duration(gait->stride_frequency()),
+                        motion.where,
+                        motion.key,
+                        {}};
+      check.joint_where = [&gait, &joints](int j) {
+        for (const GaitJoint& g : gait->joints) {
+          if (g.name == joints[static_cast<std::size_t>(j)].name)
+            return at(g.where) + ": joints." + g.name;
+        }
+        return std::string();
+      };
+      check_motion(config, check);
     }
     return source;
   } else {
@@ -39,7 +89,7 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion,
 LoadedRobot load_robot(const std::string& path) {
   LoadedRobot robot;
   robot.config = load_robot_config(path);
-  robot.motion = make_source(robot.config.motion, robot.config.joints);
+  robot.motion = make_source(robot.config.motion, robot.config);
   return robot;
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::sim {
 
@@ -17,7 +18,7 @@ int MujocoModel::actuator_of(const std::string& joint) const {
 }
 
 MujocoModel load_mujoco_model(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError({path, 0, 0}, "", "cannot open model file");
+  check_input_file(path, kMaxMediaFileBytes);
   char error[1024] = "";
   mjModel* raw = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
   if (!raw) {

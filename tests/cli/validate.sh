@@ -22,4 +22,34 @@ line=$(grep -n '^  rate_hz:' "$tmp/bad.yaml" | cut -d: -f1)
 
 out=$("$animrt" validate "$tmp/missing.yaml" 2>&1)
 [[ $? -eq 2 && $out == *"missing.yaml"*"cannot open"* ]] || fail "missing file: $out"
+# Every shipped robot validates (its motion sampled over its whole length).
+for robot in "$root"/configs/robots/*.yaml; do
+  out=$("$animrt" validate "$robot" 2>&1) || fail "shipped $robot rejected: $out"
+done
+
+# A device as the motion file: a clear error, not an endless read.
+sed "s#file: \.\./gaits/walk.yaml#file: /dev/zero#" "$root/configs/robots/quadruped.yaml" > "$tmp/zero.yaml"
+out=$(timeout 20 "$animrt" validate "$tmp/zero.yaml" 2>&1)
+code=$?
+line=$(grep -n 'file: /dev/zero' "$tmp/zero.yaml" | cut -d: -f1)
+[[ $code -eq 2 && $out == "error: $tmp/zero.yaml:$line:9: motion.file: \"/dev/zero\" is not a regular file (character device)" ]] ||
+  fail "/dev/zero as motion file (exit $code): $out"
+
+# --duration: a finite number of seconds >= 0, else a usage error (exit 1).
+for bad in -1 nan inf 1e400 soon; do
+  out=$("$animrt" run "$root/configs/robots/quadruped.yaml" --duration "$bad" 2>&1)
+  code=$?
+  [[ $code -eq 1 ]] || fail "--duration $bad: exit $code, expected 1: $out"
+  [[ $(echo "$out" | head -1) == "--duration: expected seconds from 0 (until Ctrl-C) to 31536000, found \"$bad\"" ]] ||
+    fail "--duration $bad: unexpected message: $out"
+done
+# Any other parse error is a usage error too (CLI11's own codes are 100 and up).
+out=$("$animrt" run 2>&1)
+code=$?
+[[ $code -eq 1 && $out == *"CONFIG is required"* ]] || fail "missing argument: exit $code: $out"
+out=$("$animrt" validate a.yaml --bogus 2>&1)
+code=$?
+[[ $code -eq 1 ]] || fail "unknown option: exit $code: $out"
+out=$("$animrt" --help 2>&1)
+[[ $? -eq 0 && $out == *"validate"* ]] || fail "--help: $out"
 echo "validate: ok"

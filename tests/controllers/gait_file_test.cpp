@@ -126,6 +126,25 @@ TEST(GaitFile, WrongTypes) {
             "g.yaml:10:7: joints.j1: expected a map, found \"hip\"");
 }
 
+TEST(GaitFile, ImplausibleScaleAndOffset) {
+  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, scale: 1e30}")),
+            "g.yaml:11:37: joints.j2.scale: expected a number from -100 to 100, found \"1e30\"");
+  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, offset_deg: -4000}")),
+            "g.yaml:11:42: joints.j2.offset_deg: expected a number from -3600 to 3600, found "
+            "\"-4000\"");
+  // A gait built in memory gets the same check.
+  GaitFile gait = parse_gait_file(join(kBase), "g.yaml");
+  gait.joints[1].scale = -1e30;
+  try {
+    validate_gait(gait);
+    ADD_FAILURE() << "scale accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "g.yaml:11:3: joints.j2.scale: expected a number from -100 to 100, "
+                 "found -1e+30");
+  }
+}
+
 TEST(GaitFile, MissingKeys) {
   EXPECT_EQ(error_of(with_line(1, "# no name")), "g.yaml:2:1: name: required key is missing");
   EXPECT_EQ(error_of(with_line(10, "  j1: {curve: hip}")),
@@ -241,7 +260,7 @@ GaitFile odd_gait() {
   g.limbs.push_back({"front", 1.0 / 3.0, {}});
   g.limbs.push_back({"1", 0.0, {}});
   g.joints.push_back({"lf_hip", "c0", "front", -1, 0.1 * 3, -0.0, {}});
-  g.joints.push_back({"x: y", "curve with spaces", "1", 1, 1e300, 5e-324, {}});
+  g.joints.push_back({"x: y", "curve with spaces", "1", 1, -99.99999999999999, 5e-324, {}});
   g.joints.push_back({"z", "null", "front", 1, 1.0, 0.0, {}});
   return g;
 }

@@ -92,5 +92,48 @@ TEST(Grammar, MissingFileIsAnInputError) {
   EXPECT_THROW(Grammar::load_file("/nonexistent.bnf"), InputError);
 }
 
+TEST(Grammar, HugeGrammarOfUnreachableRulesIsRejected) {
+  // 200,000 rules, each defined once and none used by the start rule: the
+  // duplicate, undefined-rule and reachability checks must not compare every
+  // rule with every other.
+  constexpr int kRules = 200000;
+  std::string text = "<start> ::= <r0> | x\n<r0> ::= y\n";
+  for (int i = 1; i <= kRules; ++i)
+    text += "<r" + std::to_string(i) + "> ::= <r" + std::to_string(i - 1) + "> | z\n";
+  EXPECT_EQ(error_of(text), "g.bnf:3:1: <r1>: unreachable from the start rule <start>");
+  // The same rules chained from the start: all reachable, all recursive-free.
+  std::string chained = "<start> ::= <r" + std::to_string(kRules) + ">\n<r0> ::= y\n";
+  for (int i = 1; i <= kRules; ++i)
+    chained += "<r" + std::to_string(i) + "> ::= <r" + std::to_string(i - 1) + "> | z\n";
+  const Grammar g = Grammar::parse(chained, "g.bnf");
+  ASSERT_EQ(g.rules().size(), static_cast<std::size_t>(kRules) + 2);
+  EXPECT_EQ(g.start().min_depth, 2);  // start -> r200000 -> z
+  EXPECT_FALSE(g.start().recursive);
+}
+
+TEST(Grammar, DepthsAndRecursionOfAMutuallyRecursiveGrammar) {
+  const Grammar g = Grammar::parse(
+      "<e> ::= <a> | <b>\n"
+      "<a> ::= (<b>) | <c>\n"
+      "<b> ::= [<a>]\n"
+      "<c> ::= <d> <d>\n"
+      "<d> ::= t\n",
+      "g.bnf");
+  const auto& r = g.rules();
+  EXPECT_EQ(r[4].min_depth, 1);  // d
+  EXPECT_EQ(r[3].min_depth, 2);  // c
+  EXPECT_EQ(r[1].min_depth, 3);  // a via c
+  EXPECT_EQ(r[2].min_depth, 4);  // b via a
+  EXPECT_EQ(r[0].min_depth, 4);  // e via a
+  EXPECT_EQ(r[1].productions[0].min_depth, 5);
+  EXPECT_TRUE(r[1].productions[0].recursive);   // a -> b -> a
+  EXPECT_FALSE(r[1].productions[1].recursive);  // a -> c
+  EXPECT_TRUE(r[2].productions[0].recursive);
+  EXPECT_FALSE(r[0].recursive);  // nothing leads back to e
+  EXPECT_FALSE(r[3].recursive);
+  EXPECT_EQ(error_of("<e> ::= <a>\n<a> ::= (<b>)\n<b> ::= [<a>]\n"),
+            "g.bnf:1:1: <e>: recursion with no terminal exit: every production leads back to it");
+}
+
 }  // namespace
 }  // namespace animrt::evolve

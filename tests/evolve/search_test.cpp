@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/evolve/phenotype.hpp"
@@ -159,6 +161,25 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(ok.search.population, 75);
   EXPECT_EQ(ok.search.elites, 7);
   ASSERT_EQ(ok.weights.size(), 1u);
+}
+
+TEST(RunConfig, MissingModelIsReportedAtItsKey) {
+  const std::string dir = ::testing::TempDir() + "/run_config_missing_model";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/run.yaml";
+  std::ofstream(path) << "name: x\ngrammar: " << kRoot
+                      << "/configs/grammars/quadruped_free.bnf\nmodel: ../models/nope.xml\n"
+                         "seed_gait: "
+                      << kRoot << "/configs/gaits/quadruped_seed.yaml\n";
+  try {
+    (void)load_run_config(path);
+    ADD_FAILURE() << "missing model accepted";
+  } catch (const InputError& e) {
+    const std::string model =
+        (std::filesystem::path(dir) / ".." / "models" / "nope.xml").lexically_normal().string();
+    EXPECT_EQ(std::string(e.what()), path + ":3:8: model: \"" + model + "\" does not exist");
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(RunConfig, ShippedRunFilesLoad) {

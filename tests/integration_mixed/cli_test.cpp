@@ -53,6 +53,10 @@ std::string patient_figure() {
     if (auto at = line.find("timeout_ms: "); at != std::string::npos) {
       line = line.substr(0, at) + "timeout_ms: 100";
     }
+    // Every bus timeout must be below the watchdog.
+    if (auto at = line.find("watchdog_timeout_s: "); at != std::string::npos) {
+      line = line.substr(0, at) + "watchdog_timeout_s: 0.5";
+    }
     for (const std::string folder : {"../shows/", "../modbus/"}) {
       if (auto at = line.find(folder); at != std::string::npos) {
         line.replace(at, folder.size(), kConfigs + "/" + folder.substr(3));

@@ -32,8 +32,12 @@ const std::string kMaps = std::string(ANIMRT_SOURCE_DIR) + "/configs/modbus/";
 // lever) on slave 2.
 std::string robot_text(const std::string& protocol, const std::string& extra_joint = "") {
   const std::string port = protocol == "modbus-tcp" ? "127.0.0.1:1502" : "/dev/null";
-  return "name: drives\nloop: {rate_hz: 100}\nbuses:\n  drives:\n    protocol: " + protocol +
-         "\n    port: " + port + "\n    timeout_ms: 200\n" +
+  // A 200 ms answer timeout needs a longer watchdog (every bus timeout is below it).
+  return "name: drives\nloop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 0.5}\nbuses:\n"
+         "  drives:\n    protocol: " +
+         protocol + "\n    port: " + port + "\n    timeout_ms: 200\n" +
+         // RTU: fast enough that two drives' traffic fits a 100 Hz cycle.
+         (protocol == "modbus-rtu" ? "    baud: 230400\n" : "") +
          "joints:\n"
          "  pan:\n"
          "    limits: {min_deg: -90, max_deg: 90, velocity_dps: 100, acceleration_dps2: 500}\n"
@@ -282,7 +286,7 @@ TEST(ModbusConfig, ErrorsNameFileLineAndKey) {
   std::string text = robot_text("modbus-tcp");
   text.replace(text.find("m_per_rad: 0.1"), 14, "m_per_rad: 0.5");
   const std::string range = error_of(text);
-  EXPECT_NE(range.find("bad.yaml:13:"), std::string::npos) << range;
+  EXPECT_NE(range.find("bad.yaml:14:"), std::string::npos) << range;
   EXPECT_NE(range.find("joints.lean.limits.min_deg: -20 deg maps to -0.124533"), std::string::npos)
       << range;
   EXPECT_NE(range.find("outside the range of"), std::string::npos) << range;

@@ -1,8 +1,10 @@
 #include "animrt/runtime/robot_config.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -239,7 +241,8 @@ loop: {rate_hz: 100}
 safety: {watchdog_s: 1}
 )"),
             at("3:10: safety.watchdog_s: unknown key (expected one of: watchdog_timeout_s, "
-               "start_ramp_s, stop_ramp_s)"));
+               "start_ramp_s, stop_ramp_s, start_ramp_max_s, stop_deadline_s, "
+               "following_error_deg, following_error_mm, following_error_window_s)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -365,9 +368,10 @@ TEST_F(RobotConfigTest, BusNumbersOutOfRange) {
       "name: t\nloop: {rate_hz: 100}\nbuses:\n  b:\n    protocol: dynamixel2\n"
       "    port: /dev/ttyUSB0\n";
   EXPECT_EQ(error_of(head + "    baud: 0\n"),
-            at("7:11: buses.b.baud: expected an integer from 1 to 10500000, found \"0\""));
+            at("7:11: buses.b.baud: expected an integer from 9600 to 10500000, found \"0\""));
   EXPECT_EQ(error_of(head + "    baud: 12000000\n"),
-            at("7:11: buses.b.baud: expected an integer from 1 to 10500000, found \"12000000\""));
+            at("7:11: buses.b.baud: expected an integer from 9600 to 10500000, found "
+               "\"12000000\""));
   EXPECT_EQ(error_of(head + "    timeout_ms: 0\n"),
             at("7:17: buses.b.timeout_ms: expected a number greater than 0 and less than 1000, "
                "found \"0\""));
@@ -375,9 +379,11 @@ TEST_F(RobotConfigTest, BusNumbersOutOfRange) {
             at("7:17: buses.b.timeout_ms: expected a number greater than 0 and less than 1000, "
                "found \"1000\""));
   EXPECT_EQ(error_of(head + "    sim: {time_constant_s: 0}\n"),
-            at("7:28: buses.b.sim.time_constant_s: expected a positive number, found \"0\""));
+            at("7:28: buses.b.sim.time_constant_s: expected a number from 0.0001 to 10, found "
+               "\"0\""));
   EXPECT_EQ(error_of(head + "    sim: {max_speed_dps: -330}\n"),
-            at("7:26: buses.b.sim.max_speed_dps: expected a positive number, found \"-330\""));
+            at("7:26: buses.b.sim.max_speed_dps: expected a number from 0.01 to 100000, found "
+               "\"-330\""));
   EXPECT_EQ(error_of(head + "    sim: {return_delay_us: 600}\n"),
             at("7:28: buses.b.sim.return_delay_us: expected an integer from 0 to 508, found "
                "\"600\""));
@@ -635,12 +641,13 @@ TEST_F(RobotConfigTest, VelocityAndAccelerationMustBePositive) {
   EXPECT_EQ(error_of(std::string(kLimitsHead) +
                      "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 0, "
                      "acceleration_dps2: 1000}\n"),
-            at("7:55: joints.j1.limits.velocity_dps: expected a positive number, found \"0\""));
+            at("7:55: joints.j1.limits.velocity_dps: expected a number from 0.01 to 5000, found "
+               "\"0\""));
   EXPECT_EQ(error_of(std::string(kLimitsHead) +
                      "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
                      "acceleration_dps2: -5}\n"),
-            at("7:79: joints.j1.limits.acceleration_dps2: expected a positive number, found "
-               "\"-5\""));
+            at("7:79: joints.j1.limits.acceleration_dps2: expected a number from 0.01 to 1e+06, "
+               "found \"-5\""));
 }
 
 TEST_F(RobotConfigTest, LimitsOutsideTheServoRange) {
@@ -688,7 +695,8 @@ TEST_F(RobotConfigTest, TicksPerRevOrPerRadNotBoth) {
                      "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
                      "acceleration_dps2: 1000}\n"
                      "    actuator: {bus: b, id: 1, ticks_per_rev: 0}\n"),
-            at("8:46: joints.j1.actuator.ticks_per_rev: expected a positive number, found \"0\""));
+            at("8:46: joints.j1.actuator.ticks_per_rev: expected a number from 16 to 1e+08, "
+               "found \"0\""));
 }
 
 // ----------------------------------------------------------------- motion
@@ -715,9 +723,28 @@ TEST_F(RobotConfigTest, MotionFileIsAFolder) {
   text.replace(text.find("../gaits/gait.yaml"), 18, "../gaits");
   const std::string resolved = (dir_ / "robots" / ".." / "gaits").string();
   EXPECT_EQ(error_of(text),
-            at("9:28: motion.file: expected a file, found a folder: \"../gaits\" (resolved "
-               "against the robot file's folder to \"" +
-               resolved + "\")"));
+            at("9:28: motion.file: \"../gaits\" (resolved against the robot file's folder to \"" +
+               resolved + "\") is a directory"));
+}
+
+TEST_F(RobotConfigTest, MotionFileIsADevice) {
+  std::string text = kMinimal;
+  text.replace(text.find("../gaits/gait.yaml"), 18, "/dev/zero");
+  EXPECT_EQ(error_of(text),
+            at("9:28: motion.file: \"/dev/zero\" is not a regular file (character device)"));
+}
+
+TEST_F(RobotConfigTest, MotionFileIsAFifo) {
+  const fs::path fifo = dir_ / "gaits" / "pipe.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string text = kMinimal;
+  text.replace(text.find("../gaits/gait.yaml"), 18, "../gaits/pipe.yaml");
+  // Nothing writes to the FIFO: opening it would block.
+  EXPECT_EQ(error_of(text),
+            at("9:28: motion.file: \"../gaits/pipe.yaml\" (resolved against the robot file's "
+               "folder to \"" +
+               (dir_ / "robots" / ".." / "gaits" / "pipe.yaml").string() +
+               "\") is not a regular file (FIFO)"));
 }
 
 }  // namespace
@@ -725,6 +752,140 @@ TEST_F(RobotConfigTest, MotionFileIsAFolder) {
 
 namespace animrt {
 namespace {
+
+// ------------------------------------------------- plausible ranges (load time)
+
+TEST_F(RobotConfigTest, ImplausibleNumbersAreRejectedAtTheirKey) {
+  const std::string limits =
+      "    limits: {min_deg: -10, max_deg: 10, velocity_dps: VEL, acceleration_dps2: ACC}\n"
+      "    actuator: {bus: b, id: 1}\n";
+  const auto with = [&](const std::string& vel, const std::string& acc) {
+    std::string text = std::string(kLimitsHead) + limits;
+    text.replace(text.find("VEL"), 3, vel);
+    text.replace(text.find("ACC"), 3, acc);
+    return text;
+  };
+  EXPECT_EQ(error_of(with("1e-300", "1000")),
+            at("7:55: joints.j1.limits.velocity_dps: expected a number from 0.01 to 5000, found "
+               "\"1e-300\""));
+  EXPECT_EQ(error_of(with("6000", "1000")),
+            at("7:55: joints.j1.limits.velocity_dps: expected a number from 0.01 to 5000, found "
+               "\"6000\""));
+  EXPECT_EQ(error_of(with("100", "1e9")),
+            at("7:79: joints.j1.limits.acceleration_dps2: expected a number from 0.01 to 1e+06, "
+               "found \"1e9\""));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -1e9, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"),
+            at("7:23: joints.j1.limits.min_deg: expected a number from -3600 to 3600, found "
+               "\"-1e9\""));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, ticks_per_rev: 1e-300}\n"),
+            at("8:46: joints.j1.actuator.ticks_per_rev: expected a number from 16 to 1e+08, "
+               "found \"1e-300\""));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) +
+                     "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+                     "acceleration_dps2: 1000}\n"
+                     "    actuator: {bus: b, id: 1, ticks_per_rad: 1e-300}\n"),
+            at("8:46: joints.j1.actuator.ticks_per_rad: expected a number from 2.54648 to "
+               "1.59155e+07, found \"1e-300\""));
+}
+
+TEST_F(RobotConfigTest, WatchdogAtMostFiveSeconds) {
+  EXPECT_EQ(error_of("name: t\nloop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 1e30}\n"),
+            at("3:30: safety.watchdog_timeout_s: expected at most 5 s, found \"1e30\""));
+}
+
+TEST_F(RobotConfigTest, BusTimeoutMustBeBelowTheWatchdog) {
+  std::string text = kMinimal;
+  text.replace(text.find("port: /dev/ttyUSB0}"), 19, "port: /dev/ttyUSB0, timeout_ms: 999}");
+  text.replace(text.find("loop: {rate_hz: 100}"), 20,
+               "loop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 0.1}");
+  EXPECT_EQ(error_of(text),
+            at("5:61: buses.b.timeout_ms: expected a bus timeout below the watchdog "
+               "(safety.watchdog_timeout_s 0.1 s), found \"999\" ms"));
+  // Without a safety section the default watchdog (0.1 s) applies.
+  text = kMinimal;
+  text.replace(text.find("port: /dev/ttyUSB0}"), 19, "port: /dev/ttyUSB0, timeout_ms: 150}");
+  EXPECT_EQ(error_of(text),
+            at("4:61: buses.b.timeout_ms: expected a bus timeout below the watchdog "
+               "(safety.watchdog_timeout_s 0.1 s, the default), found \"150\" ms"));
+}
+
+TEST_F(RobotConfigTest, LoopRateTheBusCannotCarry) {
+  const fs::path copy = dir_ / "robots" / "quadruped.yaml";
+  std::string text = read_file(kSourceDir + "/configs/robots/quadruped.yaml");
+  write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
+  const auto rate = text.find("rate_hz: 200");
+  ASSERT_NE(rate, std::string::npos);
+  text.replace(rate, 12, "rate_hz: 10000");
+  text.replace(text.find("watchdog_timeout_s: 0.1"), 23, "watchdog_timeout_s: 0.01");
+  write_file(copy, text);
+  // 12 servos: Sync Write 74 bytes, Sync Read 26, 12 answers of 15: 280
+  // bytes of 10 bits at 1 Mbaud.
+  const std::string line =
+      std::to_string(std::count(text.begin(), text.begin() + static_cast<long>(rate), '\n') + 1);
+  try {
+    (void)load_robot_config(copy.string());
+    ADD_FAILURE() << "rate accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              copy.string() + ":" + line +
+                  ":12: loop.rate_hz: bus legs (dynamixel2, 12 devices at 1000000 baud) needs "
+                  "about 2.8 ms of wire time per cycle, longer than the 0.1 ms loop period; "
+                  "expected at most 357 Hz, found \"10000\"");
+  }
+  // 350 Hz fits.
+  text.replace(text.find("rate_hz: 10000"), 14, "rate_hz: 350");
+  write_file(copy, text);
+  EXPECT_DOUBLE_EQ(load_robot_config(copy.string()).rate_hz, 350.0);
+}
+
+TEST_F(RobotConfigTest, NewSafetyKeysAreReadInTheirUnits) {
+  std::string text = kMinimal;
+  text.replace(text.find("loop: {rate_hz: 100}"), 20,
+               "loop: {rate_hz: 100}\nsafety: {start_ramp_max_s: 30, stop_deadline_s: 8, "
+               "following_error_deg: 10, following_error_mm: 5, following_error_window_s: 0.25}");
+  const RobotConfig c = load(text);
+  EXPECT_DOUBLE_EQ(c.safety.start_ramp_max_s, 30.0);
+  EXPECT_DOUBLE_EQ(c.safety.stop_deadline_s, 8.0);
+  EXPECT_DOUBLE_EQ(c.safety.following_error_rad, deg_to_rad(10.0));
+  EXPECT_DOUBLE_EQ(c.safety.following_error_m, 0.005);
+  EXPECT_DOUBLE_EQ(c.safety.following_error_window_s, 0.25);
+}
+
+TEST_F(RobotConfigTest, NewSafetyKeysOutOfRange) {
+  const std::string head = "name: t\nloop: {rate_hz: 100}\nsafety: {";
+  EXPECT_EQ(error_of(head + "start_ramp_s: 5, start_ramp_max_s: 4}\n"),
+            at("3:45: safety.start_ramp_max_s: expected more than start_ramp_s (5 s), found "
+               "\"4\""));
+  EXPECT_EQ(error_of(head + "start_ramp_max_s: 121}\n"),
+            at("3:28: safety.start_ramp_max_s: expected a number from 0 to 120, found \"121\""));
+  EXPECT_EQ(error_of(head + "start_ramp_s: 25}\n"),
+            at("3:24: safety.start_ramp_s: expected less than start_ramp_max_s (20 s by "
+               "default); set start_ramp_max_s too"));
+  EXPECT_EQ(error_of(head + "stop_ramp_s: 3, stop_deadline_s: 2}\n"),
+            at("3:43: safety.stop_deadline_s: expected at least stop_ramp_s (3 s), found \"2\""));
+  EXPECT_EQ(error_of(head + "stop_deadline_s: 31}\n"),
+            at("3:27: safety.stop_deadline_s: expected a number from 0 to 30, found \"31\""));
+  EXPECT_EQ(error_of(head + "stop_ramp_s: 10}\n"),
+            at("3:23: safety.stop_ramp_s: expected at most stop_deadline_s (6 s by default); "
+               "set stop_deadline_s too"));
+  EXPECT_EQ(error_of(head + "following_error_deg: 0.1}\n"),
+            at("3:31: safety.following_error_deg: expected a number from 0.5 to 180, found "
+               "\"0.1\""));
+  EXPECT_EQ(error_of(head + "following_error_mm: 0}\n"),
+            at("3:30: safety.following_error_mm: expected a number from 0.1 to 1000, found "
+               "\"0\""));
+  EXPECT_EQ(error_of(head + "following_error_window_s: 0.015}\n"),
+            at("3:36: safety.following_error_window_s: expected at least two loop periods "
+               "(0.02 s at loop.rate_hz 100), found \"0.015\""));
+  EXPECT_EQ(error_of(head + "following_error_window_s: 6}\n"),
+            at("3:36: safety.following_error_window_s: expected a number from 0 to 5, found "
+               "\"6\""));
+}
 
 TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {
   const std::string dir = ::testing::TempDir() + "/watchdog_test";

@@ -56,7 +56,8 @@ class Cia402 final : public Protocol {
     }
     out.device_id = static_cast<int>(id);
     double counts_per_rev = 4096.0;
-    if (auto n = node.find("counts_per_rev")) counts_per_rev = n->as_positive_double();
+    // Encoders resolve from a few counts to about 2^31 counts per turn.
+    if (auto n = node.find("counts_per_rev")) counts_per_rev = n->as_double_in(4.0, 2147483648.0);
     out.ticks_per_rad = counts_per_rev / (2.0 * kPi);
     out.zero_ticks = 0;
     if (auto n = node.find("zero_counts")) {
@@ -74,6 +75,17 @@ class Cia402 final : public Protocol {
     };
     check("min_deg", joint.limits.min_position);
     check("max_deg", joint.limits.max_position);
+  }
+
+  // One SYNC (no data) and per drive an RPDO and a TPDO of 6 data bytes;
+  // a CAN 2.0A frame is 47 + 8 per data byte bits, plus worst-case bit
+  // stuffing (one per four bits of the stuffed span).
+  double wire_bits_per_cycle(const BusConfig& bus) const override {
+    const auto frame = [](double data_bytes) {
+      const double stuffed = 34.0 + 8.0 * data_bytes;
+      return 47.0 + 8.0 * data_bytes + std::floor((stuffed - 1.0) / 4.0);
+    };
+    return frame(0) + 2.0 * frame(6) * static_cast<double>(bus.actuators.size());
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

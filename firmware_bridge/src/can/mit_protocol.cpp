@@ -65,20 +65,20 @@ class Mit final : public Protocol {
     }
     m.ranges = *ranges;
     if (auto n = node.find("position_max_rad")) {
-      m.ranges.p_max = n->as_positive_double();
+      m.ranges.p_max = n->as_double_in(0.1, 1000.0);
       m.ranges.p_min = -m.ranges.p_max;
     }
     if (auto n = node.find("velocity_max_rad_s")) {
-      m.ranges.v_max = n->as_positive_double();
+      m.ranges.v_max = n->as_double_in(0.1, 1000.0);
       m.ranges.v_min = -m.ranges.v_max;
     }
     if (auto n = node.find("torque_max_nm")) {
-      m.ranges.t_max = n->as_positive_double();
+      m.ranges.t_max = n->as_double_in(0.01, 10000.0);
       m.ranges.t_min = -m.ranges.t_max;
     }
     m.kp = node.at("kp").as_double_in(m.ranges.kp_min, m.ranges.kp_max);
     m.kd = node.at("kd").as_double_in(m.ranges.kd_min, m.ranges.kd_max);
-    if (auto n = node.find("zero_deg")) m.zero_rad = deg_to_rad(n->as_double());
+    if (auto n = node.find("zero_deg")) m.zero_rad = deg_to_rad(n->as_double_in(-3600.0, 3600.0));
     if (auto n = node.find("direction")) out.direction = can_config::read_direction(*n);
 
     // The joint's limits must be positions the packed command can carry.
@@ -101,6 +101,13 @@ class Mit final : public Protocol {
     out.ticks_per_rad = 1.0;
     out.zero_ticks = 0;
     out.options = m;
+  }
+
+  // Per motor a command and a reply frame of 8 data bytes (CAN 2.0A, 47 + 64
+  // bits and worst-case bit stuffing).
+  double wire_bits_per_cycle(const BusConfig& bus) const override {
+    const double frame = 47.0 + 64.0 + std::floor((34.0 + 64.0 - 1.0) / 4.0);
+    return 2.0 * frame * static_cast<double>(bus.actuators.size());
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

@@ -16,6 +16,8 @@ namespace {
 constexpr int kMaxDeviceId = 252;
 constexpr std::int64_t kMinTicks = 0;
 constexpr std::int64_t kMaxTicks = 4095;
+constexpr double kMinTicksPerRev = 16.0;
+constexpr double kMaxTicksPerRev = 1e8;
 
 constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms"};
 constexpr std::string_view kActuatorKeys[] = {"id", "ticks_per_rev", "ticks_per_rad", "zero_ticks",
@@ -58,7 +60,8 @@ class Dynamixel2 final : public Protocol {
     const YamlNode port = node.at("port");
     bus.port = port.as_string();
     if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");
-    if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(1, 10'500'000));
+    // Dynamixel servos run at 9600 baud and up.
+    if (auto n = node.find("baud")) bus.baud = static_cast<int>(n->as_int_in(9600, 10'500'000));
     if (auto n = node.find("timeout_ms")) {
       const double ms = n->as_double();
       if (!(ms > 0.0 && ms < 1000.0)) {
@@ -88,11 +91,14 @@ class Dynamixel2 final : public Protocol {
     const auto per_rad = node.find("ticks_per_rad");
     if (per_rev && per_rad) per_rad->fail("give either ticks_per_rev or ticks_per_rad, not both");
     std::string scale;  // for messages
+    // Servos resolve from a few hundred to about a million ticks per turn.
     if (per_rad) {
-      out.ticks_per_rad = per_rad->as_positive_double();
+      out.ticks_per_rad =
+          per_rad->as_double_in(kMinTicksPerRev / (2.0 * kPi), kMaxTicksPerRev / (2.0 * kPi));
       scale = format_number(out.ticks_per_rad) + " ticks/rad";
     } else {
-      const double ticks_per_rev = per_rev ? per_rev->as_positive_double() : 4096.0;
+      const double ticks_per_rev =
+          per_rev ? per_rev->as_double_in(kMinTicksPerRev, kMaxTicksPerRev) : 4096.0;
       out.ticks_per_rad = ticks_per_rev / (2.0 * kPi);
       scale = format_number(ticks_per_rev) + " ticks/rev";
     }
@@ -104,6 +110,14 @@ class Dynamixel2 final : public Protocol {
 
     check_ticks(limits_node.at("min_deg"), joint.limits.min_position, out, scale);
     check_ticks(limits_node.at("max_deg"), joint.limits.max_position, out, scale);
+  }
+
+  // Sync Write of 4-byte goal positions (14 + 5 N bytes), Sync Read of
+  // 4-byte present positions (14 + N) and N status packets of 15 bytes, at
+  // 10 bits per byte (start, 8 data, stop).
+  double wire_bits_per_cycle(const BusConfig& bus) const override {
+    const double n = static_cast<double>(bus.actuators.size());
+    return 10.0 * ((14.0 + 5.0 * n) + (14.0 + n) + 15.0 * n);
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

@@ -143,8 +143,12 @@ class Maestro final : public Protocol {
     }
     const YamlNode& scale = per_rad ? *per_rad : *per_deg;
     const double value = scale.as_double();
-    if (!(std::isfinite(value) && value != 0.0)) {
-      scale.fail("expected a non-zero number, found " + scale.describe());
+    // A hobby servo turns roughly 0.05..0.2 deg per microsecond of pulse.
+    const double deg_per_us = std::abs(per_rad ? rad_to_deg(value) : value);
+    if (!(std::isfinite(value) && deg_per_us >= 0.001 && deg_per_us <= 10.0)) {
+      scale.fail("expected a magnitude from " +
+                 std::string(per_rad ? "1.745e-05 to 0.1745 rad/us" : "0.001 to 10 deg/us") +
+                 " (negative for a mirrored servo), found " + scale.describe());
     }
     ch.rad_per_us = per_rad ? value : deg_to_rad(value);
     if (auto n = node.find("speed"))
@@ -162,6 +166,14 @@ class Maestro final : public Protocol {
     out.ticks_per_rad = 4.0 / std::abs(ch.rad_per_us);
     out.direction = ch.rad_per_us > 0 ? 1 : -1;
     out.options = ch;
+  }
+
+  // Per channel a Set Target (4 bytes compact, 6 Pololu) and a Get Position
+  // (2 or 4 bytes) with its 2-byte answer, at 10 bits per byte.
+  double wire_bits_per_cycle(const BusConfig& bus) const override {
+    const auto& options = std::any_cast<const MaestroBusOptions&>(bus.options);
+    const double per_channel = options.form == maestro::Form::pololu ? 12.0 : 8.0;
+    return 10.0 * per_channel * static_cast<double>(bus.actuators.size());
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

@@ -111,16 +111,17 @@ class ModbusProtocol final : public Protocol {
                   "radian (zero_m alone sets the actuator position at joint 0 m)");
       }
       j.per_rad = 1.0;
-      if (zero) j.zero = zero->as_double();
+      if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
     } else if (m.unit == "m") {
       if (!per) {
         node.fail("missing key m_per_rad: the map " + given +
                   " is in metres, so the joint needs the stroke per radian (negative to reverse)");
       }
       j.per_rad = per->as_double();
-      if (!(std::isfinite(j.per_rad) && j.per_rad != 0.0))
-        per->fail("expected a non-zero number, found " + per->describe());
-      if (zero) j.zero = zero->as_double();
+      if (!(std::abs(j.per_rad) >= 1e-6 && std::abs(j.per_rad) <= 10.0))
+        per->fail("expected a magnitude from 1e-06 to 10 m/rad (negative to reverse), found " +
+                  per->describe());
+      if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
     } else if (per || zero) {
       (per ? *per : *zero)
           .fail("the map " + given +
@@ -159,6 +160,14 @@ class ModbusProtocol final : public Protocol {
     }
     out.device_id = j.slave;
     out.options = j;
+  }
+
+  // RTU: per actuator a two-register write and read with their answers
+  // (38 characters) and the 3.5-character silence after each of the four
+  // frames, at 11 bits per character. TCP: not estimated.
+  double wire_bits_per_cycle(const BusConfig& bus) const override {
+    if (tcp_) return 0.0;
+    return 11.0 * (38.0 + 4 * 3.5) * static_cast<double>(bus.actuators.size());
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

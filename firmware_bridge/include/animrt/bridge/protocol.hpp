@@ -46,6 +46,15 @@ class Protocol {
                              const YamlNode& limits_node, const BusConfig& bus,
                              ActuatorBinding& out) const = 0;
 
+  // Bits on the wire for one loop cycle of `bus` with its actuators (framing
+  // and answers included, an estimate on the high side), so the loader can
+  // refuse a loop rate the bus cannot carry at bus.baud. 0: not estimated
+  // (a network link).
+  virtual double wire_bits_per_cycle(const BusConfig& bus) const {
+    (void)bus;
+    return 0.0;
+  }
+
   // Opens the bus (transport included). Throws DeviceError.
   virtual std::unique_ptr<ActuatorBus> make_bus(const BusConfig& bus) const = 0;
 };

@@ -34,6 +34,7 @@ struct MotionConfig {
   std::string type;  // "gait"
   std::string file;  // resolved against the robot file's folder
   Location where;
+  std::string key;  // dotted key of `where`, e.g. "motion.file" or "motion.layers[1].file"
   std::shared_ptr<const head::HeadMotionConfig> head;  // type "head" (parsed in controllers/head)
   std::vector<MotionConfig> layers;  // type "layers": applied in order, later layers win
 };

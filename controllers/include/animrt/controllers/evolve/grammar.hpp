@@ -54,6 +54,8 @@ class Grammar {
 
  private:
   void link_and_check();
+  void compute_min_depths();
+  void mark_recursion();
   std::vector<Rule> rules_;
   std::string file_;
 };

@@ -6,6 +6,12 @@
 
 namespace animrt::head {
 
+// Sample rates and channel counts an input file may declare; anything else
+// is a damaged or hostile header.
+inline constexpr int kMinAudioRate = 4000;
+inline constexpr int kMaxAudioRate = 384000;
+inline constexpr int kMaxAudioChannels = 64;
+
 struct Audio {
   int sample_rate = 0;
   std::vector<float> samples;  // mono, nominally in [-1, 1]
@@ -17,7 +23,9 @@ struct Audio {
 // Reads an audio file through libsndfile, mixes it down to mono and, when
 // `target_rate` > 0 and differs, resamples it with libsamplerate. Throws
 // InputError naming the file for a missing, empty, truncated or non-audio
-// file.
+// file, one that is not a regular file, one whose header declares a rate
+// outside kMinAudioRate..kMaxAudioRate, and one holding NaN or infinite
+// samples.
 Audio load_audio(const std::string& path, int target_rate = 0);
 
 // Resamples with libsamplerate (band-limited sinc). Returns `in` unchanged

@@ -38,6 +38,10 @@ namespace animrt {
 
 enum class Interpolation { step, linear, cubic };
 
+// Sample rates a show's sound track may have.
+inline constexpr int kMinShowAudioRate = 4000;
+inline constexpr int kMaxShowAudioRate = 384000;
+
 struct ShowKey {
   double t = 0.0;      // s
   double value = 0.0;  // as written: degrees or metres (SI once bound to a joint)
