@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Ctrl-C on a run of the simulated quadruped: the first SIGINT ramps home and
+# exits 0; a second one switches torque off at once and exits 5, saying so.
+set -uo pipefail
+animrt=$1
+root=$2
+tmp=$(mktemp -d)
+pid=""
+trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+# Starts a run until Ctrl-C and waits until its motion is under way.
+start_run() {
+  "$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --no-realtime \
+    > "$tmp/out.txt" 2> "$tmp/err.txt" &
+  pid=$!
+  for _ in $(seq 100); do
+    grep -q "activate: torque on" "$tmp/err.txt" && break
+    sleep 0.1
+  done
+  grep -q "activate: torque on" "$tmp/err.txt" || fail "run did not start: $(cat "$tmp/err.txt")"
+  sleep "$1"
+}
+
+start_run 2.5
+kill -INT $pid
+wait $pid
+code=$?
+pid=""
+[[ $code == 0 ]] || fail "one SIGINT: exit $code, expected 0: $(cat "$tmp/out.txt" "$tmp/err.txt")"
+grep -q "ended by stop request" "$tmp/out.txt" || fail "one SIGINT: $(head -3 "$tmp/out.txt")"
+grep -q "TORQUE CUT" "$tmp/out.txt" && fail "one SIGINT cut torque: $(head -3 "$tmp/out.txt")"
+grep -q "deactivate: torque off" "$tmp/err.txt" || fail "one SIGINT: $(cat "$tmp/err.txt")"
+
+start_run 2.5
+kill -INT $pid
+sleep 0.3
+kill -INT $pid
+wait $pid
+code=$?
+pid=""
+[[ $code == 5 ]] || fail "two SIGINTs: exit $code, expected 5: $(cat "$tmp/out.txt" "$tmp/err.txt")"
+grep -q "^TORQUE CUT second stop request" "$tmp/out.txt" || fail "two SIGINTs: $(head -4 "$tmp/out.txt")"
+grep -q "torque switched off at once" "$tmp/err.txt" || fail "two SIGINTs: $(cat "$tmp/err.txt")"
+echo "stop_signals: ok"
