@@ -16,9 +16,9 @@
 #include <typeinfo>
 
 // With AddressSanitizer the sanitizer owns malloc: only operator new is
-// counted there. Otherwise malloc, calloc and realloc are replaced by
-// counting forwards to glibc's allocator (free and the aligned forms stay
-// glibc's own; it is the same heap).
+// counted there. Otherwise malloc, calloc, realloc and the aligned forms are
+// replaced by counting forwards to glibc's allocator (free stays glibc's
+// own; it is the same heap).
 #if defined(__SANITIZE_ADDRESS__)
 #define ANIMRT_COUNT_MALLOC 0
 #elif defined(__has_feature)
@@ -35,6 +35,7 @@ extern "C" {
 void* __libc_malloc(std::size_t size) noexcept;
 void* __libc_calloc(std::size_t n, std::size_t size) noexcept;
 void* __libc_realloc(void* p, std::size_t size) noexcept;
+void* __libc_memalign(std::size_t alignment, std::size_t size) noexcept;
 void __libc_free(void* p) noexcept;
 }
 #endif
@@ -228,6 +229,23 @@ void* realloc(void* p, std::size_t size) noexcept {
   note_run_allocation();
   return __libc_realloc(p, size);
 }
+// The aligned forms (aligned operator new goes through aligned_alloc).
+void* memalign(std::size_t alignment, std::size_t size) noexcept {
+  note_run_allocation();
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
+  note_run_allocation();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) noexcept {
+  if (alignment % sizeof(void*) != 0 || (alignment & (alignment - 1)) != 0) return EINVAL;
+  note_run_allocation();
+  void* p = __libc_memalign(alignment, size);
+  if (p == nullptr) return ENOMEM;
+  *out = p;
+  return 0;
+}
 }
 #endif
 
@@ -253,7 +271,7 @@ extern "C" int pthread_create(pthread_t* thread, const pthread_attr_t* attr,
 }
 
 // Replacements of the global allocation functions (the aligned forms keep
-// their defaults, which do not call these).
+// their defaults, which call aligned_alloc).
 void* operator new(std::size_t size) { return allocate(size); }
 void* operator new[](std::size_t size) { return allocate(size); }
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {

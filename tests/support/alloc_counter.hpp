@@ -5,8 +5,9 @@
 // (alloc_counter.cpp replaces operator new in every test binary).
 //
 // Per run (RunAllocationWatch): allocations on every thread a run owns, C and
-// C++ alike (malloc, calloc and realloc are counted too, except in sanitizer
-// builds, where the sanitizer owns malloc and only operator new is counted).
+// C++ alike (malloc, calloc, realloc and the aligned forms are counted too,
+// except in AddressSanitizer builds, where the sanitizer owns malloc and only
+// operator new is counted).
 // Which threads a run owns is decided by lineage, not by name: pthread_create
 // is interposed, and a thread started by a run thread is a run thread. The
 // watch makes the calling thread (the one that calls Runner::run, i.e. the
