@@ -272,7 +272,7 @@ TEST(LateBus, ABusStuckBeyondTheGraceFaultsAfterIt) {
   r.rig->on_bus_call = [&](std::size_t, BusCall c, std::uint64_t index) {
     if (c == BusCall::activate) active = true;
     if (c != BusCall::read || !active) return;
-    // The hook runs before each read: the one before this read is done.
+    // The hook runs before each read, so after the read before it came back.
     if (index == 150) {
       stuck_at = wall.now();
       std::this_thread::sleep_for(std::chrono::milliseconds(1600));
