@@ -28,6 +28,8 @@ assert rows[0][0] == "time_s" and len(rows[0]) == 25, rows[0]
 assert len(rows) - 1 == s["telemetry"]["records"], (len(rows), s["telemetry"])
 PY
 
+"/usr/bin/python3" -c 'import serial' 2> /dev/null \
+  || fail "python3-serial not found for /usr/bin/python3 (scripts/install-deps.sh installs it)"
 "$animrt" sim "$root/configs/robots/quadruped.yaml" > "$tmp/sim.txt" 2>&1 &
 sim_pid=$!
 for _ in $(seq 50); do

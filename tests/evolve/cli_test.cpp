@@ -87,7 +87,8 @@ TEST_F(EvolveCli, ThreadsAndMpiGiveTheSerialResultAndTheGaitPlays) {
             0)
       << read(path("run.log"));
 
-  if (sh("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
+  ASSERT_EQ(sh("command -v mpirun > /dev/null 2>&1"), 0)
+      << "mpirun not found (scripts/install-deps.sh installs Open MPI)";
   // Leak checking would flag Open MPI's own allocations under ASan.
   const std::string mpirun =
       "ASAN_OPTIONS=detect_leaks=0 OMPI_MCA_plm_rsh_agent=false mpirun --allow-run-as-root "

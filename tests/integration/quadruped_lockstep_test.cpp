@@ -1,7 +1,7 @@
 // The runtime against simulated Dynamixel servos over a real pseudo-terminal,
-// on a lockstep clock: the whole lifecycle, tracking, determinism, the fault
-// path when a device dies or reports a hardware error, and no allocation in
-// the cycle.
+// on a lockstep clock: the whole lifecycle, tracking, determinism, and the
+// fault path when a device dies or reports a hardware error. (No allocation
+// in the cycle: cycle_allocation_test.cpp, on every thread of the run.)
 
 #include <gtest/gtest.h>
 
@@ -17,70 +17,17 @@
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
-#include "support/alloc_counter.hpp"
+#include "support/sim_rig.hpp"
 
 namespace animrt {
 namespace {
 
 const std::string kQuadruped = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml";
 
-// Wraps a motion source to act at given motion times, on the loop thread, so
-// fault injection happens at a deterministic cycle.
-class Probe final : public MotionSource {
- public:
-  explicit Probe(std::unique_ptr<MotionSource> inner) : inner_(std::move(inner)) {}
-  std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
-  void sample(double t, std::span<double> targets) const override {
-    if (on_sample) on_sample(t);
-    allocations_seen.push_back_noalloc(test::thread_allocations());
-    inner_->sample(t, targets);
-  }
-  std::function<void(double)> on_sample;
-
-  // Preallocated record of the loop thread's allocation counter per sample.
-  struct Record {
-    std::vector<std::uint64_t> values;
-    std::size_t size = 0;
-    void push_back_noalloc(std::uint64_t v) {
-      if (size < values.size()) values[size++] = v;
-    }
-  };
-  mutable Record allocations_seen;
-
- private:
-  std::unique_ptr<MotionSource> inner_;
-};
-
-struct Rig {
-  ManualClock clock;
-  LoadedRobot robot;
-  std::vector<std::unique_ptr<SimulatedBus>> sims;
-  Probe* probe = nullptr;
-  std::unique_ptr<Runner> runner;
-
-  Rig() {
-    robot = load_robot(kQuadruped);
-    for (auto& bus : robot.config.buses) {
-      bus.timeout_s = 0.05;  // generous: a loaded CI machine must not cause timeouts
-      bus.sim.wire_time = false;
-    }
-    sims = start_simulated_devices(robot.config.buses, clock);
-    std::vector<std::unique_ptr<ActuatorBus>> buses;
-    for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-    auto probe_owner = std::make_unique<Probe>(std::move(robot.motion));
-    probe = probe_owner.get();
-    probe->allocations_seen.values.assign(100000, 0);
-    runner = std::make_unique<Runner>(robot.config, std::move(buses), std::move(probe_owner));
-  }
-
-  RunSummary run(double duration, const std::string& telemetry = "") {
-    RunOptions options;
-    options.duration_s = duration;
-    options.lockstep_clock = &clock;
-    options.telemetry_path = telemetry;
-    options.backend_name = "sim";
-    return runner->run(options);
-  }
+// The quadruped on its simulated servos in lockstep (support/sim_rig.hpp);
+// wire time off, so the run does not depend on the machine's speed.
+struct Rig : test::SimRig {
+  Rig() : SimRig(kQuadruped) {}
 };
 
 struct Csv {
@@ -134,8 +81,8 @@ TEST(QuadrupedLockstep, WalksTheGaitAndTracksWithinTheServoModel) {
   // A first-order servo with time constant tau lags a command moving at v by
   // about tau*v, so the RMS error is bounded by tau * RMS(v) plus a margin for
   // the one-cycle delay and the tick quantisation.
-  const double tau = rig.robot.config.buses[0].sim.time_constant_s;
-  const double dt = 1.0 / rig.robot.config.rate_hz;
+  const double tau = rig.config().buses[0].sim.time_constant_s;
+  const double dt = 1.0 / rig.config().rate_hz;
   const double tick = 2 * M_PI / 4096;
   Csv csv = read_csv(csv_path);
   ASSERT_EQ(csv.rows.size(), s.cycles);
@@ -155,7 +102,7 @@ TEST(QuadrupedLockstep, WalksTheGaitAndTracksWithinTheServoModel) {
     EXPECT_GT(s.joints[j].rms_tracking_error_rad, 0.0) << name;
   }
   // Every servo is back home at the end.
-  for (const auto& bus : rig.robot.config.buses) {
+  for (const auto& bus : rig.config().buses) {
     for (const auto& a : bus.actuators) {
       EXPECT_NEAR(rig.sims[0]->device_position(a.device_id), 0.0, 0.02) << a.joint;
     }
@@ -183,19 +130,6 @@ TEST(QuadrupedLockstep, SameRunSameTelemetry) {
   }
   EXPECT_FALSE(std::getline(fb, lb)) << "second run is longer";
   EXPECT_GT(line, 200);
-}
-
-TEST(QuadrupedLockstep, TheCycleDoesNotAllocate) {
-  Rig rig;
-  rig.run(1.0);
-  const auto& seen = rig.probe->allocations_seen;
-  ASSERT_GT(seen.size, 150u);
-  // The first call plans the start ramp outside the cycle; compare the loop
-  // thread's allocation counter from the 10th motion cycle on.
-  for (std::size_t k = 11; k < seen.size; ++k) {
-    ASSERT_EQ(seen.values[k], seen.values[10])
-        << "allocation between motion cycles " << k - 1 << " and " << k;
-  }
 }
 
 // Checks a fault run: the faulted joint is reported, every other joint's
@@ -230,7 +164,7 @@ TEST(QuadrupedLockstep, ADeviceThatDiesMidRunFaultsAndTheOthersRampHome) {
   const std::string csv_path = ::testing::TempDir() + "/lockstep_dead.csv";
   RunSummary s = rig.run(5.0, csv_path);
   Csv csv = read_csv(csv_path);
-  expect_safe_fault_stop(s, csv, rig.robot.config, "rf_knee");
+  expect_safe_fault_stop(s, csv, rig.config(), "rf_knee");
   EXPECT_NE(s.faults[0].find("no valid answer"), std::string::npos) << s.faults[0];
   EXPECT_LT(s.motion_time_s, 1.5);  // the motion stopped soon after the fault
   for (const auto& d : s.devices) {
@@ -253,7 +187,7 @@ TEST(QuadrupedLockstep, AHardwareErrorFaultsTheDeviceAtOnce) {
   const std::string csv_path = ::testing::TempDir() + "/lockstep_hw.csv";
   RunSummary s = rig.run(5.0, csv_path);
   Csv csv = read_csv(csv_path);
-  expect_safe_fault_stop(s, csv, rig.robot.config, "lh_ankle");
+  expect_safe_fault_stop(s, csv, rig.config(), "lh_ankle");
   EXPECT_NE(s.faults[0].find("hardware error"), std::string::npos) << s.faults[0];
   EXPECT_LT(s.motion_time_s, 0.52);
   for (const auto& d : s.devices) {
@@ -269,18 +203,15 @@ TEST(QuadrupedLockstep, AStopRequestRampsHome) {
   rig.probe->on_sample = [&](double t) {
     if (t >= 0.7) controls.stop.store(true);
   };
-  RunOptions options;
-  options.duration_s = 0.0;  // forever, until the stop request
-  options.lockstep_clock = &rig.clock;
-  options.controls = &controls;
   const std::string csv_path = ::testing::TempDir() + "/lockstep_stop.csv";
-  options.telemetry_path = csv_path;
-  RunSummary s = rig.runner->run(options);
+  RunOptions options = rig.options(0.0, csv_path);  // forever, until the stop request
+  options.controls = &controls;
+  RunSummary s = rig.run(options);
   EXPECT_EQ(s.end_reason, EndReason::signal);
   EXPECT_EQ(s.exit_code(), 0);
   EXPECT_NEAR(s.motion_time_s, 0.7, 0.011);
   Csv csv = read_csv(csv_path);
-  for (const auto& joint : rig.robot.config.joints) {
+  for (const auto& joint : rig.config().joints) {
     EXPECT_NEAR(csv.rows.back()[csv.column(joint.name + "_cmd_rad")], joint.home, 1e-6);
   }
 }

@@ -112,7 +112,8 @@ TEST(HeadSource, BundledModelMovesNeckAndJawWithinLimits) {
 // Gross pitch error of our YIN features against Praat's autocorrelation
 // tracker on espeak-ng speech: frames voiced in both, |error| > 20 %.
 TEST(PitchTracker, GrossPitchErrorAgainstPraat) {
-  if (std::system("command -v praat > /dev/null 2>&1") != 0) GTEST_SKIP() << "praat not installed";
+  ASSERT_EQ(std::system("command -v praat > /dev/null 2>&1"), 0)
+      << "praat not found (scripts/install-deps.sh installs it)";
   const std::string d = tmp("gpe");
   const std::string wav = kSrc + "/configs/head/utterance.wav";
   std::ofstream(d + "/pitch.praat") << "form args\n  sentence wav\n  sentence out\nendform\n"

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -70,7 +71,14 @@ std::map<std::string, std::string> lines(const std::string& out) {
   return m;
 }
 
+// A missing peer is a failure that says what to install, never a skip.
+void require(const std::string& probe, const std::string& what) {
+  ASSERT_EQ(std::system((probe + " > /dev/null 2>&1").c_str()), 0)
+      << what << " not found (scripts/install-deps.sh installs it)";
+}
+
 void expect_pymodbus(const std::string& kind, const std::string& where) {
+  require("/usr/bin/python3 -c 'import pymodbus'", "python3-pymodbus");
   const std::string out = run("/usr/bin/python3 " + std::string(ANIMRT_SOURCE_DIR) +
                               "/tests/modbus/pymodbus_client.py " + kind + " " + where);
   auto m = lines(out);
@@ -103,6 +111,7 @@ TEST(ModbusPeers, MbpollReadsInputRegistersAndWritesTheEnableCoil) {
   RobotConfig c = drives("modbus-tcp");
   sim::ModbusSimBus sim(c.buses[0], clock);
   sim.start();
+  require("command -v mbpoll", "mbpoll");
   const std::string port = sim.endpoint().substr(sim.endpoint().rfind(':') + 1);
   // Slave 1: present (int32, 2 words) and status at input registers 0..2.
   const std::string read = run("mbpoll -m tcp -p " + port + " -a 1 -t 3 -0 -r 0 -c 3 -1 127.0.0.1");

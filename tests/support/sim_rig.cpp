@@ -1,0 +1,119 @@
+#include "support/sim_rig.hpp"
+
+#include <stdexcept>
+
+#include "animrt/sim/simulated_backend.hpp"
+
+namespace animrt::test {
+
+SimRig::SimRig(const std::string& robot_file, const RigSettings& settings)
+    : lockstep_(settings.lockstep) {
+  robot = load_robot(robot_file);
+  if (settings.edit_motion) settings.edit_motion(robot);
+  for (auto& bus : robot.config.buses) {
+    bus.timeout_s = std::max(bus.timeout_s, settings.min_bus_timeout_s);
+    bus.sim.wire_time = settings.wire_time;
+  }
+  if (settings.edit) settings.edit(robot.config);
+  sims = start_simulated_devices(robot.config.buses, clock(), settings.physics);
+  hook_ = [this](std::size_t bus, BusCall call, std::uint64_t index) {
+    bus_call(bus, call, index);
+  };
+  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  for (std::size_t b = 0; b < robot.config.buses.size(); ++b) {
+    auto watched = std::make_unique<WatchedBus>(make_bus(robot.config.buses[b]), b, hook_);
+    watched_.push_back(watched.get());
+    buses.push_back(std::move(watched));
+  }
+  auto owner = std::make_unique<ProbeSource>(std::move(robot.motion));
+  probe = owner.get();
+  runner_ = std::make_unique<Runner>(robot.config, std::move(buses), std::move(owner));
+}
+
+SimRig::~SimRig() {
+  runner_.reset();  // buses close before their devices stop
+  sims.clear();
+}
+
+const Clock& SimRig::clock() const {
+  return lockstep_ ? static_cast<const Clock&>(lockstep_clock_)
+                   : static_cast<const Clock&>(wall_clock_);
+}
+
+SimulatedBus& SimRig::sim(const std::string& bus_name) {
+  for (std::size_t b = 0; b < robot.config.buses.size(); ++b) {
+    if (robot.config.buses[b].name == bus_name) return *sims[b];
+  }
+  throw std::out_of_range("no bus " + bus_name);
+}
+
+RunOptions SimRig::options(double duration, const std::string& telemetry) {
+  RunOptions options;
+  options.duration_s = duration;
+  options.lockstep_clock = lockstep_ ? &lockstep_clock_ : nullptr;
+  options.request_realtime = false;
+  options.telemetry_path = telemetry;
+  options.backend_name = "sim";
+  return options;
+}
+
+RunSummary SimRig::run(double duration, const std::string& telemetry) {
+  return run(options(duration, telemetry));
+}
+
+RunSummary SimRig::run(const RunOptions& options) { return runner_->run(options); }
+
+void SimRig::bus_call(std::size_t bus, BusCall call, std::uint64_t index) {
+  if (watch_ != nullptr) {
+    switch (call) {
+      case BusCall::activate:
+        ++active_buses_;
+        break;
+      case BusCall::read:
+        if (!in_window_.load() &&
+            active_buses_.load() == static_cast<int>(robot.config.buses.size())) {
+          in_window_.store(true);
+          watch_->open();
+        }
+        if (bus == 0 && in_window_.load()) ++phase_cycles_[phase_.load()];
+        break;
+      case BusCall::deactivate:
+        if (in_window_.exchange(false)) watch_->close();
+        break;
+      case BusCall::configure:
+      case BusCall::write:
+        break;
+    }
+  }
+  if (on_bus_call) on_bus_call(bus, call, index);
+}
+
+RunSummary SimRig::run_watching(RunAllocationWatch& watch, const RunOptions& options) {
+  RunOptions watched = options;
+  watched.on_motion_start = [this, &watch, start = options.on_motion_start](Nanos t) {
+    phase_.store(static_cast<int>(RunPhase::motion));
+    watch.set_phase(RunPhase::motion);
+    if (start) start(t);
+  };
+  watched.on_motion_end = [this, &watch, end = options.on_motion_end] {
+    phase_.store(static_cast<int>(RunPhase::stop_ramp));
+    watch.set_phase(RunPhase::stop_ramp);
+    if (end) end();
+  };
+  watch_ = &watch;
+  active_buses_ = 0;
+  phase_ = static_cast<int>(RunPhase::start_ramp);
+  for (auto& c : phase_cycles_) c.store(0);
+  watch.set_phase(RunPhase::start_ramp);
+  struct Reset {
+    SimRig& rig;
+    ~Reset() {
+      rig.watch_->close();
+      rig.watch_ = nullptr;
+      rig.in_window_ = false;
+    }
+  } reset{*this};
+  return runner_->run(watched);
+}
+
+}  // namespace animrt::test

@@ -1,0 +1,155 @@
+#pragma once
+// A robot file run against its simulated devices, the setup the integration
+// tests share: load the robot, start the simulated devices (on a lockstep or
+// the wall clock), build the buses and the runner. Each bus is wrapped in a
+// WatchedBus, which forwards every call to the real bus and lets a test act
+// on the calling thread before a read or write (make the bus late, inject a
+// fault at a given cycle) and open an allocation window at the first cycle.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/runner.hpp"
+#include "animrt/sim/simulated_bus.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace sim {
+class JointPhysics;
+}
+
+namespace test {
+
+// Calls on_sample(t) on the loop thread before each sample of the inner source.
+class ProbeSource final : public MotionSource {
+ public:
+  explicit ProbeSource(std::unique_ptr<MotionSource> inner) : inner_(std::move(inner)) {}
+  std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
+  void sample(double t, std::span<double> targets) const override {
+    if (on_sample) on_sample(t);
+    inner_->sample(t, targets);
+  }
+  std::function<void(double)> on_sample;
+
+ private:
+  std::unique_ptr<MotionSource> inner_;
+};
+
+enum class BusCall { configure, activate, read, write, deactivate };
+
+// The real bus behind a hook, called on the calling thread before each call
+// is forwarded (bus index, call, how many calls of that kind came before).
+class WatchedBus final : public ActuatorBus {
+ public:
+  using Hook = std::function<void(std::size_t bus, BusCall call, std::uint64_t index)>;
+  WatchedBus(std::unique_ptr<ActuatorBus> inner, std::size_t index, const Hook& hook)
+      : inner_(std::move(inner)), index_(index), hook_(hook) {}
+
+  const BusConfig& config() const override { return inner_->config(); }
+  void configure() override {
+    notify(BusCall::configure);
+    inner_->configure();
+  }
+  void activate() override {
+    notify(BusCall::activate);
+    inner_->activate();
+  }
+  void deactivate() override {
+    notify(BusCall::deactivate);
+    inner_->deactivate();
+  }
+  void read(std::span<double> positions) override {
+    notify(BusCall::read);
+    inner_->read(positions);
+  }
+  void write(std::span<const double> positions) override {
+    notify(BusCall::write);
+    inner_->write(positions);
+  }
+  std::span<DeviceStatus> devices() override { return inner_->devices(); }
+
+  ActuatorBus& inner() { return *inner_; }
+  std::uint64_t calls(BusCall call) const { return calls_[static_cast<int>(call)].load(); }
+
+ private:
+  void notify(BusCall call) {
+    const std::uint64_t n = calls_[static_cast<int>(call)].fetch_add(1);
+    if (hook_) hook_(index_, call, n);
+  }
+  std::unique_ptr<ActuatorBus> inner_;
+  std::size_t index_;
+  const Hook& hook_;
+  std::atomic<std::uint64_t> calls_[5]{};
+};
+
+struct RigSettings {
+  bool lockstep = true;
+  // Every bus's answer timeout is raised to at least this: a loaded CI
+  // machine must not cause timeouts.
+  double min_bus_timeout_s = 0.05;
+  bool wire_time = false;                         // emulate Dynamixel wire time
+  std::function<void(RobotConfig&)> edit;         // before the devices start
+  sim::JointPhysics* physics = nullptr;           // dynamixel2 buses only
+  std::function<void(LoadedRobot&)> edit_motion;  // e.g. replace the motion source
+};
+
+class SimRig {
+ public:
+  explicit SimRig(const std::string& robot_file, const RigSettings& settings = {});
+  ~SimRig();
+  SimRig(const SimRig&) = delete;
+  SimRig& operator=(const SimRig&) = delete;
+
+  const RobotConfig& config() const { return robot.config; }
+  const Clock& clock() const;
+  SimulatedBus& sim(const std::string& bus_name);
+  // The real bus (behind its WatchedBus) and the wrapper.
+  ActuatorBus& bus(std::size_t index) { return watched_[index]->inner(); }
+  WatchedBus& watched(std::size_t index) { return *watched_[index]; }
+
+  // Options for a run of `duration` s (0: until a stop request), with
+  // telemetry to `telemetry` if not empty.
+  RunOptions options(double duration, const std::string& telemetry = "");
+  RunSummary run(double duration, const std::string& telemetry = "");
+  RunSummary run(const RunOptions& options);
+  // A run under `watch`: its window opens at the first read after every bus
+  // is active (the first cycle) and closes at the first deactivate (after
+  // the last cycle); the phases follow on_motion_start / on_motion_end.
+  RunSummary run_watching(RunAllocationWatch& watch, const RunOptions& options);
+  // Cycles (reads of bus 0) seen in each phase of the last watched run.
+  std::uint64_t cycles_in(RunPhase phase) const {
+    return phase_cycles_[static_cast<int>(phase)].load();
+  }
+
+  LoadedRobot robot;  // the config points at the simulated devices
+  std::vector<std::unique_ptr<SimulatedBus>> sims;
+  ProbeSource* probe = nullptr;
+  // Called before every forwarded bus call (see WatchedBus); set before run().
+  WatchedBus::Hook on_bus_call;
+
+ private:
+  void bus_call(std::size_t bus, BusCall call, std::uint64_t index);
+
+  bool lockstep_;
+  ManualClock lockstep_clock_;
+  MonotonicClock wall_clock_;
+  std::vector<WatchedBus*> watched_;
+  std::unique_ptr<Runner> runner_;
+  WatchedBus::Hook hook_;
+  RunAllocationWatch* watch_ = nullptr;
+  std::atomic<int> active_buses_{0};
+  std::atomic<int> phase_{0};
+  std::atomic<bool> in_window_{false};
+  std::atomic<std::uint64_t> phase_cycles_[3]{};
+};
+
+}  // namespace test
+}  // namespace animrt
