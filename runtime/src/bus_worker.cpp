@@ -52,6 +52,8 @@ void* thread_main(void* worker) {
 
 }  // namespace
 
+ThreadRoutine bus_worker_thread_routine() { return thread_main; }
+
 void BusWorker::run_for_thread() { run(); }
 
 bool BusWorker::start(int realtime_priority) {

@@ -26,6 +26,11 @@ namespace animrt {
 void futex_wait(std::atomic<std::uint32_t>& word, std::uint32_t expected, Nanos timeout_ns);
 void futex_wake_all(std::atomic<std::uint32_t>& word);
 
+// The start routine of every BusWorker thread (tests tell run threads apart
+// by it).
+using ThreadRoutine = void* (*)(void*);
+ThreadRoutine bus_worker_thread_routine();
+
 class BusWorker {
  public:
   // `done` is bumped (and woken) after every completed request of any worker.

@@ -52,7 +52,7 @@ std::string animatronic_on_rtu() {
   };
   replace("protocol: modbus-tcp", "protocol: modbus-rtu");
   replace("port: 192.168.1.50:502", "port: /dev/null");
-  replace("    reconnect_ms: 100", "    parity: none");
+  replace("    reconnect_ms: 100", "    parity: none\n    baud: 230400");
   replace("../", kConfigs + "/");
   const std::string path = ::testing::TempDir() + "/animatronic_rtu.yaml";
   std::ofstream(path) << text;

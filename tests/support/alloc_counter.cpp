@@ -1,5 +1,7 @@
 #include "support/alloc_counter.hpp"
 
+#include "../../runtime/src/bus_worker.hpp"
+
 #include <dlfcn.h>
 #include <execinfo.h>
 #include <pthread.h>
@@ -144,11 +146,11 @@ void* start_run_thread(void* p) {
 }
 
 Role classify(void* (*routine)(void*), void* arg) {
+  if (routine != nullptr && routine == animrt::bus_worker_thread_routine()) return kBusIo;
 #ifdef __GLIBCXX__
   if (routine != nullptr && routine == std_thread_routine.load()) {
     const char* type = typeid(*static_cast<std::thread::_State*>(arg)).name();
     if (std::strstr(type, "TelemetryWriter") != nullptr) return kWriter;
-    if (std::strstr(type, "BusWorker") != nullptr) return kBusIo;
   }
 #else
   (void)routine;
