@@ -106,6 +106,16 @@ void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>&
 
 int cmd_run(const RunArgs& args) {
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
+  // Opened before anything moves: a summary that cannot be written is found
+  // now, not after the run.
+  std::ofstream summary_out;
+  if (!args.summary_json.empty()) {
+    summary_out.open(args.summary_json);
+    if (!summary_out) {
+      spdlog::error("--summary-json: cannot write {}", args.summary_json);
+      return kExitUsage;
+    }
+  }
   if (args.lockstep && args.backend != "sim") {
     spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
     return kExitUsage;
@@ -184,14 +194,7 @@ int cmd_run(const RunArgs& args) {
     summary.physics = report;
   }
   std::cout << animrt::format_summary(summary) << std::flush;
-  if (!args.summary_json.empty()) {
-    std::ofstream out(args.summary_json);
-    if (!out) {
-      spdlog::error("cannot write summary file {}", args.summary_json);
-      return kExitUsage;
-    }
-    out << animrt::to_json(summary).dump(2) << '\n';
-  }
+  if (summary_out.is_open()) summary_out << animrt::to_json(summary).dump(2) << '\n' << std::flush;
   return summary.exit_code();
 }
 

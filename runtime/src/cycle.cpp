@@ -9,11 +9,11 @@ namespace {
 constexpr double kSettledVelocity = 1e-3;  // rad/s: the stop ramp has ended
 constexpr double kMaxSettleTime = 2.0;     // s after the stop ramp, at most
 // A late bus is judged by its answers once its I/O thread is done (every
-// transaction is bounded by the bus timeout); only a bus stuck this many
-// watchdog times (a thread that never returns) is faulted without them, so
-// a descheduled I/O thread on a loaded machine is not taken for silent
-// devices.
-constexpr double kLateBusGrace = 10.0;
+// transaction is bounded by the bus timeout); only a bus stuck for ten
+// watchdog times, at most the watchdog plus two seconds (a thread that never
+// returns), is faulted without them, so a descheduled I/O thread on a loaded
+// machine is not taken for silent devices.
+double late_bus_grace(double watchdog) { return std::min(10.0 * watchdog, watchdog + 2.0); }
 constexpr std::size_t kEventLogCapacity = 256;
 // Times are seconds in doubles; comparisons allow for their rounding, so
 // "more than 0.1 s" means what it says at 2.4 - 2.3 too.
@@ -31,7 +31,12 @@ CycleState::CycleState(const RobotModel& model)
   ramp_to_.assign(n, 0.0);
   jog_.assign(n, 0.0);
   active_.assign(n, 0);
-  over_since_.assign(n, -1.0);
+  window_ = std::max<std::size_t>(
+      1, static_cast<std::size_t>(std::lround(model.safety.following_error_window_s / model.dt)));
+  err_ring_.assign(n * window_, 0.0);
+  err_next_.assign(n, 0);
+  err_count_.assign(n, 0);
+  err_sum_.assign(n, 0.0);
   sq_error_.assign(n, 0.0);
   max_error_.assign(n, 0.0);
   error_samples_.assign(n, 0);
@@ -135,7 +140,7 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     for (std::size_t d = 0; d < s.faulted_[b].size(); ++d) {
       if (s.faulted_[b][d]) continue;
       double& last_ok = s.last_ok_[b][d];
-      if (!io.fresh && t - last_ok <= kLateBusGrace * watchdog + kTimeEps) continue;
+      if (!io.fresh && t - last_ok <= late_bus_grace(watchdog) + kTimeEps) continue;
       const DeviceHealth health = io.fresh ? io.health[d] : DeviceHealth::timeout;
       if (health == DeviceHealth::ok) {
         last_ok = t;
@@ -148,8 +153,8 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   }
 
   // Following error: the last command a device was sent against what it
-  // measured since. A joint that stays too far for the whole window is
-  // faulted like a silent device (it is held, the others ramp home).
+  // measured since. A joint whose RMS error over the last window is above
+  // the limit is faulted like a silent device (held; the others ramp home).
   if (s.cycles_ > 0) {
     for (std::size_t j = 0; j < n; ++j) {
       const JointSlot slot = s.slots_[j];
@@ -158,16 +163,22 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
       s.sq_error_[j] += e * e;
       s.max_error_[j] = std::max(s.max_error_[j], e);
       ++s.error_samples_[j];
-      if (e <= model.following_error[j]) {
-        s.over_since_[j] = -1.0;
-        continue;
+      double& slot_sq = s.err_ring_[j * s.window_ + s.err_next_[j]];
+      s.err_sum_[j] += e * e - slot_sq;
+      slot_sq = e * e;
+      s.err_next_[j] = (s.err_next_[j] + 1) % s.window_;
+      if (s.err_next_[j] == 0) {  // once per window: the running sum starts afresh
+        double sum = 0.0;
+        for (std::size_t k = 0; k < s.window_; ++k) sum += s.err_ring_[j * s.window_ + k];
+        s.err_sum_[j] = sum;
       }
-      if (s.over_since_[j] < 0.0) s.over_since_[j] = t;
-      if (t - s.over_since_[j] >= model.safety.following_error_window_s - kTimeEps) {
+      s.err_count_[j] = std::min(s.err_count_[j] + 1, s.window_);
+      const double rms = std::sqrt(std::max(0.0, s.err_sum_[j]) / static_cast<double>(s.window_));
+      if (s.err_count_[j] == s.window_ && rms > model.following_error[j]) {
         s.faulted_[slot.bus][slot.device] = 1;
         fault = true;
         s.emit(CycleEvent{EventKind::following_error, t, static_cast<int>(j), slot.bus, slot.device,
-                          DeviceHealth::ok, e});
+                          DeviceHealth::ok, rms});
       }
     }
   }

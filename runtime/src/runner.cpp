@@ -60,9 +60,9 @@ class ActivationGuard {
   std::size_t activated_ = 0;
 };
 
-std::string joint_value(double value, bool prismatic) {
-  return prismatic ? fmt::format("{:.1f} mm", value * 1e3)
-                   : fmt::format("{:.1f} deg", rad_to_deg(value));
+std::string joint_value(double value, bool prismatic, int decimals = 1) {
+  return prismatic ? fmt::format("{:.{}f} mm", value * 1e3, decimals)
+                   : fmt::format("{:.{}f} deg", rad_to_deg(value), decimals);
 }
 
 // The joint that makes the start ramp longest, for the refusal message.
@@ -103,15 +103,16 @@ std::string describe_event(const RobotModel& m,
       const auto& actuator = bus.actuators[e.device];
       const double limit = m.following_error[static_cast<std::size_t>(e.joint)];
       return fmt::format(
-          "bus {} id {} ({}): following error {} (limit {}) for {} s at t={:.3f} s; the joint "
-          "is held, other joints ramped to home (a wrong id, a blocked or unpowered joint?)",
-          bus.name, actuator.device_id, actuator.joint, joint_value(e.value, prismatic),
-          joint_value(limit, prismatic), m.safety.following_error_window_s, e.t);
+          "bus {} id {} ({}): RMS following error {} over the last {} s (limit {}) at t={:.3f} "
+          "s; the joint is held, other joints ramped to home (two servos answering under each "
+          "other's ids? a blocked or unpowered joint?)",
+          bus.name, actuator.device_id, actuator.joint, joint_value(e.value, prismatic, 2),
+          m.safety.following_error_window_s, joint_value(limit, prismatic), e.t);
     }
     case EventKind::motion_fault:
       return fmt::format(
-          "motion {}: joint {} got a non-finite target ({}) at t={:.3f} s of the run; the joint "
-          "stopped at its last command, the run ramped to home",
+          "motion {}: joint {} got a non-finite target ({}) at t={:.3f} s of the run; it never "
+          "reached the joint, which braked from its last command, and the run ramped to home",
           m.motion, m.joint_names[static_cast<std::size_t>(e.joint)],
           std::isnan(e.value) ? "NaN" : (e.value > 0 ? "+inf" : "-inf"), e.t);
     default:
@@ -264,6 +265,15 @@ RunSummary Runner::run(const RunOptions& options) {
   };
 
   // --- activate --------------------------------------------------------------
+  // A stop requested while the buses were brought up: nothing is switched on.
+  if (options.controls && options.controls->stop.load()) {
+    m.log(options, "stop requested before activation: nothing was switched on");
+    summary.end_reason = EndReason::signal;
+    for (std::size_t b = 0; b < bus_count; ++b) {
+      summary.buses.push_back(BusReport{m.buses[b]->config().name, {}, 0});
+    }
+    return summary;
+  }
   activation.activate_all();
   m.log(options, "activate: torque on; ramping from the measured pose to the first pose");
 

@@ -196,6 +196,21 @@ TEST(Runner, AStartRampLongerThanItsLimitIsRefusedBeforeTorqueGoesOn) {
   EXPECT_EQ(rig.bus_a->activations, 0);
 }
 
+TEST(Runner, AStopRequestedDuringBringUpSwitchesNothingOn) {
+  Rig rig;
+  RunControls controls;
+  controls.stop = true;
+  RunOptions o = lockstep(rig, 1.0);
+  o.controls = &controls;
+  const RunSummary s = rig.runner->run(o);
+  EXPECT_EQ(s.end_reason, EndReason::signal);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_EQ(rig.bus_a->configured, 1);
+  EXPECT_EQ(rig.bus_a->activations, 0);
+  EXPECT_EQ(rig.bus_b->activations, 0);
+  EXPECT_TRUE(rig.bus_a->goals().empty());
+}
+
 TEST(Runner, ASecondStopRequestCutsTorqueWithExitCodeFive) {
   Rig rig;
   RunControls controls;

@@ -1,7 +1,5 @@
 #include "support/alloc_counter.hpp"
 
-#include "../../runtime/src/bus_worker.hpp"
-
 #include <dlfcn.h>
 #include <execinfo.h>
 #include <pthread.h>
@@ -16,6 +14,8 @@
 #include <new>
 #include <thread>
 #include <typeinfo>
+
+#include "../../runtime/src/bus_worker.hpp"
 
 // With AddressSanitizer the sanitizer owns malloc: only operator new is
 // counted there. Otherwise malloc, calloc, realloc and the aligned forms are

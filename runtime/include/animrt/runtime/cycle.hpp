@@ -128,7 +128,12 @@ class CycleState {
   std::vector<std::vector<std::uint8_t>> faulted_;
   std::vector<std::vector<double>> last_ok_;  // per bus, per device: time of last good answer
   std::vector<std::uint64_t> late_cycles_;
-  std::vector<double> over_since_;  // per joint: when the following error went over (< 0: not)
+  // Following error per joint over the last window of answered cycles: a
+  // ring of squared errors (joint-major, window_ entries each) and its sum.
+  std::size_t window_ = 1;
+  std::vector<double> err_ring_;
+  std::vector<std::size_t> err_next_, err_count_;
+  std::vector<double> err_sum_;
   std::vector<double> sq_error_, max_error_;
   std::vector<std::uint64_t> error_samples_;
   std::vector<CycleEvent> log_;

@@ -23,10 +23,10 @@ struct SafetyConfig {
   // From a stop request (signal, duration, fault) to torque off, at most:
   // the stop ramp is cut short and torque switched off when it runs over.
   double stop_deadline_s = 6.0;
-  // Following-error watch: a joint whose measured position stays further
-  // than this from its command for the whole window is faulted.
-  double following_error_rad = 0.3490658503988659;  // 20 deg (revolute joints)
-  double following_error_m = 0.02;                  // prismatic joints
+  // Following-error watch: a joint whose RMS error (measured against the
+  // command it was sent) over the last window exceeds this is faulted.
+  double following_error_rad = 0.2617993877991494;  // 15 deg (revolute joints)
+  double following_error_m = 0.015;                 // prismatic joints
   double following_error_window_s = 0.5;
 };
 

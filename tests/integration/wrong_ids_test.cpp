@@ -1,0 +1,76 @@
+// Two servos answering under each other's ids (a wiring or id mistake): the
+// lf_hip and lf_knee answers come back swapped. Each servo follows its own
+// commands, so nothing times out; only the following-error watch can tell,
+// and it must end the run with a fault instead of walking on.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/runner.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+
+namespace animrt {
+namespace {
+
+// Passes every call through and swaps the positions of two devices on read.
+class SwappedAnswers final : public ActuatorBus {
+ public:
+  SwappedAnswers(std::unique_ptr<ActuatorBus> inner, std::size_t a, std::size_t b)
+      : inner_(std::move(inner)), a_(a), b_(b) {}
+  const BusConfig& config() const override { return inner_->config(); }
+  void configure() override { inner_->configure(); }
+  void activate() override { inner_->activate(); }
+  void deactivate() override { inner_->deactivate(); }
+  void read(std::span<double> positions) override {
+    inner_->read(positions);
+    if (swap) std::swap(positions[a_], positions[b_]);
+  }
+  void write(std::span<const double> positions) override { inner_->write(positions); }
+  std::span<DeviceStatus> devices() override { return inner_->devices(); }
+  bool swap = true;
+
+ private:
+  std::unique_ptr<ActuatorBus> inner_;
+  std::size_t a_, b_;
+};
+
+RunSummary run_quadruped(bool swapped) {
+  LoadedRobot robot = load_robot(std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml");
+  for (auto& bus : robot.config.buses) bus.timeout_s = 0.05;
+  ManualClock clock;
+  auto sims = start_simulated_devices(robot.config.buses, clock);
+  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  auto bus = std::make_unique<SwappedAnswers>(make_bus(robot.config.buses[0]), 0, 1);
+  bus->swap = swapped;
+  buses.push_back(std::move(bus));
+  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
+  RunOptions options;
+  options.duration_s = 6.0;
+  options.lockstep_clock = &clock;
+  return runner.run(options);
+}
+
+TEST(WrongIds, SwappedServosAreAFollowingErrorFault) {
+  const RunSummary s = run_quadruped(true);
+  EXPECT_EQ(s.end_reason, EndReason::fault) << format_summary(s);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_FALSE(s.faults.empty());
+  EXPECT_NE(s.faults[0].find("RMS following error"), std::string::npos) << s.faults[0];
+  const bool names_one = s.faults[0].find("(lf_hip)") != std::string::npos ||
+                         s.faults[0].find("(lf_knee)") != std::string::npos;
+  EXPECT_TRUE(names_one) << s.faults[0];
+  EXPECT_LT(s.motion_time_s, 6.0);
+}
+
+TEST(WrongIds, TheSameRunWithTheRightIdsWalksToTheEnd) {
+  const RunSummary s = run_quadruped(false);
+  EXPECT_EQ(s.end_reason, EndReason::duration) << format_summary(s);
+  EXPECT_TRUE(s.faults.empty());
+}
+
+}  // namespace
+}  // namespace animrt
