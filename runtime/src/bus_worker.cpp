@@ -1,38 +1,15 @@
 #include "bus_worker.hpp"
 
-#include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
-#include <sys/syscall.h>
-#include <time.h>
-#include <unistd.h>
 
-#include <climits>
 #include <cstring>
 #include <string>
 #include <system_error>
 
+#include "futex.hpp"
+
 namespace animrt {
-
-static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) &&
-              std::atomic<std::uint32_t>::is_always_lock_free);
-
-void futex_wait(std::atomic<std::uint32_t>& word, std::uint32_t expected, Nanos timeout_ns) {
-  timespec ts{};
-  timespec* tp = nullptr;
-  if (timeout_ns >= 0) {
-    ts.tv_sec = static_cast<time_t>(timeout_ns / 1'000'000'000);
-    ts.tv_nsec = static_cast<long>(timeout_ns % 1'000'000'000);
-    tp = &ts;
-  }
-  ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, expected, tp,
-            nullptr, 0);
-}
-
-void futex_wake_all(std::atomic<std::uint32_t>& word) {
-  ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, INT_MAX,
-            nullptr, nullptr, 0);
-}
 
 BusWorker::BusWorker(ActuatorBus& bus, std::span<const double> initial_positions,
                      std::atomic<std::uint32_t>& done)
@@ -157,7 +134,7 @@ void BusWorker::run() {
       signal_done();
       worked = true;
     }
-    if (!worked) futex_wait(wake_, seen, -1);
+    if (!worked) futex_wait_until(wake_, seen, -1);
   }
 }
 

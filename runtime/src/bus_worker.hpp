@@ -23,8 +23,6 @@
 namespace animrt {
 
 // Futex wait/wake on a 32-bit atomic. timeout_ns < 0 waits without limit.
-void futex_wait(std::atomic<std::uint32_t>& word, std::uint32_t expected, Nanos timeout_ns);
-void futex_wake_all(std::atomic<std::uint32_t>& word);
 
 // The start routine of every BusWorker thread (tests tell run threads apart
 // by it).

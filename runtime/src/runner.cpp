@@ -14,7 +14,7 @@
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/telemetry.hpp"
 #include "bus_worker.hpp"
-#include "deadline_wait.hpp"
+#include "futex.hpp"
 
 namespace animrt {
 namespace {

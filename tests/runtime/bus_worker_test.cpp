@@ -10,6 +10,8 @@
 #include <atomic>
 #include <vector>
 
+#include "../../runtime/src/futex.hpp"
+
 namespace animrt {
 namespace {
 
@@ -38,7 +40,7 @@ class PolicyBus final : public ActuatorBus {
 void one_read(BusWorker& worker, std::atomic<std::uint32_t>& done) {
   const std::uint32_t seen = done.load();
   worker.post_read();
-  while (!worker.read_done()) futex_wait(done, seen, 100'000'000);
+  while (!worker.read_done()) futex_wait_until(done, seen, MonotonicClock().now() + 100'000'000);
 }
 
 TEST(BusWorker, RealtimePriorityTakesEffectOrIsReported) {
