@@ -76,6 +76,14 @@ Audio load_audio(const std::string& path, int target_rate) {
     sf_close(file);
     fail(path, "the audio file holds no samples");
   }
+  // libsamplerate converts by a factor of at most 256 either way.
+  if (info.samplerate <= 0 ||
+      (target_rate > 0 && (static_cast<double>(target_rate) > 256.0 * info.samplerate ||
+                           256.0 * target_rate < static_cast<double>(info.samplerate)))) {
+    sf_close(file);
+    fail(path, "sample rate " + std::to_string(info.samplerate) + " Hz cannot be resampled to " +
+                   std::to_string(target_rate) + " Hz");
+  }
   std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
                                  static_cast<std::size_t>(info.channels));
   const sf_count_t got = sf_readf_float(file, interleaved.data(), info.frames);

@@ -16,7 +16,8 @@
 namespace animrt::fuzz {
 
 inline const std::string& work_dir() {
-  static const std::string dir = [] {
+  // Never destroyed: the exit handler below still needs it.
+  static const std::string* const dir = [] {
     const char* base = std::getenv("TMPDIR");
     std::string pattern =
         std::string(base != nullptr && *base != '\0' ? base : "/tmp") + "/animrt_fuzz_XXXXXX";
@@ -31,9 +32,9 @@ inline const std::string& work_dir() {
       std::error_code ignored;
       std::filesystem::remove_all(work_dir(), ignored);
     });
-    return pattern;
+    return new std::string(pattern);
   }();
-  return dir;
+  return *dir;
 }
 
 // Writes the input to <work_dir>/<name> and returns that path.

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "animrt/controllers/head/model.hpp"
+#include "animrt/core/error.hpp"
 #include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
