@@ -1,9 +1,12 @@
 # animrt: the two README commands are `make demo` and `make test`.
 BUILD ?= build
 ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-hil bench clean
+.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -19,9 +22,11 @@ demo: build
 	  --telemetry $(BUILD)/demo_telemetry.csv --summary-json $(BUILD)/demo_summary.json
 
 # Every test tier: unit and integration on the warnings-as-errors build, then
-# again under AddressSanitizer and UndefinedBehaviorSanitizer, then the
-# hardware-in-the-loop tier in a QEMU guest.
+# again under AddressSanitizer and UndefinedBehaviorSanitizer, then every
+# fuzz harness for a few seconds, then the hardware-in-the-loop tier in a
+# QEMU guest.
 test: test-release test-sanitize
+	$(MAKE) test-fuzz
 	$(MAKE) test-hil
 
 test-release: build
@@ -33,6 +38,20 @@ test-sanitize: deps
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS)
 
+# libFuzzer harnesses of every decoder and file parser (tests/fuzz), in a
+# clang build of their libraries under ASan and UBSan. `make fuzz` runs each
+# for FUZZ_SECONDS, `make test-fuzz` for FUZZ_TEST_SECONDS.
+fuzz-build: deps
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DANIMRT_WERROR=ON -DANIMRT_FUZZ=ON
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target animrt_fuzz
+
+fuzz: fuzz-build
+	scripts/run-fuzz.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
+test-fuzz: fuzz-build
+	scripts/run-fuzz.sh $(FUZZ_BUILD) $(FUZZ_TEST_SECONDS)
+
 # Hardware-in-the-loop: the release build's animrt in a Linux guest under
 # QEMU, on a real 8250 UART and on SocketCAN (vcan0); results in $(BUILD)/hil.
 test-hil: build
@@ -42,4 +61,4 @@ bench: build
 	scripts/run-benchmarks.sh $(BUILD)
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)

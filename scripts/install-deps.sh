@@ -12,6 +12,7 @@ packages=(
   libmodbus-dev mbpoll python3-pymodbus python3-serial-asyncio
   libmujoco-dev libqhull-dev libopenmpi-dev openmpi-bin gnuplot-nox
   can-utils qemu-system-x86 busybox-static cpio  # HIL tier (tests/hil/run)
+  clang libclang-rt-14-dev  # fuzz harnesses (tests/fuzz, make fuzz)
 )
 
 missing=()

@@ -168,7 +168,12 @@ std::string Expression::to_string() const {
         stack.push_back(t_piece());
         continue;
       case kNeg:
-        stack.back() = {"-" + wrap(stack.back(), stack.back().prec <= kPrecUnary), kPrecUnary};
+        // A negated negation prints as "- -x", not "-(-x)": the parentheses
+        // would double the nesting, and a long run of unary minuses would
+        // print past what compile() accepts (Expression::kMaxNesting).
+        stack.back() = {(stack.back().prec == kPrecUnary ? "- " : "-") +
+                            wrap(stack.back(), stack.back().prec < kPrecUnary),
+                        kPrecUnary};
         continue;
       case kSin:
       case kCos:

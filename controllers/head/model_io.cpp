@@ -312,7 +312,10 @@ HeadModel load_model(const std::string& path) {
   m.smoothing.key_rate_hz = r.named_num("key_rate_hz");
   m.smoothing.output_rate_hz = r.named_num("output_rate_hz");
   m.smoothing.noise_deg = r.named_num("noise_deg");
-  m.smoothing.seed = static_cast<std::uint64_t>(r.named_num("seed"));
+  const double seed = r.named_num("seed");
+  r.check(seed >= 0 && seed < 0x1p64 && seed == std::floor(seed),
+          "seed: expected a whole number from 0 to 2^64 - 1");
+  m.smoothing.seed = static_cast<std::uint64_t>(seed);
   r.check(
       m.smoothing.key_rate_hz > 0 && m.smoothing.output_rate_hz > 0 && m.smoothing.noise_deg >= 0,
       "rates must be positive and noise_deg >= 0");
@@ -339,7 +342,8 @@ HeadModel load_model(const std::string& path) {
   r.done();
   r.line("utterances");
   const double n_utt = r.num();
-  r.check(n_utt >= 0 && n_utt == std::floor(n_utt), "expected a count");
+  r.check(n_utt >= 0 && n_utt <= std::numeric_limits<int>::max() && n_utt == std::floor(n_utt),
+          "expected a count");
   r.done();
   for (int i = 0; i < static_cast<int>(n_utt); ++i) {
     r.line("utterance");

@@ -146,7 +146,7 @@ TEST(Expression, ToStringKeepsTheTree) {
   EXPECT_EQ(Expression::compile("t / (t * t)").to_string(), "t/(t*t)");
   EXPECT_EQ(Expression::compile("(t + 1) * -t").to_string(), "(t + 1)*-t");
   EXPECT_EQ(Expression::compile("-(t * t)").to_string(), "-(t*t)");
-  EXPECT_EQ(Expression::compile("-(-t)").to_string(), "-(-t)");
+  EXPECT_EQ(Expression::compile("-(-t)").to_string(), "- -t");
   EXPECT_EQ(Expression::compile("t - -1.07").to_string(), "t - -1.07");
   EXPECT_EQ(Expression::compile("cos(t)*sin(t)").to_string(), "cos(t)*sin(t)");
 }
@@ -163,6 +163,18 @@ TEST(Expression, ToStringRoundTripsBitForBit) {
       EXPECT_EQ(bits(back.eval(t)), bits(e.eval(t))) << text << " at " << t;
     }
   }
+}
+
+// Found by the gait_expression fuzz harness ("1 - " then 163 unary minuses
+// before "(t)/(t*t-0)..."): to_string printed each negation of a negation
+// with parentheses, twice the nesting of the source, and the printed text
+// no longer compiled past 128 minuses.
+TEST(Expression, LongRunOfUnaryMinusesPrintsBackToACompilableProgram) {
+  const std::string text = "1 - " + std::string(200, '-') + "(t)/(t*t-0)";
+  const Expression e = Expression::compile(text);
+  const Expression back = Expression::compile(e.to_string());
+  EXPECT_EQ(back.to_string(), e.to_string());
+  for (double t : {0.5, -3.0}) EXPECT_EQ(bits(back.eval(t)), bits(e.eval(t))) << t;
 }
 
 struct ErrorCase {

@@ -202,5 +202,36 @@ TEST(ModelFile, CorruptMismatchedAndMissingFilesAreClearErrors) {
   std::filesystem::remove_all(dir);
 }
 
+// Found by the head_model fuzz harness: a seed or an utterance count beyond
+// what the integer holds was cast anyway (undefined behaviour), instead of
+// being an error at its line.
+TEST(ModelFile, SeedAndCountsOutOfTheirIntegerRangeAreClearErrors) {
+  std::stringstream buf;
+  buf << std::ifstream(std::string(ANIMRT_SOURCE_DIR) + "/configs/head/model.txt").rdbuf();
+  const std::string text = buf.str();
+  const std::string dir = test::temp_dir("rangemodel");
+  auto replaced = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    std::ofstream(dir + "/" + name) << t;
+    return dir + "/" + name;
+  };
+  const std::string seed =
+      load_error(replaced("seed.txt", "seed 1\n",
+                          "seed 777777777777777777777777777777777777777777777777777777777771\n"));
+  EXPECT_NE(seed.find(":4:"), std::string::npos) << seed;
+  EXPECT_NE(seed.find("seed: expected a whole number"), std::string::npos) << seed;
+  EXPECT_NE(load_error(replaced("negative.txt", "seed 1\n", "seed -1\n")).find("seed: expected"),
+            std::string::npos);
+  const std::string count =
+      load_error(replaced("count.txt", "utterances 32\n", "utterances 1e300\n"));
+  EXPECT_NE(count.find(":8:"), std::string::npos) << count;
+  EXPECT_NE(count.find("expected a count"), std::string::npos) << count;
+  EXPECT_NO_THROW(load_model(replaced("ok.txt", "seed 1\n", "seed 18446744073709549568\n")));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace animrt::head

@@ -136,3 +136,36 @@ TEST(AudioFiles, MissingEmptyTruncatedAndNonAudioFilesAreClearErrors) {
 
 }  // namespace
 }  // namespace animrt::head
+
+namespace animrt::head {
+namespace {
+
+// Found by the wav_audio fuzz harness: a WAV header declaring 1845501760 Hz
+// made libsamplerate throw a bare runtime_error (ratio outside 1/256..256)
+// instead of an error naming the file.
+TEST(AudioFiles, AnAbsurdSampleRateIsAClearErrorBeforeResampling) {
+  const unsigned char wav[] = {
+      0x52, 0x49, 0x46, 0x46, 0x14, 0x01, 0x00, 0x00, 0x57, 0x41, 0x56, 0x45, 0x66, 0x6d,
+      0x74, 0x20, 0x10, 0x00, 0x00, 0x00, 0x01, 0x00, 0x01, 0x00, 0x40, 0x1f, 0x00, 0x6e,
+      0x80, 0x3e, 0x00, 0x00, 0x02, 0x00, 0x10, 0x00, 0x64, 0x61, 0x74, 0x61, 0xff, 0xff,
+      0xff, 0xff, 0x00, 0x00, 0xad, 0x15, 0xcb, 0xf4, 0x6d, 0xdf, 0xb1, 0xce, 0xca, 0xc3};
+  const std::string dir = test::temp_dir("fastaudio");
+  const std::string path = dir + "/fast.wav";
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(wav), sizeof wav);
+  try {
+    load_audio(path, 16000);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, path);
+    EXPECT_NE(
+        std::string(e.what()).find("sample rate 1845501760 Hz in the header, expected 4000..384000 Hz"),
+        std::string::npos)
+        << e.what();
+  }
+  // Nor without resampling: the rate is out of range before anything is read.
+  EXPECT_THROW(load_audio(path), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace animrt::head

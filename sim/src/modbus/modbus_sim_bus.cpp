@@ -19,51 +19,12 @@
 #include "animrt/core/error.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
+#include "animrt/sim/modbus/modbus_frame.hpp"
 
 namespace animrt::sim {
 namespace {
 
 constexpr Nanos kStep = 1'000'000;  // motor integration step: 1 ms
-
-std::uint16_t get16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
-}
-
-std::uint16_t crc16(const std::uint8_t* p, std::size_t n) {
-  std::uint16_t crc = 0xFFFF;
-  for (std::size_t i = 0; i < n; ++i) {
-    crc ^= p[i];
-    for (int b = 0; b < 8; ++b)
-      crc = (crc & 1) ? static_cast<std::uint16_t>((crc >> 1) ^ 0xA001) : crc >> 1;
-  }
-  return crc;
-}
-
-// Length of an RTU request from its first bytes; 0 = not known yet, -1 =
-// unknown function.
-int rtu_length(const std::uint8_t* b, std::size_t have) {
-  if (have < 2) return 0;
-  switch (b[1]) {
-    case 1:
-    case 2:
-    case 3:
-    case 4:
-    case 5:
-    case 6:
-      return 8;
-    case 15:
-    case 16:
-      return have < 7 ? 0 : 9 + b[6];
-    case 23:
-      return have < 11 ? 0 : 13 + b[10];
-    case 22:
-      return 10;
-    case 17:
-      return 4;
-    default:
-      return -1;
-  }
-}
 
 void sleep_us(int us) {
   if (us <= 0) return;
@@ -269,35 +230,23 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
   publish(*d);
 
   // The drive's own checks of written values, before libmodbus stores them.
-  const std::uint8_t* pdu = req + offset;
-  const int function = pdu[0];
-  int write_addr = -1, write_count = 0;
-  const std::uint8_t* values = nullptr;
-  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
-    write_addr = get16(pdu + 1);
-    write_count = 1;
-    values = pdu + 3;
-  } else if (function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
-    write_addr = get16(pdu + 1);
-    write_count = get16(pdu + 3);
-    values = pdu + 6;
-  } else if (function == MODBUS_FC_WRITE_AND_READ_REGISTERS) {
-    write_addr = get16(pdu + 5);
-    write_count = get16(pdu + 7);
-    values = pdu + 10;
-  }
+  // A write that declares more values than it carries is left to libmodbus,
+  // which answers it with an exception.
+  const std::size_t pdu_length =
+      static_cast<std::size_t>(std::max(0, length - offset - (tcp_ ? 0 : 2)));
+  modbus_frame::Write w;
   bool bad_value = false;
-  if (write_addr >= 0 && length >= offset + 1) {
+  if (modbus_frame::parse_write(req + offset, pdu_length, w)) {
     for (const Joint& j : d->joints) {
       const modbus::RegisterMap& m = *j.options.map;
       const int g0 = m.goal.address, g1 = m.goal.end();
-      if (write_addr < g1 && g0 < write_addr + write_count) {
+      if (w.address < g1 && g0 < w.address + w.count) {
         std::uint16_t words[2] = {0, 0};
         for (int a = g0; a < g1; ++a) {
           const int rel = a - d->mapping->start_registers;
           words[a - g0] =
-              (a >= write_addr && a < write_addr + write_count)
-                  ? get16(values + 2 * (a - write_addr))
+              (a >= w.address && a < w.address + w.count)
+                  ? w.value(a - w.address)
                   : (rel >= 0 && rel < d->mapping->nb_registers ? d->mapping->tab_registers[rel]
                                                                 : 0);
         }
@@ -305,9 +254,9 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
         if (!std::isfinite(si) || (m.has_range && (si < m.range_min || si > m.range_max)))
           bad_value = true;
       }
-      if (m.enable.configured && !m.enable.coil && m.enable.address >= write_addr &&
-          m.enable.address < write_addr + write_count) {
-        const std::uint16_t v = get16(values + 2 * (m.enable.address - write_addr));
+      if (m.enable.configured && !m.enable.coil && m.enable.address >= w.address &&
+          m.enable.address < w.address + w.count) {
+        const std::uint16_t v = w.value(m.enable.address - w.address);
         if (v != m.enable.on && v != m.enable.off) bad_value = true;
       }
     }
@@ -455,13 +404,13 @@ void ModbusSimBus::serve_rtu() {
     if (n <= 0) continue;
     have += static_cast<std::size_t>(n);
     for (;;) {
-      const int want = rtu_length(buf.data(), have);
+      const int want = modbus_frame::rtu_length(buf.data(), have);
       if (want == 0 || (want > 0 && have < static_cast<std::size_t>(want))) break;
       if (want < 0) {  // unknown function: wait for the silence after it
         break;
       }
       const std::size_t len = static_cast<std::size_t>(want);
-      const std::uint16_t crc = crc16(buf.data(), len - 2);
+      const std::uint16_t crc = modbus_frame::crc16(buf.data(), len - 2);
       if ((buf[len - 2] | (buf[len - 1] << 8)) != crc) {
         ++crc_errors_;  // a drive ignores a frame it cannot trust
       } else {

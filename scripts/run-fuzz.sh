@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer harness of a fuzz build (make fuzz / make test-fuzz)
+# for SECONDS each, one after the other, from its seed corpus
+# (tests/fuzz/corpus/<name>) plus what earlier runs found
+# (BUILD/fuzz-corpus/<name>). A crash, hang (10 s per input), leak or
+# sanitizer report fails the run; the input is left in BUILD/fuzz-artifacts.
+# Usage: scripts/run-fuzz.sh BUILD SECONDS [HARNESS...]
+set -euo pipefail
+build=${1:?usage: run-fuzz.sh BUILD SECONDS [HARNESS...]}
+seconds=${2:?usage: run-fuzz.sh BUILD SECONDS [HARNESS...]}
+shift 2
+root=$(cd "$(dirname "$0")/.." && pwd)
+if [ $# -gt 0 ]; then
+  harnesses=("$@")
+else
+  harnesses=()
+  for f in "$root"/tests/fuzz/*.cpp; do harnesses+=("$(basename "$f" .cpp)"); done
+fi
+mkdir -p "$build/fuzz-artifacts" "$build/fuzz-logs"
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+failed=0
+printf '%-20s %10s %8s %6s  %s\n' harness executions exec/s corpus result
+for name in "${harnesses[@]}"; do
+  bin="$build/bin/animrt_fuzz_$name"
+  log="$build/fuzz-logs/$name.log"
+  mkdir -p "$build/fuzz-corpus/$name"
+  status=ok
+  if ! "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$build/fuzz-artifacts/$name-" \
+      "$build/fuzz-corpus/$name" "$root/tests/fuzz/corpus/$name" >"$log" 2>&1; then
+    status=FAILED
+    failed=1
+  fi
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  units=$(find "$build/fuzz-corpus/$name" -type f | wc -l)
+  printf '%-20s %10s %8s %6s  %s\n' "$name" "${execs:-?}" "${rate:-?}" "$units" "$status"
+  if [ "$status" != ok ]; then
+    grep -E 'ERROR|SUMMARY|Test unit written|runtime error|uncaught|what\(\)' "$log" | head -20 || true
+    echo "full log: $log"
+  fi
+done
+exit $failed
