@@ -355,7 +355,8 @@ void ModbusSimBus::serve_tcp() {
       rx.have += static_cast<std::size_t>(n);
       bool bad = false;
       while (rx.have >= kMbapLength) {
-        const std::size_t length = get16(rx.buf.data() + 4);  // unit id + PDU
+        // MBAP length (big endian): unit id + PDU
+        const std::size_t length = static_cast<std::size_t>((rx.buf[4] << 8) | rx.buf[5]);
         const std::size_t total = 6 + length;
         if (length < 2 || total > rx.buf.size()) {
           bad = true;
