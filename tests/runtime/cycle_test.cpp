@@ -263,6 +263,22 @@ TEST(Cycle, ABusThatNeverComesBackIsFaultedOnlyAfterTenWatchdogs) {
   EXPECT_LT(fault->t - late_from, 1.0 + 0.03);
 }
 
+TEST(Cycle, ALongWatchdogCapsTheStuckBusGraceAtTwoSecondsMore) {
+  RobotModel model = two_bus_model();
+  model.safety.watchdog_timeout_s = 1.0;  // ten of them would be 10 s
+  Bench bench(model);
+  bench.begin();
+  bench.run_until(Phase::motion);
+  const double late_from = static_cast<double>(bench.count) / kRate;
+  bench.fresh[0] = 0;
+  bench.run_until(Phase::stop_ramp, 1000);
+  const CycleEvent* fault = bench.first(EventKind::device_fault);
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->bus, 0u);
+  EXPECT_GT(fault->t - late_from, 3.0 - 0.02);
+  EXPECT_LT(fault->t - late_from, 3.0 + 0.03);
+}
+
 TEST(Cycle, AJointThatDoesNotFollowIsAFaultWithinTheWindow) {
   RobotModel model = two_bus_model();
   model.safety.following_error_window_s = 0.2;  // 20 cycles
