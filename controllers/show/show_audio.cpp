@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "animrt/controllers/head/audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -17,40 +18,11 @@
 namespace animrt {
 
 AudioTrack load_audio_track(const std::string& path) {
-  check_input_file(path, kMaxMediaFileBytes);
-  SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (f == nullptr) {
-    throw InputError(Location{path, 0, 0}, "audio",
-                     "cannot open audio file: " + std::string(sf_strerror(nullptr)));
-  }
-  if (info.samplerate < kMinShowAudioRate || info.samplerate > kMaxShowAudioRate) {
-    sf_close(f);
-    throw InputError(Location{path, 0, 0}, "audio",
-                     "sample rate " + std::to_string(info.samplerate) + " Hz, expected " +
-                         std::to_string(kMinShowAudioRate) + ".." +
-                         std::to_string(kMaxShowAudioRate) + " Hz");
-  }
-  const int channels = std::max(1, info.channels);
-  std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
-                                 static_cast<std::size_t>(channels));
-  const sf_count_t got = sf_readf_float(f, interleaved.data(), info.frames);
-  sf_close(f);
-  AudioTrack track;
-  track.rate = info.samplerate;
-  track.samples.resize(static_cast<std::size_t>(std::max<sf_count_t>(got, 0)));
-  for (std::size_t i = 0; i < track.samples.size(); ++i) {
-    float sum = 0.0f;
-    for (int c = 0; c < channels; ++c) {
-      sum += interleaved[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)];
-    }
-    track.samples[i] = sum / static_cast<float>(channels);
-    if (!std::isfinite(track.samples[i])) {
-      throw InputError(Location{path, 0, 0}, "audio",
-                       "sample " + std::to_string(i) + " is not a finite number (NaN or infinity)");
-    }
-  }
-  return track;
+  // One loader for every sound file the runtime reads: the head's (regular
+  // file under a size limit, header rate and channels checked before any
+  // allocation, truncation, NaN samples), mixed down to mono.
+  head::Audio audio = head::load_audio(path);
+  return AudioTrack{audio.sample_rate, std::move(audio.samples)};
 }
 
 ShowAudioSchedule::ShowAudioSchedule(const ShowAudio& audio, bool loop, double show_duration_s,

@@ -8,6 +8,7 @@
 #include <sndfile.h>
 
 #include <condition_variable>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -171,6 +172,21 @@ TEST(ShowAudio, TracksAreMixedDownToOneChannel) {
   EXPECT_EQ(track.rate, 8000);
   ASSERT_EQ(track.samples.size(), 800u);
   EXPECT_NEAR(track.samples[10], 0.5f * 8000.0f / 32768.0f, 1e-6);
+}
+
+TEST(ShowAudio, ATruncatedTrackIsAnErrorNamingTheFile) {
+  write_show_with_audio("cut");
+  const std::string wav = ::testing::TempDir() + "/cut.wav";
+  std::filesystem::resize_file(wav, std::filesystem::file_size(wav) / 2);
+  try {
+    load_audio_track(wav);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, wav);
+    EXPECT_NE(std::string(e.what()).find("truncated WAV file: the data chunk declares 3200 bytes"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ShowAudio, WithoutASoundCardTheRunGoesOnAndSaysSoOnce) {
