@@ -185,15 +185,15 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   if (fault) s.end_.fault = true;
 
   // Torque off at once: a second stop request, or a stop that ran over.
-  if (in.abort) {
-    s.emit(CycleEvent{EventKind::aborted, t});
-  } else if (s.phase_ == Phase::stop_ramp &&
-             t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps) {
-    s.emit(CycleEvent{EventKind::stop_deadline, t, -1, 0, 0, DeviceHealth::ok,
-                      model.safety.stop_deadline_s});
-  }
-  if (in.abort || (s.phase_ == Phase::stop_ramp &&
-                   t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps)) {
+  const bool overran =
+      s.phase_ == Phase::stop_ramp && t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps;
+  if (in.abort || overran) {
+    if (in.abort) {
+      s.emit(CycleEvent{EventKind::aborted, t});
+    } else {
+      s.emit(CycleEvent{EventKind::stop_deadline, t, -1, 0, 0, DeviceHealth::ok,
+                        model.safety.stop_deadline_s});
+    }
     if (s.phase_ == Phase::motion) {
       s.motion_time_ = t - s.motion_start_;
       s.emit(CycleEvent{EventKind::motion_ended, t});
