@@ -26,6 +26,7 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
+#include "herd_command.hpp"
 #include "head_command.hpp"
 
 namespace {
@@ -249,6 +250,7 @@ int main(int argc, char** argv) {
 
   animrt::cli::add_evolve_command(app);
   animrt::cli::add_head_command(app);
+  animrt::cli::add_herd_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -1,0 +1,44 @@
+#include "animrt/controllers/herd/figure.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace animrt::herd {
+
+MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desired, double dt) {
+  const WalkResponse& walk = figure.walk;
+  const double wanted = norm(desired);
+  MotionCommand want;
+  if (wanted >= 0.5 * walk.min_speed() && wanted > 1e-9) {
+    const Vec2 h = heading_vector(agent.heading);
+    const double error = std::atan2(cross(h, desired), dot(h, desired));
+    // Walk on at no less than the slowest gait while turning toward a
+    // velocity behind the figure: a gait turns only while it walks.
+    want.speed_m_s = std::clamp(wanted * std::max(std::cos(error), 0.0), walk.min_speed(),
+                                walk.max_speed());
+    const double max_turn = walk.max_turn(want.speed_m_s);
+    want.turn_rad_s = std::clamp(error / kHeadingTimeConstant_s, -max_turn, max_turn);
+  }
+  // The gait ramps its speed at its acceleration limit; ask for no more
+  // than it can reach this step so the herd's figure and the real one agree.
+  const double dv = walk.max_acceleration() * dt;
+  const double reachable = std::clamp(want.speed_m_s, agent.speed - dv, agent.speed + dv);
+  if (want.speed_m_s > 0.0 && reachable < walk.min_speed()) {
+    want.speed_m_s = walk.min_speed();  // starting from standing: the gait's slowest walk
+  } else {
+    want.speed_m_s = std::max(reachable, 0.0);
+  }
+  if (want.speed_m_s == 0.0) want.turn_rad_s = 0.0;
+  return walk.command_for(want);
+}
+
+void walk_figure(const Figure& figure, const MotionCommand& command, double dt, Agent& agent) {
+  const MotionCommand done = figure.walk.achieved(command);
+  const double mid = agent.heading + 0.5 * done.turn_rad_s * dt;
+  agent.position += heading_vector(mid) * (done.speed_m_s * dt);
+  agent.heading = std::remainder(agent.heading + done.turn_rad_s * dt, 2.0 * M_PI);
+  agent.speed = done.speed_m_s;
+  agent.turn = done.turn_rad_s;
+}
+
+}  // namespace animrt::herd

@@ -1,0 +1,34 @@
+#pragma once
+// A walking figure in the herd: it cannot slide sideways or turn on the
+// spot; it walks forward at a speed and turns at a rate its gait can do.
+// steer_figure() turns a group's desired ground velocity into that command,
+// and walk_figure() moves the agent by what the gait achieves.
+
+#include <string>
+
+#include "animrt/controllers/gait/walk_response.hpp"
+#include "animrt/controllers/herd/agent.hpp"
+
+namespace animrt::herd {
+
+struct Figure {
+  std::string name;
+  double radius_m = 0.25;
+  WalkResponse walk;
+};
+
+// Seconds in which a figure means to close its heading error (the turn it
+// asks for is error / this, within its limits).
+inline constexpr double kHeadingTimeConstant_s = 1.0;
+
+// The command given to `figure` for walking `agent` toward `desired` (m/s on
+// the ground) over the next `dt`: forward speed from the part of `desired`
+// along the heading, a turn toward it, both within what the gait can walk
+// and its acceleration, as command_for() of the walk response chooses.
+MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desired, double dt);
+
+// Moves `agent` for `dt` by what `figure` achieves under `command`:
+// heading and position integrated at the midpoint heading.
+void walk_figure(const Figure& figure, const MotionCommand& command, double dt, Agent& agent);
+
+}  // namespace animrt::herd

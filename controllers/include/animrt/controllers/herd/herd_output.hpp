@@ -1,0 +1,32 @@
+#pragma once
+// What a herd run leaves behind: the CSV of every agent at every output
+// step, a top view (SVG: bounds, walls, obstacles, targets, trails coloured
+// by group) and the summary.
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/herd/herd.hpp"
+
+namespace animrt::herd {
+
+// time_s,agent,group,x_m,y_m,heading_rad,speed_mps,turn_rps
+void write_csv_header(std::ostream& out);
+void write_csv_rows(std::ostream& out, const Herd& herd);
+
+// Positions of every agent at every output step, for the top view.
+class TrailRecorder {
+ public:
+  void sample(const Herd& herd);
+  // Throws std::runtime_error when the file cannot be written.
+  void write_svg(const std::string& path, const Herd& herd) const;
+
+ private:
+  std::vector<std::vector<Vec2>> trails_;  // per agent
+};
+
+// The summary as text lines (printed at the end of a run).
+std::string format_metrics(const HerdMetrics& metrics);
+
+}  // namespace animrt::herd

@@ -1,0 +1,104 @@
+#pragma once
+// What a herd run is judged by, sampled at every output step: figures that
+// touch (pairs closer than the sum of their radii, whatever their groups),
+// how ordered each group walks, how tight it keeps, how far a flock is from
+// its leader, and for crowds the arrivals, their times and detours, and the
+// figures that got stuck.
+
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/herd/agent.hpp"
+
+namespace animrt::herd {
+
+struct GroupMetrics {
+  std::string name;
+  std::string kind;
+  int agents = 0;
+  long collisions = 0;         // agent-pair-steps with one member in this group
+  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group
+  double order_mean = 0.0;     // |sum v| / (N mean |v|), mean over steps after settling
+  double order_min = 0.0;      // its minimum over those steps
+  double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
+  double leader_distance_mean_m = -1.0;   // flocks: centre to leader (-1: no leader)
+  double leader_distance_max_m = -1.0;
+  // Crowds (arrivals -1 for flocks):
+  int arrivals = -1;
+  double time_to_goal_mean_s = 0.0;
+  double time_to_goal_max_s = 0.0;
+  double time_ratio_max = 0.0;   // time to goal / straight-line time (distance / max speed)
+  double path_ratio_mean = 0.0;  // walked length / straight-line length
+  double path_ratio_max = 0.0;
+  int stuck = 0;  // agents that once moved less than one radius in 5 s before arriving
+};
+
+struct HerdMetrics {
+  double duration_s = 0.0;
+  long steps = 0;           // output steps sampled
+  long collisions = 0;      // agent-pair-steps, whole scene
+  double min_pair_distance_m = 0.0;
+  double min_clearance_m = 0.0;  // min over pairs of distance - sum of radii
+  std::vector<GroupMetrics> groups;
+};
+
+// What the metrics need to know of each group.
+struct GroupInfo {
+  std::string name;
+  std::string kind;
+  std::vector<int> members;
+  std::optional<Vec2> target;  // crowds
+};
+
+class MetricsRecorder {
+ public:
+  // `settle_s`: order figures count only after this time (a flock forms).
+  MetricsRecorder(std::vector<GroupInfo> groups, std::span<const Agent> start, double settle_s);
+
+  // One output step at time t. `leaders[g]` is group g's leader position
+  // when it has one; `arrived[i]` whether agent i is at its goal; `max_speed[i]`
+  // the fastest it may walk (for the straight-line time).
+  void sample(double t, std::span<const Agent> agents, std::span<const std::optional<Vec2>> leaders,
+              std::span<const char> arrived, std::span<const double> max_speed);
+
+  HerdMetrics finish() const;
+
+ private:
+  struct AgentTrack {
+    Vec2 start;
+    Vec2 last;
+    double walked = 0.0;
+    double arrived_at = -1.0;
+    double walked_at_arrival = 0.0;
+    bool stuck = false;
+    Vec2 anchor;  // position at anchor_t, for the stuck test
+    double anchor_t = 0.0;
+  };
+  struct GroupSums {
+    long collisions = 0;
+    double min_pair = 1e300;
+    double order_sum = 0.0, order_min = 1e300;
+    long order_steps = 0;
+    double nn_sum = 0.0;
+    long nn_steps = 0;
+    double leader_sum = 0.0, leader_max = -1.0;
+    long leader_steps = 0;
+  };
+
+  std::vector<GroupInfo> groups_;
+  std::vector<int> group_of_;
+  std::vector<AgentTrack> tracks_;
+  std::vector<GroupSums> sums_;
+  std::vector<double> max_speed_;
+  double settle_s_;
+  double last_t_ = 0.0;
+  long steps_ = 0;
+  long collisions_ = 0;
+  double min_pair_ = 1e300;
+  double min_clearance_ = 1e300;
+  std::vector<int> order_;  // scratch: agents sorted by x
+};
+
+}  // namespace animrt::herd

@@ -1,0 +1,170 @@
+// The herd subcommand: load the scene, build the herd, step it to the end,
+// write the CSV, the top view and the summary.
+
+#include "herd_command.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "animrt/controllers/herd/herd_output.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_config.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct HerdArgs {
+  std::string scene;
+  std::optional<double> duration;
+  std::optional<std::uint64_t> seed;
+  std::string out;
+  std::string svg;
+  std::string summary_json;
+  bool quiet = false;
+};
+
+nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
+  nlohmann::json j;
+  j["duration_s"] = m.duration_s;
+  j["wall_s"] = wall_s;
+  j["real_time_factor"] = wall_s > 0 ? m.duration_s / wall_s : 0.0;
+  j["output_steps"] = m.steps;
+  j["collisions"] = m.collisions;
+  j["min_pair_distance_m"] = m.min_pair_distance_m;
+  j["min_clearance_m"] = m.min_clearance_m;
+  for (const herd::GroupMetrics& g : m.groups) {
+    nlohmann::json k;
+    k["name"] = g.name;
+    k["kind"] = g.kind;
+    k["agents"] = g.agents;
+    k["collisions"] = g.collisions;
+    k["min_pair_distance_m"] = g.min_pair_distance_m;
+    k["order_mean"] = g.order_mean;
+    k["order_min"] = g.order_min;
+    k["nearest_neighbour_mean_m"] = g.nearest_neighbour_mean_m;
+    if (g.leader_distance_mean_m >= 0) {
+      k["leader_distance_mean_m"] = g.leader_distance_mean_m;
+      k["leader_distance_max_m"] = g.leader_distance_max_m;
+    }
+    if (g.arrivals >= 0) {
+      k["arrivals"] = g.arrivals;
+      k["time_to_goal_mean_s"] = g.time_to_goal_mean_s;
+      k["time_to_goal_max_s"] = g.time_to_goal_max_s;
+      k["time_ratio_max"] = g.time_ratio_max;
+      k["path_ratio_mean"] = g.path_ratio_mean;
+      k["path_ratio_max"] = g.path_ratio_max;
+      k["stuck"] = g.stuck;
+    }
+    j["groups"].push_back(k);
+  }
+  return j;
+}
+
+int run_herd(const HerdArgs& a) {
+  herd::HerdScene scene = herd::load_herd_scene(a.scene);
+  if (a.duration) scene.duration_s = *a.duration;
+  herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
+  const herd::HerdScene& s = herd.scene();
+  if (!a.quiet) {
+    std::cout << "herd " << (s.name.empty() ? s.file : s.name) << ": " << herd.agents().size()
+              << " figures in " << s.groups.size() << " groups, " << s.duration_s << " s at "
+              << s.step_s << " s steps, seed " << s.seed << '\n'
+              << std::flush;
+  }
+  std::ofstream csv;
+  if (!a.out.empty()) {
+    csv.open(a.out);
+    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    herd::write_csv_header(csv);
+  }
+  herd::TrailRecorder trails;
+  const long steps = std::lround(s.duration_s / s.step_s);
+  const long steps_per_output = std::max(1L, std::lround(1.0 / (s.output_hz * s.step_s)));
+  const auto start = std::chrono::steady_clock::now();
+  auto last_progress = start;
+  const auto output = [&] {
+    herd.record_metrics();
+    if (csv.is_open()) herd::write_csv_rows(csv, herd);
+    if (!a.svg.empty()) trails.sample(herd);
+  };
+  output();
+  for (long k = 1; k <= steps; ++k) {
+    herd.step();
+    if (k % steps_per_output == 0 || k == steps) output();
+    const auto now = std::chrono::steady_clock::now();
+    if (!a.quiet && now - last_progress > std::chrono::seconds(2)) {
+      last_progress = now;
+      const double wall = std::chrono::duration<double>(now - start).count();
+      std::cout << "  t " << herd.time() << " s of " << s.duration_s << " s, "
+                << herd.time() / wall << " x real time\n"
+                << std::flush;
+    }
+  }
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const herd::HerdMetrics metrics = herd.metrics();
+  std::cout << herd::format_metrics(metrics);
+  std::cout << "ran " << s.duration_s << " s in " << wall_s << " s (" << s.duration_s / wall_s
+            << " x real time)\n";
+  if (csv.is_open()) {
+    csv.close();
+    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    std::cout << "wrote " << a.out << '\n';
+  }
+  if (!a.svg.empty()) {
+    trails.write_svg(a.svg, herd);
+    std::cout << "wrote " << a.svg << '\n';
+  }
+  if (!a.summary_json.empty()) {
+    std::ofstream j(a.summary_json);
+    j << to_json(metrics, wall_s).dump(2) << '\n';
+    if (!j) throw std::runtime_error(a.summary_json + ": cannot write the summary");
+    std::cout << "wrote " << a.summary_json << '\n';
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::string gait_of_robot(const std::string& robot_file) {
+  const RobotConfig config = load_robot_config(robot_file);
+  if (config.motion.type != "gait") {
+    throw InputError(config.motion.where, config.motion.key.empty() ? "motion" : config.motion.key,
+                     "a herd figure walks a gait; this robot's motion is " + config.motion.type);
+  }
+  return config.motion.file;
+}
+
+void add_herd_command(CLI::App& app) {
+  auto args = std::make_shared<HerdArgs>();
+  auto* cmd = app.add_subcommand("herd", "Run a herd of walking figures offline (flocks, crowds)");
+  cmd->add_option("SCENE", args->scene, "scene file (YAML, docs/herd.md)")->required();
+  cmd->add_option("--duration", args->duration, "seconds to simulate (default: the scene's)")
+      ->check(CLI::Range(0.001, 1e6));
+  cmd->add_option("--seed", args->seed, "random seed (overrides the scene's)");
+  cmd->add_option("--out", args->out, "CSV of every agent at every output step");
+  cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
+  cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON");
+  cmd->add_flag("--quiet", args->quiet, "no progress lines");
+  cmd->callback([args] {
+    int code = 0;
+    try {
+      code = run_herd(*args);
+    } catch (const InputError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 2;
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 1;
+    }
+    if (code != 0) throw CLI::RuntimeError(code);
+    throw CLI::Success();
+  });
+}
+
+}  // namespace animrt::cli

@@ -1,0 +1,18 @@
+#pragma once
+// `animrt herd SCENE.yaml`: a herd of walking figures run offline, faster
+// than real time (docs/herd.md).
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "animrt/controllers/herd/herd.hpp"
+
+namespace animrt::cli {
+
+void add_herd_command(CLI::App& app);
+
+// The gait a robot file plays (its motion must be a gait).
+std::string gait_of_robot(const std::string& robot_file);
+
+}  // namespace animrt::cli
