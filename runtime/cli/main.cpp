@@ -27,6 +27,7 @@
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
 #include "herd_command.hpp"
+#include "herd_driver.hpp"
 #include "head_command.hpp"
 
 namespace {
@@ -97,6 +98,8 @@ struct RunArgs {
   bool no_realtime = false;
   bool no_audio = false;
   std::string physics;  // MJCF model behind the simulated servos
+  std::string herd;     // scene file: the robot is one agent of this herd
+  std::string agent;    // which one
 };
 
 // The show files a motion plays (a show, or show layers).
@@ -150,6 +153,19 @@ int cmd_run(const RunArgs& args) {
   std::vector<std::unique_ptr<animrt::ActuatorBus>> buses;
   for (const auto& bus : robot.config.buses) buses.push_back(animrt::make_bus(bus));
 
+  if (args.herd.empty() != args.agent.empty()) {
+    spdlog::error("--herd and --agent go together: the scene and which of its agents the robot is");
+    return kExitUsage;
+  }
+  std::unique_ptr<animrt::cli::EmbodiedHerd> herd;
+  if (!args.herd.empty()) {
+    const animrt::Clock& run_clock = args.lockstep ? static_cast<const animrt::Clock&>(lockstep_clock)
+                                                   : static_cast<const animrt::Clock&>(wall_clock);
+    herd = std::make_unique<animrt::cli::EmbodiedHerd>(args.herd, args.agent, run_clock, g_controls,
+                                                       physics.get());
+    spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
+  }
+
   animrt::RunOptions options;
   options.duration_s = args.duration;
   options.lockstep_clock = args.lockstep ? &lockstep_clock : nullptr;
@@ -168,8 +184,9 @@ int cmd_run(const RunArgs& args) {
         shows, args.lockstep, [](int rate) { return animrt::open_alsa_sink("default", rate); },
         wall_clock, [](const std::string& message) { spdlog::warn("{}", message); });
   }
-  options.on_motion_start = [&audio, p = physics.get()](animrt::Nanos t0) {
+  options.on_motion_start = [&audio, &herd, p = physics.get()](animrt::Nanos t0) {
     for (auto& player : audio) player->start(t0);
+    if (herd) herd->start(t0);
     if (p) p->mark_motion_start();
   };
   options.on_motion_end = [&audio, p = physics.get()] {
@@ -179,6 +196,7 @@ int cmd_run(const RunArgs& args) {
 
   animrt::Runner runner(std::move(robot.config), std::move(buses), std::move(robot.motion));
   animrt::RunSummary summary = runner.run(options);
+  if (herd) herd->stop();
   if (physics) {
     const animrt::sim::PhysicsMeasures m = physics->measures();
     animrt::PhysicsReport report;
@@ -195,6 +213,7 @@ int cmd_run(const RunArgs& args) {
     summary.physics = report;
   }
   std::cout << animrt::format_summary(summary) << std::flush;
+  if (herd) std::cout << herd->report() << '\n' << std::flush;
   if (summary_out.is_open()) summary_out << animrt::to_json(summary).dump(2) << '\n' << std::flush;
   return summary.exit_code();
 }
@@ -243,6 +262,10 @@ int main(int argc, char** argv) {
   run->add_option("--physics", run_args.physics,
                   "MuJoCo model (MJCF) behind the simulated servos; the summary reports distance, "
                   "speed and falls (sim backend, dynamixel2 buses)");
+
+  run->add_option("--herd", run_args.herd,
+                  "herd scene (YAML): the robot walks as one of its agents (needs --agent)");
+  run->add_option("--agent", run_args.agent, "the herd agent the robot is, GROUP.INDEX (e.g. red.0)");
 
   std::string sim_path;
   auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");

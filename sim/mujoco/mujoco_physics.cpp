@@ -54,6 +54,7 @@ MujocoJointPhysics::MujocoJointPhysics(const std::string& model_path,
   standing_z_ = data_->xpos[3 * torso + 2];
   x0_ = data_->xpos[3 * torso];
   y0_ = data_->xpos[3 * torso + 1];
+  yaw0_ = std::atan2(data_->xmat[9 * torso + 3], data_->xmat[9 * torso]);
 }
 
 MujocoJointPhysics::~MujocoJointPhysics() = default;
@@ -147,6 +148,20 @@ PhysicsMeasures MujocoJointPhysics::measures() const {
   out.first_fall_s = first_fall_s_;
   out.fallen = fallen_;
   return out;
+}
+
+TorsoPose MujocoJointPhysics::torso_pose() const {
+  std::lock_guard lock(mutex_);
+  const int torso = meta_.torso_body;
+  const double dx = data_->xpos[3 * torso] - x0_, dy = data_->xpos[3 * torso + 1] - y0_;
+  const double c = std::cos(yaw0_), s = std::sin(yaw0_);
+  TorsoPose pose;
+  pose.x_m = c * dx + s * dy;
+  pose.y_m = -s * dx + c * dy;
+  pose.yaw_rad = std::remainder(std::atan2(data_->xmat[9 * torso + 3], data_->xmat[9 * torso]) - yaw0_,
+                                2.0 * M_PI);
+  pose.time_s = data_->time;
+  return pose;
 }
 
 }  // namespace animrt::sim

@@ -24,6 +24,15 @@
 
 namespace animrt::sim {
 
+// Where the torso is on the ground, relative to where it started: x forward
+// and y to the left of its starting heading, yaw counter-clockwise.
+struct TorsoPose {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+  double time_s = 0.0;  // physics time
+};
+
 struct PhysicsMeasures {
   std::string model_file;
   double timestep_s = 0.0;
@@ -66,6 +75,7 @@ class MujocoJointPhysics final : public JointPhysics {
   void mark_motion_end();
 
   PhysicsMeasures measures() const;
+  TorsoPose torso_pose() const;
 
  private:
   void step();  // one mj_step and the fall watch; mutex held
@@ -81,6 +91,7 @@ class MujocoJointPhysics final : public JointPhysics {
   double standing_z_ = 0.0;
   double x0_ = 0.0;
   double y0_ = 0.0;
+  double yaw0_ = 0.0;
 
   mutable std::mutex mutex_;
   std::uint64_t steps_ = 0;
