@@ -8,7 +8,7 @@
 
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/core/error.hpp"
-#include "steered_gait_source.hpp"
+#include "animrt/controllers/gait/steered_gait_source.hpp"
 
 namespace animrt {
 namespace {

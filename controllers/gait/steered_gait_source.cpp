@@ -1,6 +1,6 @@
 // Steered playback of a gait (see steered_gait_source.hpp).
 
-#include "steered_gait_source.hpp"
+#include "animrt/controllers/gait/steered_gait_source.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -45,6 +45,11 @@ void SteeredGaitSource::steer(const MotionCommand& command) {
   target_speed_ = (std::isfinite(v) && v >= min_speed_) ? std::min(v, max_speed_) : 0.0;
   const double w = std::isfinite(command.turn_rad_s) ? command.turn_rad_s : 0.0;
   target_turn_ = std::clamp(w, -steering_.max_turn_rad_s, steering_.max_turn_rad_s);
+}
+
+MotionCommand SteeredGaitSource::current() const {
+  if (!started_) return {0.0, 0.0};
+  return {speed_ * smoothstep(blend_), turn_};
 }
 
 void SteeredGaitSource::reset() const {

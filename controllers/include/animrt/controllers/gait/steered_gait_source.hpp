@@ -45,6 +45,9 @@ class SteeredGaitSource final : public MotionSource {
   // The command in force after clamping (speed 0 = stand).
   MotionCommand target() const { return {target_speed_, target_turn_}; }
   double native_speed_m_s() const { return native_speed_; }
+  // Speed and turn rate the playback is at now (speed 0 when standing; the
+  // walk/stand blend scales it).
+  MotionCommand current() const;
 
  private:
   void advance(double t) const;
