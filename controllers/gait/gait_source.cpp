@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "animrt/controllers/gait/expression.hpp"
-#include "animrt/core/error.hpp"
 #include "animrt/controllers/gait/steered_gait_source.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt {
 namespace {

@@ -52,19 +52,23 @@ MotionCommand SteeredGaitSource::current() const {
   return {speed_ * smoothstep(blend_), turn_};
 }
 
-void SteeredGaitSource::reset() const {
+void SteeredGaitSource::reset(double t) const {
   const bool walking = target_speed_ > 0.0;
   started_ = true;
   phase_ = 0.0;
   speed_ = walking ? target_speed_ : min_speed_;
   turn_ = walking ? target_turn_ : 0.0;
   blend_ = walking ? 1.0 : 0.0;
+  // As if it had walked at this command since t = 0 (the unsteered gait's
+  // phase at a constant speed).
+  const double h = steering_.hip_height_m;
+  phase_ = froude_stride_frequency(speed_ / std::sqrt(kStandardGravity * h), h) * blend_ * t;
+  last_t_ = t;
 }
 
 void SteeredGaitSource::advance(double t) const {
   if (!started_ || t <= 0.0 || t < last_t_) {
-    reset();
-    last_t_ = std::max(t, 0.0);
+    reset(t);
     return;
   }
   const double dt = t - last_t_;

@@ -156,8 +156,8 @@ std::vector<SteeringStep> steering_check_plan(const GaitSteering& s) {
   // Long enough to reach any command from any other and walk two strides.
   const double stride_s = 1.0 / froude_stride_frequency(s.min_froude, s.hip_height_m);
   const double hold = 2.0 * stride_s + (hi / s.max_acceleration_m_s2) + stride_s;
-  const MotionCommand commands[] = {{hi, 0.0}, {hi, w},   {hi, -w},  {lo, 0.0},  {lo, w},
-                                    {lo, -w},  {0.0, 0.0}, {mid, 0.0}, {mid, w}, {hi, -w},
+  const MotionCommand commands[] = {{hi, 0.0}, {hi, w},    {hi, -w},   {lo, 0.0}, {lo, w},
+                                    {lo, -w},  {0.0, 0.0}, {mid, 0.0}, {mid, w},  {hi, -w},
                                     {lo, w},   {0.0, 0.0}, {hi, 0.0}};
   std::vector<SteeringStep> plan;
   double t = 0.0;
@@ -169,8 +169,8 @@ std::vector<SteeringStep> steering_check_plan(const GaitSteering& s) {
   return plan;
 }
 
-void check_steered_motion(const RobotConfig& config, const MotionCheck& check,
-                          MotionSource& source, const GaitSteering& steering) {
+void check_steered_motion(const RobotConfig& config, const MotionCheck& check, MotionSource& source,
+                          const GaitSteering& steering) {
   const std::vector<SteeringStep> plan = steering_check_plan(steering);
   MotionCheck steered = check;
   steered.source = &source;

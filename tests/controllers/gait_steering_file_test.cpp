@@ -12,26 +12,26 @@ namespace animrt {
 namespace {
 
 const std::string kHead =
-    "name: s\n"                            // 1
-    "stride_frequency_hz: 1.0\n"           // 2
-    "curves: {hip: \"sin(2*PI*t)\"}\n"     // 3
-    "limbs: {lf: 0, rf: 0.5}\n"            // 4
-    "joints:\n"                            // 5
-    "  a: {curve: hip, limb: lf}\n"        // 6
-    "  b: {curve: hip, limb: rf}\n"        // 7
-    "  yaw: {curve: hip, limb: lf}\n";     // 8
+    "name: s\n"                         // 1
+    "stride_frequency_hz: 1.0\n"        // 2
+    "curves: {hip: \"sin(2*PI*t)\"}\n"  // 3
+    "limbs: {lf: 0, rf: 0.5}\n"         // 4
+    "joints:\n"                         // 5
+    "  a: {curve: hip, limb: lf}\n"     // 6
+    "  b: {curve: hip, limb: rf}\n"     // 7
+    "  yaw: {curve: hip, limb: lf}\n";  // 8
 
 std::string steering(const std::string& body) { return kHead + "steering:\n" + body; }  // 9
 
 const std::string kGood =
-    "  min_froude: 0.05\n"                 // 10
-    "  max_froude: 0.1\n"                  // 11
-    "  max_turn_dps: 30\n"                 // 12
-    "  max_acceleration_m_s2: 0.3\n"       // 13
-    "  hip_height_m: 0.2\n"                // 14
-    "  track_width_m: 0.15\n"              // 15
-    "  sides: {left: [lf], right: [rf]}\n" // 16
-    "  yaw_joints: [yaw]\n";               // 17
+    "  min_froude: 0.05\n"                  // 10
+    "  max_froude: 0.1\n"                   // 11
+    "  max_turn_dps: 30\n"                  // 12
+    "  max_acceleration_m_s2: 0.3\n"        // 13
+    "  hip_height_m: 0.2\n"                 // 14
+    "  track_width_m: 0.15\n"               // 15
+    "  sides: {left: [lf], right: [rf]}\n"  // 16
+    "  yaw_joints: [yaw]\n";                // 17
 
 std::string error_of(const std::string& text) {
   try {
@@ -78,7 +78,8 @@ TEST(GaitSteeringFile, ErrorsNameFileLineAndKey) {
   // Required with stride_frequency_hz; reported at the section.
   EXPECT_EQ(error_of(replace(good, "  hip_height_m: 0.2\n", "")),
             "g.yaml:10:3: steering.hip_height_m: required key is missing");
-  const std::string unknown = error_of(replace(good, "  track_width_m", "  speed: 1\n  track_width_m"));
+  const std::string unknown =
+      error_of(replace(good, "  track_width_m", "  speed: 1\n  track_width_m"));
   EXPECT_NE(unknown.find("g.yaml:15:3: steering.speed"), std::string::npos) << unknown;
   const std::string limb = error_of(replace(good, "left: [lf]", "left: [xx]"));
   EXPECT_NE(limb.find("g.yaml:16:18: steering.sides.left"), std::string::npos) << limb;

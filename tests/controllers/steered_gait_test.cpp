@@ -90,8 +90,8 @@ TEST(SteeredGait, PhaseIsContinuousAcrossAFrequencyStep) {
   // the largest amplitude scale.
   const double h = rig.st().hip_height_m;
   const double native_fr = froude_for_stride_frequency(1.0, h);
-  const double scale = froude_stride_length(rig.st().max_froude, h) /
-                       froude_stride_length(native_fr, h);
+  const double scale =
+      froude_stride_length(rig.st().max_froude, h) / froude_stride_length(native_fr, h);
   const double f_max = froude_stride_frequency(rig.st().max_froude, h);
   const double bound = deg_to_rad(kSwingDeg * scale * 2.0 * kPi * f_max) * kDt * 1.1;
   std::vector<double> prev(4);

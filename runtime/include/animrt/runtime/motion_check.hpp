@@ -49,8 +49,8 @@ std::vector<SteeringStep> steering_check_plan(const GaitSteering& steering);
 // steering_check_plan(steering) (check.source and check.duration_s are
 // ignored). Messages name the command in force. Leaves `source` steered:
 // check a source of its own, not the one that will run.
-void check_steered_motion(const RobotConfig& config, const MotionCheck& check,
-                          MotionSource& source, const GaitSteering& steering);
+void check_steered_motion(const RobotConfig& config, const MotionCheck& check, MotionSource& source,
+                          const GaitSteering& steering);
 
 // The length a gait is checked over: 20 strides, at least 60 s, at most 600 s.
 double gait_check_duration(double stride_frequency_hz);

@@ -51,7 +51,7 @@ class SteeredGaitSource final : public MotionSource {
 
  private:
   void advance(double t) const;
-  void reset() const;
+  void reset(double t) const;
 
   GaitSteering steering_;
   std::vector<Expression> curves_;
@@ -69,7 +69,8 @@ class SteeredGaitSource final : public MotionSource {
   // Integrated playback state. sample() is const in the interface but is
   // called once per cycle with non-decreasing t, so it advances this state
   // by the time since the previous sample; t <= 0 or a t earlier than the
-  // previous one starts over. Only the cycle thread touches it.
+  // previous one starts over, at the phase of walking the command in force
+  // since t = 0. Only the cycle thread touches it.
   mutable bool started_ = false;
   mutable double last_t_ = 0.0;
   mutable double phase_ = 0.0;  // stride cycles
