@@ -26,9 +26,13 @@ SteeredGaitSource::SteeredGaitSource(const GaitSteering& steering, double native
     : steering_(steering), curves_(std::move(curves)), drives_(std::move(drives)) {
   for (const Drive& d : drives_) driven_.push_back(d.joint);
   for (const Expression& c : curves_) {
-    double sum = 0.0;
-    for (int i = 0; i < kMeanSamples; ++i) sum += c.eval(static_cast<double>(i) / kMeanSamples);
-    means_.push_back(sum / kMeanSamples);
+    // Summed as fractions: a curve that is finite but huge must not
+    // overflow into an infinite mean.
+    double mean = 0.0;
+    for (int i = 0; i < kMeanSamples; ++i) {
+      mean += c.eval(static_cast<double>(i) / kMeanSamples) / kMeanSamples;
+    }
+    means_.push_back(mean);
   }
   const double h = steering_.hip_height_m;
   const double native_froude = froude_for_stride_frequency(native_frequency_hz, h);
