@@ -15,6 +15,7 @@
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/controllers/gait/froude.hpp"
 #include "animrt/core/input_file.hpp"
+#include "animrt/core/joint.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
@@ -22,6 +23,9 @@ namespace {
 
 constexpr double kMaxScale = 100.0;
 constexpr double kMaxOffsetDeg = 3600.0;
+// Walking gaits stay well below Fr 1 in this convention; beyond 10 is a typo.
+constexpr double kMaxFroude = 10.0;
+constexpr double kMaxTurnDps = 3600.0;
 
 // A curve must be finite over one stride; it is sampled this many times.
 constexpr int kFiniteSamples = 1024;
@@ -247,6 +251,78 @@ void read_joints(const YamlNode& root, GaitFile& gait) {
   }
 }
 
+// Names in a list, each once.
+std::vector<std::string> read_names(const YamlNode& list) {
+  if (!list.is_sequence()) list.fail("expected a list of names, found " + list.describe());
+  std::vector<std::string> out;
+  for (const YamlNode& item : list.items()) {
+    std::string name = item.as_string();
+    for (const auto& seen : out) {
+      if (seen == name) item.fail("'" + name + "' is listed twice");
+    }
+    out.push_back(std::move(name));
+  }
+  return out;
+}
+
+void read_steering(const YamlNode& root, GaitFile& gait) {
+  const auto node = root.find("steering");
+  if (!node) return;
+  node->allow_only({"min_froude", "max_froude", "max_turn_dps", "max_acceleration_m_s2",
+                    "hip_height_m", "track_width_m", "sides", "yaw_joints"});
+  GaitSteering s;
+  s.where = node->location();
+  const YamlNode min_fr = node->at("min_froude");
+  s.min_froude = min_fr.as_double_in(1e-6, kMaxFroude);
+  const YamlNode max_fr = node->at("max_froude");
+  s.max_froude = max_fr.as_double_in(1e-6, kMaxFroude);
+  if (s.max_froude < s.min_froude) {
+    max_fr.fail("max_froude (" + shortest_exact(s.max_froude) + ") is below min_froude (" +
+                shortest_exact(s.min_froude) + ")");
+  }
+  s.max_turn_rad_s = deg_to_rad(node->at("max_turn_dps").as_double_in(0.0, kMaxTurnDps));
+  s.max_acceleration_m_s2 = node->at("max_acceleration_m_s2").as_positive_double();
+  if (const auto h = node->find("hip_height_m")) {
+    s.hip_height_m = h->as_positive_double();
+  } else if (gait.froude) {
+    s.hip_height_m = gait.froude->hip_height_m;
+  } else {
+    node->at("hip_height_m");  // throws: required with stride_frequency_hz
+  }
+  s.track_width_m = node->at("track_width_m").as_positive_double();
+  const YamlNode sides = node->at("sides");
+  sides.allow_only({"left", "right"});
+  for (const char* side : {"left", "right"}) {
+    const YamlNode list = sides.at(side);
+    std::vector<std::string> names = read_names(list);
+    if (names.empty()) list.fail("expected at least one limb");
+    const auto items = list.items();
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (!gait.find_limb(names[i])) {
+        items[i].fail("undefined limb '" + names[i] + "' (limbs: " + join_names(limb_names(gait)) +
+                      ")");
+      }
+      for (const auto& l : s.left) {
+        if (l == names[i]) items[i].fail("limb '" + names[i] + "' is on both sides");
+      }
+    }
+    (side[0] == 'l' ? s.left : s.right) = std::move(names);
+  }
+  if (const auto yaw = node->find("yaw_joints")) {
+    s.yaw_joints = read_names(*yaw);
+    const auto items = yaw->items();
+    for (std::size_t i = 0; i < s.yaw_joints.size(); ++i) {
+      bool mapped = false;
+      for (const auto& j : gait.joints) mapped = mapped || j.name == s.yaw_joints[i];
+      if (!mapped) {
+        items[i].fail("yaw joint '" + s.yaw_joints[i] +
+                      "' is not one of the gait's joints (map it under joints)");
+      }
+    }
+  }
+  gait.steering = std::move(s);
+}
+
 // ---- writing ----
 
 bool needs_quotes(const std::string& s) {
@@ -289,6 +365,61 @@ std::string double_quoted(const std::string& s) {
 
 std::string name_text(const std::string& s) { return needs_quotes(s) ? double_quoted(s) : s; }
 
+void validate_steering(const GaitFile& gait) {
+  if (!gait.steering) return;
+  const GaitSteering& s = *gait.steering;
+  const Location at = s.where.line > 0 ? s.where : Location{gait.file, 0, 0};
+  const auto fail = [&](const std::string& key, const std::string& message) {
+    throw InputError(at, "steering." + key, message);
+  };
+  const auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };
+  if (!in(s.min_froude, 1e-6, kMaxFroude)) fail("min_froude", "expected a number from 1e-06 to 10");
+  if (!in(s.max_froude, s.min_froude, kMaxFroude))
+    fail("max_froude", "expected a number from min_froude to 10");
+  if (!in(s.max_turn_rad_s, 0.0, deg_to_rad(kMaxTurnDps)))
+    fail("max_turn_dps", "expected a number from 0 to 3600");
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(s.max_acceleration_m_s2))
+    fail("max_acceleration_m_s2", "expected a positive number");
+  if (!positive(s.hip_height_m)) fail("hip_height_m", "expected a positive number");
+  if (!positive(s.track_width_m)) fail("track_width_m", "expected a positive number");
+  if (s.left.empty() || s.right.empty()) fail("sides", "each side needs at least one limb");
+  for (const auto* side : {&s.left, &s.right}) {
+    for (std::size_t i = 0; i < side->size(); ++i) {
+      const std::string& limb = (*side)[i];
+      if (!gait.find_limb(limb)) fail("sides", "undefined limb '" + limb + "'");
+      for (std::size_t k = 0; k < i; ++k) {
+        if ((*side)[k] == limb) fail("sides", "limb '" + limb + "' is listed twice");
+      }
+    }
+  }
+  for (const auto& l : s.left) {
+    for (const auto& r : s.right) {
+      if (l == r) fail("sides", "limb '" + l + "' is on both sides");
+    }
+  }
+  for (const auto& y : s.yaw_joints) {
+    bool mapped = false;
+    for (const auto& j : gait.joints) mapped = mapped || j.name == y;
+    if (!mapped) fail("yaw_joints", "yaw joint '" + y + "' is not one of the gait's joints");
+  }
+}
+
+std::string names_text(const std::vector<std::string>& names) {
+  std::string out = "[";
+  for (const auto& n : names) out += (out.size() > 1 ? ", " : "") + name_text(n);
+  return out + "]";
+}
+
+// Degrees/s that read back (deg_to_rad) to exactly `rad_s`.
+double exact_dps(double rad_s) {
+  double c = rad_to_deg(rad_s);
+  for (int k = 0; k < 8 && deg_to_rad(c) != rad_s; ++k) {
+    c = std::nextafter(c, deg_to_rad(c) < rad_s ? 1e300 : -1e300);
+  }
+  return c;
+}
+
 }  // namespace
 
 double GaitFile::stride_frequency() const {
@@ -326,12 +457,25 @@ bool operator==(const FroudeTiming& a, const FroudeTiming& b) {
 }
 bool operator==(const GaitFile& a, const GaitFile& b) {
   return a.name == b.name && a.stride_frequency_hz == b.stride_frequency_hz &&
-         a.froude == b.froude && a.curves == b.curves && a.limbs == b.limbs && a.joints == b.joints;
+         a.froude == b.froude && a.curves == b.curves && a.limbs == b.limbs &&
+         a.joints == b.joints && a.steering == b.steering;
+}
+
+double GaitSteering::min_speed_m_s() const { return froude_velocity(min_froude, hip_height_m); }
+double GaitSteering::max_speed_m_s() const { return froude_velocity(max_froude, hip_height_m); }
+
+bool operator==(const GaitSteering& a, const GaitSteering& b) {
+  return a.min_froude == b.min_froude && a.max_froude == b.max_froude &&
+         a.max_turn_rad_s == b.max_turn_rad_s &&
+         a.max_acceleration_m_s2 == b.max_acceleration_m_s2 && a.hip_height_m == b.hip_height_m &&
+         a.track_width_m == b.track_width_m && a.left == b.left && a.right == b.right &&
+         a.yaw_joints == b.yaw_joints;
 }
 
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
   const YamlNode root = YamlNode::load_string(text, file_name);
-  root.allow_only({"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints"});
+  root.allow_only(
+      {"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering"});
   GaitFile gait;
   gait.file = file_name;
   const YamlNode name = root.at("name");
@@ -341,6 +485,7 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
   read_curves(root, text, gait);
   read_limbs(root, gait);
   read_joints(root, gait);
+  read_steering(root, gait);
   return gait;
 }
 
@@ -423,6 +568,7 @@ void validate_gait(const GaitFile& gait) {
           "expected a number from -3600 to 3600, found " + format_number(j.offset_deg));
     }
   }
+  validate_steering(gait);
 }
 
 std::string format_gait_file(const GaitFile& gait) {
@@ -450,6 +596,18 @@ std::string format_gait_file(const GaitFile& gait) {
            ", limb: " + name_text(j.limb) + ", sign: " + std::to_string(j.sign) +
            ", scale: " + shortest_exact(j.scale) + ", offset_deg: " + shortest_exact(j.offset_deg) +
            "}\n";
+  }
+  if (gait.steering) {
+    const GaitSteering& s = *gait.steering;
+    out += "steering:\n";
+    out += "  min_froude: " + shortest_exact(s.min_froude) + "\n";
+    out += "  max_froude: " + shortest_exact(s.max_froude) + "\n";
+    out += "  max_turn_dps: " + shortest_exact(exact_dps(s.max_turn_rad_s)) + "\n";
+    out += "  max_acceleration_m_s2: " + shortest_exact(s.max_acceleration_m_s2) + "\n";
+    out += "  hip_height_m: " + shortest_exact(s.hip_height_m) + "\n";
+    out += "  track_width_m: " + shortest_exact(s.track_width_m) + "\n";
+    out += "  sides: {left: " + names_text(s.left) + ", right: " + names_text(s.right) + "}\n";
+    if (!s.yaw_joints.empty()) out += "  yaw_joints: " + names_text(s.yaw_joints) + "\n";
   }
   return out;
 }

@@ -2,10 +2,12 @@
 
 #include "animrt/controllers/gait/gait_source.hpp"
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
 #include "animrt/controllers/gait/expression.hpp"
+#include "animrt/controllers/gait/steered_gait_source.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -78,8 +80,30 @@ std::unique_ptr<MotionSource> bind(const GaitFile& gait, std::span<const JointSp
     d.offset_deg = gj.offset_deg;
     drives.push_back(d);
   }
-  return std::make_unique<GaitSource>(gait.stride_frequency(), std::move(curves),
-                                      std::move(drives));
+  if (!gait.steering) {
+    return std::make_unique<GaitSource>(gait.stride_frequency(), std::move(curves),
+                                        std::move(drives));
+  }
+  const GaitSteering& steering = *gait.steering;
+  std::vector<SteeredGaitSource::Drive> steered;
+  for (std::size_t i = 0; i < drives.size(); ++i) {
+    const GaitJoint& gj = gait.joints[i];
+    SteeredGaitSource::Drive d;
+    d.joint = drives[i].joint;
+    d.curve = drives[i].curve;
+    d.phase = drives[i].phase;
+    d.gain = drives[i].gain;
+    d.offset_deg = drives[i].offset_deg;
+    const auto has = [](const std::vector<std::string>& names, const std::string& n) {
+      return std::find(names.begin(), names.end(), n) != names.end();
+    };
+    if (has(steering.left, gj.limb)) d.side = SteeredGaitSource::kLeft;
+    if (has(steering.right, gj.limb)) d.side = SteeredGaitSource::kRight;
+    if (has(steering.yaw_joints, gj.name)) d.side = SteeredGaitSource::kYaw;
+    steered.push_back(d);
+  }
+  return std::make_unique<SteeredGaitSource>(steering, gait.stride_frequency(), std::move(curves),
+                                             std::move(steered));
 }
 
 }  // namespace

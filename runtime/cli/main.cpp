@@ -26,6 +26,7 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
+#include "gait_command.hpp"
 #include "herd_command.hpp"
 #include "herd_driver.hpp"
 #include "head_command.hpp"
@@ -272,6 +273,7 @@ int main(int argc, char** argv) {
   sim->add_option("CONFIG", sim_path, "robot file (YAML)")->required();
 
   animrt::cli::add_evolve_command(app);
+  animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
   try {

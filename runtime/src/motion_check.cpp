@@ -5,6 +5,7 @@
 #include <sstream>
 #include <vector>
 
+#include "animrt/controllers/gait/froude.hpp"
 #include "animrt/core/yaml_doc.hpp"
 #include "animrt/runtime/pose_ramp.hpp"
 
@@ -68,9 +69,15 @@ double gait_check_duration(double stride_frequency_hz) {
   return std::clamp(strides, 60.0, 600.0);
 }
 
-void check_motion(const RobotConfig& config, const MotionCheck& check) {
+namespace {
+
+// Samples check.source over [0, check.duration_s]; `before(t)` runs before
+// each sample (steering), `context()` is appended to every message.
+void sample_motion(const RobotConfig& config, const MotionCheck& check,
+                   const std::function<void(double)>& before,
+                   const std::function<std::string()>& context) {
   const auto fail = [&](const std::string& message) {
-    throw InputError(check.where, check.key, message);
+    throw InputError(check.where, check.key, message + (context ? context() : std::string()));
   };
   const std::size_t n = config.joints.size();
   std::vector<double> home(n), pose(n);
@@ -89,6 +96,7 @@ void check_motion(const RobotConfig& config, const MotionCheck& check) {
   for (long k = 0; k <= samples; ++k) {
     const double t = std::min(static_cast<double>(k) * step, check.duration_s);
     pose = home;
+    if (before) before(t);
     check.source->sample(t, pose);
     for (int j : driven) {
       const auto i = static_cast<std::size_t>(j);
@@ -130,6 +138,58 @@ void check_motion(const RobotConfig& config, const MotionCheck& check) {
       }
     }
   }
+}
+
+}  // namespace
+
+}  // namespace animrt
+
+namespace animrt {
+
+void check_motion(const RobotConfig& config, const MotionCheck& check) {
+  sample_motion(config, check, {}, {});
+}
+
+std::vector<SteeringStep> steering_check_plan(const GaitSteering& s) {
+  const double lo = s.min_speed_m_s(), hi = s.max_speed_m_s(), mid = 0.5 * (lo + hi);
+  const double w = s.max_turn_rad_s;
+  // Long enough to reach any command from any other and walk two strides.
+  const double stride_s = 1.0 / froude_stride_frequency(s.min_froude, s.hip_height_m);
+  const double hold = 2.0 * stride_s + (hi / s.max_acceleration_m_s2) + stride_s;
+  const MotionCommand commands[] = {{hi, 0.0}, {hi, w},    {hi, -w},   {lo, 0.0}, {lo, w},
+                                    {lo, -w},  {0.0, 0.0}, {mid, 0.0}, {mid, w},  {hi, -w},
+                                    {lo, w},   {0.0, 0.0}, {hi, 0.0}};
+  std::vector<SteeringStep> plan;
+  double t = 0.0;
+  for (const MotionCommand& c : commands) {
+    plan.push_back({t, c});
+    t += hold;
+  }
+  plan.push_back({t, {0.0, 0.0}});  // end: the plan's length
+  return plan;
+}
+
+void check_steered_motion(const RobotConfig& config, const MotionCheck& check, MotionSource& source,
+                          const GaitSteering& steering) {
+  const std::vector<SteeringStep> plan = steering_check_plan(steering);
+  MotionCheck steered = check;
+  steered.source = &source;
+  steered.duration_s = plan.back().t;
+  std::size_t next = 0;
+  MotionCommand current{};
+  sample_motion(
+      config, steered,
+      [&](double t) {
+        while (next + 1 < plan.size() && plan[next].t <= t) {
+          current = plan[next].command;
+          source.steer(current);
+          ++next;
+        }
+      },
+      [&] {
+        return " (steered: speed " + number(current.speed_m_s) + " m/s, turn " +
+               number(rad_to_deg(current.turn_rad_s)) + " deg/s)";
+      });
 }
 
 }  // namespace animrt

@@ -76,6 +76,11 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
         return std::string();
       };
       check_motion(config, check);
+      if (gait->steering) {
+        // Over its whole range of commands, on a source of its own.
+        const auto steered = make_gait_source(*gait, joints);
+        check_steered_motion(config, check, *steered, *gait->steering);
+      }
     }
     return source;
   } else {

@@ -101,7 +101,7 @@ TEST(GaitFile, FroudeTiming) {
 TEST(GaitFile, UnknownKeys) {
   EXPECT_EQ(error_of(with_line(1, "name: test\nspeed: 3")),
             "g.yaml:2:1: speed: unknown key (expected one of: name, stride_frequency_hz, froude, "
-            "curves, limbs, joints)");
+            "curves, limbs, joints, steering)");
   EXPECT_EQ(error_of(with_line(10, "  j1: {curve: hip, limb: a, gain: 2}")),
             "g.yaml:10:29: joints.j1.gain: unknown key (expected one of: curve, limb, sign, scale, "
             "offset_deg)");

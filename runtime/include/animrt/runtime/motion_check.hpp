@@ -7,7 +7,9 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
+#include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
@@ -30,6 +32,25 @@ struct MotionCheck {
 
 // Throws InputError at check.where / check.key on the first problem.
 void check_motion(const RobotConfig& config, const MotionCheck& check);
+
+// One command of the steering check: given at time t.
+struct SteeringStep {
+  double t = 0.0;
+  MotionCommand command;
+};
+
+// The commands a steerable gait is checked under, in order: fastest and
+// slowest speed straight and at the fastest turn both ways, standing, mid
+// speed, and steps between them, each held long enough to reach it; the
+// last step's t is the plan's length.
+std::vector<SteeringStep> steering_check_plan(const GaitSteering& steering);
+
+// check_motion() for `source`, a steerable gait, steered through
+// steering_check_plan(steering) (check.source and check.duration_s are
+// ignored). Messages name the command in force. Leaves `source` steered:
+// check a source of its own, not the one that will run.
+void check_steered_motion(const RobotConfig& config, const MotionCheck& check, MotionSource& source,
+                          const GaitSteering& steering);
 
 // The length a gait is checked over: 20 strides, at least 60 s, at most 600 s.
 double gait_check_duration(double stride_frequency_hz);

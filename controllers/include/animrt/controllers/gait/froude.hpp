@@ -37,4 +37,11 @@ inline double froude_stride_frequency(double froude, double hip_height_m,
   return froude_velocity(froude, hip_height_m, g) / froude_stride_length(froude, hip_height_m, g);
 }
 
+// The Froude number whose stride frequency is `frequency_hz` (the inverse of
+// froude_stride_frequency: f = Fr^0.4 sqrt(g / h) / 2.3).
+inline double froude_for_stride_frequency(double frequency_hz, double hip_height_m,
+                                          double g = kStandardGravity) {
+  return std::pow(2.3 * frequency_hz * std::sqrt(hip_height_m / g), 2.5);
+}
+
 }  // namespace animrt

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -55,6 +56,9 @@ struct GaitFile {
   std::vector<GaitCurve> curves;  // in file order
   std::vector<GaitLimb> limbs;
   std::vector<GaitJoint> joints;
+  // Present when the gait can be steered (speed and turn commands); without
+  // it the gait plays at its own timing and ignores commands.
+  std::optional<GaitSteering> steering;
   std::string file;  // where it was loaded from ("" when built in memory)
 
   // Stride cycles per second, from whichever timing is set (0 if neither).

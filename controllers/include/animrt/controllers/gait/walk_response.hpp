@@ -8,21 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/controllers/motion_source.hpp"
 
 namespace animrt {
-
-// The `steering` section of a gait file (documented in docs/gait.md).
-struct GaitSteering {
-  double min_froude = 0.0;             // slowest walking Froude number (> 0)
-  double max_froude = 0.0;             // fastest
-  double max_turn_rad_s = 0.0;         // fastest turn rate, either way
-  double max_acceleration_m_s2 = 0.0;  // forward speed changes at most this fast
-  double hip_height_m = 0.0;           // h of Fr = v / sqrt(g h)
-
-  double min_speed_m_s() const;
-  double max_speed_m_s() const;
-};
 
 // One calibrated command: what the figure walked when told to.
 struct CalibrationPoint {
@@ -34,16 +23,30 @@ struct CalibrationPoint {
 };
 
 struct GaitCalibration {
-  std::string gait_file;   // the gait it was measured for
-  std::string model_file;  // the MJCF model it walked on
-  double tolerance = 0.15; // relative speed error accepted as usable
+  std::string gait_file;    // the gait it was measured for
+  std::string model_file;   // the MJCF model it walked on
+  double tolerance = 0.15;  // relative speed error accepted as usable
   std::vector<CalibrationPoint> points;
 };
 
+bool operator==(const MotionCommand& a, const MotionCommand& b);
+// Compares content (usable included).
+bool operator==(const CalibrationPoint& a, const CalibrationPoint& b);
+bool operator==(const GaitCalibration& a, const GaitCalibration& b);
+
+// Whether a measured point counts as usable under `tolerance`: no fall, and
+// achieved speed within tolerance x commanded of the commanded speed.
+bool calibration_usable(const CalibrationPoint& point, double tolerance);
+
 // walk.yaml -> walk.calibration.yaml (next to the gait).
 std::string calibration_path_for(const std::string& gait_path);
-// Throws InputError naming the file, line and key.
+// Reads a calibration file (format: docs/gait.md). Throws InputError naming
+// the file, line, column and key (also for a `usable` flag that contradicts
+// the tolerance).
 GaitCalibration load_gait_calibration(const std::string& path);
+GaitCalibration parse_gait_calibration(const std::string& text, const std::string& file_name);
+std::string format_gait_calibration(const GaitCalibration& calibration);
+// Throws std::runtime_error when the file cannot be written.
 void write_gait_calibration(const std::string& path, const GaitCalibration& calibration);
 
 class WalkResponse {
@@ -68,8 +71,24 @@ class WalkResponse {
   MotionCommand command_for(const MotionCommand& wanted) const;
 
  private:
+  // Usable points of one commanded speed, sorted by commanded turn.
+  struct Level {
+    double speed = 0.0;
+    std::vector<CalibrationPoint> points;
+  };
+  double level_max_turn(const Level& level) const;
+  MotionCommand level_achieved(const Level& level, double turn) const;
+  MotionCommand clamp(const MotionCommand& command) const;
+
   GaitSteering steering_;
-  std::vector<CalibrationPoint> usable_;  // sorted by commanded speed, then turn
+  bool calibrated_ = false;
+  std::vector<Level> levels_;  // by commanded speed
 };
+
+// The walk response of a steerable gait: its steering section, and its
+// calibration (calibration_path_for(gait_path)) when that file exists.
+// Throws InputError when the gait has no steering section, or for errors in
+// either file.
+WalkResponse load_walk_response(const std::string& gait_path);
 
 }  // namespace animrt

@@ -1,0 +1,115 @@
+// Steered playback of a gait (see steered_gait_source.hpp).
+
+#include "animrt/controllers/gait/steered_gait_source.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr int kMeanSamples = 256;
+
+double smoothstep(double u) { return u * u * (3.0 - 2.0 * u); }
+
+double step_toward(double value, double goal, double max_step) {
+  return value + std::clamp(goal - value, -max_step, max_step);
+}
+
+}  // namespace
+
+SteeredGaitSource::SteeredGaitSource(const GaitSteering& steering, double native_frequency_hz,
+                                     std::vector<Expression> curves, std::vector<Drive> drives)
+    : steering_(steering), curves_(std::move(curves)), drives_(std::move(drives)) {
+  for (const Drive& d : drives_) driven_.push_back(d.joint);
+  for (const Expression& c : curves_) {
+    // Summed as fractions: a curve that is finite but huge must not
+    // overflow into an infinite mean.
+    double mean = 0.0;
+    for (int i = 0; i < kMeanSamples; ++i) {
+      mean += c.eval(static_cast<double>(i) / kMeanSamples) / kMeanSamples;
+    }
+    means_.push_back(mean);
+  }
+  const double h = steering_.hip_height_m;
+  const double native_froude = froude_for_stride_frequency(native_frequency_hz, h);
+  native_speed_ = froude_velocity(native_froude, h);
+  native_length_ = froude_stride_length(native_froude, h);
+  min_speed_ = steering_.min_speed_m_s();
+  max_speed_ = steering_.max_speed_m_s();
+  blend_time_s_ = 1.0 / froude_stride_frequency(steering_.min_froude, h);
+  target_speed_ = std::clamp(native_speed_, min_speed_, max_speed_);
+}
+
+void SteeredGaitSource::steer(const MotionCommand& command) {
+  const double v = command.speed_m_s;
+  target_speed_ = (std::isfinite(v) && v >= min_speed_) ? std::min(v, max_speed_) : 0.0;
+  const double w = std::isfinite(command.turn_rad_s) ? command.turn_rad_s : 0.0;
+  target_turn_ = std::clamp(w, -steering_.max_turn_rad_s, steering_.max_turn_rad_s);
+}
+
+MotionCommand SteeredGaitSource::current() const {
+  if (!started_) return {0.0, 0.0};
+  return {speed_ * smoothstep(blend_), turn_};
+}
+
+void SteeredGaitSource::reset(double t) const {
+  const bool walking = target_speed_ > 0.0;
+  started_ = true;
+  phase_ = 0.0;
+  speed_ = walking ? target_speed_ : min_speed_;
+  turn_ = walking ? target_turn_ : 0.0;
+  blend_ = walking ? 1.0 : 0.0;
+  // As if it had walked at this command since t = 0 (the unsteered gait's
+  // phase at a constant speed).
+  const double h = steering_.hip_height_m;
+  phase_ = froude_stride_frequency(speed_ / std::sqrt(kStandardGravity * h), h) * blend_ * t;
+  last_t_ = t;
+}
+
+void SteeredGaitSource::advance(double t) const {
+  if (!started_ || t <= 0.0 || t < last_t_) {
+    reset(t);
+    return;
+  }
+  const double dt = t - last_t_;
+  last_t_ = t;
+  const bool walking = target_speed_ > 0.0;
+  speed_ = step_toward(speed_, walking ? target_speed_ : min_speed_,
+                       steering_.max_acceleration_m_s2 * dt);
+  blend_ = std::clamp(blend_ + (walking ? dt : -dt) / blend_time_s_, 0.0, 1.0);
+  turn_ = step_toward(turn_, walking ? target_turn_ : 0.0,
+                      steering_.max_turn_rad_s * dt / blend_time_s_);
+  const double h = steering_.hip_height_m;
+  const double fr = speed_ / std::sqrt(kStandardGravity * h);
+  phase_ += froude_stride_frequency(fr, h) * smoothstep(blend_) * dt;
+}
+
+void SteeredGaitSource::sample(double t, std::span<double> targets) const {
+  advance(t);
+  const double h = steering_.hip_height_m;
+  const double s = smoothstep(blend_);
+  const double fr = speed_ / std::sqrt(kStandardGravity * h);
+  const double amplitude = s * froude_stride_length(fr, h) / native_length_;
+  const double half_track = 0.5 * steering_.track_width_m;
+  // Positive turn is to the left: the left side is inside.
+  const double left = std::max(0.0, (speed_ - turn_ * half_track) / speed_);
+  const double right = std::max(0.0, (speed_ + turn_ * half_track) / speed_);
+  const double yaw = steering_.max_turn_rad_s > 0.0 ? s * turn_ / steering_.max_turn_rad_s : 0.0;
+  for (const Drive& d : drives_) {
+    if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
+    const auto c = static_cast<std::size_t>(d.curve);
+    double scale = amplitude;
+    if (d.side == kLeft) scale *= left;
+    if (d.side == kRight) scale *= right;
+    if (d.side == kYaw) scale = yaw;
+    const double deviation = curves_[c].eval(phase_ - d.phase) - means_[c];
+    const double deg = d.gain * (means_[c] + scale * deviation) + d.offset_deg;
+    targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);
+  }
+}
+
+}  // namespace animrt

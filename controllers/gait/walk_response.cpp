@@ -1,0 +1,175 @@
+// What a steerable gait walks when commanded (see walk_response.hpp).
+
+#include "animrt/controllers/gait/walk_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "animrt/controllers/gait/gait_file.hpp"
+
+namespace animrt {
+namespace {
+
+MotionCommand lerp(const MotionCommand& a, const MotionCommand& b, double u) {
+  return {a.speed_m_s + u * (b.speed_m_s - a.speed_m_s),
+          a.turn_rad_s + u * (b.turn_rad_s - a.turn_rad_s)};
+}
+
+// Candidates per axis in each pass of command_for's search.
+constexpr int kSearchSteps = 24;
+constexpr int kSearchPasses = 3;
+
+}  // namespace
+
+WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* calibration)
+    : steering_(steering), calibrated_(calibration != nullptr) {
+  if (!calibration) return;
+  for (const CalibrationPoint& p : calibration->points) {
+    if (!p.usable) continue;
+    auto it = std::find_if(levels_.begin(), levels_.end(),
+                           [&](const Level& l) { return l.speed == p.commanded.speed_m_s; });
+    if (it == levels_.end()) {
+      levels_.push_back(Level{p.commanded.speed_m_s, {}});
+      it = levels_.end() - 1;
+    }
+    it->points.push_back(p);
+  }
+  std::sort(levels_.begin(), levels_.end(),
+            [](const Level& a, const Level& b) { return a.speed < b.speed; });
+  for (Level& l : levels_) {
+    std::sort(l.points.begin(), l.points.end(), [](const auto& a, const auto& b) {
+      return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
+    });
+  }
+}
+
+double WalkResponse::min_speed() const {
+  if (!calibrated_) return steering_.min_speed_m_s();
+  return levels_.empty() ? 0.0 : levels_.front().speed;
+}
+
+double WalkResponse::max_speed() const {
+  if (!calibrated_) return steering_.max_speed_m_s();
+  return levels_.empty() ? 0.0 : levels_.back().speed;
+}
+
+double WalkResponse::max_acceleration() const { return steering_.max_acceleration_m_s2; }
+
+double WalkResponse::level_max_turn(const Level& level) const {
+  // Either way: the smaller of the fastest usable left and right turns.
+  double left = 0.0, right = 0.0;
+  for (const auto& p : level.points) {
+    left = std::max(left, p.commanded.turn_rad_s);
+    right = std::max(right, -p.commanded.turn_rad_s);
+  }
+  return std::min({left, right, steering_.max_turn_rad_s});
+}
+
+double WalkResponse::max_turn(double speed) const {
+  if (!(speed >= min_speed() && speed <= max_speed()) || max_speed() <= 0.0) return 0.0;
+  if (!calibrated_) return steering_.max_turn_rad_s;
+  for (std::size_t i = 0; i < levels_.size(); ++i) {
+    if (levels_[i].speed == speed) return level_max_turn(levels_[i]);
+    if (levels_[i].speed > speed) {
+      return std::min(level_max_turn(levels_[i - 1]), level_max_turn(levels_[i]));
+    }
+  }
+  return level_max_turn(levels_.back());
+}
+
+MotionCommand WalkResponse::clamp(const MotionCommand& c) const {
+  const double v = c.speed_m_s;
+  if (!std::isfinite(v) || v < min_speed() || max_speed() <= 0.0) return {0.0, 0.0};
+  MotionCommand out;
+  out.speed_m_s = std::min(v, max_speed());
+  const double limit = max_turn(out.speed_m_s);
+  const double w = std::isfinite(c.turn_rad_s) ? c.turn_rad_s : 0.0;
+  out.turn_rad_s = std::clamp(w, -limit, limit);
+  return out;
+}
+
+MotionCommand WalkResponse::level_achieved(const Level& level, double turn) const {
+  const auto& pts = level.points;
+  if (turn <= pts.front().commanded.turn_rad_s) return pts.front().achieved;
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double w0 = pts[i - 1].commanded.turn_rad_s;
+    const double w1 = pts[i].commanded.turn_rad_s;
+    if (turn <= w1) return lerp(pts[i - 1].achieved, pts[i].achieved, (turn - w0) / (w1 - w0));
+  }
+  return pts.back().achieved;
+}
+
+MotionCommand WalkResponse::achieved(const MotionCommand& commanded) const {
+  const MotionCommand c = clamp(commanded);
+  if (c.speed_m_s <= 0.0 || !calibrated_) return c;
+  const double v = c.speed_m_s;
+  for (std::size_t i = 0; i < levels_.size(); ++i) {
+    if (levels_[i].speed < v) continue;
+    if (levels_[i].speed == v || i == 0) return level_achieved(levels_[i], c.turn_rad_s);
+    const Level& lo = levels_[i - 1];
+    const Level& hi = levels_[i];
+    return lerp(level_achieved(lo, c.turn_rad_s), level_achieved(hi, c.turn_rad_s),
+                (v - lo.speed) / (hi.speed - lo.speed));
+  }
+  return level_achieved(levels_.back(), c.turn_rad_s);
+}
+
+MotionCommand WalkResponse::command_for(const MotionCommand& wanted) const {
+  // Turn error weighed as the speed of a foot at half the track.
+  const double arm = 0.5 * steering_.track_width_m;
+  const auto error = [&](const MotionCommand& c) {
+    const MotionCommand a = achieved(c);
+    const double dv = a.speed_m_s - wanted.speed_m_s;
+    const double dw = (a.turn_rad_s - wanted.turn_rad_s) * arm;
+    return dv * dv + dw * dw;
+  };
+  MotionCommand best{0.0, 0.0};
+  double best_error = error(best);
+  if (max_speed() <= 0.0 || !std::isfinite(wanted.speed_m_s) || !std::isfinite(wanted.turn_rad_s))
+    return best;
+  double v_lo = min_speed(), v_hi = max_speed();
+  double w_span = steering_.max_turn_rad_s;
+  double w_mid = 0.0;
+  for (int pass = 0; pass < kSearchPasses; ++pass) {
+    for (int i = 0; i <= kSearchSteps; ++i) {
+      const double v = v_lo + (v_hi - v_lo) * i / kSearchSteps;
+      const double limit = max_turn(v);
+      for (int k = 0; k <= kSearchSteps; ++k) {
+        const double w =
+            std::clamp(w_mid - w_span + 2.0 * w_span * k / kSearchSteps, -limit, limit);
+        const MotionCommand c{v, w};
+        const double e = error(c);
+        if (e < best_error) {
+          best_error = e;
+          best = clamp(c);
+        }
+      }
+    }
+    if (best.speed_m_s <= 0.0) break;
+    const double dv = (v_hi - v_lo) / kSearchSteps;
+    v_lo = std::max(min_speed(), best.speed_m_s - dv);
+    v_hi = std::min(max_speed(), best.speed_m_s + dv);
+    w_span = 2.0 * w_span / kSearchSteps;
+    w_mid = best.turn_rad_s;
+  }
+  return best;
+}
+
+WalkResponse load_walk_response(const std::string& gait_path) {
+  const GaitFile gait = load_gait_file(gait_path);
+  if (!gait.steering) {
+    throw InputError(Location{gait_path, 0, 0}, "steering",
+                     "gait '" + gait.name + "' has no steering section, so it cannot be steered");
+  }
+  const std::string cal_path = calibration_path_for(gait_path);
+  std::error_code ec;
+  if (std::filesystem::exists(cal_path, ec)) {
+    const GaitCalibration cal = load_gait_calibration(cal_path);
+    return WalkResponse(*gait.steering, &cal);
+  }
+  return WalkResponse(*gait.steering);
+}
+
+}  // namespace animrt

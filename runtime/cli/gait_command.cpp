@@ -1,0 +1,149 @@
+// The gait subcommand: calibrate a steerable gait on MuJoCo physics.
+
+#include "gait_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/controllers/gait/walk_response.hpp"
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_config.hpp"
+#include "animrt/sim/mujoco/mujoco_walk.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct CalibrateArgs {
+  std::string robot;
+  std::string physics;
+  std::string gait;  // overrides the robot's motion.file
+  std::string out;
+  int speeds = 5;
+  int turns = 2;
+  std::uint64_t seed = 0;
+};
+
+constexpr double kSettleS = 0.5;
+constexpr double kWarmupStrides = 3.0;
+constexpr double kMeasureStrides = 4.0;
+
+std::string relative_to(const std::string& path, const std::string& from_file) {
+  std::error_code ec;
+  const auto base = std::filesystem::absolute(from_file, ec).parent_path();
+  const auto rel = std::filesystem::absolute(path, ec).lexically_relative(base);
+  return rel.empty() ? path : rel.string();
+}
+
+int run_calibrate(const CalibrateArgs& a) {
+  std::string gait_path = a.gait;
+  if (gait_path.empty()) {
+    const RobotConfig config = load_robot_config(a.robot);
+    if (config.motion.type != "gait") {
+      throw InputError(config.motion.where, "motion.type",
+                       "gait calibrate needs a robot whose motion.type is gait, found \"" +
+                           config.motion.type + "\"");
+    }
+    gait_path = config.motion.file;
+  }
+  const GaitFile gait = load_gait_file(gait_path);
+  if (!gait.steering) {
+    throw InputError(Location{gait_path, 0, 0}, "steering",
+                     "the gait has no steering section; add one (docs/gait.md) to calibrate it");
+  }
+  const GaitSteering& st = *gait.steering;
+  const sim::MujocoModel model = sim::load_mujoco_model(a.physics);
+  const auto specs = sim::model_joint_specs(model);
+  (void)make_gait_source(gait, specs);  // its joints must be the model's (errors name the gait)
+
+  GaitCalibration cal;
+  const std::string out = a.out.empty() ? calibration_path_for(gait_path) : a.out;
+  cal.gait_file = relative_to(gait_path, out);
+  cal.model_file = relative_to(a.physics, out);
+  std::printf("calibrating %s on %s: %d speeds x %d turn rates\n", gait_path.c_str(),
+              a.physics.c_str(), a.speeds, 1 + 2 * a.turns);
+  std::printf("%10s %9s | %10s %9s %7s  %s\n", "cmd m/s", "cmd deg/s", "got m/s", "got deg/s",
+              "err %", "");
+  for (int i = 0; i < a.speeds; ++i) {
+    const double u = a.speeds == 1 ? 0.5 : static_cast<double>(i) / (a.speeds - 1);
+    const double fr = st.min_froude + u * (st.max_froude - st.min_froude);
+    const double v = froude_velocity(fr, st.hip_height_m);
+    const double stride_s = 1.0 / froude_stride_frequency(fr, st.hip_height_m);
+    const double ramp_s = v / st.max_acceleration_m_s2 + stride_s;
+    for (int k = -a.turns; k <= a.turns; ++k) {
+      const double sign = k < 0 ? -1.0 : 1.0;
+      const double w = a.turns == 0 ? 0.0 : sign * st.max_turn_rad_s * std::abs(k) / a.turns;
+      sim::WalkTrial trial;
+      trial.settle_s = kSettleS;
+      trial.warmup_s = ramp_s + kWarmupStrides * stride_s;
+      trial.measure_s = kMeasureStrides * stride_s;
+      trial.seed = a.seed;
+      auto source = make_gait_source(gait, specs);
+      const sim::WalkTrace trace = sim::walk_command(model, *source, {v, w}, trial);
+      CalibrationPoint p;
+      p.commanded = {v, w};
+      p.achieved = trace.achieved;
+      p.fell = trace.fell;
+      p.usable = calibration_usable(p, cal.tolerance);
+      cal.points.push_back(p);
+      std::printf("%10.4f %9.2f | %10.4f %9.2f %7.1f  %s\n", v, rad_to_deg(w), p.achieved.speed_m_s,
+                  rad_to_deg(p.achieved.turn_rad_s), 100.0 * (p.achieved.speed_m_s - v) / v,
+                  p.fell ? "FELL" : (p.usable ? "usable" : "off"));
+    }
+  }
+  // Standing first, then by speed and turn, so the table reads in order.
+  std::stable_sort(cal.points.begin(), cal.points.end(), [](const auto& x, const auto& y) {
+    return x.commanded.speed_m_s < y.commanded.speed_m_s ||
+           (x.commanded.speed_m_s == y.commanded.speed_m_s &&
+            x.commanded.turn_rad_s < y.commanded.turn_rad_s);
+  });
+  write_gait_calibration(out, cal);
+  int usable = 0;
+  for (const auto& p : cal.points) usable += p.usable ? 1 : 0;
+  std::printf(
+      "%d of %zu points usable (within %.0f %% of the commanded speed, no fall)\nwrote %s\n",
+      usable, cal.points.size(), 100.0 * cal.tolerance, out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_gait_command(CLI::App& app) {
+  auto* gait = app.add_subcommand("gait", "Steerable gaits");
+  gait->require_subcommand(1);
+  auto args = std::make_shared<CalibrateArgs>();
+  auto* cmd = gait->add_subcommand(
+      "calibrate", "Walk a robot's steerable gait on MuJoCo over its speed and turn range");
+  cmd->add_option("ROBOT", args->robot, "robot file (motion.type gait)")->required();
+  cmd->add_option("--physics", args->physics, "MuJoCo MJCF model to walk on")->required();
+  cmd->add_option("--gait", args->gait, "gait file to calibrate instead of the robot's");
+  cmd->add_option("--out", args->out, "calibration file (default: next to the gait)");
+  cmd->add_option("--speeds", args->speeds, "speeds from min to max Froude")
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--turns", args->turns, "turn rates each way (fractions of the fastest)")
+      ->check(CLI::Range(0, 20));
+  cmd->add_option("--seed", args->seed, "perturb the start pose (0: exact standing pose)");
+  cmd->callback([args] {
+    int code = 0;
+    try {
+      code = run_calibrate(*args);
+    } catch (const InputError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 2;
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 1;
+    }
+    if (code != 0) throw CLI::RuntimeError(code);
+    throw CLI::Success();
+  });
+}
+
+}  // namespace animrt::cli

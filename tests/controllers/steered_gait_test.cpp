@@ -1,0 +1,234 @@
+// Steered playback of a gait: phase continuity, turning, standing,
+// acceleration limit, clamping, no allocation.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/controllers/gait/steered_gait_source.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr double kDt = 0.005;  // the quadruped's 200 Hz cycle
+constexpr double kMeanDeg = 10.0;
+constexpr double kSwingDeg = 20.0;
+
+const char* const kGait = R"yaml(name: steer
+stride_frequency_hz: 1.0
+curves:
+  hip: "10 + 20*sin(2*PI*t)"
+limbs: {lf: 0, rf: 0.5, lh: 0.5, rh: 0}
+joints:
+  lf_hip: {curve: hip, limb: lf}
+  rf_hip: {curve: hip, limb: rf}
+  lh_hip: {curve: hip, limb: lh}
+  rh_hip: {curve: hip, limb: rh}
+steering:
+  min_froude: 0.03
+  max_froude: 0.12
+  max_turn_dps: 30
+  max_acceleration_m_s2: 0.2
+  hip_height_m: 0.2
+  track_width_m: 0.2
+  sides: {left: [lf, lh], right: [rf, rh]}
+)yaml";
+
+std::vector<JointSpec> specs() {
+  std::vector<JointSpec> out;
+  for (const char* n : {"lf_hip", "rf_hip", "lh_hip", "rh_hip"}) {
+    JointSpec s;
+    s.name = n;
+    s.limits = {-kPi, kPi, 100.0, 10000.0};
+    out.push_back(s);
+  }
+  return out;
+}
+
+struct Rig {
+  GaitFile gait = parse_gait_file(kGait, "steer.yaml");
+  std::vector<JointSpec> joints = specs();
+  std::unique_ptr<MotionSource> source = make_gait_source(gait, joints);
+  SteeredGaitSource& steered = dynamic_cast<SteeredGaitSource&>(*source);
+  std::vector<double> targets = std::vector<double>(4, 0.0);
+  double t = 0.0;
+  const GaitSteering& st() const { return *gait.steering; }
+
+  // Samples for `seconds`, returning the largest and smallest target (deg)
+  // of each joint over that time.
+  std::vector<std::pair<double, double>> run(double seconds) {
+    std::vector<std::pair<double, double>> range(4, {1e9, -1e9});
+    const long steps = std::lround(seconds / kDt);
+    for (long k = 0; k < steps; ++k) {
+      source->sample(t, targets);
+      t += kDt;
+      for (std::size_t j = 0; j < 4; ++j) {
+        const double deg = rad_to_deg(targets[j]);
+        range[j] = {std::min(range[j].first, deg), std::max(range[j].second, deg)};
+      }
+    }
+    return range;
+  }
+};
+
+double swing(const std::pair<double, double>& r) { return r.second - r.first; }
+
+TEST(SteeredGait, PhaseIsContinuousAcrossAFrequencyStep) {
+  Rig rig;
+  const double lo = rig.st().min_speed_m_s(), hi = rig.st().max_speed_m_s();
+  rig.source->steer({lo, 0.0});
+  rig.run(3.0);
+  rig.source->steer({hi, 0.0});
+  // Fastest possible joint speed at the fastest stride: swing x 2 pi f x
+  // the largest amplitude scale.
+  const double h = rig.st().hip_height_m;
+  const double native_fr = froude_for_stride_frequency(1.0, h);
+  const double scale =
+      froude_stride_length(rig.st().max_froude, h) / froude_stride_length(native_fr, h);
+  const double f_max = froude_stride_frequency(rig.st().max_froude, h);
+  const double bound = deg_to_rad(kSwingDeg * scale * 2.0 * kPi * f_max) * kDt * 1.1;
+  std::vector<double> prev(4);
+  rig.source->sample(rig.t, prev);
+  double worst = 0.0;
+  for (int k = 0; k < 1200; ++k) {
+    rig.t += kDt;
+    rig.source->sample(rig.t, rig.targets);
+    for (std::size_t j = 0; j < 4; ++j) worst = std::max(worst, std::abs(rig.targets[j] - prev[j]));
+    prev = rig.targets;
+  }
+  EXPECT_LT(worst, bound);
+  EXPECT_GT(worst, 0.2 * bound);  // it does walk
+}
+
+TEST(SteeredGait, TurnShortensTheInnerSideStrides) {
+  Rig rig;
+  const double v = 0.5 * (rig.st().min_speed_m_s() + rig.st().max_speed_m_s());
+  const double w = rig.st().max_turn_rad_s;
+  rig.source->steer({v, w});  // to the left: left side inside
+  rig.run(4.0);
+  const auto range = rig.run(3.0);
+  const double inner = swing(range[0]), outer = swing(range[1]);
+  EXPECT_LT(inner, outer);
+  const double half = 0.5 * rig.st().track_width_m;
+  EXPECT_NEAR(inner / outer, (v - w * half) / (v + w * half), 0.02);
+  EXPECT_NEAR(swing(range[2]), inner, 0.05);  // lh: left too
+  // And the other way.
+  rig.source->steer({v, -w});
+  rig.run(4.0);
+  const auto back = rig.run(3.0);
+  EXPECT_GT(swing(back[0]), swing(back[1]));
+}
+
+TEST(SteeredGait, ZeroSpeedStandsInTheMeanPoseAndStays) {
+  Rig rig;
+  rig.source->steer({rig.st().max_speed_m_s(), 0.0});
+  const auto walking = rig.run(2.0);
+  EXPECT_GT(swing(walking[0]), 10.0);
+  rig.source->steer({0.0, 0.0});
+  rig.run(3.0);
+  const auto standing = rig.run(2.0);
+  for (const auto& r : standing) {
+    EXPECT_NEAR(r.first, kMeanDeg, 1e-9);
+    EXPECT_NEAR(r.second, kMeanDeg, 1e-9);
+  }
+  EXPECT_EQ(rig.steered.current().speed_m_s, 0.0);
+  // Below the slowest speed stands as well; a new command walks again.
+  rig.source->steer({0.5 * rig.st().min_speed_m_s(), 0.0});
+  EXPECT_LT(swing(rig.run(2.0)[0]), 1e-9);
+  rig.source->steer({rig.st().min_speed_m_s(), 0.0});
+  rig.run(3.0);
+  EXPECT_GT(swing(rig.run(2.0)[0]), 5.0);
+}
+
+TEST(SteeredGait, SpeedRampsAtTheAccelerationLimit) {
+  Rig rig;
+  const double lo = rig.st().min_speed_m_s(), hi = rig.st().max_speed_m_s();
+  const double a = rig.st().max_acceleration_m_s2;
+  rig.source->steer({lo, 0.0});
+  rig.run(1.0);
+  ASSERT_NEAR(rig.steered.current().speed_m_s, lo, 1e-12);
+  rig.source->steer({hi, 0.0});
+  double prev = rig.steered.current().speed_m_s;
+  double reached = -1.0;
+  const double start = rig.t;
+  for (int k = 0; k < 2000 && reached < 0; ++k) {
+    rig.run(kDt);
+    const double v = rig.steered.current().speed_m_s;
+    EXPECT_LE(v - prev, a * kDt + 1e-12);
+    prev = v;
+    if (v >= hi - 1e-12) reached = rig.t - start;
+  }
+  ASSERT_GT(reached, 0.0);
+  EXPECT_GE(reached, (hi - lo) / a - 2 * kDt);
+  EXPECT_LE(reached, (hi - lo) / a + 2 * kDt);
+}
+
+TEST(SteeredGait, CommandsAreClampedToTheSteeringLimits) {
+  Rig rig;
+  rig.source->steer({100.0, 100.0});
+  EXPECT_EQ(rig.steered.target().speed_m_s, rig.st().max_speed_m_s());
+  EXPECT_EQ(rig.steered.target().turn_rad_s, rig.st().max_turn_rad_s);
+  rig.source->steer({0.1, -100.0});
+  EXPECT_EQ(rig.steered.target().turn_rad_s, -rig.st().max_turn_rad_s);
+  rig.source->steer({std::nan(""), std::nan("")});
+  EXPECT_EQ(rig.steered.target().speed_m_s, 0.0);
+  EXPECT_EQ(rig.steered.target().turn_rad_s, 0.0);
+  rig.source->steer({-1.0, 0.0});
+  EXPECT_EQ(rig.steered.target().speed_m_s, 0.0);
+}
+
+TEST(SteeredGait, RestartsWhenTimeGoesBack) {
+  Rig rig;
+  std::vector<double> first(4), again(4);
+  rig.source->sample(0.0, first);
+  rig.run(2.5);
+  rig.source->sample(0.0, again);
+  EXPECT_EQ(first, again);
+}
+
+TEST(SteeredGait, WithoutASteeringSectionCommandsAreIgnored) {
+  GaitFile gait = parse_gait_file(kGait, "steer.yaml");
+  gait.steering.reset();
+  const auto joints = specs();
+  auto a = make_gait_source(gait, joints);
+  auto b = make_gait_source(gait, joints);
+  b->steer({0.0, 1.0});
+  std::vector<double> ta(4), tb(4);
+  for (int k = 0; k < 400; ++k) {
+    a->sample(k * kDt, ta);
+    b->sample(k * kDt, tb);
+    ASSERT_EQ(ta, tb);
+  }
+  b->sample(0.25, tb);
+  EXPECT_NEAR(rad_to_deg(tb[0]), kMeanDeg + kSwingDeg, 1e-9);  // plays as the file says
+}
+
+TEST(SteeredGait, UncommandedPlaysTheGaitsOwnTiming) {
+  Rig rig;
+  // Native speed of 1 Hz at h = 0.2 is inside the range: amplitude scale 1.
+  std::vector<double> tg(4);
+  rig.source->sample(0.0, tg);
+  for (int k = 1; k <= 50; ++k) rig.source->sample(k * kDt, tg);  // t = 0.25 s
+  EXPECT_NEAR(rad_to_deg(tg[0]), kMeanDeg + kSwingDeg, 1e-6);
+}
+
+TEST(SteeredGait, SteerAndSampleDoNotAllocate) {
+  Rig rig;
+  rig.source->sample(0.0, rig.targets);
+  test::AllocationCounter counter;
+  for (int k = 1; k < 2000; ++k) {
+    if (k % 100 == 0) rig.source->steer({0.02 * (k % 700) / 100.0, 0.1 * ((k / 100) % 3 - 1)});
+    rig.source->sample(k * kDt, rig.targets);
+  }
+  EXPECT_EQ(counter.count(), 0);
+}
+
+}  // namespace
+}  // namespace animrt

@@ -1,0 +1,192 @@
+// Calibration tables and the walk response built from them.
+
+#include "animrt/controllers/gait/walk_response.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+namespace {
+
+GaitSteering steering() {
+  GaitSteering s;
+  s.min_froude = 0.05;
+  s.max_froude = 0.1;
+  s.max_turn_rad_s = 0.4;
+  s.max_acceleration_m_s2 = 0.2;
+  s.hip_height_m = 0.2;
+  s.track_width_m = 0.2;
+  s.left = {"l"};
+  s.right = {"r"};
+  return s;
+}
+
+CalibrationPoint point(double v, double w, double av, double aw, bool fell = false) {
+  CalibrationPoint p;
+  p.commanded = {v, w};
+  p.achieved = {av, aw};
+  p.fell = fell;
+  p.usable = calibration_usable(p, 0.15);
+  return p;
+}
+
+// Two speed levels, 0.1 and 0.2 m/s; at 0.2 the fastest right turn falls.
+GaitCalibration table() {
+  GaitCalibration c;
+  c.gait_file = "walk.yaml";
+  c.model_file = "quadruped.xml";
+  c.points = {point(0.1, -0.2, 0.09, -0.1),  point(0.1, 0.0, 0.1, 0.0),
+              point(0.1, 0.2, 0.11, 0.1),    point(0.2, -0.4, 0.1, -0.3, true),
+              point(0.2, -0.1, 0.19, -0.05), point(0.2, 0.0, 0.18, 0.0),
+              point(0.2, 0.1, 0.21, 0.05),   point(0.3, 0.0, 0.1, 0.0)};  // 67 % slow: not usable
+  return c;
+}
+
+TEST(Calibration, UsableMeansNoFallAndWithinTolerance) {
+  EXPECT_TRUE(point(0.1, 0, 0.114, 0).usable);
+  EXPECT_FALSE(point(0.1, 0, 0.116, 0).usable);
+  EXPECT_FALSE(point(0.1, 0, 0.1, 0, true).usable);
+}
+
+TEST(Calibration, FileRoundTrips) {
+  GaitCalibration c = table();
+  c.points[1].achieved.turn_rad_s = 0.0123456789;
+  const GaitCalibration back = parse_gait_calibration(format_gait_calibration(c), "c.yaml");
+  EXPECT_EQ(back, c);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "round.calibration.yaml").string();
+  write_gait_calibration(path, c);
+  EXPECT_EQ(load_gait_calibration(path), c);
+  std::filesystem::remove(path);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_gait_calibration(text, "c.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Calibration, BadFilesNameLineAndKey) {
+  const std::string head = "gait: w.yaml\nmodel: m.xml\ntolerance: 0.15\npoints:\n";
+  const std::string ok =
+      "  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.1, achieved_turn_dps: 0, "
+      "fell: false}\n";
+  EXPECT_EQ(error_of(head + ok), "no error");
+  const std::string unknown = error_of(head + "  - {speed_m_s: 0.1, turn: 0}\n");
+  EXPECT_NE(unknown.find("c.yaml:5:"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("points[0].turn"), std::string::npos) << unknown;
+  const std::string missing = error_of(head + ok + "  - {speed_m_s: 0.1, turn_dps: 0}\n");
+  EXPECT_NE(missing.find("c.yaml:6:"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("points[1]."), std::string::npos) << missing;
+  EXPECT_NE(missing.find("required key is missing"), std::string::npos) << missing;
+  // A usable flag the numbers contradict.
+  const std::string liar =
+      error_of(head +
+               "  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.5, achieved_turn_dps: 0, "
+               "fell: false, usable: true}\n");
+  EXPECT_NE(liar.find("c.yaml:5:"), std::string::npos) << liar;
+  EXPECT_NE(liar.find("points[0].usable"), std::string::npos) << liar;
+  const std::string tol = error_of("gait: w\nmodel: m\ntolerance: 2\npoints: []\n");
+  EXPECT_NE(tol.find("c.yaml:3:12: tolerance"), std::string::npos) << tol;
+  EXPECT_THROW(load_gait_calibration("/nonexistent/x.calibration.yaml"), InputError);
+}
+
+TEST(Calibration, PathSitsNextToTheGait) {
+  EXPECT_EQ(calibration_path_for("configs/gaits/walk.yaml"), "configs/gaits/walk.calibration.yaml");
+  EXPECT_EQ(calibration_path_for("walk.yaml"), "walk.calibration.yaml");
+}
+
+TEST(WalkResponse, WithoutCalibrationWalksWhatItIsToldWithinLimits) {
+  const GaitSteering s = steering();
+  const WalkResponse r(s);
+  EXPECT_DOUBLE_EQ(r.min_speed(), s.min_speed_m_s());
+  EXPECT_DOUBLE_EQ(r.max_speed(), s.max_speed_m_s());
+  EXPECT_EQ(r.max_acceleration(), 0.2);
+  EXPECT_EQ(r.max_turn(r.min_speed()), 0.4);
+  EXPECT_EQ(r.max_turn(0.0), 0.0);
+  const double mid = 0.5 * (r.min_speed() + r.max_speed());
+  EXPECT_EQ(r.achieved({mid, 0.1}).speed_m_s, mid);
+  EXPECT_EQ(r.achieved({mid, 0.1}).turn_rad_s, 0.1);
+  EXPECT_EQ(r.achieved({10.0, 9.0}).speed_m_s, r.max_speed());
+  EXPECT_EQ(r.achieved({10.0, 9.0}).turn_rad_s, 0.4);
+  EXPECT_EQ(r.achieved({0.5 * r.min_speed(), 0.3}).speed_m_s, 0.0);  // stands
+  EXPECT_EQ(r.achieved({0.5 * r.min_speed(), 0.3}).turn_rad_s, 0.0);
+  const MotionCommand c = r.command_for({mid, -0.2});
+  EXPECT_NEAR(c.speed_m_s, mid, 1e-3);
+  EXPECT_NEAR(c.turn_rad_s, -0.2, 1e-3);
+}
+
+TEST(WalkResponse, InterpolatesTheUsablePoints) {
+  const GaitCalibration cal = table();
+  const WalkResponse r(steering(), &cal);
+  EXPECT_EQ(r.min_speed(), 0.1);
+  EXPECT_EQ(r.max_speed(), 0.2);  // 0.3 was not usable
+  EXPECT_NEAR(r.max_turn(0.1), 0.2, 1e-12);
+  EXPECT_NEAR(r.max_turn(0.2), 0.1, 1e-12);   // the faster right turn fell
+  EXPECT_NEAR(r.max_turn(0.15), 0.1, 1e-12);  // the tighter of the two levels
+  EXPECT_EQ(r.max_turn(0.25), 0.0);
+  // On a point, between turns, between speeds.
+  EXPECT_NEAR(r.achieved({0.2, 0.0}).speed_m_s, 0.18, 1e-12);
+  EXPECT_NEAR(r.achieved({0.1, 0.1}).speed_m_s, 0.105, 1e-12);
+  EXPECT_NEAR(r.achieved({0.1, 0.1}).turn_rad_s, 0.05, 1e-12);
+  EXPECT_NEAR(r.achieved({0.15, 0.0}).speed_m_s, 0.14, 1e-12);
+  // Clamped first: too fast is max speed, too tight is the usable turn.
+  EXPECT_NEAR(r.achieved({0.5, 0.0}).speed_m_s, 0.18, 1e-12);
+  EXPECT_NEAR(r.achieved({0.2, -1.0}).turn_rad_s, -0.05, 1e-12);
+  EXPECT_EQ(r.achieved({0.05, 0.0}).speed_m_s, 0.0);
+}
+
+TEST(WalkResponse, CommandForFindsTheCommandThatAchievesTheWish) {
+  const GaitCalibration cal = table();
+  const WalkResponse r(steering(), &cal);
+  // 0.18 m/s straight is achieved by commanding 0.2.
+  MotionCommand c = r.command_for({0.18, 0.0});
+  EXPECT_NEAR(c.speed_m_s, 0.2, 2e-3);
+  EXPECT_NEAR(c.turn_rad_s, 0.0, 2e-3);
+  EXPECT_NEAR(r.achieved(c).speed_m_s, 0.18, 1e-3);
+  // A turn of 0.05 rad/s at 0.105 m/s is commanded as 0.1 rad/s at 0.1 m/s.
+  c = r.command_for({0.105, 0.05});
+  EXPECT_NEAR(r.achieved(c).speed_m_s, 0.105, 2e-3);
+  EXPECT_NEAR(r.achieved(c).turn_rad_s, 0.05, 2e-3);
+  // Standing still is standing; beyond the range is the nearest usable.
+  c = r.command_for({0.0, 0.0});
+  EXPECT_EQ(c.speed_m_s, 0.0);
+  c = r.command_for({1.0, 0.0});
+  EXPECT_LE(c.speed_m_s, r.max_speed());
+  // The fastest the table achieves: 0.21 m/s, at 0.2 m/s turning 0.1 rad/s.
+  EXPECT_NEAR(r.achieved(c).speed_m_s, 0.21, 1e-3);
+}
+
+TEST(WalkResponse, LoadsTheGaitAndItsCalibration) {
+  const std::string gait =
+      "name: w\nstride_frequency_hz: 1\ncurves: {c: \"sin(2*PI*t)\"}\nlimbs: {l: 0, r: 0.5}\n"
+      "joints: {a: {curve: c, limb: l}}\n";
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string plain = (dir / "plain.yaml").string();
+  const std::string steer = (dir / "steer.yaml").string();
+  std::filesystem::remove(calibration_path_for(steer));
+  std::ofstream(plain) << gait;
+  EXPECT_THROW(load_walk_response(plain), InputError);
+  std::ofstream(steer) << gait
+                       << "steering: {min_froude: 0.05, max_froude: 0.1, max_turn_dps: 10,"
+                          " max_acceleration_m_s2: 0.2, hip_height_m: 0.2,"
+                          " track_width_m: 0.2, sides: {left: [l], right: [r]}}\n";
+  const WalkResponse uncalibrated = load_walk_response(steer);
+  EXPECT_DOUBLE_EQ(uncalibrated.min_speed(), 0.05 * std::sqrt(9.81 * 0.2));
+  write_gait_calibration(calibration_path_for(steer), table());
+  const WalkResponse calibrated = load_walk_response(steer);
+  EXPECT_EQ(calibrated.min_speed(), 0.1);
+  EXPECT_NEAR(calibrated.max_turn(0.1), deg_to_rad(10.0), 1e-12);  // capped by the steering
+}
+
+}  // namespace
+}  // namespace animrt

@@ -1,0 +1,104 @@
+// The shipped walk, steered on the MuJoCo quadruped: a mid-range straight
+// command achieves its speed, standing stays put, and validate checks the
+// steering range.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/controllers/gait/walk_response.hpp"
+#include "animrt/core/input_file.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/sim/mujoco/mujoco_walk.hpp"
+
+namespace animrt {
+namespace {
+
+const std::string kRoot = ANIMRT_SOURCE_DIR;
+const std::string kWalk = kRoot + "/configs/gaits/walk.yaml";
+const std::string kModel = kRoot + "/configs/models/quadruped.xml";
+
+struct Walk {
+  GaitFile gait = load_gait_file(kWalk);
+  sim::MujocoModel model = sim::load_mujoco_model(kModel);
+
+  sim::WalkTrace walk(const MotionCommand& command, double measure_strides) {
+    const auto specs = sim::model_joint_specs(model);
+    auto source = make_gait_source(gait, specs);
+    const GaitSteering& st = *gait.steering;
+    const double fr = command.speed_m_s / std::sqrt(kStandardGravity * st.hip_height_m);
+    const double stride_s =
+        1.0 / froude_stride_frequency(fr > 0 ? fr : st.min_froude, st.hip_height_m);
+    sim::WalkTrial trial;
+    trial.warmup_s = command.speed_m_s / st.max_acceleration_m_s2 + 3.0 * stride_s;
+    trial.measure_s = measure_strides * stride_s;
+    return sim::walk_command(model, *source, command, trial);
+  }
+};
+
+TEST(GaitCalibrate, MidRangeStraightCommandAchievesItsSpeed) {
+  Walk w;
+  ASSERT_TRUE(w.gait.steering.has_value());
+  const GaitSteering& st = *w.gait.steering;
+  const double v = 0.5 * (st.min_speed_m_s() + st.max_speed_m_s());
+  const sim::WalkTrace trace = w.walk({v, 0.0}, 4.0);
+  ASSERT_FALSE(trace.fell);
+  EXPECT_NEAR(trace.achieved.speed_m_s, v, 0.15 * v);
+  EXPECT_FALSE(trace.samples.empty());
+}
+
+TEST(GaitCalibrate, StandingCommandStaysPut) {
+  Walk w;
+  const sim::WalkTrace trace = w.walk({0.0, 0.0}, 2.0);
+  ASSERT_FALSE(trace.fell);
+  ASSERT_FALSE(trace.samples.empty());
+  const auto& first = trace.samples.front();
+  const auto& last = trace.samples.back();
+  EXPECT_LT(std::hypot(last.x - first.x, last.y - first.y), 0.005);
+  EXPECT_LT(std::abs(trace.achieved.speed_m_s), 0.002);
+}
+
+TEST(GaitCalibrate, ShippedCalibrationIsUsableOverTheStraightRange) {
+  const GaitCalibration cal = load_gait_calibration(calibration_path_for(kWalk));
+  const WalkResponse response = load_walk_response(kWalk);
+  int straight = 0;
+  for (const CalibrationPoint& p : cal.points) {
+    if (p.commanded.turn_rad_s != 0.0) continue;
+    ++straight;
+    EXPECT_TRUE(p.usable) << p.commanded.speed_m_s;
+  }
+  EXPECT_GE(straight, 2);
+  EXPECT_GT(response.max_speed(), response.min_speed());
+}
+
+TEST(GaitCalibrate, ValidateRefusesASteeringRangeBeyondTheJointLimits) {
+  // The walk with a range whose strides swing the joints past their limits.
+  std::string gait = read_input_file(kWalk);
+  gait = std::regex_replace(gait, std::regex("max_froude: [0-9.]+"), "max_froude: 2.0");
+  const auto dir = std::filesystem::temp_directory_path();
+  std::ofstream(dir / "wide.yaml") << gait;
+  std::string robot = read_input_file(kRoot + "/configs/robots/quadruped.yaml");
+  robot = std::regex_replace(robot, std::regex("file: \\.\\./gaits/walk\\.yaml"),
+                             "file: " + (dir / "wide.yaml").string());
+  std::ofstream(dir / "robot.yaml") << robot;
+  try {
+    (void)load_robot((dir / "robot.yaml").string());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("motion.file"), std::string::npos) << what;
+    EXPECT_NE(what.find("outside its limits"), std::string::npos) << what;
+    EXPECT_NE(what.find("steered: speed"), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace animrt
