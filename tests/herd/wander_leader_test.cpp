@@ -64,6 +64,20 @@ TEST(WanderLeader, ReachesGoalsAndStaysNearTheRectangle) {
   EXPECT_GT(w.goals_drawn(), 20);
 }
 
+TEST(WanderLeader, DrawsANewGoalExactlyWhenWithinReach) {
+  WanderLeader w(params(), {4.0, 0.0}, 0.0, 21);
+  for (int k = 0; k < 5000; ++k) {
+    const Vec2 goal = w.goal();
+    const int drawn = w.goals_drawn();
+    w.step(0.1);
+    const bool reached = norm(goal - w.position()) <= params().reach_m;
+    ASSERT_EQ(w.goals_drawn(), drawn + (reached ? 1 : 0)) << "step " << k;
+    if (!reached) {
+      ASSERT_EQ(w.goal(), goal);
+    }
+  }
+}
+
 TEST(WanderLeader, IsDeterministicForASeed) {
   WanderLeader a(params(), {0, 0}, 0.0, 9), b(params(), {0, 0}, 0.0, 9),
       c(params(), {0, 0}, 0.0, 10);
