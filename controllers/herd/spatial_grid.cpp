@@ -1,0 +1,102 @@
+#include "animrt/controllers/herd/spatial_grid.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace animrt::herd {
+
+namespace {
+
+// Table of at least 2n buckets, a power of two.
+std::size_t table_size(std::size_t n) {
+  std::size_t t = 16;
+  while (t < 2 * n) t *= 2;
+  return t;
+}
+
+std::int64_t coord(double v) {
+  const double lim = static_cast<double>(kGridCoordLimit);
+  return static_cast<std::int64_t>(std::floor(std::clamp(v, -lim, lim)));
+}
+
+}  // namespace
+
+void SpatialGrid::reserve(std::size_t n) {
+  pos_.reserve(n);
+  cell_idx_.reserve(n);
+  sorted_.reserve(n);
+  sorted_cell_.reserve(n);
+  sorted_pos_.reserve(n);
+  start_.reserve(table_size(n) + 1);
+}
+
+SpatialGrid::Cell SpatialGrid::cell_of(Vec2 p) const {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y)) return {kGridCoordLimit + 1, kGridCoordLimit + 1};
+  return {coord(p.x / cell_), coord(p.y / cell_)};
+}
+
+std::size_t SpatialGrid::bucket_of(Cell c) const {
+  // Two large odd multipliers mix the coordinates; the table size is a
+  // power of two, so the high bits are folded down before masking.
+  std::uint64_t h = static_cast<std::uint64_t>(c.x) * 0x9E3779B97F4A7C15ull ^
+                    static_cast<std::uint64_t>(c.y) * 0xC2B2AE3D27D4EB4Full;
+  h ^= h >> 29;
+  return static_cast<std::size_t>(h) & mask_;
+}
+
+void SpatialGrid::build(std::span<const Vec2> points, double cell_size) {
+  if (!(cell_size > 0.0) || !std::isfinite(cell_size))
+    throw std::invalid_argument("SpatialGrid: cell size must be positive and finite");
+  cell_ = cell_size;
+  pos_.assign(points.begin(), points.end());
+  sort_into_buckets();
+}
+
+void SpatialGrid::build(std::span<const Agent> agents, double cell_size) {
+  if (!(cell_size > 0.0) || !std::isfinite(cell_size))
+    throw std::invalid_argument("SpatialGrid: cell size must be positive and finite");
+  cell_ = cell_size;
+  pos_.resize(agents.size());
+  for (std::size_t i = 0; i < agents.size(); ++i) pos_[i] = agents[i].position;
+  sort_into_buckets();
+}
+
+void SpatialGrid::sort_into_buckets() {
+  const std::size_t n = pos_.size();
+  const std::size_t t = table_size(n);
+  mask_ = t - 1;
+  cell_idx_.resize(n);
+  start_.assign(t + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    cell_idx_[i] = cell_of(pos_[i]);
+    ++start_[bucket_of(cell_idx_[i]) + 1];
+  }
+  for (std::size_t b = 0; b < t; ++b) start_[b + 1] += start_[b];
+  sorted_.resize(n);
+  sorted_cell_.resize(n);
+  sorted_pos_.resize(n);
+  // Fill each bucket in index order: start_[b] walks forward while filling,
+  // and ends where bucket b+1 began, so it is shifted back afterwards.
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t k = start_[bucket_of(cell_idx_[i])]++;
+    sorted_[k] = static_cast<int>(i);
+    sorted_cell_[k] = cell_idx_[i];
+    sorted_pos_[k] = pos_[i];
+  }
+  for (std::size_t b = t; b > 0; --b) start_[b] = start_[b - 1];
+  start_[0] = 0;
+}
+
+std::size_t SpatialGrid::query(Vec2 p, double r, std::vector<int>& out) const {
+  out.clear();
+  for_each_within(p, r, [&](int j, double) { out.push_back(j); });
+  return out.size();
+}
+
+std::size_t SpatialGrid::query_near(int i, double r, std::vector<int>& out) const {
+  out.clear();
+  for_each_near(i, r, [&](int j, double) { out.push_back(j); });
+  return out.size();
+}
+
+}  // namespace animrt::herd

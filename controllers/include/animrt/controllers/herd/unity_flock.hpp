@@ -1,0 +1,86 @@
+#pragma once
+// The first flocking variant: the boid of Unity's old Tropical Paradise
+// sample, following a wandering controller point (the "origin").
+//
+// Per step and member, from the figures as they walk:
+//   v       the walked velocity, raised to min_speed (along the heading when
+//           the figure stands);
+//   avg     over every agent within follow_radius (d < follow_radius):
+//           separation (any group) closer than avoidance_radius,
+//             (1 - d/avoidance_radius) * avoidance_force along the way apart,
+//           alignment (own group only),
+//             the neighbour's unit velocity * d/follow_radius * follow_velocity,
+//           divided by the number of other members of the group;
+//   to_avg  toward the mean position of the other members (cohesion);
+//   origin  toward the leader, |origin| = d/to_origin_range * to_origin_force;
+//   push    a point of the unit disc * random_force, renewed after a random
+//           interval uniform in [0.5, 1.5] / random_freq;
+//   wanted  = v - v*dt + (push + origin + avg + unit(to_avg)*gravity) * dt;
+// and the desired velocity is v turned toward wanted by at most
+// turn_speed*dt (its length moved toward |wanted| by at most
+// max_length_delta), never slower than min_speed.
+//
+// Units: metres, seconds; the forces are accelerations (m/s^2), the speeds
+// m/s, turn_speed rad/s. The defaults are the text's, for birds in a Unity
+// scene; walking figures need much smaller ones (docs/herd.md).
+
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "animrt/controllers/herd/agent.hpp"
+#include "animrt/controllers/herd/boid.hpp"
+#include "animrt/controllers/herd/spatial_grid.hpp"
+#include "animrt/controllers/herd/wander_leader.hpp"
+
+namespace animrt::herd {
+
+struct UnityFlockParams {
+  double min_speed = 20.0;          // m/s
+  double turn_speed = 20.0;         // rad/s
+  double random_freq = 20.0;        // 1/s, mean rate of renewing the random push
+  double random_force = 20.0;       // m/s^2, radius of the random push's disc
+  double to_origin_force = 50.0;    // m/s^2 at to_origin_range from the leader
+  double to_origin_range = 100.0;   // m
+  double gravity = 2.0;             // m/s^2 toward the members' mean position
+  double avoidance_radius = 50.0;   // m
+  double avoidance_force = 20.0;    // m/s^2 at zero distance
+  double follow_velocity = 4.0;     // m/s^2 at follow_radius
+  double follow_radius = 40.0;      // m, neighbours farther than this are not seen
+  double max_length_delta = 100.0;  // m/s per step, RotateTowards' length limit (the text's 100)
+};
+
+// Throws std::invalid_argument for a negative or non-finite value, or a
+// non-positive to_origin_range.
+void validate(const UnityFlockParams& p);
+
+class UnityFlock : public GroupSteering {
+ public:
+  // `members` index the herd's agents; `seed` fixes the random pushes. Space
+  // for a herd of max(herd_capacity, max member + 1) agents is reserved, so
+  // steer() on such a herd does not allocate.
+  UnityFlock(std::vector<int> members, const UnityFlockParams& params, WanderLeader leader,
+             std::uint64_t seed, std::size_t herd_capacity = 0);
+
+  std::span<const int> members() const override { return members_; }
+  // Steers toward the leader as it stands at t, then moves the leader by dt.
+  void steer(double t, double dt, std::span<const Agent> agents, std::span<Vec2> desired) override;
+
+  const WanderLeader& leader() const { return leader_; }
+  const UnityFlockParams& params() const { return params_; }
+  void set_neighbour_search(NeighbourSearch s) { search_ = s; }
+
+ private:
+  std::vector<int> members_;
+  UnityFlockParams params_;
+  WanderLeader leader_;
+  std::mt19937_64 rng_;
+  NeighbourSearch search_ = NeighbourSearch::grid;
+  SpatialGrid grid_;
+  std::vector<Vec2> push_;            // per member
+  std::vector<double> next_renewal_;  // per member, s
+};
+
+}  // namespace animrt::herd
