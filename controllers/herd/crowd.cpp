@@ -46,6 +46,7 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   active_.assign(agents.size(), false);
   has_target_.assign(agents.size(), false);
   target_.assign(agents.size(), Vec2{});
+  synced_.assign(agents.size(), Vec2{});
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const double r = agents[i].radius + params_.avoidance_margin_m;
     dtCrowdAgentParams ap{};
@@ -70,8 +71,9 @@ void Crowd::make_active(int i, double max_speed) {
   ap.maxSpeed = static_cast<float>(max_speed);
   ap.maxAcceleration =
       static_cast<float>(max_speed * params_.figure_turn_rad_s * params_.accel_factor);
-  ap.updateFlags = DT_CROWD_ANTICIPATE_TURNS | DT_CROWD_OBSTACLE_AVOIDANCE | DT_CROWD_SEPARATION |
-                   DT_CROWD_OPTIMIZE_VIS | DT_CROWD_OPTIMIZE_TOPO;
+  ap.updateFlags = DT_CROWD_ANTICIPATE_TURNS | DT_CROWD_OBSTACLE_AVOIDANCE | DT_CROWD_OPTIMIZE_VIS |
+                   DT_CROWD_OPTIMIZE_TOPO;
+  if (params_.separation_weight > 0.0) ap.updateFlags |= DT_CROWD_SEPARATION;
   ap.obstacleAvoidanceType = 0;
   crowd_->updateAgentParameters(i, &ap);
   crowd_->resetMoveTarget(i);
@@ -138,14 +140,39 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
   stepped_ = true;
   last_t_ = t;
   world_.update(t, agents);
-  for (std::size_t i = 0; i < agents.size(); ++i) sync(static_cast<int>(i), agents[i]);
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    sync(static_cast<int>(i), agents[i]);
+    synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
+  }
   crowd_->update(static_cast<float>(dt), nullptr);
+  dt_ = dt;
 }
 
 Vec2 Crowd::planned_velocity(int i) const {
   const dtCrowdAgent* ag = crowd_->getAgent(i);
-  if (ag->state != DT_CROWDAGENT_STATE_WALKING) return {};
-  return NavWorld::from_recast(ag->vel);
+  if (ag->state != DT_CROWDAGENT_STATE_WALKING || !(dt_ > 0.0)) return {};
+  // The step the crowd took, collision resolution included: overlapping
+  // agents are pushed apart by position, not by velocity, and that push
+  // is lost unless the figures walk it.
+  Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
+  const Vec2 want = NavWorld::from_recast(ag->dvel);
+  if (!params_.unstick || norm(v) >= 0.2 * norm(want)) return v;
+  // Stalled: agents resting exactly at contact make every sampled velocity
+  // look like a collision but standing still, so they would never move
+  // again. Follow the path instead, less any part that closes on a
+  // neighbour in contact: the agent slides along them.
+  v = want;
+  const Vec2 p = synced_[static_cast<std::size_t>(i)];
+  for (int k = 0; k < ag->nneis; ++k) {
+    const dtCrowdAgent* nb = crowd_->getAgent(ag->neis[k].idx);
+    const Vec2 q = NavWorld::from_recast(nb->npos);
+    const double contact = ag->params.radius + nb->params.radius + 0.05;
+    if (norm(p - q) > contact) continue;
+    const Vec2 n = normalized(p - q);
+    const double in = dot(v, n);
+    if (in < 0.0) v -= n * in;
+  }
+  return v;
 }
 
 CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<int> members,
@@ -169,11 +196,12 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   }
   state_.assign(members_.size(), State::kTravelling);
   slot_of_.assign(members_.size(), -1);
+  candidate_.assign(members_.size(), -1);
   make_slots(rmax + crowd_.params().avoidance_margin_m);
 }
 
 void CrowdGroup::make_slots(double radius) {
-  const double s = params_.slot_spacing_m > 0.0 ? params_.slot_spacing_m : 2 * radius + 0.1;
+  const double s = params_.slot_spacing_m > 0.0 ? params_.slot_spacing_m : 2 * radius + 0.3;
   const NavWorld& w = crowd_.world();
   const Vec2 t = params_.target;
   // Hexagonal lattice around the target, nearest first; ties broken by
@@ -192,7 +220,7 @@ void CrowdGroup::make_slots(double radius) {
            std::atan2(b.second.y - t.y, b.second.x - t.x);
   });
   for (const auto& [d, q] : cand) {
-    if (slots_.size() >= members_.size()) break;
+    if (slots_.size() >= 3 * members_.size()) break;
     if (!w.on_mesh(q, 0.01) || w.in_wall(q, radius)) continue;
     bool under_obstacle = false;
     for (const MovingObstacle& m : w.config().moving) {
@@ -207,8 +235,32 @@ void CrowdGroup::make_slots(double radius) {
     slots_.push_back(q);
   }
   slot_taken_.assign(slots_.size(), false);
+  frontier_.assign(slots_.size(), false);
+  if (!frontier_.empty()) frontier_[0] = true;
+  neighbours_.assign(slots_.size(), {});
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    for (std::size_t j = 0; j < slots_.size(); ++j) {
+      if (i != j && norm(slots_[i] - slots_[j]) < 1.1 * s)
+        neighbours_[i].push_back(static_cast<int>(j));
+    }
+  }
+  spacing_ = s;
   const double extent = slots_.empty() ? 0.0 : norm(slots_.back() - t);
   assign_distance_ = params_.assign_distance_m > 0.0 ? params_.assign_distance_m : extent + 2 * s;
+}
+
+bool CrowdGroup::reachable(Vec2 from, std::size_t slot) const {
+  // The straight walk from `from` to the slot keeps clear of every taken
+  // slot (but the slot's neighbours may be grazed at the very end).
+  const Vec2 to = slots_[slot];
+  const Vec2 d = to - from;
+  const double len2 = norm2(d);
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (!slot_taken_[s]) continue;
+    const double u = len2 > 0.0 ? std::clamp(dot(slots_[s] - from, d) / len2, 0.0, 1.0) : 0.0;
+    if (norm(from + d * u - slots_[s]) < 0.7 * spacing_) return false;
+  }
+  return true;
 }
 
 std::size_t CrowdGroup::arrived_count() const {
@@ -217,35 +269,87 @@ std::size_t CrowdGroup::arrived_count() const {
 
 void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
                        std::span<Vec2> desired) {
+  // The gathering grows from the target outward: a travelling member near
+  // the target heads for a free slot at the gathering's edge (next to a
+  // taken slot, or the slot at the target) that it can walk to in a
+  // straight line past the taken ones, nearest the target first and then
+  // on its own side; it takes the slot once it is next to it. Arrivals so
+  // settle on the side they come from and never walk through the members
+  // already standing, and no slot is held by a member that cannot reach it.
   const Vec2 target = params_.target;
   for (std::size_t k = 0; k < members_.size(); ++k) {
+    if (state_[k] != State::kTravelling) continue;
     const int m = members_[k];
     const Vec2 p = agents[static_cast<std::size_t>(m)].position;
-    if (state_[k] == State::kTravelling && norm(p - target) < assign_distance_) {
-      // Inside out: the free slot nearest the target, and among those the
-      // one on this member's side, so arrivals do not walk through the
-      // members already standing.
-      int best = -1;
-      double best_cost = std::numeric_limits<double>::infinity();
+    if (norm(p - target) > assign_distance_) continue;
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
+    for (std::size_t s = 0; s < slots_.size(); ++s) {
+      if (slot_taken_[s] || !frontier_[s] || !reachable(p, s)) continue;
+      const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
+      if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = static_cast<int>(s);
+      }
+    }
+    if (best < 0) {
+      // Nothing reachable in a straight line: the best edge slot anyway,
+      // never the target itself, which a slot holder may be heading for.
       for (std::size_t s = 0; s < slots_.size(); ++s) {
-        if (slot_taken_[s]) continue;
+        if (slot_taken_[s] || !frontier_[s]) continue;
         const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
+        if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
         if (cost < best_cost) {
           best_cost = cost;
           best = static_cast<int>(s);
         }
       }
-      if (best >= 0) {
-        slot_taken_[static_cast<std::size_t>(best)] = true;
-        slot_of_[k] = best;
-        state_[k] = State::kToSlot;
-        crowd_.request_target(m, slots_[static_cast<std::size_t>(best)]);
+    }
+    if (kept_cost > best_cost + 0.3 * spacing_) {  // hysteresis: no flapping between equals
+      candidate_[k] = best;
+      crowd_.request_target(m, best >= 0 ? slots_[static_cast<std::size_t>(best)] : target);
+    }
+    const int c = candidate_[k];
+    if (c >= 0 && norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
+      const auto b = static_cast<std::size_t>(c);
+      slot_taken_[b] = true;
+      for (int n : neighbours_[b]) frontier_[static_cast<std::size_t>(n)] = true;
+      slot_of_[k] = c;
+      state_[k] = State::kToSlot;
+      for (std::size_t j = 0; j < members_.size(); ++j) {
+        if (j != k && candidate_[j] == c) candidate_[j] = -1;
       }
     }
+  }
+  // A travelling member standing on a slot whose holder has not arrived
+  // takes it over, and the holder looks again: otherwise each waits for
+  // the other.
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    if (state_[k] != State::kTravelling) continue;
+    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
+    for (std::size_t j = 0; j < members_.size(); ++j) {
+      if (state_[j] != State::kToSlot) continue;
+      const Vec2 slot = slots_[static_cast<std::size_t>(slot_of_[j])];
+      const Vec2 q = agents[static_cast<std::size_t>(members_[j])].position;
+      if (norm(p - slot) < 0.5 * spacing_ && norm(p - slot) < norm(q - slot)) {
+        slot_of_[k] = slot_of_[j];
+        state_[k] = State::kToSlot;
+        crowd_.request_target(members_[k], slot);
+        slot_of_[j] = -1;
+        candidate_[j] = -1;
+        state_[j] = State::kTravelling;
+        crowd_.request_target(members_[j], target);
+        break;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
     if (state_[k] == State::kToSlot &&
         norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) < params_.arrive_tolerance_m) {
       state_[k] = State::kArrived;
-      crowd_.stop(m);
+      crowd_.stop(members_[k]);
     }
   }
   crowd_.step(t, dt, agents);

@@ -91,21 +91,27 @@ struct CrossingResult {
 };
 
 inline CrossingResult run_crossing(double vlo, double vhi, bool moving_obstacle, int per_team,
-                                   std::uint64_t seed, double t_max) {
+                                   std::uint64_t seed, double t_max, CrowdParams params = {},
+                                   double slot_spacing = 0.0) {
   NavWorld world(crossing_world(moving_obstacle));
   std::vector<Agent> agents;
   std::mt19937_64 rng(seed);
   const double r = 0.25;
   spawn(agents, per_team, {-18, -8, -14, 8}, r, 0.8, 0.0, 0, rng);
   spawn(agents, per_team, {14, -8, 18, 8}, r, 0.8, M_PI, 1, rng);
-  Crowd crowd(world, agents);
+  Crowd crowd(world, agents, params);
   std::vector<int> red, blue;
   for (int i = 0; i < per_team; ++i) {
     red.push_back(i);
     blue.push_back(per_team + i);
   }
-  CrowdGroup g_red(crowd, agents, red, {{16, 0}, vlo, vhi, seed * 2 + 1});
-  CrowdGroup g_blue(crowd, agents, blue, {{-16, 0}, vlo, vhi, seed * 2 + 2});
+  CrowdGroupParams pr{{16, 0}, vlo, vhi, seed * 2 + 1};
+  pr.slot_spacing_m = slot_spacing;
+  CrowdGroupParams pb = pr;
+  pb.target = {-16, 0};
+  pb.seed = seed * 2 + 2;
+  CrowdGroup g_red(crowd, agents, red, pr);
+  CrowdGroup g_blue(crowd, agents, blue, pb);
   std::vector<double> vmax(agents.size());
   std::vector<double> ideal(agents.size());
   std::vector<double> arrival(agents.size(), -1.0);

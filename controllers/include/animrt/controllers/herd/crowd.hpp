@@ -32,8 +32,14 @@ struct CrowdParams {
   // so the plan stays one the figures can follow.
   double figure_turn_rad_s = 0.6;
   double accel_factor = 2.0;
-  double separation_weight = 2.0;
+  // Separation pushes members apart over the whole collision query range
+  // (12 radii): in a packed start it drives the outer ones away from their
+  // goal, so it is off unless asked for; avoidance keeps them apart.
+  double separation_weight = 0.0;
   double avoidance_horizon_s = 4.0;  // how far ahead avoidance looks
+  // A member the avoidance holds still while its path leads on follows the
+  // path, sliding along neighbours in contact (see planned_velocity).
+  bool unstick = false;
 };
 
 class CrowdGroup;
@@ -71,6 +77,8 @@ class Crowd {
   std::vector<bool> active_;
   std::vector<bool> has_target_;
   std::vector<Vec2> target_;
+  std::vector<Vec2> synced_;  // each agent's position before the last crowd update
+  double dt_ = 0.0;
   double last_t_ = -1e300;
   bool stepped_ = false;
 };
@@ -81,11 +89,10 @@ struct CrowdGroupParams {
   double speed_max_mps = 0.25;
   std::uint64_t seed = 1;
   // Arrival slots around the target, packed this far apart; 0: two
-  // avoidance radii plus 0.1 m.
+  // avoidance radii plus 0.3 m (room to walk in between).
   double slot_spacing_m = 0.0;
-  // A member within this distance of the target is given the free slot
-  // that is nearest the target (inside out) and then nearest itself; 0:
-  // the slots' extent plus two spacings.
+  // Members within this distance of the target (0: the slots' extent plus
+  // two spacings) head for a free slot at the edge of the gathering.
   double assign_distance_m = 0.0;
   double arrive_tolerance_m = 0.12;  // a member this close to its slot has arrived
 };
@@ -104,22 +111,29 @@ class CrowdGroup final : public GroupSteering {
   double max_speed(std::size_t k) const { return max_speed_[k]; }
   bool arrived(std::size_t k) const { return state_[k] == State::kArrived; }
   std::size_t arrived_count() const;
+  // The member's slot in slots(), or -1 while it has none.
+  int slot_index(std::size_t k) const { return slot_of_[k]; }
   std::span<const Vec2> slots() const { return slots_; }
   Vec2 target() const { return params_.target; }
 
  private:
   enum class State { kTravelling, kToSlot, kArrived };
   void make_slots(double radius);
+  bool reachable(Vec2 from, std::size_t slot) const;
 
   Crowd& crowd_;
   std::vector<int> members_;
   CrowdGroupParams params_;
   std::vector<double> max_speed_;
   std::vector<State> state_;
-  std::vector<int> slot_of_;  // per member, -1 while travelling
-  std::vector<Vec2> slots_;   // sorted by distance from the target
+  std::vector<int> slot_of_;    // per member, -1 while travelling
+  std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
+  std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
+  std::vector<bool> frontier_;  // free slots that may be taken next
+  std::vector<std::vector<int>> neighbours_;
   double assign_distance_ = 0.0;
+  double spacing_ = 0.0;
 };
 
 }  // namespace animrt::herd
