@@ -1,0 +1,363 @@
+#include "animrt/controllers/herd/crowd.hpp"
+
+#include <DetourCommon.h>
+#include <DetourCrowd.h>
+#include <DetourNavMeshQuery.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+namespace animrt::herd {
+namespace {
+
+constexpr double kPassiveSpeed =
+    10.0;  // passive agents are moved by velocity requests, never limited
+constexpr double kResnapDistance = 0.5;  // a figure this far from its crowd agent is placed afresh
+
+// A uniform draw in [0, 1) from the top 53 bits: the same numbers on every
+// standard library, unlike std::uniform_real_distribution.
+double unit(std::mt19937_64& rng) {
+  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
+}
+
+}  // namespace
+
+Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
+    : world_(world), params_(params) {
+  if (static_cast<int>(agents.size()) > params_.max_agents) {
+    throw std::invalid_argument("crowd: more agents than max_agents");
+  }
+  double rmax = 0.0;
+  for (const Agent& a : agents) rmax = std::max(rmax, a.radius);
+  crowd_ = dtAllocCrowd();
+  if (!crowd_ ||
+      !crowd_->init(params_.max_agents, static_cast<float>(rmax + params_.avoidance_margin_m),
+                    world_.navmesh())) {
+    throw std::runtime_error("crowd: could not initialise the Detour crowd");
+  }
+  dtObstacleAvoidanceParams oa = *crowd_->getObstacleAvoidanceParams(0);
+  oa.horizTime = static_cast<float>(params_.avoidance_horizon_s);
+  crowd_->setObstacleAvoidanceParams(0, &oa);
+  *crowd_->getEditableFilter(0) = world_.filter();
+
+  active_.assign(agents.size(), false);
+  has_target_.assign(agents.size(), false);
+  target_.assign(agents.size(), Vec2{});
+  synced_.assign(agents.size(), Vec2{});
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const double r = agents[i].radius + params_.avoidance_margin_m;
+    dtCrowdAgentParams ap{};
+    ap.radius = static_cast<float>(r);
+    ap.height = 1.0f;
+    ap.maxAcceleration = 100.0f;
+    ap.maxSpeed = static_cast<float>(kPassiveSpeed);
+    ap.collisionQueryRange = static_cast<float>(12 * r);
+    ap.pathOptimizationRange = static_cast<float>(30 * r);
+    ap.separationWeight = static_cast<float>(params_.separation_weight);
+    ap.updateFlags = 0;
+    const auto p = NavWorld::to_recast(agents[i].position);
+    const int idx = crowd_->addAgent(p.data(), &ap);
+    if (idx != static_cast<int>(i)) throw std::runtime_error("crowd: could not add an agent");
+  }
+}
+
+Crowd::~Crowd() { dtFreeCrowd(crowd_); }
+
+void Crowd::make_active(int i, double max_speed) {
+  dtCrowdAgentParams ap = crowd_->getAgent(i)->params;
+  ap.maxSpeed = static_cast<float>(max_speed);
+  ap.maxAcceleration =
+      static_cast<float>(max_speed * params_.figure_turn_rad_s * params_.accel_factor);
+  ap.updateFlags = DT_CROWD_ANTICIPATE_TURNS | DT_CROWD_OBSTACLE_AVOIDANCE | DT_CROWD_OPTIMIZE_VIS |
+                   DT_CROWD_OPTIMIZE_TOPO;
+  if (params_.separation_weight > 0.0) ap.updateFlags |= DT_CROWD_SEPARATION;
+  ap.obstacleAvoidanceType = 0;
+  crowd_->updateAgentParameters(i, &ap);
+  crowd_->resetMoveTarget(i);
+  active_[static_cast<std::size_t>(i)] = true;
+}
+
+bool Crowd::request_target(int i, Vec2 target) {
+  const auto p = NavWorld::to_recast(target);
+  const float ext[3] = {1.0f, 2.0f, 1.0f};
+  dtPolyRef ref = 0;
+  float nearest[3];
+  world_.query()->findNearestPoly(p.data(), ext, &world_.filter(), &ref, nearest);
+  has_target_[static_cast<std::size_t>(i)] = true;
+  target_[static_cast<std::size_t>(i)] = target;
+  return ref && crowd_->requestMoveTarget(i, ref, nearest);
+}
+
+void Crowd::stop(int i) {
+  crowd_->resetMoveTarget(i);
+  has_target_[static_cast<std::size_t>(i)] = false;
+}
+
+void Crowd::sync(int i, const Agent& a) {
+  dtCrowdAgent* ag = crowd_->getEditableAgent(i);
+  const auto p = NavWorld::to_recast(a.position);
+  dtNavMeshQuery* q = world_.query();
+  const dtQueryFilter* f = &world_.filter();
+  bool placed =
+      ag->state == DT_CROWDAGENT_STATE_WALKING && q->isValidPolyRef(ag->corridor.getFirstPoly(), f);
+  if (placed) {
+    // Slide along the mesh from where the crowd put the agent to where the
+    // figure really is: the corridor stays valid and the agent stays on the
+    // mesh even when the figure has strayed a little off it.
+    ag->corridor.movePosition(p.data(), q, f);
+    dtVcopy(ag->npos, ag->corridor.getPos());
+    const float dx = ag->npos[0] - p[0], dz = ag->npos[2] - p[2];
+    placed = dx * dx + dz * dz <= kResnapDistance * kResnapDistance;
+  }
+  if (!placed) {
+    const float ext[3] = {1.0f, 2.0f, 1.0f};
+    dtPolyRef ref = 0;
+    float nearest[3];
+    q->findNearestPoly(p.data(), ext, f, &ref, nearest);
+    if (!ref) {
+      ag->state = DT_CROWDAGENT_STATE_INVALID;
+      return;
+    }
+    ag->corridor.reset(ref, nearest);
+    ag->boundary.reset();
+    ag->state = DT_CROWDAGENT_STATE_WALKING;
+    dtVcopy(ag->npos, nearest);
+    if (active_[static_cast<std::size_t>(i)] && has_target_[static_cast<std::size_t>(i)]) {
+      request_target(i, target_[static_cast<std::size_t>(i)]);
+    }
+  }
+  const auto v = NavWorld::to_recast(a.velocity());
+  dtVcopy(ag->vel, v.data());
+  if (!active_[static_cast<std::size_t>(i)]) crowd_->requestMoveVelocity(i, v.data());
+}
+
+void Crowd::step(double t, double dt, std::span<const Agent> agents) {
+  if (stepped_ && t == last_t_) return;
+  if (agents.size() != active_.size()) throw std::invalid_argument("crowd: the herd changed size");
+  stepped_ = true;
+  last_t_ = t;
+  world_.update(t, agents);
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    sync(static_cast<int>(i), agents[i]);
+    synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
+  }
+  crowd_->update(static_cast<float>(dt), nullptr);
+  dt_ = dt;
+}
+
+Vec2 Crowd::planned_velocity(int i) const {
+  const dtCrowdAgent* ag = crowd_->getAgent(i);
+  if (ag->state != DT_CROWDAGENT_STATE_WALKING || !(dt_ > 0.0)) return {};
+  // The step the crowd took, collision resolution included: overlapping
+  // agents are pushed apart by position, not by velocity, and that push
+  // is lost unless the figures walk it.
+  Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
+  const Vec2 want = NavWorld::from_recast(ag->dvel);
+  if (!params_.unstick || norm(v) >= 0.2 * norm(want)) return v;
+  // Stalled: agents resting exactly at contact make every sampled velocity
+  // look like a collision but standing still, so they would never move
+  // again. Follow the path instead, less any part that closes on a
+  // neighbour in contact: the agent slides along them.
+  v = want;
+  const Vec2 p = synced_[static_cast<std::size_t>(i)];
+  for (int k = 0; k < ag->nneis; ++k) {
+    const dtCrowdAgent* nb = crowd_->getAgent(ag->neis[k].idx);
+    const Vec2 q = NavWorld::from_recast(nb->npos);
+    const double contact = ag->params.radius + nb->params.radius + 0.05;
+    if (norm(p - q) > contact) continue;
+    const Vec2 n = normalized(p - q);
+    const double in = dot(v, n);
+    if (in < 0.0) v -= n * in;
+  }
+  return v;
+}
+
+CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<int> members,
+                       CrowdGroupParams params)
+    : crowd_(crowd), members_(std::move(members)), params_(params) {
+  if (!(params_.speed_min_mps > 0.0 && params_.speed_max_mps >= params_.speed_min_mps)) {
+    throw std::invalid_argument("crowd group: speeds must satisfy 0 < min <= max");
+  }
+  std::mt19937_64 rng(params_.seed);
+  double rmax = 0.0;
+  for (int m : members_) {
+    if (m < 0 || static_cast<std::size_t>(m) >= agents.size()) {
+      throw std::invalid_argument("crowd group: member index out of range");
+    }
+    const double v =
+        params_.speed_min_mps + (params_.speed_max_mps - params_.speed_min_mps) * unit(rng);
+    max_speed_.push_back(v);
+    rmax = std::max(rmax, agents[static_cast<std::size_t>(m)].radius);
+    crowd_.make_active(m, v);
+    crowd_.request_target(m, params_.target);
+  }
+  state_.assign(members_.size(), State::kTravelling);
+  slot_of_.assign(members_.size(), -1);
+  candidate_.assign(members_.size(), -1);
+  make_slots(rmax + crowd_.params().avoidance_margin_m);
+}
+
+void CrowdGroup::make_slots(double radius) {
+  const double s = params_.slot_spacing_m > 0.0 ? params_.slot_spacing_m : 2 * radius + 0.3;
+  const NavWorld& w = crowd_.world();
+  const Vec2 t = params_.target;
+  // Hexagonal lattice around the target, nearest first; ties broken by
+  // angle so the order never depends on floating-point noise in sorting.
+  std::vector<std::pair<double, Vec2>> cand;
+  const int n = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(members_.size())))) + 3;
+  for (int j = -n; j <= n; ++j) {
+    for (int i = -n; i <= n; ++i) {
+      const Vec2 q = t + Vec2{(i + 0.5 * j) * s, j * s * std::sqrt(3.0) / 2};
+      cand.push_back({norm(q - t), q});
+    }
+  }
+  std::sort(cand.begin(), cand.end(), [&](const auto& a, const auto& b) {
+    if (std::abs(a.first - b.first) > 1e-9) return a.first < b.first;
+    return std::atan2(a.second.y - t.y, a.second.x - t.x) <
+           std::atan2(b.second.y - t.y, b.second.x - t.x);
+  });
+  for (const auto& [d, q] : cand) {
+    if (slots_.size() >= 3 * members_.size()) break;
+    if (!w.on_mesh(q, 0.01) || w.in_wall(q, radius)) continue;
+    bool under_obstacle = false;
+    for (const MovingObstacle& m : w.config().moving) {
+      if (NavWorld::distance_to_box(q, m.footprint) < radius + w.config().agent_radius_m)
+        under_obstacle = true;
+    }
+    if (under_obstacle) continue;
+    // Only slots reached from the target roughly in a straight line: not
+    // behind a wall.
+    const auto len = w.path_length(t, q);
+    if (!len || *len > d + s) continue;
+    slots_.push_back(q);
+  }
+  slot_taken_.assign(slots_.size(), false);
+  frontier_.assign(slots_.size(), false);
+  if (!frontier_.empty()) frontier_[0] = true;
+  neighbours_.assign(slots_.size(), {});
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    for (std::size_t j = 0; j < slots_.size(); ++j) {
+      if (i != j && norm(slots_[i] - slots_[j]) < 1.1 * s)
+        neighbours_[i].push_back(static_cast<int>(j));
+    }
+  }
+  spacing_ = s;
+  const double extent = slots_.empty() ? 0.0 : norm(slots_.back() - t);
+  assign_distance_ = params_.assign_distance_m > 0.0 ? params_.assign_distance_m : extent + 2 * s;
+}
+
+bool CrowdGroup::reachable(Vec2 from, std::size_t slot) const {
+  // The straight walk from `from` to the slot keeps clear of every taken
+  // slot (but the slot's neighbours may be grazed at the very end).
+  const Vec2 to = slots_[slot];
+  const Vec2 d = to - from;
+  const double len2 = norm2(d);
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (!slot_taken_[s]) continue;
+    const double u = len2 > 0.0 ? std::clamp(dot(slots_[s] - from, d) / len2, 0.0, 1.0) : 0.0;
+    if (norm(from + d * u - slots_[s]) < 0.7 * spacing_) return false;
+  }
+  return true;
+}
+
+std::size_t CrowdGroup::arrived_count() const {
+  return static_cast<std::size_t>(std::count(state_.begin(), state_.end(), State::kArrived));
+}
+
+void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
+                       std::span<Vec2> desired) {
+  // The gathering grows from the target outward: a travelling member near
+  // the target heads for a free slot at the gathering's edge (next to a
+  // taken slot, or the slot at the target) that it can walk to in a
+  // straight line past the taken ones, nearest the target first and then
+  // on its own side; it takes the slot once it is next to it. Arrivals so
+  // settle on the side they come from and never walk through the members
+  // already standing, and no slot is held by a member that cannot reach it.
+  const Vec2 target = params_.target;
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    if (state_[k] != State::kTravelling) continue;
+    const int m = members_[k];
+    const Vec2 p = agents[static_cast<std::size_t>(m)].position;
+    if (norm(p - target) > assign_distance_) continue;
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
+    for (std::size_t s = 0; s < slots_.size(); ++s) {
+      if (slot_taken_[s] || !frontier_[s] || !reachable(p, s)) continue;
+      const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
+      if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = static_cast<int>(s);
+      }
+    }
+    if (best < 0) {
+      // Nothing reachable in a straight line: the best edge slot anyway,
+      // never the target itself, which a slot holder may be heading for.
+      for (std::size_t s = 0; s < slots_.size(); ++s) {
+        if (slot_taken_[s] || !frontier_[s]) continue;
+        const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
+        if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
+        if (cost < best_cost) {
+          best_cost = cost;
+          best = static_cast<int>(s);
+        }
+      }
+    }
+    if (kept_cost > best_cost + 0.3 * spacing_) {  // hysteresis: no flapping between equals
+      candidate_[k] = best;
+      crowd_.request_target(m, best >= 0 ? slots_[static_cast<std::size_t>(best)] : target);
+    }
+    const int c = candidate_[k];
+    if (c >= 0 && norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
+      const auto b = static_cast<std::size_t>(c);
+      slot_taken_[b] = true;
+      for (int n : neighbours_[b]) frontier_[static_cast<std::size_t>(n)] = true;
+      slot_of_[k] = c;
+      state_[k] = State::kToSlot;
+      for (std::size_t j = 0; j < members_.size(); ++j) {
+        if (j != k && candidate_[j] == c) candidate_[j] = -1;
+      }
+    }
+  }
+  // A travelling member standing on a slot whose holder has not arrived
+  // takes it over, and the holder looks again: otherwise each waits for
+  // the other.
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    if (state_[k] != State::kTravelling) continue;
+    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
+    for (std::size_t j = 0; j < members_.size(); ++j) {
+      if (state_[j] != State::kToSlot) continue;
+      const Vec2 slot = slots_[static_cast<std::size_t>(slot_of_[j])];
+      const Vec2 q = agents[static_cast<std::size_t>(members_[j])].position;
+      if (norm(p - slot) < 0.5 * spacing_ && norm(p - slot) < norm(q - slot)) {
+        slot_of_[k] = slot_of_[j];
+        state_[k] = State::kToSlot;
+        crowd_.request_target(members_[k], slot);
+        slot_of_[j] = -1;
+        candidate_[j] = -1;
+        state_[j] = State::kTravelling;
+        crowd_.request_target(members_[j], target);
+        break;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
+    if (state_[k] == State::kToSlot &&
+        norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) < params_.arrive_tolerance_m) {
+      state_[k] = State::kArrived;
+      crowd_.stop(members_[k]);
+    }
+  }
+  crowd_.step(t, dt, agents);
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    const int m = members_[k];
+    desired[static_cast<std::size_t>(m)] =
+        state_[k] == State::kArrived ? Vec2{} : crowd_.planned_velocity(m);
+  }
+}
+
+}  // namespace animrt::herd

@@ -1,0 +1,139 @@
+#pragma once
+// Navigation-mesh crowds: one Detour crowd shared by every crowd group of a
+// herd, so teams avoid each other, and the groups that walk in it.
+//
+// The herd moves its figures itself, by what their gaits achieve, so each
+// step the crowd is first told where every figure really is and how fast it
+// really moves (each crowd agent is slid along the mesh to the figure's
+// position), then plans one step, and the planned velocities go back to the
+// herd as desired velocities. Figures of other groups (flocks, the embodied
+// robot) are passive crowd agents: crowd members avoid them, nothing steers
+// them.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "animrt/controllers/herd/agent.hpp"
+#include "animrt/controllers/herd/nav_world.hpp"
+
+class dtCrowd;
+
+namespace animrt::herd {
+
+struct CrowdParams {
+  int max_agents = 1024;
+  // Added to every figure's radius for avoidance, so figures that lag
+  // behind the plan (gait response, turn limits) still keep apart.
+  double avoidance_margin_m = 0.1;
+  // The figures' turn-rate limit; the crowd's acceleration is limited to
+  // what such a figure can do at its top speed (max_speed * turn * accel_factor),
+  // so the plan stays one the figures can follow.
+  double figure_turn_rad_s = 0.6;
+  double accel_factor = 2.0;
+  // Separation pushes members apart over the whole collision query range
+  // (12 radii): in a packed start it drives the outer ones away from their
+  // goal, so it is off unless asked for; avoidance keeps them apart.
+  double separation_weight = 0.0;
+  double avoidance_horizon_s = 4.0;  // how far ahead avoidance looks
+  // A member the avoidance holds still while its path leads on follows the
+  // path, sliding along neighbours in contact (see planned_velocity).
+  bool unstick = false;
+};
+
+class CrowdGroup;
+
+class Crowd {
+ public:
+  // Registers every agent of the herd (all passive until a CrowdGroup
+  // claims its members). `world` must outlive the crowd.
+  Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params = {});
+  ~Crowd();
+  Crowd(const Crowd&) = delete;
+  Crowd& operator=(const Crowd&) = delete;
+
+  // Advances the world's obstacles and the crowd by one step: syncs every
+  // agent's position and velocity into the crowd, then plans. Called by
+  // each group's steer(); only the first call for a given t does the work.
+  void step(double t, double dt, std::span<const Agent> agents);
+
+  NavWorld& world() { return world_; }
+  const CrowdParams& params() const { return params_; }
+  dtCrowd* native() { return crowd_; }
+  std::size_t agent_count() const { return active_.size(); }
+
+ private:
+  friend class CrowdGroup;
+  void sync(int i, const Agent& a);
+  void make_active(int i, double max_speed);
+  bool request_target(int i, Vec2 target);
+  void stop(int i);
+  Vec2 planned_velocity(int i) const;
+
+  NavWorld& world_;
+  CrowdParams params_;
+  dtCrowd* crowd_ = nullptr;
+  std::vector<bool> active_;
+  std::vector<bool> has_target_;
+  std::vector<Vec2> target_;
+  std::vector<Vec2> synced_;  // each agent's position before the last crowd update
+  double dt_ = 0.0;
+  double last_t_ = -1e300;
+  bool stepped_ = false;
+};
+
+struct CrowdGroupParams {
+  Vec2 target;
+  double speed_min_mps = 0.15;  // each member's top speed is drawn from [min, max]
+  double speed_max_mps = 0.25;
+  std::uint64_t seed = 1;
+  // Arrival slots around the target, packed this far apart; 0: two
+  // avoidance radii plus 0.3 m (room to walk in between).
+  double slot_spacing_m = 0.0;
+  // Members within this distance of the target (0: the slots' extent plus
+  // two spacings) head for a free slot at the edge of the gathering.
+  double assign_distance_m = 0.0;
+  double arrive_tolerance_m = 0.12;  // a member this close to its slot has arrived
+};
+
+class CrowdGroup final : public GroupSteering {
+ public:
+  // `members` index the herd's agents (as given to the crowd); the crowd
+  // must outlive the group.
+  CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<int> members,
+             CrowdGroupParams params);
+
+  std::span<const int> members() const override { return members_; }
+  void steer(double t, double dt, std::span<const Agent> agents, std::span<Vec2> desired) override;
+
+  // Per member k (position in members()).
+  double max_speed(std::size_t k) const { return max_speed_[k]; }
+  bool arrived(std::size_t k) const { return state_[k] == State::kArrived; }
+  std::size_t arrived_count() const;
+  // The member's slot in slots(), or -1 while it has none.
+  int slot_index(std::size_t k) const { return slot_of_[k]; }
+  std::span<const Vec2> slots() const { return slots_; }
+  Vec2 target() const { return params_.target; }
+
+ private:
+  enum class State { kTravelling, kToSlot, kArrived };
+  void make_slots(double radius);
+  bool reachable(Vec2 from, std::size_t slot) const;
+
+  Crowd& crowd_;
+  std::vector<int> members_;
+  CrowdGroupParams params_;
+  std::vector<double> max_speed_;
+  std::vector<State> state_;
+  std::vector<int> slot_of_;    // per member, -1 while travelling
+  std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
+  std::vector<Vec2> slots_;     // sorted by distance from the target
+  std::vector<bool> slot_taken_;
+  std::vector<bool> frontier_;  // free slots that may be taken next
+  std::vector<std::vector<int>> neighbours_;
+  double assign_distance_ = 0.0;
+  double spacing_ = 0.0;
+};
+
+}  // namespace animrt::herd
