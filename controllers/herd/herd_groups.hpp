@@ -17,7 +17,8 @@ bool overlaps_box(const Box& box, Vec2 p, double radius);
 // obstacles), or null when no group needs one and nothing moves.
 std::unique_ptr<NavWorld> make_nav_world(const HerdScene& scene, double max_radius);
 
-// One group per scene group, over `members` (agent indices per group).
+// One group per scene group, over `members` (agent indices per group); the
+// crowd every crowd group shares is made in `crowd` (it must outlive them).
 // Throws InputError at the scene's locations (unknown parameters, a target
 // with no path from the spawn area).
 std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
@@ -25,6 +26,6 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                                                     std::span<const Agent> agents,
                                                     const std::vector<Figure>& figures,
                                                     const std::vector<int>& figure_of, NavWorld* nav,
-                                                    std::mt19937_64& rng);
+                                                    std::unique_ptr<Crowd>& crowd);
 
 }  // namespace animrt::herd

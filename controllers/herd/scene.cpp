@@ -74,7 +74,7 @@ GroupKind kind_of(const YamlNode& node) {
 }
 
 LeaderSpec leader(const YamlNode& node, const Rect& bounds) {
-  node.allow_only({"wander_m", "speed_mps", "reach_m"});
+  node.allow_only({"wander_m", "speed_mps", "reach_m", "turn_gain", "max_turn_dps"});
   LeaderSpec l;
   l.where = node.location();
   const YamlNode w = node.at("wander_m");
@@ -82,6 +82,8 @@ LeaderSpec leader(const YamlNode& node, const Rect& bounds) {
   if (!inside(bounds, l.wander_m)) w.fail("the wander area must lie inside bounds_m");
   if (auto s = node.find("speed_mps")) l.speed_mps = s->as_double_in(0.001, 10.0);
   if (auto r = node.find("reach_m")) l.reach_m = r->as_double_in(0.01, 100.0);
+  if (auto g = node.find("turn_gain")) l.turn_gain = g->as_double_in(0.001, 100.0);
+  if (auto m = node.find("max_turn_dps")) l.max_turn_rad_s = m->as_double_in(0.01, 36000.0) * std::numbers::pi / 180;
   return l;
 }
 
@@ -170,7 +172,7 @@ HerdScene parse_herd_scene(const YamlNode& root) {
     for (const YamlNode& o : obstacles->items()) {
       o.allow_only({"center_m", "size_m", "yaw_deg", "period_s", "down_fraction", "phase_s"});
       MovingObstacle m;
-      m.where = o.location();
+      scene.obstacle_where.push_back(o.location());
       m.footprint = box(o);
       if (auto p = o.find("period_s")) m.period_s = p->as_double_in(0.1, 1e6);
       if (auto d = o.find("down_fraction")) m.down_fraction = d->as_double_in(0.0, 1.0);

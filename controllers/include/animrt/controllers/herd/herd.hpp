@@ -21,6 +21,7 @@
 namespace animrt::herd {
 
 class NavWorld;
+class Crowd;
 
 // What the herd needs of a group beyond its steering.
 class HerdGroup {
@@ -85,6 +86,7 @@ class Herd {
   std::vector<MotionCommand> commands_;
   std::vector<char> embodied_;
   std::unique_ptr<NavWorld> nav_;
+  std::unique_ptr<Crowd> crowd_;  // shared by the crowd groups, outlives them
   std::vector<std::unique_ptr<HerdGroup>> groups_;
   std::unique_ptr<MetricsRecorder> recorder_;
   std::vector<std::optional<Vec2>> leaders_scratch_;

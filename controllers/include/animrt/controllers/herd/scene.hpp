@@ -10,18 +10,11 @@
 #include <vector>
 
 #include "animrt/controllers/herd/agent.hpp"
+#include "animrt/controllers/herd/nav_world.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt::herd {
-
-struct MovingObstacle {
-  Box footprint;
-  double period_s = 8.0;
-  double down_fraction = 0.5;  // carves the mesh for this part of each period
-  double phase_s = 0.0;        // offset into the period at t = 0
-  Location where;
-};
 
 struct FigureSpec {
   std::string name;
@@ -37,6 +30,8 @@ struct LeaderSpec {
   Rect wander_m;         // the leader picks its points inside this rectangle
   double speed_mps = 0.1;
   double reach_m = 1.0;  // a point this close counts as reached
+  double turn_gain = 1.0;  // 1/s: how fast it turns toward its point (per second, of the angle)
+  double max_turn_rad_s = 1e9;
   Location where;
 };
 
@@ -62,6 +57,7 @@ struct HerdScene {
   std::vector<Box> walls;
   std::vector<Location> wall_where;
   std::vector<MovingObstacle> moving_obstacles;
+  std::vector<Location> obstacle_where;
   std::string geometry_obj;  // extra static geometry (OBJ), "" for none
   std::vector<FigureSpec> figures;
   std::vector<GroupSpec> groups;

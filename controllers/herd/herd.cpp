@@ -1,0 +1,189 @@
+#include "animrt/controllers/herd/herd.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "animrt/controllers/herd/crowd.hpp"
+#include "animrt/controllers/herd/nav_world.hpp"
+#include "herd_groups.hpp"
+
+namespace animrt::herd {
+namespace {
+
+// Closest point of a box to p, and whether p is inside it.
+Vec2 closest_on_box(const Box& box, Vec2 p, bool& inside) {
+  const Vec2 ax = heading_vector(box.yaw_rad);
+  const Vec2 ay{-ax.y, ax.x};
+  const Vec2 d = p - box.center;
+  const double u = dot(d, ax), v = dot(d, ay);
+  const double hu = box.size.x / 2, hv = box.size.y / 2;
+  inside = std::abs(u) <= hu && std::abs(v) <= hv;
+  if (inside) {
+    // Out through the nearest side.
+    if (hu - std::abs(u) < hv - std::abs(v)) {
+      return box.center + ax * std::copysign(hu, u) + ay * v;
+    }
+    return box.center + ax * u + ay * std::copysign(hv, v);
+  }
+  return box.center + ax * std::clamp(u, -hu, hu) + ay * std::clamp(v, -hv, hv);
+}
+
+}  // namespace
+
+bool overlaps_box(const Box& box, Vec2 p, double radius) {
+  bool inside = false;
+  const Vec2 c = closest_on_box(box, p, inside);
+  return inside || norm(p - c) < radius;
+}
+
+Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std::uint64_t> seed)
+    : scene_(std::move(scene)) {
+  if (seed) scene_.seed = *seed;
+  for (const FigureSpec& spec : scene_.figures) {
+    const std::string gait = spec.gait.empty() ? gait_of_robot(spec.robot) : spec.gait;
+    figures_.push_back(Figure{spec.name, spec.radius_m, load_walk_response(gait)});
+  }
+  double max_radius = 0.0;
+  for (const Figure& f : figures_) max_radius = std::max(max_radius, f.radius_m);
+  nav_ = make_nav_world(scene_, max_radius);
+
+  std::mt19937_64 rng(scene_.seed);
+  std::vector<GroupInfo> infos;
+  std::vector<std::vector<int>> members(scene_.groups.size());
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const GroupSpec& spec = scene_.groups[g];
+    int figure = 0;
+    while (figures_[static_cast<std::size_t>(figure)].name != spec.figure) ++figure;
+    const double r = figures_[static_cast<std::size_t>(figure)].radius_m;
+    std::uniform_real_distribution<double> ux(spec.spawn_m.xmin, spec.spawn_m.xmax);
+    std::uniform_real_distribution<double> uy(spec.spawn_m.ymin, spec.spawn_m.ymax);
+    for (int k = 0; k < spec.count; ++k) {
+      // Rejection sampling: apart from every figure placed so far (a margin
+      // of a tenth of a radius) and clear of walls.
+      Agent a;
+      a.radius = r;
+      a.group = static_cast<int>(g);
+      bool placed = false;
+      for (int attempt = 0; attempt < 10000 && !placed; ++attempt) {
+        a.position = {ux(rng), uy(rng)};
+        placed = true;
+        for (const Agent& b : agents_) {
+          if (norm(b.position - a.position) < 1.1 * (a.radius + b.radius)) {
+            placed = false;
+            break;
+          }
+        }
+        for (const Box& w : scene_.walls) placed = placed && !overlaps_box(w, a.position, r);
+        if (placed && nav_ && spec.kind == GroupKind::crowd) placed = nav_->on_mesh(a.position);
+      }
+      if (!placed) {
+        throw InputError(spec.spawn_where, "groups." + spec.name + ".spawn_m",
+                         "the spawn area has no room for " + std::to_string(spec.count) +
+                             " figures of radius " + format_number(r) +
+                             " m clear of each other and of the walls");
+      }
+      const Vec2 aim = spec.target_m ? *spec.target_m
+                                     : (spec.leader ? spec.leader->wander_m.center() : scene_.bounds_m.center());
+      a.heading = std::atan2(aim.y - a.position.y, aim.x - a.position.x);
+      members[g].push_back(static_cast<int>(agents_.size()));
+      agents_.push_back(a);
+      figure_of_.push_back(figure);
+      names_.push_back(spec.name + "." + std::to_string(k));
+    }
+  }
+  const std::size_t n = agents_.size();
+  desired_.assign(n, Vec2{});
+  commands_.assign(n, MotionCommand{});
+  embodied_.assign(n, 0);
+  leaders_scratch_.assign(scene_.groups.size(), std::nullopt);
+  arrived_scratch_.assign(n, 0);
+  max_speed_scratch_.assign(n, 0.0);
+  groups_ = make_groups(scene_, members, agents_, figures_, figure_of_, nav_.get(), crowd_);
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const GroupSpec& spec = scene_.groups[g];
+    infos.push_back(GroupInfo{spec.name,
+                              spec.kind == GroupKind::crowd   ? "crowd"
+                              : spec.kind == GroupKind::unity ? "unity"
+                                                              : "reynolds",
+                              members[g], spec.target_m});
+  }
+  // Flocks form in the first quarter of the run; order counts after it.
+  recorder_ = std::make_unique<MetricsRecorder>(infos, agents_, scene_.duration_s / 4);
+}
+
+Herd::~Herd() = default;
+
+int Herd::find_agent(const std::string& name) const {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());
+}
+
+std::optional<Vec2> Herd::leader(int group) const { return groups_[static_cast<std::size_t>(group)]->leader(); }
+
+bool Herd::arrived(int agent) const {
+  const int g = agents_[static_cast<std::size_t>(agent)].group;
+  return groups_[static_cast<std::size_t>(g)]->arrived(agent);
+}
+
+void Herd::keep_out_of_walls(Agent& agent) const {
+  const auto push_out = [&](const Box& box) {
+    bool inside = false;
+    const Vec2 c = closest_on_box(box, agent.position, inside);
+    const Vec2 away = inside ? c - agent.position : agent.position - c;
+    const double d = norm(away);
+    if (inside || d < agent.radius) {
+      const Vec2 dir = d > 1e-12 ? away / d : heading_vector(agent.heading + M_PI);
+      agent.position = c + dir * agent.radius;
+    }
+  };
+  for (const Box& w : scene_.walls) push_out(w);
+  if (nav_) {
+    for (std::size_t k = 0; k < scene_.moving_obstacles.size(); ++k) {
+      if (nav_->obstacle_down(k)) push_out(scene_.moving_obstacles[k].footprint);
+    }
+  }
+  const Rect& b = scene_.bounds_m;
+  agent.position.x = std::clamp(agent.position.x, b.xmin + agent.radius, b.xmax - agent.radius);
+  agent.position.y = std::clamp(agent.position.y, b.ymin + agent.radius, b.ymax - agent.radius);
+}
+
+void Herd::step() {
+  const double dt = scene_.step_s;
+  // The crowd moves the obstacles itself (before it plans); without one,
+  // the herd does.
+  if (nav_ && !crowd_) nav_->update(t_, agents_);
+  for (auto& g : groups_) g->steering().steer(t_, dt, agents_, desired_);
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    const Figure& figure = figures_[static_cast<std::size_t>(figure_of_[i])];
+    commands_[i] = steer_figure(figure, agents_[i], desired_[i], dt);
+    if (embodied_[i]) continue;
+    walk_figure(figure, commands_[i], dt, agents_[i]);
+    // Flocks have no navigation mesh: a wall or a lowered obstacle stops a
+    // figure at its surface (crowds steer around them before).
+    keep_out_of_walls(agents_[i]);
+  }
+  t_ += dt;
+}
+
+void Herd::embody(int agent) { embodied_[static_cast<std::size_t>(agent)] = 1; }
+
+void Herd::set_pose(int agent, Vec2 position, double heading, double speed, double turn) {
+  Agent& a = agents_[static_cast<std::size_t>(agent)];
+  a.position = position;
+  a.heading = heading;
+  a.speed = speed;
+  a.turn = turn;
+}
+
+void Herd::record_metrics() {
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) leaders_scratch_[g] = groups_[g]->leader();
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    const auto& group = *groups_[static_cast<std::size_t>(agents_[i].group)];
+    arrived_scratch_[i] = group.arrived(static_cast<int>(i)) ? 1 : 0;
+    max_speed_scratch_[i] = group.max_speed(static_cast<int>(i));
+  }
+  recorder_->sample(t_, agents_, leaders_scratch_, arrived_scratch_, max_speed_scratch_);
+}
+
+}  // namespace animrt::herd
