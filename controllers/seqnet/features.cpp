@@ -1,5 +1,7 @@
 #include "animrt/controllers/seqnet/features.hpp"
 
+#include "animrt/controllers/seqnet/reconstruction.hpp"
+
 #include <algorithm>
 #include <queue>
 #include <stdexcept>
@@ -76,7 +78,8 @@ FeatureFrame FeatureScale::denormalise(const FeatureFrame& normalised) const {
   return out;
 }
 
-SequenceFeatures compute_features(const MeshSequence& sequence, int first, int count) {
+SequenceFeatures compute_features(const MeshSequence& sequence, int first, int count,
+                                  bool exact_round_trip) {
   if (sequence.frames.empty()) throw std::invalid_argument("compute_features: no frames");
   if (count == 0) count = sequence.frame_count() - first;
   if (first < 0 || count < 1 || first + count > sequence.frame_count()) {
@@ -85,12 +88,14 @@ SequenceFeatures compute_features(const MeshSequence& sequence, int first, int c
   SequenceFeatures out;
   out.rest = sequence.frames.front();
   out.triangles = sequence.triangles;
-  const Neighbourhood ring = build_neighbourhood(out.rest, out.triangles);
+  const Reconstructor solver(out.rest, out.triangles);
+  const Neighbourhood& ring = solver.neighbourhood();
   FeatureFrame previous = FeatureFrame::Zero(kFeatureDims, out.rest.cols());
   std::vector<FeatureFrame> raw;
   raw.reserve(static_cast<std::size_t>(count));
   for (int f = first; f < first + count; ++f) {
-    const auto gradients = deformation_gradients(ring, out.triangles, out.rest, sequence.frames[f]);
+    auto gradients = deformation_gradients(ring, out.triangles, out.rest, sequence.frames[f]);
+    if (exact_round_trip) gradients = solver.exact_gradients(gradients, sequence.frames[f]);
     raw.push_back(features_from_gradients(gradients, ring, previous));
     previous = raw.back();
   }

@@ -90,6 +90,7 @@ MeshSequence read_md2(const std::string& file) {
   }
   out.clips = detail::clips_from_frame_names(names);
   detail::merge_coincident(out, std::vector<int>(static_cast<std::size_t>(num_xyz), 0));
+  detail::detach_non_manifold(out);
   detail::validate_mesh(out, file);
   return out;
 }

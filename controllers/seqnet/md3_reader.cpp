@@ -194,6 +194,7 @@ MeshSequence read_md3(const std::string& file) {
     at += static_cast<std::uint64_t>(ofs_end);
   }
   detail::merge_coincident(out, group);
+  detail::detach_non_manifold(out);
   detail::validate_mesh(out, file);
   const std::filesystem::path cfg = std::filesystem::path(file).parent_path() / "animation.cfg";
   out.clips = clips_from_cfg(cfg.string(), file, num_frames);

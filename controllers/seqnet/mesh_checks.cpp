@@ -1,5 +1,6 @@
 #include "mesh_checks.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -58,6 +59,35 @@ void merge_coincident(MeshSequence& sequence, const std::vector<int>& group) {
   for (auto& t : sequence.triangles) {
     for (int& corner : t) corner = new_index[representative[corner]];
   }
+}
+
+int detach_non_manifold(MeshSequence& sequence) {
+  std::map<std::pair<int, int>, int> edge_use;
+  int detached = 0;
+  for (auto& tri : sequence.triangles) {
+    bool over = false;
+    for (int k = 0; k < 3; ++k) {
+      const auto e = std::minmax(tri[k], tri[(k + 1) % 3]);
+      if (edge_use[{e.first, e.second}] >= 2) over = true;
+    }
+    if (!over) {
+      for (int k = 0; k < 3; ++k) {
+        const auto e = std::minmax(tri[k], tri[(k + 1) % 3]);
+        ++edge_use[{e.first, e.second}];
+      }
+      continue;
+    }
+    for (int& corner : tri) {
+      const int copy = sequence.vertex_count();
+      for (auto& frame : sequence.frames) {
+        frame.conservativeResize(3, copy + 1);
+        frame.col(copy) = frame.col(corner);
+      }
+      corner = copy;
+    }
+    ++detached;
+  }
+  return detached;
 }
 
 void validate_mesh(const MeshSequence& sequence, const std::string& file) {

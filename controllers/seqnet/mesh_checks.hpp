@@ -14,6 +14,12 @@ namespace animrt::seqnet::detail {
 // renumbered; vertices keep the order of their first occurrence.
 void merge_coincident(MeshSequence& sequence, const std::vector<int>& group);
 
+// Game models carry a few edges shared by more than two triangles (fins,
+// overlapping parts). Every triangle beyond the second on such an edge gets
+// its own copies of its three vertices, so it becomes a piece of its own.
+// Returns the number of triangles detached.
+int detach_non_manifold(MeshSequence& sequence);
+
 // Throws InputError naming `file` and the frame for: no frames or no
 // triangles, frames of different sizes, a vertex index out of range, a
 // triangle that repeats a vertex or has zero area, an edge shared by more

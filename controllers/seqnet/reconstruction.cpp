@@ -7,6 +7,11 @@ namespace animrt::seqnet {
 
 struct Reconstructor::Factor {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  // b = B t per coordinate row t of the gradients (3 V entries), and the
+  // factor of B B^T for the minimal-norm correction.
+  Eigen::SparseMatrix<double> b;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> bbt;
+  bool bbt_ok = false;
 };
 
 Reconstructor::Reconstructor(const Positions& rest, const Triangles& triangles)
@@ -34,6 +39,30 @@ Reconstructor::Reconstructor(const Positions& rest, const Triangles& triangles)
       if (c >= 0) entries.emplace_back(r, c, -ring_.weights[k]);
     }
     entries.emplace_back(r, r, diagonal);
+  }
+  std::vector<Eigen::Triplet<double>> b_entries;
+  for (int i = 0; i < v; ++i) {
+    const int r = free_index_[i];
+    if (r < 0) continue;
+    for (int k = ring_.offsets[i]; k < ring_.offsets[i + 1]; ++k) {
+      const int j = ring_.neighbours[k];
+      const Eigen::Vector3d d = 0.5 * ring_.weights[k] * (rest_.col(i) - rest_.col(j));
+      for (int c = 0; c < 3; ++c) {
+        b_entries.emplace_back(r, 3 * i + c, d[c]);
+        b_entries.emplace_back(r, 3 * j + c, d[c]);
+      }
+    }
+  }
+  factor_->b.resize(free, 3 * v);
+  factor_->b.setFromTriplets(b_entries.begin(), b_entries.end());
+  if (free > 0) {
+    Eigen::SparseMatrix<double> bbt = factor_->b * Eigen::SparseMatrix<double>(factor_->b.transpose());
+    double trace = 0.0;
+    for (int k = 0; k < free; ++k) trace += bbt.coeff(k, k);
+    // A whisker of ridge keeps the factor defined if B loses rank.
+    for (int k = 0; k < free; ++k) bbt.coeffRef(k, k) += 1e-12 * trace / free;
+    factor_->bbt.compute(bbt);
+    factor_->bbt_ok = factor_->bbt.info() == Eigen::Success;
   }
   Eigen::SparseMatrix<double> laplacian(free, free);
   laplacian.setFromTriplets(entries.begin(), entries.end());
@@ -76,6 +105,33 @@ Positions Reconstructor::solve_gradients(const std::vector<Eigen::Matrix3d>& t) 
   for (int i = 0; i < v; ++i) {
     out.col(i) = free_index_[i] < 0 ? Eigen::Vector3d(rest_.col(i))
                                     : Eigen::Vector3d(solved.row(free_index_[i]).transpose());
+  }
+  return out;
+}
+
+std::vector<Eigen::Matrix3d> Reconstructor::exact_gradients(const std::vector<Eigen::Matrix3d>& fitted,
+                                                            const Positions& frame) const {
+  std::vector<Eigen::Matrix3d> out = fitted;
+  if (!factor_->bbt_ok) return out;
+  const int v = ring_.vertex_count;
+  const Eigen::Index free = factor_->b.rows();
+  for (int x = 0; x < 3; ++x) {
+    Eigen::VectorXd t(3 * v);
+    for (int i = 0; i < v; ++i) t.segment<3>(3 * i) = fitted[i].row(x).transpose();
+    Eigen::VectorXd target(free);
+    for (int i = 0; i < v; ++i) {
+      const int r = free_index_[i];
+      if (r < 0) continue;
+      double sum = 0.0;
+      for (int k = ring_.offsets[i]; k < ring_.offsets[i + 1]; ++k) {
+        sum += ring_.weights[k] * (frame(x, i) - frame(x, ring_.neighbours[k]));
+      }
+      target[r] = sum;
+    }
+    const Eigen::VectorXd residual = target - factor_->b * t;
+    const Eigen::VectorXd y = factor_->bbt.solve(residual);
+    const Eigen::VectorXd change = factor_->b.transpose() * y;
+    for (int i = 0; i < v; ++i) out[i].row(x) += change.segment<3>(3 * i).transpose();
   }
   return out;
 }

@@ -51,7 +51,11 @@ struct SequenceFeatures {
 };
 
 // Features of frames first .. first + count - 1 against frame 0 (the whole
-// sequence when count is 0), clips that lie inside that range kept.
-SequenceFeatures compute_features(const MeshSequence& sequence, int first = 0, int count = 0);
+// sequence when count is 0), clips that lie inside that range kept. With
+// exact_round_trip the fitted gradients get the minimal correction that
+// makes reconstruction give the frame back (Reconstructor::exact_gradients);
+// without it they are the plain per-vertex fits of the paper's Eq. 1.
+SequenceFeatures compute_features(const MeshSequence& sequence, int first = 0, int count = 0,
+                                  bool exact_round_trip = true);
 
 }  // namespace animrt::seqnet
