@@ -177,12 +177,13 @@ Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& v) {
 
 Eigen::Vector3d closest_equivalent(const Eigen::Vector3d& v, const Eigen::Vector3d& reference) {
   const double theta = v.norm();
-  if (theta < 1e-12) {
-    // The identity: 2 pi k about any axis; the reference's axis is closest.
+  if (theta < 1e-6) {
+    // (Nearly) the identity, whose axis is noise: 2 pi k about the
+    // reference's axis is the closest.
     const double len = reference.norm();
-    if (len < 1e-12) return Eigen::Vector3d::Zero();
+    if (len < 1e-12) return v;
     const double k = std::round(len / (2.0 * std::numbers::pi));
-    return reference / len * (2.0 * std::numbers::pi * k);
+    return v + reference / len * (2.0 * std::numbers::pi * k);
   }
   const Eigen::Vector3d axis = v / theta;
   // |phi axis - ref|^2 is smallest for phi nearest axis . ref.

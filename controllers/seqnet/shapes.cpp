@@ -2,6 +2,7 @@
 
 #include "animrt/controllers/seqnet/deformation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -46,7 +47,8 @@ MeshSequence make_twisting_bar(int rings, int around, double length, double tota
     const double progress = frames > 1 ? static_cast<double>(f) / (frames - 1) : 0.0;
     Positions p = rest;
     for (Eigen::Index i = 0; i < p.cols(); ++i) {
-      const double angle = total_angle * progress * rest(2, i) / length;
+      const double u = std::clamp((rest(2, i) / length - 0.25) / 0.5, 0.0, 1.0);
+      const double angle = total_angle * progress * u * u * (3.0 - 2.0 * u);
       const double c = std::cos(angle), s = std::sin(angle);
       p(0, i) = c * rest(0, i) - s * rest(1, i);
       p(1, i) = s * rest(0, i) + c * rest(1, i);
