@@ -35,7 +35,8 @@ void BM_FeaturesPerFrame(benchmark::State& state) {
   const Reconstructor solver(bar.frames[0], bar.triangles);
   const FeatureFrame previous = FeatureFrame::Zero(kFeatureDims, bar.vertex_count());
   for (auto _ : state) {
-    auto gradients = deformation_gradients(solver.neighbourhood(), bar.triangles, bar.frames[0], bar.frames[1]);
+    auto gradients =
+        deformation_gradients(solver.neighbourhood(), bar.triangles, bar.frames[0], bar.frames[1]);
     gradients = solver.exact_gradients(gradients, bar.frames[1]);
     FeatureFrame f = features_from_gradients(gradients, solver.neighbourhood(), previous);
     benchmark::DoNotOptimize(f.data());

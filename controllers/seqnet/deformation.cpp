@@ -103,7 +103,8 @@ Neighbourhood build_neighbourhood(const Positions& rest, const Triangles& triang
   return out;
 }
 
-std::vector<Eigen::Matrix3d> deformation_gradients(const Neighbourhood& ring, const Triangles& triangles,
+std::vector<Eigen::Matrix3d> deformation_gradients(const Neighbourhood& ring,
+                                                   const Triangles& triangles,
                                                    const Positions& rest, const Positions& frame) {
   // Flat rings: below this ratio of the smallest to the largest eigenvalue
   // of the template's weighted scatter, the normal direction is added.
@@ -132,7 +133,8 @@ std::vector<Eigen::Matrix3d> deformation_gradients(const Neighbourhood& ring, co
       const Eigen::Vector3d n = rest_normals.col(i);
       // Template normal goes to the frame normal, scaled like the ring's
       // edges (square root of the area change).
-      const double scale = ring.ring_area[i] > 0.0 ? std::sqrt(frame_area[i] / ring.ring_area[i]) : 1.0;
+      const double scale =
+          ring.ring_area[i] > 0.0 ? std::sqrt(frame_area[i] / ring.ring_area[i]) : 1.0;
       const Eigen::Vector3d m = frame_normals.col(i) * scale;
       a.noalias() += extra * n * n.transpose();
       b.noalias() += extra * m * n.transpose();

@@ -37,8 +37,8 @@ struct Reader {
     return v;
   }
   double f64_unchecked() {
-    const std::uint64_t bits = static_cast<std::uint64_t>(in.u32(at)) |
-                               static_cast<std::uint64_t>(in.u32(at + 4)) << 32;
+    const std::uint64_t bits =
+        static_cast<std::uint64_t>(in.u32(at)) | static_cast<std::uint64_t>(in.u32(at + 4)) << 32;
     at += 8;
     double v;
     std::memcpy(&v, &bits, sizeof v);
@@ -77,7 +77,8 @@ void write_feature_file(const std::string& file, const SequenceFeatures& f) {
   w.u32(static_cast<std::uint32_t>(crc32(0L, w.bytes.data(), static_cast<uInt>(w.bytes.size()))));
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error(file + ": cannot write");
-  out.write(reinterpret_cast<const char*>(w.bytes.data()), static_cast<std::streamsize>(w.bytes.size()));
+  out.write(reinterpret_cast<const char*>(w.bytes.data()),
+            static_cast<std::streamsize>(w.bytes.size()));
   if (!out) throw std::runtime_error(file + ": write failed");
 }
 
@@ -103,11 +104,13 @@ SequenceFeatures read_feature_file(const std::string& file) {
   if (dims != kFeatureDims) {
     detail::fail(file, "header", std::to_string(dims) + " numbers per vertex, expected 9");
   }
-  if (v == 0 || t == 0 || n == 0) detail::fail(file, "header", "empty vertex, triangle or frame count");
+  if (v == 0 || t == 0 || n == 0)
+    detail::fail(file, "header", "empty vertex, triangle or frame count");
   // The checksum covers everything before its own 4 bytes.
   if (bytes.size() < 36) detail::fail(file, "checksum", "file is truncated");
   const std::uint32_t stored = in.u32(bytes.size() - 4);
-  const auto computed = static_cast<std::uint32_t>(crc32(0L, bytes.data(), static_cast<uInt>(bytes.size() - 4)));
+  const auto computed =
+      static_cast<std::uint32_t>(crc32(0L, bytes.data(), static_cast<uInt>(bytes.size() - 4)));
 
   SequenceFeatures out;
   in.need(r.at, v, 24, "header", "the template vertices");
@@ -140,7 +143,8 @@ SequenceFeatures read_feature_file(const std::string& file) {
     clip.count = in.i32(r.at + 4);
     r.at += 8;
     clip.fps = r.f64_unchecked();
-    if (clip.first < 0 || clip.count < 1 || static_cast<std::uint64_t>(clip.first) + static_cast<std::uint64_t>(clip.count) > n) {
+    if (clip.first < 0 || clip.count < 1 ||
+        static_cast<std::uint64_t>(clip.first) + static_cast<std::uint64_t>(clip.count) > n) {
       detail::fail(file, key, "frames out of range of the file's " + std::to_string(n) + " frames");
     }
     out.clips.push_back(clip);
@@ -153,8 +157,10 @@ SequenceFeatures read_feature_file(const std::string& file) {
   if (stored != computed) detail::fail(file, "checksum", "CRC-32 mismatch: the file is corrupt");
   out.scale.low.resize(kFeatureDims, v);
   out.scale.high.resize(kFeatureDims, v);
-  for (Eigen::Index i = 0; i < out.scale.low.size(); ++i) out.scale.low.data()[i] = r.f64_unchecked();
-  for (Eigen::Index i = 0; i < out.scale.high.size(); ++i) out.scale.high.data()[i] = r.f64_unchecked();
+  for (Eigen::Index i = 0; i < out.scale.low.size(); ++i)
+    out.scale.low.data()[i] = r.f64_unchecked();
+  for (Eigen::Index i = 0; i < out.scale.high.size(); ++i)
+    out.scale.high.data()[i] = r.f64_unchecked();
   if (!out.scale.low.allFinite() || !out.scale.high.allFinite() || !out.rest.allFinite()) {
     detail::fail(file, "header", "the template or the normalisation holds a non-finite number");
   }
@@ -162,7 +168,8 @@ SequenceFeatures read_feature_file(const std::string& file) {
   for (std::uint32_t f = 0; f < n; ++f) {
     FeatureFrame frame(kFeatureDims, v);
     for (Eigen::Index i = 0; i < frame.size(); ++i) frame.data()[i] = r.f64_unchecked();
-    if (!frame.allFinite()) detail::fail(file, "frame " + std::to_string(f), "a feature is not finite");
+    if (!frame.allFinite())
+      detail::fail(file, "frame " + std::to_string(f), "a feature is not finite");
     out.frames.push_back(std::move(frame));
   }
   return out;

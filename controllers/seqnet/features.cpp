@@ -1,10 +1,10 @@
 #include "animrt/controllers/seqnet/features.hpp"
 
-#include "animrt/controllers/seqnet/reconstruction.hpp"
-
 #include <algorithm>
 #include <queue>
 #include <stdexcept>
+
+#include "animrt/controllers/seqnet/reconstruction.hpp"
 
 namespace animrt::seqnet {
 

@@ -40,8 +40,9 @@ class ByteView {
             const std::string& what) const {
     const std::uint64_t n = bytes_.size();
     if (item != 0 && count > n / item) {
-      fail(file_, key, what + " (" + std::to_string(count) + " x " + std::to_string(item) +
-                           " bytes) is larger than the file (" + std::to_string(n) + " bytes)");
+      fail(file_, key,
+           what + " (" + std::to_string(count) + " x " + std::to_string(item) +
+               " bytes) is larger than the file (" + std::to_string(n) + " bytes)");
     }
     if (offset > n || count * item > n - offset) {
       fail(file_, key,
@@ -52,7 +53,8 @@ class ByteView {
 
   std::int32_t i32(std::uint64_t at) const { return static_cast<std::int32_t>(u32(at)); }
   std::uint32_t u32(std::uint64_t at) const {
-    return static_cast<std::uint32_t>(bytes_[at]) | static_cast<std::uint32_t>(bytes_[at + 1]) << 8 |
+    return static_cast<std::uint32_t>(bytes_[at]) |
+           static_cast<std::uint32_t>(bytes_[at + 1]) << 8 |
            static_cast<std::uint32_t>(bytes_[at + 2]) << 16 |
            static_cast<std::uint32_t>(bytes_[at + 3]) << 24;
   }

@@ -18,7 +18,8 @@ MeshSequence read_md2(const std::string& file) {
     detail::fail(file, "header", "not an MD2 file (magic is not IDP2)");
   }
   const std::int32_t version = in.i32(4);
-  if (version != 8) detail::fail(file, "header", "MD2 version " + std::to_string(version) + ", expected 8");
+  if (version != 8)
+    detail::fail(file, "header", "MD2 version " + std::to_string(version) + ", expected 8");
   const std::int32_t frame_size = in.i32(16);
   const std::int32_t num_xyz = in.i32(24);
   const std::int32_t num_st = in.i32(28);
@@ -28,14 +29,16 @@ MeshSequence read_md2(const std::string& file) {
   const std::int32_t ofs_frames = in.i32(56);
   auto positive = [&](std::int32_t value, const char* what) {
     if (value <= 0) {
-      detail::fail(file, "header", std::string(what) + " is " + std::to_string(value) + ", expected > 0");
+      detail::fail(file, "header",
+                   std::string(what) + " is " + std::to_string(value) + ", expected > 0");
     }
   };
   positive(num_xyz, "vertex count");
   positive(num_tris, "triangle count");
   positive(num_frames, "frame count");
   if (num_st < 0) detail::fail(file, "header", "texture coordinate count is negative");
-  if (ofs_tris < 68 || ofs_frames < 68) detail::fail(file, "header", "an offset points into the header");
+  if (ofs_tris < 68 || ofs_frames < 68)
+    detail::fail(file, "header", "an offset points into the header");
   const std::int64_t expected_frame = 40 + 4 * static_cast<std::int64_t>(num_xyz);
   if (frame_size != expected_frame) {
     detail::fail(file, "header",
@@ -52,7 +55,8 @@ MeshSequence read_md2(const std::string& file) {
   out.source = file;
   out.triangles.reserve(static_cast<std::size_t>(num_tris));
   for (std::int32_t t = 0; t < num_tris; ++t) {
-    const std::uint64_t at = static_cast<std::uint64_t>(ofs_tris) + 12u * static_cast<std::uint64_t>(t);
+    const std::uint64_t at =
+        static_cast<std::uint64_t>(ofs_tris) + 12u * static_cast<std::uint64_t>(t);
     std::array<int, 3> tri{};
     for (int k = 0; k < 3; ++k) {
       tri[k] = static_cast<std::uint16_t>(in.i16(at + 2u * static_cast<unsigned>(k)));
@@ -67,8 +71,8 @@ MeshSequence read_md2(const std::string& file) {
   std::vector<std::string> names;
   out.frames.reserve(static_cast<std::size_t>(num_frames));
   for (std::int32_t f = 0; f < num_frames; ++f) {
-    const std::uint64_t at =
-        static_cast<std::uint64_t>(ofs_frames) + static_cast<std::uint64_t>(frame_size) * static_cast<std::uint64_t>(f);
+    const std::uint64_t at = static_cast<std::uint64_t>(ofs_frames) +
+                             static_cast<std::uint64_t>(frame_size) * static_cast<std::uint64_t>(f);
     Eigen::Vector3d scale, translate;
     for (int k = 0; k < 3; ++k) {
       scale[k] = in.f32(at + 4u * static_cast<unsigned>(k));
@@ -82,7 +86,8 @@ MeshSequence read_md2(const std::string& file) {
     for (std::int32_t i = 0; i < num_xyz; ++i) {
       const std::uint64_t v = at + 40u + 4u * static_cast<std::uint64_t>(i);
       for (int k = 0; k < 3; ++k) {
-        frame(k, i) = static_cast<double>(in.u8(v + static_cast<unsigned>(k))) * scale[k] + translate[k];
+        frame(k, i) =
+            static_cast<double>(in.u8(v + static_cast<unsigned>(k))) * scale[k] + translate[k];
       }
       // Byte 3 is the index of a precomputed normal: not used.
     }

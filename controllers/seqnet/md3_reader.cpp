@@ -26,14 +26,15 @@ constexpr double kXyzScale = 1.0 / 64.0;
 // animation.cfg lines in the order the engine reads them (the last six are
 // Team Arena additions some configs carry).
 const char* const kAnimationNames[] = {
-    "BOTH_DEATH1",   "BOTH_DEAD1",       "BOTH_DEATH2",    "BOTH_DEAD2",    "BOTH_DEATH3",
-    "BOTH_DEAD3",    "TORSO_GESTURE",    "TORSO_ATTACK",   "TORSO_ATTACK2", "TORSO_DROP",
-    "TORSO_RAISE",   "TORSO_STAND",      "TORSO_STAND2",   "LEGS_WALKCR",   "LEGS_WALK",
-    "LEGS_RUN",      "LEGS_BACK",        "LEGS_SWIM",      "LEGS_JUMP",     "LEGS_LAND",
-    "LEGS_JUMPB",    "LEGS_LANDB",       "LEGS_IDLE",      "LEGS_IDLECR",   "LEGS_TURN",
-    "TORSO_GETFLAG", "TORSO_GUARDBASE",  "TORSO_PATROL",   "TORSO_FOLLOWME", "TORSO_AFFIRMATIVE",
+    "BOTH_DEATH1",   "BOTH_DEAD1",      "BOTH_DEATH2",  "BOTH_DEAD2",     "BOTH_DEATH3",
+    "BOTH_DEAD3",    "TORSO_GESTURE",   "TORSO_ATTACK", "TORSO_ATTACK2",  "TORSO_DROP",
+    "TORSO_RAISE",   "TORSO_STAND",     "TORSO_STAND2", "LEGS_WALKCR",    "LEGS_WALK",
+    "LEGS_RUN",      "LEGS_BACK",       "LEGS_SWIM",    "LEGS_JUMP",      "LEGS_LAND",
+    "LEGS_JUMPB",    "LEGS_LANDB",      "LEGS_IDLE",    "LEGS_IDLECR",    "LEGS_TURN",
+    "TORSO_GETFLAG", "TORSO_GUARDBASE", "TORSO_PATROL", "TORSO_FOLLOWME", "TORSO_AFFIRMATIVE",
     "TORSO_NEGATIVE"};
-constexpr int kAnimationCount = static_cast<int>(sizeof kAnimationNames / sizeof kAnimationNames[0]);
+constexpr int kAnimationCount =
+    static_cast<int>(sizeof kAnimationNames / sizeof kAnimationNames[0]);
 constexpr int kTorsoGesture = 6;
 constexpr int kLegsWalkCrouched = 13;
 constexpr int kLegsTurn = 24;
@@ -66,7 +67,8 @@ std::vector<Clip> clips_from_cfg(const std::string& cfg, const std::string& mode
     std::istringstream words(line);
     std::string first;
     if (!(words >> first)) continue;
-    if (!(std::isdigit(static_cast<unsigned char>(first[0])) || first[0] == '-')) continue;  // sex, footsteps, headoffset, ...
+    if (!(std::isdigit(static_cast<unsigned char>(first[0])) || first[0] == '-'))
+      continue;  // sex, footsteps, headoffset, ...
     std::istringstream numbers(line);
     CfgEntry e;
     int looping = 0;
@@ -92,16 +94,17 @@ std::vector<Clip> clips_from_cfg(const std::string& cfg, const std::string& mode
     if (lower && legs) e.first -= skip;
     if (e.first < 0 || e.count < 1 || e.first + e.count > frames) {
       throw InputError(Location{cfg, e.line, 1}, kAnimationNames[i],
-                       "frames " + std::to_string(e.first) + ".." + std::to_string(e.first + e.count - 1) +
-                           " are outside " + model + "'s " + std::to_string(frames) + " frames");
+                       "frames " + std::to_string(e.first) + ".." +
+                           std::to_string(e.first + e.count - 1) + " are outside " + model + "'s " +
+                           std::to_string(frames) + " frames");
     }
     clips.push_back(Clip{kAnimationNames[i], e.first, e.count, e.fps});
   }
   return clips;
 }
 
-void check_count(const std::string& file, const std::string& key, const char* what, std::int32_t value,
-                 std::int32_t low, std::int32_t high) {
+void check_count(const std::string& file, const std::string& key, const char* what,
+                 std::int32_t value, std::int32_t low, std::int32_t high) {
   if (value < low || value > high) {
     detail::fail(file, key,
                  std::string(what) + " is " + std::to_string(value) + ", expected " +
@@ -129,8 +132,8 @@ MeshSequence read_md3(const std::string& file) {
   check_count(file, "header", "tag count", num_tags, 0, kMaxTags);
   check_count(file, "header", "surface count", num_surfaces, 1, kMaxSurfaces);
   if (ofs_frames < 0 || ofs_surfaces < 0) detail::fail(file, "header", "negative offset");
-  in.need(static_cast<std::uint64_t>(ofs_frames), static_cast<std::uint64_t>(num_frames), 56, "header",
-          "the frames");
+  in.need(static_cast<std::uint64_t>(ofs_frames), static_cast<std::uint64_t>(num_frames), 56,
+          "header", "the frames");
 
   MeshSequence out;
   out.source = file;
@@ -165,7 +168,8 @@ MeshSequence read_md3(const std::string& file) {
     in.need(at, 1, static_cast<std::uint64_t>(ofs_end), key, "the surface");
     const int base = static_cast<int>(group.size());
     for (std::int32_t t = 0; t < tris; ++t) {
-      const std::uint64_t tat = at + static_cast<std::uint64_t>(ofs_tris) + 12u * static_cast<std::uint64_t>(t);
+      const std::uint64_t tat =
+          at + static_cast<std::uint64_t>(ofs_tris) + 12u * static_cast<std::uint64_t>(t);
       std::array<int, 3> tri{};
       for (int k = 0; k < 3; ++k) {
         const std::int32_t index = in.i32(tat + 4u * static_cast<unsigned>(k));
@@ -181,11 +185,14 @@ MeshSequence read_md3(const std::string& file) {
     for (std::int32_t f = 0; f < num_frames; ++f) {
       Positions& frame = out.frames[static_cast<std::size_t>(f)];
       frame.conservativeResize(3, base + verts);
-      const std::uint64_t fat = at + static_cast<std::uint64_t>(ofs_xyz) +
-                                8u * static_cast<std::uint64_t>(verts) * static_cast<std::uint64_t>(f);
+      const std::uint64_t fat =
+          at + static_cast<std::uint64_t>(ofs_xyz) +
+          8u * static_cast<std::uint64_t>(verts) * static_cast<std::uint64_t>(f);
       for (std::int32_t i = 0; i < verts; ++i) {
         for (int k = 0; k < 3; ++k) {
-          frame(k, base + i) = in.i16(fat + 8u * static_cast<std::uint64_t>(i) + 2u * static_cast<unsigned>(k)) * kXyzScale;
+          frame(k, base + i) =
+              in.i16(fat + 8u * static_cast<std::uint64_t>(i) + 2u * static_cast<unsigned>(k)) *
+              kXyzScale;
         }
         // Bytes 6..7: latitude/longitude of the normal, not used.
       }

@@ -98,7 +98,8 @@ MeshSequence parse_obj(const std::string& file) {
     // vt, vn, g, o, s, usemtl, mtllib and the rest carry nothing we use.
   }
   Positions frame(3, static_cast<Eigen::Index>(vertices.size()));
-  for (std::size_t i = 0; i < vertices.size(); ++i) frame.col(static_cast<Eigen::Index>(i)) = vertices[i];
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    frame.col(static_cast<Eigen::Index>(i)) = vertices[i];
   out.frames.push_back(std::move(frame));
   return out;
 }
@@ -162,7 +163,9 @@ MeshSequence read_mesh_sequence(const std::string& path) {
   if (ext == ".obj") return read_obj(path);
   if (ext == ".md2") return read_md2(path);
   if (ext == ".md3") return read_md3(path);
-  detail::fail(path, "", "unknown mesh format \"" + ext + "\" (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
+  detail::fail(path, "",
+               "unknown mesh format \"" + ext +
+                   "\" (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
 }
 
 }  // namespace animrt::seqnet

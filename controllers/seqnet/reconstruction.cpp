@@ -15,7 +15,9 @@ struct Reconstructor::Factor {
 };
 
 Reconstructor::Reconstructor(const Positions& rest, const Triangles& triangles)
-    : rest_(rest), ring_(build_neighbourhood(rest, triangles)), factor_(std::make_unique<Factor>()) {
+    : rest_(rest),
+      ring_(build_neighbourhood(rest, triangles)),
+      factor_(std::make_unique<Factor>()) {
   const int v = ring_.vertex_count;
   free_index_.assign(static_cast<std::size_t>(v), 0);
   std::vector<char> piece_pinned(static_cast<std::size_t>(ring_.piece_count), 0);
@@ -56,7 +58,8 @@ Reconstructor::Reconstructor(const Positions& rest, const Triangles& triangles)
   factor_->b.resize(free, 3 * v);
   factor_->b.setFromTriplets(b_entries.begin(), b_entries.end());
   if (free > 0) {
-    Eigen::SparseMatrix<double> bbt = factor_->b * Eigen::SparseMatrix<double>(factor_->b.transpose());
+    Eigen::SparseMatrix<double> bbt =
+        factor_->b * Eigen::SparseMatrix<double>(factor_->b.transpose());
     double trace = 0.0;
     for (int k = 0; k < free; ++k) trace += bbt.coeff(k, k);
     // A whisker of ridge keeps the factor defined if B loses rank.
@@ -109,8 +112,8 @@ Positions Reconstructor::solve_gradients(const std::vector<Eigen::Matrix3d>& t) 
   return out;
 }
 
-std::vector<Eigen::Matrix3d> Reconstructor::exact_gradients(const std::vector<Eigen::Matrix3d>& fitted,
-                                                            const Positions& frame) const {
+std::vector<Eigen::Matrix3d> Reconstructor::exact_gradients(
+    const std::vector<Eigen::Matrix3d>& fitted, const Positions& frame) const {
   std::vector<Eigen::Matrix3d> out = fitted;
   if (!factor_->bbt_ok) return out;
   const int v = ring_.vertex_count;
@@ -139,7 +142,8 @@ std::vector<Eigen::Matrix3d> Reconstructor::exact_gradients(const std::vector<Ei
 std::vector<Positions> reconstruct_all(const SequenceFeatures& features) {
   const Reconstructor solver(features.rest, features.triangles);
   std::vector<Positions> out;
-  for (int f = 0; f < static_cast<int>(features.frames.size()); ++f) out.push_back(solver.solve(features.raw(f)));
+  for (int f = 0; f < static_cast<int>(features.frames.size()); ++f)
+    out.push_back(solver.solve(features.raw(f)));
   return out;
 }
 

@@ -1,12 +1,12 @@
 #include "animrt/controllers/seqnet/shapes.hpp"
 
-#include "animrt/controllers/seqnet/deformation.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <utility>
+
+#include "animrt/controllers/seqnet/deformation.hpp"
 
 namespace animrt::seqnet {
 
@@ -39,7 +39,8 @@ MeshSequence make_bar(int rings, int around, double length) {
   return out;
 }
 
-MeshSequence make_twisting_bar(int rings, int around, double length, double total_angle, int frames) {
+MeshSequence make_twisting_bar(int rings, int around, double length, double total_angle,
+                               int frames) {
   MeshSequence out = make_bar(rings, around, length);
   const Positions rest = out.frames.front();
   out.frames.clear();
@@ -61,13 +62,14 @@ MeshSequence make_twisting_bar(int rings, int around, double length, double tota
 
 MeshSequence make_icosphere(int levels) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0},  {-1, -g, 0}, {1, -g, 0},
-                                    {0, -1, g}, {0, 1, g},  {0, -1, -g}, {0, 1, -g},
-                                    {g, 0, -1}, {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
   for (auto& p : v) p.normalize();
-  Triangles t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  Triangles t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int level = 0; level < levels; ++level) {
     std::map<std::pair<int, int>, int> middle;
     auto mid = [&](int a, int b) {

@@ -38,8 +38,10 @@ void write_frames(const std::string& folder, const seqnet::Triangles& triangles,
     if (!out) throw std::runtime_error(path + ": cannot write");
     out.precision(9);
     const auto& p = frames[f];
-    for (Eigen::Index i = 0; i < p.cols(); ++i) out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
-    for (const auto& t : triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    for (Eigen::Index i = 0; i < p.cols(); ++i)
+      out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
+    for (const auto& t : triangles)
+      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
     if (!out) throw std::runtime_error(path + ": write failed");
   }
 }
@@ -55,16 +57,19 @@ int run_features(const SeqArgs& a) {
     if (found == nullptr) {
       std::string names;
       for (const auto& c : sequence.clips) names += (names.empty() ? "" : ", ") + c.name;
-      throw InputError(Location{a.input, 0, 0}, "--clip",
-                       "no clip \"" + a.clip + "\" (clips: " + (names.empty() ? "none" : names) + ")");
+      throw InputError(
+          Location{a.input, 0, 0}, "--clip",
+          "no clip \"" + a.clip + "\" (clips: " + (names.empty() ? "none" : names) + ")");
     }
     first = found->first;
     count = found->count;
   }
-  const seqnet::SequenceFeatures features = seqnet::compute_features(sequence, first, count, !a.plain);
+  const seqnet::SequenceFeatures features =
+      seqnet::compute_features(sequence, first, count, !a.plain);
   seqnet::write_feature_file(a.out, features);
-  std::cout << a.input << ": " << sequence.vertex_count() << " vertices, " << sequence.triangles.size()
-            << " triangles, frames " << first << ".." << first + count - 1 << " -> " << a.out << '\n';
+  std::cout << a.input << ": " << sequence.vertex_count() << " vertices, "
+            << sequence.triangles.size() << " triangles, frames " << first << ".."
+            << first + count - 1 << " -> " << a.out << '\n';
   // Round trip per clip (or the whole range when it has none).
   const seqnet::Reconstructor solver(features.rest, features.triangles);
   std::vector<seqnet::Clip> clips = features.clips;
@@ -72,14 +77,15 @@ int run_features(const SeqArgs& a) {
   for (const auto& c : clips) {
     double mean = 0.0, max = 0.0;
     for (int f = c.first; f < c.first + c.count; ++f) {
-      const seqnet::FrameError e = seqnet::error_up_to_translation(
-          sequence.frames[static_cast<std::size_t>(first + f)], solver.solve(features.raw(f)),
-          solver.neighbourhood());
+      const seqnet::FrameError e =
+          seqnet::error_up_to_translation(sequence.frames[static_cast<std::size_t>(first + f)],
+                                          solver.solve(features.raw(f)), solver.neighbourhood());
       mean += e.mean / c.count;
       max = std::max(max, e.max);
     }
-    std::printf("  clip %-14s %3d frames  round trip mean %.2e  max %.2e (of the bounding-box diagonal)\n",
-                c.name.c_str(), c.count, mean, max);
+    std::printf(
+        "  clip %-14s %3d frames  round trip mean %.2e  max %.2e (of the bounding-box diagonal)\n",
+        c.name.c_str(), c.count, mean, max);
   }
   return 0;
 }
@@ -114,11 +120,13 @@ void add_seq_command(CLI::App& app) {
   seq->require_subcommand(1);
   auto args = std::make_shared<SeqArgs>();
   auto* features = seq->add_subcommand("features", "Deformation features of a mesh sequence");
-  features->add_option("SEQ", args->input, "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs")
+  features
+      ->add_option("SEQ", args->input, "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs")
       ->required();
   features->add_option("--out", args->out, "feature file to write")->required();
   features->add_option("--clip", args->clip, "only this clip's frames");
-  features->add_flag("--plain", args->plain, "per-vertex fits only (no exact round-trip correction)");
+  features->add_flag("--plain", args->plain,
+                     "per-vertex fits only (no exact round-trip correction)");
   features->callback([args] { guarded(run_features, *args); });
   auto* reconstruct = seq->add_subcommand("reconstruct", "Mesh frames from a feature file");
   reconstruct->add_option("FEATURES", args->input, "feature file")->required();

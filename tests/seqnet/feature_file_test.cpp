@@ -1,10 +1,11 @@
 // The binary feature file: round trip and broken files.
 
+#include "animrt/controllers/seqnet/feature_file.hpp"
+
 #include <gtest/gtest.h>
 
 #include <numbers>
 
-#include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/shapes.hpp"
 #include "animrt/core/error.hpp"
 #include "seq_test_util.hpp"

@@ -1,12 +1,13 @@
 // Deformation features: cotangent weights, gradients, polar split, rotation
 // consistency, reconstruction and interpolation.
 
+#include "animrt/controllers/seqnet/features.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <numbers>
 
-#include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/interpolation.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/controllers/seqnet/shapes.hpp"
@@ -27,17 +28,17 @@ double weight_of(const EdgeWeights& w, int a, int b) {
 TEST(CotangentWeights, HandComputedWithObtuseAngleClamped) {
   // Triangle 0,1,2 is obtuse at 2 (cot -3/4); triangle 0,3,1 sits below.
   Positions p(3, 4);
-  p << 0, 2, 1, 1,  //
+  p << 0, 2, 1, 1,    //
       0, 0, 0.5, -3,  //
       0, 0, 0, 0;
   const Triangles t = {{0, 1, 2}, {0, 3, 1}};
   const EdgeWeights w = cotangent_weights(p, t);
   ASSERT_EQ(w.edges.size(), 5u);
-  EXPECT_NEAR(weight_of(w, 1, 2), 1.0, 1e-12);        // cot 2 at vertex 0, halved
-  EXPECT_NEAR(weight_of(w, 0, 2), 1.0, 1e-12);        // cot 2 at vertex 1
+  EXPECT_NEAR(weight_of(w, 1, 2), 1.0, 1e-12);         // cot 2 at vertex 0, halved
+  EXPECT_NEAR(weight_of(w, 0, 2), 1.0, 1e-12);         // cot 2 at vertex 1
   EXPECT_NEAR(weight_of(w, 0, 1), 7.0 / 24.0, 1e-12);  // (-3/4 + 4/3) / 2
-  EXPECT_NEAR(weight_of(w, 0, 3), 1.0 / 6.0, 1e-12);  // cot 1/3 at vertex 1
-  EXPECT_NEAR(weight_of(w, 1, 3), 1.0 / 6.0, 1e-12);  // cot 1/3 at vertex 0
+  EXPECT_NEAR(weight_of(w, 0, 3), 1.0 / 6.0, 1e-12);   // cot 1/3 at vertex 1
+  EXPECT_NEAR(weight_of(w, 1, 3), 1.0 / 6.0, 1e-12);   // cot 1/3 at vertex 0
   // Alone, the obtuse triangle's edge 0-1 would be -3/8: clamped to 0.
   const EdgeWeights single = cotangent_weights(p, {{0, 1, 2}});
   EXPECT_EQ(weight_of(single, 0, 1), 0.0);
@@ -81,7 +82,8 @@ TEST(DeformationGradient, FlatRingsStayInvertible) {
 TEST(Polar, RotationTimesSymmetricWithPositiveDeterminant) {
   Eigen::Matrix3d t;
   t << 1.0, 0.4, -0.2, 0.1, 0.8, 0.3, -0.3, 0.2, 1.5;
-  for (const Eigen::Matrix3d& m : {Eigen::Matrix3d(t), Eigen::Matrix3d(t * Eigen::Vector3d(1, 1, -1).asDiagonal())}) {
+  for (const Eigen::Matrix3d& m :
+       {Eigen::Matrix3d(t), Eigen::Matrix3d(t * Eigen::Vector3d(1, 1, -1).asDiagonal())}) {
     const Polar p = polar_decomposition(m);
     EXPECT_LT((p.rotation * p.rotation.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
     EXPECT_NEAR(p.rotation.determinant(), 1.0, 1e-12);
@@ -99,8 +101,11 @@ TEST(Rotation, ClosestEquivalentAddsTurnsOrFlipsTheAxis) {
   // 3 rad about z is also 3 - 2 pi about z (= 2 pi - 3 about -z).
   EXPECT_LT((closest_equivalent(3.0 * z, -3.2 * z) - (3.0 - 2 * kPi) * z).norm(), 1e-12);
   EXPECT_LT((closest_equivalent(3.0 * z, 2.9 * z) - 3.0 * z).norm(), 1e-12);
-  EXPECT_LT((rotation_exp(closest_equivalent(3.0 * z, -3.2 * z)) - rotation_exp(3.0 * z)).norm(), 1e-12);
-  EXPECT_LT((rotation_log(rotation_exp(Eigen::Vector3d(0.2, -0.4, 1.1))) - Eigen::Vector3d(0.2, -0.4, 1.1)).norm(),
+  EXPECT_LT((rotation_exp(closest_equivalent(3.0 * z, -3.2 * z)) - rotation_exp(3.0 * z)).norm(),
+            1e-12);
+  EXPECT_LT((rotation_log(rotation_exp(Eigen::Vector3d(0.2, -0.4, 1.1))) -
+             Eigen::Vector3d(0.2, -0.4, 1.1))
+                .norm(),
             1e-12);
 }
 
@@ -139,7 +144,8 @@ TEST(Rotation, ConsistentThroughAFullTwistAcrossFrames) {
   // Round trip through the normalisation on every frame.
   const Reconstructor solver(f.rest, f.triangles);
   for (int k = 0; k < frames; ++k) {
-    const FrameError e = error_up_to_translation(bar.frames[k], solver.solve(f.raw(k)), solver.neighbourhood());
+    const FrameError e =
+        error_up_to_translation(bar.frames[k], solver.solve(f.raw(k)), solver.neighbourhood());
     EXPECT_LT(e.max, 1e-6) << "frame " << k;
   }
 }
@@ -164,16 +170,16 @@ TEST(Interpolation, FeatureSpaceFollowsTheTwistVertexSpaceCollapses) {
   EXPECT_EQ(vertex_space_positions(bar.frames, 0, 12, 12.0), bar.frames[12]);
   EXPECT_EQ(vertex_space_positions(bar.frames, 4, 8, 4.0), bar.frames[4]);
   // Half way through a 270-degree twist.
-  const FrameError feature = error_up_to_translation(bar.frames[6], feature_space_positions(f, solver, 0, 12, 6.0),
-                                                     solver.neighbourhood());
-  const FrameError vertex =
-      error_up_to_translation(bar.frames[6], vertex_space_positions(bar.frames, 0, 12, 6.0), solver.neighbourhood());
+  const FrameError feature = error_up_to_translation(
+      bar.frames[6], feature_space_positions(f, solver, 0, 12, 6.0), solver.neighbourhood());
+  const FrameError vertex = error_up_to_translation(
+      bar.frames[6], vertex_space_positions(bar.frames, 0, 12, 6.0), solver.neighbourhood());
   EXPECT_LT(feature.mean, 0.02);
   EXPECT_LT(feature.mean * 5, vertex.mean);
   EXPECT_GT(vertex.mean, 0.05);
   // Extrapolation from frames 4 and 6 to 8 continues the twist.
-  const FrameError ahead = error_up_to_translation(bar.frames[8], feature_space_positions(f, solver, 4, 6, 8.0),
-                                                   solver.neighbourhood());
+  const FrameError ahead = error_up_to_translation(
+      bar.frames[8], feature_space_positions(f, solver, 4, 6, 8.0), solver.neighbourhood());
   EXPECT_LT(ahead.mean, 0.01);
 }
 

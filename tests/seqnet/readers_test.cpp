@@ -30,8 +30,8 @@ Bytes make_md2(const std::vector<Md2Frame>& frames, int version = 8) {
   const int ofs_tris = 68, ofs_frames = ofs_tris + 12 * tris;
   const int ofs_end = ofs_frames + frame_size * static_cast<int>(frames.size());
   b.text("IDP2", 4);
-  for (int v : {version, 64, 64, frame_size, 0, verts, 0, tris, 0, static_cast<int>(frames.size()), 68, 68,
-                ofs_tris, ofs_frames, ofs_end, ofs_end}) {
+  for (int v : {version, 64, 64, frame_size, 0, verts, 0, tris, 0, static_cast<int>(frames.size()),
+                68, 68, ofs_tris, ofs_frames, ofs_end, ofs_end}) {
     b.i32(v);
   }
   for (const auto& t : kTetraTris) {
@@ -51,7 +51,9 @@ Bytes make_md2(const std::vector<Md2Frame>& frames, int version = 8) {
 }
 
 std::vector<Md2Frame> three_frames() {
-  return {{{1, 1, 1}, {0, 0, 0}, "run1"}, {{0.5f, 1, 2}, {1, 2, 3}, "run2"}, {{1, 1, 1}, {0, 0, 5}, "jump1"}};
+  return {{{1, 1, 1}, {0, 0, 0}, "run1"},
+          {{0.5f, 1, 2}, {1, 2, 3}, "run2"},
+          {{1, 1, 1}, {0, 0, 5}, "jump1"}};
 }
 
 TEST(Md2Reader, HeaderFramesScaleTranslateSeamsAndClips) {
@@ -171,7 +173,8 @@ Bytes make_md3(int frames, int second_surface_frames) {
     const int ofs_end = ofs_xyz + 8 * verts * surface_frames;
     b.text("IDP3", 4);
     b.text(s == 0 ? "body" : "belt", 64);
-    for (int v : {0, surface_frames, 0, verts, tris, ofs_tris, ofs_st, ofs_st, ofs_xyz, ofs_end}) b.i32(v);
+    for (int v : {0, surface_frames, 0, verts, tris, ofs_tris, ofs_st, ofs_st, ofs_xyz, ofs_end})
+      b.i32(v);
     for (const auto& t : kTetraTris) {
       for (int c : t) b.i32(c);
     }
@@ -256,7 +259,8 @@ TEST(ObjReader, BadFacesNameLineAndColumn) {
   seqtest::write_text(path, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
   EXPECT_NE(error_of(path, read_obj).find("zero area"), std::string::npos);
   // Three triangles on the edge 1-2.
-  seqtest::write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+  seqtest::write_text(path,
+                      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
   e = error_of(path, read_obj);
   EXPECT_NE(e.find("non-manifold"), std::string::npos) << e;
   EXPECT_NE(e.find("frame 0"), std::string::npos) << e;

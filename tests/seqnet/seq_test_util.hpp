@@ -41,16 +41,19 @@ struct Bytes {
     i32(static_cast<std::int32_t>(bits));
   }
   void text(const std::string& s, std::size_t width) {
-    for (std::size_t k = 0; k < width; ++k) data.push_back(k < s.size() ? static_cast<std::uint8_t>(s[k]) : 0);
+    for (std::size_t k = 0; k < width; ++k)
+      data.push_back(k < s.size() ? static_cast<std::uint8_t>(s[k]) : 0);
   }
   void put_i32(std::size_t at, std::int32_t v) {
     const auto u = static_cast<std::uint32_t>(v);
-    for (int k = 0; k < 4; ++k) data[at + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(u >> (8 * k));
+    for (int k = 0; k < 4; ++k)
+      data[at + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(u >> (8 * k));
   }
   std::size_t size() const { return data.size(); }
   void save(const std::string& path) const {
     std::ofstream out(path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+    out.write(reinterpret_cast<const char*>(data.data()),
+              static_cast<std::streamsize>(data.size()));
   }
 };
 
@@ -60,12 +63,15 @@ inline void write_text(const std::string& path, const std::string& text) {
 }
 
 // One frame as OBJ (1-based faces).
-inline void write_obj_frame(const std::string& path, const animrt::seqnet::MeshSequence& s, int frame) {
+inline void write_obj_frame(const std::string& path, const animrt::seqnet::MeshSequence& s,
+                            int frame) {
   std::ofstream out(path);
   out.precision(17);
   const auto& p = s.frames[static_cast<std::size_t>(frame)];
-  for (Eigen::Index i = 0; i < p.cols(); ++i) out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
-  for (const auto& t : s.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  for (Eigen::Index i = 0; i < p.cols(); ++i)
+    out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
+  for (const auto& t : s.triangles)
+    out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
 }
 
 // The real models; a missing package is a failure, since install-deps.sh
@@ -90,8 +96,9 @@ inline std::string sarge_lower_path() {
     return "";
   }
   const std::string dir = temp_path("sarge");
-  const std::string command = std::string("unzip -o -q -j ") + kPak0 +
-                              " models/players/sarge/lower.md3 models/players/sarge/animation.cfg -d " + dir;
+  const std::string command =
+      std::string("unzip -o -q -j ") + kPak0 +
+      " models/players/sarge/lower.md3 models/players/sarge/animation.cfg -d " + dir;
   if (std::system(command.c_str()) != 0) {
     ADD_FAILURE() << "could not run: " << command << " (install the Debian package unzip)";
     return "";

@@ -3,10 +3,9 @@
 // over each vertex's 1-ring, weighted by cotangent weights, and the rotation
 // tools the deformation features are built from (docs/seqnet.md).
 
+#include <Eigen/Core>
 #include <array>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
 
@@ -49,7 +48,8 @@ std::vector<double> ring_areas(const Positions& points, const Triangles& triangl
 // in the normal direction; there the template normal, mapped to the frame's
 // normal scaled by the change of ring area, is added as one more weighted
 // direction, which leaves well-conditioned rings untouched.
-std::vector<Eigen::Matrix3d> deformation_gradients(const Neighbourhood& ring, const Triangles& triangles,
+std::vector<Eigen::Matrix3d> deformation_gradients(const Neighbourhood& ring,
+                                                   const Triangles& triangles,
                                                    const Positions& rest, const Positions& frame);
 
 // T = R S with R a rotation (det +1) and S symmetric.

@@ -5,9 +5,8 @@
 // axis-angle vector kept consistent across the mesh and across frames, then
 // each of the 9 V numbers mapped linearly to [-0.95, 0.95].
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "animrt/controllers/seqnet/deformation.hpp"
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
@@ -47,7 +46,9 @@ struct SequenceFeatures {
   std::vector<FeatureFrame> frames;  // normalised
 
   int vertex_count() const { return static_cast<int>(rest.cols()); }
-  FeatureFrame raw(int frame) const { return scale.denormalise(frames[static_cast<std::size_t>(frame)]); }
+  FeatureFrame raw(int frame) const {
+    return scale.denormalise(frames[static_cast<std::size_t>(frame)]);
+  }
 };
 
 // Features of frames first .. first + count - 1 against frame 0 (the whole

@@ -5,10 +5,9 @@
 // It is factorised once per connectivity and solved per frame; the lowest
 // vertex of every connected piece is pinned at its template position.
 
+#include <Eigen/Core>
 #include <memory>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "animrt/controllers/seqnet/features.hpp"
 

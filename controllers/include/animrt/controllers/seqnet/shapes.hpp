@@ -14,7 +14,8 @@ MeshSequence make_bar(int rings, int around, double length);
 // ring at height z turns by total_angle * f / (frames - 1) * ramp(z / length),
 // where ramp is 0 up to 0.25, 1 from 0.75 and smooth between, so the top
 // quarter turns rigidly and the middle half takes the twist.
-MeshSequence make_twisting_bar(int rings, int around, double length, double total_angle, int frames);
+MeshSequence make_twisting_bar(int rings, int around, double length, double total_angle,
+                               int frames);
 
 // An icosahedron subdivided `levels` times onto the unit sphere.
 MeshSequence make_icosphere(int levels);
