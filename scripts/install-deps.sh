@@ -14,6 +14,8 @@ packages=(
   librecast-dev  # navigation-mesh crowds (controllers/herd)
   can-utils qemu-system-x86 busybox-static cpio  # HIL tier (tests/hil/run)
   clang libclang-rt-14-dev  # fuzz harnesses (tests/fuzz, make fuzz)
+  zlib1g-dev  # gzip-compressed mesh sequences (controllers/seqnet)
+  libirrlicht-doc openarena-data unzip  # real MD2/MD3 clips for tests/seqnet
 )
 
 missing=()

@@ -30,6 +30,7 @@
 #include "herd_command.hpp"
 #include "herd_driver.hpp"
 #include "head_command.hpp"
+#include "seq_command.hpp"
 
 namespace {
 
@@ -276,6 +277,7 @@ int main(int argc, char** argv) {
   animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
+  animrt::cli::add_seq_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -1,0 +1,137 @@
+// The seq subcommand: deformation features of a mesh sequence to a feature
+// file (with the round-trip error per clip), and a feature file back to OBJ
+// frames.
+
+#include "seq_command.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "animrt/controllers/seqnet/feature_file.hpp"
+#include "animrt/controllers/seqnet/features.hpp"
+#include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/controllers/seqnet/reconstruction.hpp"
+#include "animrt/core/error.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct SeqArgs {
+  std::string input;
+  std::string out;
+  std::string clip;
+  bool plain = false;
+};
+
+// One OBJ per frame, DIR/frame_0000.obj, ...
+void write_frames(const std::string& folder, const seqnet::Triangles& triangles,
+                  const std::vector<seqnet::Positions>& frames) {
+  std::filesystem::create_directories(folder);
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04zu.obj", f);
+    const std::string path = (std::filesystem::path(folder) / name).string();
+    std::ofstream out(path);
+    if (!out) throw std::runtime_error(path + ": cannot write");
+    out.precision(9);
+    const auto& p = frames[f];
+    for (Eigen::Index i = 0; i < p.cols(); ++i)
+      out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
+    for (const auto& t : triangles)
+      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    if (!out) throw std::runtime_error(path + ": write failed");
+  }
+}
+
+int run_features(const SeqArgs& a) {
+  const seqnet::MeshSequence sequence = seqnet::read_mesh_sequence(a.input);
+  int first = 0, count = sequence.frame_count();
+  if (!a.clip.empty()) {
+    const seqnet::Clip* found = nullptr;
+    for (const auto& c : sequence.clips) {
+      if (c.name == a.clip) found = &c;
+    }
+    if (found == nullptr) {
+      std::string names;
+      for (const auto& c : sequence.clips) names += (names.empty() ? "" : ", ") + c.name;
+      throw InputError(
+          Location{a.input, 0, 0}, "--clip",
+          "no clip \"" + a.clip + "\" (clips: " + (names.empty() ? "none" : names) + ")");
+    }
+    first = found->first;
+    count = found->count;
+  }
+  const seqnet::SequenceFeatures features =
+      seqnet::compute_features(sequence, first, count, !a.plain);
+  seqnet::write_feature_file(a.out, features);
+  std::cout << a.input << ": " << sequence.vertex_count() << " vertices, "
+            << sequence.triangles.size() << " triangles, frames " << first << ".."
+            << first + count - 1 << " -> " << a.out << '\n';
+  // Round trip per clip (or the whole range when it has none).
+  const seqnet::Reconstructor solver(features.rest, features.triangles);
+  std::vector<seqnet::Clip> clips = features.clips;
+  if (clips.empty()) clips.push_back(seqnet::Clip{"all", 0, count, 0.0});
+  for (const auto& c : clips) {
+    double mean = 0.0, max = 0.0;
+    for (int f = c.first; f < c.first + c.count; ++f) {
+      const seqnet::FrameError e =
+          seqnet::error_up_to_translation(sequence.frames[static_cast<std::size_t>(first + f)],
+                                          solver.solve(features.raw(f)), solver.neighbourhood());
+      mean += e.mean / c.count;
+      max = std::max(max, e.max);
+    }
+    std::printf(
+        "  clip %-14s %3d frames  round trip mean %.2e  max %.2e (of the bounding-box diagonal)\n",
+        c.name.c_str(), c.count, mean, max);
+  }
+  return 0;
+}
+
+int run_reconstruct(const SeqArgs& a) {
+  const seqnet::SequenceFeatures features = seqnet::read_feature_file(a.input);
+  const std::vector<seqnet::Positions> frames = seqnet::reconstruct_all(features);
+  write_frames(a.out, features.triangles, frames);
+  std::cout << a.input << ": " << frames.size() << " frames -> " << a.out << "/frame_*.obj\n";
+  return 0;
+}
+
+void guarded(int (*run)(const SeqArgs&), const SeqArgs& a) {
+  int code = 0;
+  try {
+    code = run(a);
+  } catch (const InputError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    code = 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    code = 1;
+  }
+  if (code != 0) throw CLI::RuntimeError(code);
+  throw CLI::Success();  // main() dispatches only its own subcommands
+}
+
+}  // namespace
+
+void add_seq_command(CLI::App& app) {
+  auto* seq = app.add_subcommand("seq", "Mesh sequences: deformation features and reconstruction");
+  seq->require_subcommand(1);
+  auto args = std::make_shared<SeqArgs>();
+  auto* features = seq->add_subcommand("features", "Deformation features of a mesh sequence");
+  features
+      ->add_option("SEQ", args->input, "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs")
+      ->required();
+  features->add_option("--out", args->out, "feature file to write")->required();
+  features->add_option("--clip", args->clip, "only this clip's frames");
+  features->add_flag("--plain", args->plain,
+                     "per-vertex fits only (no exact round-trip correction)");
+  features->callback([args] { guarded(run_features, *args); });
+  auto* reconstruct = seq->add_subcommand("reconstruct", "Mesh frames from a feature file");
+  reconstruct->add_option("FEATURES", args->input, "feature file")->required();
+  reconstruct->add_option("--out", args->out, "folder for frame_NNNN.obj")->required();
+  reconstruct->callback([args] { guarded(run_reconstruct, *args); });
+}
+
+}  // namespace animrt::cli
