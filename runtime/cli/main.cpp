@@ -27,6 +27,7 @@
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
 #include "head_command.hpp"
+#include "seq_corpus_command.hpp"
 
 namespace {
 
@@ -249,6 +250,9 @@ int main(int argc, char** argv) {
 
   animrt::cli::add_evolve_command(app);
   animrt::cli::add_head_command(app);
+  auto* seq = app.add_subcommand("seq", "Mesh sequences: generated corpus");
+  seq->require_subcommand(1);
+  animrt::cli::add_seq_corpus_command(*seq);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
