@@ -1,6 +1,8 @@
 #pragma once
 // A skinned mesh around a MuJoCo model: one closed, manifold triangle mesh
-// made from the bodies' distance field (body_field.hpp) at a bind pose, each
+// made from the bodies' distance field (body_field.hpp) at a bind pose (a
+// fine marching-tetrahedra surface, its largest component, decimated to
+// the vertex count asked for), each
 // vertex bound to the bodies nearest to it, posed by linear blend skinning
 // with every body's world transform relative to the bind pose.
 
@@ -22,8 +24,8 @@ struct SkinOptions {
 };
 
 struct Skin {
-  TriangleMesh rest;  // at the bind pose, world frame
-  double grid_step_m = 0.0;
+  TriangleMesh rest;         // at the bind pose, world frame
+  double grid_step_m = 0.0;  // of the fine surface it was decimated from
   // Per vertex: body ids and weights (summing to 1); unused slots have
   // weight 0 and body 0.
   std::vector<std::array<int, kInfluences>> bodies;
