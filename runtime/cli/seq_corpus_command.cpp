@@ -15,7 +15,7 @@ namespace {
 
 struct SeqCorpusArgs {
   std::string out;
-  std::string model = "horse";
+  std::string model = "quadruped";
   std::string configs = "configs";
   std::vector<std::string> gaits;
   std::vector<double> froude;

@@ -70,7 +70,7 @@ CorpusOptions model_preset(const std::string& name, const std::string& configs_d
   if (name == "horse") {
     o.model_file = (root / "models/horse.xml").string();
     o.gaits = {(root / "gaits/horse_seed.yaml").string()};
-    o.froude = {0.3, 0.4, 0.5};  // around the seed gait's 0.4
+    o.froude = {0.35, 0.4, 0.45};  // around the seed gait's 0.4
   } else if (name == "quadruped") {
     o.model_file = (root / "models/quadruped.xml").string();
     o.gaits = {(root / "gaits/walk.yaml").string(),

@@ -17,6 +17,8 @@ namespace {
 
 // Noise of a seed (relative Froude number, settling range in seconds).
 constexpr double kFroudeJitter = 0.02;
+// Start phase in stride cycles.
+constexpr double kPhaseJitter = 0.1;
 constexpr double kSettleMinS = 0.4;
 constexpr double kSettleRangeS = 0.2;
 
@@ -59,7 +61,7 @@ WalkTiming draw_timing(const WalkConfig& config) {
   SplitMix rng{config.seed};
   WalkTiming t;
   t.froude = config.froude * (1.0 + kFroudeJitter * (2.0 * rng.uniform() - 1.0));
-  t.start_phase = rng.uniform();
+  t.start_phase = kPhaseJitter * rng.uniform();
   t.settle_s = kSettleMinS + kSettleRangeS * rng.uniform();
   return t;
 }
