@@ -137,9 +137,10 @@ CorpusSummary generate_corpus(const std::string& dir, const CorpusOptions& o) {
   index += "vertices: " + std::to_string(summary.vertices) + "\n";
   index += "triangles: " + std::to_string(summary.triangles) + "\n";
   index += "rest_mesh: rest.obj\nskin_weights: skin_weights.csv\n";
-  index += "joints:";
-  for (const auto& j : model.actuated_joints) index += " " + j;
-  index += "\nsequences:\n";
+  index += "joints: [";
+  for (std::size_t j = 0; j < model.actuated_joints.size(); ++j)
+    index += (j ? ", " : "") + quoted(model.actuated_joints[j]);
+  index += "]\nsequences:\n";
   for (const WalkConfig& c : corpus_schedule(o)) {
     const std::string name = sequence_name(c);
     const WalkRecord walk = walk_sequence(model, skin, c, o.walk);
