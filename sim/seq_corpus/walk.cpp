@@ -107,7 +107,8 @@ WalkRecord walk_sequence(const MujocoModel& mm, const Skin& skin, const WalkConf
   gait.stride_frequency_hz.reset();
   gait.froude = FroudeTiming{out.timing.froude, hip};
   const auto specs = joint_specs(mm);
-  const auto source = make_gait_source(gait, specs);
+  const auto source =
+      options.make_source ? options.make_source(gait, specs) : make_gait_source(gait, specs);
   source->steer(MotionCommand{froude_velocity(out.timing.froude, hip), config.turn_rad_s});
   const double f = gait.stride_frequency();
 

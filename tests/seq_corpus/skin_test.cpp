@@ -9,6 +9,8 @@
 #include <cmath>
 #include <set>
 
+#include "animrt/controllers/gait/froude.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/seq_corpus/body_field.hpp"
 #include "animrt/sim/seq_corpus/generator.hpp"
@@ -224,6 +226,36 @@ TEST(Walk, SameSeedSameFramesOtherSeedOtherFrames) {
   EXPECT_NE(a1.timing.start_phase, b1.timing.start_phase);
   EXPECT_NEAR(a1.timing.froude, 0.06, 0.06 * 0.021);
   EXPECT_EQ(a1.time_s[1] - a1.time_s[0], 1.0 / options.fps);
+}
+
+// Wraps a gait and keeps the steering commands it is given.
+class SteerRecorder final : public animrt::MotionSource {
+ public:
+  SteerRecorder(std::unique_ptr<animrt::MotionSource> inner,
+                std::vector<animrt::MotionCommand>* seen)
+      : inner_(std::move(inner)), seen_(seen) {}
+  std::span<const int> driven_joints() const override { return inner_->driven_joints(); }
+  void sample(double t, std::span<double> targets) const override { inner_->sample(t, targets); }
+  void steer(const animrt::MotionCommand& c) override { seen_->push_back(c); }
+
+ private:
+  std::unique_ptr<animrt::MotionSource> inner_;
+  std::vector<animrt::MotionCommand>* seen_;
+};
+
+TEST(Walk, TheTurnRateGoesToTheGaitThroughSteer) {
+  const ModelSkin& s = quadruped_skin();
+  std::vector<animrt::MotionCommand> seen;
+  WalkOptions options;
+  options.frames = 2;
+  options.make_source = [&seen](const animrt::GaitFile& g, std::span<const animrt::JointSpec> j) {
+    return std::make_unique<SteerRecorder>(animrt::make_gait_source(g, j), &seen);
+  };
+  const WalkConfig c{kRoot + "/configs/gaits/walk.yaml", 0.05, 1, -0.25};
+  const WalkRecord walk = walk_sequence(s.model, s.skin, c, options);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].turn_rad_s, -0.25);
+  EXPECT_NEAR(seen[0].speed_m_s, animrt::froude_velocity(walk.timing.froude, 0.18), 1e-12);
 }
 
 TEST(Walk, RejectsAFrameRateOffThePhysicsSteps) {

@@ -17,10 +17,15 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/controllers/motion_source.hpp"
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
+#include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 #include "animrt/sim/seq_corpus/skin.hpp"
 
@@ -29,15 +34,24 @@ namespace animrt::sim::seq_corpus {
 // One sequence of the schedule.
 struct WalkConfig {
   std::string gait_file;
-  double froude = 0.0;      // nominal Fr = v / sqrt(g h)
-  std::uint64_t seed = 1;   // the timing noise
-  double turn_rad_s = 0.0;  // given to the gait through MotionSource::steer
+  double froude = 0.0;     // nominal Fr = v / sqrt(g h)
+  std::uint64_t seed = 1;  // the timing noise
+  // Given to the gait with its speed through MotionSource::steer before the
+  // walk starts. Gaits that cannot be steered ignore it and walk straight;
+  // the record says what the figure achieved.
+  double turn_rad_s = 0.0;
 };
+
+// Binds a gait to the model's joints as a motion source (default:
+// make_gait_source).
+using GaitSourceFactory =
+    std::function<std::unique_ptr<MotionSource>(const GaitFile&, std::span<const JointSpec>)>;
 
 struct WalkOptions {
   int frames = 64;
   double fps = 25.0;           // a whole number of physics steps per frame
   double warmup_cycles = 1.0;  // strides walked (the first blends in from standing) before frame 0
+  GaitSourceFactory make_source;  // empty: make_gait_source
 };
 
 // The seed's noise: a few per cent on the Froude number, where in its stride
