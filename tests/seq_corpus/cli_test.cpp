@@ -107,6 +107,10 @@ TEST_F(SeqCorpusCli, BadInputIsAClearError) {
   EXPECT_EQ(sh(kAnimrt + " seq corpus --out " + (dir / "x").string() + " --model " +
                (dir / "m.xml").string() + " > /dev/null 2>&1"),
             1);  // a model of its own needs --gait and --froude
+  EXPECT_EQ(sh(kAnimrt + " seq corpus --out " + (dir / "x").string() + " --model cat > " +
+               (dir / "log").string() + " 2>&1"),
+            1);
+  EXPECT_NE(read(dir / "log").find("horse, quadruped"), std::string::npos) << read(dir / "log");
   EXPECT_EQ(
       sh(kAnimrt + " seq corpus --out " + (dir / "y").string() + " --model quadruped --configs " +
          kRoot + "/configs --fps 30 > " + (dir / "log").string() + " 2>&1"),
