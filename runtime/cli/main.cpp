@@ -31,6 +31,7 @@
 #include "herd_driver.hpp"
 #include "head_command.hpp"
 #include "seq_command.hpp"
+#include "seq_corpus_command.hpp"
 
 namespace {
 
@@ -277,7 +278,10 @@ int main(int argc, char** argv) {
   animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
-  animrt::cli::add_seq_command(app);
+  auto* seq = app.add_subcommand("seq", "Mesh sequences: generated corpus, deformation features");
+  seq->require_subcommand(1);
+  animrt::cli::add_seq_corpus_command(*seq);
+  animrt::cli::add_seq_command(*seq);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -115,9 +115,8 @@ void guarded(int (*run)(const SeqArgs&), const SeqArgs& a) {
 
 }  // namespace
 
-void add_seq_command(CLI::App& app) {
-  auto* seq = app.add_subcommand("seq", "Mesh sequences: deformation features and reconstruction");
-  seq->require_subcommand(1);
+void add_seq_command(CLI::App& seq_group) {
+  CLI::App* seq = &seq_group;
   auto args = std::make_shared<SeqArgs>();
   auto* features = seq->add_subcommand("features", "Deformation features of a mesh sequence");
   features

@@ -7,6 +7,7 @@
 
 namespace animrt::cli {
 
-void add_seq_command(CLI::App& app);
+// Adds `features` and `reconstruct` to the `seq` subcommand group.
+void add_seq_command(CLI::App& seq);
 
 }  // namespace animrt::cli
