@@ -117,6 +117,15 @@ MotionCommand WalkResponse::achieved(const MotionCommand& commanded) const {
 }
 
 MotionCommand WalkResponse::command_for(const MotionCommand& wanted) const {
+  // Uncalibrated, the figure walks what it is told: the closest command is
+  // the wanted one within the limits (a herd asks this for every figure at
+  // every step, so skip the search).
+  if (!calibrated_) {
+    const MotionCommand c = clamp(wanted);
+    if (c.speed_m_s > 0.0 || !(wanted.speed_m_s > 0.0)) return c;
+    // Slower than the slowest walk: standing or the slowest walk, whichever is closer.
+    return wanted.speed_m_s < 0.5 * min_speed() ? c : clamp({min_speed(), wanted.turn_rad_s});
+  }
   // Turn error weighed as the speed of a foot at half the track.
   const double arm = 0.5 * steering_.track_width_m;
   const auto error = [&](const MotionCommand& c) {

@@ -29,6 +29,10 @@ Vec2 closest_on_box(const Box& box, Vec2 p, bool& inside) {
   return box.center + ax * std::clamp(u, -hu, hu) + ay * std::clamp(v, -hv, hv);
 }
 
+// Figures start this many times the sum of their radii apart: closer, a
+// flock's first steps push neighbours into each other.
+constexpr double kSpawnSpacing = 1.6;
+
 }  // namespace
 
 bool overlaps_box(const Box& box, Vec2 p, double radius) {
@@ -59,8 +63,8 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
     std::uniform_real_distribution<double> ux(spec.spawn_m.xmin, spec.spawn_m.xmax);
     std::uniform_real_distribution<double> uy(spec.spawn_m.ymin, spec.spawn_m.ymax);
     for (int k = 0; k < spec.count; ++k) {
-      // Rejection sampling: apart from every figure placed so far (a margin
-      // of a tenth of a radius) and clear of walls.
+      // Rejection sampling: apart from every figure placed so far and clear
+      // of walls.
       Agent a;
       a.radius = r;
       a.group = static_cast<int>(g);
@@ -69,7 +73,7 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
         a.position = {ux(rng), uy(rng)};
         placed = true;
         for (const Agent& b : agents_) {
-          if (norm(b.position - a.position) < 1.1 * (a.radius + b.radius)) {
+          if (norm(b.position - a.position) < kSpawnSpacing * (a.radius + b.radius)) {
             placed = false;
             break;
           }
@@ -154,14 +158,38 @@ void Herd::step() {
   // the herd does.
   if (nav_ && !crowd_) nav_->update(t_, agents_);
   for (auto& g : groups_) g->steering().steer(t_, dt, agents_, desired_);
+  double reach = 0.0;  // farthest a figure can come toward another in one step
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    const Figure& f = figures_[static_cast<std::size_t>(figure_of_[i])];
+    reach = std::max(reach, 2 * f.radius_m + 2 * f.walk.max_speed() * dt);
+  }
+  grid_.build(std::span<const Agent>(agents_), std::max(reach, 1e-3));
   for (std::size_t i = 0; i < agents_.size(); ++i) {
     const Figure& figure = figures_[static_cast<std::size_t>(figure_of_[i])];
     commands_[i] = steer_figure(figure, agents_[i], desired_[i], dt);
     if (embodied_[i]) continue;
-    walk_figure(figure, commands_[i], dt, agents_[i]);
+    Agent next = agents_[i];
+    walk_figure(figure, commands_[i], dt, next);
     // Flocks have no navigation mesh: a wall or a lowered obstacle stops a
     // figure at its surface (crowds steer around them before).
-    keep_out_of_walls(agents_[i]);
+    keep_out_of_walls(next);
+    // Figures are solid: the last guard, whatever the steering asked, is a
+    // figure that stops rather than step into another.
+    bool blocked = false;
+    grid_.for_each_near(static_cast<int>(i), reach, [&](int j, double) {
+      const Agent& other = agents_[static_cast<std::size_t>(j)];
+      const double contact = next.radius + other.radius;
+      const double before = norm(agents_[i].position - other.position);
+      const double after = norm(next.position - other.position);
+      if (after < contact && after < before) blocked = true;
+    });
+    if (blocked) {
+      ++contact_stops_;
+      agents_[i].speed = 0.0;
+      agents_[i].turn = 0.0;
+      continue;
+    }
+    agents_[i] = next;
   }
   t_ += dt;
 }
@@ -184,6 +212,7 @@ void Herd::record_metrics() {
     max_speed_scratch_[i] = group.max_speed(static_cast<int>(i));
   }
   recorder_->sample(t_, agents_, leaders_scratch_, arrived_scratch_, max_speed_scratch_);
+  recorder_->set_contact_stops(contact_stops_);
 }
 
 }  // namespace animrt::herd

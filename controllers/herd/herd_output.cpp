@@ -101,8 +101,9 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
 }
 
 std::string format_metrics(const HerdMetrics& m) {
-  std::string s = fmt::format("herd: {:.1f} s, {} collisions, min pair distance {:.3f} m (clearance {:.3f} m)\n",
-                              m.duration_s, m.collisions, m.min_pair_distance_m, m.min_clearance_m);
+  std::string s = fmt::format(
+      "herd: {:.1f} s, {} collisions, min pair distance {:.3f} m (clearance {:.3f} m), {} contact stops\n",
+      m.duration_s, m.collisions, m.min_pair_distance_m, m.min_clearance_m, m.contact_stops);
   for (const GroupMetrics& g : m.groups) {
     s += fmt::format("  {} ({}, {} figures): {} collisions, order {:.3f} mean / {:.3f} min, "
                      "nearest neighbour {:.2f} m",

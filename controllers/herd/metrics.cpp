@@ -149,6 +149,7 @@ HerdMetrics MetricsRecorder::finish() const {
   m.duration_s = last_t_;
   m.steps = steps_;
   m.collisions = collisions_;
+  m.contact_stops = contact_stops_;
   m.min_pair_distance_m = min_pair_ < 1e299 ? min_pair_ : 0.0;
   m.min_clearance_m = min_clearance_ < 1e299 ? min_clearance_ : 0.0;
   for (std::size_t g = 0; g < groups_.size(); ++g) {

@@ -38,6 +38,7 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
   j["collisions"] = m.collisions;
   j["min_pair_distance_m"] = m.min_pair_distance_m;
   j["min_clearance_m"] = m.min_clearance_m;
+  j["contact_stops"] = m.contact_stops;
   for (const herd::GroupMetrics& g : m.groups) {
     nlohmann::json k;
     k["name"] = g.name;

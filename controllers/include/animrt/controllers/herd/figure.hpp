@@ -19,7 +19,7 @@ struct Figure {
 
 // Seconds in which a figure means to close its heading error (the turn it
 // asks for is error / this, within its limits).
-inline constexpr double kHeadingTimeConstant_s = 1.0;
+inline constexpr double kHeadingTimeConstant_s = 0.3;
 
 // The command given to `figure` for walking `agent` toward `desired` (m/s on
 // the ground) over the next `dt`: forward speed from the part of `desired`

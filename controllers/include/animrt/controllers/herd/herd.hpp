@@ -17,6 +17,7 @@
 #include "animrt/controllers/herd/figure.hpp"
 #include "animrt/controllers/herd/metrics.hpp"
 #include "animrt/controllers/herd/scene.hpp"
+#include "animrt/controllers/herd/spatial_grid.hpp"
 
 namespace animrt::herd {
 
@@ -64,7 +65,9 @@ class Herd {
   bool arrived(int agent) const;
 
   // One step of scene().step_s: steer every group, command every figure,
-  // walk it (an embodied agent is left where set_pose() put it).
+  // walk it (an embodied agent is left where set_pose() put it). A figure
+  // whose step would take it into another stands still for that step
+  // instead (counted as a contact stop).
   void step();
   // The embodied agent: from now on its pose comes from outside.
   void embody(int agent);
@@ -92,6 +95,8 @@ class Herd {
   std::vector<std::optional<Vec2>> leaders_scratch_;
   std::vector<char> arrived_scratch_;
   std::vector<double> max_speed_scratch_;
+  SpatialGrid grid_;        // the agents at the start of a step, for the contact guard
+  long contact_stops_ = 0;  // figure-steps the contact guard stopped
   double t_ = 0.0;
 };
 

@@ -41,6 +41,7 @@ struct HerdMetrics {
   long collisions = 0;      // agent-pair-steps, whole scene
   double min_pair_distance_m = 0.0;
   double min_clearance_m = 0.0;  // min over pairs of distance - sum of radii
+  long contact_stops = 0;  // figure-steps stopped by the herd's contact guard
   std::vector<GroupMetrics> groups;
 };
 
@@ -64,6 +65,7 @@ class MetricsRecorder {
               std::span<const char> arrived, std::span<const double> max_speed);
 
   HerdMetrics finish() const;
+  void set_contact_stops(long stops) { contact_stops_ = stops; }
 
  private:
   struct AgentTrack {
@@ -96,6 +98,7 @@ class MetricsRecorder {
   double last_t_ = 0.0;
   long steps_ = 0;
   long collisions_ = 0;
+  long contact_stops_ = 0;
   double min_pair_ = 1e300;
   double min_clearance_ = 1e300;
   std::vector<int> order_;  // scratch: agents sorted by x
