@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "animrt/controllers/gait/froude.hpp"
@@ -217,6 +219,46 @@ TEST(SteeredGait, UncommandedPlaysTheGaitsOwnTiming) {
   rig.source->sample(0.0, tg);
   for (int k = 1; k <= 50; ++k) rig.source->sample(k * kDt, tg);  // t = 0.25 s
   EXPECT_NEAR(rad_to_deg(tg[0]), kMeanDeg + kSwingDeg, 1e-6);
+}
+
+TEST(SteeredGait, YawJointsSwingWithTheTurn) {
+  std::string text = kGait;
+  const std::string last = "  rh_hip: {curve: hip, limb: rh}";
+  text.replace(text.find(last), last.size(), last + "\n  yaw: {curve: hip, limb: lf}");
+  text += "  yaw_joints: [yaw]\n";
+  const GaitFile gait = parse_gait_file(text, "yaw.yaml");
+  auto joints = specs();
+  JointSpec yaw;
+  yaw.name = "yaw";
+  yaw.limits = {-kPi, kPi, 100.0, 10000.0};
+  joints.push_back(yaw);
+  auto source = make_gait_source(gait, joints);
+  const double v = gait.steering->max_speed_m_s(), w = gait.steering->max_turn_rad_s;
+  std::vector<double> tg(5);
+  double t = 0.0;
+  // Swing of the yaw joint (deg) and its value a quarter stride after the
+  // lf hip's peak, over 3 s after 4 s under `command`.
+  const auto swing_under = [&](MotionCommand command) {
+    source->steer(command);
+    for (int k = 0; k < 800; ++k, t += kDt) source->sample(t, tg);
+    double lo = 1e9, hi = -1e9, corr = 0.0;
+    for (int k = 0; k < 600; ++k, t += kDt) {
+      source->sample(t, tg);
+      const double y = rad_to_deg(tg[4]) - kMeanDeg, hip = rad_to_deg(tg[0]) - kMeanDeg;
+      lo = std::min(lo, y);
+      hi = std::max(hi, y);
+      corr += y * hip;
+    }
+    return std::pair<double, double>{hi - lo, corr};
+  };
+  const auto straight = swing_under({v, 0.0});
+  EXPECT_LT(straight.first, 1e-9);  // at its mean when walking straight
+  const auto left = swing_under({v, w});
+  EXPECT_GT(left.first, 30.0);  // the full curve at the fastest turn
+  EXPECT_GT(left.second, 0.0);  // in phase with its curve
+  const auto right = swing_under({v, -w});
+  EXPECT_NEAR(right.first, left.first, 1.0);
+  EXPECT_LT(right.second, 0.0);  // the other way round
 }
 
 TEST(SteeredGait, SteerAndSampleDoNotAllocate) {
