@@ -93,7 +93,16 @@ SequenceFeatures compute_features(const MeshSequence& sequence, int first, int c
   FeatureFrame previous = FeatureFrame::Zero(kFeatureDims, out.rest.cols());
   std::vector<FeatureFrame> raw;
   raw.reserve(static_cast<std::size_t>(count));
+  // Clips are separate motions: the pose jumps where one ends and the next
+  // begins, so each clip's first frame starts again from the template and
+  // takes its rotations from the walk over the mesh alone.
+  std::vector<char> clip_start(static_cast<std::size_t>(sequence.frame_count()), 0);
+  for (const Clip& c : sequence.clips) {
+    if (c.first >= 0 && c.first < sequence.frame_count()) clip_start[c.first] = 1;
+  }
+  const FeatureFrame from_template = previous;
   for (int f = first; f < first + count; ++f) {
+    if (clip_start[f]) previous = from_template;
     auto gradients = deformation_gradients(ring, out.triangles, out.rest, sequence.frames[f]);
     if (exact_round_trip) gradients = solver.exact_gradients(gradients, sequence.frames[f]);
     raw.push_back(features_from_gradients(gradients, ring, previous));

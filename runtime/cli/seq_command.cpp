@@ -75,17 +75,21 @@ int run_features(const SeqArgs& a) {
   std::vector<seqnet::Clip> clips = features.clips;
   if (clips.empty()) clips.push_back(seqnet::Clip{"all", 0, count, 0.0});
   for (const auto& c : clips) {
-    double mean = 0.0, max = 0.0;
+    double mean = 0.0, max = 0.0, turn = 0.0;
     for (int f = c.first; f < c.first + c.count; ++f) {
+      const seqnet::FeatureFrame raw = features.raw(f);
       const seqnet::FrameError e =
           seqnet::error_up_to_translation(sequence.frames[static_cast<std::size_t>(first + f)],
-                                          solver.solve(features.raw(f)), solver.neighbourhood());
+                                          solver.solve(raw), solver.neighbourhood());
       mean += e.mean / c.count;
       max = std::max(max, e.max);
+      turn = std::max(turn, raw.topRows<3>().colwise().norm().maxCoeff());
     }
+    // turn: the largest local rotation from the first frame, in degrees.
     std::printf(
-        "  clip %-14s %3d frames  round trip mean %.2e  max %.2e (of the bounding-box diagonal)\n",
-        c.name.c_str(), c.count, mean, max);
+        "  clip %-14s %3d frames  turn %4.0f deg  round trip mean %.2e  max %.2e (of the "
+        "bounding-box diagonal)\n",
+        c.name.c_str(), c.count, turn * 180.0 / 3.14159265358979323846, mean, max);
   }
   return 0;
 }

@@ -52,7 +52,9 @@ struct SequenceFeatures {
 };
 
 // Features of frames first .. first + count - 1 against frame 0 (the whole
-// sequence when count is 0), clips that lie inside that range kept. With
+// sequence when count is 0), clips that lie inside that range kept.
+// Rotations follow frame to frame within a clip; a clip's first frame is
+// referred to the template. With
 // exact_round_trip the fitted gradients get the minimal correction that
 // makes reconstruction give the frame back (Reconstructor::exact_gradients);
 // without it they are the plain per-vertex fits of the paper's Eq. 1.
