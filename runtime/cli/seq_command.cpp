@@ -26,26 +26,6 @@ struct SeqArgs {
   bool plain = false;
 };
 
-// One OBJ per frame, DIR/frame_0000.obj, ...
-void write_frames(const std::string& folder, const seqnet::Triangles& triangles,
-                  const std::vector<seqnet::Positions>& frames) {
-  std::filesystem::create_directories(folder);
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    char name[32];
-    std::snprintf(name, sizeof name, "frame_%04zu.obj", f);
-    const std::string path = (std::filesystem::path(folder) / name).string();
-    std::ofstream out(path);
-    if (!out) throw std::runtime_error(path + ": cannot write");
-    out.precision(9);
-    const auto& p = frames[f];
-    for (Eigen::Index i = 0; i < p.cols(); ++i)
-      out << "v " << p(0, i) << ' ' << p(1, i) << ' ' << p(2, i) << '\n';
-    for (const auto& t : triangles)
-      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    if (!out) throw std::runtime_error(path + ": write failed");
-  }
-}
-
 int run_features(const SeqArgs& a) {
   const seqnet::MeshSequence sequence = seqnet::read_mesh_sequence(a.input);
   int first = 0, count = sequence.frame_count();
@@ -97,8 +77,11 @@ int run_features(const SeqArgs& a) {
 int run_reconstruct(const SeqArgs& a) {
   const seqnet::SequenceFeatures features = seqnet::read_feature_file(a.input);
   const std::vector<seqnet::Positions> frames = seqnet::reconstruct_all(features);
-  write_frames(a.out, features.triangles, frames);
-  std::cout << a.input << ": " << frames.size() << " frames -> " << a.out << "/frame_*.obj\n";
+  seqnet::MeshSequence out;
+  out.triangles.assign(features.triangles.begin(), features.triangles.end());
+  out.frames = std::move(frames);
+  seqnet::write_obj_sequence(a.out, out);
+  std::cout << a.input << ": " << out.frames.size() << " frames -> " << a.out << "/frame_*.obj\n";
   return 0;
 }
 
