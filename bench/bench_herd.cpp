@@ -23,7 +23,9 @@ HerdScene scene_of(int n, bool crowds) {
   s.bounds_m = {s.bounds_m.xmin * k, s.bounds_m.ymin * k, s.bounds_m.xmax * k, s.bounds_m.ymax * k};
   s.walls.clear();
   for (GroupSpec& g : s.groups) {
-    g.spawn_m = {g.spawn_m.xmin * k, g.spawn_m.ymin * k, g.spawn_m.xmax * k, g.spawn_m.ymax * k};
+    // A flock alone has all n figures in its spawn area: twice the room.
+    const double ks = crowds || g.kind == GroupKind::crowd ? k : k * std::sqrt(2.0);
+    g.spawn_m = {g.spawn_m.xmin * ks, g.spawn_m.ymin * ks, g.spawn_m.xmax * ks, g.spawn_m.ymax * ks};
     if (g.target_m) g.target_m = Vec2{g.target_m->x * k, g.target_m->y * k};
     if (g.leader) {
       Rect& w = g.leader->wander_m;
