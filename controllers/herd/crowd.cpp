@@ -54,7 +54,10 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
     ap.height = 1.0f;
     ap.maxAcceleration = 100.0f;
     ap.maxSpeed = static_cast<float>(kPassiveSpeed);
-    ap.collisionQueryRange = static_cast<float>(12 * r);
+    // Detour looks at no more than 32 agents in the query square before
+    // picking the nearest: a wide range in a dense crowd drops the agents
+    // that matter.
+    ap.collisionQueryRange = static_cast<float>(params_.query_range_radii * r);
     ap.pathOptimizationRange = static_cast<float>(30 * r);
     ap.separationWeight = static_cast<float>(params_.separation_weight);
     ap.updateFlags = 0;
@@ -171,6 +174,31 @@ Vec2 Crowd::planned_velocity(int i) const {
     const Vec2 n = normalized(p - q);
     const double in = dot(v, n);
     if (in < 0.0) v -= n * in;
+  }
+  return v;
+}
+
+Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
+  // The figures follow the plan late (a gait turns at a bounded rate and
+  // walks where it faces), so near contact the plan must not close on a
+  // neighbour at all: neither by its own direction nor by the figure
+  // walking along a heading that still points at the neighbour (then it
+  // only turns, in place).
+  const dtCrowdAgent* ag = crowd_->getAgent(i);
+  const Agent& a = agents[static_cast<std::size_t>(i)];
+  const Vec2 h = heading_vector(a.heading);
+  for (int k = 0; k < ag->nneis; ++k) {
+    const Agent& b = agents[static_cast<std::size_t>(ag->neis[k].idx)];
+    const Vec2 d = b.position - a.position;
+    const double dist = norm(d);
+    if (dist > a.radius + b.radius + params_.contact_margin_m || dist <= 0.0) continue;
+    const Vec2 n = d / dist;
+    const double closing = dot(v, n);
+    if (closing > 0.0) v -= n * closing;
+    if (dot(h, n) > 0.0) {
+      const double forward = dot(v, h);
+      if (forward > 0.0) v -= h * forward;
+    }
   }
   return v;
 }
@@ -356,7 +384,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   for (std::size_t k = 0; k < members_.size(); ++k) {
     const int m = members_[k];
     desired[static_cast<std::size_t>(m)] =
-        state_[k] == State::kArrived ? Vec2{} : crowd_.planned_velocity(m);
+        state_[k] == State::kArrived ? Vec2{}
+                                     : crowd_.safe_velocity(m, crowd_.planned_velocity(m), agents);
   }
 }
 

@@ -40,6 +40,11 @@ struct CrowdParams {
   // A member the avoidance holds still while its path leads on follows the
   // path, sliding along neighbours in contact (see planned_velocity).
   bool unstick = false;
+  // Figures closer than the sum of their radii plus this never walk
+  // toward each other (see safe_velocity); 0 turns the rule off.
+  double contact_margin_m = 0.1;
+  // Neighbours within this many avoidance radii are avoided.
+  double query_range_radii = 5.0;
 };
 
 class CrowdGroup;
@@ -70,6 +75,7 @@ class Crowd {
   bool request_target(int i, Vec2 target);
   void stop(int i);
   Vec2 planned_velocity(int i) const;
+  Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
 
   NavWorld& world_;
   CrowdParams params_;
