@@ -151,7 +151,7 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
   dt_ = dt;
 }
 
-Vec2 Crowd::planned_velocity(int i) const {
+Vec2 Crowd::planned_velocity(int i, bool unstick) const {
   const dtCrowdAgent* ag = crowd_->getAgent(i);
   if (ag->state != DT_CROWDAGENT_STATE_WALKING || !(dt_ > 0.0)) return {};
   // The step the crowd took, collision resolution included: overlapping
@@ -159,7 +159,7 @@ Vec2 Crowd::planned_velocity(int i) const {
   // is lost unless the figures walk it.
   Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
   const Vec2 want = NavWorld::from_recast(ag->dvel);
-  if (!params_.unstick || norm(v) >= 0.2 * norm(want)) return v;
+  if (!unstick || norm(v) >= 0.2 * norm(want)) return v;
   // Stalled: agents resting exactly at contact make every sampled velocity
   // look like a collision but standing still, so they would never move
   // again. Follow the path instead, less any part that closes on a
@@ -235,7 +235,8 @@ void CrowdGroup::make_slots(double radius) {
   // Hexagonal lattice around the target, nearest first; ties broken by
   // angle so the order never depends on floating-point noise in sorting.
   std::vector<std::pair<double, Vec2>> cand;
-  const int n = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(members_.size())))) + 3;
+  const int n =
+      static_cast<int>(std::ceil(std::sqrt(6.0 * static_cast<double>(members_.size())))) + 3;
   for (int j = -n; j <= n; ++j) {
     for (int i = -n; i <= n; ++i) {
       const Vec2 q = t + Vec2{(i + 0.5 * j) * s, j * s * std::sqrt(3.0) / 2};
@@ -248,7 +249,9 @@ void CrowdGroup::make_slots(double radius) {
            std::atan2(b.second.y - t.y, b.second.x - t.x);
   });
   for (const auto& [d, q] : cand) {
-    if (slots_.size() >= 3 * members_.size()) break;
+    // Room for a lopsided gathering: it grows toward where its members
+    // come from.
+    if (slots_.size() >= 6 * members_.size()) break;
     if (!w.on_mesh(q, 0.01) || w.in_wall(q, radius)) continue;
     bool under_obstacle = false;
     for (const MovingObstacle& m : w.config().moving) {
@@ -313,10 +316,10 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
     for (std::size_t s = 0; s < slots_.size(); ++s) {
-      if (slot_taken_[s] || !frontier_[s] || !reachable(p, s)) continue;
+      if (slot_taken_[s] || !frontier_[s]) continue;
       const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
       if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
-      if (cost < best_cost) {
+      if (cost < best_cost && reachable(p, s)) {
         best_cost = cost;
         best = static_cast<int>(s);
       }
@@ -384,8 +387,14 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   for (std::size_t k = 0; k < members_.size(); ++k) {
     const int m = members_[k];
     desired[static_cast<std::size_t>(m)] =
-        state_[k] == State::kArrived ? Vec2{}
-                                     : crowd_.safe_velocity(m, crowd_.planned_velocity(m), agents);
+        state_[k] == State::kArrived
+            ? Vec2{}
+            : crowd_.safe_velocity(
+                  m,
+                  crowd_.planned_velocity(m, crowd_.params().unstick &&
+                                                 norm(agents[static_cast<std::size_t>(m)].position -
+                                                      target) < assign_distance_),
+                  agents);
   }
 }
 

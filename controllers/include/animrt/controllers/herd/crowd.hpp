@@ -37,9 +37,10 @@ struct CrowdParams {
   // goal, so it is off unless asked for; avoidance keeps them apart.
   double separation_weight = 0.0;
   double avoidance_horizon_s = 4.0;  // how far ahead avoidance looks
-  // A member the avoidance holds still while its path leads on follows the
-  // path, sliding along neighbours in contact (see planned_velocity).
-  bool unstick = false;
+  // Near its target (where the gathering is, away from walls), a member
+  // the avoidance holds still while its path leads on follows the path,
+  // sliding along neighbours in contact (see planned_velocity).
+  bool unstick = true;
   // Figures closer than the sum of their radii plus this never walk
   // toward each other (see safe_velocity); 0 turns the rule off.
   double contact_margin_m = 0.1;
@@ -74,7 +75,7 @@ class Crowd {
   void make_active(int i, double max_speed);
   bool request_target(int i, Vec2 target);
   void stop(int i);
-  Vec2 planned_velocity(int i) const;
+  Vec2 planned_velocity(int i, bool unstick) const;
   Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
 
   NavWorld& world_;
