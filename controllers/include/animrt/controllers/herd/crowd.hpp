@@ -101,7 +101,7 @@ struct CrowdGroupParams {
   // Members within this distance of the target (0: the slots' extent plus
   // two spacings) head for a free slot at the edge of the gathering.
   double assign_distance_m = 0.0;
-  double arrive_tolerance_m = 0.12;  // a member this close to its slot has arrived
+  double arrive_tolerance_m = 0.2;  // a member this close to its slot has arrived
 };
 
 class CrowdGroup final : public GroupSteering {
