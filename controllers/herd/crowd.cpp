@@ -225,6 +225,8 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   state_.assign(members_.size(), State::kTravelling);
   slot_of_.assign(members_.size(), -1);
   candidate_.assign(members_.size(), -1);
+  stall_since_.assign(members_.size(), 0.0);
+  for (int m : members_) stall_anchor_.push_back(agents[static_cast<std::size_t>(m)].position);
   make_slots(rmax + crowd_.params().avoidance_margin_m);
 }
 
@@ -381,7 +383,28 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
         norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) < params_.arrive_tolerance_m) {
       state_[k] = State::kArrived;
       crowd_.stop(members_[k]);
+      continue;
     }
+    // A member that has stood still for stall_time_s next to the gathering
+    // (within a spacing and a half of an arrived member) has gathered
+    // where it stands; its slot, if it held one, is free again.
+    if (state_[k] == State::kArrived) continue;
+    if (norm(p - stall_anchor_[k]) > 0.1) {
+      stall_anchor_[k] = p;
+      stall_since_[k] = t;
+      continue;
+    }
+    if (params_.stall_time_s <= 0.0 || t - stall_since_[k] < params_.stall_time_s) continue;
+    bool beside = false;
+    for (std::size_t j = 0; j < members_.size() && !beside; ++j) {
+      beside = state_[j] == State::kArrived &&
+               norm(agents[static_cast<std::size_t>(members_[j])].position - p) < 1.5 * spacing_;
+    }
+    if (!beside) continue;
+    if (slot_of_[k] >= 0) slot_taken_[static_cast<std::size_t>(slot_of_[k])] = false;
+    slot_of_[k] = -1;
+    state_[k] = State::kArrived;
+    crowd_.stop(members_[k]);
   }
   crowd_.step(t, dt, agents);
   for (std::size_t k = 0; k < members_.size(); ++k) {
