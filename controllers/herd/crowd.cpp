@@ -54,7 +54,10 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
     ap.height = 1.0f;
     ap.maxAcceleration = 100.0f;
     ap.maxSpeed = static_cast<float>(kPassiveSpeed);
-    ap.collisionQueryRange = static_cast<float>(12 * r);
+    // Detour looks at no more than 32 agents in the query square before
+    // picking the nearest: a wide range in a dense crowd drops the agents
+    // that matter.
+    ap.collisionQueryRange = static_cast<float>(params_.query_range_radii * r);
     ap.pathOptimizationRange = static_cast<float>(30 * r);
     ap.separationWeight = static_cast<float>(params_.separation_weight);
     ap.updateFlags = 0;
@@ -148,7 +151,7 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
   dt_ = dt;
 }
 
-Vec2 Crowd::planned_velocity(int i) const {
+Vec2 Crowd::planned_velocity(int i, bool unstick) const {
   const dtCrowdAgent* ag = crowd_->getAgent(i);
   if (ag->state != DT_CROWDAGENT_STATE_WALKING || !(dt_ > 0.0)) return {};
   // The step the crowd took, collision resolution included: overlapping
@@ -156,7 +159,7 @@ Vec2 Crowd::planned_velocity(int i) const {
   // is lost unless the figures walk it.
   Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
   const Vec2 want = NavWorld::from_recast(ag->dvel);
-  if (!params_.unstick || norm(v) >= 0.2 * norm(want)) return v;
+  if (!unstick || norm(v) >= 0.2 * norm(want)) return v;
   // Stalled: agents resting exactly at contact make every sampled velocity
   // look like a collision but standing still, so they would never move
   // again. Follow the path instead, less any part that closes on a
@@ -171,6 +174,31 @@ Vec2 Crowd::planned_velocity(int i) const {
     const Vec2 n = normalized(p - q);
     const double in = dot(v, n);
     if (in < 0.0) v -= n * in;
+  }
+  return v;
+}
+
+Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
+  // The figures follow the plan late (a gait turns at a bounded rate and
+  // walks where it faces), so near contact the plan must not close on a
+  // neighbour at all: neither by its own direction nor by the figure
+  // walking along a heading that still points at the neighbour (then it
+  // only turns, in place).
+  const dtCrowdAgent* ag = crowd_->getAgent(i);
+  const Agent& a = agents[static_cast<std::size_t>(i)];
+  const Vec2 h = heading_vector(a.heading);
+  for (int k = 0; k < ag->nneis; ++k) {
+    const Agent& b = agents[static_cast<std::size_t>(ag->neis[k].idx)];
+    const Vec2 d = b.position - a.position;
+    const double dist = norm(d);
+    if (dist > a.radius + b.radius + params_.contact_margin_m || dist <= 0.0) continue;
+    const Vec2 n = d / dist;
+    const double closing = dot(v, n);
+    if (closing > 0.0) v -= n * closing;
+    if (dot(h, n) > 0.0) {
+      const double forward = dot(v, h);
+      if (forward > 0.0) v -= h * forward;
+    }
   }
   return v;
 }
@@ -197,6 +225,8 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   state_.assign(members_.size(), State::kTravelling);
   slot_of_.assign(members_.size(), -1);
   candidate_.assign(members_.size(), -1);
+  stall_since_.assign(members_.size(), 0.0);
+  for (int m : members_) stall_anchor_.push_back(agents[static_cast<std::size_t>(m)].position);
   make_slots(rmax + crowd_.params().avoidance_margin_m);
 }
 
@@ -207,7 +237,8 @@ void CrowdGroup::make_slots(double radius) {
   // Hexagonal lattice around the target, nearest first; ties broken by
   // angle so the order never depends on floating-point noise in sorting.
   std::vector<std::pair<double, Vec2>> cand;
-  const int n = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(members_.size())))) + 3;
+  const int n =
+      static_cast<int>(std::ceil(std::sqrt(6.0 * static_cast<double>(members_.size())))) + 3;
   for (int j = -n; j <= n; ++j) {
     for (int i = -n; i <= n; ++i) {
       const Vec2 q = t + Vec2{(i + 0.5 * j) * s, j * s * std::sqrt(3.0) / 2};
@@ -220,7 +251,9 @@ void CrowdGroup::make_slots(double radius) {
            std::atan2(b.second.y - t.y, b.second.x - t.x);
   });
   for (const auto& [d, q] : cand) {
-    if (slots_.size() >= 3 * members_.size()) break;
+    // Room for a lopsided gathering: it grows toward where its members
+    // come from.
+    if (slots_.size() >= 6 * members_.size()) break;
     if (!w.on_mesh(q, 0.01) || w.in_wall(q, radius)) continue;
     bool under_obstacle = false;
     for (const MovingObstacle& m : w.config().moving) {
@@ -285,10 +318,10 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
     for (std::size_t s = 0; s < slots_.size(); ++s) {
-      if (slot_taken_[s] || !frontier_[s] || !reachable(p, s)) continue;
+      if (slot_taken_[s] || !frontier_[s]) continue;
       const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
       if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
-      if (cost < best_cost) {
+      if (cost < best_cost && reachable(p, s)) {
         best_cost = cost;
         best = static_cast<int>(s);
       }
@@ -350,13 +383,41 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
         norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) < params_.arrive_tolerance_m) {
       state_[k] = State::kArrived;
       crowd_.stop(members_[k]);
+      continue;
     }
+    // A member that has stood still for stall_time_s next to the gathering
+    // (within a spacing and a half of an arrived member) has gathered
+    // where it stands; its slot, if it held one, is free again.
+    if (state_[k] == State::kArrived) continue;
+    if (norm(p - stall_anchor_[k]) > 0.1) {
+      stall_anchor_[k] = p;
+      stall_since_[k] = t;
+      continue;
+    }
+    if (params_.stall_time_s <= 0.0 || t - stall_since_[k] < params_.stall_time_s) continue;
+    bool beside = false;
+    for (std::size_t j = 0; j < members_.size() && !beside; ++j) {
+      beside = state_[j] == State::kArrived &&
+               norm(agents[static_cast<std::size_t>(members_[j])].position - p) < 1.5 * spacing_;
+    }
+    if (!beside) continue;
+    if (slot_of_[k] >= 0) slot_taken_[static_cast<std::size_t>(slot_of_[k])] = false;
+    slot_of_[k] = -1;
+    state_[k] = State::kArrived;
+    crowd_.stop(members_[k]);
   }
   crowd_.step(t, dt, agents);
   for (std::size_t k = 0; k < members_.size(); ++k) {
     const int m = members_[k];
     desired[static_cast<std::size_t>(m)] =
-        state_[k] == State::kArrived ? Vec2{} : crowd_.planned_velocity(m);
+        state_[k] == State::kArrived
+            ? Vec2{}
+            : crowd_.safe_velocity(
+                  m,
+                  crowd_.planned_velocity(m, crowd_.params().unstick &&
+                                                 norm(agents[static_cast<std::size_t>(m)].position -
+                                                      target) < assign_distance_),
+                  agents);
   }
 }
 

@@ -25,31 +25,30 @@ void expect_goal(const test::CrossingResult& r) {
   EXPECT_LT(r.max_time_ratio, 2.0);
 }
 
-// What the crowd reaches today: no figure touches another or a wall, and
-// most gather at their slots; the rest stall at the gathering's edge.
-TEST(CrowdCrossing, TeamsCrossWithoutCollisionsAndMostGather) {
+// Every figure arrives within twice its straight-line time (distance to
+// the target over its top speed), and no two ever touch.
+TEST(CrowdCrossing, TeamsCrossAndGatherWithoutCollisions) {
   const auto r = test::run_crossing(0.15, 0.25, false, 25, 7, 600.0);
-  print(r);
-  EXPECT_EQ(r.collisions, 0);
-  EXPECT_EQ(r.wall_contacts, 0);
-  EXPECT_GE(r.arrived, 35u);
+  expect_goal(r);
 }
 
-// The moving wall drops and rises through the run, deferring drops over
-// figures, and most figures still gather.
+// Slow figures and a wall that drops into one gap and rises again (drops
+// deferred while figures stand under it): all cross without touching
+// each other or a wall, and gather, within three times their
+// straight-line time.
 TEST(CrowdCrossing, SlowTeamsCrossThroughTheMovingWall) {
   const auto r = test::run_crossing(0.06, 0.12, true, 25, 11, 1400.0);
   print(r);
   EXPECT_GT(r.drops, 10);
   EXPECT_GT(r.deferred_drops, 0);
-  EXPECT_GE(r.arrived, 35u);
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_EQ(r.wall_contacts, 0);
+  EXPECT_EQ(r.arrived, r.agents);
+  EXPECT_LT(r.max_time_ratio, 3.0);
 }
 
-// The full goal: every figure arrives within twice its straight-line time,
-// with no collision. Not reached yet (see the two tests above).
-TEST(CrowdCrossing, DISABLED_GoalFastTeams) {
-  expect_goal(test::run_crossing(0.15, 0.25, false, 25, 7, 600.0));
-}
+// The full goal for the slow teams: within twice the straight-line time.
+// Not reached yet (2.8 here); run with --gtest_also_run_disabled_tests.
 TEST(CrowdCrossing, DISABLED_GoalSlowTeamsMovingWall) {
   expect_goal(test::run_crossing(0.06, 0.12, true, 25, 11, 1400.0));
 }

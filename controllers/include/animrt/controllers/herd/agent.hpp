@@ -16,9 +16,21 @@ struct Vec2 {
   double x = 0.0;
   double y = 0.0;
 
-  Vec2& operator+=(Vec2 o) { x += o.x; y += o.y; return *this; }
-  Vec2& operator-=(Vec2 o) { x -= o.x; y -= o.y; return *this; }
-  Vec2& operator*=(double k) { x *= k; y *= k; return *this; }
+  Vec2& operator+=(Vec2 o) {
+    x += o.x;
+    y += o.y;
+    return *this;
+  }
+  Vec2& operator-=(Vec2 o) {
+    x -= o.x;
+    y -= o.y;
+    return *this;
+  }
+  Vec2& operator*=(double k) {
+    x *= k;
+    y *= k;
+    return *this;
+  }
   friend Vec2 operator+(Vec2 a, Vec2 b) { return a += b; }
   friend Vec2 operator-(Vec2 a, Vec2 b) { return a -= b; }
   friend Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }

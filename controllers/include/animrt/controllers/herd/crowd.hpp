@@ -37,9 +37,15 @@ struct CrowdParams {
   // goal, so it is off unless asked for; avoidance keeps them apart.
   double separation_weight = 0.0;
   double avoidance_horizon_s = 4.0;  // how far ahead avoidance looks
-  // A member the avoidance holds still while its path leads on follows the
-  // path, sliding along neighbours in contact (see planned_velocity).
-  bool unstick = false;
+  // Near its target (where the gathering is, away from walls), a member
+  // the avoidance holds still while its path leads on follows the path,
+  // sliding along neighbours in contact (see planned_velocity).
+  bool unstick = true;
+  // Figures closer than the sum of their radii plus this never walk
+  // toward each other (see safe_velocity); 0 turns the rule off.
+  double contact_margin_m = 0.1;
+  // Neighbours within this many avoidance radii are avoided.
+  double query_range_radii = 5.0;
 };
 
 class CrowdGroup;
@@ -69,7 +75,8 @@ class Crowd {
   void make_active(int i, double max_speed);
   bool request_target(int i, Vec2 target);
   void stop(int i);
-  Vec2 planned_velocity(int i) const;
+  Vec2 planned_velocity(int i, bool unstick) const;
+  Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
 
   NavWorld& world_;
   CrowdParams params_;
@@ -94,7 +101,10 @@ struct CrowdGroupParams {
   // Members within this distance of the target (0: the slots' extent plus
   // two spacings) head for a free slot at the edge of the gathering.
   double assign_distance_m = 0.0;
-  double arrive_tolerance_m = 0.12;  // a member this close to its slot has arrived
+  double arrive_tolerance_m = 0.2;  // a member this close to its slot has arrived
+  // A member that stands still this long beside the gathering has arrived
+  // where it stands (0: never).
+  double stall_time_s = 20.0;
 };
 
 class CrowdGroup final : public GroupSteering {
@@ -126,7 +136,9 @@ class CrowdGroup final : public GroupSteering {
   CrowdGroupParams params_;
   std::vector<double> max_speed_;
   std::vector<State> state_;
-  std::vector<int> slot_of_;    // per member, -1 while travelling
+  std::vector<int> slot_of_;        // per member, -1 while travelling
+  std::vector<Vec2> stall_anchor_;  // where each member was when it last moved 0.1 m
+  std::vector<double> stall_since_;
   std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
