@@ -25,9 +25,10 @@ int name_width(int frames) {
 }
 
 std::string frame_name(int frame, int width) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%0*d.obj", width, frame);
-  return name;
+  std::string digits = std::to_string(frame);
+  if (static_cast<int>(digits.size()) < width)
+    digits.insert(0, static_cast<std::size_t>(width) - digits.size(), '0');
+  return "frame_" + digits + ".obj";
 }
 
 // frame_<digits>.obj
