@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -26,9 +25,21 @@ int name_width(int frames) {
 }
 
 std::string frame_name(int frame, int width) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%0*d.obj", width, frame);
-  return name;
+  std::string digits = std::to_string(frame);
+  if (static_cast<int>(digits.size()) < width)
+    digits.insert(0, static_cast<std::size_t>(width) - digits.size(), '0');
+  return "frame_" + digits + ".obj";
+}
+
+// frame_<digits>.obj
+bool is_frame_name(const std::string& name) {
+  const std::string head = "frame_", tail = ".obj";
+  if (name.size() <= head.size() + tail.size()) return false;
+  if (name.compare(0, head.size(), head) != 0) return false;
+  if (name.compare(name.size() - tail.size(), tail.size(), tail) != 0) return false;
+  for (std::size_t i = head.size(); i < name.size() - tail.size(); ++i)
+    if (name[i] < '0' || name[i] > '9') return false;
+  return true;
 }
 
 void check(const MeshSequence& sequence) {
@@ -94,10 +105,9 @@ void write_obj_sequence(const std::string& folder, const MeshSequence& sequence)
   }
   // Frames of an earlier, longer sequence would be read back as part of this
   // one: remove every frame file first.
-  static const std::regex frame_file(R"(frame_[0-9]+\.obj)");
   std::vector<fs::path> stale;
   for (const auto& entry : fs::directory_iterator(folder)) {
-    if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), frame_file))
+    if (entry.is_regular_file() && is_frame_name(entry.path().filename().string()))
       stale.push_back(entry.path());
   }
   for (const auto& path : stale) fs::remove(path);
