@@ -15,6 +15,7 @@
 #include "animrt/controllers/evolve/search.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/error.hpp"
+#include "subcommand.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 
 namespace animrt::cli {
@@ -132,20 +133,7 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
   cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
-  cmd->callback([args] {
-    int code = 0;
-    try {
-      code = run_evolve(*args);
-    } catch (const InputError& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 2;
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 1;
-    }
-    if (code != 0) throw CLI::RuntimeError(code);
-    throw CLI::Success();  // main() dispatches only its own subcommands
-  });
+  set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }
 
 }  // namespace animrt::cli

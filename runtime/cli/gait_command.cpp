@@ -15,6 +15,7 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/gait/walk_response.hpp"
 #include "animrt/core/error.hpp"
+#include "subcommand.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
@@ -130,20 +131,7 @@ void add_gait_command(CLI::App& app) {
   cmd->add_option("--turns", args->turns, "turn rates each way (fractions of the fastest)")
       ->check(CLI::Range(0, 20));
   cmd->add_option("--seed", args->seed, "perturb the start pose (0: exact standing pose)");
-  cmd->callback([args] {
-    int code = 0;
-    try {
-      code = run_calibrate(*args);
-    } catch (const InputError& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 2;
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 1;
-    }
-    if (code != 0) throw CLI::RuntimeError(code);
-    throw CLI::Success();
-  });
+  set_subcommand_body(cmd, [args] { return run_calibrate(*args); });
 }
 
 }  // namespace animrt::cli

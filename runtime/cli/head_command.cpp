@@ -2,6 +2,7 @@
 // evaluation and the paper's Table 1.
 
 #include "head_command.hpp"
+#include "subcommand.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -33,22 +34,6 @@ struct HeadArgs {
   bool quiet = false;
 };
 
-void wrap(CLI::App* cmd, std::function<int()> body) {
-  cmd->callback([body] {
-    int code = 0;
-    try {
-      code = body();
-    } catch (const InputError& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 2;
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 1;
-    }
-    if (code != 0) throw CLI::RuntimeError(code);
-    throw CLI::Success();
-  });
-}
 
 TrainOptions train_options(const HeadArgs& a) {
   TrainOptions o;
@@ -186,7 +171,7 @@ void add_head_command(CLI::App& app) {
   auto* f = head->add_subcommand("features", "Prosodic features of a WAV file as CSV");
   f->add_option("IN", a->in, "audio file")->required();
   f->add_option("--out", a->out, "features CSV")->required();
-  wrap(f, [a] { return run_features(*a); });
+  set_subcommand_body(f, [a] { return run_features(*a); });
 
   auto* c = head->add_subcommand("corpus",
                                  "Generate a synthetic corpus (espeak-ng speech + head motion)");
@@ -195,13 +180,13 @@ void add_head_command(CLI::App& app) {
   c->add_option("--speakers", a->speakers, "speaker styles (1..4)")->check(CLI::Range(1, 4));
   c->add_option("--seed", a->seed, "random seed");
   c->add_flag("--quiet", a->quiet, "no progress lines");
-  wrap(c, [a] { return run_corpus(*a); });
+  set_subcommand_body(c, [a] { return run_corpus(*a); });
 
   auto* t = head->add_subcommand("train", "Train a model on the training split of a corpus");
   t->add_option("CORPUS", a->corpus, "corpus folder")->required();
   t->add_option("--out", a->out, "model file")->required();
   add_train_options(t, *a);
-  wrap(t, [a] { return run_train(*a); });
+  set_subcommand_body(t, [a] { return run_train(*a); });
 
   auto* s = head->add_subcommand("synth", "Synthesize head poses for a WAV file");
   s->add_option("MODEL", a->model, "model file")->required();
@@ -209,20 +194,20 @@ void add_head_command(CLI::App& app) {
   s->add_option("--out", a->out, "poses CSV (time_s, yaw_deg, pitch_deg, roll_deg)")->required();
   s->add_option("--noise-deg", a->noise_deg, "override the model's noise amplitude")
       ->check(CLI::Range(0.0, 10.0));
-  wrap(s, [a] { return run_synth(*a); });
+  set_subcommand_body(s, [a] { return run_synth(*a); });
 
   auto* e = head->add_subcommand("eval",
                                  "Evaluate a model on the corpus utterances it was not trained on");
   e->add_option("MODEL", a->model, "model file")->required();
   e->add_option("CORPUS", a->corpus, "corpus folder")->required();
-  wrap(e, [a] { return run_eval(*a); });
+  set_subcommand_body(e, [a] { return run_eval(*a); });
 
   auto* tb = head->add_subcommand("table",
                                   "Train and evaluate the paper's eight configurations (Table 1)");
   tb->add_option("CORPUS", a->corpus, "corpus folder")->required();
   tb->add_option("--out", a->out, "also write the table (markdown) here");
   add_train_options(tb, *a);
-  wrap(tb, [a] { return run_table(*a); });
+  set_subcommand_body(tb, [a] { return run_table(*a); });
 }
 
 }  // namespace animrt::cli

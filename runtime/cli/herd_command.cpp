@@ -14,6 +14,7 @@
 
 #include "animrt/controllers/herd/herd_output.hpp"
 #include "animrt/core/error.hpp"
+#include "subcommand.hpp"
 #include "animrt/runtime/robot_config.hpp"
 
 namespace animrt::cli {
@@ -152,20 +153,7 @@ void add_herd_command(CLI::App& app) {
   cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
   cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
-  cmd->callback([args] {
-    int code = 0;
-    try {
-      code = run_herd(*args);
-    } catch (const InputError& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 2;
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 1;
-    }
-    if (code != 0) throw CLI::RuntimeError(code);
-    throw CLI::Success();
-  });
+  set_subcommand_body(cmd, [args] { return run_herd(*args); });
 }
 
 }  // namespace animrt::cli

@@ -3,6 +3,7 @@
 // frames.
 
 #include "seq_command.hpp"
+#include "subcommand.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -85,20 +86,6 @@ int run_reconstruct(const SeqArgs& a) {
   return 0;
 }
 
-void guarded(int (*run)(const SeqArgs&), const SeqArgs& a) {
-  int code = 0;
-  try {
-    code = run(a);
-  } catch (const InputError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    code = 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    code = 1;
-  }
-  if (code != 0) throw CLI::RuntimeError(code);
-  throw CLI::Success();  // main() dispatches only its own subcommands
-}
 
 }  // namespace
 
@@ -113,11 +100,11 @@ void add_seq_command(CLI::App& seq_group) {
   features->add_option("--clip", args->clip, "only this clip's frames");
   features->add_flag("--plain", args->plain,
                      "per-vertex fits only (no exact round-trip correction)");
-  features->callback([args] { guarded(run_features, *args); });
+  set_subcommand_body(features, [args] { return run_features(*args); });
   auto* reconstruct = seq->add_subcommand("reconstruct", "Mesh frames from a feature file");
   reconstruct->add_option("FEATURES", args->input, "feature file")->required();
   reconstruct->add_option("--out", args->out, "folder for frame_NNNN.obj")->required();
-  reconstruct->callback([args] { guarded(run_reconstruct, *args); });
+  set_subcommand_body(reconstruct, [args] { return run_reconstruct(*args); });
 }
 
 }  // namespace animrt::cli

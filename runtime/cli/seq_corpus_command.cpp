@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "animrt/core/error.hpp"
+#include "subcommand.hpp"
 #include "animrt/sim/seq_corpus/generator.hpp"
 
 namespace animrt::cli {
@@ -98,20 +99,7 @@ void add_seq_corpus_command(CLI::App& seq) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress lines");
-  c->callback([a] {
-    int code = 0;
-    try {
-      code = run_seq_corpus(*a);
-    } catch (const InputError& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 2;
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << '\n';
-      code = 1;
-    }
-    if (code != 0) throw CLI::RuntimeError(code);
-    throw CLI::Success();
-  });
+  set_subcommand_body(c, [a] { return run_seq_corpus(*a); });
 }
 
 }  // namespace animrt::cli

@@ -8,6 +8,7 @@
 
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
+#include "animrt/sim/mujoco/mujoco_walk.hpp"
 
 namespace animrt::sim {
 namespace {
@@ -15,22 +16,6 @@ namespace {
 // A foot must be off the ground this long before its next contact counts as
 // a touchdown (contacts chatter for a few steps when a foot lands).
 constexpr double kDebounceS = 0.02;
-
-std::vector<JointSpec> joint_specs(const MujocoModel& mm) {
-  const mjModel* m = mm.model.get();
-  std::vector<JointSpec> specs;
-  for (std::size_t a = 0; a < mm.actuated_joints.size(); ++a) {
-    const int j = m->actuator_trnid[2 * a];
-    JointSpec s;
-    s.name = mm.actuated_joints[a];
-    s.limits.min_position = m->jnt_limited[j] ? m->jnt_range[2 * j] : -kPi;
-    s.limits.max_position = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : kPi;
-    s.limits.max_velocity = 100.0;
-    s.limits.max_acceleration = 10000.0;
-    specs.push_back(s);
-  }
-  return specs;
-}
 
 int root_qpos(const mjModel* m, int torso) {
   const int j = m->body_jntadr[torso];
@@ -85,7 +70,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   const MujocoModel& mm = *model_;
   const mjModel* m = mm.model.get();
   mjData* d = data_.get();
-  const auto specs = joint_specs(mm);
+  const auto specs = model_joint_specs(mm);
   const auto source = make_gait_source(gait, specs);
   std::vector<double> targets(specs.size(), 0.0);
   evolve::GaitMeasures out;

@@ -11,6 +11,7 @@
 #include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/seq_corpus/generator.hpp"
+#include "animrt/sim/mujoco/mujoco_walk.hpp"
 
 namespace animrt::sim::seq_corpus {
 namespace {
@@ -33,22 +34,6 @@ struct SplitMix {
   }
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
 };
-
-std::vector<JointSpec> joint_specs(const MujocoModel& mm) {
-  const mjModel* m = mm.model.get();
-  std::vector<JointSpec> specs;
-  for (std::size_t a = 0; a < mm.actuated_joints.size(); ++a) {
-    const int j = m->actuator_trnid[2 * a];
-    JointSpec s;
-    s.name = mm.actuated_joints[a];
-    s.limits.min_position = m->jnt_limited[j] ? m->jnt_range[2 * j] : -kPi;
-    s.limits.max_position = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : kPi;
-    s.limits.max_velocity = 100.0;
-    s.limits.max_acceleration = 10000.0;
-    specs.push_back(s);
-  }
-  return specs;
-}
 
 double torso_yaw(const MujocoModel& mm, const mjData* d) {
   const double* r = d->xmat + 9 * mm.torso_body;
@@ -106,7 +91,7 @@ WalkRecord walk_sequence(const MujocoModel& mm, const Skin& skin, const WalkConf
   const double hip = gait.froude ? gait.froude->hip_height_m : mm.hip_height_m;
   gait.stride_frequency_hz.reset();
   gait.froude = FroudeTiming{out.timing.froude, hip};
-  const auto specs = joint_specs(mm);
+  const auto specs = model_joint_specs(mm);
   const auto source =
       options.make_source ? options.make_source(gait, specs) : make_gait_source(gait, specs);
   source->steer(MotionCommand{froude_velocity(out.timing.froude, hip), config.turn_rad_s});

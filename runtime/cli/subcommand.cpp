@@ -1,0 +1,26 @@
+#include "subcommand.hpp"
+
+#include <iostream>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::cli {
+
+void set_subcommand_body(CLI::App* cmd, std::function<int()> body) {
+  cmd->callback([body = std::move(body)] {
+    int code = 0;
+    try {
+      code = body();
+    } catch (const InputError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 2;
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      code = 1;
+    }
+    if (code != 0) throw CLI::RuntimeError(code);
+    throw CLI::Success();
+  });
+}
+
+}  // namespace animrt::cli

@@ -1,0 +1,15 @@
+#pragma once
+// How every subcommand other than run, validate and sim reports its result:
+// the body's exit code, an InputError as exit 2 (one line naming file, line
+// and key), any other error as exit 1. main() dispatches only its own
+// subcommands, so the outcome leaves CLI11's parse as an exception.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace animrt::cli {
+
+void set_subcommand_body(CLI::App* cmd, std::function<int()> body);
+
+}  // namespace animrt::cli
