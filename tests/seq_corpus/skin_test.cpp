@@ -11,6 +11,8 @@
 
 #include "animrt/controllers/gait/froude.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/controllers/seqnet/features.hpp"
+#include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/seq_corpus/body_field.hpp"
 #include "animrt/sim/seq_corpus/generator.hpp"
@@ -279,6 +281,38 @@ TEST(Schedule, EveryGaitFroudeTurnAndSeed) {
   for (const auto& c : schedule) names.insert(sequence_name(c));
   EXPECT_EQ(names.size(), schedule.size());
   EXPECT_THROW(model_preset("cat", "configs"), std::invalid_argument);
+}
+
+}  // namespace
+
+namespace {
+
+// The generated corpus goes through the deformation features and back like
+// the real clips: every walked frame within 0.2 % mean and 1 % max of the
+// bounding-box diagonal, up to a translation.
+TEST(Skin, WalkedFramesComeBackFromTheirFeatures) {
+  const ModelSkin& s = quadruped_skin();
+  const WalkConfig config{kRoot + "/configs/gaits/walk.yaml", 0.054, 5, 0.0};
+  WalkOptions options;
+  options.frames = 10;
+  const WalkRecord walk = walk_sequence(s.model, s.skin, config, options);
+  ASSERT_EQ(walk.mesh.frame_count(), 10);
+  const animrt::seqnet::SequenceFeatures features = animrt::seqnet::compute_features(walk.mesh);
+  const animrt::seqnet::Reconstructor solver(features.rest, features.triangles);
+  double worst_mean = 0.0;
+  for (int f = 0; f < walk.mesh.frame_count(); ++f) {
+    const animrt::seqnet::Positions got = solver.solve(features.raw(f));
+    const animrt::seqnet::FrameError e = animrt::seqnet::error_up_to_translation(
+        walk.mesh.frames[static_cast<std::size_t>(f)], got, solver.neighbourhood());
+    EXPECT_LT(e.mean, 0.002) << "frame " << f;
+    EXPECT_LT(e.max, 0.01) << "frame " << f;
+    worst_mean = std::max(worst_mean, e.mean);
+  }
+  // The walk moved the skin: the round trip is not of a still mesh.
+  const animrt::seqnet::FrameError moved = animrt::seqnet::error_up_to_translation(
+      walk.mesh.frames.front(), walk.mesh.frames.back(), solver.neighbourhood());
+  EXPECT_GT(moved.max, 0.01);
+  EXPECT_LT(worst_mean, moved.mean);
 }
 
 }  // namespace
