@@ -13,7 +13,9 @@ namespace {
 
 using namespace animrt::herd;
 
-std::string gait_of(const std::string& robot) { return animrt::load_robot_config(robot).motion.file; }
+std::string gait_of(const std::string& robot) {
+  return animrt::load_robot_config(robot).motion.file;
+}
 
 // The shipped pasture scene with its groups resized to `n` figures (half
 // flock, a quarter per crowd) and its ground grown to keep the density.
@@ -25,7 +27,8 @@ HerdScene scene_of(int n, bool crowds) {
   for (GroupSpec& g : s.groups) {
     // A flock alone has all n figures in its spawn area: twice the room.
     const double ks = crowds || g.kind == GroupKind::crowd ? k : k * std::sqrt(2.0);
-    g.spawn_m = {g.spawn_m.xmin * ks, g.spawn_m.ymin * ks, g.spawn_m.xmax * ks, g.spawn_m.ymax * ks};
+    g.spawn_m = {g.spawn_m.xmin * ks, g.spawn_m.ymin * ks, g.spawn_m.xmax * ks,
+                 g.spawn_m.ymax * ks};
     if (g.target_m) g.target_m = Vec2{g.target_m->x * k, g.target_m->y * k};
     if (g.leader) {
       Rect& w = g.leader->wander_m;

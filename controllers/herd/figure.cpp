@@ -14,8 +14,8 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
     const double error = std::atan2(cross(h, desired), dot(h, desired));
     // Walk on at no less than the slowest gait while turning toward a
     // velocity behind the figure: a gait turns only while it walks.
-    want.speed_m_s = std::clamp(wanted * std::max(std::cos(error), 0.0), walk.min_speed(),
-                                walk.max_speed());
+    want.speed_m_s =
+        std::clamp(wanted * std::max(std::cos(error), 0.0), walk.min_speed(), walk.max_speed());
     const double max_turn = walk.max_turn(want.speed_m_s);
     want.turn_rad_s = std::clamp(error / kHeadingTimeConstant_s, -max_turn, max_turn);
   }

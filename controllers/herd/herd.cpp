@@ -87,8 +87,9 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
                              " figures of radius " + format_number(r) +
                              " m clear of each other and of the walls");
       }
-      const Vec2 aim = spec.target_m ? *spec.target_m
-                                     : (spec.leader ? spec.leader->wander_m.center() : scene_.bounds_m.center());
+      const Vec2 aim =
+          spec.target_m ? *spec.target_m
+                        : (spec.leader ? spec.leader->wander_m.center() : scene_.bounds_m.center());
       a.heading = std::atan2(aim.y - a.position.y, aim.x - a.position.x);
       members[g].push_back(static_cast<int>(agents_.size()));
       agents_.push_back(a);
@@ -123,7 +124,9 @@ int Herd::find_agent(const std::string& name) const {
   return it == names_.end() ? -1 : static_cast<int>(it - names_.begin());
 }
 
-std::optional<Vec2> Herd::leader(int group) const { return groups_[static_cast<std::size_t>(group)]->leader(); }
+std::optional<Vec2> Herd::leader(int group) const {
+  return groups_[static_cast<std::size_t>(group)]->leader();
+}
 
 bool Herd::arrived(int agent) const {
   const int g = agents_[static_cast<std::size_t>(agent)].group;

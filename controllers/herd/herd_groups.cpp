@@ -114,15 +114,16 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                                                     const std::vector<std::vector<int>>& members,
                                                     std::span<const Agent> agents,
                                                     const std::vector<Figure>& figures,
-                                                    const std::vector<int>& figure_of, NavWorld* nav,
-                                                    std::unique_ptr<Crowd>& crowd) {
+                                                    const std::vector<int>& figure_of,
+                                                    NavWorld* nav, std::unique_ptr<Crowd>& crowd) {
   std::vector<std::unique_ptr<HerdGroup>> groups;
   CrowdParams crowd_params;
   double crowd_turn = 1e9;
   for (std::size_t g = 0; g < scene.groups.size(); ++g) {
     const GroupSpec& spec = scene.groups[g];
     if (spec.kind != GroupKind::crowd) continue;
-    const Figure& f = figures[static_cast<std::size_t>(figure_of[static_cast<std::size_t>(members[g].front())])];
+    const Figure& f =
+        figures[static_cast<std::size_t>(figure_of[static_cast<std::size_t>(members[g].front())])];
     crowd_turn = std::min(crowd_turn, f.walk.max_turn(spec.speed_mps->second));
   }
   for (std::size_t g = 0; g < scene.groups.size(); ++g) {
@@ -131,18 +132,25 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
     const std::string where = "groups[" + std::to_string(g) + "].params";
     if (spec.kind == GroupKind::unity) {
       UnityFlockParams p;
-      const Param table[] = {
-          {"min_speed", &p.min_speed, 0, 100},           {"turn_speed", &p.turn_speed, 0, 1000},
-          {"random_freq", &p.random_freq, 1e-6, 1000},   {"random_force", &p.random_force, 0, 1e4},
-          {"to_origin_force", &p.to_origin_force, 0, 1e4}, {"to_origin_range", &p.to_origin_range, 1e-6, 1e6},
-          {"gravity", &p.gravity, 0, 1e4},               {"avoidance_radius", &p.avoidance_radius, 1e-6, 1e6},
-          {"avoidance_force", &p.avoidance_force, 0, 1e4}, {"follow_velocity", &p.follow_velocity, 0, 1e4},
-          {"follow_radius", &p.follow_radius, 1e-6, 1e6}, {"max_length_delta", &p.max_length_delta, 0, 1e6}};
+      const Param table[] = {{"min_speed", &p.min_speed, 0, 100},
+                             {"turn_speed", &p.turn_speed, 0, 1000},
+                             {"random_freq", &p.random_freq, 1e-6, 1000},
+                             {"random_force", &p.random_force, 0, 1e4},
+                             {"to_origin_force", &p.to_origin_force, 0, 1e4},
+                             {"to_origin_range", &p.to_origin_range, 1e-6, 1e6},
+                             {"gravity", &p.gravity, 0, 1e4},
+                             {"avoidance_radius", &p.avoidance_radius, 1e-6, 1e6},
+                             {"avoidance_force", &p.avoidance_force, 0, 1e4},
+                             {"follow_velocity", &p.follow_velocity, 0, 1e4},
+                             {"follow_radius", &p.follow_radius, 1e-6, 1e6},
+                             {"max_length_delta", &p.max_length_delta, 0, 1e6}};
       read_params(spec.params, table);
       validate(p);
-      auto flock = std::make_unique<UnityFlock>(members[g], p, make_leader(spec, seed), seed, agents.size());
+      auto flock =
+          std::make_unique<UnityFlock>(members[g], p, make_leader(spec, seed), seed, agents.size());
       const UnityFlock* view = flock.get();
-      groups.push_back(std::make_unique<FlockGroup>(std::move(flock), [view] { return view->leader().position(); }));
+      groups.push_back(std::make_unique<FlockGroup>(std::move(flock),
+                                                    [view] { return view->leader().position(); }));
     } else if (spec.kind == GroupKind::reynolds) {
       ReynoldsFlockParams p;
       double flock_size = spec.count;
@@ -157,17 +165,20 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                              {"separation_radius", &p.separation_radius, 1e-6, 1e6}};
       read_params(spec.params, table);
       if (static_cast<int>(flock_size) != spec.count) {
-        throw InputError(spec.params->at("flock_size").location(), where + ".flock_size",
-                         "the flock size is the group's count (" + std::to_string(spec.count) + ")");
+        throw InputError(
+            spec.params->at("flock_size").location(), where + ".flock_size",
+            "the flock size is the group's count (" + std::to_string(spec.count) + ")");
       }
       if (p.min_velocity > p.max_velocity) {
         throw InputError(spec.where, where, "min_velocity must not exceed max_velocity");
       }
       p.flock_size = spec.count;
       validate(p);
-      auto flock = std::make_unique<ReynoldsFlock>(members[g], p, make_leader(spec, seed), seed, agents.size());
+      auto flock = std::make_unique<ReynoldsFlock>(members[g], p, make_leader(spec, seed), seed,
+                                                   agents.size());
       const ReynoldsFlock* view = flock.get();
-      groups.push_back(std::make_unique<FlockGroup>(std::move(flock), [view] { return view->leader().position(); }));
+      groups.push_back(std::make_unique<FlockGroup>(std::move(flock),
+                                                    [view] { return view->leader().position(); }));
     } else {
       if (!crowd) {
         crowd_params.figure_turn_rad_s = crowd_turn;
@@ -182,10 +193,12 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                              {"assign_distance_m", &p.assign_distance_m, 0, 1e4},
                              {"arrive_tolerance_m", &p.arrive_tolerance_m, 0.001, 100}};
       read_params(spec.params, table);
-      const Figure& f = figures[static_cast<std::size_t>(figure_of[static_cast<std::size_t>(members[g].front())])];
+      const Figure& f = figures[static_cast<std::size_t>(
+          figure_of[static_cast<std::size_t>(members[g].front())])];
       if (p.speed_max_mps > f.walk.max_speed() * (1 + 1e-9)) {
         throw InputError(spec.where, "groups[" + std::to_string(g) + "].speed_mps",
-                         "figure '" + f.name + "' walks at most " + format_number(f.walk.max_speed()) +
+                         "figure '" + f.name + "' walks at most " +
+                             format_number(f.walk.max_speed()) +
                              " m/s (its gait's steering range)");
       }
       for (int i : members[g]) {
@@ -195,7 +208,8 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                                std::to_string(i - members[g].front()) + ")");
         }
       }
-      groups.push_back(std::make_unique<CrowdTeam>(std::make_unique<CrowdGroup>(*crowd, agents, members[g], p)));
+      groups.push_back(
+          std::make_unique<CrowdTeam>(std::make_unique<CrowdGroup>(*crowd, agents, members[g], p)));
     }
   }
   return groups;

@@ -25,7 +25,7 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                                                     const std::vector<std::vector<int>>& members,
                                                     std::span<const Agent> agents,
                                                     const std::vector<Figure>& figures,
-                                                    const std::vector<int>& figure_of, NavWorld* nav,
-                                                    std::unique_ptr<Crowd>& crowd);
+                                                    const std::vector<int>& figure_of,
+                                                    NavWorld* nav, std::unique_ptr<Crowd>& crowd);
 
 }  // namespace animrt::herd

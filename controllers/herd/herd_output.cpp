@@ -14,10 +14,12 @@ namespace {
 const char* const kPalette[] = {"#d62728", "#1f77b4", "#2ca02c", "#9467bd",
                                 "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
 
-const char* group_colour(int g) { return kPalette[static_cast<std::size_t>(g) % std::size(kPalette)]; }
+const char* group_colour(int g) {
+  return kPalette[static_cast<std::size_t>(g) % std::size(kPalette)];
+}
 
-std::string box_polygon(const Box& b, double (*sx)(double, const Rect&), double (*sy)(double, const Rect&),
-                        const Rect& r) {
+std::string box_polygon(const Box& b, double (*sx)(double, const Rect&),
+                        double (*sy)(double, const Rect&), const Rect& r) {
   const Vec2 ax = heading_vector(b.yaw_rad);
   const Vec2 ay{-ax.y, ax.x};
   std::string pts;
@@ -62,12 +64,16 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
   if (!out) throw std::runtime_error(path + ": cannot write the top view");
   const double w = (r.xmax - r.xmin) * kPixelsPerMetre, h = (r.ymax - r.ymin) * kPixelsPerMetre;
   out << fmt::format(
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" viewBox=\"0 0 {:.0f} "
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" viewBox=\"0 0 "
+      "{:.0f} "
       "{:.0f}\">\n",
       w, h, w, h);
   out << fmt::format("<title>{} (top view, {:.0f} px per metre)</title>\n",
                      scene.name.empty() ? scene.file : scene.name, kPixelsPerMetre);
-  out << fmt::format("<rect x=\"0\" y=\"0\" width=\"{:.0f}\" height=\"{:.0f}\" fill=\"#f7f7f2\" stroke=\"#333\"/>\n", w, h);
+  out << fmt::format(
+      "<rect x=\"0\" y=\"0\" width=\"{:.0f}\" height=\"{:.0f}\" fill=\"#f7f7f2\" "
+      "stroke=\"#333\"/>\n",
+      w, h);
   for (const Box& b : scene.walls) {
     out << "<polygon points=\"" << box_polygon(b, to_x, to_y, r) << "\" fill=\"#555\"/>\n";
   }
@@ -78,23 +84,27 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
   for (std::size_t i = 0; i < trails_.size(); ++i) {
     const int g = herd.agents()[i].group;
     std::string pts;
-    for (const Vec2& p : trails_[i]) pts += fmt::format("{:.2f},{:.2f} ", to_x(p.x, r), to_y(p.y, r));
-    out << fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1\" "
-                       "stroke-opacity=\"0.6\"/>\n",
-                       pts, group_colour(g));
+    for (const Vec2& p : trails_[i])
+      pts += fmt::format("{:.2f},{:.2f} ", to_x(p.x, r), to_y(p.y, r));
+    out << fmt::format(
+        "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1\" "
+        "stroke-opacity=\"0.6\"/>\n",
+        pts, group_colour(g));
   }
   for (std::size_t i = 0; i < herd.agents().size(); ++i) {
     const Agent& a = herd.agents()[i];
-    out << fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"{:.2f}\" fill=\"{}\"/>\n", to_x(a.position.x, r),
-                       to_y(a.position.y, r), a.radius * kPixelsPerMetre, group_colour(a.group));
+    out << fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"{:.2f}\" fill=\"{}\"/>\n",
+                       to_x(a.position.x, r), to_y(a.position.y, r), a.radius * kPixelsPerMetre,
+                       group_colour(a.group));
   }
   for (std::size_t g = 0; g < scene.groups.size(); ++g) {
     const GroupSpec& spec = scene.groups[g];
     if (!spec.target_m) continue;
     const Vec2 t = *spec.target_m;
-    out << fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"8\" fill=\"none\" stroke=\"{}\" "
-                       "stroke-width=\"3\"/>\n",
-                       to_x(t.x, r), to_y(t.y, r), group_colour(static_cast<int>(g)));
+    out << fmt::format(
+        "<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"8\" fill=\"none\" stroke=\"{}\" "
+        "stroke-width=\"3\"/>\n",
+        to_x(t.x, r), to_y(t.y, r), group_colour(static_cast<int>(g)));
   }
   out << "</svg>\n";
   if (!out) throw std::runtime_error(path + ": cannot write the top view");
@@ -102,22 +112,25 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
 
 std::string format_metrics(const HerdMetrics& m) {
   std::string s = fmt::format(
-      "herd: {:.1f} s, {} collisions, min pair distance {:.3f} m (clearance {:.3f} m), {} contact stops\n",
+      "herd: {:.1f} s, {} collisions, min pair distance {:.3f} m (clearance {:.3f} m), {} contact "
+      "stops\n",
       m.duration_s, m.collisions, m.min_pair_distance_m, m.min_clearance_m, m.contact_stops);
   for (const GroupMetrics& g : m.groups) {
-    s += fmt::format("  {} ({}, {} figures): {} collisions, order {:.3f} mean / {:.3f} min, "
-                     "nearest neighbour {:.2f} m",
-                     g.name, g.kind, g.agents, g.collisions, g.order_mean, g.order_min,
-                     g.nearest_neighbour_mean_m);
+    s += fmt::format(
+        "  {} ({}, {} figures): {} collisions, order {:.3f} mean / {:.3f} min, "
+        "nearest neighbour {:.2f} m",
+        g.name, g.kind, g.agents, g.collisions, g.order_mean, g.order_min,
+        g.nearest_neighbour_mean_m);
     if (g.leader_distance_mean_m >= 0) {
       s += fmt::format(", leader {:.2f} m mean / {:.2f} m max", g.leader_distance_mean_m,
                        g.leader_distance_max_m);
     }
     if (g.arrivals >= 0) {
-      s += fmt::format(", arrived {}/{}, time to goal {:.1f} s mean / {:.1f} s max ({:.2f} x straight-line "
-                       "time at most), path {:.2f} x straight mean / {:.2f} max, stuck {}",
-                       g.arrivals, g.agents, g.time_to_goal_mean_s, g.time_to_goal_max_s, g.time_ratio_max,
-                       g.path_ratio_mean, g.path_ratio_max, g.stuck);
+      s += fmt::format(
+          ", arrived {}/{}, time to goal {:.1f} s mean / {:.1f} s max ({:.2f} x straight-line "
+          "time at most), path {:.2f} x straight mean / {:.2f} max, stuck {}",
+          g.arrivals, g.agents, g.time_to_goal_mean_s, g.time_to_goal_max_s, g.time_ratio_max,
+          g.path_ratio_mean, g.path_ratio_max, g.stuck);
     }
     s += "\n";
   }

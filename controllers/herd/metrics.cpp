@@ -40,7 +40,8 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
   // Pairs closer than the sum of radii, by a sweep over x.
   std::iota(order_.begin(), order_.end(), 0);
   std::sort(order_.begin(), order_.end(), [&](int a, int b) {
-    return agents[static_cast<std::size_t>(a)].position.x < agents[static_cast<std::size_t>(b)].position.x;
+    return agents[static_cast<std::size_t>(a)].position.x <
+           agents[static_cast<std::size_t>(b)].position.x;
   });
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = static_cast<std::size_t>(order_[k]);
@@ -77,12 +78,14 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
     for (std::size_t m = k + 1; m < n; ++m) {
       const Agent& b = agents[static_cast<std::size_t>(order_[m])];
       if (b.position.x - a.position.x > best) break;
-      if (group_of_[static_cast<std::size_t>(order_[m])] == group_of_[i]) best = std::min(best, norm(b.position - a.position));
+      if (group_of_[static_cast<std::size_t>(order_[m])] == group_of_[i])
+        best = std::min(best, norm(b.position - a.position));
     }
     for (std::size_t m = k; m-- > 0;) {
       const Agent& b = agents[static_cast<std::size_t>(order_[m])];
       if (a.position.x - b.position.x > best) break;
-      if (group_of_[static_cast<std::size_t>(order_[m])] == group_of_[i]) best = std::min(best, norm(b.position - a.position));
+      if (group_of_[static_cast<std::size_t>(order_[m])] == group_of_[i])
+        best = std::min(best, norm(b.position - a.position));
     }
   }
 
@@ -186,7 +189,8 @@ HerdMetrics MetricsRecorder::finish() const {
           path_sum += path;
           gm.path_ratio_max = std::max(gm.path_ratio_max, path);
           const double v = max_speed_[static_cast<std::size_t>(i)];
-          if (v > 0) gm.time_ratio_max = std::max(gm.time_ratio_max, tr.arrived_at / (straight / v));
+          if (v > 0)
+            gm.time_ratio_max = std::max(gm.time_ratio_max, tr.arrived_at / (straight / v));
         }
       }
       if (gm.arrivals > 0) {

@@ -50,7 +50,8 @@ Box box(const YamlNode& node) {
   Box b;
   b.center = point(node.at("center_m"));
   b.size = positive_size(node.at("size_m"));
-  if (auto y = node.find("yaw_deg")) b.yaw_rad = y->as_double_in(-360, 360) * std::numbers::pi / 180;
+  if (auto y = node.find("yaw_deg"))
+    b.yaw_rad = y->as_double_in(-360, 360) * std::numbers::pi / 180;
   return b;
 }
 
@@ -83,7 +84,8 @@ LeaderSpec leader(const YamlNode& node, const Rect& bounds) {
   if (auto s = node.find("speed_mps")) l.speed_mps = s->as_double_in(0.001, 10.0);
   if (auto r = node.find("reach_m")) l.reach_m = r->as_double_in(0.01, 100.0);
   if (auto g = node.find("turn_gain")) l.turn_gain = g->as_double_in(0.001, 100.0);
-  if (auto m = node.find("max_turn_dps")) l.max_turn_rad_s = m->as_double_in(0.01, 36000.0) * std::numbers::pi / 180;
+  if (auto m = node.find("max_turn_dps"))
+    l.max_turn_rad_s = m->as_double_in(0.01, 36000.0) * std::numbers::pi / 180;
   return l;
 }
 
@@ -93,7 +95,8 @@ GroupSpec group(const YamlNode& node, const HerdScene& scene, std::set<std::stri
   const YamlNode kind = node.at("kind");
   g.kind = kind_of(kind);
   if (g.kind == GroupKind::crowd) {
-    node.allow_only({"name", "kind", "figure", "count", "spawn_m", "target_m", "speed_mps", "params"});
+    node.allow_only(
+        {"name", "kind", "figure", "count", "spawn_m", "target_m", "speed_mps", "params"});
   } else {
     node.allow_only({"name", "kind", "figure", "count", "spawn_m", "leader", "params"});
   }
@@ -148,14 +151,15 @@ int HerdScene::agent_count() const {
 }
 
 HerdScene parse_herd_scene(const YamlNode& root) {
-  root.allow_only({"name", "seed", "bounds_m", "walls", "moving_obstacles", "geometry_obj", "figures",
-                   "groups", "step_s", "output_hz", "duration_s"});
+  root.allow_only({"name", "seed", "bounds_m", "walls", "moving_obstacles", "geometry_obj",
+                   "figures", "groups", "step_s", "output_hz", "duration_s"});
   namespace fs = std::filesystem;
   const fs::path folder = fs::path(root.file()).parent_path();
   HerdScene scene;
   scene.file = root.file();
   scene.name = root.get_string("name", "");
-  if (auto s = root.find("seed")) scene.seed = static_cast<std::uint64_t>(s->as_int_in(0, INT64_MAX));
+  if (auto s = root.find("seed"))
+    scene.seed = static_cast<std::uint64_t>(s->as_int_in(0, INT64_MAX));
   scene.bounds_m = rect(root.at("bounds_m"));
   if (auto s = root.find("step_s")) scene.step_s = s->as_double_in(0.001, 1.0);
   if (auto s = root.find("output_hz")) scene.output_hz = s->as_double_in(0.01, 1000.0);

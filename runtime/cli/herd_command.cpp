@@ -3,19 +3,18 @@
 
 #include "herd_command.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "animrt/controllers/herd/herd_output.hpp"
 #include "animrt/core/error.hpp"
-#include "subcommand.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -103,12 +102,13 @@ int run_herd(const HerdArgs& a) {
     if (!a.quiet && now - last_progress > std::chrono::seconds(2)) {
       last_progress = now;
       const double wall = std::chrono::duration<double>(now - start).count();
-      std::cout << "  t " << herd.time() << " s of " << s.duration_s << " s, "
-                << herd.time() / wall << " x real time\n"
+      std::cout << "  t " << herd.time() << " s of " << s.duration_s << " s, " << herd.time() / wall
+                << " x real time\n"
                 << std::flush;
     }
   }
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const herd::HerdMetrics metrics = herd.metrics();
   std::cout << herd::format_metrics(metrics);
   std::cout << "ran " << s.duration_s << " s in " << wall_s << " s (" << s.duration_s / wall_s

@@ -3,7 +3,6 @@
 // than real time (docs/herd.md).
 
 #include <CLI/CLI.hpp>
-
 #include <string>
 
 #include "animrt/controllers/herd/herd.hpp"

@@ -10,8 +10,9 @@
 
 namespace animrt::cli {
 
-EmbodiedHerd::EmbodiedHerd(const std::string& scene_file, const std::string& agent, const Clock& clock,
-                           RunControls& controls, const sim::MujocoJointPhysics* physics)
+EmbodiedHerd::EmbodiedHerd(const std::string& scene_file, const std::string& agent,
+                           const Clock& clock, RunControls& controls,
+                           const sim::MujocoJointPhysics* physics)
     : clock_(clock), controls_(controls), physics_(physics) {
   herd::HerdScene scene = herd::load_herd_scene(scene_file);
   herd_ = std::make_unique<herd::Herd>(std::move(scene), gait_of_robot);
@@ -42,8 +43,7 @@ void EmbodiedHerd::stop() {
 
 void EmbodiedHerd::loop() {
   const double dt = herd_->scene().step_s;
-  const long steps_per_output =
-      std::max(1L, std::lround(1.0 / (herd_->scene().output_hz * dt)));
+  const long steps_per_output = std::max(1L, std::lround(1.0 / (herd_->scene().output_hz * dt)));
   long steps = 0;
   herd::Vec2 last_position = spawn_;
   double last_heading = spawn_heading_;
@@ -77,19 +77,22 @@ void EmbodiedHerd::loop() {
 std::string EmbodiedHerd::report() const {
   const herd::Agent& a = herd_->agents()[static_cast<std::size_t>(agent_)];
   std::string s = fmt::format(
-      "herd: {:.1f} s stepped; agent {} ({}) walked from ({:.2f}, {:.2f}) to ({:.2f}, {:.2f}) m, heading "
+      "herd: {:.1f} s stepped; agent {} ({}) walked from ({:.2f}, {:.2f}) to ({:.2f}, {:.2f}) m, "
+      "heading "
       "{:.2f} rad, last command {:.3f} m/s, {:.3f} rad/s",
-      herd_->time(), herd_->agent_name(agent_), physics_ ? "measured by physics" : "as its gait achieves",
-      spawn_.x, spawn_.y, a.position.x, a.position.y, a.heading,
-      herd_->commands()[static_cast<std::size_t>(agent_)].speed_m_s,
+      herd_->time(), herd_->agent_name(agent_),
+      physics_ ? "measured by physics" : "as its gait achieves", spawn_.x, spawn_.y, a.position.x,
+      a.position.y, a.heading, herd_->commands()[static_cast<std::size_t>(agent_)].speed_m_s,
       herd_->commands()[static_cast<std::size_t>(agent_)].turn_rad_s);
   const auto& group = herd_->scene().groups[static_cast<std::size_t>(a.group)];
   if (group.target_m) {
-    s += fmt::format("; distance to its goal {:.2f} -> {:.2f} m", herd::norm(*group.target_m - spawn_),
-                     herd::norm(*group.target_m - a.position));
+    s +=
+        fmt::format("; distance to its goal {:.2f} -> {:.2f} m",
+                    herd::norm(*group.target_m - spawn_), herd::norm(*group.target_m - a.position));
   }
   const herd::HerdMetrics m = herd_->metrics();
-  s += fmt::format("\nherd: {} collisions, min clearance {:.3f} m", m.collisions, m.min_clearance_m);
+  s +=
+      fmt::format("\nherd: {} collisions, min clearance {:.3f} m", m.collisions, m.min_clearance_m);
   return s;
 }
 

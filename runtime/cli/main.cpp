@@ -27,9 +27,9 @@
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
 #include "gait_command.hpp"
+#include "head_command.hpp"
 #include "herd_command.hpp"
 #include "herd_driver.hpp"
-#include "head_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
 
@@ -162,8 +162,9 @@ int cmd_run(const RunArgs& args) {
   }
   std::unique_ptr<animrt::cli::EmbodiedHerd> herd;
   if (!args.herd.empty()) {
-    const animrt::Clock& run_clock = args.lockstep ? static_cast<const animrt::Clock&>(lockstep_clock)
-                                                   : static_cast<const animrt::Clock&>(wall_clock);
+    const animrt::Clock& run_clock = args.lockstep
+                                         ? static_cast<const animrt::Clock&>(lockstep_clock)
+                                         : static_cast<const animrt::Clock&>(wall_clock);
     herd = std::make_unique<animrt::cli::EmbodiedHerd>(args.herd, args.agent, run_clock, g_controls,
                                                        physics.get());
     spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
@@ -268,7 +269,8 @@ int main(int argc, char** argv) {
 
   run->add_option("--herd", run_args.herd,
                   "herd scene (YAML): the robot walks as one of its agents (needs --agent)");
-  run->add_option("--agent", run_args.agent, "the herd agent the robot is, GROUP.INDEX (e.g. red.0)");
+  run->add_option("--agent", run_args.agent,
+                  "the herd agent the robot is, GROUP.INDEX (e.g. red.0)");
 
   std::string sim_path;
   auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");

@@ -3,7 +3,6 @@
 // frames.
 
 #include "seq_command.hpp"
-#include "subcommand.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -85,7 +85,6 @@ int run_reconstruct(const SeqArgs& a) {
   std::cout << a.input << ": " << out.frames.size() << " frames -> " << a.out << "/frame_*.obj\n";
   return 0;
 }
-
 
 }  // namespace
 

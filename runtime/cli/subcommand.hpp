@@ -5,7 +5,6 @@
 // subcommands, so the outcome leaves CLI11's parse as an exception.
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 
 namespace animrt::cli {

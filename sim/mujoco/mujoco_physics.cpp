@@ -158,8 +158,8 @@ TorsoPose MujocoJointPhysics::torso_pose() const {
   TorsoPose pose;
   pose.x_m = c * dx + s * dy;
   pose.y_m = -s * dx + c * dy;
-  pose.yaw_rad = std::remainder(std::atan2(data_->xmat[9 * torso + 3], data_->xmat[9 * torso]) - yaw0_,
-                                2.0 * M_PI);
+  pose.yaw_rad = std::remainder(
+      std::atan2(data_->xmat[9 * torso + 3], data_->xmat[9 * torso]) - yaw0_, 2.0 * M_PI);
   pose.time_s = data_->time;
   return pose;
 }

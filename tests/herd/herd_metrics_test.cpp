@@ -26,8 +26,11 @@ struct Fixture {
   std::vector<std::optional<Vec2>> leaders;
   std::vector<char> arrived;
   std::vector<double> max_speed;
-  Fixture(std::vector<Agent> a, int groups) : agents(std::move(a)), leaders(static_cast<std::size_t>(groups)),
-      arrived(agents.size(), 0), max_speed(agents.size(), 0.1) {}
+  Fixture(std::vector<Agent> a, int groups)
+      : agents(std::move(a)),
+        leaders(static_cast<std::size_t>(groups)),
+        arrived(agents.size(), 0),
+        max_speed(agents.size(), 0.1) {}
 };
 
 std::vector<GroupInfo> one_group(int n, std::optional<Vec2> target = {}) {
@@ -50,7 +53,8 @@ TEST(HerdMetrics, CountsPairsCloserThanTheirRadii) {
 
 TEST(HerdMetrics, CollisionsAcrossGroupsCountForBoth) {
   Fixture f({at(0, 0, 0, 0.1, 0), at(0.3, 0, 0, 0.1, 1)}, 2);
-  MetricsRecorder r({GroupInfo{"a", "unity", {0}, {}}, GroupInfo{"b", "crowd", {1}, Vec2{9, 9}}}, f.agents, 0.0);
+  MetricsRecorder r({GroupInfo{"a", "unity", {0}, {}}, GroupInfo{"b", "crowd", {1}, Vec2{9, 9}}},
+                    f.agents, 0.0);
   r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
   const HerdMetrics m = r.finish();
   EXPECT_EQ(m.collisions, 1);
@@ -97,7 +101,8 @@ TEST(HerdMetrics, OrderParameterAfterSettling) {
 TEST(HerdMetrics, NearestNeighbourWithinTheGroupOnly) {
   // Agent 2 (other group) sits closest to agent 0 but does not count.
   Fixture f({at(0, 0, 0, 0.1, 0), at(3, 0, 0, 0.1, 0), at(0.1, 2, 0, 0.1, 1)}, 2);
-  MetricsRecorder r({GroupInfo{"a", "unity", {0, 1}, {}}, GroupInfo{"b", "unity", {2}, {}}}, f.agents, 0.0);
+  MetricsRecorder r({GroupInfo{"a", "unity", {0, 1}, {}}, GroupInfo{"b", "unity", {2}, {}}},
+                    f.agents, 0.0);
   r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
   EXPECT_NEAR(r.finish().groups[0].nearest_neighbour_mean_m, 3.0, 1e-12);
 }

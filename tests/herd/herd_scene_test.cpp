@@ -32,14 +32,16 @@ TEST(HerdScene, LoadsEveryKey) {
       "name: crossing\nseed: 7\nbounds_m: [-20, -10, 20, 10]\nstep_s: 0.05\noutput_hz: 5\n"
       "duration_s: 60\n"
       "walls:\n  - {center_m: [0, 4], size_m: [0.5, 6], yaw_deg: 90}\n"
-      "moving_obstacles:\n  - {center_m: [0, -3], size_m: [0.5, 4], period_s: 8, down_fraction: 0.25, "
+      "moving_obstacles:\n  - {center_m: [0, -3], size_m: [0.5, 4], period_s: 8, down_fraction: "
+      "0.25, "
       "phase_s: 2}\n" +
       kFigures +
       "groups:\n"
       "  - {name: red, kind: crowd, figure: pony, count: 20, spawn_m: [-18, -8, -14, 8],\n"
       "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n"
       "  - {name: flock, kind: reynolds, figure: pony, count: 30, spawn_m: [-5, -5, 5, 5],\n"
-      "     leader: {wander_m: [-15, -8, 15, 8], speed_mps: 0.08, reach_m: 2}, params: {center_weight: 2}}\n");
+      "     leader: {wander_m: [-15, -8, 15, 8], speed_mps: 0.08, reach_m: 2}, params: "
+      "{center_weight: 2}}\n");
   EXPECT_EQ(s.name, "crossing");
   EXPECT_EQ(s.seed, 7u);
   EXPECT_DOUBLE_EQ(s.bounds_m.xmin, -20);
@@ -71,75 +73,88 @@ TEST(HerdScene, LoadsEveryKey) {
 const std::string kHead = "bounds_m: [-20, -10, 20, 10]\n" + kFigures + "groups:\n";
 
 TEST(HerdScene, UnknownKeyNamesItsLine) {
-  const std::string e = error_of(kHead +
-                                 "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
-                                 "     target_m: [16, 0], speed_mps: [0.05, 0.1], colour: red}\n");
+  const std::string e =
+      error_of(kHead +
+               "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
+               "     target_m: [16, 0], speed_mps: [0.05, 0.1], colour: red}\n");
   EXPECT_NE(e.find("scene.yaml:6:"), std::string::npos) << e;
   EXPECT_NE(e.find("colour"), std::string::npos) << e;
 }
 
 TEST(HerdScene, FlockKeysAreNotCrowdKeys) {
-  const std::string e = error_of(kHead +
-                                 "  - {name: f, kind: unity, figure: pony, count: 2, spawn_m: [-1, -1, 1, 1],\n"
-                                 "     leader: {wander_m: [-5, -5, 5, 5]}, target_m: [1, 1]}\n");
+  const std::string e =
+      error_of(kHead +
+               "  - {name: f, kind: unity, figure: pony, count: 2, spawn_m: [-1, -1, 1, 1],\n"
+               "     leader: {wander_m: [-5, -5, 5, 5]}, target_m: [1, 1]}\n");
   EXPECT_NE(e.find("target_m"), std::string::npos) << e;
 }
 
 TEST(HerdScene, WrongTypeNamesTheKey) {
-  const std::string e = error_of(kHead +
-                                 "  - {name: red, kind: crowd, figure: pony, count: many, spawn_m: [-18, -8, -14, 8],\n"
-                                 "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n");
+  const std::string e = error_of(
+      kHead +
+      "  - {name: red, kind: crowd, figure: pony, count: many, spawn_m: [-18, -8, -14, 8],\n"
+      "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n");
   EXPECT_NE(e.find("groups[0].count"), std::string::npos) << e;
   EXPECT_NE(e.find("scene.yaml:5:"), std::string::npos) << e;
 }
 
 TEST(HerdScene, SpawnOutsideTheBounds) {
-  const std::string e = error_of(kHead +
-                                 "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-25, -8, -14, 8],\n"
-                                 "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n");
+  const std::string e =
+      error_of(kHead +
+               "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-25, -8, -14, 8],\n"
+               "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n");
   EXPECT_NE(e.find("groups[0].spawn_m"), std::string::npos) << e;
   EXPECT_NE(e.find("inside bounds_m"), std::string::npos) << e;
 }
 
 TEST(HerdScene, TargetOutsideTheBounds) {
-  const std::string e = error_of(kHead +
-                                 "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
-                                 "     target_m: [26, 0], speed_mps: [0.05, 0.1]}\n");
+  const std::string e =
+      error_of(kHead +
+               "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
+               "     target_m: [26, 0], speed_mps: [0.05, 0.1]}\n");
   EXPECT_NE(e.find("groups[0].target_m"), std::string::npos) << e;
 }
 
 TEST(HerdScene, UnknownFigureAndKind) {
-  EXPECT_NE(error_of(kHead + "  - {name: red, kind: crowd, figure: horse, count: 2, spawn_m: [-18, -8, -14, 8],\n"
-                             "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n")
-                .find("no figure named 'horse'"),
-            std::string::npos);
-  EXPECT_NE(error_of(kHead + "  - {name: red, kind: swarm, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8]}\n")
-                .find("groups[0].kind"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(kHead +
+               "  - {name: red, kind: crowd, figure: horse, count: 2, spawn_m: [-18, -8, -14, 8],\n"
+               "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n")
+          .find("no figure named 'horse'"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(kHead +
+               "  - {name: red, kind: swarm, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8]}\n")
+          .find("groups[0].kind"),
+      std::string::npos);
 }
 
 TEST(HerdScene, DuplicateGroupNames) {
-  const std::string g = "  - {name: a, kind: unity, figure: pony, count: 2, spawn_m: [-1, -1, 1, 1],\n"
-                        "     leader: {wander_m: [-5, -5, 5, 5]}}\n";
+  const std::string g =
+      "  - {name: a, kind: unity, figure: pony, count: 2, spawn_m: [-1, -1, 1, 1],\n"
+      "     leader: {wander_m: [-5, -5, 5, 5]}}\n";
   EXPECT_NE(error_of(kHead + g + g).find("already defined"), std::string::npos);
 }
 
 TEST(HerdScene, BadRectanglesAndSizes) {
   EXPECT_NE(error_of("bounds_m: [20, -10, -20, 10]\n" + kFigures + "groups: []\n").find("bounds_m"),
             std::string::npos);
-  EXPECT_NE(error_of("bounds_m: [-20, -10, 20, 10]\nwalls:\n  - {center_m: [0, 0], size_m: [0, 1]}\n" +
-                     kFigures + "groups: []\n")
-                .find("walls[0].size_m"),
-            std::string::npos);
-  EXPECT_NE(error_of(kHead + "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
-                             "     target_m: [16, 0], speed_mps: [0.2, 0.1]}\n")
-                .find("speed_mps"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("bounds_m: [-20, -10, 20, 10]\nwalls:\n  - {center_m: [0, 0], size_m: [0, 1]}\n" +
+               kFigures + "groups: []\n")
+          .find("walls[0].size_m"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(kHead +
+               "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
+               "     target_m: [16, 0], speed_mps: [0.2, 0.1]}\n")
+          .find("speed_mps"),
+      std::string::npos);
 }
 
 TEST(HerdScene, MissingFigureFile) {
-  const std::string e =
-      error_of("bounds_m: [-20, -10, 20, 10]\nfigures:\n  pony: {robot: no/such/robot.yaml}\ngroups: []\n");
+  const std::string e = error_of(
+      "bounds_m: [-20, -10, 20, 10]\nfigures:\n  pony: {robot: no/such/robot.yaml}\ngroups: []\n");
   EXPECT_NE(e.find("figures.pony.robot"), std::string::npos) << e;
   EXPECT_NE(e.find("no such file"), std::string::npos) << e;
 }

@@ -73,7 +73,8 @@ TEST(HerdScenes, AnObstacleDownHoldsTheCrowdBackAndUpLetsItPass) {
   EXPECT_FALSE(crossed_while_down);
   EXPECT_GT(first_across, 60.0);
   int arrived = 0;
-  for (int i = 0; i < static_cast<int>(herd.agents().size()); ++i) arrived += herd.arrived(i) ? 1 : 0;
+  for (int i = 0; i < static_cast<int>(herd.agents().size()); ++i)
+    arrived += herd.arrived(i) ? 1 : 0;
   EXPECT_EQ(arrived, static_cast<int>(herd.agents().size()));
 }
 

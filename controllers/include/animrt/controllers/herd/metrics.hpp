@@ -18,10 +18,10 @@ struct GroupMetrics {
   std::string name;
   std::string kind;
   int agents = 0;
-  long collisions = 0;         // agent-pair-steps with one member in this group
-  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group
-  double order_mean = 0.0;     // |sum v| / (N mean |v|), mean over steps after settling
-  double order_min = 0.0;      // its minimum over those steps
+  long collisions = 0;                    // agent-pair-steps with one member in this group
+  double min_pair_distance_m = 0.0;       // centre distance, over pairs touching this group
+  double order_mean = 0.0;                // |sum v| / (N mean |v|), mean over steps after settling
+  double order_min = 0.0;                 // its minimum over those steps
   double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
   double leader_distance_mean_m = -1.0;   // flocks: centre to leader (-1: no leader)
   double leader_distance_max_m = -1.0;
@@ -37,11 +37,11 @@ struct GroupMetrics {
 
 struct HerdMetrics {
   double duration_s = 0.0;
-  long steps = 0;           // output steps sampled
-  long collisions = 0;      // agent-pair-steps, whole scene
+  long steps = 0;       // output steps sampled
+  long collisions = 0;  // agent-pair-steps, whole scene
   double min_pair_distance_m = 0.0;
   double min_clearance_m = 0.0;  // min over pairs of distance - sum of radii
-  long contact_stops = 0;  // figure-steps stopped by the herd's contact guard
+  long contact_stops = 0;        // figure-steps stopped by the herd's contact guard
   std::vector<GroupMetrics> groups;
 };
 

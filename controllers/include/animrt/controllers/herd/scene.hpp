@@ -18,8 +18,8 @@ namespace animrt::herd {
 
 struct FigureSpec {
   std::string name;
-  std::string robot;    // robot file (its gait is the figure's gait), or ""
-  std::string gait;     // gait file, when no robot file is given, or ""
+  std::string robot;  // robot file (its gait is the figure's gait), or ""
+  std::string gait;   // gait file, when no robot file is given, or ""
   double radius_m = 0.25;
   Location where;
 };
@@ -27,9 +27,9 @@ struct FigureSpec {
 enum class GroupKind { crowd, unity, reynolds };
 
 struct LeaderSpec {
-  Rect wander_m;         // the leader picks its points inside this rectangle
+  Rect wander_m;  // the leader picks its points inside this rectangle
   double speed_mps = 0.1;
-  double reach_m = 1.0;  // a point this close counts as reached
+  double reach_m = 1.0;    // a point this close counts as reached
   double turn_gain = 1.0;  // 1/s: how fast it turns toward its point (per second, of the angle)
   double max_turn_rad_s = 1e9;
   Location where;
@@ -41,10 +41,10 @@ struct GroupSpec {
   std::string figure;  // a FigureSpec name
   int count = 1;
   Rect spawn_m;
-  std::optional<Vec2> target_m;                 // crowds
+  std::optional<Vec2> target_m;                        // crowds
   std::optional<std::pair<double, double>> speed_mps;  // crowds: random speed range
-  std::optional<LeaderSpec> leader;             // flocks
-  std::optional<YamlNode> params;               // the kind's parameters, read by make_herd
+  std::optional<LeaderSpec> leader;                    // flocks
+  std::optional<YamlNode> params;                      // the kind's parameters, read by make_herd
   Location where;
   Location spawn_where, target_where;
 };
