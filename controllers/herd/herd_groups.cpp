@@ -7,7 +7,6 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <numbers>
 
 #include "animrt/controllers/herd/crowd.hpp"
 #include "animrt/controllers/herd/nav_world.hpp"

@@ -42,6 +42,18 @@ void EmbodiedHerd::stop() {
 }
 
 void EmbodiedHerd::loop() {
+  try {
+    step_until_quit();
+  } catch (const std::exception& e) {
+    // A herd that cannot go on must not leave the robot walking on its last
+    // command or end the program: the figure stands and the run ramps home.
+    failure_ = e.what();
+    controls_.steer.post(MotionCommand{});
+    controls_.stop.store(true);
+  }
+}
+
+void EmbodiedHerd::step_until_quit() {
   const double dt = herd_->scene().step_s;
   const long steps_per_output = std::max(1L, std::lround(1.0 / (herd_->scene().output_hz * dt)));
   long steps = 0;
@@ -90,6 +102,7 @@ std::string EmbodiedHerd::report() const {
         fmt::format("; distance to its goal {:.2f} -> {:.2f} m",
                     herd::norm(*group.target_m - spawn_), herd::norm(*group.target_m - a.position));
   }
+  if (!failure_.empty()) s += "\nherd: stopped the run: " + failure_;
   const herd::HerdMetrics m = herd_->metrics();
   s +=
       fmt::format("\nherd: {} collisions, min clearance {:.3f} m", m.collisions, m.min_clearance_m);

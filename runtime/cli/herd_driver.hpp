@@ -33,6 +33,7 @@ class EmbodiedHerd {
 
  private:
   void loop();
+  void step_until_quit();
 
   std::unique_ptr<herd::Herd> herd_;
   int agent_ = -1;
@@ -43,6 +44,7 @@ class EmbodiedHerd {
   double spawn_heading_ = 0.0;
   std::atomic<Nanos> t0_{-1};
   std::atomic<bool> quit_{false};
+  std::string failure_;  // why the herd stopped the run ("" if it did not); read after stop()
   std::thread thread_;
 };
 
