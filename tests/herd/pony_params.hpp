@@ -3,6 +3,8 @@
 // m/s, turning at most 0.6 rad/s), stepped at dt = 0.1 s; docs/herd.md
 // lists the same numbers for the scenes.
 
+#include <vector>
+
 #include "animrt/controllers/herd/reynolds_flock.hpp"
 #include "animrt/controllers/herd/unity_flock.hpp"
 #include "animrt/controllers/herd/wander_leader.hpp"
@@ -48,6 +50,31 @@ inline UnityFlockParams pony_unity() {
   p.follow_radius = 2.0;
   p.max_length_delta = 100.0;
   return p;
+}
+
+// Shared by the flock tests: a leader that stays at `at`, an agent, and
+// member lists 0..n-1.
+inline WanderLeader still_leader(Vec2 at) {
+  WanderParams w;
+  w.speed = 0.0;
+  w.wander_m = {at.x, at.y, at.x, at.y};
+  w.reach_m = 0.0;
+  return WanderLeader(w, at, 0.0, 1);
+}
+
+inline Agent agent(Vec2 p, double heading = 0.0, double speed = 0.0, int group = 0) {
+  Agent a;
+  a.position = p;
+  a.heading = heading;
+  a.speed = speed;
+  a.group = group;
+  return a;
+}
+
+inline std::vector<int> iota(int n) {
+  std::vector<int> v(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = i;
+  return v;
 }
 
 }  // namespace animrt::herd::test

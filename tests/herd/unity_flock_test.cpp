@@ -14,7 +14,10 @@
 namespace animrt::herd {
 namespace {
 
+using test::agent;
 using test::FigureLimits;
+using test::iota;
+using test::still_leader;
 
 // Every force zero, no minimum speed, turning free: a test turns on the rule
 // it checks.
@@ -32,29 +35,6 @@ UnityFlockParams none() {
   p.follow_velocity = 0.0;
   p.follow_radius = 2.0;
   return p;
-}
-
-WanderLeader still_leader(Vec2 at) {
-  WanderParams w;
-  w.speed = 0.0;
-  w.wander_m = {at.x, at.y, at.x, at.y};
-  w.reach_m = 0.0;
-  return WanderLeader(w, at, 0.0, 1);
-}
-
-Agent agent(Vec2 p, double heading = 0.0, double speed = 0.0, int group = 0) {
-  Agent a;
-  a.position = p;
-  a.heading = heading;
-  a.speed = speed;
-  a.group = group;
-  return a;
-}
-
-std::vector<int> iota(int n) {
-  std::vector<int> v(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = i;
-  return v;
 }
 
 TEST(UnityFlock, SeparationPushesApartAcrossGroupsInsideTheRadius) {
