@@ -10,6 +10,7 @@
 
 #include "animrt/controllers/herd/reynolds_flock.hpp"
 #include "animrt/controllers/herd/unity_flock.hpp"
+#include "../tests/herd/pony_params.hpp"
 
 namespace {
 
@@ -61,32 +62,9 @@ void run(benchmark::State& state, const Params& p, NeighbourSearch search) {
       benchmark::Counter(static_cast<double>(state.iterations()) * n, benchmark::Counter::kIsRate);
 }
 
-ReynoldsFlockParams reynolds() {
-  ReynoldsFlockParams p;
-  p.min_velocity = 0.0;
-  p.max_velocity = 0.12;
-  p.center_weight = 0.05;
-  p.follow_weight = 0.3;
-  p.randomize_weight = 0.05;
-  p.separation_radius = 2.0;
-  return p;
-}
-
-UnityFlockParams unity() {
-  UnityFlockParams p;
-  p.min_speed = 0.0;
-  p.turn_speed = 0.6;
-  p.random_freq = 1.0;
-  p.random_force = 0.01;
-  p.to_origin_force = 0.05;
-  p.to_origin_range = 1.0;
-  p.gravity = 0.02;
-  p.avoidance_radius = 1.0;
-  p.avoidance_force = 30.0;
-  p.follow_velocity = 0.1;
-  p.follow_radius = 2.0;
-  return p;
-}
+// The pony-size parameters the flock tests and the shipped scenes use.
+ReynoldsFlockParams reynolds() { return test::pony_reynolds(); }
+UnityFlockParams unity() { return test::pony_unity(); }
 
 void BM_ReynoldsGrid(benchmark::State& s) {
   run<ReynoldsFlock>(s, reynolds(), NeighbourSearch::grid);
