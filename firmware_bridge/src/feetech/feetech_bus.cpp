@@ -200,9 +200,11 @@ void FeetechBus::transact(std::size_t length, std::size_t count, std::size_t dat
       suspect_[expected] = 1;
       continue;
     }
-    // A half-duplex adapter echoes our own instruction: no answer.
-    if (packet.raw.size() == tx_length_ &&
-        std::memcmp(packet.raw.data(), tx_.data(), tx_length_) == 0) {
+    // A half-duplex adapter echoes our own instruction: no answer. Nor is
+    // anything from the broadcast id (an echo of an earlier broadcast).
+    if (packet.id == ft::kBroadcastId ||
+        (packet.raw.size() == tx_length_ &&
+         std::memcmp(packet.raw.data(), tx_.data(), tx_length_) == 0)) {
       continue;
     }
     std::size_t slot = expected;
