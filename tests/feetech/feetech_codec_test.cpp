@@ -184,7 +184,7 @@ TEST(FeetechCodec, NegativeValuesRoundTripThroughTheSignBit) {
   EXPECT_EQ(encode_signed(-2048, kStsSignBit), 0x8800);
   EXPECT_EQ(encode_signed(2048, kStsSignBit), 0x0800);
   EXPECT_EQ(decode_signed(0x8800, kStsSignBit), -2048);
-  // SCS: bit 10.
+  // SCS loads and PWM: bit 10.
   EXPECT_EQ(encode_signed(-100, kScsSignBit), 0x0464);
   EXPECT_EQ(decode_signed(0x0464, kScsSignBit), -100);
   for (int bit : {kStsSignBit, kScsSignBit}) {

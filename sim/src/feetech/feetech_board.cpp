@@ -180,8 +180,8 @@ void FeetechServo::advance(Nanos now) {
 void FeetechServo::publish() {
   store_position(reg::present_position, motor_.position);
   const auto speed = static_cast<std::int32_t>(std::lround(motor_.velocity));
-  const int sign_bit = series_ == ft::Series::sts ? ft::kStsSignBit : ft::kScsSignBit;
-  ft::put_u16(series_, &table_[reg::present_speed], ft::encode_signed(speed, sign_bit));
+  // Speeds carry their direction in bit 15 on both series.
+  ft::put_u16(series_, &table_[reg::present_speed], ft::encode_signed(speed, ft::kStsSignBit));
   table_[reg::moving] = std::abs(motor_.velocity) > 1.0 ? 1 : 0;
 }
 

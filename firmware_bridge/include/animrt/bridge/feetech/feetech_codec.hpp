@@ -14,8 +14,8 @@
 // turn) stores them low byte first, the SCS series (potentiometer, 1024
 // steps over about 300 degrees) high byte first. Signed values are
 // sign-magnitude: a direction bit above the magnitude (bit 15 for STS
-// positions and speeds, bit 10 for SCS speeds, loads and PWM; SCS positions
-// are unsigned).
+// positions and for speeds of both series, bit 10 for SCS loads and PWM;
+// SCS positions are unsigned).
 
 #include <cstddef>
 #include <cstdint>
@@ -91,7 +91,8 @@ inline constexpr std::int32_t kStsMaxPosition = 4095;
 // SCS: 1024 steps over about 300 degrees (0..1023).
 inline constexpr double kScsStepsPerRev = 1024.0 * 360.0 / 300.0;
 inline constexpr std::int32_t kScsMaxPosition = 1023;
-// Direction bit of signed values.
+// Direction bit of signed values: STS positions and both series' speeds
+// (15); SCS loads and PWM (10).
 inline constexpr int kStsSignBit = 15;
 inline constexpr int kScsSignBit = 10;
 
