@@ -139,10 +139,21 @@ ft::DecodeResult FeetechBus::next_event(ft::Packet& packet, Deadline deadline) {
       continue;
     }
     const auto now = steady_clock::now();
-    if (now >= deadline) return ft::DecodeResult::need_more;
+    std::chrono::microseconds wait{0};
+    if (now < deadline) {
+      wait = std::chrono::ceil<std::chrono::microseconds>(deadline - now);
+    } else if (late_read_done_) {
+      return ft::DecodeResult::need_more;
+    } else {
+      // Past the deadline, one last look without waiting: an answer already
+      // queued while this thread was not running is not a timeout.
+      late_read_done_ = true;
+    }
     rx_begin_ = 0;
-    rx_end_ = transport_->read(rx_, std::chrono::ceil<std::chrono::microseconds>(deadline - now));
-    if (rx_end_ == 0 && transport_->failure() != nullptr) return ft::DecodeResult::need_more;
+    rx_end_ = transport_->read(rx_, wait);
+    if (rx_end_ == 0 && (wait.count() == 0 || transport_->failure() != nullptr)) {
+      return ft::DecodeResult::need_more;
+    }
   }
 }
 
@@ -177,6 +188,7 @@ void FeetechBus::transact(std::size_t length, std::size_t count, std::size_t dat
   transport_->discard_input();  // late answers must not pass for this one's
   decoder_.reset();
   rx_begin_ = rx_end_ = 0;
+  late_read_done_ = false;
   tx_length_ = length;
   transport_->write({tx_.data(), length});
 

@@ -105,6 +105,7 @@ class FeetechBus final : public ActuatorBus {
   std::size_t tx_length_ = 0;
   std::array<std::uint8_t, 256> rx_{};
   std::size_t rx_begin_ = 0, rx_end_ = 0;
+  bool late_read_done_ = false;  // the one read allowed past a transaction's deadline
   ft::Decoder decoder_;
 };
 
