@@ -15,6 +15,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "animrt/core/error.hpp"
@@ -30,6 +31,7 @@ class ScriptedLine final : public ByteTransport {
  public:
   std::function<Bytes(const Bytes&)> answer;
   bool echo = false;
+  int stalls = 0;  // reads that come back empty only after their timeout
 
   void set_timeout(std::chrono::microseconds) override {}
   bool write(std::span<const std::uint8_t> bytes) override {
@@ -42,7 +44,14 @@ class ScriptedLine final : public ByteTransport {
     }
     return true;
   }
-  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds) override {
+  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) override {
+    if (stalls > 0 && timeout.count() > 0) {
+      // As if this thread was not scheduled until the wait was over: the
+      // answer is queued, but the reader saw nothing in time.
+      --stalls;
+      std::this_thread::sleep_for(timeout + std::chrono::milliseconds(1));
+      return 0;
+    }
     const std::size_t n = std::min(buffer.size(), pending_.size());
     std::copy_n(pending_.begin(), n, buffer.begin());
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(n));
@@ -162,6 +171,26 @@ TEST(FeetechBus, DamagedTruncatedAndStrayAnswersAreCountedPerServo) {
   EXPECT_EQ(q[0], before[0]);
   EXPECT_NEAR(q[1], 0.0, 1e-12);  // servo 2 at 0x0800 = 2048 = 0 rad
   EXPECT_EQ(rig.bus->devices()[1].health, DeviceHealth::ok);
+}
+
+TEST(FeetechBus, AnAnswerQueuedBeforeALateWakeUpIsNoTimeout) {
+  Rig rig;
+  rig.bus->configure();
+  std::vector<double> q(2, 0.0);
+  rig.bus->read(q);
+  rig.line->stalls = 1;
+  rig.bus->read(q);
+  for (const DeviceStatus& st : rig.bus->devices()) {
+    EXPECT_EQ(st.timeouts, 0u);
+    EXPECT_EQ(st.health, DeviceHealth::ok);
+  }
+  // Past the deadline the bus looks once more, and no longer: nothing queued
+  // then is a timeout.
+  rig.line->stalls = 1;
+  rig.line->answer = nullptr;
+  rig.bus->read(q);
+  EXPECT_EQ(rig.bus->devices()[0].timeouts, 1u);
+  EXPECT_EQ(rig.bus->devices()[1].timeouts, 1u);
 }
 
 TEST(FeetechBus, ScsReadsOneServoAtATimeHighByteFirst) {
