@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -120,6 +122,50 @@ TEST(FeetechBusOnSim, NegativePositionsRoundTripThroughTheSignBit) {
   f.clock.advance(3'000'000'000);
   f.bus.read(q);
   EXPECT_NEAR(q[0], -1.0, 2 * kPi / 4096);
+}
+
+TEST(FeetechBusOnSim, ServoKeepsGoalsInsideTheJointLimitsTheBusWrote) {
+  for (ft::Series series : {ft::Series::sts, ft::Series::scs}) {
+    BusConfig config = arm(series, {1, 2});
+    config.actuators[0].min_position = -0.3;
+    config.actuators[0].max_position = 0.4;
+    config.actuators[0].direction = -1;  // the limits swap ends in steps
+    Fixture f(config, series);
+    f.bus.configure();
+    const ActuatorBinding& b = f.config.actuators[0];
+    // Read back over the wire by another client: Min/Max Angle Limit.
+    auto line = open_serial(f.sim.endpoint(), 1'000'000);
+    std::array<std::uint8_t, ft::kMaxPacket> tx{};
+    std::array<std::uint8_t, 32> rx{};
+    // Collects `n` answer bytes (or what came within half a second).
+    const auto answer = [&](std::size_t n) {
+      std::size_t got = 0;
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+      while (got < n && std::chrono::steady_clock::now() < deadline) {
+        got += line->read(std::span(rx).subspan(got, n - got), std::chrono::milliseconds(50));
+      }
+      return got;
+    };
+    line->write({tx.data(), ft::encode_read(1, ft::reg::min_angle_limit, 4, tx)});
+    ASSERT_EQ(answer(10), 10u);
+    EXPECT_EQ(ft::get_u16(series, &rx[5]), b.to_ticks(0.4));  // direction -1: the low end
+    EXPECT_EQ(ft::get_u16(series, &rx[7]), b.to_ticks(-0.3));
+    // The servo itself stops at the limit whatever goal it is given.
+    std::uint8_t goal[2];
+    ft::put_u16(series, goal, series == ft::Series::sts ? 4000 : 1000);
+    const std::uint8_t on = 1;
+    line->write({tx.data(), ft::encode_write(1, ft::reg::torque_enable, {&on, 1}, tx)});
+    ASSERT_EQ(answer(6), 6u);
+    line->write({tx.data(), ft::encode_write(1, ft::reg::goal_position, goal, tx)});
+    ASSERT_EQ(answer(6), 6u);
+    f.clock.advance(3'000'000'000);
+    EXPECT_NEAR(f.sim.device_position(1), -0.3, 0.01);
+    // The joint without limits keeps the whole range.
+    line->write({tx.data(), ft::encode_read(2, ft::reg::max_angle_limit, 2, tx)});
+    ASSERT_EQ(answer(8), 8u);
+    EXPECT_EQ(ft::get_u16(series, &rx[5]),
+              series == ft::Series::sts ? ft::kStsMaxPosition : ft::kScsMaxPosition);
+  }
 }
 
 TEST(FeetechBusOnSim, ASilentServoIsCountedAndTheOthersStillServed) {

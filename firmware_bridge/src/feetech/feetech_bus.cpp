@@ -338,7 +338,42 @@ void FeetechBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
+  for (std::size_t i = 0; i < n; ++i) write_angle_limits(i);
   fresh_ = true;
+}
+
+void FeetechBus::write_angle_limits(std::size_t device) {
+  const ActuatorBinding& b = config_.actuators[device];
+  if (!b.has_limits()) return;
+  // The joint's limits in steps, inside the position-mode range.
+  const std::int32_t top = series_ == ft::Series::sts ? ft::kStsMaxPosition : ft::kScsMaxPosition;
+  const std::int32_t a = b.to_ticks(b.min_position);
+  const std::int32_t c = b.to_ticks(b.max_position);
+  const auto lo = static_cast<std::uint16_t>(std::clamp(std::min(a, c), 0, top));
+  const auto hi = static_cast<std::uint16_t>(std::clamp(std::max(a, c), 0, top));
+  const auto id = static_cast<std::uint8_t>(b.device_id);
+  const auto fail = [&](Answer answer, const std::string& what) {
+    throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +
+                      failure(device, answer));
+  };
+  Answer r = unicast(device, ft::encode_read(id, ft::reg::min_angle_limit, 2, tx_), 2);
+  if (r != Answer::ok) fail(r, "read Min Angle Limit");
+  const std::uint16_t now_lo = value_[0];
+  r = unicast(device, ft::encode_read(id, ft::reg::max_angle_limit, 2, tx_), 2);
+  if (r != Answer::ok) fail(r, "read Max Angle Limit");
+  if (now_lo == lo && value_[0] == hi) return;  // EEPROM: written only when it differs
+  // EEPROM writes persist only while the lock flag is 0; lock it again after.
+  const std::uint8_t lock = series_ == ft::Series::sts ? ft::reg::sts_lock : ft::reg::scs_lock;
+  r = write_byte(device, lock, 0);
+  if (r != Answer::ok) fail(r, "unlock the EEPROM");
+  std::uint8_t data[4];
+  ft::put_u16(series_, data, lo);
+  ft::put_u16(series_, data + 2, hi);
+  r = unicast(device, ft::encode_write(id, ft::reg::min_angle_limit, data, tx_), 0);
+  if (r != Answer::ok)
+    fail(r, "write Min/Max Angle Limit " + std::to_string(lo) + ".." + std::to_string(hi));
+  r = write_byte(device, lock, 1);
+  if (r != Answer::ok) fail(r, "lock the EEPROM");
 }
 
 void FeetechBus::activate() {

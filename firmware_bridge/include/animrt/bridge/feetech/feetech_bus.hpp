@@ -42,6 +42,9 @@ class FeetechBus final : public ActuatorBus {
 
   // Resets the counters, pings every servo (kTries each) and reads its
   // present position. Throws one DeviceError listing every servo that failed.
+  // Then, for joints with limits, writes Min/Max Angle Limit (9/11) from
+  // them when the values read back differ (EEPROM unlocked for the write and
+  // locked again), so the servo itself keeps its goals inside the joint.
   void configure() override;
   // Per servo: goal position = present position, then torque on. On failure
   // (or a servo reporting a fault) turns torque off again and throws.
@@ -68,6 +71,7 @@ class FeetechBus final : public ActuatorBus {
                  int tries = kTries);
   Answer write_byte(std::size_t device, std::uint8_t address, std::uint8_t value);
   Answer write_goal(std::size_t device, std::int32_t ticks);
+  void write_angle_limits(std::size_t device);
   ft::DecodeResult next_event(ft::Packet& packet, Deadline deadline);
   void accept(std::size_t slot, const ft::Packet& packet);
   void blame(std::size_t slot, bool checksum);
