@@ -6,6 +6,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/can/can_protocols.hpp"
 #include "animrt/bridge/dynamixel/dynamixel_protocol.hpp"
+#include "animrt/bridge/feetech/feetech_protocol.hpp"
 #include "animrt/bridge/maestro/maestro_protocol.hpp"
 #include "animrt/bridge/modbus/modbus_protocol.hpp"
 #include "animrt/bridge/protocol.hpp"
@@ -16,8 +17,9 @@ namespace {
 
 // Every protocol the runtime can drive. Add a module here to add a device.
 const Protocol* const kProtocols[] = {
-    &dynamixel2_protocol(), &mit_protocol(),        &cia402_protocol(),
-    &maestro_protocol(),    &modbus_tcp_protocol(), &modbus_rtu_protocol(),
+    &dynamixel2_protocol(),  &mit_protocol(),         &cia402_protocol(),
+    &maestro_protocol(),     &modbus_tcp_protocol(),  &modbus_rtu_protocol(),
+    &feetech_sts_protocol(), &feetech_scs_protocol(),
 };
 
 }  // namespace

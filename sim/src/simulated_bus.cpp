@@ -4,9 +4,11 @@
 
 #include <memory>
 
+#include "animrt/bridge/feetech/feetech_protocol.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/dynamixel_sim_bus.hpp"
+#include "animrt/sim/feetech/feetech_sim_bus.hpp"
 #include "animrt/sim/maestro/maestro_sim_bus.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
 
@@ -22,6 +24,9 @@ std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const 
         config.where, "protocol",
         "physics drives only dynamixel2 buses; bus '" + config.name + "' is " + config.protocol);
   }
+  if (ft::Series series; feetech_series(config.protocol, series)) {
+    return std::make_unique<sim::FeetechSimBus>(config, series, clock);
+  }
   if (config.protocol == "mit" || config.protocol == "cia402")
     return sim::make_can_sim_bus(config, clock);
   if (config.protocol == "maestro") return std::make_unique<sim::MaestroSimBus>(config, clock);
@@ -30,7 +35,9 @@ std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const 
   }
   throw InputError(config.where, "protocol",
                    "no simulated devices for protocol '" + config.protocol + "' on bus '" +
-                       config.name + "' (expected dynamixel2)");
+                       config.name +
+                       "' (expected dynamixel2, feetech_sts, feetech_scs, mit, cia402, maestro, "
+                       "modbus-tcp or modbus-rtu)");
 }
 
 }  // namespace animrt

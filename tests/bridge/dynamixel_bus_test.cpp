@@ -770,7 +770,7 @@ TEST(MakeBus, UnknownProtocolIsADeviceError) {
   config.where = Location{"robot.yaml", 12, 5};
   EXPECT_EQ(error_of([&] { make_bus(config); }),
             "bus legs: unknown protocol 'dynamixel1' (supported: dynamixel2, mit, cia402, maestro, "
-            "modbus-tcp, modbus-rtu)");
+            "modbus-tcp, modbus-rtu, feetech_sts, feetech_scs)");
 }
 
 TEST(MakeBus, MissingPortNamesTheBusAndThePort) {

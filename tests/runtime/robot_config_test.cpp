@@ -504,7 +504,7 @@ buses:
   b: {protocol: modbus, port: /dev/ttyUSB0}
 )"),
             at("4:17: buses.b.protocol: unknown protocol \"modbus\" (supported: dynamixel2, mit, "
-               "cia402, maestro, modbus-tcp, modbus-rtu)"));
+               "cia402, maestro, modbus-tcp, modbus-rtu, feetech_sts, feetech_scs)"));
 }
 
 TEST_F(RobotConfigTest, TwoBusesOnOnePort) {

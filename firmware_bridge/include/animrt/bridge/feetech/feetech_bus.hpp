@@ -1,0 +1,116 @@
+#pragma once
+// Master side of a Feetech STS/SCS serial bus (servos in position mode).
+// configure() pings and reads every servo; each cycle is then one read of the
+// present positions (STS: one Sync Read; SCS, which has none: one Read per
+// servo) and one Sync Write of the goal positions.
+//
+// The status packet's error byte holds the servo's fault bits (voltage,
+// sensor, temperature, current, angle, overload); a non-zero byte counts as
+// a hardware error and shows as DeviceHealth::hardware_error, which the
+// runtime's watchdog faults. Its last value is kept in hardware_error_status.
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/feetech/feetech_codec.hpp"
+
+namespace animrt {
+
+class FeetechBus final : public ActuatorBus {
+ public:
+  // Largest number of servos whose 2-byte goals fit one Sync Write (LEN is
+  // one byte: 3 N + 4 <= 255).
+  static constexpr std::size_t kMaxDevices = 83;
+  // Attempts per servo for the lifecycle transactions (not for the cycle).
+  static constexpr int kTries = 3;
+
+  // Takes an open transport (tests inject one). Allocates every buffer the
+  // cycle needs. Throws DeviceError for ids outside 0..253, duplicate ids, a
+  // bad scale or direction, or more than kMaxDevices servos.
+  FeetechBus(BusConfig config, ft::Series series, std::unique_ptr<ByteTransport> transport);
+
+  const BusConfig& config() const override { return config_; }
+  ft::Series series() const { return series_; }
+
+  // Resets the counters, pings every servo (kTries each) and reads its
+  // present position. Throws one DeviceError listing every servo that failed.
+  // Then, for joints with limits, writes Min/Max Angle Limit (9/11) from
+  // them when the values read back differ (EEPROM unlocked for the write and
+  // locked again), so the servo itself keeps its goals inside the joint.
+  void configure() override;
+  // Per servo: goal position = present position, then torque on. On failure
+  // (or a servo reporting a fault) turns torque off again and throws.
+  void activate() override;
+  // Torque off on every servo, best effort; never throws.
+  void deactivate() override;
+
+  // One cycle; neither throws nor allocates. read() takes at most one
+  // timeout (STS) or one timeout per servo (SCS). Goals are clamped into the
+  // joint limits and the servo's position range; NaN holds the last goal.
+  void read(std::span<double> positions) override;
+  void write(std::span<const double> positions) override;
+
+  std::span<DeviceStatus> devices() override { return status_; }
+
+ private:
+  using Deadline = std::chrono::steady_clock::time_point;
+  enum class Answer : std::uint8_t { pending, ok, timeout, garbled };
+
+  // Sends tx_[0, length) and collects status packets for the servos in
+  // asked_[0, count) until each answered or the deadline passed.
+  void transact(std::size_t length, std::size_t count, std::size_t data_length);
+  Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
+                 int tries = kTries);
+  Answer write_byte(std::size_t device, std::uint8_t address, std::uint8_t value);
+  Answer write_goal(std::size_t device, std::int32_t ticks);
+  void write_angle_limits(std::size_t device);
+  ft::DecodeResult next_event(ft::Packet& packet, Deadline deadline);
+  void accept(std::size_t slot, const ft::Packet& packet);
+  void blame(std::size_t slot, bool checksum);
+  void read_positions(std::size_t count);
+  std::int32_t to_position(std::uint16_t raw) const;
+  std::uint16_t from_position(std::int32_t ticks) const;
+  std::int32_t goal_ticks(std::size_t device, double rad) const;
+
+  std::string failure(std::size_t device, Answer answer) const;
+  std::string prefix() const;
+  std::string describe(std::size_t device) const;
+
+  BusConfig config_;
+  ft::Series series_;
+  std::unique_ptr<ByteTransport> transport_;
+  std::chrono::microseconds timeout_;
+  std::int32_t min_ticks_, max_ticks_;  // position range of the series
+
+  std::vector<DeviceStatus> status_;
+  std::array<std::int16_t, 256> device_of_id_{};
+  std::vector<std::int32_t> present_ticks_;
+  std::vector<std::int32_t> goal_ticks_;
+  std::vector<double> min_rad_, max_rad_;
+  bool fresh_ = false;
+
+  // Per slot of the current transaction.
+  std::vector<std::uint8_t> ids_;
+  std::vector<std::size_t> asked_;
+  std::vector<Answer> answer_;
+  std::vector<std::uint8_t> suspect_;
+  std::vector<std::uint16_t> value_;
+  std::vector<std::uint8_t> sync_data_;
+
+  std::array<std::uint8_t, ft::kMaxPacket> tx_{};
+  std::size_t tx_length_ = 0;
+  std::array<std::uint8_t, 256> rx_{};
+  std::size_t rx_begin_ = 0, rx_end_ = 0;
+  bool late_read_done_ = false;  // the one read allowed past a transaction's deadline
+  ft::Decoder decoder_;
+};
+
+}  // namespace animrt

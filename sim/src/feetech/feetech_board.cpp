@@ -1,0 +1,374 @@
+#include "animrt/sim/feetech/feetech_board.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "animrt/core/error.hpp"
+#include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
+
+namespace animrt::sim {
+namespace {
+
+namespace reg = ft::reg;
+
+constexpr int kBauds[] = {1'000'000, 500'000, 250'000, 128'000, 115'200, 76'800, 57'600, 38'400};
+// STS3215 identity (memory table v3.6): firmware 3.6, servo version 9.3.
+constexpr std::uint8_t kStsModel[2] = {9, 3};
+constexpr std::uint8_t kScsModel[2] = {5, 4};
+// Unload Condition default of the STS3215: temperature, current, overload.
+constexpr std::uint8_t kDefaultUnload =
+    ft::error_bit::temperature | ft::error_bit::current | ft::error_bit::overload;
+// Voltage and temperature as in the Sync Read example of the protocol manual.
+constexpr std::uint8_t kTemperatureC = 30;
+constexpr std::uint8_t kVoltageDeciV = 121;
+
+// Addresses a master may write (the rest is read-only).
+bool writable(std::size_t address) {
+  switch (address) {
+    case reg::id:
+    case reg::baud_rate:
+    case reg::return_delay:
+    case reg::status_return_level:
+    case reg::min_angle_limit:
+    case reg::min_angle_limit + 1:
+    case reg::max_angle_limit:
+    case reg::max_angle_limit + 1:
+    case reg::max_temperature:
+    case reg::unload_condition:
+    case reg::position_offset:
+    case reg::position_offset + 1:
+    case reg::operating_mode:
+    case reg::torque_enable:
+    case reg::acceleration:
+    case reg::goal_position:
+    case reg::goal_position + 1:
+    case reg::goal_time:
+    case reg::goal_time + 1:
+    case reg::goal_speed:
+    case reg::goal_speed + 1:
+    case reg::scs_lock:
+    case reg::sts_lock:
+      return true;
+    default:
+      return false;
+  }
+}
+
+std::uint8_t baud_register(int baud) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
+    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
+        std::abs(static_cast<long>(kBauds[best]) - baud)) {
+      best = i;
+    }
+  }
+  return static_cast<std::uint8_t>(best);
+}
+
+}  // namespace
+
+bool feetech_may_answer(const ft::Packet& packet) {
+  if (packet.id != ft::kBroadcastId) return true;
+  return packet.code == ft::inst::ping || packet.code == ft::inst::sync_read;
+}
+
+// ---- one servo ---------------------------------------------------------------
+
+FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
+                           const SimBusSettings& settings, int baud, Nanos now)
+    : binding_(binding),
+      series_(series),
+      tau_s_(std::max(0.0, settings.time_constant_s)),
+      vmax_steps_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
+      motor_time_(now) {
+  const bool sts = series_ == ft::Series::sts;
+  table_[reg::firmware_major] = 3;
+  std::memcpy(&table_[reg::model], sts ? kStsModel : kScsModel, 2);
+  table_[reg::id] = static_cast<std::uint8_t>(binding.device_id);
+  table_[reg::baud_rate] = baud_register(baud);
+  table_[reg::return_delay] =
+      static_cast<std::uint8_t>(std::clamp(settings.return_delay_us / 2, 0, 254));
+  table_[reg::status_return_level] = 1;
+  ft::put_u16(series_, &table_[reg::min_angle_limit], 0);
+  ft::put_u16(series_, &table_[reg::max_angle_limit],
+              static_cast<std::uint16_t>(sts ? ft::kStsMaxPosition : ft::kScsMaxPosition));
+  table_[reg::max_temperature] = 70;
+  table_[reg::unload_condition] = kDefaultUnload;
+  table_[reg::present_voltage] = kVoltageDeciV;
+  table_[reg::present_temperature] = kTemperatureC;
+  const double start = binding.to_ticks(initial_offset_rad(binding.device_id));
+  motor_.position = std::clamp(start, static_cast<double>(position_value(reg::min_angle_limit)),
+                               static_cast<double>(position_value(reg::max_angle_limit)));
+  // Hold still when torque comes on: the goal starts at the present position.
+  store_position(reg::goal_position, motor_.position);
+  publish();
+}
+
+std::uint16_t FeetechServo::u16(std::uint8_t address) const {
+  return ft::get_u16(series_, &table_[address]);
+}
+
+std::int32_t FeetechServo::position_value(std::uint8_t address) const {
+  const std::uint16_t raw = u16(address);
+  return series_ == ft::Series::sts ? ft::decode_signed(raw, ft::kStsSignBit) : raw;
+}
+
+void FeetechServo::store_position(std::uint8_t address, double steps) {
+  const auto v = static_cast<std::int32_t>(std::lround(steps));
+  const std::uint16_t raw = series_ == ft::Series::sts
+                                ? ft::encode_signed(v, ft::kStsSignBit)
+                                : static_cast<std::uint16_t>(std::clamp(v, 0, 0xFFFF));
+  ft::put_u16(series_, &table_[address], raw);
+}
+
+std::int32_t FeetechServo::goal_position() const {
+  const std::int32_t lo = position_value(reg::min_angle_limit);
+  const std::int32_t hi = position_value(reg::max_angle_limit);
+  const std::int32_t goal = position_value(reg::goal_position);
+  // Both limits 0: multi-turn (STS step mode), no clamp.
+  if (lo == 0 && hi == 0) return goal;
+  return std::clamp(goal, lo, std::max(lo, hi));
+}
+
+FeetechServo::Motor FeetechServo::motor_at(Nanos now) const {
+  Motor m = motor_;
+  if (!torque_on() || vmax_steps_s_ <= 0) {
+    m.velocity = 0;
+    return m;
+  }
+  if (now <= motor_time_) return m;
+  double dt = to_seconds(now - motor_time_);
+  const double goal = goal_position();
+  const double vmax = vmax_steps_s_;
+  const double error = goal - m.position;
+  const double dir = error >= 0 ? 1.0 : -1.0;
+  if (tau_s_ <= 0) {
+    const double travel = std::min(std::abs(error), vmax * dt);
+    m.position += dir * travel;
+    m.velocity = m.position == goal ? 0.0 : dir * vmax;
+    return m;
+  }
+  // speed = clamp(error / tau, +-vmax): a ramp at vmax until the error is
+  // vmax * tau, then an exponential decay.
+  const double band = vmax * tau_s_;
+  if (std::abs(error) > band) {
+    const double ramp_s = (std::abs(error) - band) / vmax;
+    if (dt <= ramp_s) {
+      m.position += dir * vmax * dt;
+      m.velocity = dir * vmax;
+      return m;
+    }
+    m.position = goal - dir * band;
+    dt -= ramp_s;
+  }
+  const double remaining = (goal - m.position) * std::exp(-dt / tau_s_);
+  m.position = goal - remaining;
+  m.velocity = remaining / tau_s_;
+  return m;
+}
+
+void FeetechServo::advance(Nanos now) {
+  if (now <= motor_time_) return;
+  motor_ = motor_at(now);
+  motor_time_ = now;
+  publish();
+}
+
+void FeetechServo::publish() {
+  store_position(reg::present_position, motor_.position);
+  const auto speed = static_cast<std::int32_t>(std::lround(motor_.velocity));
+  // Speeds carry their direction in bit 15 on both series.
+  ft::put_u16(series_, &table_[reg::present_speed], ft::encode_signed(speed, ft::kStsSignBit));
+  table_[reg::moving] = std::abs(motor_.velocity) > 1.0 ? 1 : 0;
+}
+
+bool FeetechServo::read(std::uint8_t address, std::uint8_t length,
+                        std::span<std::uint8_t> out) const {
+  if (static_cast<std::size_t>(address) + length > table_.size() || out.size() < length) {
+    return false;
+  }
+  std::memcpy(out.data(), &table_[address], length);
+  return true;
+}
+
+void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> data) {
+  const bool torque_was_on = torque_on();
+  bool goal_written = false;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const std::size_t a = address + i;
+    if (a >= table_.size() || !writable(a)) continue;
+    if (a == reg::torque_enable) {
+      // A latched fault in Unload Condition keeps torque off.
+      const bool unloaded = (table_[reg::servo_status] & table_[reg::unload_condition]) != 0;
+      table_[a] = unloaded ? 0 : static_cast<std::uint8_t>(data[i] != 0 ? 1 : 0);
+      continue;
+    }
+    table_[a] = data[i];
+    if (a == reg::goal_position + 1u) goal_written = true;
+  }
+  if (goal_written) {
+    ++goals_received_;
+    last_goal_ = position_value(reg::goal_position);
+  }
+  if (torque_was_on != torque_on()) {
+    motor_.velocity = 0;
+    publish();
+  }
+}
+
+void FeetechServo::reg_write(std::uint8_t address, std::span<const std::uint8_t> data) {
+  const std::size_t n = std::min(data.size(), pending_.size());
+  std::memcpy(pending_.data(), data.data(), n);
+  pending_address_ = address;
+  pending_length_ = static_cast<std::uint8_t>(n);
+  table_[reg::registered] = 1;
+}
+
+void FeetechServo::action() {
+  if (table_[reg::registered] == 0) return;
+  table_[reg::registered] = 0;
+  write(pending_address_, {pending_.data(), pending_length_});
+}
+
+void FeetechServo::set_fault(std::uint8_t bits, Nanos now) {
+  advance(now);
+  table_[reg::servo_status] = bits;
+  if ((bits & table_[reg::unload_condition]) != 0 && torque_on()) {
+    table_[reg::torque_enable] = 0;
+    motor_.velocity = 0;
+    publish();
+  }
+}
+
+double FeetechServo::position_rad(Nanos now) const {
+  const Motor m = motor_at(std::max(now, motor_time_));
+  return binding_.direction * (m.position - binding_.zero_ticks) / binding_.ticks_per_rad;
+}
+
+// ---- the board ----------------------------------------------------------------
+
+FeetechBoard::FeetechBoard(const BusConfig& config, ft::Series series, Nanos now)
+    : series_(series) {
+  servos_.reserve(config.actuators.size());
+  for (const ActuatorBinding& b : config.actuators) {
+    if (b.device_id < 0 || b.device_id > ft::kMaxDeviceId) {
+      throw InputError(config.where, "id",
+                       "Feetech id " + std::to_string(b.device_id) + " of joint '" + b.joint +
+                           "' is outside 0.." + std::to_string(ft::kMaxDeviceId));
+    }
+    if (find_configured(b.device_id) != nullptr) {
+      throw InputError(config.where, "id",
+                       "Feetech id " + std::to_string(b.device_id) + " is used twice on bus '" +
+                           config.name + "'");
+    }
+    servos_.emplace_back(b, series, config.sim, config.baud, now);
+  }
+}
+
+FeetechServo* FeetechBoard::find_configured(int device_id) {
+  for (FeetechServo& s : servos_) {
+    if (s.device_id() == device_id) return &s;
+  }
+  return nullptr;
+}
+
+const FeetechServo* FeetechBoard::find_configured(int device_id) const {
+  for (const FeetechServo& s : servos_) {
+    if (s.device_id() == device_id) return &s;
+  }
+  return nullptr;
+}
+
+FeetechServo* FeetechBoard::target(std::uint8_t id) {
+  for (FeetechServo& s : servos_) {
+    if (s.id() == id && s.responding()) return &s;
+  }
+  return nullptr;
+}
+
+void FeetechBoard::answer(const FeetechServo& servo, std::span<const std::uint8_t> data,
+                          FeetechAnswers& out) const {
+  const std::size_t offset = out.bytes.size();
+  out.bytes.resize(offset + ft::kMaxPacket);
+  const std::size_t n = ft::encode_status(servo.id(), servo.error_byte(), data,
+                                          {out.bytes.data() + offset, ft::kMaxPacket});
+  out.bytes.resize(offset + n);
+  if (n > 0) out.list.push_back({offset, n, servo.return_delay_us()});
+}
+
+void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out) {
+  for (FeetechServo& s : servos_) s.advance(now);
+  const std::span<const std::uint8_t> p = packet.params;
+  const bool broadcast = packet.id == ft::kBroadcastId;
+  auto each_target = [&](auto&& act) {
+    if (broadcast) {
+      for (FeetechServo& s : servos_) {
+        if (s.responding()) act(s);
+      }
+    } else if (FeetechServo* s = target(packet.id)) {
+      act(*s);
+    }
+  };
+  // Write, Reg Write and Action answer per Status Return Level (the level the
+  // packet arrived under), never to a broadcast.
+  auto acknowledge = [&](const FeetechServo& s, std::uint8_t level) {
+    if (!broadcast && level >= 1) answer(s, {}, out);
+  };
+  std::array<std::uint8_t, 256> data{};
+  switch (packet.code) {
+    case ft::inst::ping:
+      each_target([&](FeetechServo& s) { answer(s, {}, out); });
+      break;
+    case ft::inst::read:
+      if (broadcast || p.size() != 2) break;
+      if (FeetechServo* s = target(packet.id)) {
+        if (s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
+      }
+      break;
+    case ft::inst::write:
+    case ft::inst::reg_write:
+      if (p.size() < 2) break;
+      each_target([&](FeetechServo& s) {
+        const std::uint8_t level = s.status_return_level();
+        if (packet.code == ft::inst::write) {
+          s.write(p[0], p.subspan(1));
+        } else {
+          s.reg_write(p[0], p.subspan(1));
+        }
+        acknowledge(s, level);
+      });
+      break;
+    case ft::inst::action:
+      each_target([&](FeetechServo& s) {
+        const std::uint8_t level = s.status_return_level();
+        s.action();
+        acknowledge(s, level);
+      });
+      break;
+    case ft::inst::sync_read:
+      // Only STS servos know Sync Read; each listed servo answers in turn.
+      if (series_ != ft::Series::sts || !broadcast || p.size() < 3) break;
+      for (std::uint8_t id : p.subspan(2)) {
+        FeetechServo* s = target(id);
+        if (s != nullptr && s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
+      }
+      break;
+    case ft::inst::sync_write: {
+      if (!broadcast || p.size() < 2) break;
+      const std::size_t length = p[1];
+      const std::span<const std::uint8_t> blocks = p.subspan(2);
+      if (length == 0 || blocks.size() % (length + 1) != 0) break;  // malformed: ignored
+      for (std::size_t i = 0; i < blocks.size(); i += length + 1) {
+        if (FeetechServo* s = target(blocks[i])) s->write(p[0], blocks.subspan(i + 1, length));
+      }
+      break;
+    }
+    default:
+      break;  // Reset and unknown instructions: not modelled, no answer
+  }
+}
+
+}  // namespace animrt::sim
