@@ -1,0 +1,136 @@
+// Controls: stop, manual mode with a slider per joint, steering. Every
+// control needs the run's token; without it they are shown disabled.
+
+import { post, throttle, token } from './api.js';
+import { el, isNum, jointUnit } from './format.js';
+
+const JOG_INTERVAL_MS = 50;
+const STEER_INTERVAL_MS = 100;
+
+export class Controls {
+  constructor(info) {
+    this.info = info;
+    this.enabled = token !== '';
+    this.ended = false;
+    this.stop = document.getElementById('btn-stop');
+    this.manual = document.getElementById('manual-toggle');
+    this.resume = document.getElementById('btn-resume');
+    this.jogBox = document.getElementById('jog-sliders');
+    this.error = document.getElementById('control-error');
+    this.sliders = new Map();
+
+    document.getElementById('readonly-note').hidden = this.enabled;
+
+    this.stop.addEventListener('click', () => this.send('/api/stop', {}));
+    this.manual.addEventListener('change', () => this.send('/api/manual', { on: this.manual.checked }));
+    this.resume.addEventListener('click', () => this.send('/api/manual', { on: false }));
+
+    this.buildJog(Array.isArray(info.joints) ? info.joints : []);
+    this.buildSteer(info.motion || {});
+    this.refresh(null);
+  }
+
+  buildJog(joints) {
+    for (const j of joints) {
+      if (!j || typeof j.name !== 'string' || !isNum(j.min) || !isNum(j.max)) continue;
+      const u = jointUnit(j);
+      const input = el('input', { type: 'range', min: String(j.min), max: String(j.max), step: String((j.max - j.min) / 500) });
+      input.dataset.joint = j.name;
+      const out = el('output', { class: 'num' });
+      const show = () => { out.textContent = (Number(input.value) * u.scale).toFixed(1) + u.pos; };
+      const jog = throttle((position) => this.send('/api/jog', { joint: j.name, position }), JOG_INTERVAL_MS);
+      input.addEventListener('input', () => {
+        this.dragging = j.name;
+        show();
+        jog(Number(input.value));
+      });
+      input.addEventListener('change', () => { this.dragging = null; });
+      this.jogBox.append(el('label', {}, j.name, input, out));
+      this.sliders.set(j.name, { input, show });
+    }
+  }
+
+  buildSteer(motion) {
+    if (!motion.steerable) return;
+    document.getElementById('steer').hidden = false;
+    const speed = document.getElementById('steer-speed');
+    const turn = document.getElementById('steer-turn');
+    const range = (input, r, fallback) => {
+      const [lo, hi] = Array.isArray(r) && isNum(r[0]) && isNum(r[1]) ? r : fallback;
+      input.min = String(lo);
+      input.max = String(hi);
+      input.step = String((hi - lo) / 200);
+    };
+    range(speed, motion.speed_mps, [0, 0.3]);
+    range(turn, motion.turn_rps, [-1, 1]);
+    this.steerInputs = { speed, turn };
+    const steer = throttle(() => this.send('/api/steer', {
+      speed_mps: Number(speed.value), turn_rps: Number(turn.value),
+    }), STEER_INTERVAL_MS);
+    for (const input of [speed, turn]) {
+      input.addEventListener('input', () => {
+        this.steering = true;
+        this.showSteer();
+        steer();
+      });
+      input.addEventListener('change', () => { this.steering = false; });
+    }
+    this.showSteer();
+  }
+
+  showSteer() {
+    if (!this.steerInputs) return;
+    document.getElementById('steer-speed-value').textContent = `${Number(this.steerInputs.speed.value).toFixed(2)} m/s`;
+    document.getElementById('steer-turn-value').textContent = `${Number(this.steerInputs.turn.value).toFixed(2)} rad/s`;
+  }
+
+  async send(path, body) {
+    if (!this.enabled || this.ended) return;
+    const res = await post(path, body);
+    if (res.ok) {
+      this.error.hidden = true;
+      this.error.textContent = '';
+    } else {
+      this.error.textContent = res.error;
+      this.error.hidden = false;
+    }
+  }
+
+  // Follows the run: manual mode's switch and sliders, the steer command,
+  // and what may be used in the current phase.
+  refresh(state) {
+    const manualOn = !!(state && state.manual && state.manual.on);
+    const phase = state && state.phase;
+    const live = phase === 'motion' || phase === 'start_ramp';
+    const can = this.enabled && !this.ended;
+    this.stop.disabled = !can || phase === 'stop_ramp' || phase === 'ended';
+    this.manual.disabled = !can || !live;
+    this.manual.checked = manualOn;
+    this.resume.disabled = !can || !manualOn;
+    this.jogBox.hidden = !manualOn;
+    for (const [name, s] of this.sliders) {
+      s.input.disabled = !can || !manualOn;
+      if (this.dragging === name) continue;
+      const held = state && state.manual && state.manual.positions && state.manual.positions[name];
+      const joint = state && Array.isArray(state.joints) ? state.joints.find((j) => j && j.name === name) : null;
+      const v = isNum(held) ? held : joint && isNum(joint.cmd) ? joint.cmd : null;
+      if (v !== null && document.activeElement !== s.input) s.input.value = String(v);
+      s.show();
+    }
+    if (this.steerInputs) {
+      for (const input of Object.values(this.steerInputs)) input.disabled = !can || !live || manualOn;
+      const m = state && state.motion;
+      if (m && !this.steering && document.activeElement !== this.steerInputs.speed &&
+          document.activeElement !== this.steerInputs.turn) {
+        if (isNum(m.speed_mps)) this.steerInputs.speed.value = String(m.speed_mps);
+        if (isNum(m.turn_rps)) this.steerInputs.turn.value = String(m.turn_rps);
+        this.showSteer();
+      }
+    }
+  }
+
+  end() {
+    this.ended = true;
+    this.refresh(null);
+  }
+}
