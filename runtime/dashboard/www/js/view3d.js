@@ -92,6 +92,34 @@ function applyPoses(figure, poses) {
   });
 }
 
+const GRID = { size: 6, cell: 0.25 };
+
+// The floor: a grid in the x-y plane. Every cell edge is its own segment,
+// so lines that pass behind the camera are clipped piecewise (software GL
+// drops long clipped lines).
+function floorGrid() {
+  const n = Math.round(GRID.size / GRID.cell);
+  const half = GRID.size / 2;
+  const points = [];
+  const colors = [];
+  const minor = new THREE.Color(0x3a4656);
+  const major = new THREE.Color(0x6a7a90);
+  for (let i = 0; i <= n; i++) {
+    const a = -half + i * GRID.cell;
+    const c = i === n / 2 ? major : minor;
+    for (let j = 0; j < n; j++) {
+      const b0 = -half + j * GRID.cell;
+      const b1 = b0 + GRID.cell;
+      points.push(a, b0, 0, a, b1, 0, b0, a, 0, b1, a, 0);
+      for (let k = 0; k < 4; k++) colors.push(c.r, c.g, c.b);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(points, 3));
+  geometry.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
+  return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ vertexColors: THREE.VertexColors }));
+}
+
 // A small orbit around a target point: drag turns, wheel zooms.
 class Orbit {
   constructor(camera, element, onChange) {
@@ -149,6 +177,7 @@ export class FigureView {
     const canvas = document.createElement('canvas');
     const gl = webglContext(canvas);
     if (!gl) {
+      container.dataset.webgl = '0';
       this.showNote('3-D view unavailable: this browser gives no WebGL context.');
       return;
     }
@@ -164,16 +193,15 @@ export class FigureView {
     const sun = new THREE.DirectionalLight(0xffffff, 0.7);
     sun.position.set(2, -3, 5);
     this.scene.add(sun);
-    const grid = new THREE.GridHelper(10, 40, 0x6a7a90, 0x3a4656);
-    grid.rotation.x = Math.PI / 2; // three's grid lies in x-z; the floor here is x-y
-    this.scene.add(grid);
-    this.grid = grid;
+    this.grid = floorGrid();
+    this.scene.add(this.grid);
 
     this.pending = false;
     this.orbit = new Orbit(this.camera, container, () => this.requestRender());
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
     this.ok = true;
+    container.dataset.webgl = '1';
   }
 
   showNote(text) {
@@ -192,6 +220,7 @@ export class FigureView {
     this.commanded = buildFigure(model, true);
     this.scene.add(this.measured.root);
     this.scene.add(this.commanded.root);
+    this.container.dataset.model = String(model.bodies.length);
     this.framed = false;
     this.requestRender();
   }
@@ -216,7 +245,7 @@ export class FigureView {
       this.framed = true;
     }
     this.orbit.target.lerp(centre, 0.2);
-    const cell = 10 / 40;
+    const cell = GRID.cell;
     this.grid.position.set(Math.round(centre.x / cell) * cell, Math.round(centre.y / cell) * cell, 0);
     this.orbit.update();
   }
