@@ -50,7 +50,7 @@ async function start() {
   const history = new JointHistory();
   const charts = new JointCharts(document.getElementById('chart-position'), document.getElementById('chart-velocity'));
   const jitter = new JitterHistogram(document.getElementById('chart-jitter'));
-  if (!charts.available) showPageError('Chart.js did not load (/lib/chart.min.js): no charts.');
+  if (!charts.available) showPageError('Chart.js did not load (/lib/chart.umd.js): no charts.');
   const devices = new DeviceTable(document.getElementById('device-table'));
   const controls = new Controls(info);
 
