@@ -76,7 +76,7 @@ async function start() {
       list.update(state.joints);
       history.add(state.t_s, state.joints);
       showLoop(state.loop);
-      devices.update(state.devices);
+      devices.update(state.devices, state.faults);
       showFaults(state.faults);
       controls.refresh(state);
       if (figure) figure.update(state.bodies);

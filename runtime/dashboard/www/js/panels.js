@@ -42,7 +42,7 @@ export function showMotion(info, state) {
     text += ` · at ${live.position_s.toFixed(1)} s`;
     if (isNum(m.duration_s)) text += ` of ${m.duration_s.toFixed(1)} s`;
   }
-  if (live.playing === false) text += ' · paused';
+  if (live.playing === false && state.phase === 'motion' && !manual) text += ' · paused';
   if (manual) text = `manual (was: ${text})`;
   setText('motion-source', text);
 }
@@ -121,8 +121,13 @@ export class DeviceTable {
     this.rows = new Map();
   }
 
-  update(devices) {
+  // `faults` (the run's log) gives a last fault that comes as bare text its time.
+  update(devices, faults) {
     if (!Array.isArray(devices)) return;
+    const times = new Map();
+    if (Array.isArray(faults)) {
+      for (const f of faults) if (f && typeof f.text === 'string' && isNum(f.t_s)) times.set(f.text, f.t_s);
+    }
     for (const d of devices) {
       if (!d) continue;
       const key = `${d.bus}:${d.id}`;
@@ -144,16 +149,21 @@ export class DeviceTable {
         r = { row, cells };
         this.rows.set(key, r);
       }
-      const health = d.faulted ? 'faulted' : (typeof d.health === 'string' ? d.health : 'unknown');
+      const latest = typeof d.health === 'string' ? d.health : 'unknown';
+      const health = d.faulted ? 'faulted' : latest;
       r.row.dataset.health = health;
       r.cells.health.dataset.health = health;
-      if (r.cells.health.textContent !== health) r.cells.health.textContent = health;
+      r.cells.health.title = `latest transaction: ${latest.replace('_', ' ')}`;
+      const label = health.replace('_', ' ');
+      if (r.cells.health.textContent !== label) r.cells.health.textContent = label;
       for (const c of COUNTERS) {
         const text = fmtInt(d[c]);
         if (r.cells[c].textContent !== text) r.cells[c].textContent = text;
         r.cells[c].classList.toggle('nonzero', c !== 'transactions' && isNum(d[c]) && d[c] > 0);
       }
-      const fault = faultText(d.last_fault);
+      const fault = typeof d.last_fault === 'string' && times.has(d.last_fault)
+        ? faultText({ t_s: times.get(d.last_fault), text: d.last_fault })
+        : faultText(d.last_fault);
       if (r.cells.fault.textContent !== fault) r.cells.fault.textContent = fault;
     }
   }
