@@ -260,10 +260,10 @@ TEST(Dashboard, SteeringReachesASteerableGaitAndIsRefusedOtherwise) {
     run.wait_state(in_motion);
     EXPECT_EQ(run.post("/api/steer", {{"speed_mps", 0.1}}), 400);
     EXPECT_EQ(run.post("/api/steer", {{"speed_mps", 0.1}, {"turn_rps", 0.2}}), 200);
-    const json s =
+    const json steered =
         run.wait_state([](const json& s) { return !s["motion"]["speed_mps"].is_null(); });
-    EXPECT_DOUBLE_EQ(s["motion"]["speed_mps"].get<double>(), 0.1);
-    EXPECT_DOUBLE_EQ(s["motion"]["turn_rps"].get<double>(), 0.2);
+    EXPECT_DOUBLE_EQ(steered["motion"]["speed_mps"].get<double>(), 0.1);
+    EXPECT_DOUBLE_EQ(steered["motion"]["turn_rps"].get<double>(), 0.2);
   }
   DashboardRun run(0.0, /*steerable=*/false);
   run.wait_state(in_motion);
