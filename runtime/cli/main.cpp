@@ -147,7 +147,14 @@ int cmd_run(const RunArgs& args) {
     }
   }
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
-  const std::unique_ptr<animrt::sim::MujocoFigure> figure = load_figure(robot.config);
+  // The figure: the robot file's model, or else the physics model.
+  std::unique_ptr<animrt::sim::MujocoFigure> figure = load_figure(robot.config);
+  if (!figure && !args.physics.empty() && !args.dashboard.empty()) {
+    animrt::RobotConfig with_physics = robot.config;
+    with_physics.model = args.physics;
+    with_physics.model_where = animrt::Location{args.physics, 0, 0};
+    figure = load_figure(with_physics);
+  }
   // What the dashboard tells of the run, taken before the runner owns the config.
   animrt::DashboardSetup dashboard_setup;
   if (!args.dashboard.empty()) {

@@ -48,7 +48,6 @@ bool same_token(const std::string& given, const std::string& token) {
 
 json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
-
 // The loop's statistics, from every cycle's timing as the reader drains it.
 struct LoopStats {
   MicrosHistogram period, jitter;
@@ -451,6 +450,9 @@ struct DashboardServer::Impl {
     });
 
     // The page, and Debian's three.js and Chart.js.
+    // Browsers load ES modules only with a JavaScript type.
+    server.set_file_extension_and_mimetype_mapping("js", "text/javascript");
+    server.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
     if (!setup.www_dir.empty()) server.set_mount_point("/", setup.www_dir);
     const std::string three = setup.lib_dir + "/three";
     const std::string chart = setup.lib_dir + "/chart.js";
