@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
+#include "support/alloc_counter.hpp"
 #include "support/sim_rig.hpp"
 
 namespace animrt {
@@ -210,6 +211,7 @@ TEST(Dashboard, StopWithTheTokenEndsTheRunThroughTheRampAtHome) {
   EXPECT_EQ(summary.end_reason, EndReason::signal);
   EXPECT_TRUE(summary.torque_cut.empty());
   EXPECT_TRUE(summary.faults.empty());
+  run.server_->stop();  // the monitor has one reader
   RunView view;
   run.monitor_->read(view);
   EXPECT_EQ(view.phase, RunPhaseView::ended);
@@ -302,6 +304,54 @@ TEST(Dashboard, AStreamClientThatNeverReadsDoesNotHoldUpTheLoop) {
   EXPECT_EQ(summary.overruns, 0u);
   EXPECT_EQ(summary.buses[0].late_cycles, 0u);
   EXPECT_EQ(run.monitor_->timing_dropped(), 0u);
+}
+
+// Publishing to the dashboard and taking its controls adds no allocation to
+// the run's threads, with a client streaming and manual targets arriving.
+TEST(Dashboard, TheCycleStillDoesNotAllocate) {
+  test::RigSettings settings;
+  settings.edit = [](RobotConfig& c) {
+    c.safety.start_ramp_s = 0.3;
+    c.safety.stop_ramp_s = 0.3;
+  };
+  test::SimRig rig(kQuadruped, settings);
+  RunMonitor monitor(rig.runner().model());
+  RunControls controls;
+  DashboardSetup setup;
+  setup.rate_hz = 200.0;  // read the monitor as often as the loop writes it
+  DashboardServer server(monitor, controls, setup);
+  std::atomic<bool> quit{false};
+  std::atomic<int> frames{0};
+  std::thread client([&] {
+    httplib::Client c("127.0.0.1", server.port());
+    c.Get("/api/stream", [&](const char*, std::size_t) {
+      ++frames;
+      return !quit.load();
+    });
+  });
+  while (frames.load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  test::RunAllocationWatch watch;
+  int sample = 0;
+  rig.probe->on_sample = [&](double t) {  // outside the window: the test's own calls
+    const bool open = watch.is_open();
+    watch.close();
+    if (t > 0.2) controls.manual.store(true);
+    const double target[2] = {0.0, 0.1 * (++sample % 7)};
+    controls.manual_targets.push(target);
+    if (t > 0.6) controls.manual.store(false);
+    if (open) watch.open();
+  };
+  RunOptions options = rig.options(1.0);
+  options.controls = &controls;
+  options.monitor = &monitor;
+  const RunSummary s = rig.run_watching(watch, options);
+  quit = true;
+  server.stop();
+  client.join();
+  EXPECT_EQ(s.end_reason, EndReason::duration);
+  ASSERT_TRUE(watch.was_opened());
+  EXPECT_GT(rig.cycles_in(test::RunPhase::motion), 100u);
+  EXPECT_EQ(watch.counted(), 0u) << watch.where();
 }
 
 TEST(Dashboard, OnlyLoopbackUnlessRemoteIsAllowed) {
