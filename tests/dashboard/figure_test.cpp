@@ -63,6 +63,19 @@ TEST(Figure, PosesFollowTheJointsByName) {
   EXPECT_NEAR(std::abs(bent[at("lf_foot_link")].quat[0]), std::cos(0.3), 1e-9);
 }
 
+TEST(Figure, TheHeadTurnsItsSkullAboutTheNeck) {
+  const std::string model = std::string(ANIMRT_SOURCE_DIR) + "/configs/models/head.xml";
+  sim::MujocoFigure figure(model, {"neck_yaw", "neck_pitch", "neck_roll", "jaw"},
+                           Location{"head.yaml", 1, 1});
+  EXPECT_EQ(figure.matched_joints(), 4u);
+  const auto skull = static_cast<std::size_t>(body_index(figure, "skull"));
+  std::vector<BodyPose> poses(figure.bodies().size());
+  figure.pose(std::vector<double>{0.5, 0.0, 0.0, 0.0}, poses);
+  // Yaw about z: the skull's orientation is a rotation of 0.5 rad about z.
+  EXPECT_NEAR(poses[skull].quat[0], std::cos(0.25), 1e-9);
+  EXPECT_NEAR(poses[skull].quat[3], std::sin(0.25), 1e-9);
+}
+
 TEST(Figure, AModelThatDoesNotLoadOrHasNoneOfTheJointsIsAnErrorAtTheKey) {
   const std::string bad = ::testing::TempDir() + "animrt_figure_bad.xml";
   std::ofstream(bad) << "<mujoco><worldbody><body><geom type='box'/></worldbody></mujoco>\n";
