@@ -50,39 +50,44 @@ void run_case(bool dashboard, double seconds) {
   options.backend_name = "sim";
   options.controls = &controls;
 
-  std::unique_ptr<RunMonitor> monitor;
-  std::unique_ptr<DashboardServer> server;
-  std::thread client;
-  std::atomic<bool> quit{false};
-  std::atomic<int> frames{0};
+  // Stops the stream and joins its client however the run ends.
+  struct Dashboard {
+    std::unique_ptr<RunMonitor> monitor;
+    std::unique_ptr<DashboardServer> server;
+    std::thread client;
+    std::atomic<bool> quit{false};
+    std::atomic<int> frames{0};
+    ~Dashboard() {
+      quit = true;
+      if (server) server->stop();
+      if (client.joinable()) client.join();
+    }
+  } d;
   if (dashboard) {
-    monitor = std::make_unique<RunMonitor>(runner.model());
-    server = std::make_unique<DashboardServer>(*monitor, controls, setup);
-    options.monitor = monitor.get();
-    client = std::thread([&] {
-      httplib::Client c("127.0.0.1", server->port());
-      c.Get("/api/stream", [&](const char* data, std::size_t length) {
+    d.monitor = std::make_unique<RunMonitor>(runner.model());
+    d.server = std::make_unique<DashboardServer>(*d.monitor, controls, setup);
+    options.monitor = d.monitor.get();
+    d.client = std::thread([&d] {
+      httplib::Client c("127.0.0.1", d.server->port());
+      c.Get("/api/stream", [&d](const char* data, std::size_t length) {
         for (std::size_t i = 0; i + 1 < length; ++i) {
-          if (data[i] == '\n' && data[i + 1] == '\n') ++frames;
+          if (data[i] == '\n' && data[i + 1] == '\n') ++d.frames;
         }
-        return !quit.load();
+        return !d.quit.load();
       });
     });
   }
   RunSummary s = runner.run(options);
-  quit = true;
-  if (server) server->stop();
-  if (client.joinable()) client.join();
   std::printf(
       "%-14s period p50 %6.3f p99 %6.3f max %6.3f ms | jitter p50 %6.3f p99 %6.3f max %6.3f ms | "
-      "work p50 %6.3f p99 %6.3f max %6.3f ms | overruns %3llu/%-5llu late %3llu | %s",
+      "work p50 %6.3f p99 %6.3f max %6.3f ms | overruns %3llu/%-5llu late %3llu | ended by %s | %s",
       dashboard ? "dashboard" : "alone", ms(s.period.p50_s), ms(s.period.p99_s), ms(s.period.max_s),
       ms(s.jitter.p50_s), ms(s.jitter.p99_s), ms(s.jitter.max_s), ms(s.busy.p50_s),
       ms(s.busy.p99_s), ms(s.busy.max_s), static_cast<unsigned long long>(s.overruns),
       static_cast<unsigned long long>(s.cycles),
-      static_cast<unsigned long long>(s.buses[0].late_cycles),
+      static_cast<unsigned long long>(s.buses[0].late_cycles), to_string(s.end_reason),
       s.sched_fifo ? "SCHED_FIFO" : "SCHED_OTHER");
-  if (dashboard) std::printf(" | %d frames streamed", frames.load());
+  if (dashboard) std::printf(" | %d frames streamed", d.frames.load());
   std::printf("\n");
 }
 
