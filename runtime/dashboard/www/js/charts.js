@@ -81,7 +81,7 @@ export class JointCharts {
     });
     this.velocity = new Chart(velocityCanvas, {
       type: 'line',
-      data: { datasets: [{ label: 'measured velocity', data: [], borderColor: COLORS.vel }] },
+      data: { datasets: [{ label: 'commanded velocity', data: [], borderColor: COLORS.vel }] },
       options: lineOptions('velocity'),
     });
   }
@@ -91,7 +91,9 @@ export class JointCharts {
     if (!this.available || !joint || !isNum(t)) return;
     const u = jointUnit(joint);
     const scale = (a) => a.map((p) => ({ x: p.x, y: p.y * u.scale }));
-    const x0 = t - WINDOW_S;
+    // The first seconds fill the window from its left edge.
+    const x0 = Math.max(t - WINDOW_S, 0);
+    t = Math.max(t, WINDOW_S);
     const pos = this.position;
     pos.data.datasets[0].data = scale(series.cmd);
     pos.data.datasets[1].data = scale(series.meas);

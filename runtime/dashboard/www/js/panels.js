@@ -161,10 +161,19 @@ export class DeviceTable {
         if (r.cells[c].textContent !== text) r.cells[c].textContent = text;
         r.cells[c].classList.toggle('nonzero', c !== 'transactions' && isNum(d[c]) && d[c] > 0);
       }
-      const fault = typeof d.last_fault === 'string' && times.has(d.last_fault)
+      let fault = typeof d.last_fault === 'string' && times.has(d.last_fault)
         ? faultText({ t_s: times.get(d.last_fault), text: d.last_fault })
         : faultText(d.last_fault);
-      if (r.cells.fault.textContent !== fault) r.cells.fault.textContent = fault;
+      // The row already names the device: "legs id 3 (lf_ankle): timeout" -> "timeout".
+      const own = fault.indexOf(`${d.bus} id ${d.id} `);
+      if (own >= 0) {
+        const colon = fault.indexOf(': ', own);
+        if (colon > own) fault = fault.slice(0, own) + fault.slice(colon + 2);
+      }
+      if (r.cells.fault.textContent !== fault) {
+        r.cells.fault.textContent = fault;
+        r.cells.fault.title = fault;
+      }
     }
   }
 }
