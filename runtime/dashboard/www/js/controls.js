@@ -55,14 +55,18 @@ export class Controls {
     document.getElementById('steer').hidden = false;
     const speed = document.getElementById('steer-speed');
     const turn = document.getElementById('steer-turn');
-    const range = (input, r, fallback) => {
+    const range = (input, r, fallback, start) => {
       const [lo, hi] = Array.isArray(r) && isNum(r[0]) && isNum(r[1]) ? r : fallback;
+      input.step = 'any';
       input.min = String(lo);
       input.max = String(hi);
-      input.step = String((hi - lo) / 200);
+      input.value = String(Math.min(hi, Math.max(lo, start(lo, hi))));
     };
-    range(speed, motion.speed_mps, [0, 0.3]);
-    range(turn, motion.turn_rps, [-1, 1]);
+    // Until the first command the gait runs at its own speed, which the
+    // state does not report: the outputs say so with a dash.
+    range(speed, motion.speed_mps, [0, 0.3], (lo, hi) => (lo + hi) / 2);
+    range(turn, motion.turn_rps, [-1, 1], () => 0);
+    this.steerKnown = false;
     this.steerInputs = { speed, turn };
     const steer = throttle(() => this.send('/api/steer', {
       speed_mps: Number(speed.value), turn_rps: Number(turn.value),
@@ -70,6 +74,7 @@ export class Controls {
     for (const input of [speed, turn]) {
       input.addEventListener('input', () => {
         this.steering = true;
+        this.steerKnown = true;
         this.showSteer();
         steer();
       });
@@ -80,8 +85,11 @@ export class Controls {
 
   showSteer() {
     if (!this.steerInputs) return;
-    document.getElementById('steer-speed-value').textContent = `${Number(this.steerInputs.speed.value).toFixed(2)} m/s`;
-    document.getElementById('steer-turn-value').textContent = `${Number(this.steerInputs.turn.value).toFixed(2)} rad/s`;
+    const show = (id, input, unit) => {
+      document.getElementById(id).textContent = this.steerKnown ? `${Number(input.value).toFixed(2)} ${unit}` : '–';
+    };
+    show('steer-speed-value', this.steerInputs.speed, 'm/s');
+    show('steer-turn-value', this.steerInputs.turn, 'rad/s');
   }
 
   async send(path, body) {
@@ -122,8 +130,11 @@ export class Controls {
       const m = state && state.motion;
       if (m && !this.steering && document.activeElement !== this.steerInputs.speed &&
           document.activeElement !== this.steerInputs.turn) {
-        if (isNum(m.speed_mps)) this.steerInputs.speed.value = String(m.speed_mps);
-        if (isNum(m.turn_rps)) this.steerInputs.turn.value = String(m.turn_rps);
+        if (isNum(m.speed_mps) && isNum(m.turn_rps)) {
+          this.steerInputs.speed.value = String(m.speed_mps);
+          this.steerInputs.turn.value = String(m.turn_rps);
+          this.steerKnown = true;
+        }
         this.showSteer();
       }
     }
