@@ -326,7 +326,6 @@ def run_test(args, tmp, page_holder):
         page.wait("manual mode on", lambda: page.js(
             "return document.getElementById('manual-toggle').checked &&"
             " !document.getElementById('jog-sliders').hidden;"), 5)
-        joint = next(j for j in info["joints"] if j["name"] == "lf_knee")
         held = joint_values(page)["lf_knee"]["cmd"] or 0.0
         target = round(held + (0.15 if held < 0 else -0.15), 3)
         page.js("""const s = document.querySelector('#jog-sliders input[data-joint="lf_knee"]');

@@ -126,7 +126,7 @@ class Orbit {
     this.camera = camera;
     this.target = new THREE.Vector3(0, 0, 0.2);
     this.azimuth = -Math.PI / 3;
-    this.elevation = 0.45;
+    this.elevation = 0.6;
     this.distance = 1.6;
     this.onChange = onChange;
     let drag = null;
