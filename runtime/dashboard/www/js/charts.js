@@ -39,6 +39,9 @@ export class JointHistory {
 
   add(t, joints) {
     if (!isNum(t) || !Array.isArray(joints)) return;
+    // Time went back (a replay looped or was sought): a new history.
+    if (isNum(this.lastT) && t < this.lastT) this.series.clear();
+    this.lastT = t;
     for (const j of joints) {
       if (!j || typeof j.name !== 'string') continue;
       let s = this.series.get(j.name);

@@ -7,6 +7,67 @@ import { el, isNum, jointUnit } from './format.js';
 const JOG_INTERVAL_MS = 50;
 const STEER_INTERVAL_MS = 100;
 
+// A replay of a recording: play, pause and seek (no token needed: it
+// moves no robot).
+class ReplayControls {
+  constructor(info, error) {
+    const range = Array.isArray(info.replay_range_s) ? info.replay_range_s : [];
+    const [lo, hi] = isNum(range[0]) && isNum(range[1]) ? range : [0, 1];
+    this.error = error;
+    this.playing = true;
+    this.seek = document.getElementById('seek');
+    this.play = document.getElementById('btn-play');
+    this.value = document.getElementById('seek-value');
+    this.seek.min = String(lo);
+    this.seek.max = String(hi);
+    this.seek.value = String(lo);
+    document.getElementById('replay').hidden = false;
+    document.getElementById('live-controls').hidden = true;
+    const send = throttle((t, playing) => this.send(t, playing), 100);
+    this.seek.addEventListener('input', () => {
+      this.dragging = true;
+      this.show(Number(this.seek.value));
+      send(Number(this.seek.value), false);
+    });
+    this.seek.addEventListener('change', () => {
+      this.dragging = false;
+      send(Number(this.seek.value), this.playing);
+    });
+    this.play.addEventListener('click', () => {
+      this.playing = !this.playing;
+      this.play.textContent = this.playing ? 'Pause' : 'Play';
+      send(Number(this.seek.value), this.playing);
+    });
+  }
+
+  async send(t_s, playing) {
+    const res = await post('/api/seek', { t_s, playing });
+    this.error.hidden = res.ok;
+    this.error.textContent = res.ok ? '' : res.error;
+  }
+
+  show(t) {
+    this.value.textContent = isNum(t) ? `${t.toFixed(1)} s` : '–';
+  }
+
+  refresh(state) {
+    if (!state || this.dragging || !isNum(state.t_s)) return;
+    this.seek.value = String(state.t_s);
+    this.show(state.t_s);
+  }
+
+  end() {
+    this.seek.disabled = true;
+    this.play.disabled = true;
+  }
+}
+
+export function makeControls(info) {
+  return info && info.replay
+    ? new ReplayControls(info, document.getElementById('control-error'))
+    : new Controls(info);
+}
+
 export class Controls {
   constructor(info) {
     this.info = info;

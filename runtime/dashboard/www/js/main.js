@@ -2,7 +2,7 @@
 
 import { getInfo, openStream } from './api.js';
 import { JitterHistogram, JointCharts, JointHistory } from './charts.js';
-import { Controls } from './controls.js';
+import { makeControls } from './controls.js';
 import { DeviceTable, JointList, showFaults, showInfo, showLoop, showMotion, showPhase } from './panels.js';
 import { FigureView } from './view3d.js';
 
@@ -52,7 +52,7 @@ async function start() {
   const jitter = new JitterHistogram(document.getElementById('chart-jitter'));
   if (!charts.available) showPageError('Chart.js did not load (/lib/chart.umd.js): no charts.');
   const devices = new DeviceTable(document.getElementById('device-table'));
-  const controls = new Controls(info);
+  const controls = makeControls(info);
 
   let last = null;
   let lastChart = 0;
