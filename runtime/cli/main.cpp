@@ -35,6 +35,7 @@
 #include "herd_driver.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "view_command.hpp"
 
 namespace {
 
@@ -362,6 +363,7 @@ int main(int argc, char** argv) {
   animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
+  animrt::cli::add_view_command(app);
   auto* seq = app.add_subcommand("seq", "Mesh sequences: generated corpus, deformation features");
   seq->require_subcommand(1);
   animrt::cli::add_seq_corpus_command(*seq);

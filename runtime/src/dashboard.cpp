@@ -215,9 +215,16 @@ struct DashboardServer::Impl {
       }
       figure = {{"bodies", bodies}};
     }
-    return json{{"robot", setup.robot}, {"backend", setup.backend}, {"rate_hz", model.rate_hz},
-                {"joints", joints},     {"buses", buses},           {"motion", motion},
-                {"model", figure},      {"replay", setup.replay}}
+    return json{{"robot", setup.robot},
+                {"backend", setup.backend},
+                {"rate_hz", model.rate_hz},
+                {"joints", joints},
+                {"buses", buses},
+                {"motion", motion},
+                {"model", figure},
+                {"replay", setup.replay},
+                {"replay_range_s",
+                 setup.replay ? json{setup.replay_start_s, setup.replay_end_s} : json(nullptr)}}
         .dump();
   }
 
@@ -362,6 +369,7 @@ struct DashboardServer::Impl {
       if (body.is_discarded() || !body.is_object()) {
         return error(res, 400, "expected a JSON object as the body");
       }
+      if (setup.replay) return error(res, 409, "a replay controls no robot");
       std::lock_guard lock(controls_mutex);
       act(body, res);
     });
@@ -446,6 +454,23 @@ struct DashboardServer::Impl {
         return error(res, 400, "expected \"speed_mps\" and \"turn_rps\": finite numbers");
       }
       controls.steer.post(MotionCommand{*speed, *turn});
+      answer(res, 200, {{"ok", true}});
+    });
+
+    server.Post("/api/seek", [this](const httplib::Request& req, httplib::Response& res) {
+      if (!setup.replay || !setup.seek) return error(res, 409, "not a replay");
+      const json body = json::parse(req.body, nullptr, false);
+      if (body.is_discarded() || !body.is_object()) {
+        return error(res, 400, "expected a JSON object as the body");
+      }
+      const auto t = number(body, "t_s");
+      if (!t) return error(res, 400, "expected \"t_s\": a finite number of seconds");
+      const auto playing = body.find("playing");
+      if (playing != body.end() && !playing->is_boolean()) {
+        return error(res, 400, "expected \"playing\": true or false");
+      }
+      std::lock_guard lock(controls_mutex);
+      setup.seek(*t, playing == body.end() || playing->get<bool>());
       answer(res, 200, {{"ok", true}});
     });
 

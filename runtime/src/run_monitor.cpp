@@ -153,6 +153,23 @@ void RunMonitor::publish_ended() {
   end_write();
 }
 
+void RunMonitor::publish_sample(double t, RunPhaseView phase, std::uint64_t cycle,
+                                std::span<const double> cmd, std::span<const double> meas,
+                                std::span<const double> vel) {
+  begin_write();
+  store(kT, t);
+  store_u(kPhase, static_cast<std::uint64_t>(phase));
+  store(kMotionTime, t);
+  store_u(kCycles, cycle);
+  for (std::size_t j = 0; j < joints_ && j < cmd.size(); ++j) {
+    const std::size_t w = kHeaderWords + kJointWords * j;
+    store(w, cmd[j]);
+    store(w + 1, meas[j]);
+    store(w + 2, vel[j]);
+  }
+  end_write();
+}
+
 void RunMonitor::push_timing(const CycleTiming& timing) {
   const double record[4] = {timing.t_s, timing.period_s, timing.jitter_s, timing.busy_s};
   timing_.push(record);

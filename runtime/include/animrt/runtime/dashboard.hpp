@@ -6,6 +6,7 @@
 // client gets; controls reach the cycle only through RunControls, and need
 // the run's token.
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,7 +35,11 @@ struct DashboardSetup {
   std::optional<GaitSteering> steering;    // a steerable gait's range
   double duration_s = 0.0;                 // 0: until stopped
   FigureKinematics* figure = nullptr;      // the figure's model, if any
+  // A replay (`animrt view`): POST /api/seek calls `seek` (no token: it
+  // moves no robot), and the run's controls answer 409.
   bool replay = false;
+  std::function<void(double t_s, bool playing)> seek;
+  double replay_start_s = 0.0, replay_end_s = 0.0;  // the recording's times
 };
 
 // Whether `host` names the loopback interface (127.0.0.0/8, ::1, localhost).

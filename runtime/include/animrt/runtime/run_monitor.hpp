@@ -66,6 +66,11 @@ class RunMonitor {
                std::uint64_t skipped, const MotionCommand* steer);
   // The run is over (after the last cycle).
   void publish_ended();
+  // A recorded sample (a replay): time, phase and per joint command,
+  // measurement and velocity; the rest of the block stays as it is.
+  void publish_sample(double t, RunPhaseView phase, std::uint64_t cycle,
+                      std::span<const double> cmd, std::span<const double> meas,
+                      std::span<const double> vel);
   void push_timing(const CycleTiming& timing);
   void push_event(const CycleEvent& event);
 
