@@ -141,7 +141,7 @@ def robot_on_pty(root, pty, folder):
                   lambda m: m.group(1) + os.path.normpath(os.path.join(here, m.group(2))), text)
     # The simulator is another process sharing the CPU with the browser:
     # slack, so that only the frozen simulator is a fault, not a busy machine.
-    text, n = re.subn(r"(?m)^(\s*watchdog_timeout_s:\s*)[\d.]+", r"\g<1>1.0", text)
+    text, n = re.subn(r"(?m)^(\s*watchdog_timeout_s:\s*)[\d.]+", r"\g<1>2.0", text)
     check(n == 1, f"expected one watchdog_timeout_s in {source}")
     text, n = re.subn(r"(?m)^(\s*timeout_ms:\s*)\d+", r"\g<1>20", text)
     check(n == 1, f"expected one timeout_ms in {source}")
@@ -326,6 +326,7 @@ def run_test(args, tmp, page_holder):
         page.wait("manual mode on", lambda: page.js(
             "return document.getElementById('manual-toggle').checked &&"
             " !document.getElementById('jog-sliders').hidden;"), 5)
+        step("manual mode on")
         held = joint_values(page)["lf_knee"]["cmd"] or 0.0
         target = round(held + (0.15 if held < 0 else -0.15), 3)
         page.js("""const s = document.querySelector('#jog-sliders input[data-joint="lf_knee"]');
@@ -334,6 +335,7 @@ def run_test(args, tmp, page_holder):
                    s.dispatchEvent(new Event('change'));""", target)
         page.wait(f"lf_knee commanded to {target} rad", lambda: abs(
             (joint_values(page)["lf_knee"]["cmd"] or 1e9) - target) < 0.02, 10)
+        step("jogged")
         check(page.js("return document.getElementById('control-error').hidden;"),
               f"a control was refused: {page.text('#control-error')}")
         driver.find_element("id", "btn-resume").click()
