@@ -127,7 +127,9 @@ struct DashboardServer::Impl {
   std::condition_variable changed;
   std::shared_ptr<const std::string> state;  // the latest /api/state
   std::uint64_t generation = 0;
-  bool quit = false;
+  bool sampler_quit = false;  // the sampler publishes a last frame and ends
+  bool quit = false;          // the streams end (after that frame)
+  int streams = 0;            // open /api/stream responses
   std::vector<std::pair<double, std::string>> faults;  // also the sampler's, under mutex
 
   // Controls: one writer at a time for RunControls' single-writer channels.
@@ -330,14 +332,15 @@ struct DashboardServer::Impl {
   void sample_loop() {
     const auto period = std::chrono::duration<double>(1.0 / setup.rate_hz);
     auto next = std::chrono::steady_clock::now();
-    for (;;) {
+    for (bool last = false;;) {
       auto frame = std::make_shared<const std::string>(build_state());
       std::unique_lock lock(mutex);
       state = std::move(frame);
       ++generation;
       changed.notify_all();
+      if (last) return;
       next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-      if (changed.wait_until(lock, next, [this] { return quit; })) return;
+      last = changed.wait_until(lock, next, [this] { return sampler_quit; });
     }
   }
 
@@ -384,6 +387,13 @@ struct DashboardServer::Impl {
   }
 
   void routes() {
+    // No compression: on loopback it only costs CPU (brotli at its slowest
+    // setting takes seconds for three.js), and the machine runs the loop.
+    server.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
+      // The request object itself is not const; httplib passes it so.
+      const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
+      return httplib::Server::HandlerResponse::Unhandled;
+    });
     server.Get("/api/info", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(info, "application/json");
     });
@@ -393,14 +403,19 @@ struct DashboardServer::Impl {
     server.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) {
       res.set_header("Cache-Control", "no-cache");
       auto seen = std::make_shared<std::uint64_t>(0);
+      {
+        std::lock_guard lock(mutex);
+        ++streams;
+      }
       res.set_chunked_content_provider(
-          "text/event-stream", [this, seen](std::size_t, httplib::DataSink& sink) {
+          "text/event-stream",
+          [this, seen](std::size_t, httplib::DataSink& sink) {
             std::shared_ptr<const std::string> frame;
             {
               std::unique_lock lock(mutex);
               changed.wait(lock, [&] { return quit || generation != *seen; });
-              if (quit) {
-                sink.done();
+              if (generation == *seen) {
+                sink.done();  // the last chunk: the client sees a complete stream
                 return true;
               }
               *seen = generation;
@@ -410,6 +425,13 @@ struct DashboardServer::Impl {
             // A client that does not read makes this fail after the write
             // timeout; only this connection's thread waits for it.
             return sink.write(event.data(), event.size());
+          },
+          [this](bool) {
+            {
+              std::lock_guard lock(mutex);
+              --streams;
+            }
+            changed.notify_all();
           });
     });
 
@@ -540,10 +562,18 @@ void DashboardServer::stop() {
   Impl& m = *impl_;
   {
     std::lock_guard lock(m.mutex);
-    m.quit = true;
+    m.sampler_quit = true;
   }
   m.changed.notify_all();
-  if (m.sampler.joinable()) m.sampler.join();
+  if (m.sampler.joinable()) m.sampler.join();  // after its last frame
+  {
+    std::unique_lock lock(m.mutex);
+    m.quit = true;
+    m.changed.notify_all();
+    // Open streams end with their last chunk before the server closes; a
+    // client that does not read is not waited for long.
+    m.changed.wait_for(lock, std::chrono::seconds(1), [&m] { return m.streams == 0; });
+  }
   m.server.stop();
   if (m.listener.joinable()) m.listener.join();
 }

@@ -59,6 +59,7 @@ class DashboardRun {
   ~DashboardRun() {
     controls_.stop = true;
     if (thread_.joinable()) thread_.join();
+    server_->stop();
   }
 
   httplib::Client client() const {
@@ -178,6 +179,31 @@ TEST(Dashboard, TheStreamDeliversStatesWithIncreasingTimes) {
   ASSERT_GE(times.size(), 6u);
   for (std::size_t i = 1; i < times.size(); ++i) EXPECT_GE(times[i], times[i - 1]);
   EXPECT_GT(times.back(), times.front());
+}
+
+TEST(Dashboard, TheStreamEndsCompleteWithTheRunsLastState) {
+  DashboardRun run(0.5);
+  std::string buffer, last;
+  std::atomic<bool> connected{false};
+  httplib::Result result{nullptr, httplib::Error::Unknown};
+  std::thread client([&] {
+    result = run.client().Get("/api/stream", [&](const char* data, std::size_t length) {
+      connected = true;
+      buffer.append(data, length);
+      for (std::size_t end; (end = buffer.find("\n\n")) != std::string::npos;) {
+        last = buffer.substr(6, end - 6);
+        buffer.erase(0, end + 2);
+      }
+      return true;
+    });
+  });
+  while (!connected) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(run.finish().end_reason, EndReason::duration);
+  run.server_->stop();  // as the CLI does when the run has ended
+  client.join();
+  ASSERT_TRUE(result) << httplib::to_string(result.error());  // the last chunk arrived
+  EXPECT_TRUE(buffer.empty());
+  EXPECT_EQ(json::parse(last)["phase"], "ended");
 }
 
 TEST(Dashboard, AControlWithoutTheTokenIsRefusedAndChangesNothing) {
