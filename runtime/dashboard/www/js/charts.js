@@ -136,7 +136,10 @@ export class JitterHistogram {
         scales: {
           x: { ticks: { color: COLORS.tick, maxRotation: 0, autoSkip: true, maxTicksLimit: 8 }, grid: { display: false },
                title: { display: true, text: 'jitter (ms)', color: COLORS.tick } },
-          y: { type: 'logarithmic', ticks: { color: COLORS.tick, maxTicksLimit: 4 }, grid: { color: COLORS.grid } },
+          // Counts span decades: a log scale labelled at the powers of ten.
+          y: { type: 'logarithmic', min: 0.7, grid: { color: COLORS.grid },
+               ticks: { color: COLORS.tick,
+                        callback: (v) => (v >= 1 && Number.isInteger(Math.log10(v)) ? String(v) : '') } },
         },
       },
     });
