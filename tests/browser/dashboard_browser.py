@@ -175,11 +175,6 @@ def start_browser(profile):
     driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
                            dict(VIEWPORT, deviceScaleFactor=1, mobile=False))
     driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": ERROR_HOOK})
-    # Uncompressed answers: the server's brotli compression of three.js costs
-    # seconds of CPU per load, enough on a busy machine to make the simulated
-    # servos miss the watchdog (docs/dashboard.md, notes for the page).
-    driver.execute_cdp_cmd("Network.enable", {})
-    driver.execute_cdp_cmd("Network.setExtraHTTPHeaders", {"headers": {"Accept-Encoding": "identity"}})
     return driver
 
 
