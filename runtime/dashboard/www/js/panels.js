@@ -15,7 +15,7 @@ export function showInfo(info) {
   const parts = [];
   if (info.backend) parts.push(`${info.backend} backend`);
   if (isNum(info.rate_hz)) parts.push(`${info.rate_hz} Hz`);
-  if (info.replay) parts.push('replay');
+  if (info.replay && info.backend !== 'replay') parts.push('replay');
   setText('robot-backend', parts.join(' · '));
   document.title = `${info.robot || 'robot'} · animrt dashboard`;
 }
