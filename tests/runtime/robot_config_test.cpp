@@ -248,7 +248,7 @@ TEST_F(RobotConfigTest, AbsoluteMotionFileIsKeptAsGiven) {
 TEST_F(RobotConfigTest, UnknownKeysAreRejectedAtEveryLevel) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"),
             at("10:1: colour: unknown key (expected one of: name, loop, safety, buses, joints, "
-               "motion)"));
+               "motion, model)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100, rate: 5}
 )"),
