@@ -32,7 +32,10 @@ constexpr auto kPatience = std::chrono::seconds(30);  // a bound for waits, not 
 // loopback port.
 class DashboardRun {
  public:
-  explicit DashboardRun(double duration_s, bool steerable = true) : rig_(kQuadruped) {
+  explicit DashboardRun(double duration_s, bool steerable = true,
+                        const std::function<void(test::SimRig&)>& before = {})
+      : rig_(kQuadruped) {
+    if (before) before(rig_);
     monitor_ = std::make_unique<RunMonitor>(rig_.runner().model());
     DashboardSetup setup;
     setup.robot = rig_.config().name;
@@ -204,6 +207,27 @@ TEST(Dashboard, TheStreamEndsCompleteWithTheRunsLastState) {
   ASSERT_TRUE(result) << httplib::to_string(result.error());  // the last chunk arrived
   EXPECT_TRUE(buffer.empty());
   EXPECT_EQ(json::parse(last)["phase"], "ended");
+}
+
+TEST(Dashboard, AFaultReachesTheFaultLogWithItsTimeAndItsDevice) {
+  DashboardRun run(0.0, true, [](test::SimRig& rig) {
+    rig.probe->on_sample = [&rig](double t) {
+      if (t >= 0.5) rig.sims[0]->set_device_hardware_error(9, 0x04);  // lh_ankle overheating
+    };
+  });
+  const json state = run.wait_state([](const json& s) { return s["phase"] == "ended"; });
+  EXPECT_EQ(run.finish().end_reason, EndReason::fault);
+  ASSERT_EQ(state["faults"].size(), 1u);
+  const json& fault = state["faults"][0];
+  EXPECT_EQ(fault["text"], "legs id 9 (lh_ankle): hardware error");
+  // Motion time 0.5 s is run time 2.5 s (after the 2 s start ramp); the
+  // error is read within a cycle or two.
+  EXPECT_GE(fault["t_s"].get<double>(), 2.5);
+  EXPECT_LE(fault["t_s"].get<double>(), 2.52);
+  for (const json& d : state["devices"]) {
+    EXPECT_EQ(d["faulted"].get<bool>(), d["id"] == 9) << d["id"];
+    EXPECT_EQ(d["last_fault"], d["id"] == 9 ? fault["text"] : json(nullptr)) << d["id"];
+  }
 }
 
 TEST(Dashboard, AControlWithoutTheTokenIsRefusedAndChangesNothing) {
