@@ -170,7 +170,8 @@ int cmd_run(const RunArgs& args) {
       dashboard_setup.bus_protocols.push_back(bus.protocol);
     dashboard_setup.motion_kind = robot.config.motion.type;
     dashboard_setup.motion_name = std::filesystem::path(robot.config.motion.file).stem().string();
-    dashboard_setup.steering = robot.steering;
+    // A herd steers the gait itself (and the steering mailbox takes one writer).
+    if (args.herd.empty()) dashboard_setup.steering = robot.steering;
     dashboard_setup.duration_s = args.duration;
     dashboard_setup.figure = figure.get();
   }
