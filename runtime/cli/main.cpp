@@ -12,6 +12,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -19,10 +20,12 @@
 
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
+#include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "evolve_command.hpp"
@@ -32,6 +35,7 @@
 #include "herd_driver.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "view_command.hpp"
 
 namespace {
 
@@ -59,8 +63,18 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+// The robot file's figure model, loaded (so a model that does not load is an
+// error of the robot file), or null when it names none.
+std::unique_ptr<animrt::sim::MujocoFigure> load_figure(const animrt::RobotConfig& config) {
+  if (config.model.empty()) return nullptr;
+  std::vector<std::string> names;
+  for (const auto& joint : config.joints) names.push_back(joint.name);
+  return std::make_unique<animrt::sim::MujocoFigure>(config.model, names, config.model_where);
+}
+
 int cmd_validate(const std::string& path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
+  load_figure(robot.config);
   std::size_t devices = 0;
   for (const auto& bus : robot.config.buses) devices += bus.actuators.size();
   std::cout << path << ": ok (" << robot.config.joints.size() << " joints, "
@@ -100,9 +114,13 @@ struct RunArgs {
   bool lockstep = false;
   bool no_realtime = false;
   bool no_audio = false;
-  std::string physics;  // MJCF model behind the simulated servos
-  std::string herd;     // scene file: the robot is one agent of this herd
-  std::string agent;    // which one
+  std::string physics;    // MJCF model behind the simulated servos
+  std::string herd;       // scene file: the robot is one agent of this herd
+  std::string agent;      // which one
+  std::string dashboard;  // HOST:PORT, empty = none
+  bool dashboard_remote = false;
+  double dashboard_rate = 30.0;
+  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
 // The show files a motion plays (a show, or show layers).
@@ -112,7 +130,51 @@ void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>&
 }
 
 int cmd_run(const RunArgs& args) {
+  // The dashboard's address is a usage error before any file is read.
+  std::pair<std::string, int> dashboard_at;
+  if (!args.dashboard.empty()) {
+    try {
+      dashboard_at = animrt::parse_host_port(args.dashboard);
+    } catch (const std::invalid_argument& e) {
+      spdlog::error("--dashboard: {}", e.what());
+      return kExitUsage;
+    }
+    if (!args.dashboard_remote && !animrt::is_loopback_host(dashboard_at.first)) {
+      spdlog::error(
+          "--dashboard: {} is not a loopback address; the dashboard takes controls, so serving "
+          "other machines needs --dashboard-remote",
+          dashboard_at.first);
+      return kExitUsage;
+    }
+  }
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
+  // The figure: the robot file's model, or else the physics model.
+  std::unique_ptr<animrt::sim::MujocoFigure> figure = load_figure(robot.config);
+  if (!figure && !args.physics.empty() && !args.dashboard.empty()) {
+    animrt::RobotConfig with_physics = robot.config;
+    with_physics.model = args.physics;
+    with_physics.model_where = animrt::Location{args.physics, 0, 0};
+    figure = load_figure(with_physics);
+  }
+  // What the dashboard tells of the run, taken before the runner owns the config.
+  animrt::DashboardSetup dashboard_setup;
+  if (!args.dashboard.empty()) {
+    dashboard_setup.host = dashboard_at.first;
+    dashboard_setup.port = dashboard_at.second;
+    dashboard_setup.remote = args.dashboard_remote;
+    dashboard_setup.rate_hz = args.dashboard_rate;
+    dashboard_setup.www_dir = args.dashboard_www;
+    dashboard_setup.robot = robot.config.name;
+    dashboard_setup.backend = args.backend;
+    for (const auto& bus : robot.config.buses)
+      dashboard_setup.bus_protocols.push_back(bus.protocol);
+    dashboard_setup.motion_kind = robot.config.motion.type;
+    dashboard_setup.motion_name = std::filesystem::path(robot.config.motion.file).stem().string();
+    // A herd steers the gait itself (and the steering mailbox takes one writer).
+    if (args.herd.empty()) dashboard_setup.steering = robot.steering;
+    dashboard_setup.duration_s = args.duration;
+    dashboard_setup.figure = figure.get();
+  }
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
   std::ofstream summary_out;
@@ -199,7 +261,17 @@ int cmd_run(const RunArgs& args) {
   };
 
   animrt::Runner runner(std::move(robot.config), std::move(buses), std::move(robot.motion));
+  // The dashboard serves before the start ramp, so its line comes first.
+  std::unique_ptr<animrt::RunMonitor> monitor;
+  std::unique_ptr<animrt::DashboardServer> dashboard;
+  if (!args.dashboard.empty()) {
+    monitor = std::make_unique<animrt::RunMonitor>(runner.model());
+    dashboard = std::make_unique<animrt::DashboardServer>(*monitor, g_controls, dashboard_setup);
+    options.monitor = monitor.get();
+    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+  }
   animrt::RunSummary summary = runner.run(options);
+  if (dashboard) dashboard->stop();
   if (herd) herd->stop();
   if (physics) {
     const animrt::sim::PhysicsMeasures m = physics->measures();
@@ -267,6 +339,18 @@ int main(int argc, char** argv) {
                   "MuJoCo model (MJCF) behind the simulated servos; the summary reports distance, "
                   "speed and falls (sim backend, dynamixel2 buses)");
 
+  run->add_option("--dashboard", run_args.dashboard,
+                  "serve the dashboard at HOST:PORT (port 0: a free one; loopback only unless "
+                  "--dashboard-remote); prints its URL with the run's token");
+  run->add_flag("--dashboard-remote", run_args.dashboard_remote,
+                "let the dashboard listen on an address other machines can reach");
+  run->add_option("--dashboard-rate", run_args.dashboard_rate,
+                  "dashboard stream rate in Hz (default 30)")
+      ->check(CLI::Range(0.5, 200.0));
+  run->add_option("--dashboard-www", run_args.dashboard_www,
+                  "folder of the dashboard's page (default: the source tree's)")
+      ->check(CLI::ExistingDirectory);
+
   run->add_option("--herd", run_args.herd,
                   "herd scene (YAML): the robot walks as one of its agents (needs --agent)");
   run->add_option("--agent", run_args.agent,
@@ -280,6 +364,7 @@ int main(int argc, char** argv) {
   animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
+  animrt::cli::add_view_command(app);
   auto* seq = app.add_subcommand("seq", "Mesh sequences: generated corpus, deformation features");
   seq->require_subcommand(1);
   animrt::cli::add_seq_corpus_command(*seq);

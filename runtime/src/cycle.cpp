@@ -30,6 +30,7 @@ CycleState::CycleState(const RobotModel& model)
   ramp_from_.assign(n, 0.0);
   ramp_to_.assign(n, 0.0);
   jog_.assign(n, 0.0);
+  manual_pose_.assign(n, 0.0);
   active_.assign(n, 0);
   window_ = std::max<std::size_t>(
       1, static_cast<std::size_t>(std::lround(model.safety.following_error_window_s / model.dt)));
@@ -224,8 +225,34 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     }
   }
 
-  // Sample.
+  // Manual mode: on, the joints hold where the filter has them and move
+  // only by manual targets (clamped to the limits); off, the motion's
+  // targets return, and the filter makes the way back smooth.
   if (s.phase_ == Phase::motion) {
+    if (in.manual && !s.manual_) {
+      const auto held = s.filter_.position();
+      std::copy(held.begin(), held.end(), s.manual_pose_.begin());
+    }
+    s.manual_ = in.manual;
+    if (s.manual_) {
+      for (const ManualTarget& target : in.manual_targets) {
+        if (target.joint < 0 || static_cast<std::size_t>(target.joint) >= n ||
+            !std::isfinite(target.position)) {
+          continue;
+        }
+        const auto j = static_cast<std::size_t>(target.joint);
+        s.manual_pose_[j] =
+            std::clamp(target.position, model.limits[j].min_position, model.limits[j].max_position);
+      }
+    }
+  } else {
+    s.manual_ = false;
+  }
+
+  // Sample.
+  if (s.phase_ == Phase::motion && s.manual_) {
+    std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
+  } else if (s.phase_ == Phase::motion) {
     std::copy(model.home.begin(), model.home.end(), s.targets_.begin());
     motion.sample(t - s.motion_start_, s.targets_);
     bool bad = false;

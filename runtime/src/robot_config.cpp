@@ -338,6 +338,25 @@ void check_bus_load(const YamlNode& rate_node, const RobotConfig& config) {
   }
 }
 
+// A file named by `node`, resolved against the robot file's folder; it must
+// be a readable regular file.
+std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
+  const std::string given = node.as_string();
+  if (given.empty()) node.fail("expected a file path, found \"\"");
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(robot_path).parent_path();
+  const std::string resolved =
+      (fs::path(given).is_absolute() ? fs::path(given) : folder / given).string();
+  const std::string problem = input_file_problem(resolved, kMaxMediaFileBytes);
+  const std::string where =
+      given == resolved
+          ? "\"" + given + "\""
+          : "\"" + given + "\" (resolved against the robot file's folder to \"" + resolved + "\")";
+  if (problem == kFileMissing) node.fail("file not found: " + where);
+  if (!problem.empty()) node.fail(where + " " + problem);
+  return resolved;
+}
+
 MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
                           bool in_layers = false) {
   // Layers: sources applied in order; later ones win on the joints they drive.
@@ -398,7 +417,7 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
 
 RobotConfig load_robot_config(const std::string& path) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"name", "loop", "safety", "buses", "joints", "motion"});
+  root.allow_only({"name", "loop", "safety", "buses", "joints", "motion", "model"});
 
   RobotConfig config;
   config.file = path;
@@ -430,6 +449,11 @@ RobotConfig load_robot_config(const std::string& path) {
   }
 
   config.motion = parse_motion(root.at("motion"), path);
+  if (auto model = root.find("model")) {
+    // Whether MuJoCo can load it is checked where the model is loaded.
+    config.model = resolve_file(*model, path);
+    config.model_where = model->location();
+  }
   return config;
 }
 

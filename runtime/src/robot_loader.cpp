@@ -95,6 +95,9 @@ LoadedRobot load_robot(const std::string& path) {
   LoadedRobot robot;
   robot.config = load_robot_config(path);
   robot.motion = make_source(robot.config.motion, robot.config);
+  if (robot.config.motion.type == "gait") {
+    robot.steering = load_gait_file(robot.config.motion.file).steering;
+  }
   return robot;
 }
 

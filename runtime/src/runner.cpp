@@ -147,6 +147,8 @@ Runner::Runner(RobotConfig config, std::vector<std::unique_ptr<ActuatorBus>> bus
 
 Runner::~Runner() = default;
 
+const RobotModel& Runner::model() const { return impl_->model; }
+
 RunSummary Runner::run(const RunOptions& options) {
   Impl& m = *impl_;
   const RobotModel& model = m.model;
@@ -268,6 +270,7 @@ RunSummary Runner::run(const RunOptions& options) {
   // A stop requested while the buses were brought up: nothing is switched on.
   if (options.controls && options.controls->stop.load()) {
     m.log(options, "stop requested before activation: nothing was switched on");
+    if (options.monitor) options.monitor->publish_ended();
     summary.end_reason = EndReason::signal;
     for (std::size_t b = 0; b < bus_count; ++b) {
       summary.buses.push_back(BusReport{m.buses[b]->config().name, {}, 0});
@@ -281,18 +284,26 @@ RunSummary Runner::run(const RunOptions& options) {
   const Nanos start = clock.now();
   Nanos deadline = start;
   Nanos previous_wake = -1;
+  double last_period_s = -1.0;
   CycleInputs in;
   in.buses = io;
   in.motion_duration_s = options.duration_s;
   MotionCommand steer;
   JogCommand jog;
+  constexpr std::size_t kManualPerCycle = 64;
+  std::vector<ManualTarget> manual(kManualPerCycle);
+  RunMonitor* const monitor = options.monitor;
+  std::vector<std::span<const DeviceStatus>> monitor_devices(bus_count);
   bool torque_off_now = false;
   while (!state.done()) {
     if (options.lockstep_clock) options.lockstep_clock->set(deadline);
     const Nanos wake = clock.now();
     const Nanos wake_wall = wall.now();
     jitter_hist.add(to_seconds(wake - deadline));
-    if (previous_wake >= 0) period_hist.add(to_seconds(wake - previous_wake));
+    if (previous_wake >= 0) {
+      last_period_s = to_seconds(wake - previous_wake);
+      period_hist.add(last_period_s);
+    }
     previous_wake = wake;
 
     // read: every idle bus reads on its own thread; a bus still busy from an
@@ -329,7 +340,29 @@ RunSummary Runner::run(const RunOptions& options) {
     in.abort = options.controls && options.controls->abort.load(std::memory_order_relaxed);
     in.steer = options.controls && options.controls->steer.take(steer) ? &steer : nullptr;
     in.jog = options.controls && options.controls->jog.take(jog) ? &jog : nullptr;
+    // Targets first, then the mode: a target posted after manual mode was
+    // switched on is never taken for one sent before it.
+    std::size_t manual_count = 0;
+    if (options.controls) {
+      double target[2];
+      while (manual_count < manual.size() && options.controls->manual_targets.pop(target)) {
+        manual[manual_count++] = ManualTarget{static_cast<int>(target[0]), target[1]};
+      }
+      in.manual = options.controls->manual.load(std::memory_order_acquire);
+    }
+    in.manual_targets = std::span<const ManualTarget>(manual.data(), manual_count);
     const CycleOutputs& out = step(model, *m.motion, state, in);
+    if (monitor) {
+      // Before the writes are posted: a fresh bus's I/O thread is idle, so
+      // its device statuses hold still while they are copied.
+      for (std::size_t b = 0; b < bus_count; ++b) {
+        monitor_devices[b] = io[b].fresh ? std::span<const DeviceStatus>(m.buses[b]->devices())
+                                         : std::span<const DeviceStatus>();
+      }
+      monitor->publish(in.t, state, out.commands, monitor_devices, summary.overruns,
+                       summary.skipped_cycles, in.steer);
+      for (const CycleEvent& e : out.events) monitor->push_event(e);
+    }
     for (const CycleEvent& e : out.events) {
       if (e.kind == EventKind::motion_started && options.on_motion_start) {
         options.on_motion_start(deadline);
@@ -359,7 +392,12 @@ RunSummary Runner::run(const RunOptions& options) {
       ring.push(record);
     }
 
-    busy_hist.add(to_seconds(wall.now() - wake_wall));
+    const Nanos busy = wall.now() - wake_wall;
+    busy_hist.add(to_seconds(busy));
+    if (monitor) {
+      monitor->push_timing(CycleTiming{in.t, period_hist.count() ? last_period_s : -1.0,
+                                       to_seconds(wake - deadline), to_seconds(busy)});
+    }
     if (options.lockstep_clock) {
       deadline += period;
     } else {
@@ -371,6 +409,7 @@ RunSummary Runner::run(const RunOptions& options) {
     }
   }
   for (auto& w : workers) w->stop();
+  if (monitor) monitor->publish_ended();
   for (std::size_t b = 0; b < bus_count; ++b) {
     if (workers[b]->io_cycles() != io_seen[b]) {
       bus_hist[b].add(to_seconds(workers[b]->last_io_ns()));

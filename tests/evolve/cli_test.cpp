@@ -80,6 +80,10 @@ TEST_F(EvolveCli, ThreadsAndMpiGiveTheSerialResultAndTheGaitPlays) {
   const std::string from = "file: ../gaits/walk.yaml";
   ASSERT_NE(robot.find(from), std::string::npos);
   robot.replace(robot.find(from), from.size(), "file: " + path("serial.yaml"));
+  const std::string model = "model: ../models/quadruped.xml";  // relative: the copy's is absolute
+  ASSERT_NE(robot.find(model), std::string::npos);
+  robot.replace(robot.find(model), model.size(),
+                "model: " + kRoot + "/configs/models/quadruped.xml");
   std::ofstream(path("robot.yaml")) << robot;
   EXPECT_EQ(sh(kAnimrt + " validate " + path("robot.yaml") + " > /dev/null"), 0);
   EXPECT_EQ(sh(kAnimrt + " run " + path("robot.yaml") +

@@ -47,6 +47,7 @@ void replace_once(std::string& text, const std::string& from, const std::string&
 std::string write_robot(const std::string& name, const std::string& gait) {
   std::string robot = read(kRoot + "/configs/robots/quadruped.yaml");
   replace_once(robot, "file: ../gaits/walk.yaml", "file: " + gait);
+  replace_once(robot, "model: ../models/quadruped.xml", "model: " + kModel);
   replace_once(robot, "wire_time: true", "wire_time: false");
   // Bus timeouts are wall-clock time even in lockstep; a loaded machine must not hit them.
   replace_once(robot, "timeout_ms: 4 ", "timeout_ms: 50 ");

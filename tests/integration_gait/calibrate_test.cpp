@@ -92,6 +92,9 @@ TEST(GaitCalibrate, ValidateRefusesASteeringRangeBeyondTheJointLimits) {
   const auto file_at = robot.find(file_key);
   ASSERT_NE(file_at, std::string::npos);
   robot.replace(file_at, file_key.size(), "file: " + (dir / "wide.yaml").string());
+  const std::string model_key = "model: ../models/quadruped.xml";
+  ASSERT_NE(robot.find(model_key), std::string::npos);
+  robot.replace(robot.find(model_key), model_key.size(), "model: " + kModel);
   std::ofstream(dir / "robot.yaml") << robot;
   try {
     (void)load_robot((dir / "robot.yaml").string());

@@ -376,6 +376,84 @@ TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {
   EXPECT_EQ(bench.motion.steered.turn_rad_s, -0.5);
 }
 
+TEST(Cycle, ManualModeHoldsTheJointsMovesThemToClampedTargetsAndReturnsSmoothly) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t j, double t) { return 0.5 * std::sin(3.0 * t + j); };
+  bench.begin();
+  bench.run_until(Phase::motion);
+  for (int i = 0; i < 30; ++i) bench.cycle();
+  const double max_step = bench.model.limits[0].max_velocity / kRate + 1e-9;
+  std::vector<double> last(bench.state.measured().begin(), bench.state.measured().end());
+  auto check_step = [&](const CycleOutputs& out) {
+    for (std::size_t j = 0; j < 4; ++j) {
+      EXPECT_LE(std::abs(out.commands[j] - last[j]), max_step) << "joint " << j;
+      last[j] = out.commands[j];
+    }
+  };
+  for (std::size_t j = 0; j < 4; ++j) last[j] = bench.written[j / 2].back()[j % 2];
+
+  // On: the joints come to rest where they were, whatever the motion asks.
+  bench.in.manual = true;
+  const CycleOutputs& first = bench.cycle();
+  check_step(first);
+  EXPECT_TRUE(bench.state.manual());
+  const std::vector<double> held(bench.state.manual_pose().begin(),
+                                 bench.state.manual_pose().end());
+  for (int i = 0; i < 100; ++i) check_step(bench.cycle());
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_NEAR(last[j], held[j], 1e-6) << "joint " << j;
+  }
+
+  // A target beyond the limit stops at the limit; another joint's target,
+  // sent in the same cycle, arrives too.
+  const ManualTarget targets[2] = {{0, 10.0}, {3, -0.4}};
+  bench.in.manual_targets = targets;
+  check_step(bench.cycle());
+  bench.in.manual_targets = {};
+  EXPECT_EQ(bench.state.manual_pose()[0], bench.model.limits[0].max_position);
+  for (int i = 0; i < 300; ++i) {
+    check_step(bench.cycle());
+    EXPECT_LE(last[0], bench.model.limits[0].max_position);
+  }
+  EXPECT_NEAR(last[0], bench.model.limits[0].max_position, 1e-6);
+  EXPECT_NEAR(last[3], -0.4, 1e-6);
+  EXPECT_NEAR(last[1], held[1], 1e-6);
+
+  // Off: back to the motion, through the filter.
+  bench.in.manual = false;
+  for (int i = 0; i < 300; ++i) check_step(bench.cycle());
+  EXPECT_FALSE(bench.state.manual());
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_NEAR(last[j], bench.motion.fn(j, bench.in.t - bench.state.motion_start()), 1e-6);
+  }
+}
+
+TEST(Cycle, ManualTargetsOutsideTheMotionPhaseAreIgnored) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double) { return 0.3; };
+  bench.begin();
+  bench.in.manual = true;
+  const ManualTarget target{1, -1.0};
+  bench.in.manual_targets = std::span<const ManualTarget>(&target, 1);
+  // The start ramp goes to the first pose regardless.
+  while (bench.state.phase() == Phase::start_ramp) {
+    EXPECT_FALSE(bench.state.manual());
+    bench.cycle();
+  }
+  const auto& goals = bench.written[0];
+  ASSERT_GE(goals.size(), 2u);
+  EXPECT_NEAR(goals[goals.size() - 2][1], 0.3, 1e-2);
+  // In the motion phase the same input takes effect.
+  EXPECT_TRUE(bench.state.manual());
+  EXPECT_EQ(bench.state.manual_pose()[1], -1.0);
+  bench.in.manual_targets = {};
+  // A stop ends manual mode: the stop ramp goes home.
+  bench.in.stop = true;
+  bench.run_until(Phase::done);
+  EXPECT_FALSE(bench.state.manual());
+  for (double goal : bench.written[0].back()) EXPECT_NEAR(goal, 0.0, 1e-3);
+}
+
 TEST(Cycle, StepDoesNotAllocate) {
   Bench bench(two_bus_model());
   bench.motion.fn = [](std::size_t j, double t) {
@@ -389,6 +467,9 @@ TEST(Cycle, StepDoesNotAllocate) {
   for (int i = 0; i < 600 && !bench.state.done(); ++i) {
     bench.in.t = i / kRate;
     io[1].fresh = i % 7 != 0;
+    bench.in.manual = i > 150 && i < 250;  // manual mode on and off on the way
+    const ManualTarget target{0, 0.1 * (i % 5)};
+    bench.in.manual_targets = std::span<const ManualTarget>(&target, 1);
     step(bench.model, bench.motion, bench.state, bench.in);
   }
   EXPECT_EQ(counter.count(), 0);

@@ -46,6 +46,7 @@ class MotionCheckTest : public ::testing::Test {
     fs::remove_all(dir_);
     robot_text_ = read_file(kSourceDir + "/configs/robots/quadruped.yaml");
     write_file(robot(), robot_text_);
+    write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
     gait_text_ = read_file(kSourceDir + "/configs/gaits/walk.yaml");
   }
   void TearDown() override { fs::remove_all(dir_); }

@@ -83,6 +83,7 @@ TEST_F(RobotConfigTest, ShippedQuadrupedHasTheDocumentedValues) {
   const fs::path copy = dir_ / "robots" / "quadruped.yaml";
   write_file(copy, read_file(kSourceDir + "/configs/robots/quadruped.yaml"));
   write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
+  write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
   const RobotConfig c = load_robot_config(copy.string());
 
   EXPECT_EQ(c.file, copy.string());
@@ -153,6 +154,22 @@ TEST_F(RobotConfigTest, ShippedQuadrupedLoadsInPlace) {
   EXPECT_EQ(c.joints.size(), 12u);
   EXPECT_EQ(c.motion.file, kSourceDir + "/configs/robots/../gaits/walk.yaml");
   EXPECT_TRUE(fs::equivalent(c.motion.file, walk));
+  EXPECT_TRUE(fs::equivalent(c.model, kSourceDir + "/configs/models/quadruped.xml"));
+}
+
+TEST_F(RobotConfigTest, TheFigureModelIsOptionalAndMustExist) {
+  EXPECT_EQ(load(kMinimal).model, "");
+  write_file(dir_ / "models" / "figure.xml", "<mujoco/>\n");
+  const RobotConfig c = load(std::string(kMinimal) + "model: ../models/figure.xml\n");
+  EXPECT_EQ(c.model, (dir_ / "robots" / ".." / "models" / "figure.xml").string());
+  EXPECT_EQ(c.model_where.line, 10);
+  EXPECT_EQ(error_of(std::string(kMinimal) + "model: ../models/missing.xml\n"),
+            at("10:8: model: file not found: \"../models/missing.xml\" (resolved against the "
+               "robot file's folder to \"" +
+               (dir_ / "robots" / ".." / "models" / "missing.xml").string() + "\")"));
+  EXPECT_EQ(error_of(std::string(kMinimal) + "model: ../models\n"),
+            at("10:8: model: \"../models\" (resolved against the robot file's folder to \"" +
+               (dir_ / "robots" / ".." / "models").string() + "\") is a directory"));
 }
 
 TEST_F(RobotConfigTest, OptionalKeysTakeTheirDefaults) {
@@ -231,7 +248,7 @@ TEST_F(RobotConfigTest, AbsoluteMotionFileIsKeptAsGiven) {
 TEST_F(RobotConfigTest, UnknownKeysAreRejectedAtEveryLevel) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"),
             at("10:1: colour: unknown key (expected one of: name, loop, safety, buses, joints, "
-               "motion)"));
+               "motion, model)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100, rate: 5}
 )"),
@@ -818,6 +835,7 @@ TEST_F(RobotConfigTest, LoopRateTheBusCannotCarry) {
   const fs::path copy = dir_ / "robots" / "quadruped.yaml";
   std::string text = read_file(kSourceDir + "/configs/robots/quadruped.yaml");
   write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
+  write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
   const auto rate = text.find("rate_hz: 200");
   ASSERT_NE(rate, std::string::npos);
   text.replace(rate, 12, "rate_hz: 10000");

@@ -114,6 +114,7 @@ class SimRig {
   // The real bus (behind its WatchedBus) and the wrapper.
   ActuatorBus& bus(std::size_t index) { return watched_[index]->inner(); }
   WatchedBus& watched(std::size_t index) { return *watched_[index]; }
+  const Runner& runner() const { return *runner_; }
 
   // Options for a run of `duration` s (0: until a stop request), with
   // telemetry to `telemetry` if not empty.

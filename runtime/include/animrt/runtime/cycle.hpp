@@ -42,6 +42,10 @@ struct CycleInputs {
   bool abort = false;                    // torque off at once
   const MotionCommand* steer = nullptr;  // a new steering command, if one arrived
   const JogCommand* jog = nullptr;       // a new jog, if one arrived
+  // Manual mode (RunControls::manual) and the manual targets that arrived
+  // since the last cycle, oldest first. Both act in the motion phase only.
+  bool manual = false;
+  std::span<const ManualTarget> manual_targets;
 };
 
 enum class EventKind : std::uint8_t {
@@ -91,6 +95,7 @@ class CycleState {
   Phase phase() const { return phase_; }
   bool done() const { return phase_ == Phase::done; }
   double motion_time() const { return motion_time_; }
+  double motion_start() const { return motion_start_; }  // run time the motion began
   const CycleEnd& end() const { return end_; }
   std::span<const double> measured() const { return measured_; }
   // The watchdog's record, per bus and device (1 = faulted).
@@ -104,6 +109,11 @@ class CycleState {
   double rms_error(std::size_t j) const;
   double max_error(std::size_t j) const { return max_error_[j]; }
   std::uint64_t cycles() const { return cycles_; }
+  // The safety filter's output velocity per joint (rad/s or m/s).
+  std::span<const double> command_velocity() const { return filter_.velocity(); }
+  // Manual mode: on (in the motion phase) and the held pose it steers to.
+  bool manual() const { return manual_; }
+  std::span<const double> manual_pose() const { return manual_pose_; }
 
  private:
   friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
@@ -123,6 +133,8 @@ class CycleState {
   PoseRamp ramp_;
   std::vector<JointSlot> slots_;
   std::vector<double> measured_, targets_, ramp_from_, ramp_to_, jog_;
+  bool manual_ = false;
+  std::vector<double> manual_pose_;
   std::vector<std::uint8_t> active_;            // per joint: its bus takes a write
   std::vector<std::vector<double>> last_sent_;  // per bus, per device
   std::vector<std::vector<std::uint8_t>> faulted_;

@@ -47,6 +47,10 @@ struct RobotConfig {
   std::vector<JointSpec> joints;
   std::vector<BusConfig> buses;  // each with its actuators (joint_index filled in)
   MotionConfig motion;
+  // Optional MJCF model of the figure (the dashboard draws it): resolved
+  // against the robot file's folder; empty when the file names none.
+  std::string model;
+  Location model_where;  // of the `model` key's value
 };
 
 // Throws InputError (file, line, column, key) on the first problem found.

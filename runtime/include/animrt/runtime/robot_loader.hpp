@@ -3,8 +3,10 @@
 // `animrt validate` checks exactly what `animrt run` would use.
 
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/runtime/robot_config.hpp"
 
@@ -13,6 +15,8 @@ namespace animrt {
 struct LoadedRobot {
   RobotConfig config;
   std::unique_ptr<MotionSource> motion;
+  // A gait motion with a `steering` section: its command range.
+  std::optional<GaitSteering> steering;
 };
 
 // Loads the robot file and its motion source. Throws InputError on the first

@@ -8,6 +8,7 @@
 
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/mailbox.hpp"
+#include "animrt/runtime/telemetry.hpp"
 
 namespace animrt {
 
@@ -19,6 +20,13 @@ struct JogCommand {
   double offset = 0.0;
 };
 
+// Manual mode's absolute target for one joint (rad, or m for a prismatic
+// joint); clamped to the joint's limits and passed through the safety filter.
+struct ManualTarget {
+  int joint = -1;  // robot joint index
+  double position = 0.0;
+};
+
 struct RunControls {
   // Ramp home and end the run (SIGINT, SIGTERM, a dashboard's stop).
   std::atomic<bool> stop{false};
@@ -27,6 +35,14 @@ struct RunControls {
   // Speed and turn of a steered motion source.
   Mailbox<MotionCommand> steer;
   Mailbox<JogCommand> jog;
+  // Manual mode (a dashboard's sliders): while on, the motion's targets are
+  // replaced by a held pose that starts where the joints are and moves only
+  // by manual targets; off returns to the motion through the safety filter.
+  std::atomic<bool> manual{false};
+  // Manual targets, in order (one writer): a ring, not a mailbox, so that
+  // targets for two joints posted within one cycle both arrive. Each record
+  // is {joint, position}.
+  TelemetryRing manual_targets{2, 256};
 };
 
 }  // namespace animrt

@@ -16,7 +16,9 @@
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/run_controls.hpp"
+#include "animrt/runtime/run_monitor.hpp"
 #include "animrt/runtime/run_summary.hpp"
 
 namespace animrt {
@@ -40,6 +42,9 @@ struct RunOptions {
   // a show's sound track can follow it. Must not block, lock or allocate.
   std::function<void(Nanos)> on_motion_start;
   std::function<void()> on_motion_end;
+  // Readers of the run (a dashboard): the cycle publishes its state, timing
+  // and events here, lock-free. Built on this runner's model().
+  RunMonitor* monitor = nullptr;
 };
 
 class Runner {
@@ -54,6 +59,9 @@ class Runner {
   // Whatever ends the run (return, exception), every bus that was activated
   // is deactivated.
   RunSummary run(const RunOptions& options);
+
+  // The immutable model of the run (joints, limits, buses), known before it.
+  const RobotModel& model() const;
 
  private:
   struct Impl;

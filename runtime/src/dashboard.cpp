@@ -1,0 +1,581 @@
+// The dashboard's server (see dashboard.hpp and docs/dashboard.md).
+
+#include "animrt/runtime/dashboard.hpp"
+
+#include <fmt/format.h>
+#include <httplib.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+#include <thread>
+
+#include "animrt/runtime/loop_stats.hpp"
+
+namespace animrt {
+namespace {
+
+using nlohmann::json;
+
+// Jitter histogram bins (ms); the last bin holds everything beyond.
+constexpr std::array<double, 10> kJitterEdgesMs{0.0, 0.025, 0.05, 0.1, 0.25,
+                                                0.5, 1.0,   2.5,  5.0, 10.0};
+constexpr std::size_t kRecentPeriods = 256;  // the rate is their mean's inverse
+constexpr std::size_t kFaultLogCapacity = 200;
+
+std::string random_token() {
+  std::random_device device;  // /dev/urandom on Linux
+  std::string token;
+  for (int i = 0; i < 4; ++i) token += fmt::format("{:08x}", device());
+  return token;
+}
+
+// Equal strings, in time that depends only on their lengths.
+bool same_token(const std::string& given, const std::string& token) {
+  if (given.size() != token.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < token.size(); ++i) {
+    diff |= static_cast<unsigned char>(given[i] ^ token[i]);
+  }
+  return diff == 0;
+}
+
+json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+// The loop's statistics, from every cycle's timing as the reader drains it.
+struct LoopStats {
+  MicrosHistogram period, jitter;
+  std::array<std::uint64_t, kJitterEdgesMs.size()> jitter_bins{};
+  std::array<double, kRecentPeriods> recent{};
+  std::size_t recent_count = 0, recent_next = 0;
+
+  void add(const CycleTiming& t) {
+    jitter.add(std::max(0.0, t.jitter_s));
+    const double ms = t.jitter_s * 1e3;
+    std::size_t bin = 0;
+    while (bin + 1 < kJitterEdgesMs.size() && ms >= kJitterEdgesMs[bin + 1]) ++bin;
+    ++jitter_bins[bin];
+    if (t.period_s >= 0.0) {
+      period.add(t.period_s);
+      recent[recent_next] = t.period_s;
+      recent_next = (recent_next + 1) % recent.size();
+      recent_count = std::min(recent_count + 1, recent.size());
+    }
+  }
+  double rate_hz() const {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < recent_count; ++i) sum += recent[i];
+    return sum > 0.0 ? static_cast<double>(recent_count) / sum : 0.0;
+  }
+};
+
+json timing_json(const MicrosHistogram& h) {
+  return {{"p50", h.quantile(0.5) * 1e3}, {"p99", h.quantile(0.99) * 1e3}, {"max", h.max() * 1e3}};
+}
+
+}  // namespace
+
+bool is_loopback_host(const std::string& host) {
+  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
+}
+
+std::pair<std::string, int> parse_host_port(const std::string& text) {
+  const auto colon = text.rfind(':');
+  const std::string expected =
+      "expected HOST:PORT (e.g. 127.0.0.1:8080, port 0 for a free one), found \"" + text + "\"";
+  if (colon == std::string::npos || colon == 0) throw std::invalid_argument(expected);
+  std::string host = text.substr(0, colon);
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  const std::string port_text = text.substr(colon + 1);
+  if (port_text.empty() || port_text.size() > 5 ||
+      !std::all_of(port_text.begin(), port_text.end(),
+                   [](char c) { return c >= '0' && c <= '9'; })) {
+    throw std::invalid_argument(expected);
+  }
+  const int port = std::stoi(port_text);
+  if (port > 65535) throw std::invalid_argument(expected);
+  return {host, port};
+}
+
+struct DashboardServer::Impl {
+  RunMonitor& monitor;
+  RunControls& controls;
+  DashboardSetup setup;
+  const RobotModel& model;
+  std::string token;
+  int port = 0;
+  std::string info;  // /api/info, built once
+
+  httplib::Server server;
+  std::thread listener, sampler;
+
+  // The sampler's own state (its thread only).
+  RunView view;
+  LoopStats stats;
+  std::vector<BodyPose> measured_bodies, commanded_bodies;
+
+  // Shared with the HTTP handlers.
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::shared_ptr<const std::string> state;  // the latest /api/state
+  std::uint64_t generation = 0;
+  bool sampler_quit = false;  // the sampler publishes a last frame and ends
+  bool quit = false;          // the streams end (after that frame)
+  int streams = 0;            // open /api/stream responses
+  std::vector<std::pair<double, std::string>> faults;  // also the sampler's, under mutex
+
+  // Controls: one writer at a time for RunControls' single-writer channels.
+  std::mutex controls_mutex;
+  bool manual = false;
+
+  Impl(RunMonitor& m, RunControls& c, DashboardSetup s)
+      : monitor(m), controls(c), setup(std::move(s)), model(m.model()), token(random_token()) {}
+
+  std::string fault_text(const CycleEvent& e) const {
+    const auto joint = [&](int j) {
+      return j >= 0 && static_cast<std::size_t>(j) < model.joint_count()
+                 ? model.joint_names[static_cast<std::size_t>(j)]
+                 : std::string("?");
+    };
+    const auto device = [&] {
+      const BusModel& bus = model.buses[e.bus];
+      return fmt::format("{} id {} ({})", bus.name, bus.device_id[e.device], joint(e.joint));
+    };
+    switch (e.kind) {
+      case EventKind::device_fault:
+        return fmt::format("{}: {}", device(),
+                           e.health == DeviceHealth::hardware_error
+                               ? "hardware error"
+                               : fmt::format("no valid answer (last: {})", to_string(e.health)));
+      case EventKind::following_error:
+        return fmt::format("{}: following error, RMS {:.4f} {}", device(), e.value,
+                           model.prismatic[static_cast<std::size_t>(e.joint)] ? "m" : "rad");
+      case EventKind::motion_fault:
+        return fmt::format("motion fault: joint {} got a non-finite target", joint(e.joint));
+      case EventKind::stop_deadline:
+        return "the stop ramp ran over its deadline: torque switched off";
+      case EventKind::aborted:
+        return "abort: torque switched off";
+      default:
+        return {};
+    }
+  }
+
+  std::string build_info() const {
+    json joints = json::array();
+    for (std::size_t j = 0; j < model.joint_count(); ++j) {
+      joints.push_back({{"name", model.joint_names[j]},
+                        {"kind", model.prismatic[j] ? "prismatic" : "revolute"},
+                        {"min", model.limits[j].min_position},
+                        {"max", model.limits[j].max_position},
+                        {"max_velocity", model.limits[j].max_velocity},
+                        {"home", model.home[j]}});
+    }
+    json buses = json::array();
+    for (std::size_t b = 0; b < model.buses.size(); ++b) {
+      json devices = json::array();
+      for (std::size_t d = 0; d < model.buses[b].joint.size(); ++d) {
+        devices.push_back(
+            {{"id", model.buses[b].device_id[d]},
+             {"joint", model.joint_names[static_cast<std::size_t>(model.buses[b].joint[d])]}});
+      }
+      buses.push_back({{"name", model.buses[b].name},
+                       {"protocol", b < setup.bus_protocols.size() ? setup.bus_protocols[b] : ""},
+                       {"devices", devices}});
+    }
+    json motion = {{"kind", setup.motion_kind},
+                   {"name", setup.motion_name},
+                   {"steerable", setup.steering.has_value()},
+                   {"speed_mps", nullptr},
+                   {"turn_rps", nullptr},
+                   {"duration_s", setup.duration_s > 0 ? json(setup.duration_s) : json(nullptr)}};
+    if (setup.steering) {
+      motion["speed_mps"] = {0.0, setup.steering->max_speed_m_s()};
+      motion["turn_rps"] = {-setup.steering->max_turn_rad_s, setup.steering->max_turn_rad_s};
+    }
+    json figure = nullptr;
+    if (setup.figure) {
+      json bodies = json::array();
+      for (const FigureBody& body : setup.figure->bodies()) {
+        json geoms = json::array();
+        for (const FigureGeom& g : body.geoms) {
+          geoms.push_back({{"type", g.type},
+                           {"size", g.size},
+                           {"pos", g.pos},
+                           {"quat", g.quat},
+                           {"rgba", g.rgba}});
+        }
+        bodies.push_back({{"name", body.name}, {"parent", body.parent}, {"geoms", geoms}});
+      }
+      figure = {{"bodies", bodies}};
+    }
+    return json{{"robot", setup.robot},
+                {"backend", setup.backend},
+                {"rate_hz", model.rate_hz},
+                {"joints", joints},
+                {"buses", buses},
+                {"motion", motion},
+                {"model", figure},
+                {"replay", setup.replay},
+                {"replay_range_s",
+                 setup.replay ? json{setup.replay_start_s, setup.replay_end_s} : json(nullptr)}}
+        .dump();
+  }
+
+  json poses_json(const std::vector<BodyPose>& poses) const {
+    json out = json::array();
+    for (const BodyPose& p : poses) out.push_back({{"pos", p.pos}, {"quat", p.quat}});
+    return out;
+  }
+
+  // One frame: drain the rings, read the block, build the JSON.
+  std::string build_state() {
+    CycleTiming timing;
+    while (monitor.pop_timing(timing)) stats.add(timing);
+    CycleEvent event;
+    while (monitor.pop_event(event)) {
+      std::string text = fault_text(event);
+      if (text.empty()) continue;
+      std::lock_guard lock(mutex);
+      if (faults.size() < kFaultLogCapacity) faults.emplace_back(event.t, std::move(text));
+    }
+    monitor.read(view);
+    const std::size_t n = model.joint_count();
+    json joints = json::array();
+    json manual_positions = json::object();
+    for (std::size_t j = 0; j < n; ++j) {
+      joints.push_back({{"name", model.joint_names[j]},
+                        {"cmd", nullable(view.cmd[j])},
+                        {"meas", nullable(view.meas[j])},
+                        {"vel", nullable(view.vel[j])}});
+      if (view.manual) manual_positions[model.joint_names[j]] = nullable(view.manual_pose[j]);
+    }
+    json late = json::object();
+    for (std::size_t b = 0; b < model.buses.size(); ++b) late[model.buses[b].name] = view.late[b];
+    json edges = json::array(), counts = json::array();
+    for (std::size_t i = 0; i < kJitterEdgesMs.size(); ++i) {
+      edges.push_back(kJitterEdgesMs[i]);
+      counts.push_back(stats.jitter_bins[i]);
+    }
+    json devices = json::array();
+    std::size_t k = 0;
+    for (const BusModel& bus : model.buses) {
+      for (std::size_t d = 0; d < bus.joint.size(); ++d, ++k) {
+        const DeviceStatus& s = view.devices[k];
+        devices.push_back({{"bus", bus.name},
+                           {"id", bus.device_id[d]},
+                           {"joint", model.joint_names[static_cast<std::size_t>(bus.joint[d])]},
+                           {"health", to_string(s.health)},
+                           {"faulted", s.faulted},
+                           {"transactions", s.transactions},
+                           {"timeouts", s.timeouts},
+                           {"crc", s.crc_errors},
+                           {"protocol", s.protocol_errors},
+                           {"hardware", s.hardware_errors},
+                           {"exceptions", s.exceptions},
+                           {"last_fault", nullptr}});
+      }
+    }
+    json fault_log = json::array();
+    {
+      std::lock_guard lock(mutex);
+      for (const auto& [t, text] : faults) {
+        fault_log.push_back({{"t_s", t}, {"text", text}});
+        // The device's latest fault, for its row.
+        for (json& d : devices) {
+          const std::string prefix =
+              fmt::format("{} id {} ", d["bus"].get<std::string>(), d["id"].get<int>());
+          if (text.rfind(prefix, 0) == 0) d["last_fault"] = text;
+        }
+      }
+    }
+    json frame = {{"t_s", view.t_s},
+                  {"phase", to_string(view.phase)},
+                  {"joints", joints},
+                  {"loop",
+                   {{"cycles", view.cycles},
+                    {"rate_hz", stats.rate_hz()},
+                    {"period_ms", timing_json(stats.period)},
+                    {"jitter_ms", timing_json(stats.jitter)},
+                    {"overruns", view.overruns},
+                    {"skipped", view.skipped},
+                    {"late", late},
+                    {"jitter_hist", {{"edges_ms", edges}, {"counts", counts}}}}},
+                  {"devices", devices},
+                  {"faults", fault_log},
+                  {"motion",
+                   {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
+                    {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
+                    {"position_s", view.motion_time_s},
+                    {"playing", view.phase == RunPhaseView::motion && !view.manual}}},
+                  {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
+    if (setup.figure && view.published) {
+      const std::size_t bodies = setup.figure->bodies().size();
+      measured_bodies.resize(bodies);
+      commanded_bodies.resize(bodies);
+      setup.figure->pose(view.meas, measured_bodies);
+      setup.figure->pose(view.cmd, commanded_bodies);
+      frame["bodies"] = {{"measured", poses_json(measured_bodies)},
+                         {"commanded", poses_json(commanded_bodies)}};
+    }
+    return frame.dump();
+  }
+
+  void sample_loop() {
+    const auto period = std::chrono::duration<double>(1.0 / setup.rate_hz);
+    auto next = std::chrono::steady_clock::now();
+    for (bool last = false;;) {
+      auto frame = std::make_shared<const std::string>(build_state());
+      std::unique_lock lock(mutex);
+      state = std::move(frame);
+      ++generation;
+      changed.notify_all();
+      if (last) return;
+      next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+      last = changed.wait_until(lock, next, [this] { return sampler_quit; });
+    }
+  }
+
+  std::shared_ptr<const std::string> latest() {
+    std::lock_guard lock(mutex);
+    return state;
+  }
+
+  bool authorized(const httplib::Request& req) const {
+    const std::string header = req.get_header_value("Authorization");
+    const std::string bearer = "Bearer ";
+    if (header.rfind(bearer, 0) == 0) return same_token(header.substr(bearer.size()), token);
+    return req.has_param("token") && same_token(req.get_param_value("token"), token);
+  }
+
+  static void answer(httplib::Response& res, int status, const json& body) {
+    res.status = status;
+    res.set_content(body.dump(), "application/json");
+  }
+  static void error(httplib::Response& res, int status, const std::string& message) {
+    answer(res, status, {{"ok", false}, {"error", message}});
+  }
+
+  // A control: the token, then a JSON object body, then `act`.
+  void control(const std::string& path, std::function<void(const json&, httplib::Response&)> act) {
+    server.Post(path, [this, act](const httplib::Request& req, httplib::Response& res) {
+      if (!authorized(req)) return error(res, 401, "a valid token is needed for controls");
+      json body = req.body.empty() ? json::object() : json::parse(req.body, nullptr, false);
+      if (body.is_discarded() || !body.is_object()) {
+        return error(res, 400, "expected a JSON object as the body");
+      }
+      if (setup.replay) return error(res, 409, "a replay controls no robot");
+      std::lock_guard lock(controls_mutex);
+      act(body, res);
+    });
+  }
+
+  static std::optional<double> number(const json& body, const char* key) {
+    const auto it = body.find(key);
+    if (it == body.end() || !it->is_number()) return std::nullopt;
+    const double value = it->get<double>();
+    if (!std::isfinite(value)) return std::nullopt;
+    return value;
+  }
+
+  void routes() {
+    // No compression: on loopback it only costs CPU (brotli at its slowest
+    // setting takes seconds for three.js), and the machine runs the loop.
+    server.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
+      // The request object itself is not const; httplib passes it so.
+      const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
+      return httplib::Server::HandlerResponse::Unhandled;
+    });
+    server.Get("/api/info", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(info, "application/json");
+    });
+    server.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(*latest(), "application/json");
+    });
+    server.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_header("Cache-Control", "no-cache");
+      auto seen = std::make_shared<std::uint64_t>(0);
+      {
+        std::lock_guard lock(mutex);
+        ++streams;
+      }
+      res.set_chunked_content_provider(
+          "text/event-stream",
+          [this, seen](std::size_t, httplib::DataSink& sink) {
+            std::shared_ptr<const std::string> frame;
+            {
+              std::unique_lock lock(mutex);
+              changed.wait(lock, [&] { return quit || generation != *seen; });
+              if (generation == *seen) {
+                sink.done();  // the last chunk: the client sees a complete stream
+                return true;
+              }
+              *seen = generation;
+              frame = state;
+            }
+            const std::string event = "data: " + *frame + "\n\n";
+            // A client that does not read makes this fail after the write
+            // timeout; only this connection's thread waits for it.
+            return sink.write(event.data(), event.size());
+          },
+          [this](bool) {
+            {
+              std::lock_guard lock(mutex);
+              --streams;
+            }
+            changed.notify_all();
+          });
+    });
+
+    control("/api/stop", [this](const json&, httplib::Response& res) {
+      controls.stop.store(true);
+      answer(res, 200, {{"ok", true}});
+    });
+    control("/api/manual", [this](const json& body, httplib::Response& res) {
+      const auto on = body.find("on");
+      if (on == body.end() || !on->is_boolean()) {
+        return error(res, 400, "expected {\"on\": true} or {\"on\": false}");
+      }
+      manual = on->get<bool>();
+      controls.manual.store(manual, std::memory_order_release);
+      answer(res, 200, {{"ok", true}});
+    });
+    control("/api/jog", [this](const json& body, httplib::Response& res) {
+      const auto joint = body.find("joint");
+      if (joint == body.end() || !joint->is_string()) {
+        return error(res, 400, "expected \"joint\": a joint name");
+      }
+      const auto& names = model.joint_names;
+      const auto it = std::find(names.begin(), names.end(), joint->get<std::string>());
+      if (it == names.end()) return error(res, 400, "no joint named " + joint->dump());
+      const auto position = number(body, "position");
+      if (!position) return error(res, 400, "expected \"position\": a finite number (rad or m)");
+      if (!manual) return error(res, 409, "not in manual mode (POST /api/manual {\"on\": true})");
+      const auto j = static_cast<std::size_t>(it - names.begin());
+      const double clamped =
+          std::clamp(*position, model.limits[j].min_position, model.limits[j].max_position);
+      const double record[2] = {static_cast<double>(j), clamped};
+      if (!controls.manual_targets.push(record)) {
+        return error(res, 409, "too many manual targets waiting for the cycle");
+      }
+      answer(res, 200, {{"ok", true}, {"position", clamped}});
+    });
+    control("/api/steer", [this](const json& body, httplib::Response& res) {
+      if (!setup.steering) return error(res, 409, "the motion is not steerable");
+      const auto speed = number(body, "speed_mps");
+      const auto turn = number(body, "turn_rps");
+      if (!speed || !turn) {
+        return error(res, 400, "expected \"speed_mps\" and \"turn_rps\": finite numbers");
+      }
+      controls.steer.post(MotionCommand{*speed, *turn});
+      answer(res, 200, {{"ok", true}});
+    });
+
+    server.Post("/api/seek", [this](const httplib::Request& req, httplib::Response& res) {
+      if (!setup.replay || !setup.seek) return error(res, 409, "not a replay");
+      const json body = json::parse(req.body, nullptr, false);
+      if (body.is_discarded() || !body.is_object()) {
+        return error(res, 400, "expected a JSON object as the body");
+      }
+      const auto t = number(body, "t_s");
+      if (!t) return error(res, 400, "expected \"t_s\": a finite number of seconds");
+      const auto playing = body.find("playing");
+      if (playing != body.end() && !playing->is_boolean()) {
+        return error(res, 400, "expected \"playing\": true or false");
+      }
+      std::lock_guard lock(controls_mutex);
+      setup.seek(*t, playing == body.end() || playing->get<bool>());
+      answer(res, 200, {{"ok", true}});
+    });
+
+    // The page, and Debian's three.js and Chart.js.
+    // Browsers load ES modules only with a JavaScript type.
+    server.set_file_extension_and_mimetype_mapping("js", "text/javascript");
+    server.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
+    if (!setup.www_dir.empty()) server.set_mount_point("/", setup.www_dir);
+    const std::string three = setup.lib_dir + "/three";
+    const std::string chart = setup.lib_dir + "/chart.js";
+    server.set_mount_point("/lib/three", three);
+    server.set_mount_point("/lib/chart.js", chart);
+    const auto file = [](const std::string& path) {
+      return [path](const httplib::Request&, httplib::Response& res) {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) return error(res, 404, path + " is not installed");
+        res.set_content(std::string(std::istreambuf_iterator<char>(in), {}), "text/javascript");
+      };
+    };
+    server.Get("/lib/three.module.js", file(three + "/three.module.js"));
+    server.Get("/lib/chart.umd.js", file(chart + "/chart.min.js"));
+  }
+};
+
+DashboardServer::DashboardServer(RunMonitor& monitor, RunControls& controls, DashboardSetup setup)
+    : impl_(std::make_unique<Impl>(monitor, controls, std::move(setup))) {
+  Impl& m = *impl_;
+  if (!m.setup.remote && !is_loopback_host(m.setup.host)) {
+    throw std::invalid_argument("--dashboard " + m.setup.host +
+                                " is not a loopback address; add --dashboard-remote to serve "
+                                "other machines");
+  }
+  if (!(m.setup.rate_hz > 0.0) || !std::isfinite(m.setup.rate_hz)) {
+    throw std::invalid_argument("the dashboard rate must be a positive number of Hz");
+  }
+  m.info = m.build_info();
+  m.state = std::make_shared<const std::string>(m.build_state());
+  m.routes();
+  // A stream to a client that never reads gives up after this.
+  m.server.set_write_timeout(2, 0);
+  if (m.setup.port == 0) {
+    m.port = m.server.bind_to_any_port(m.setup.host);
+  } else {
+    m.port = m.server.bind_to_port(m.setup.host, m.setup.port) ? m.setup.port : -1;
+  }
+  if (m.port <= 0) {
+    throw std::runtime_error(
+        fmt::format("dashboard: cannot listen on {}:{}", m.setup.host, m.setup.port));
+  }
+  m.sampler = std::thread([&m] { m.sample_loop(); });
+  m.listener = std::thread([&m] { m.server.listen_after_bind(); });
+}
+
+DashboardServer::~DashboardServer() { stop(); }
+
+int DashboardServer::port() const { return impl_->port; }
+const std::string& DashboardServer::token() const { return impl_->token; }
+
+std::string DashboardServer::url() const {
+  const std::string& host = impl_->setup.host;
+  const bool v6 = host.find(':') != std::string::npos;
+  return fmt::format("http://{}:{}/?token={}", v6 ? "[" + host + "]" : host, impl_->port,
+                     impl_->token);
+}
+
+void DashboardServer::stop() {
+  Impl& m = *impl_;
+  {
+    std::lock_guard lock(m.mutex);
+    m.sampler_quit = true;
+  }
+  m.changed.notify_all();
+  if (m.sampler.joinable()) m.sampler.join();  // after its last frame
+  {
+    std::unique_lock lock(m.mutex);
+    m.quit = true;
+    m.changed.notify_all();
+    // Open streams end with their last chunk before the server closes; a
+    // client that does not read is not waited for long.
+    m.changed.wait_for(lock, std::chrono::seconds(1), [&m] { return m.streams == 0; });
+  }
+  m.server.stop();
+  if (m.listener.joinable()) m.listener.join();
+}
+
+}  // namespace animrt

@@ -1,0 +1,214 @@
+// Replaying a telemetry CSV into a RunMonitor (see telemetry_replay.hpp).
+
+#include "animrt/runtime/telemetry_replay.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
+
+namespace animrt {
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) out.push_back(field);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() > tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+}  // namespace
+
+TelemetryRecording load_telemetry_csv(const std::string& path) {
+  const std::string text = read_input_file(path);
+  TelemetryRecording rec;
+  rec.file = path;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  const auto fail = [&](int column, const std::string& message) {
+    throw InputError(Location{path, line_no, column}, "", message);
+  };
+  if (!std::getline(in, line)) fail(0, "expected a telemetry CSV header, found an empty file");
+  ++line_no;
+  const std::vector<std::string> header = split(line);
+  const std::size_t n = header.size() > 1 ? (header.size() - 1) / 2 : 0;
+  if (header.empty() || header[0] != "time_s" || n == 0 || header.size() != 1 + 2 * n) {
+    fail(1,
+         "expected the header time_s,<joint>_cmd_rad,...,<joint>_meas_rad,... of animrt run "
+         "--telemetry, found \"" +
+             line.substr(0, 80) + "\"");
+  }
+  int column = static_cast<int>(header[0].size()) + 2;
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::string& cmd = header[1 + j];
+    const std::string& meas = header[1 + n + j];
+    if (!ends_with(cmd, "_cmd_rad"))
+      fail(column, "expected <joint>_cmd_rad, found \"" + cmd + "\"");
+    const std::string name = cmd.substr(0, cmd.size() - 8);
+    if (meas != name + "_meas_rad") {
+      fail(0, "expected " + name + "_meas_rad as column " + std::to_string(2 + n + j) +
+                  ", found \"" + meas + "\"");
+    }
+    rec.joints.push_back(name);
+    column += static_cast<int>(cmd.size()) + 1;
+  }
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = split(line);
+    if (fields.size() != 1 + 2 * n) {
+      fail(1, "expected " + std::to_string(1 + 2 * n) + " fields, found " +
+                  std::to_string(fields.size()));
+    }
+    int col = 1;
+    std::vector<double> values(fields.size());
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const std::string& f = fields[i];
+      const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), values[i]);
+      if (ec != std::errc() || end != f.data() + f.size()) {
+        fail(col, "expected a number, found \"" + f + "\"");
+      }
+      col += static_cast<int>(f.size()) + 1;
+    }
+    if (!rec.t.empty() && !(values[0] >= rec.t.back())) {
+      fail(1, "time goes backwards (" + fields[0] + " after " + std::to_string(rec.t.back()) + ")");
+    }
+    rec.t.push_back(values[0]);
+    rec.cmd.insert(rec.cmd.end(), values.begin() + 1, values.begin() + 1 + static_cast<long>(n));
+    rec.meas.insert(rec.meas.end(), values.begin() + 1 + static_cast<long>(n), values.end());
+  }
+  if (rec.t.empty()) fail(0, "expected at least one row after the header");
+  return rec;
+}
+
+RobotModel replay_model(const TelemetryRecording& recording, const RobotConfig* robot) {
+  RobotModel m;
+  m.name = robot ? robot->name : recording.file;
+  m.rate_hz = robot ? robot->rate_hz : 0.0;
+  if (!robot && recording.rows() > 1) {
+    const double span = recording.t.back() - recording.t.front();
+    if (span > 0) m.rate_hz = static_cast<double>(recording.rows() - 1) / span;
+  }
+  m.dt = m.rate_hz > 0 ? 1.0 / m.rate_hz : 0.0;
+  m.period = from_seconds(m.dt);
+  for (const std::string& name : recording.joints) {
+    JointLimits limits{-std::numbers::pi, std::numbers::pi, 10.0, 100.0};
+    double home = 0.0;
+    bool prismatic = false;
+    if (robot) {
+      const auto it = std::find_if(robot->joints.begin(), robot->joints.end(),
+                                   [&](const JointSpec& j) { return j.name == name; });
+      if (it == robot->joints.end()) {
+        throw InputError(Location{recording.file, 1, 0}, "",
+                         "joint " + name + " of the recording is not a joint of " + robot->file);
+      }
+      limits = it->limits;
+      home = it->home;
+      prismatic = it->type == JointType::prismatic;
+    }
+    m.joint_names.push_back(name);
+    m.limits.push_back(limits);
+    m.home.push_back(home);
+    m.prismatic.push_back(prismatic ? 1 : 0);
+    m.following_error.push_back(0.0);
+    m.slots.push_back(JointSlot{});
+  }
+  // The robot's buses, when they can be laid over the recording's joints.
+  if (robot && robot->joints.size() == recording.joints.size()) {
+    for (const BusConfig& bus : robot->buses) {
+      BusModel b;
+      b.name = bus.name;
+      for (const ActuatorBinding& a : bus.actuators) {
+        const auto at = std::find(recording.joints.begin(), recording.joints.end(), a.joint);
+        b.joint.push_back(static_cast<int>(at - recording.joints.begin()));
+        b.device_id.push_back(a.device_id);
+      }
+      m.buses.push_back(std::move(b));
+    }
+  }
+  return m;
+}
+
+TelemetryReplay::TelemetryReplay(const TelemetryRecording& recording, RunMonitor& monitor)
+    : recording_(recording), monitor_(monitor), vel_(recording.joints.size(), 0.0) {
+  publish(0);
+  thread_ = std::thread([this] { loop(); });
+}
+
+TelemetryReplay::~TelemetryReplay() {
+  {
+    std::lock_guard lock(mutex_);
+    quit_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+void TelemetryReplay::seek(double t_s, bool playing) {
+  const auto it = std::upper_bound(recording_.t.begin(), recording_.t.end(), t_s);
+  const std::size_t row =
+      it == recording_.t.begin() ? 0 : static_cast<std::size_t>(it - recording_.t.begin()) - 1;
+  {
+    std::lock_guard lock(mutex_);
+    row_ = row;
+    playing_ = playing;
+    moved_ = true;
+    publish(row);
+  }
+  changed_.notify_all();
+}
+
+void TelemetryReplay::publish(std::size_t row) {
+  const std::size_t n = recording_.joints.size();
+  const double* cmd = recording_.cmd.data() + row * n;
+  const double* meas = recording_.meas.data() + row * n;
+  for (std::size_t j = 0; j < n; ++j) {
+    vel_[j] = 0.0;
+    if (row > 0 && recording_.t[row] > recording_.t[row - 1]) {
+      vel_[j] = (cmd[j] - cmd[j - n]) / (recording_.t[row] - recording_.t[row - 1]);
+    }
+  }
+  monitor_.publish_sample(recording_.t[row], RunPhaseView::motion, row,
+                          std::span<const double>(cmd, n), std::span<const double>(meas, n), vel_);
+}
+
+void TelemetryReplay::loop() {
+  using Steady = std::chrono::steady_clock;
+  std::unique_lock lock(mutex_);
+  // Row `row_` is shown at `shown`; the next one is due its time later.
+  Steady::time_point shown = Steady::now();
+  while (!quit_) {
+    if (!playing_) {
+      changed_.wait(lock, [this] { return quit_ || moved_; });
+      moved_ = false;
+      shown = Steady::now();
+      continue;
+    }
+    const std::size_t next = row_ + 1 < recording_.rows() ? row_ + 1 : 0;  // loop at the end
+    const double gap = next == 0 ? 0.5 : recording_.t[next] - recording_.t[row_];
+    const auto due = shown + std::chrono::duration_cast<Steady::duration>(
+                                 std::chrono::duration<double>(std::max(0.0, gap)));
+    if (changed_.wait_until(lock, due, [this] { return quit_ || moved_; })) {
+      moved_ = false;
+      shown = Steady::now();
+      continue;
+    }
+    row_ = next;
+    shown = due;
+    publish(row_);
+  }
+}
+
+}  // namespace animrt
