@@ -242,6 +242,10 @@ BusConfig make_config(const std::string& port) {
   c.protocol = "dynamixel2";
   c.port = port;
   c.timeout_s = 0.05;  // generous: the machine may be loaded
+  // These devices speak plain Sync Read only (Fast Sync Read: tests/sim).
+  dxl::BusOptions options;
+  options.fast_read = dxl::FastRead::off;
+  c.options = options;
   const char* joints[] = {"lf_hip", "lf_knee", "lf_ankle"};
   for (int i = 0; i < 3; ++i) {
     ActuatorBinding b;
