@@ -144,9 +144,10 @@ TEST(DynamixelBusFastRead, SilentServoInTheMiddleCostsOnlyItself) {
   EXPECT_NEAR(q[1], rig.sim.device_position(2), 1e-3);
 }
 
-// 12 servos, each answer 15 ms late, timeout 25 ms per answer: a Sync Read's
-// twelve answers take 180 ms, a Fast Sync Read's twelve slices as long, far
-// more than one timeout and well inside twelve. Neither times out.
+// 12 servos, each answer 15 ms after the one before, timeout 25 ms: the
+// twelve answers of a Sync Read (or slices of a Fast Sync Read) take 180 ms,
+// far more than one timeout; since the timeout is per answer, neither times
+// out.
 void twelve_late_answers(dxl::FastRead mode) {
   Rig rig(bus_of(12, 46, mode, 0.025));
   rig.bus->configure();

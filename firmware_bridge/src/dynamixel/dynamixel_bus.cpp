@@ -217,7 +217,11 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
 
-  const Deadline deadline = deadline_for(count);
+  const steady_clock::time_point start = steady_clock::now();
+  const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
+  Deadline deadline = std::min(cap, start + timeout_);
+  // Each answer (whatever it was) restarts the wait for the next one.
+  const auto answered = [&] { deadline = std::min(cap, steady_clock::now() + timeout_); };
   std::size_t remaining = count;
   std::size_t expected = 0;  // first slot still waiting: whose answer comes next
   dxl::Packet packet;
@@ -229,6 +233,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
       // A whole packet arrived damaged: that was the answer, no other follows.
       blame(expected, true);
       --remaining;
+      answered();
       continue;
     }
     std::size_t slot = count;
@@ -266,6 +271,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
     }
     accept(slot, packet, data_length, diagnostic);
     --remaining;
+    answered();
   }
 
   // Bytes of an unfinished packet at the deadline: the next answer was cut short.
@@ -287,12 +293,6 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
   }
 }
 
-DynamixelBus::Deadline DynamixelBus::deadline_for(std::size_t answers) const {
-  // The timeout is per answer: N answers may take N times as long.
-  return steady_clock::now() +
-         timeout_ * static_cast<std::int64_t>(std::max<std::size_t>(1, answers));
-}
-
 void DynamixelBus::transact_fast(std::size_t length, std::size_t count, std::size_t data_length) {
   for (std::size_t s = 0; s < count; ++s) {
     answer_[s] = Answer::pending;
@@ -306,11 +306,21 @@ void DynamixelBus::transact_fast(std::size_t length, std::size_t count, std::siz
 
   // Collect bytes until the packet the header announces is complete. The
   // packet is not byte-stuffed, so it is read raw, not through the Decoder.
-  const Deadline deadline = deadline_for(count);
+  const steady_clock::time_point start = steady_clock::now();
+  const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
+  Deadline deadline = std::min(cap, start + timeout_);
+  const std::size_t slice_size = dxl::kFastSliceOverhead + data_length;
+  std::size_t slices = 0;
   std::size_t got = 0;
   for (;;) {
-    if (dxl::FastStatusReader({fast_rx_.data(), got}).complete()) break;
+    const dxl::FastStatusReader so_far({fast_rx_.data(), got});
+    if (so_far.complete()) break;
     const auto now = steady_clock::now();
+    if (so_far.after_header() / slice_size > slices) {
+      // Another servo's slice is in: the wait for the next one starts again.
+      slices = so_far.after_header() / slice_size;
+      deadline = std::min(cap, now + timeout_);
+    }
     if (now >= deadline || got == fast_rx_.size()) break;
     const std::size_t n =
         transport_->read({fast_rx_.data() + got, fast_rx_.size() - got},

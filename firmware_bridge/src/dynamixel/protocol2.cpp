@@ -240,6 +240,10 @@ bool FastStatusReader::complete() const {
   return has_header() && bytes_.size() - start_ >= announced_size();
 }
 
+std::size_t FastStatusReader::after_header() const {
+  return has_header() ? bytes_.size() - start_ - kFastHeaderSize : 0;
+}
+
 bool FastStatusReader::peek_id(std::uint8_t& id) const {
   if (!has_header() || stopped_ || pos_ + 2 > bytes_.size()) return false;
   id = bytes_[pos_ + 1];

@@ -4,12 +4,13 @@
 // read of the present positions (Fast Sync Read when the servos support it,
 // else Sync Read) and one Sync Write of the goals.
 //
-// Timeout: BusConfig::timeout_s is the wait allowed for ONE answer. A
-// transaction that expects N answers (N status packets of a Sync Read, or N
-// slices of one Fast Sync Read status packet) waits at most N times that from
-// sending its instruction, so a bus of 12 healthy servos cannot time out just
-// because twelve answers take longer than one. A silent device therefore
-// costs the whole N x timeout_s of its transaction.
+// Timeout: BusConfig::timeout_s is the wait allowed for ONE answer: from
+// sending the instruction to the first answer, and from each answer to the
+// next (a status packet of a Sync Read, a servo's slice of a Fast Sync Read
+// status packet). A transaction expecting N answers thus ends at the latest
+// N x timeout_s after its instruction, and twelve healthy servos cannot time
+// out a read because twelve answers take longer than one. A silent servo
+// costs one timeout_s (the wait after the last answer that came).
 
 #include <array>
 #include <chrono>
@@ -88,8 +89,9 @@ class DynamixelBus final : public ActuatorBus {
   };
 
   // Sends tx_[0, length) and collects status packets for the devices in
-  // asked_[0, count) (ids in ids_) until each answered or the one deadline
-  // passed. Updates every counter; results land in answer_ and value_.
+  // asked_[0, count) (ids in ids_) until each answered or the wait for the
+  // next answer (see Timeout at the top) ran out. Updates every counter; results land in answer_
+  // and value_.
   void transact(std::size_t length, std::size_t count, std::size_t data_length, bool diagnostic);
   // One device, one instruction; kTries attempts while nothing usable came.
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
@@ -97,8 +99,6 @@ class DynamixelBus final : public ActuatorBus {
   // The same for one Fast Sync Read of asked_[0, count): one status packet
   // with a slice per device, judged slice by slice.
   void transact_fast(std::size_t length, std::size_t count, std::size_t data_length);
-  // Deadline of a transaction expecting `answers` answers (see the top).
-  Deadline deadline_for(std::size_t answers) const;
   void choose_fast_read();
   // Judges one status packet for slot `slot`.
   void accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,

@@ -179,6 +179,8 @@ class FastStatusReader {
   // Bytes the header announces (header + LEN), once the header is in.
   std::size_t announced_size() const;
   bool complete() const;  // every announced byte is in
+  // Bytes received after the header (0 without one).
+  std::size_t after_header() const;
   // The id of the next slice, if its first two bytes are in.
   bool peek_id(std::uint8_t& id) const;
   enum class Step : std::uint8_t {
