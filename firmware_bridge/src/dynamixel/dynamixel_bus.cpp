@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "animrt/bridge/dynamixel/latency_timer.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -443,6 +444,11 @@ std::string DynamixelBus::failure(std::size_t device, Answer answer) const {
 // ---- lifecycle --------------------------------------------------------------
 
 void DynamixelBus::configure() {
+  // A USB adapter's latency timer above 1 ms delays every answer by it.
+  latency_warning_ = latency_timer_warning(transport_->port(), sysfs_root_);
+  if (!latency_warning_.empty()) {
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), latency_warning_.c_str());
+  }
   const std::size_t n = status_.size();
   for (std::size_t i = 0; i < n; ++i) {
     status_[i] = DeviceStatus{};

@@ -70,6 +70,13 @@ class DynamixelBus final : public ActuatorBus {
 
   std::span<DeviceStatus> devices() override { return status_; }
 
+  // Where configure() looks for the USB adapter's latency timer (tests point
+  // it at a fake tree); "/sys" by default.
+  void set_sysfs_root(std::string root) { sysfs_root_ = std::move(root); }
+  // The warning configure() printed (to stderr) about a latency timer above
+  // 1 ms, with the command that fixes it; empty when there was none.
+  const std::string& latency_warning() const { return latency_warning_; }
+
   // Whether the cycle's read is a Fast Sync Read (decided by configure()).
   bool fast_read_active() const { return fast_; }
   // Model number and firmware version of a device, from its Ping answer.
@@ -140,7 +147,9 @@ class DynamixelBus final : public ActuatorBus {
   std::vector<std::uint8_t> status_pending_;  // hardware error register to read
   bool fresh_ = false;                        // configure() values not yet handed out
   dxl::FastRead fast_mode_ = dxl::FastRead::automatic;
-  bool fast_ = false;                 // the cycle's read is a Fast Sync Read
+  bool fast_ = false;  // the cycle's read is a Fast Sync Read
+  std::string sysfs_root_ = "/sys";
+  std::string latency_warning_;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
