@@ -953,15 +953,15 @@ TEST_F(RobotConfigTest, DynamixelBadFastReadOrModelIsNamed) {
   const std::string motion = "}\nmotion: {type: gait, file: ../gaits/gait.yaml}\n";
   EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, fast_read: fast}\n" +
                      tail + motion),
-            at("4:59: buses.b.fast_read: expected auto, on or off, found \"fast\""));
+            at("4:60: buses.b.fast_read: expected auto, on or off, found \"fast\""));
   const std::string names = dxl::x_model_names();
   EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, model: XM430}\n" +
                      tail + motion),
-            at("4:55: buses.b.model: expected a Dynamixel X-series model (" + names +
+            at("4:56: buses.b.model: expected a Dynamixel X-series model (" + names +
                "), found \"XM430\""));
   EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0}\n" + tail +
                      ", model: AX-12A" + motion),
-            at("8:42: joints.j1.actuator.model: expected a Dynamixel X-series model (" + names +
+            at("8:38: joints.j1.actuator.model: expected a Dynamixel X-series model (" + names +
                "), found \"AX-12A\""));
   EXPECT_NE(error_of(head +
                      "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, sim: {firmware_version: "
