@@ -81,7 +81,7 @@ TEST(DynamixelBusFastRead, AutoKeepsSyncReadForOldFirmwareAndOffAlways) {
 
 TEST(DynamixelBusFastRead, ForcedOnOldFirmwareTimesOutEveryServo) {
   // `on` is obeyed even when the servos cannot: every read then times out.
-  Rig rig(bus_of(2, 38, dxl::FastRead::on, 0.01));
+  Rig rig(bus_of(2, 38, dxl::FastRead::on, 0.05));
   rig.bus->configure();
   ASSERT_TRUE(rig.bus->fast_read_active());
   std::vector<double> q(2, 0.0);
@@ -113,7 +113,7 @@ TEST(DynamixelBusFastRead, ConfiguredModelMustMatchTheServo) {
 }
 
 TEST(DynamixelBusFastRead, SilentServoInTheMiddleCostsOnlyItself) {
-  Rig rig(bus_of(4, 46, dxl::FastRead::automatic, 0.02));
+  Rig rig(bus_of(4, 46, dxl::FastRead::automatic, 0.1));
   rig.bus->configure();
   ASSERT_TRUE(rig.bus->fast_read_active());
   std::vector<double> q(4, 0.0);
@@ -144,17 +144,16 @@ TEST(DynamixelBusFastRead, SilentServoInTheMiddleCostsOnlyItself) {
   EXPECT_NEAR(q[1], rig.sim.device_position(2), 1e-3);
 }
 
-// 12 servos, each answer 15 ms after the one before, timeout 25 ms: the
-// twelve answers of a Sync Read (or slices of a Fast Sync Read) take 180 ms,
+// 12 servos, each answer 30 ms after the one before, timeout 100 ms: the
+// twelve answers of a Sync Read (or slices of a Fast Sync Read) take 360 ms,
 // far more than one timeout; since the timeout is per answer, neither times
-// out.
+// out (with one deadline for the whole read, ten of them would).
 void twelve_late_answers(dxl::FastRead mode) {
-  Rig rig(bus_of(12, 46, mode, 0.025));
+  Rig rig(bus_of(12, 46, mode, 0.1));
   rig.bus->configure();
   EXPECT_EQ(rig.bus->fast_read_active(), mode == dxl::FastRead::on);
-  for (int id = 1; id <= 12; ++id) rig.sim.set_device_answer_delay(id, 15'000'000);
+  for (int id = 1; id <= 12; ++id) rig.sim.set_device_answer_delay(id, 30'000'000);
   std::vector<double> q(12, 0.0);
-  rig.bus->read(q);
   rig.bus->read(q);
   for (const DeviceStatus& st : rig.bus->devices()) {
     EXPECT_EQ(st.timeouts, 0u) << st.device_id;
