@@ -13,6 +13,7 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/sim/dynamixel_sim_bus.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace animrt {
 namespace {
@@ -142,6 +143,30 @@ TEST(DynamixelBusFastRead, SilentServoInTheMiddleCostsOnlyItself) {
   rig.bus->read(q);
   EXPECT_EQ(dev[1].health, DeviceHealth::ok);
   EXPECT_NEAR(q[1], rig.sim.device_position(2), 1e-3);
+}
+
+TEST(DynamixelBusFastRead, CycleNeverAllocates) {
+  Rig rig(bus_of(4, 46, dxl::FastRead::automatic, 0.05));
+  rig.bus->configure();
+  ASSERT_TRUE(rig.bus->fast_read_active());
+  rig.bus->activate();
+  std::vector<double> q(4, 0.0);
+  rig.bus->read(q);
+  rig.bus->write(q);
+  long allocations = 0;
+  const auto cycle = [&] {
+    test::AllocationCounter counter;  // this thread only: the simulator is not counted
+    rig.bus->read(q);
+    rig.bus->write(q);
+    allocations += counter.count();
+  };
+  cycle();
+  rig.sim.set_device_responding(3, false);  // the slice-by-slice path with a gap
+  cycle();
+  rig.sim.set_device_responding(3, true);
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(rig.bus->devices()[2].timeouts, 1u);
+  EXPECT_EQ(rig.bus->devices()[3].timeouts, 0u);
 }
 
 // 12 servos, each answer 30 ms after the one before, timeout 100 ms: the
