@@ -107,7 +107,8 @@ SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
 }
 
 SimBusSettings parse_sim(const YamlNode& node) {
-  node.allow_only({"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us"});
+  node.allow_only(
+      {"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us", "firmware_version"});
   SimBusSettings sim;
   if (auto n = node.find("time_constant_s")) sim.time_constant_s = n->as_double_in(1e-4, 10.0);
   if (auto n = node.find("max_speed_dps")) {
@@ -117,6 +118,11 @@ SimBusSettings parse_sim(const YamlNode& node) {
   // Dynamixel's Return Delay Time register counts 2 us units, 0..254.
   if (auto n = node.find("return_delay_us")) {
     sim.return_delay_us = static_cast<int>(n->as_int_in(0, 508));
+  }
+  // The firmware version simulated Dynamixel servos report (Fast Sync Read
+  // needs 45 or later).
+  if (auto n = node.find("firmware_version")) {
+    sim.firmware_version = static_cast<int>(n->as_int_in(1, 255));
   }
   return sim;
 }

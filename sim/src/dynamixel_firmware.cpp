@@ -24,12 +24,14 @@ bool may_answer(const dxl::Packet& packet) {
   if (packet.instruction == inst::status) return false;
   if (packet.id != dxl::kBroadcastId) return true;
   return packet.instruction == inst::ping || packet.instruction == inst::sync_read ||
-         packet.instruction == inst::bulk_read;
+         packet.instruction == inst::bulk_read || packet.instruction == inst::fast_sync_read ||
+         packet.instruction == inst::fast_bulk_read;
 }
 
 DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now, JointPhysics* physics) {
   servos_.reserve(config.actuators.size());
   by_id_.reserve(config.actuators.size());
+  fast_entries_.reserve(256);
   for (const ActuatorBinding& binding : config.actuators) {
     if (binding.device_id < 0 || binding.device_id > kMaxDeviceId) {
       throw InputError(config.where, "device_id",
@@ -84,6 +86,34 @@ void DynamixelFirmware::answer_read(const DynamixelServo& servo, std::uint16_t a
       length <= data.size() ? servo.read(address, length, data) : StatusError::access;
   const std::size_t n = error == StatusError::none ? length : 0;
   answer(servo, error, {data.data(), n}, out);
+}
+
+void DynamixelFirmware::answer_fast(std::span<const dxl::BulkReadEntry> entries, Answers& out) {
+  std::size_t data_bytes = 0;
+  for (const dxl::BulkReadEntry& e : entries) data_bytes += e.length;
+  const std::size_t size = dxl::fast_status_size(entries.size(), data_bytes);
+  if (size > dxl::kMaxPacket) return;  // no LEN the devices could agree on: silence
+  const std::size_t offset = out.bytes.size();
+  out.bytes.resize(offset + size);
+  dxl::FastStatusWriter w({out.bytes.data() + offset, size}, entries.size(), data_bytes);
+  std::array<std::uint8_t, dxl::kMaxPacket> data{};
+  for (const dxl::BulkReadEntry& e : entries) {
+    const DynamixelServo* s = target(e.id);
+    // A servo that is absent, silent (Status Return Level 0) or too old for
+    // fast read leaves its slice out; the others still answer in turn.
+    if (s == nullptr || s->status_return_level() < kReplyPingAndRead || !s->fast_read()) continue;
+    const std::size_t begin = w.size();
+    if (begin == 0) w.header();
+    std::fill_n(data.begin(), e.length, std::uint8_t{0});
+    const StatusError error = s->read(e.address, e.length, {data.data(), e.length});
+    // On an error the slice keeps its length (the packet's LEN counted it),
+    // with zeros for data.
+    if (error != StatusError::none) std::fill_n(data.begin(), e.length, std::uint8_t{0});
+    w.slice(s->status_error(error), s->id(), {data.data(), e.length});
+    out.list.push_back(
+        {offset + begin, w.size() - begin, s->return_delay_us(), s->take_answer_delay()});
+  }
+  out.bytes.resize(offset + w.size());
 }
 
 void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& out) {
@@ -166,6 +196,23 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
         if (DynamixelServo* s = target(id)) answer_read(*s, u16_at(p, 0), u16_at(p, 2), out);
       }
       break;
+    case inst::fast_sync_read: {
+      if (!broadcast || p.size() < 5) break;
+      fast_entries_.clear();
+      for (std::uint8_t id : p.subspan(4))
+        fast_entries_.push_back({id, u16_at(p, 0), u16_at(p, 2)});
+      answer_fast(fast_entries_, out);
+      break;
+    }
+    case inst::fast_bulk_read: {
+      if (!broadcast || p.empty() || p.size() % 5 != 0) break;
+      fast_entries_.clear();
+      for (std::size_t i = 0; i < p.size(); i += 5) {
+        fast_entries_.push_back({p[i], u16_at(p, i + 1), u16_at(p, i + 3)});
+      }
+      answer_fast(fast_entries_, out);
+      break;
+    }
     case inst::sync_write: {
       if (!broadcast || p.size() < 4) break;
       const std::size_t length = u16_at(p, 2);

@@ -18,12 +18,13 @@ struct Item {
   std::uint16_t address;
   std::uint8_t size;
   bool writable;
-  std::int64_t min = 0;
+  std::int64_t min = 0;  // a negative min makes the item signed
   std::int64_t max = 0;
 };
 
-// X-series control table (XM430-W210 e-manual), the part the simulator keeps.
-// Goal Position's range is the position limits (checked separately).
+// X430 control table (XM430-W350 / XH540-W270 e-manual pages; External Port
+// items of the XH540 left out). Goal Position's range is the position limits
+// (checked separately). Indirect Address / Data: find_item.
 constexpr Item kItems[] = {
     {xreg::model_number, 2, false},
     {xreg_sim::model_information, 4, false},
@@ -33,33 +34,82 @@ constexpr Item kItems[] = {
     {xreg::return_delay_time, 1, true, 0, 254},
     {xreg_sim::drive_mode, 1, true, 0, 5},
     {xreg::operating_mode, 1, true, 3, 3},  // only position control is modelled
+    {xreg_sim::secondary_id, 1, true, 0, 255},
+    {xreg_sim::protocol_type, 1, true, 1, 2},
+    {xreg_sim::homing_offset, 4, true, -1'044'479, 1'044'479},
     {xreg_sim::moving_threshold, 4, true, 0, 1023},
     {xreg_sim::temperature_limit, 1, true, 0, 100},
+    {xreg_sim::max_voltage_limit, 2, true, 95, 160},
+    {xreg_sim::min_voltage_limit, 2, true, 95, 160},
+    {xreg_sim::pwm_limit, 2, true, 0, 885},
+    {xreg_sim::current_limit, 2, true, 0, 1193},
     {xreg::velocity_limit, 4, true, 0, 1023},
     {xreg::max_position_limit, 4, true, 0, 4095},
     {xreg::min_position_limit, 4, true, 0, 4095},
+    {xreg_sim::startup_configuration, 1, true, 0, 3},
     {xreg_sim::shutdown, 1, true, 0, 255},
     {xreg::torque_enable, 1, true, 0, 1},
     {xreg::led, 1, true, 0, 1},
     {xreg::status_return_level, 1, true, 0, 2},
     {xreg_sim::registered_instruction, 1, false},
     {xreg::hardware_error_status, 1, false},
+    {xreg_sim::velocity_i_gain, 2, true, 0, 16383},
+    {xreg_sim::velocity_p_gain, 2, true, 0, 16383},
+    {xreg_sim::position_d_gain, 2, true, 0, 16383},
+    {xreg_sim::position_i_gain, 2, true, 0, 16383},
+    {xreg_sim::position_p_gain, 2, true, 0, 16383},
+    {xreg_sim::feedforward_2nd_gain, 2, true, 0, 16383},
+    {xreg_sim::feedforward_1st_gain, 2, true, 0, 16383},
+    {xreg_sim::bus_watchdog, 1, true, 0, 127},
+    {xreg_sim::goal_pwm, 2, true, -885, 885},
+    {xreg_sim::goal_current, 2, true, -1193, 1193},
+    {xreg_sim::goal_velocity, 4, true, -1023, 1023},
     {xreg_sim::profile_acceleration, 4, true, 0, 32767},
     {xreg_sim::profile_velocity, 4, true, 0, 32767},
     {xreg::goal_position, 4, true, INT32_MIN, INT32_MAX},
     {xreg_sim::realtime_tick, 2, false},
     {xreg::moving, 1, false},
+    {xreg_sim::moving_status, 1, false},
+    {xreg_sim::present_pwm, 2, false},
+    {xreg_sim::present_current, 2, false},
     {xreg::present_velocity, 4, false},
     {xreg::present_position, 4, false},
+    {xreg_sim::velocity_trajectory, 4, false},
+    {xreg_sim::position_trajectory, 4, false},
     {xreg_sim::present_input_voltage, 2, false},
     {xreg::present_temperature, 1, false},
+    {xreg_sim::backup_ready, 1, false},
 };
 
-const Item* item_containing(std::size_t address) {
-  for (const Item& item : kItems) {
-    if (address >= item.address && address < item.address + item.size) return &item;
+// Indirect Address n: 2 bytes, 64..661. Indirect Data n: 1 byte.
+constexpr std::int64_t kIndirectMin = xreg_sim::eeprom_end;
+constexpr std::int64_t kIndirectMax = xreg::table_size - 1;
+
+bool in_block(std::size_t address, std::size_t first, std::size_t item_size) {
+  return address >= first && address < first + item_size * xreg::indirect_count;
+}
+
+bool find_item(std::size_t address, Item& out) {
+  for (const std::uint16_t first : {xreg::indirect_address_1, xreg::indirect_address_29}) {
+    if (in_block(address, first, 2)) {
+      out = {static_cast<std::uint16_t>(address - (address - first) % 2), 2, true, kIndirectMin,
+             kIndirectMax};
+      return true;
+    }
   }
-  return nullptr;
+  for (const std::uint16_t first : {xreg::indirect_data_1, xreg::indirect_data_29}) {
+    if (in_block(address, first, 1)) {
+      out = {static_cast<std::uint16_t>(address), 1, true, 0, 255};
+      return true;
+    }
+  }
+  for (const Item& item : kItems) {
+    if (address >= item.address && address < item.address + item.size) {
+      out = item;
+      return true;
+    }
+  }
+  return false;
 }
 
 std::uint32_t get_le(const std::uint8_t* p, std::size_t size) {
@@ -67,6 +117,26 @@ std::uint32_t get_le(const std::uint8_t* p, std::size_t size) {
   for (std::size_t i = 0; i < size; ++i) v |= static_cast<std::uint32_t>(p[i]) << (8 * i);
   return v;
 }
+
+// An item's value as the servo reads it: signed items are two's complement.
+std::int64_t item_value(const Item& item, std::uint32_t raw) {
+  if (item.min >= 0 || item.size >= 8) return raw;
+  const unsigned bits = 8u * item.size;
+  const std::uint32_t sign = 1u << (bits - 1);
+  const std::int64_t v = raw & ((bits == 32) ? 0xFFFFFFFFu : ((1u << bits) - 1));
+  return (v & sign) ? v - (std::int64_t{1} << bits) : v;
+}
+
+// Registers reset to these on power-on and Reboot (RAM) or kept (EEPROM).
+constexpr std::uint16_t kDefaultVelocityIGain = 1920;
+constexpr std::uint16_t kDefaultVelocityPGain = 100;
+constexpr std::uint16_t kDefaultPositionPGain = 800;
+constexpr std::uint8_t kDefaultSecondaryId = 255;  // off
+constexpr std::uint8_t kDefaultProtocolType = 2;
+constexpr std::uint16_t kDefaultMaxVoltage = 160;
+constexpr std::uint16_t kDefaultMinVoltage = 95;
+constexpr std::uint16_t kDefaultPwmLimit = 885;
+constexpr std::uint16_t kDefaultCurrentLimit = 1193;
 
 constexpr int kBauds[] = {9600,      57600,     115200,    1'000'000,
                           2'000'000, 3'000'000, 4'000'000, 4'500'000};
@@ -111,8 +181,16 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
     }
   }
   // EEPROM at its defaults, shaped by the bus config.
-  dxl::put_u16(&table_[xreg::model_number], kXModelNumber);
-  table_[xreg::firmware_version] = kXFirmwareVersion;
+  const std::uint16_t model = dxl::device_options(binding).model_number;
+  dxl::put_u16(&table_[xreg::model_number], model != 0 ? model : kXModelNumber);
+  table_[xreg::firmware_version] = static_cast<std::uint8_t>(
+      settings.firmware_version > 0 ? settings.firmware_version : kXFirmwareVersion);
+  table_[xreg_sim::secondary_id] = kDefaultSecondaryId;
+  table_[xreg_sim::protocol_type] = kDefaultProtocolType;
+  dxl::put_u16(&table_[xreg_sim::max_voltage_limit], kDefaultMaxVoltage);
+  dxl::put_u16(&table_[xreg_sim::min_voltage_limit], kDefaultMinVoltage);
+  dxl::put_u16(&table_[xreg_sim::pwm_limit], kDefaultPwmLimit);
+  dxl::put_u16(&table_[xreg_sim::current_limit], kDefaultCurrentLimit);
   table_[xreg::id] = static_cast<std::uint8_t>(binding.device_id);
   table_[xreg::baud_rate] = baud_rate_register(baud);
   table_[xreg::return_delay_time] =
@@ -151,6 +229,16 @@ std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
 void DynamixelServo::reset_ram() {
   std::fill(table_.begin() + xreg_sim::eeprom_end, table_.end(), std::uint8_t{0});
   table_[xreg::status_return_level] = 2;
+  dxl::put_u16(&table_[xreg_sim::velocity_i_gain], kDefaultVelocityIGain);
+  dxl::put_u16(&table_[xreg_sim::velocity_p_gain], kDefaultVelocityPGain);
+  dxl::put_u16(&table_[xreg_sim::position_p_gain], kDefaultPositionPGain);
+  // Indirect Address n starts at Indirect Data n itself.
+  for (std::uint16_t k = 0; k < xreg::indirect_count; ++k) {
+    dxl::put_u16(&table_[xreg::indirect_address_1 + 2 * k],
+                 static_cast<std::uint16_t>(xreg::indirect_data_1 + k));
+    dxl::put_u16(&table_[xreg::indirect_address_29 + 2 * k],
+                 static_cast<std::uint16_t>(xreg::indirect_data_29 + k));
+  }
   // Hold still when torque comes on: the goal starts at the present position.
   dxl::put_u32(&table_[xreg::goal_position],
                static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
@@ -235,41 +323,82 @@ StatusError DynamixelServo::read(std::uint16_t address, std::uint16_t length,
                                  std::span<std::uint8_t> out) const {
   if (length == 0 || out.size() < length) return StatusError::data_length;
   if (static_cast<std::size_t>(address) + length > table_.size()) return StatusError::access;
-  std::memcpy(out.data(), &table_[address], length);
+  for (std::size_t i = 0; i < length; ++i) out[i] = table_[resolve(address + i)];
   return StatusError::none;
+}
+
+std::uint16_t DynamixelServo::resolve(std::size_t address) const {
+  if (in_block(address, xreg::indirect_data_1, 1)) {
+    return dxl::get_u16(&table_[xreg::indirect_address_1 + 2 * (address - xreg::indirect_data_1)]);
+  }
+  if (in_block(address, xreg::indirect_data_29, 1)) {
+    return dxl::get_u16(
+        &table_[xreg::indirect_address_29 + 2 * (address - xreg::indirect_data_29)]);
+  }
+  return static_cast<std::uint16_t>(address);
+}
+
+bool DynamixelServo::fast_read() const {
+  return dxl::supports_fast_read(model_number(), firmware_version());
+}
+
+// Calls f(target, bytes) for each run of bytes whose target registers are
+// consecutive (one run for a write without Indirect Data).
+template <typename F>
+void for_each_run(const DynamixelServo& servo, std::uint16_t address,
+                  std::span<const std::uint8_t> data, F&& f) {
+  std::size_t i = 0;
+  while (i < data.size()) {
+    const std::uint16_t start = servo.resolve(address + i);
+    std::size_t n = 1;
+    while (i + n < data.size() && servo.resolve(address + i + n) == start + n) ++n;
+    f(start, data.subspan(i, n));
+    i += n;
+  }
 }
 
 StatusError DynamixelServo::check_write(std::uint16_t address,
                                         std::span<const std::uint8_t> data) const {
   if (data.empty()) return StatusError::data_length;
+  if (address + data.size() > table_.size()) return StatusError::access;
+  StatusError error = StatusError::none;
+  for_each_run(*this, address, data, [&](std::uint16_t target, std::span<const std::uint8_t> run) {
+    if (error == StatusError::none) error = check_direct(target, run);
+  });
+  return error;
+}
+
+StatusError DynamixelServo::check_direct(std::uint16_t address,
+                                         std::span<const std::uint8_t> data) const {
   const std::size_t end = address + data.size();
   if (end > table_.size()) return StatusError::access;
   // Whole writable items only: a gap or read-only item is an Access Error, a
   // part of an item a Data Length Error (as the Protocol 2.0 page defines).
   for (std::size_t a = address; a < end;) {
-    const Item* item = item_containing(a);
-    if (item == nullptr) return StatusError::access;
-    if (item->address != a || a + item->size > end) return StatusError::data_length;
-    if (!item->writable) return StatusError::access;
-    a += item->size;
+    Item item{};
+    if (!find_item(a, item)) return StatusError::access;
+    if (!item.writable) return StatusError::access;
+    if (item.address != a || a + item.size > end) return StatusError::data_length;
+    a += item.size;
   }
   if (address < xreg_sim::eeprom_end && torque_on()) return StatusError::access;  // ROM lock
 
   std::array<std::uint8_t, dxl::xreg::table_size> after = table_;
   std::memcpy(&after[address], data.data(), data.size());
   for (std::size_t a = address; a < end;) {
-    const Item* item = item_containing(a);
-    const std::uint32_t raw = get_le(&after[a], item->size);
-    if (item->address == xreg::goal_position) {
+    Item item{};
+    find_item(a, item);
+    const std::uint32_t raw = get_le(&after[a], item.size);
+    if (item.address == xreg::goal_position) {
       const auto goal = static_cast<std::int32_t>(raw);
       if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
           goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
         return StatusError::data_limit;
       }
-    } else if (raw < item->min || raw > item->max) {
+    } else if (const std::int64_t v = item_value(item, raw); v < item.min || v > item.max) {
       return StatusError::data_range;
     }
-    a += item->size;
+    a += item.size;
   }
   // After a shutdown only a Reboot allows torque on again.
   if (shut_down_ && after[xreg::torque_enable] != 0) return StatusError::result_fail;
@@ -278,9 +407,19 @@ StatusError DynamixelServo::check_write(std::uint16_t address,
 
 StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::uint8_t> data) {
   const StatusError error = check_write(address, data);
-  log_goal(address, data, error == StatusError::none);
+  if (address + data.size() > table_.size()) {
+    log_goal(address, data, false);
+    return error;
+  }
+  for_each_run(*this, address, data, [&](std::uint16_t target, std::span<const std::uint8_t> run) {
+    log_goal(target, run, error == StatusError::none);
+  });
   if (error != StatusError::none) return error;
-  std::memcpy(&table_[address], data.data(), data.size());
+  // Resolved before any byte lands: a write may change an Indirect Address
+  // and an Indirect Data at once; the data goes where the old address said.
+  std::array<std::uint16_t, xreg::table_size> targets;
+  for (std::size_t i = 0; i < data.size(); ++i) targets[i] = resolve(address + i);
+  for (std::size_t i = 0; i < data.size(); ++i) table_[targets[i]] = data[i];
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
   command_physics();

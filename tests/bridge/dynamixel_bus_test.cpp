@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -242,6 +244,10 @@ BusConfig make_config(const std::string& port) {
   c.protocol = "dynamixel2";
   c.port = port;
   c.timeout_s = 0.05;  // generous: the machine may be loaded
+  // These devices speak plain Sync Read only (Fast Sync Read: tests/sim).
+  dxl::BusOptions options;
+  options.fast_read = dxl::FastRead::off;
+  c.options = options;
   const char* joints[] = {"lf_hip", "lf_knee", "lf_ankle"};
   for (int i = 0; i < 3; ++i) {
     ActuatorBinding b;
@@ -333,6 +339,29 @@ TEST_F(DynamixelBusTest, FirstReadHasConfiguredPositionsEvenIfNobodyAnswers) {
   EXPECT_DOUBLE_EQ(q[2], rad(2, 1500));
   EXPECT_DOUBLE_EQ(q[1], kPi / 2);
   EXPECT_EQ(status(0).timeouts, 1u);
+}
+
+TEST(DynamixelBus, ConfigureWarnsAboutASlowUsbLatencyTimer) {
+  // The fake devices' pty behind a link named like a USB adapter, and a
+  // fake sysfs tree that gives that adapter Linux's default 16 ms.
+  FakeDevices fake(three_servos());
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("animrt_latency_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "sys/bus/usb-serial/devices/ttyUSB9");
+  std::ofstream(dir / "sys/bus/usb-serial/devices/ttyUSB9/latency_timer") << "16\n";
+  std::filesystem::create_symlink(fake.port(), dir / "ttyUSB9");
+  const std::string port = (dir / "ttyUSB9").string();
+  DynamixelBus bus(make_config(port), open_serial(port, 1'000'000));
+  bus.set_sysfs_root((dir / "sys").string());
+  bus.configure();
+  EXPECT_NE(bus.latency_warning().find("latency timer is 16 ms"), std::string::npos)
+      << bus.latency_warning();
+  // At 1 ms nothing is said.
+  std::ofstream(dir / "sys/bus/usb-serial/devices/ttyUSB9/latency_timer") << "1\n";
+  bus.configure();
+  EXPECT_EQ(bus.latency_warning(), "");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(DynamixelBus, ConfigureListsEveryMissingDeviceInOneError) {

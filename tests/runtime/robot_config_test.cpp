@@ -9,6 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include "animrt/bridge/dynamixel/x_models.hpp"
+
 namespace animrt {
 namespace {
 
@@ -269,7 +271,7 @@ buses:
     parity: none
 )"),
             at("7:5: buses.b.parity: unknown key (expected one of: protocol, port, baud, "
-               "timeout_ms, sim)"));
+               "timeout_ms, fast_read, model, sim)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -279,7 +281,8 @@ buses:
     sim: {max_speed_rad_s: 6}
 )"),
             at("7:11: buses.b.sim.max_speed_rad_s: unknown key (expected one of: "
-               "time_constant_s, max_speed_dps, wire_time, return_delay_us)"));
+               "time_constant_s, max_speed_dps, wire_time, return_delay_us, "
+               "firmware_version)"));
   EXPECT_EQ(
       error_of(R"(name: t
 loop: {rate_hz: 100}
@@ -311,7 +314,7 @@ joints:
     actuator: {bus: b, id: 1, inverted: true}
 )"),
             at("8:31: joints.j1.actuator.inverted: unknown key (expected one of: bus, id, "
-               "ticks_per_rev, ticks_per_rad, zero_ticks, direction)"));
+               "ticks_per_rev, ticks_per_rad, zero_ticks, direction, model)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -925,6 +928,65 @@ TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {
                   ":3:30: safety.watchdog_timeout_s: expected at least two loop periods "
                   "(0.02 s at loop.rate_hz 100), found \"0.015\"");
   }
+}
+
+// ------------------------------------------------------- dynamixel2 options
+
+TEST_F(RobotConfigTest, DynamixelFastReadModelAndFirmwareKeys) {
+  const RobotConfig c = load(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b:
+    protocol: dynamixel2
+    port: /dev/ttyUSB0
+    fast_read: "on"
+    model: XM430-W350
+    sim: {firmware_version: 46}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1}
+  j2:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 2, model: XH540-W270}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)");
+  ASSERT_EQ(c.buses.size(), 1u);
+  EXPECT_EQ(dxl::bus_options(c.buses[0]).fast_read, dxl::FastRead::on);
+  EXPECT_EQ(c.buses[0].sim.firmware_version, 46);
+  ASSERT_EQ(c.buses[0].actuators.size(), 2u);
+  EXPECT_EQ(dxl::device_options(c.buses[0].actuators[0]).model_number, 1020);  // the bus's
+  EXPECT_EQ(dxl::device_options(c.buses[0].actuators[1]).model_number, 1100);  // its own
+  // Defaults: auto, no model.
+  const RobotConfig d = load(kMinimal);
+  EXPECT_EQ(dxl::bus_options(d.buses[0]).fast_read, dxl::FastRead::automatic);
+  EXPECT_EQ(dxl::device_options(d.buses[0].actuators[0]).model_number, 0);
+}
+
+TEST_F(RobotConfigTest, DynamixelBadFastReadOrModelIsNamed) {
+  const std::string head = "name: t\nloop: {rate_hz: 100}\nbuses:\n";
+  const std::string tail =
+      "joints:\n  j1:\n    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, "
+      "acceleration_dps2: 1000}\n    actuator: {bus: b, id: 1";
+  const std::string motion = "}\nmotion: {type: gait, file: ../gaits/gait.yaml}\n";
+  EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, fast_read: fast}\n" +
+                     tail + motion),
+            at("4:60: buses.b.fast_read: expected auto, on or off, found \"fast\""));
+  const std::string names = dxl::x_model_names();
+  EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, model: XM430}\n" +
+                     tail + motion),
+            at("4:56: buses.b.model: expected a Dynamixel X-series model (" + names +
+               "), found \"XM430\""));
+  EXPECT_EQ(error_of(head + "  b: {protocol: dynamixel2, port: /dev/ttyUSB0}\n" + tail +
+                     ", model: AX-12A" + motion),
+            at("8:38: joints.j1.actuator.model: expected a Dynamixel X-series model (" + names +
+               "), found \"AX-12A\""));
+  EXPECT_NE(error_of(head +
+                     "  b: {protocol: dynamixel2, port: /dev/ttyUSB0, sim: {firmware_version: "
+                     "0}}\n" +
+                     tail + motion)
+                .find("buses.b.sim.firmware_version"),
+            std::string::npos);
 }
 
 }  // namespace

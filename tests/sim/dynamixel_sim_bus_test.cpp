@@ -436,9 +436,12 @@ TEST_F(DynamixelSimBusTest, BadAddressOrLengthErrors) {
   // Read-only and undefined addresses: Access Error.
   EXPECT_EQ(write_u32(1, xreg::present_position, 100), err(StatusError::access));
   EXPECT_EQ(write_u8(1, 66, 1), err(StatusError::access));
-  // Outside the control table.
-  EXPECT_EQ(transact(test::read(1, 146, 4)).error, err(StatusError::access));
-  EXPECT_EQ(transact(test::write(1, 200, {1})).error, err(StatusError::access));
+  // Outside the control table (it ends with Indirect Data 56 at 661).
+  EXPECT_EQ(transact(test::read(1, 660, 4)).error, err(StatusError::access));
+  EXPECT_EQ(transact(test::write(1, 662, {1})).error, err(StatusError::access));
+  // Inside it, a real servo answers: Indirect Address 17 reads 240.
+  EXPECT_EQ(transact(test::read(1, 200, 2)).data, Bytes({240, 0}));
+  EXPECT_EQ(transact(test::write(1, 200, {1})).error, err(StatusError::data_length));
   // Values outside an item's range: Data Range Error.
   EXPECT_EQ(write_u8(1, xreg::torque_enable, 2), err(StatusError::data_range));
   EXPECT_EQ(write_u8(1, xreg::status_return_level, 3), err(StatusError::data_range));

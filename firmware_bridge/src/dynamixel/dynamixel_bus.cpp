@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "animrt/bridge/dynamixel/latency_timer.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -105,6 +106,9 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   suspect_.resize(n);
   value_.resize(n);
   sync_data_.resize(4 * n);
+  model_.resize(n);
+  firmware_.resize(n);
+  fast_mode_ = dxl::bus_options(config_).fast_read;
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
@@ -163,13 +167,17 @@ void DynamixelBus::blame(std::size_t slot, bool crc) {
 
 void DynamixelBus::accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
                           bool diagnostic) {
-  const std::size_t device = asked_[slot];
-  DeviceStatus& st = status_[device];
   if (packet.params.empty()) {  // a status packet always carries its error byte
     blame(slot, false);
     return;
   }
-  const std::uint8_t error = packet.params[0];
+  accept(slot, packet.params[0], packet.params.subspan(1), data_length, diagnostic);
+}
+
+void DynamixelBus::accept(std::size_t slot, std::uint8_t error, std::span<const std::uint8_t> data,
+                          std::size_t data_length, bool diagnostic) {
+  const std::size_t device = asked_[slot];
+  DeviceStatus& st = status_[device];
   const bool alert = (error & dxl::kAlertBit) != 0;
   st.last_error_byte = error;
   if (!diagnostic) {
@@ -180,7 +188,6 @@ void DynamixelBus::accept(std::size_t slot, const dxl::Packet& packet, std::size
     }
     alert_seen_[device] = alert ? 1 : 0;
   }
-  const auto data = packet.params.subspan(1);
   const bool bad_number = (error & kErrorNumberMask) != 0;
   const bool bad_length = !bad_number && data_length != kAnyLength && data.size() != data_length;
   if (bad_number || bad_length) {
@@ -211,8 +218,11 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
 
-  // One deadline for the whole transaction: a dead device costs one timeout.
-  const Deadline deadline = steady_clock::now() + timeout_;
+  const steady_clock::time_point start = steady_clock::now();
+  const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
+  Deadline deadline = std::min(cap, start + timeout_);
+  // Each answer (whatever it was) restarts the wait for the next one.
+  const auto answered = [&] { deadline = std::min(cap, steady_clock::now() + timeout_); };
   std::size_t remaining = count;
   std::size_t expected = 0;  // first slot still waiting: whose answer comes next
   dxl::Packet packet;
@@ -224,6 +234,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
       // A whole packet arrived damaged: that was the answer, no other follows.
       blame(expected, true);
       --remaining;
+      answered();
       continue;
     }
     std::size_t slot = count;
@@ -261,6 +272,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
     }
     accept(slot, packet, data_length, diagnostic);
     --remaining;
+    answered();
   }
 
   // Bytes of an unfinished packet at the deadline: the next answer was cut short.
@@ -276,6 +288,86 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
       st.health = DeviceHealth::protocol_error;
       continue;
     }
+    ++st.timeouts;
+    st.health = DeviceHealth::timeout;
+    answer_[s] = Answer::timeout;
+  }
+}
+
+void DynamixelBus::transact_fast(std::size_t length, std::size_t count, std::size_t data_length) {
+  for (std::size_t s = 0; s < count; ++s) {
+    answer_[s] = Answer::pending;
+    suspect_[s] = 0;
+    ++status_[asked_[s]].transactions;
+  }
+  transport_->discard_input();
+  decoder_.reset();
+  rx_begin_ = rx_end_ = 0;
+  transport_->write({tx_.data(), length});
+
+  // Collect bytes until the packet the header announces is complete. The
+  // packet is not byte-stuffed, so it is read raw, not through the Decoder.
+  const steady_clock::time_point start = steady_clock::now();
+  const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
+  Deadline deadline = std::min(cap, start + timeout_);
+  const std::size_t slice_size = dxl::kFastSliceOverhead + data_length;
+  std::size_t slices = 0;
+  std::size_t got = 0;
+  for (;;) {
+    const dxl::FastStatusReader so_far({fast_rx_.data(), got});
+    if (so_far.complete()) break;
+    const auto now = steady_clock::now();
+    if (so_far.after_header() / slice_size > slices) {
+      // Another servo's slice is in: the wait for the next one starts again.
+      slices = so_far.after_header() / slice_size;
+      deadline = std::min(cap, now + timeout_);
+    }
+    if (now >= deadline || got == fast_rx_.size()) break;
+    const std::size_t n =
+        transport_->read({fast_rx_.data() + got, fast_rx_.size() - got},
+                         std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+    got += n;
+    if (n == 0 && transport_->failure() != nullptr) break;
+  }
+
+  // Slice by slice: each carries its own CRC, so a damaged or missing slice
+  // costs only its device (and, when damaged, the slices behind it).
+  dxl::FastStatusReader reader({fast_rx_.data(), got});
+  std::size_t expected = 0;  // slots before it have had their turn
+  for (;;) {
+    std::uint8_t id = 0;
+    if (!reader.peek_id(id)) break;
+    std::size_t slot = expected;
+    while (slot < count && !(ids_[slot] == id && answer_[slot] == Answer::pending)) ++slot;
+    if (slot == count) {
+      // An id not asked (or twice): its length is unknown, nothing behind it
+      // can be read.
+      if (expected < count) {
+        DeviceStatus& st = status_[asked_[expected]];
+        ++st.protocol_errors;
+        st.health = DeviceHealth::protocol_error;
+        suspect_[expected] = 1;
+      }
+      break;
+    }
+    dxl::FastSlice slice;
+    const auto step = reader.next(data_length, slice);
+    if (step == dxl::FastStatusReader::Step::slice) {
+      accept(slot, slice.error, slice.data, data_length, false);
+      expected = slot + 1;
+      continue;
+    }
+    if (step == dxl::FastStatusReader::Step::bad_crc ||
+        step == dxl::FastStatusReader::Step::short_) {
+      blame(slot, step == dxl::FastStatusReader::Step::bad_crc);
+    }
+    break;
+  }
+  for (std::size_t s = 0; s < count; ++s) {
+    if (answer_[s] != Answer::pending) continue;
+    answer_[s] = Answer::garbled;
+    if (suspect_[s] != 0) continue;  // already counted as a protocol error
+    DeviceStatus& st = status_[asked_[s]];
     ++st.timeouts;
     st.health = DeviceHealth::timeout;
     answer_[s] = Answer::timeout;
@@ -352,6 +444,11 @@ std::string DynamixelBus::failure(std::size_t device, Answer answer) const {
 // ---- lifecycle --------------------------------------------------------------
 
 void DynamixelBus::configure() {
+  // A USB adapter's latency timer above 1 ms delays every answer by it.
+  latency_warning_ = latency_timer_warning(transport_->port(), sysfs_root_);
+  if (!latency_warning_.empty()) {
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), latency_warning_.c_str());
+  }
   const std::size_t n = status_.size();
   for (std::size_t i = 0; i < n; ++i) {
     status_[i] = DeviceStatus{};
@@ -364,6 +461,10 @@ void DynamixelBus::configure() {
   for (std::size_t i = 0; i < n; ++i) {
     const auto id = static_cast<std::uint8_t>(status_[i].device_id);
     const Answer a = unicast(i, dxl::encode_ping(id, tx_), kAnyLength);
+    if (a == Answer::ok) {  // model number (2 bytes), firmware version
+      model_[i] = static_cast<std::uint16_t>(value_[0] & 0xFFFF);
+      firmware_[i] = static_cast<std::uint8_t>((value_[0] >> 16) & 0xFF);
+    }
     std::string& list = a == Answer::timeout ? silent : garbled;
     if (a == Answer::ok || a == Answer::rejected) continue;  // it answered: it is there
     list += (list.empty() ? "" : ", ") + describe(i);
@@ -381,6 +482,20 @@ void DynamixelBus::configure() {
     throw DeviceError(message);
   }
 
+  std::string wrong_model;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint16_t want = dxl::device_options(config_.actuators[i]).model_number;
+    if (want == 0 || want == model_[i]) continue;
+    const auto name = [](std::uint16_t number) {
+      const dxl::XModel* m = dxl::find_x_model(number);
+      return m != nullptr ? std::string(m->name) + " (model number " + std::to_string(number) + ")"
+                          : "model number " + std::to_string(number);
+    };
+    wrong_model += (wrong_model.empty() ? "" : "; ") + describe(i) + " is a " + name(model_[i]) +
+                   ", the config says " + name(want);
+  }
+  if (!wrong_model.empty()) throw DeviceError(prefix() + wrong_model);
+
   std::string unread;
   for (std::size_t i = 0; i < n; ++i) {
     const auto id = static_cast<std::uint8_t>(status_[i].device_id);
@@ -394,8 +509,38 @@ void DynamixelBus::configure() {
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
   for (std::size_t i = 0; i < n; ++i) write_position_limits(i);
+  choose_fast_read();
   read_pending_hardware_status();
   fresh_ = true;
+}
+
+void DynamixelBus::choose_fast_read() {
+  fast_ = false;
+  const std::size_t n = status_.size();
+  if (fast_mode_ == dxl::FastRead::off || n == 0) return;
+  if (fast_mode_ == dxl::FastRead::on) {
+    fast_ = true;
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!dxl::supports_fast_read(model_[i], firmware_[i])) return;
+  }
+  // Every servo claims it: one Fast Sync Read of all of them must then work,
+  // or the cycle falls back to Sync Read (its counters do not count against
+  // the devices: configure() resets nothing after this).
+  std::vector<DeviceStatus> before(status_.begin(), status_.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    ids_[i] = static_cast<std::uint8_t>(status_[i].device_id);
+    asked_[i] = i;
+  }
+  const std::size_t length =
+      dxl::encode_fast_sync_read(dxl::xreg::present_position, 4, {ids_.data(), n}, tx_);
+  if (length > 0) {
+    transact_fast(length, n, 4);
+    fast_ = std::all_of(answer_.begin(), answer_.begin() + static_cast<std::ptrdiff_t>(n),
+                        [](Answer a) { return a == Answer::ok; });
+  }
+  std::copy(before.begin(), before.end(), status_.begin());
 }
 
 void DynamixelBus::write_position_limits(std::size_t device) {
@@ -484,9 +629,15 @@ void DynamixelBus::read(std::span<double> positions) {
   }
   if (count > 0) {
     const std::size_t length =
-        dxl::encode_sync_read(dxl::xreg::present_position, 4, {ids_.data(), count}, tx_);
+        fast_
+            ? dxl::encode_fast_sync_read(dxl::xreg::present_position, 4, {ids_.data(), count}, tx_)
+            : dxl::encode_sync_read(dxl::xreg::present_position, 4, {ids_.data(), count}, tx_);
     if (length > 0) {
-      transact(length, count, 4, false);
+      if (fast_) {
+        transact_fast(length, count, 4);
+      } else {
+        transact(length, count, 4, false);
+      }
       for (std::size_t s = 0; s < count; ++s) {
         if (answer_[s] != Answer::ok) continue;
         const std::size_t i = asked_[s];

@@ -7,6 +7,7 @@
 
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
+#include "animrt/bridge/dynamixel/x_models.hpp"
 
 namespace animrt {
 namespace {
@@ -19,9 +20,27 @@ constexpr std::int64_t kMaxTicks = 4095;
 constexpr double kMinTicksPerRev = 16.0;
 constexpr double kMaxTicksPerRev = 1e8;
 
-constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms"};
-constexpr std::string_view kActuatorKeys[] = {"id", "ticks_per_rev", "ticks_per_rad", "zero_ticks",
-                                              "direction"};
+constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms", "fast_read", "model"};
+constexpr std::string_view kActuatorKeys[] = {"id",         "ticks_per_rev", "ticks_per_rad",
+                                              "zero_ticks", "direction",     "model"};
+
+std::uint16_t parse_model(const YamlNode& node) {
+  if (node.is_scalar()) {
+    if (const dxl::XModel* m = dxl::find_x_model(node.raw().Scalar())) return m->number;
+  }
+  node.fail("expected a Dynamixel X-series model (" + dxl::x_model_names() + "), found " +
+            node.describe());
+}
+
+dxl::FastRead parse_fast_read(const YamlNode& node) {
+  if (node.is_scalar()) {
+    const std::string& s = node.raw().Scalar();
+    if (s == "auto") return dxl::FastRead::automatic;
+    if (s == "on") return dxl::FastRead::on;
+    if (s == "off") return dxl::FastRead::off;
+  }
+  node.fail("expected auto, on or off, found " + node.describe());
+}
 
 int parse_direction(const YamlNode& node) {
   if (node.is_scalar()) {
@@ -69,6 +88,10 @@ class Dynamixel2 final : public Protocol {
       }
       bus.timeout_s = ms / 1000.0;
     }
+    dxl::BusOptions options;
+    if (auto n = node.find("fast_read")) options.fast_read = parse_fast_read(*n);
+    if (auto n = node.find("model")) options.model_number = parse_model(*n);
+    bus.options = options;
   }
 
   void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,
@@ -107,6 +130,10 @@ class Dynamixel2 final : public Protocol {
           std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
     }
     if (auto n = node.find("direction")) out.direction = parse_direction(*n);
+    dxl::DeviceOptions device;
+    device.model_number = dxl::bus_options(bus).model_number;
+    if (auto n = node.find("model")) device.model_number = parse_model(*n);
+    out.options = device;
 
     check_ticks(limits_node.at("min_deg"), joint.limits.min_position, out, scale);
     check_ticks(limits_node.at("max_deg"), joint.limits.max_position, out, scale);
@@ -114,10 +141,12 @@ class Dynamixel2 final : public Protocol {
 
   // Sync Write of 4-byte goal positions (14 + 5 N bytes), Sync Read of
   // 4-byte present positions (14 + N) and N status packets of 15 bytes, at
-  // 10 bits per byte (start, 8 data, stop).
+  // 10 bits per byte (start, 8 data, stop). With `fast_read: on` one Fast
+  // Sync Read status packet (8 + 8 N) instead; `auto` may fall back to Sync
+  // Read, so it is judged by the longer one.
   double wire_bits_per_cycle(const BusConfig& bus) const override {
-    const double n = static_cast<double>(bus.actuators.size());
-    return 10.0 * ((14.0 + 5.0 * n) + (14.0 + n) + 15.0 * n);
+    const bool fast = dxl::bus_options(bus).fast_read == dxl::FastRead::on;
+    return 10.0 * static_cast<double>(dynamixel_wire_bytes(bus.actuators.size(), fast));
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
@@ -126,6 +155,14 @@ class Dynamixel2 final : public Protocol {
 };
 
 }  // namespace
+
+std::size_t dynamixel_wire_bytes(std::size_t devices, bool fast_read) {
+  const std::size_t n = devices;
+  const std::size_t write = 14 + 5 * n;
+  const std::size_t read = 14 + n;
+  const std::size_t answers = fast_read ? dxl::fast_status_size(n, 4 * n) : 15 * n;
+  return write + read + answers;
+}
 
 const Protocol& dynamixel2_protocol() {
   static const Dynamixel2 protocol;

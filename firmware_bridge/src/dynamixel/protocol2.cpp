@@ -152,6 +152,127 @@ std::size_t encode_sync_write(std::uint16_t address, std::uint16_t length,
   return w.finish();
 }
 
+std::size_t encode_fast_sync_read(std::uint16_t address, std::uint16_t length,
+                                  std::span<const std::uint8_t> ids, std::span<std::uint8_t> out) {
+  PacketWriter w(out, kBroadcastId, inst::fast_sync_read);
+  w.body_u16(address);
+  w.body_u16(length);
+  w.body(ids);
+  return w.finish();
+}
+
+namespace {
+std::size_t encode_bulk(std::uint8_t instruction, std::span<const BulkReadEntry> entries,
+                        std::span<std::uint8_t> out) {
+  PacketWriter w(out, kBroadcastId, instruction);
+  for (const BulkReadEntry& e : entries) {
+    w.body(e.id);
+    w.body_u16(e.address);
+    w.body_u16(e.length);
+  }
+  return w.finish();
+}
+}  // namespace
+
+std::size_t encode_bulk_read(std::span<const BulkReadEntry> entries, std::span<std::uint8_t> out) {
+  return encode_bulk(inst::bulk_read, entries, out);
+}
+
+std::size_t encode_fast_bulk_read(std::span<const BulkReadEntry> entries,
+                                  std::span<std::uint8_t> out) {
+  return encode_bulk(inst::fast_bulk_read, entries, out);
+}
+
+std::size_t fast_status_size(std::size_t devices, std::size_t data_bytes) {
+  return kFastHeaderSize + kFastSliceOverhead * devices + data_bytes;
+}
+
+FastStatusWriter::FastStatusWriter(std::span<std::uint8_t> out, std::size_t devices,
+                                   std::size_t data_bytes)
+    : out_(out), length_(fast_status_size(devices, data_bytes) - kPrefixSize) {}
+
+void FastStatusWriter::header() {
+  if (out_.size() < kFastHeaderSize) {
+    overflow_ = true;
+    return;
+  }
+  std::memcpy(out_.data(), kHeader, kHeaderSize);
+  out_[4] = kBroadcastId;
+  put_u16(out_.data() + 5, static_cast<std::uint16_t>(length_));
+  out_[7] = inst::status;
+  size_ = kFastHeaderSize;
+}
+
+bool FastStatusWriter::slice(std::uint8_t error, std::uint8_t id,
+                             std::span<const std::uint8_t> data) {
+  if (overflow_ || size_ == 0 || size_ + kFastSliceOverhead + data.size() > out_.size()) {
+    overflow_ = true;
+    return false;
+  }
+  std::uint8_t* p = out_.data() + size_;
+  p[0] = error;
+  p[1] = id;
+  if (!data.empty()) std::memcpy(p + 2, data.data(), data.size());
+  const std::size_t crc_at = size_ + 2 + data.size();
+  put_u16(out_.data() + crc_at, crc16(out_.first(crc_at)));
+  size_ = crc_at + kCrcSize;
+  return true;
+}
+
+FastStatusReader::FastStatusReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {
+  for (std::size_t i = 0; i + kFastHeaderSize <= bytes_.size(); ++i) {
+    if (std::memcmp(bytes_.data() + i, kHeader, kHeaderSize) == 0 &&
+        bytes_[i + 4] == kBroadcastId && bytes_[i + 7] == inst::status) {
+      start_ = i;
+      pos_ = i + kFastHeaderSize;
+      crc_ = crc16(bytes_.subspan(i, kFastHeaderSize));
+      return;
+    }
+  }
+}
+
+std::size_t FastStatusReader::announced_size() const {
+  if (!has_header()) return 0;
+  return kPrefixSize + get_u16(bytes_.data() + start_ + 5);
+}
+
+bool FastStatusReader::complete() const {
+  return has_header() && bytes_.size() - start_ >= announced_size();
+}
+
+std::size_t FastStatusReader::after_header() const {
+  return has_header() ? bytes_.size() - start_ - kFastHeaderSize : 0;
+}
+
+bool FastStatusReader::peek_id(std::uint8_t& id) const {
+  if (!has_header() || stopped_ || pos_ + 2 > bytes_.size()) return false;
+  id = bytes_[pos_ + 1];
+  return true;
+}
+
+FastStatusReader::Step FastStatusReader::next(std::size_t data_length, FastSlice& out) {
+  if (!has_header() || stopped_ || pos_ >= bytes_.size() || pos_ >= start_ + announced_size()) {
+    return Step::end;
+  }
+  const std::size_t crc_at = pos_ + 2 + data_length;
+  if (crc_at + kCrcSize > bytes_.size()) {
+    stopped_ = true;
+    return Step::short_;
+  }
+  const std::uint16_t crc = crc16(bytes_.subspan(pos_, crc_at - pos_), crc_);
+  if (crc != get_u16(bytes_.data() + crc_at)) {
+    stopped_ = true;
+    return Step::bad_crc;
+  }
+  out.error = bytes_[pos_];
+  out.id = bytes_[pos_ + 1];
+  out.data = bytes_.subspan(pos_ + 2, data_length);
+  // The running CRC continues over this slice's CRC bytes.
+  crc_ = crc16(bytes_.subspan(crc_at, kCrcSize), crc);
+  pos_ = crc_at + kCrcSize;
+  return Step::slice;
+}
+
 std::size_t encode_status(std::uint8_t id, std::uint8_t error, std::span<const std::uint8_t> data,
                           std::span<std::uint8_t> out) {
   PacketWriter w(out, id, inst::status);

@@ -44,6 +44,7 @@ struct SimBusSettings {
   double max_speed_rad_s = 6.0;   // rate limit of each motor
   bool wire_time = false;         // emulate bytes on the wire at the baud rate
   int return_delay_us = 0;        // device's delay before answering
+  int firmware_version = 0;       // Dynamixel: firmware the servos report (0: the default, 38)
 };
 
 struct BusConfig {

@@ -5,18 +5,27 @@
 //
 // Instructions: Ping (broadcast: every servo answers, in id order), Read,
 // Write, Reg Write, Action, Reboot, Sync Read, Sync Write, Bulk Read, Bulk
-// Write. Factory Reset, Clear and unknown instructions answer Instruction
-// Error. A broadcast Read is ignored; broadcast Write/Reg Write/Action/Reboot
-// act without answering.
-// Status Return Level is respected (Ping always answers; a write that
-// changes the level is answered per the level it arrived under). Sync and Bulk
-// instructions are obeyed only with the broadcast id. A servo that is not
-// responding ignores every packet. A write to ID takes effect at once (its
-// status packet already carries the new ID).
+// Write, Fast Sync Read, Fast Bulk Read. Factory Reset, Clear and unknown instructions answer
+// Instruction Error. A broadcast Read is ignored; broadcast Write/Reg Write/Action/Reboot act
+// without answering. Status Return Level is respected (Ping always answers; a write that changes
+// the level is answered per the level it arrived under). Sync and Bulk instructions are obeyed only
+// with the broadcast id. A servo that is not responding ignores every packet. A write to ID takes
+// effect at once (its status packet already carries the new ID).
+//
+// Fast Sync Read and Fast Bulk Read (servos whose model and firmware support
+// them; see dxl::supports_fast_read) answer with one combined status packet:
+// the first servo that answers sends the header, whose LEN counts every
+// servo asked, and each servo appends its slice (error, id, data, CRC of the
+// packet so far). A servo with an error number still sends a full-length
+// slice, its data zero.
 //
 // Simplification: on a real bus each servo of a Sync/Bulk Read waits for the
 // previous one's status packet; here a servo that does not respond is simply
-// skipped and the next one answers at once.
+// skipped and the next one answers at once. For a fast read that means the
+// packet comes out shorter than its LEN by the silent servo's slice, and the
+// later slices' CRCs cover what was actually sent. (The manual does not say
+// what real servos do then; a master must not rely on either outcome, and
+// ours reads what arrived slice by slice.)
 
 #include <cstdint>
 #include <span>
@@ -76,9 +85,11 @@ class DynamixelFirmware {
               std::span<const std::uint8_t> data, Answers& out) const;
   void answer_read(const DynamixelServo& servo, std::uint16_t address, std::uint16_t length,
                    Answers& out) const;
+  void answer_fast(std::span<const dxl::BulkReadEntry> entries, Answers& out);
 
   std::vector<DynamixelServo> servos_;
   std::vector<DynamixelServo*> by_id_;  // scratch for broadcast ping
+  std::vector<dxl::BulkReadEntry> fast_entries_;
 };
 
 }  // namespace animrt::sim

@@ -1,17 +1,27 @@
 #pragma once
-// One simulated Dynamixel X-series servo (identity of an XM430-W210: model
-// 1030, firmware 38): its control table, the firmware's rules for reading and
-// writing it, and a motor model. No I/O; DynamixelFirmware feeds it packets.
+// One simulated Dynamixel X-series servo: its control table, the firmware's
+// rules for reading and writing it, and a motor model. No I/O;
+// DynamixelFirmware feeds it packets. Identity: the model of the actuator's
+// `model` key (default XM430-W210, model 1030) and the bus's
+// sim.firmware_version (default 38, as in the manual's Ping example).
 //
-// Control table: the X-series items listed in kItems (dynamixel_servo.cpp);
-// other addresses below 147 read as 0 and cannot be written (Access Error).
+// Control table: the X430 table (addresses 0..661, kItems in
+// dynamixel_servo.cpp); addresses without an item read as 0 and cannot be
+// written (Access Error); reads and writes past 661 are Access Errors.
+// EEPROM items (below 64) refuse writes while torque is on (Access Error),
+// read-only items refuse every write (Access Error), a write of part of an
+// item is a Data Length Error, a value outside the item's range a Data Range
+// Error. Indirect Data n reads and writes the register Indirect Address n
+// names (64..661), under that register's rules; a write that covers several
+// Indirect Data maps to one write per run of consecutive target addresses,
+// all checked before any is applied.
 // Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (only 3,
 // position control; other modes answer Data Range Error), Moving Threshold,
 // Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
 // Return Level, Registered Instruction, Hardware Error Status, Goal Position,
 // Realtime Tick, Moving, Present Velocity/Position/Input Voltage/Temperature.
-// Stored but without effect: Model Information, Drive Mode, Temperature
-// Limit, Profile Acceleration, Profile Velocity, Velocity Limit (the rate
+// Stored but without effect: every other item, e.g. Drive Mode, Temperature
+// Limit, the gains, Profile Acceleration/Velocity, Velocity Limit (the rate
 // limit is SimBusSettings::max_speed_rad_s).
 //
 // Motor: with torque on, Present Position follows Goal Position as a first
@@ -32,6 +42,7 @@
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
 
@@ -41,18 +52,43 @@ namespace animrt::sim {
 namespace xreg_sim {
 inline constexpr std::uint16_t model_information = 2;        // 4
 inline constexpr std::uint16_t drive_mode = 10;              // 1
+inline constexpr std::uint16_t secondary_id = 12;            // 1
+inline constexpr std::uint16_t protocol_type = 13;           // 1
+inline constexpr std::uint16_t homing_offset = 20;           // 4, signed
 inline constexpr std::uint16_t moving_threshold = 24;        // 4, unit 0.229 rpm
 inline constexpr std::uint16_t temperature_limit = 31;       // 1
+inline constexpr std::uint16_t max_voltage_limit = 32;       // 2, unit 0.1 V
+inline constexpr std::uint16_t min_voltage_limit = 34;       // 2
+inline constexpr std::uint16_t pwm_limit = 36;               // 2
+inline constexpr std::uint16_t current_limit = 38;           // 2
+inline constexpr std::uint16_t startup_configuration = 60;   // 1
 inline constexpr std::uint16_t shutdown = 63;                // 1
 inline constexpr std::uint16_t registered_instruction = 69;  // 1
+inline constexpr std::uint16_t velocity_i_gain = 76;         // 2
+inline constexpr std::uint16_t velocity_p_gain = 78;         // 2
+inline constexpr std::uint16_t position_d_gain = 80;         // 2
+inline constexpr std::uint16_t position_i_gain = 82;         // 2
+inline constexpr std::uint16_t position_p_gain = 84;         // 2
+inline constexpr std::uint16_t feedforward_2nd_gain = 88;    // 2
+inline constexpr std::uint16_t feedforward_1st_gain = 90;    // 2
+inline constexpr std::uint16_t bus_watchdog = 98;            // 1
+inline constexpr std::uint16_t goal_pwm = 100;               // 2, signed
+inline constexpr std::uint16_t goal_current = 102;           // 2, signed
+inline constexpr std::uint16_t goal_velocity = 104;          // 4, signed
 inline constexpr std::uint16_t profile_acceleration = 108;   // 4
 inline constexpr std::uint16_t profile_velocity = 112;       // 4
 inline constexpr std::uint16_t realtime_tick = 120;          // 2, ms modulo 32768
+inline constexpr std::uint16_t moving_status = 123;          // 1
+inline constexpr std::uint16_t present_pwm = 124;            // 2
+inline constexpr std::uint16_t present_current = 126;        // 2
+inline constexpr std::uint16_t velocity_trajectory = 136;    // 4
+inline constexpr std::uint16_t position_trajectory = 140;    // 4
 inline constexpr std::uint16_t present_input_voltage = 144;  // 2, unit 0.1 V
+inline constexpr std::uint16_t backup_ready = 147;           // 1
 inline constexpr std::uint16_t eeprom_end = 64;              // first RAM address
 }  // namespace xreg_sim
 
-inline constexpr std::uint16_t kXModelNumber = 1030;  // XM430-W210
+inline constexpr std::uint16_t kXModelNumber = 1030;  // XM430-W210, when no model is given
 inline constexpr std::uint8_t kXFirmwareVersion = 38;
 inline constexpr double kXTicksPerRev = 4096.0;
 inline constexpr double kXVelocityUnitRpm = 0.229;
@@ -90,6 +126,13 @@ class DynamixelServo {
   std::uint8_t id() const { return table_[dxl::xreg::id]; }  // answers to this
   std::uint8_t status_return_level() const { return table_[dxl::xreg::status_return_level]; }
   int return_delay_us() const { return 2 * table_[dxl::xreg::return_delay_time]; }
+  std::uint16_t model_number() const { return dxl::get_u16(&table_[dxl::xreg::model_number]); }
+  std::uint8_t firmware_version() const { return table_[dxl::xreg::firmware_version]; }
+  // Whether this model and firmware answer Fast Sync / Fast Bulk Read.
+  bool fast_read() const;
+  // The register an address stands for: itself, or for Indirect Data n the
+  // address in Indirect Address n.
+  std::uint16_t resolve(std::size_t address) const;
   bool torque_on() const { return table_[dxl::xreg::torque_enable] != 0; }
 
   // Brings the motor and the present-value registers to `now` (never back).
@@ -140,6 +183,7 @@ class DynamixelServo {
   };
   Motor motor_at(Nanos now) const;
   dxl::StatusError check_write(std::uint16_t address, std::span<const std::uint8_t> data) const;
+  dxl::StatusError check_direct(std::uint16_t address, std::span<const std::uint8_t> data) const;
   void reset_ram();
   void latch_shutdown();
   void publish(Nanos now);  // motor state -> present-value registers

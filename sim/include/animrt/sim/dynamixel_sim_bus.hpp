@@ -20,6 +20,8 @@
 // Wire time (SimBusSettings::wire_time): each answer is held back (real time)
 // until the instruction's bytes, the servo's Return Delay Time and the
 // answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
+// Each servo's slice of a Fast Sync/Bulk Read status packet counts as its
+// answer here (the first one with the packet's header).
 
 #include <array>
 #include <atomic>

@@ -1,7 +1,16 @@
 #pragma once
 // Master side of a Dynamixel Protocol 2.0 bus (X-series servos in position
 // mode). configure() pings and reads every device; each cycle is then one
-// Sync Read of the present positions and one Sync Write of the goals.
+// read of the present positions (Fast Sync Read when the servos support it,
+// else Sync Read) and one Sync Write of the goals.
+//
+// Timeout: BusConfig::timeout_s is the wait allowed for ONE answer: from
+// sending the instruction to the first answer, and from each answer to the
+// next (a status packet of a Sync Read, a servo's slice of a Fast Sync Read
+// status packet). A transaction expecting N answers thus ends at the latest
+// N x timeout_s after its instruction, and twelve healthy servos cannot time
+// out a read because twelve answers take longer than one. A silent servo
+// costs one timeout_s (the wait after the last answer that came).
 
 #include <array>
 #include <chrono>
@@ -15,6 +24,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "animrt/bridge/dynamixel/x_models.hpp"
 
 namespace animrt {
 
@@ -36,7 +46,11 @@ class DynamixelBus final : public ActuatorBus {
   const BusConfig& config() const override { return config_; }
 
   // Resets the counters, pings every device (kTries each) and reads its
-  // present position. Throws one DeviceError listing every device that failed.
+  // present position. Throws one DeviceError listing every device that failed,
+  // or naming a device whose model number is not the configured `model`.
+  // Decides the cycle's read: with `fast_read: auto`, Fast Sync Read when
+  // every device's model and firmware (from its Ping answer) support it and
+  // one Fast Sync Read of all of them succeeds; else Sync Read.
   // Then, for joints with limits, writes Min/Max Position Limit (52/48) from
   // them when the values read back differ (torque off first: EEPROM), so the
   // servo itself refuses goals outside the joint.
@@ -56,6 +70,19 @@ class DynamixelBus final : public ActuatorBus {
 
   std::span<DeviceStatus> devices() override { return status_; }
 
+  // Where configure() looks for the USB adapter's latency timer (tests point
+  // it at a fake tree); "/sys" by default.
+  void set_sysfs_root(std::string root) { sysfs_root_ = std::move(root); }
+  // The warning configure() printed (to stderr) about a latency timer above
+  // 1 ms, with the command that fixes it; empty when there was none.
+  const std::string& latency_warning() const { return latency_warning_; }
+
+  // Whether the cycle's read is a Fast Sync Read (decided by configure()).
+  bool fast_read_active() const { return fast_; }
+  // Model number and firmware version of a device, from its Ping answer.
+  std::uint16_t model_number(std::size_t device) const { return model_[device]; }
+  std::uint8_t firmware_version(std::size_t device) const { return firmware_[device]; }
+
  private:
   using Deadline = std::chrono::steady_clock::time_point;
 
@@ -69,15 +96,22 @@ class DynamixelBus final : public ActuatorBus {
   };
 
   // Sends tx_[0, length) and collects status packets for the devices in
-  // asked_[0, count) (ids in ids_) until each answered or the one deadline
-  // passed. Updates every counter; results land in answer_ and value_.
+  // asked_[0, count) (ids in ids_) until each answered or the wait for the
+  // next answer (see Timeout at the top) ran out. Updates every counter; results land in answer_
+  // and value_.
   void transact(std::size_t length, std::size_t count, std::size_t data_length, bool diagnostic);
   // One device, one instruction; kTries attempts while nothing usable came.
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
                  int tries = kTries, bool diagnostic = false);
+  // The same for one Fast Sync Read of asked_[0, count): one status packet
+  // with a slice per device, judged slice by slice.
+  void transact_fast(std::size_t length, std::size_t count, std::size_t data_length);
+  void choose_fast_read();
   // Judges one status packet for slot `slot`.
   void accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
               bool diagnostic);
+  void accept(std::size_t slot, std::uint8_t error, std::span<const std::uint8_t> data,
+              std::size_t data_length, bool diagnostic);
   void blame(std::size_t slot, bool crc);
   // A status packet from the right id that cannot answer this instruction.
   static bool stale(const dxl::Packet& packet, std::size_t data_length);
@@ -112,6 +146,13 @@ class DynamixelBus final : public ActuatorBus {
   std::vector<std::uint8_t> alert_seen_;      // alert bit in the latest status
   std::vector<std::uint8_t> status_pending_;  // hardware error register to read
   bool fresh_ = false;                        // configure() values not yet handed out
+  dxl::FastRead fast_mode_ = dxl::FastRead::automatic;
+  bool fast_ = false;  // the cycle's read is a Fast Sync Read
+  std::string sysfs_root_ = "/sys";
+  std::string latency_warning_;
+  std::vector<std::uint16_t> model_;  // from each device's Ping answer
+  std::vector<std::uint8_t> firmware_;
+  std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
 
   // Per slot of the current transaction.
   std::vector<std::uint8_t> ids_;
