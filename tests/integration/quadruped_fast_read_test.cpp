@@ -34,6 +34,8 @@ std::string quadruped_with(const std::string& fast_read) {
                   "    fast_read: " + fast_read + "\n    model: XL430-W250\n    timeout_ms: 4");
   text = replaced(text, "    sim:", "    sim:\n      firmware_version: 46");
   text = replaced(text, "file: ../gaits/walk.yaml", "file: " + kConfigs + "/gaits/walk.yaml");
+  text = replaced(text, "model: ../models/quadruped.xml",
+                  "model: " + kConfigs + "/models/quadruped.xml");
   const std::string path = ::testing::TempDir() + "/quadruped_fast_" + fast_read + ".yaml";
   std::ofstream(path) << text;
   return path;
