@@ -166,6 +166,12 @@ double initial_offset_rad(int device_id) {
   return degrees * std::numbers::pi / 180.0;
 }
 
+double initial_position_rad(const ActuatorBinding& binding) {
+  const double offset = initial_offset_rad(binding.device_id);
+  if (!binding.has_limits()) return offset;
+  return std::clamp(offset, binding.min_position, binding.max_position);
+}
+
 DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSettings& settings,
                                int baud, Nanos now, JointPhysics* physics)
     : binding_(binding),
@@ -206,8 +212,8 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
   table_[xreg_sim::shutdown] = kDefaultShutdown;
 
   const std::int32_t start =
-      std::clamp(binding.to_ticks(initial_offset_rad(binding.device_id)),
-                 reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
+      std::clamp(binding.to_ticks(initial_position_rad(binding)), reg32(xreg::min_position_limit),
+                 reg32(xreg::max_position_limit));
   motor_.position = start;
   if (physics_ != nullptr) motor_ = motor_at(now);  // where the physics put the joint
   reset_ram();

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -98,6 +99,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
   const std::size_t most = (firmware_.size() + 1) * dxl::kMaxPacket;
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
+  due_.reserve(firmware_.size() + 1);
 }
 
 DynamixelSimBus::~DynamixelSimBus() {
@@ -132,6 +134,9 @@ void DynamixelSimBus::stop() {
 }
 
 void DynamixelSimBus::serve() {
+  // Answers are timed to the microsecond: no timer slack (50 us by default)
+  // on this thread's sleeps.
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   std::array<std::uint8_t, 4096> buffer{};
   const MonotonicClock wall;
   Nanos last_byte = 0;
@@ -210,14 +215,40 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   } else {
     // One line: the instruction, then each servo's delay and answer in turn.
     Nanos t = std::max(arrival, bus_free_) + wire_ns(instruction_bytes);
+    due_.clear();
     for (const Answers::Answer& a : answers_.list) {
       t += static_cast<Nanos>(a.return_delay_us) * 1000 + a.late_ns + wire_ns(a.size);
-      sleep_until_monotonic(t);
-      send(answers_.packet(a));
+      due_.push_back(t);
     }
     bus_free_ = t;
+    send_paced();
   }
   answers_sent_ += answers_.list.size();
+}
+
+void DynamixelSimBus::send_paced() {
+  // Each answer leaves when its last byte would have arrived (due_), never
+  // sooner. Every wake-up costs the machine far more than a few bytes' wire
+  // time, so whatever is due by the time the thread runs goes out in one
+  // write, and the thread sleeps again only until the next answer's time.
+  const MonotonicClock wall;
+  const std::vector<Answers::Answer>& list = answers_.list;
+  std::size_t k = 0;
+  while (k < list.size()) {
+    const Nanos now = wall.now();
+    std::size_t end = k;
+    while (end < list.size() && due_[end] <= now &&
+           (end == k || list[end].offset == list[end - 1].offset + list[end - 1].size)) {
+      ++end;
+    }
+    if (end == k) {
+      sleep_until_monotonic(due_[k]);
+      continue;
+    }
+    const std::size_t first = list[k].offset;
+    send({answers_.bytes.data() + first, list[end - 1].offset + list[end - 1].size - first});
+    k = end;
+  }
 }
 
 Nanos DynamixelSimBus::wire_ns(std::size_t bytes) const {

@@ -705,6 +705,8 @@ TEST_F(DynamixelBusTest, WriteClampsIntoTheJointLimits) {
   config.actuators[2].min_position = -0.1;  // mirrored joint: limits swap in ticks
   config.actuators[2].max_position = 0.2;
   DynamixelBus bus(config, open_serial(fake_.port(), 1'000'000));
+  // Every joint rests inside its limits (one outside: DynamixelBusOnSim).
+  fake_.edit([&](auto& s) { s[3].present = config.actuators[2].to_ticks(0.0); });
   // The fake answers 0 to the limit registers, so configure writes them.
   bus.configure();
   fake_.clear_log();

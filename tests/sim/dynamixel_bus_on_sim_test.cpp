@@ -98,5 +98,58 @@ TEST(DynamixelBusOnSim, ServoRefusesGoalsOutsideTheJointLimitsTheBusWrote) {
   EXPECT_EQ(as_u32(other.transact(test::read(4, xreg::max_position_limit, 4)).data), 4095u);
 }
 
+TEST(DynamixelBusOnSim, JointRestingOutsideItsLimitsStartsAndIsLedInside) {
+  // The servo rests at 3 degrees below zero (the simulator knows no limits
+  // here, as a figure's hanging jaw does not); the bus is told 0..0.5 rad.
+  BusConfig device_side = two_servos(0.1);
+  BusConfig config = device_side;
+  config.actuators[1].min_position = 0.0;
+  config.actuators[1].max_position = 0.5;
+  const ActuatorBinding& jaw = config.actuators[1];
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(device_side, clock);
+  sim.start();
+  const double rest = sim.device_position(4);
+  ASSERT_LT(rest, -0.04);
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  ASSERT_NO_THROW(bus.configure());
+  EXPECT_NE(bus.outside_warning().find("id 4 (joint4) is at -3.0 deg"), std::string::npos)
+      << bus.outside_warning();
+  ASSERT_NO_THROW(bus.activate());
+  std::vector<double> q(2, 0.0);
+  bus.read(q);
+  EXPECT_NEAR(q[1], rest, 1e-3);
+
+  // Goals farther out than the rest pose are held at it; on the way in, a
+  // goal never goes back out past one already sent; inside, the limits rule.
+  const std::vector<double> wanted = {-0.2, -0.02, -0.04, 0.1, -0.3, 0.7};
+  const std::vector<double> sent = {rest, -0.02, -0.02, 0.1, 0.0, 0.5};
+  const std::uint64_t before = sim.device_goals_received(4);
+  for (double w : wanted) {
+    bus.write(std::vector<double>{0.0, w});
+    bus.read(q);  // a round trip: the servo has handled the write
+  }
+  ASSERT_EQ(sim.device_goals_received(4) - before, sent.size());
+  const auto log = sim.device_goal_log(4);
+  ASSERT_GE(log.size(), sent.size());
+  for (std::size_t k = 0; k < sent.size(); ++k) {
+    const sim::GoalRecord& g = log[log.size() - sent.size() + k];
+    EXPECT_EQ(g.ticks, jaw.to_ticks(sent[k])) << "goal " << k;
+    EXPECT_TRUE(g.accepted) << "goal " << k;
+  }
+  EXPECT_EQ(bus.devices()[1].protocol_errors, 0u);
+
+  // Back inside, the next bring-up writes the joint's own limits again.
+  clock.advance(2'000'000'000);
+  bus.read(q);
+  EXPECT_NEAR(q[1], 0.5, 0.01);
+  bus.deactivate();
+  bus.configure();
+  EXPECT_TRUE(bus.outside_warning().empty()) << bus.outside_warning();
+  test::PtyClient other(sim.endpoint());
+  EXPECT_EQ(as_u32(other.transact(test::read(4, xreg::min_position_limit, 4)).data),
+            static_cast<std::uint32_t>(jaw.to_ticks(0.0)));
+}
+
 }  // namespace
 }  // namespace animrt

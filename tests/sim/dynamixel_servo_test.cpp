@@ -102,5 +102,21 @@ TEST(DynamixelSimServo, BaudRateRegisterAndOffsets) {
   }
 }
 
+TEST(DynamixelSimServo, StartsInsideTheJointLimitsOfItsBinding) {
+  // id 4 starts 3 degrees below zero; a jaw of 0..30 degrees forbids that.
+  ActuatorBinding jaw = binding(4);
+  ASSERT_LT(initial_offset_rad(4), 0.0);
+  DynamixelServo free(jaw, {}, 1'000'000, 0);
+  EXPECT_EQ(present(free), jaw.to_ticks(initial_offset_rad(4)));
+  jaw.min_position = 0.0;
+  jaw.max_position = 30.0 * 3.14159265358979323846 / 180.0;
+  DynamixelServo limited(jaw, {}, 1'000'000, 0);
+  EXPECT_EQ(present(limited), jaw.to_ticks(0.0));
+  EXPECT_DOUBLE_EQ(initial_position_rad(jaw), 0.0);
+  // Limits that hold the offset leave it alone.
+  jaw.min_position = -0.5;
+  EXPECT_DOUBLE_EQ(initial_position_rad(jaw), initial_offset_rad(4));
+}
+
 }  // namespace
 }  // namespace animrt::sim

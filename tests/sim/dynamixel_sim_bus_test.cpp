@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <vector>
 
 #include "animrt/core/error.hpp"
 #include "sim/pty_client.hpp"
@@ -571,6 +573,51 @@ TEST_F(DynamixelSimBusTest, WireTimeHoldsAnswersForTheirBytesOnTheLine) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_GE(elapsed, 24 * 10 / 57600.0 + 500e-6);
   EXPECT_EQ(read_u8(1, xreg::return_delay_time), 250);
+}
+
+// Sends `instruction` and reads `sizes` bytes in turn; returns when each
+// piece was complete, in seconds after sending.
+std::vector<double> arrival_times(PtyClient& client, const Bytes& instruction,
+                                  std::initializer_list<std::size_t> sizes) {
+  const auto t0 = std::chrono::steady_clock::now();
+  client.send(instruction);
+  std::vector<double> times;
+  for (std::size_t n : sizes) {
+    EXPECT_EQ(client.read_raw(n).size(), n);
+    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return times;
+}
+
+TEST_F(DynamixelSimBusTest, WireTimeSendsNoAnswerBeforeItsLastByteCouldArrive) {
+  // Answers that are due together may leave in one write, but none before
+  // the instruction's and its own bytes (and those before it) have passed.
+  BusConfig slow = make_config({1, 2, 3});
+  slow.baud = 57'600;
+  slow.sim.wire_time = true;
+  slow.sim.firmware_version = 46;  // fast read
+  open(slow);
+  const double byte_s = 10 / 57600.0;
+  const std::uint8_t ids[] = {1, 2, 3};
+  std::array<std::uint8_t, dxl::kMaxPacket> buf{};
+  const Bytes sync(buf.begin(),
+                   buf.begin() + dxl::encode_sync_read(xreg::present_position, 4, ids, buf));
+  ASSERT_EQ(sync.size(), 17u);
+  const auto sync_times = arrival_times(*client_, sync, {15, 15, 15});
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_GE(sync_times[k], (17 + 15 * (k + 1)) * byte_s) << "answer " << k;
+  }
+  EXPECT_TRUE(client_->silent(std::chrono::milliseconds(20)));
+
+  // Fast Sync Read with the middle servo silent: its slice is left out, and
+  // the next one still waits for its own bytes only.
+  bus_->set_device_responding(2, false);
+  const Bytes fast(buf.begin(),
+                   buf.begin() + dxl::encode_fast_sync_read(xreg::present_position, 4, ids, buf));
+  const auto fast_times = arrival_times(*client_, fast, {16, 8});
+  EXPECT_GE(fast_times[0], (17 + 16) * byte_s);
+  EXPECT_GE(fast_times[1], (17 + 24) * byte_s);
+  EXPECT_TRUE(client_->silent(std::chrono::milliseconds(20)));
 }
 
 TEST_F(DynamixelSimBusTest, StopAndStartAgain) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 #include "animrt/bridge/dynamixel/latency_timer.hpp"
@@ -96,6 +97,8 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   status_.resize(n);
   present_ticks_.resize(n);
   goal_ticks_.resize(n);
+  limit_lo_.resize(n);
+  limit_hi_.resize(n);
   min_rad_.resize(n);
   max_rad_.resize(n);
   alert_seen_.resize(n);
@@ -117,12 +120,14 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
     // One tick inside the int32 range so rounding cannot wrap.
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
     const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
-    min_rad_[i] = std::min(a, c);
-    max_rad_[i] = std::max(a, c);
+    limit_lo_[i] = std::min(a, c);
+    limit_hi_[i] = std::max(a, c);
     if (b.has_limits()) {  // defence in depth: never a goal outside the joint
-      min_rad_[i] = std::max(min_rad_[i], b.min_position);
-      max_rad_[i] = std::min(max_rad_[i], b.max_position);
+      limit_lo_[i] = std::max(limit_lo_[i], b.min_position);
+      limit_hi_[i] = std::min(limit_hi_[i], b.max_position);
     }
+    min_rad_[i] = limit_lo_[i];
+    max_rad_[i] = limit_hi_[i];
   }
 }
 
@@ -508,7 +513,34 @@ void DynamixelBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
-  for (std::size_t i = 0; i < n; ++i) write_position_limits(i);
+  outside_warning_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    // Goals may lead from where the joint rests to its limits, never farther.
+    const ActuatorBinding& b = config_.actuators[i];
+    min_rad_[i] = limit_lo_[i];
+    max_rad_[i] = limit_hi_[i];
+    const std::int32_t a = b.to_ticks(min_rad_[i]);
+    const std::int32_t c = b.to_ticks(max_rad_[i]);
+    const std::int32_t ticks = present_ticks_[i];
+    if (ticks < std::min(a, c) || ticks > std::max(a, c)) {  // outside by a tick or more
+      const double at = b.to_rad(ticks);
+      min_rad_[i] = std::min(min_rad_[i], at);
+      max_rad_[i] = std::max(max_rad_[i], at);
+      char text[160];
+      std::snprintf(text, sizeof text, "%.1f deg, outside its limits %.1f..%.1f deg",
+                    at * 180.0 / std::numbers::pi, limit_lo_[i] * 180.0 / std::numbers::pi,
+                    limit_hi_[i] * 180.0 / std::numbers::pi);
+      outside_warning_ += (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + text;
+    }
+    write_position_limits(i);
+  }
+  if (!outside_warning_.empty()) {
+    outside_warning_ +=
+        ": its servo's position limits now include where it is, so torque on holds it there, "
+        "and the start ramp brings it inside (check the joint's zero_ticks and limits if this "
+        "is not expected)";
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
+  }
   choose_fast_read();
   read_pending_hardware_status();
   fresh_ = true;
@@ -546,12 +578,15 @@ void DynamixelBus::choose_fast_read() {
 void DynamixelBus::write_position_limits(std::size_t device) {
   const ActuatorBinding& b = config_.actuators[device];
   if (!b.has_limits()) return;
-  // The joint's limits in ticks, inside the range X-series position mode
-  // accepts (0..4095).
+  // The joint's limits in ticks, widened to the measured position of a joint
+  // that rests outside them (else the servo would refuse to hold it there:
+  // Data Limit Error), inside the range X-series position mode accepts
+  // (0..4095).
   const std::int32_t a = b.to_ticks(b.min_position);
   const std::int32_t c = b.to_ticks(b.max_position);
-  const auto lo = static_cast<std::uint32_t>(std::clamp(std::min(a, c), 0, kXMaxTicks));
-  const auto hi = static_cast<std::uint32_t>(std::clamp(std::max(a, c), 0, kXMaxTicks));
+  const std::int32_t at = present_ticks_[device];
+  const auto lo = static_cast<std::uint32_t>(std::clamp(std::min({a, c, at}), 0, kXMaxTicks));
+  const auto hi = static_cast<std::uint32_t>(std::clamp(std::max({a, c, at}), 0, kXMaxTicks));
   const auto id = static_cast<std::uint8_t>(b.device_id);
   const auto fail = [&](Answer answer, const std::string& what) {
     throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +
@@ -659,7 +694,16 @@ void DynamixelBus::write(std::span<const double> positions) {
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
-    if (i < positions.size()) goal_ticks_[i] = goal_ticks(i, positions[i]);
+    if (i < positions.size()) {
+      goal_ticks_[i] = goal_ticks(i, positions[i]);
+      if (std::isfinite(positions[i])) {
+        // A joint that started outside its limits: the goals sent so far
+        // bound the way back out (a no-op for a joint inside its limits).
+        const double sent = std::clamp(positions[i], min_rad_[i], max_rad_[i]);
+        min_rad_[i] = std::max(min_rad_[i], std::min(sent, limit_lo_[i]));
+        max_rad_[i] = std::min(max_rad_[i], std::max(sent, limit_hi_[i]));
+      }
+    }
     ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
     dxl::put_u32(sync_data_.data() + 4 * count, static_cast<std::uint32_t>(goal_ticks_[i]));
     ++count;

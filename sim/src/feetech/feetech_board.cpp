@@ -7,7 +7,7 @@
 #include <string>
 
 #include "animrt/core/error.hpp"
-#include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
+#include "animrt/sim/dynamixel_servo.hpp"  // initial_position_rad
 
 namespace animrt::sim {
 namespace {
@@ -99,7 +99,7 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
   table_[reg::unload_condition] = kDefaultUnload;
   table_[reg::present_voltage] = kVoltageDeciV;
   table_[reg::present_temperature] = kTemperatureC;
-  const double start = binding.to_ticks(initial_offset_rad(binding.device_id));
+  const double start = binding.to_ticks(initial_position_rad(binding));
   motor_.position = std::clamp(start, static_cast<double>(position_value(reg::min_angle_limit)),
                                static_cast<double>(position_value(reg::max_angle_limit)));
   // Hold still when torque comes on: the goal starts at the present position.

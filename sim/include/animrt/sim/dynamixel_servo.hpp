@@ -103,6 +103,12 @@ std::uint8_t baud_rate_register(int baud);
 // do: (2 + id % 3) degrees, positive for odd ids and negative for even ones.
 double initial_offset_rad(int device_id);
 
+// Where a simulated device of this binding starts: initial_offset_rad moved
+// into the joint's limits when it has limits (a joint whose limits exclude
+// the offset, e.g. a jaw of 0..30 deg, starts at the nearest limit), so the
+// runtime's bring-up never meets a pose the config forbids.
+double initial_position_rad(const ActuatorBinding& binding);
+
 // One Goal Position the servo received (Write, Reg Write + Action, Sync or
 // Bulk Write), as it arrived.
 struct GoalRecord {

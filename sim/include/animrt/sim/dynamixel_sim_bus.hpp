@@ -21,7 +21,12 @@
 // until the instruction's bytes, the servo's Return Delay Time and the
 // answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
 // Each servo's slice of a Fast Sync/Bulk Read status packet counts as its
-// answer here (the first one with the packet's header).
+// answer here (the first one with the packet's header). The times are
+// absolute (from the instruction's arrival, or from the end of the line's
+// previous traffic if later), so a late wake-up never delays what follows;
+// answers already due when the thread runs leave in one write, and the
+// thread sleeps only until the next answer's time (one wake-up costs this
+// machine more than a slice's wire time at 1 Mbaud).
 
 #include <array>
 #include <atomic>
@@ -81,6 +86,7 @@ class DynamixelSimBus final : public SimulatedBus {
   void process(std::span<const std::uint8_t> bytes, Nanos arrival);
   void handle(const dxl::Packet& packet, Nanos arrival);
   void send(std::span<const std::uint8_t> bytes);
+  void send_paced();  // answers_ at the times in due_
   Nanos wire_ns(std::size_t bytes) const;
   void close_fds();
   void drop_partial_packet();
@@ -100,7 +106,8 @@ class DynamixelSimBus final : public SimulatedBus {
   Nanos last_time_ = 0;  // when the previous packet took effect
   dxl::Decoder decoder_;
   Answers answers_;
-  Nanos bus_free_ = 0;  // wire time: when the emulated line is idle again
+  Nanos bus_free_ = 0;      // wire time: when the emulated line is idle again
+  std::vector<Nanos> due_;  // wire time: when each answer's last byte has arrived
 
   std::thread thread_;
   std::atomic<bool> stop_{false};

@@ -53,7 +53,10 @@ class DynamixelBus final : public ActuatorBus {
   // one Fast Sync Read of all of them succeeds; else Sync Read.
   // Then, for joints with limits, writes Min/Max Position Limit (52/48) from
   // them when the values read back differ (torque off first: EEPROM), so the
-  // servo itself refuses goals outside the joint.
+  // servo itself refuses goals outside the joint. A joint that rests outside
+  // its limits (a jaw hanging open past closed) gets limits widened to its
+  // measured position, with a warning (outside_warning()): torque on then
+  // holds it where it is, and the goals lead it back inside (below).
   void configure() override;
   // Per device: goal position = present position, then torque on. On failure
   // turns torque off again and throws DeviceError naming the device.
@@ -65,6 +68,9 @@ class DynamixelBus final : public ActuatorBus {
   // packets that expected an answer from the device (Sync Write expects none).
   // Neither throws: a line that is gone (adapter unplugged) shows as timeouts
   // of every device. Goals are clamped into the joint limits; NaN holds.
+  // A joint that started outside its limits may also take goals between its
+  // measured start and the limit, never farther out than a goal already
+  // sent: the start ramp walks it in, and once inside it stays inside.
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
 
@@ -76,6 +82,9 @@ class DynamixelBus final : public ActuatorBus {
   // The warning configure() printed (to stderr) about a latency timer above
   // 1 ms, with the command that fixes it; empty when there was none.
   const std::string& latency_warning() const { return latency_warning_; }
+  // The warning configure() printed about joints resting outside their
+  // limits (each with its angle and limits); empty when there was none.
+  const std::string& outside_warning() const { return outside_warning_; }
 
   // Whether the cycle's read is a Fast Sync Read (decided by configure()).
   bool fast_read_active() const { return fast_; }
@@ -142,7 +151,8 @@ class DynamixelBus final : public ActuatorBus {
   }
   std::vector<std::int32_t> present_ticks_;   // latest known, per device
   std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
-  std::vector<double> min_rad_, max_rad_;     // goals that stay inside int32 ticks
+  std::vector<double> limit_lo_, limit_hi_;   // the joint's limits, inside int32 ticks
+  std::vector<double> min_rad_, max_rad_;     // goals allowed now (see write())
   std::vector<std::uint8_t> alert_seen_;      // alert bit in the latest status
   std::vector<std::uint8_t> status_pending_;  // hardware error register to read
   bool fresh_ = false;                        // configure() values not yet handed out
@@ -150,6 +160,7 @@ class DynamixelBus final : public ActuatorBus {
   bool fast_ = false;  // the cycle's read is a Fast Sync Read
   std::string sysfs_root_ = "/sys";
   std::string latency_warning_;
+  std::string outside_warning_;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
