@@ -33,6 +33,8 @@ struct DashboardSetup {
   std::string motion_kind;                 // gait, show, head, layers
   std::string motion_name;                 // the motion file's stem
   std::optional<GaitSteering> steering;    // a steerable gait's range
+  bool show = false;                       // the motion plays a show: POST /api/show
+  double show_duration_s = 0.0;            // its length
   double duration_s = 0.0;                 // 0: until stopped
   FigureKinematics* figure = nullptr;      // the figure's model, if any
   // A replay (`animrt view`): POST /api/seek calls `seek` (no token: it
