@@ -82,6 +82,11 @@ json timing_json(const MicrosHistogram& h) {
 
 }  // namespace
 
+std::string new_dashboard_token() { return random_token(); }
+bool same_dashboard_token(const std::string& given, const std::string& token) {
+  return same_token(given, token);
+}
+
 bool is_loopback_host(const std::string& host) {
   return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
 }

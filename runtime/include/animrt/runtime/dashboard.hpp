@@ -44,6 +44,11 @@ struct DashboardSetup {
   double replay_start_s = 0.0, replay_end_s = 0.0;  // the recording's times
 };
 
+// A new random token (32 hex characters), and whether `given` is `token`,
+// compared in time that depends only on the lengths.
+std::string new_dashboard_token();
+bool same_dashboard_token(const std::string& given, const std::string& token);
+
 // Whether `host` names the loopback interface (127.0.0.0/8, ::1, localhost).
 bool is_loopback_host(const std::string& host);
 
