@@ -613,6 +613,30 @@ TEST(Cycle, StepDoesNotAllocate) {
   EXPECT_TRUE(bench.state.end().fault);  // the NaN path ran
 }
 
+TEST(Cycle, AShowsTransportDoesNotAllocate) {
+  Bench bench(two_bus_model());
+  bench.show = ramp_show(bench.model);
+  // step() is called directly (Bench::cycle() records, and so allocates):
+  // the devices stay where they are, which is no fault here.
+  bench.model.following_error.assign(bench.model.joint_count(), 1e9);
+  bench.begin();
+  bench.run_until(Phase::motion);
+  test::AllocationCounter counter;
+  ShowCommand command;
+  for (int i = 0; i < 300; ++i) {
+    command.playing = (i / 40) % 2 == 0;
+    if (i % 25 == 0) command = ShowCommand{command.playing, command.seeks + 1, 0.01 * i};
+    bench.in.show = i % 5 == 0 ? &command : nullptr;
+    step(bench.model, bench.source(), bench.state, bench.in);
+    bench.in.t += 1.0 / kRate;
+  }
+  bench.in.show = nullptr;
+  EXPECT_EQ(counter.count(), 0);
+  ASSERT_EQ(bench.state.phase(), Phase::motion);
+  // Sought to 2.75 s while playing (cycle 275), paused five cycles later.
+  EXPECT_NEAR(bench.state.show().position_s, 2.80, 1e-9);
+}
+
 TEST(NextDeadline, CountsOverrunsAndSkipsWholeMissedCycles) {
   const Nanos period = 5'000'000;
   NextDeadline on_time = next_deadline(0, 3'000'000, period);
