@@ -10,14 +10,19 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <thread>
 
 #include "animrt/controllers/herd/herd_output.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
+
+constexpr int kExitUsage = 1;  // as the run command's
 
 struct HerdArgs {
   std::string scene;
@@ -27,6 +32,11 @@ struct HerdArgs {
   std::string svg;
   std::string summary_json;
   bool quiet = false;
+  std::string dashboard;  // HOST:PORT, "" for none
+  bool dashboard_remote = false;
+  double dashboard_speed = 1.0;
+  double dashboard_rate = 30.0;
+  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
 nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
@@ -70,8 +80,35 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
 int run_herd(const HerdArgs& a) {
   herd::HerdScene scene = herd::load_herd_scene(a.scene);
   if (a.duration) scene.duration_s = *a.duration;
+  std::optional<std::pair<std::string, int>> dashboard_at;
+  if (!a.dashboard.empty()) {
+    try {
+      dashboard_at = parse_host_port(a.dashboard);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "--dashboard: " << e.what() << '\n';
+      return kExitUsage;
+    }
+    if (!a.dashboard_remote && !is_loopback_host(dashboard_at->first)) {
+      std::cerr << "--dashboard: " << dashboard_at->first
+                << " is not a loopback address; serving other machines needs --dashboard-remote\n";
+      return kExitUsage;
+    }
+  }
   herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
   const herd::HerdScene& s = herd.scene();
+  // With a dashboard the herd walks at real time (or a multiple of it), so
+  // it can be watched; without one it runs as fast as it can.
+  std::unique_ptr<HerdDashboardServer> dashboard;
+  if (dashboard_at) {
+    HerdDashboardSetup setup;
+    setup.host = dashboard_at->first;
+    setup.port = dashboard_at->second;
+    setup.remote = a.dashboard_remote;
+    setup.www_dir = a.dashboard_www;
+    setup.speed = a.dashboard_speed;
+    dashboard = std::make_unique<HerdDashboardServer>(herd, setup);
+    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+  }
   if (!a.quiet) {
     std::cout << "herd " << (s.name.empty() ? s.file : s.name) << ": " << herd.agents().size()
               << " figures in " << s.groups.size() << " groups, " << s.duration_s << " s at "
@@ -95,9 +132,23 @@ int run_herd(const HerdArgs& a) {
     if (!a.svg.empty()) trails.sample(herd);
   };
   output();
+  const auto publish_period = std::chrono::duration<double>(1.0 / a.dashboard_rate);
+  auto last_publish = start;
   for (long k = 1; k <= steps; ++k) {
+    if (dashboard) {
+      if (dashboard->stop_requested()) break;
+      const auto due =
+          start +
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+              std::chrono::duration<double>(static_cast<double>(k) * s.step_s / a.dashboard_speed));
+      std::this_thread::sleep_until(due);
+    }
     herd.step();
     if (k % steps_per_output == 0 || k == steps) output();
+    if (dashboard && std::chrono::steady_clock::now() - last_publish >= publish_period) {
+      last_publish = std::chrono::steady_clock::now();
+      dashboard->publish(herd);
+    }
     const auto now = std::chrono::steady_clock::now();
     if (!a.quiet && now - last_progress > std::chrono::seconds(2)) {
       last_progress = now;
@@ -107,12 +158,19 @@ int run_herd(const HerdArgs& a) {
                 << std::flush;
     }
   }
+  if (dashboard) {
+    dashboard->publish(herd);
+    dashboard->stop();
+  }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const herd::HerdMetrics metrics = herd.metrics();
   std::cout << herd::format_metrics(metrics);
-  std::cout << "ran " << s.duration_s << " s in " << wall_s << " s (" << s.duration_s / wall_s
-            << " x real time)\n";
+  // A stop from the dashboard ends the herd early.
+  const bool stopped = dashboard && dashboard->stop_requested();
+  const double ran_s = stopped ? herd.time() : s.duration_s;
+  std::cout << "ran " << ran_s << " s in " << wall_s << " s (" << ran_s / wall_s << " x real time)"
+            << (stopped ? ", stopped from the dashboard" : "") << '\n';
   if (csv.is_open()) {
     csv.close();
     if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
@@ -153,6 +211,18 @@ void add_herd_command(CLI::App& app) {
   cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
   cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
+  cmd->add_option("--dashboard", args->dashboard,
+                  "serve a live top view at HOST:PORT (port 0: a free one); the herd then walks "
+                  "at real time");
+  cmd->add_flag("--dashboard-remote", args->dashboard_remote,
+                "allow a --dashboard host that is not loopback");
+  cmd->add_option("--dashboard-speed", args->dashboard_speed,
+                  "with --dashboard: the pace, in multiples of real time (default 1)")
+      ->check(CLI::Range(0.01, 1000.0));
+  cmd->add_option("--dashboard-rate", args->dashboard_rate,
+                  "with --dashboard: states streamed per second (default 30)")
+      ->check(CLI::Range(0.5, 200.0));
+  cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page");
   set_subcommand_body(cmd, [args] { return run_herd(*args); });
 }
 

@@ -172,6 +172,9 @@ int cmd_run(const RunArgs& args) {
     dashboard_setup.motion_name = std::filesystem::path(robot.config.motion.file).stem().string();
     // A herd steers the gait itself (and the steering mailbox takes one writer).
     if (args.herd.empty()) dashboard_setup.steering = robot.steering;
+    const animrt::ShowPosition show = robot.motion->show_position(0.0);
+    dashboard_setup.show = show.show;
+    dashboard_setup.show_duration_s = show.duration_s;
     dashboard_setup.duration_s = args.duration;
     dashboard_setup.figure = figure.get();
   }

@@ -249,6 +249,9 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     s.manual_ = false;
   }
 
+  // A show's transport acts at the motion's time, before it is sampled.
+  if (s.phase_ == Phase::motion && in.show) motion.control(*in.show, t - s.motion_start_);
+
   // Sample.
   if (s.phase_ == Phase::motion && s.manual_) {
     std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
@@ -271,6 +274,9 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     }
   }
   if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
+  s.show_ = motion.show_position(s.phase_ == Phase::motion       ? t - s.motion_start_
+                                 : s.phase_ == Phase::start_ramp ? 0.0
+                                                                 : s.motion_time_);
   const auto position = s.filter_.position();
   for (std::size_t j = 0; j < n; ++j) {
     if (s.joint_faulted(j)) s.targets_[j] = position[j];

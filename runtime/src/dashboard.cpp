@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -81,6 +82,11 @@ json timing_json(const MicrosHistogram& h) {
 
 }  // namespace
 
+std::string new_dashboard_token() { return random_token(); }
+bool same_dashboard_token(const std::string& given, const std::string& token) {
+  return same_token(given, token);
+}
+
 bool is_loopback_host(const std::string& host) {
   return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
 }
@@ -135,6 +141,8 @@ struct DashboardServer::Impl {
   // Controls: one writer at a time for RunControls' single-writer channels.
   std::mutex controls_mutex;
   bool manual = false;
+  std::atomic<RunPhaseView> phase{RunPhaseView::configure};  // the sampler's latest
+  ShowCommand show;  // the show's transport as the controls last set it
 
   Impl(RunMonitor& m, RunControls& c, DashboardSetup s)
       : monitor(m), controls(c), setup(std::move(s)), model(m.model()), token(random_token()) {}
@@ -194,6 +202,7 @@ struct DashboardServer::Impl {
     json motion = {{"kind", setup.motion_kind},
                    {"name", setup.motion_name},
                    {"steerable", setup.steering.has_value()},
+                   {"show", setup.show},
                    {"speed_mps", nullptr},
                    {"turn_rps", nullptr},
                    {"duration_s", setup.duration_s > 0 ? json(setup.duration_s) : json(nullptr)}};
@@ -248,6 +257,7 @@ struct DashboardServer::Impl {
       if (faults.size() < kFaultLogCapacity) faults.emplace_back(event.t, std::move(text));
     }
     monitor.read(view);
+    phase.store(view.phase, std::memory_order_relaxed);
     const std::size_t n = model.joint_count();
     json joints = json::array();
     json manual_positions = json::object();
@@ -314,8 +324,10 @@ struct DashboardServer::Impl {
                   {"motion",
                    {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
                     {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
-                    {"position_s", view.motion_time_s},
-                    {"playing", view.phase == RunPhaseView::motion && !view.manual}}},
+                    {"position_s", view.show.show ? view.show.position_s : view.motion_time_s},
+                    {"playing", view.phase == RunPhaseView::motion && !view.manual &&
+                                    (!view.show.show || view.show.playing)},
+                    {"duration_s", view.show.show ? json(view.show.duration_s) : json(nullptr)}}},
                   {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
     if (setup.figure && view.published) {
       const std::size_t bodies = setup.figure->bodies().size();
@@ -477,6 +489,32 @@ struct DashboardServer::Impl {
       }
       controls.steer.post(MotionCommand{*speed, *turn});
       answer(res, 200, {{"ok", true}});
+    });
+    control("/api/show", [this](const json& body, httplib::Response& res) {
+      if (!setup.show) return error(res, 409, "the motion is not a show");
+      const auto action = body.find("action");
+      const std::string name =
+          action != body.end() && action->is_string() ? action->get<std::string>() : "";
+      std::optional<double> seek;
+      if (name == "seek") {
+        seek = number(body, "t_s");
+        if (!seek) return error(res, 400, "expected \"t_s\": a finite number of seconds");
+        seek = std::clamp(*seek, 0.0, setup.show_duration_s);
+      } else if (name != "play" && name != "pause") {
+        return error(res, 400, "expected \"action\": \"play\", \"pause\" or \"seek\"");
+      }
+      if (phase.load(std::memory_order_relaxed) != RunPhaseView::motion) {
+        return error(res, 409, "the show plays in the motion phase only");
+      }
+      if (name != "seek") show.playing = name == "play";
+      if (seek) {
+        ++show.seeks;
+        show.t_s = *seek;
+      }
+      controls.show.post(show);
+      json answer_body = {{"ok", true}};
+      if (seek) answer_body["t_s"] = *seek;
+      answer(res, 200, answer_body);
     });
 
     server.Post("/api/seek", [this](const httplib::Request& req, httplib::Response& res) {

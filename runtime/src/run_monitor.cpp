@@ -17,6 +17,10 @@ enum Header : std::size_t {
   kSteered,
   kSpeed,
   kTurn,
+  kShow,
+  kShowPlaying,
+  kShowPosition,
+  kShowDuration,
   kHeaderWords
 };
 constexpr std::size_t kJointWords = 4;            // cmd, meas, vel, manual pose
@@ -113,6 +117,11 @@ void RunMonitor::publish(double t, const CycleState& state, std::span<const doub
   store_u(kSteered, steered_ ? 1 : 0);
   store(kSpeed, steer_.speed_m_s);
   store(kTurn, steer_.turn_rad_s);
+  const ShowPosition& show = state.show();
+  store_u(kShow, show.show ? 1 : 0);
+  store_u(kShowPlaying, show.playing ? 1 : 0);
+  store(kShowPosition, show.position_s);
+  store(kShowDuration, show.duration_s);
   const auto measured = state.measured();
   const auto velocity = state.command_velocity();
   const auto manual = state.manual_pose();
@@ -213,6 +222,8 @@ void RunMonitor::read(RunView& view) const {
   view.manual = w[kManual] != 0;
   view.steered = w[kSteered] != 0;
   view.steer = MotionCommand{as_double(w[kSpeed]), as_double(w[kTurn])};
+  view.show = ShowPosition{w[kShow] != 0, w[kShowPlaying] != 0, as_double(w[kShowPosition]),
+                           as_double(w[kShowDuration])};
   view.cmd.resize(joints_);
   view.meas.resize(joints_);
   view.vel.resize(joints_);

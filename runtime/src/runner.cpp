@@ -289,6 +289,7 @@ RunSummary Runner::run(const RunOptions& options) {
   in.buses = io;
   in.motion_duration_s = options.duration_s;
   MotionCommand steer;
+  ShowCommand show;
   JogCommand jog;
   constexpr std::size_t kManualPerCycle = 64;
   std::vector<ManualTarget> manual(kManualPerCycle);
@@ -340,6 +341,7 @@ RunSummary Runner::run(const RunOptions& options) {
     in.abort = options.controls && options.controls->abort.load(std::memory_order_relaxed);
     in.steer = options.controls && options.controls->steer.take(steer) ? &steer : nullptr;
     in.jog = options.controls && options.controls->jog.take(jog) ? &jog : nullptr;
+    in.show = options.controls && options.controls->show.take(show) ? &show : nullptr;
     // Targets first, then the mode: a target posted after manual mode was
     // switched on is never taken for one sent before it.
     std::size_t manual_count = 0;

@@ -26,30 +26,39 @@ namespace {
 
 using nlohmann::json;
 const std::string kQuadruped = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml";
+// Plays a looping keyframe show (configs/shows/hello.yaml) over a gait.
+const std::string kAnimatronic =
+    std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/animatronic.yaml";
 constexpr auto kPatience = std::chrono::seconds(30);  // a bound for waits, not a timing check
 
-// A run of the quadruped on its own thread, with a dashboard on a free
-// loopback port.
+// A run of the quadruped (or another robot) on its own thread, with a
+// dashboard on a free loopback port.
 class DashboardRun {
  public:
   explicit DashboardRun(double duration_s, bool steerable = true,
-                        const std::function<void(test::SimRig&)>& before = {})
-      : rig_(kQuadruped) {
+                        const std::function<void(test::SimRig&)>& before = {},
+                        const std::string& robot_file = kQuadruped)
+      : rig_(robot_file) {
     if (before) before(rig_);
     monitor_ = std::make_unique<RunMonitor>(rig_.runner().model());
     DashboardSetup setup;
     setup.robot = rig_.config().name;
     setup.backend = "sim";
     for (const auto& bus : rig_.config().buses) setup.bus_protocols.push_back(bus.protocol);
-    setup.motion_kind = "gait";
+    setup.motion_kind = rig_.config().motion.type;
     setup.motion_name = "walk";
     if (steerable) setup.steering = rig_.robot.steering;
+    const ShowPosition show = rig_.probe->show_position(0.0);
+    setup.show = show.show;
+    setup.show_duration_s = show.duration_s;
     setup.duration_s = duration_s;
     std::vector<std::string> names;
     for (const auto& joint : rig_.config().joints) names.push_back(joint.name);
-    figure_ =
-        std::make_unique<sim::MujocoFigure>(rig_.config().model, names, rig_.config().model_where);
-    setup.figure = figure_.get();
+    if (!rig_.config().model.empty()) {
+      figure_ = std::make_unique<sim::MujocoFigure>(rig_.config().model, names,
+                                                    rig_.config().model_where);
+      setup.figure = figure_.get();
+    }
     server_ = std::make_unique<DashboardServer>(*monitor_, controls_, setup);
     RunOptions options = rig_.options(duration_s);
     options.controls = &controls_;
@@ -326,6 +335,54 @@ TEST(Dashboard, SteeringReachesASteerableGaitAndIsRefusedOtherwise) {
 // cycles as it would without it (lockstep: the count is fixed by the
 // duration and the ramps), the other clients are still served, and the
 // reader keeps up with every cycle's timing.
+TEST(Dashboard, ShowControlsPauseSeekAndPlayTheShowWithTheToken) {
+  DashboardRun run(0.0, false, {}, kAnimatronic);
+  const json info = run.get("/api/info");
+  EXPECT_TRUE(info["motion"]["show"].get<bool>());
+  EXPECT_EQ(info["motion"]["kind"], "layers");
+  json state = run.wait_state(in_motion);
+  EXPECT_EQ(state["motion"]["duration_s"], 6.0);  // hello.yaml's
+  EXPECT_TRUE(state["motion"]["playing"].get<bool>());
+
+  // Without the token: refused, and the show plays on.
+  EXPECT_EQ(run.post("/api/show", {{"action", "pause"}}, std::string("")), 401);
+  EXPECT_EQ(run.post("/api/show", {{"action", "pause"}}, std::string("0123")), 401);
+  EXPECT_EQ(run.post("/api/show", {{"action", "seek"}}), 400);  // no t_s
+  EXPECT_EQ(run.post("/api/show", {{"action", "rewind"}}), 400);
+  state = run.get("/api/state");
+  EXPECT_TRUE(state["motion"]["playing"].get<bool>());
+
+  // Pause, then seek: the show holds at the new time.
+  EXPECT_EQ(run.post("/api/show", {{"action", "pause"}}), 200);
+  json answer;
+  ASSERT_EQ(run.post("/api/show", {{"action", "seek"}, {"t_s", 2.5}}, std::nullopt, &answer), 200);
+  EXPECT_EQ(answer["t_s"], 2.5);
+  state = run.wait_state([](const json& s) {
+    return !s["motion"]["playing"].get<bool>() && s["motion"]["position_s"] == 2.5;
+  });
+  const std::uint64_t cycles = state["loop"]["cycles"].get<std::uint64_t>();
+  state = run.wait_state(
+      [&](const json& s) { return s["loop"]["cycles"].get<std::uint64_t>() > cycles + 20; });
+  EXPECT_EQ(state["motion"]["position_s"], 2.5);
+  EXPECT_FALSE(state["motion"]["playing"].get<bool>());
+
+  // Play: the show's time advances again from there.
+  EXPECT_EQ(run.post("/api/show", {{"action", "play"}}), 200);
+  state = run.wait_state([](const json& s) {
+    return s["motion"]["playing"].get<bool>() && s["motion"]["position_s"].get<double>() > 2.5;
+  });
+  EXPECT_EQ(state["phase"], "motion");
+}
+
+TEST(Dashboard, ShowControlsAreRefusedForAMotionThatIsNotAShow) {
+  DashboardRun run(0.0);
+  EXPECT_FALSE(run.get("/api/info")["motion"]["show"].get<bool>());
+  const json state = run.wait_state(in_motion);
+  EXPECT_TRUE(state["motion"]["duration_s"].is_null());
+  EXPECT_EQ(run.post("/api/show", {{"action", "pause"}}), 409);
+  EXPECT_EQ(run.post("/api/show", {{"action", "seek"}, {"t_s", 1.0}}), 409);
+}
+
 TEST(Dashboard, AStreamClientThatNeverReadsDoesNotHoldUpTheLoop) {
   std::uint64_t alone = 0;
   {

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 
+#include "animrt/controllers/show/show_file.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace animrt {
@@ -72,7 +73,7 @@ struct Bench {
   void begin() {
     std::vector<double> measured(model.joint_count(), 0.0);
     std::vector<double> first(model.home);
-    motion.sample(0.0, first);
+    source().sample(0.0, first);
     state.begin(model, measured, first);
   }
   const CycleOutputs& cycle() {
@@ -81,7 +82,7 @@ struct Bench {
     }
     in.t = static_cast<double>(count) / kRate;
     in.buses = io;
-    const CycleOutputs& out = step(model, motion, state, in);
+    const CycleOutputs& out = step(model, source(), state, in);
     for (std::size_t b = 0; b < io.size(); ++b) {
       if (!out.write[b]) continue;
       if (follow) positions[b] = out.bus_commands[b];
@@ -106,8 +107,11 @@ struct Bench {
     return nullptr;
   }
 
+  MotionSource& source() { return show ? *show : static_cast<MotionSource&>(motion); }
+
   RobotModel model;
   LambdaSource motion;
+  std::unique_ptr<MotionSource> show;  // when set, the motion instead of `motion`
   CycleState state;
   std::vector<std::vector<double>> positions;
   std::vector<std::vector<DeviceHealth>> health;
@@ -454,6 +458,139 @@ TEST(Cycle, ManualTargetsOutsideTheMotionPhaseAreIgnored) {
   for (double goal : bench.written[0].back()) EXPECT_NEAR(goal, 0.0, 1e-3);
 }
 
+// A non-looping 4 s show on joint 0 of the two-bus model: a ramp from 0 to
+// 40 deg over 2 s (0.35 rad/s), then held.
+std::unique_ptr<MotionSource> ramp_show(const RobotModel& model) {
+  std::vector<JointSpec> joints;
+  for (std::size_t j = 0; j < model.joint_count(); ++j) {
+    joints.push_back(JointSpec{model.joint_names[j], model.limits[j], 0.0, JointType::revolute});
+  }
+  ShowFile show;
+  show.name = "ramp";
+  show.duration_s = 4.0;
+  ShowTrack track;
+  track.joint = "j0";
+  track.keys = {ShowKey{0.0, 0.0, Interpolation::linear, {}},
+                ShowKey{2.0, 40.0, Interpolation::linear, {}}};
+  show.tracks.push_back(track);
+  return make_show_source(show, joints);
+}
+
+double ramp_show_value(double show_t) {
+  return deg_to_rad(40.0) * std::clamp(show_t, 0.0, 2.0) / 2.0;
+}
+
+// Joint 0's commands never change velocity by more than its acceleration
+// limit allows (nor move faster than its velocity limit) from cycle to cycle.
+struct SmoothCheck {
+  explicit SmoothCheck(const RobotModel& model) : limits(model.limits[0]), dt(model.dt) {}
+  void add(double command) {
+    if (have_last) {
+      const double v = (command - last) / dt;
+      EXPECT_LE(std::abs(v), limits.max_velocity + 1e-6);
+      if (have_v) {
+        EXPECT_LE(std::abs(v - last_v), limits.max_acceleration * dt + 1e-6);
+      }
+      last_v = v;
+      have_v = true;
+    }
+    last = command;
+    have_last = true;
+  }
+  JointLimits limits;
+  double dt;
+  double last = 0.0, last_v = 0.0;
+  bool have_last = false, have_v = false;
+};
+
+TEST(Cycle, APausedShowHoldsItsPoseAndPlayResumesFromThere) {
+  Bench bench(two_bus_model());
+  bench.show = ramp_show(bench.model);
+  bench.begin();
+  bench.run_until(Phase::motion);
+  SmoothCheck smooth(bench.model);
+  for (int i = 0; i < 50; ++i) smooth.add(bench.cycle().commands[0]);
+  EXPECT_TRUE(bench.state.show().show);
+  EXPECT_TRUE(bench.state.show().playing);
+  EXPECT_EQ(bench.state.show().duration_s, 4.0);
+  const double paused_at = bench.state.show().position_s;
+  EXPECT_NEAR(paused_at, bench.in.t - bench.state.motion_start(), 1e-9);
+
+  // Pause: the show's time stops; the joint comes to rest at its pose then.
+  ShowCommand command{false, 0, 0.0};
+  bench.in.show = &command;
+  smooth.add(bench.cycle().commands[0]);
+  bench.in.show = nullptr;
+  for (int i = 0; i < 100; ++i) {
+    smooth.add(bench.cycle().commands[0]);
+    EXPECT_FALSE(bench.state.show().playing);
+    EXPECT_NEAR(bench.state.show().position_s, paused_at + 1.0 / kRate, 1e-9);
+  }
+  EXPECT_NEAR(smooth.last, ramp_show_value(paused_at + 1.0 / kRate), 1e-6);
+  EXPECT_NEAR(bench.state.command_velocity()[0], 0.0, 1e-6);
+
+  // Play: on from the same show time, one cycle per cycle.
+  command.playing = true;
+  bench.in.show = &command;
+  smooth.add(bench.cycle().commands[0]);
+  bench.in.show = nullptr;
+  for (int i = 0; i < 60; ++i) smooth.add(bench.cycle().commands[0]);
+  EXPECT_TRUE(bench.state.show().playing);
+  EXPECT_NEAR(bench.state.show().position_s, paused_at + 1.0 / kRate + 60.0 / kRate, 1e-9);
+  EXPECT_NEAR(smooth.last, ramp_show_value(bench.state.show().position_s), 1e-6);
+}
+
+TEST(Cycle, ASeekMovesTheShowsTimeAndTheFilterRampsToThePose) {
+  Bench bench(two_bus_model());
+  bench.show = ramp_show(bench.model);
+  bench.begin();
+  bench.run_until(Phase::motion);
+  SmoothCheck smooth(bench.model);
+  for (int i = 0; i < 20; ++i) smooth.add(bench.cycle().commands[0]);
+
+  // Ahead, past the ramp's end (beyond the show: clamped to its end).
+  ShowCommand command{true, 1, 9.0};
+  bench.in.show = &command;
+  smooth.add(bench.cycle().commands[0]);
+  bench.in.show = nullptr;
+  EXPECT_EQ(bench.state.show().position_s, 4.0);
+  EXPECT_FALSE(bench.state.show().playing);  // a non-looping show at its end
+  for (int i = 0; i < 200; ++i) smooth.add(bench.cycle().commands[0]);
+  EXPECT_NEAR(smooth.last, deg_to_rad(40.0), 1e-6);
+
+  // Back to 1 s while paused: the show stays paused there.
+  command = ShowCommand{false, 2, 1.0};
+  bench.in.show = &command;
+  smooth.add(bench.cycle().commands[0]);
+  bench.in.show = nullptr;
+  for (int i = 0; i < 200; ++i) smooth.add(bench.cycle().commands[0]);
+  EXPECT_FALSE(bench.state.show().playing);
+  EXPECT_EQ(bench.state.show().position_s, 1.0);
+  EXPECT_NEAR(smooth.last, ramp_show_value(1.0), 1e-6);
+
+  // The same command again (no new seek) plays on from there.
+  command.playing = true;
+  bench.in.show = &command;
+  bench.cycle();
+  bench.in.show = nullptr;
+  EXPECT_TRUE(bench.state.show().playing);
+  EXPECT_NEAR(bench.state.show().position_s, 1.0, 1e-9);
+}
+
+TEST(Cycle, ShowCommandsOutsideTheMotionPhaseAreIgnored) {
+  Bench bench(two_bus_model());
+  bench.show = ramp_show(bench.model);
+  bench.begin();
+  const ShowCommand command{false, 1, 3.0};
+  bench.in.show = &command;
+  bench.cycle();
+  bench.in.show = nullptr;
+  bench.run_until(Phase::motion);
+  bench.cycle();
+  EXPECT_TRUE(bench.state.show().playing);
+  EXPECT_NEAR(bench.state.show().position_s, 1.0 / kRate, 1e-9);
+}
+
 TEST(Cycle, StepDoesNotAllocate) {
   Bench bench(two_bus_model());
   bench.motion.fn = [](std::size_t j, double t) {
@@ -474,6 +611,30 @@ TEST(Cycle, StepDoesNotAllocate) {
   }
   EXPECT_EQ(counter.count(), 0);
   EXPECT_TRUE(bench.state.end().fault);  // the NaN path ran
+}
+
+TEST(Cycle, AShowsTransportDoesNotAllocate) {
+  Bench bench(two_bus_model());
+  bench.show = ramp_show(bench.model);
+  // step() is called directly (Bench::cycle() records, and so allocates):
+  // the devices stay where they are, which is no fault here.
+  bench.model.following_error.assign(bench.model.joint_count(), 1e9);
+  bench.begin();
+  bench.run_until(Phase::motion);
+  test::AllocationCounter counter;
+  ShowCommand command;
+  for (int i = 0; i < 300; ++i) {
+    command.playing = (i / 40) % 2 == 0;
+    if (i % 25 == 0) command = ShowCommand{command.playing, command.seeks + 1, 0.01 * i};
+    bench.in.show = i % 5 == 0 ? &command : nullptr;
+    step(bench.model, bench.source(), bench.state, bench.in);
+    bench.in.t += 1.0 / kRate;
+  }
+  bench.in.show = nullptr;
+  EXPECT_EQ(counter.count(), 0);
+  ASSERT_EQ(bench.state.phase(), Phase::motion);
+  // Sought to 2.75 s while playing (cycle 275), paused five cycles later.
+  EXPECT_NEAR(bench.state.show().position_s, 2.80, 1e-9);
 }
 
 TEST(NextDeadline, CountsOverrunsAndSkipsWholeMissedCycles) {

@@ -107,6 +107,64 @@ TEST(Show, LoopingWrapsSmoothly) {
   EXPECT_NEAR(left, right, 1e-3);
 }
 
+TEST(Show, ThePlayheadPausesSeeksAndWrapsALoopingShow) {
+  std::string text = kShow;
+  text.replace(text.find("name: test\n"), 11, "name: test\nloop: true\nduration_s: 5\n");
+  auto s = load_show_source(write("loop.yaml", text), joints());
+  ShowPosition p = s->show_position(7.0);
+  EXPECT_TRUE(p.show);
+  EXPECT_TRUE(p.playing);
+  EXPECT_DOUBLE_EQ(p.position_s, 2.0);  // wrapped
+  EXPECT_DOUBLE_EQ(p.duration_s, 5.0);
+
+  // Paused at motion time 1.5: the show stays at 1.5 s whatever the time.
+  s->control(ShowCommand{false, 0, 0.0}, 1.5);
+  EXPECT_FALSE(s->show_position(9.0).playing);
+  EXPECT_DOUBLE_EQ(s->show_position(9.0).position_s, 1.5);
+  EXPECT_DOUBLE_EQ(deg_at(*s, 9.0, 2), deg_at(*s, 1.5, 2));
+  // A seek while paused moves the held time (clamped to the show).
+  s->control(ShowCommand{false, 1, 3.25}, 9.0);
+  EXPECT_DOUBLE_EQ(s->show_position(20.0).position_s, 3.25);
+  s->control(ShowCommand{false, 2, 99.0}, 9.0);
+  EXPECT_DOUBLE_EQ(s->show_position(20.0).position_s, 0.0);  // a loop's end is its start
+  s->control(ShowCommand{false, 3, 3.25}, 9.0);
+  // Play at motion time 10: on from 3.25 s.
+  s->control(ShowCommand{true, 3, 3.25}, 10.0);
+  EXPECT_NEAR(s->show_position(10.5).position_s, 3.75, 1e-12);
+  // A seek while playing.
+  s->control(ShowCommand{true, 4, 1.0}, 11.0);
+  EXPECT_NEAR(s->show_position(11.25).position_s, 1.25, 1e-12);
+  EXPECT_TRUE(s->show_position(11.25).playing);
+}
+
+TEST(Show, ANonLoopingShowEndsAndPlaysAgainFromItsStart) {
+  auto s = load_show_source(write("show.yaml", kShow), joints());
+  const double end = s->show_position(0.0).duration_s;
+  ASSERT_GT(end, 0.0);
+  EXPECT_FALSE(s->show_position(end + 1.0).playing);
+  EXPECT_DOUBLE_EQ(s->show_position(end + 1.0).position_s, end);
+  s->control(ShowCommand{true, 0, 0.0}, end + 1.0);
+  EXPECT_TRUE(s->show_position(end + 1.5).playing);
+  EXPECT_DOUBLE_EQ(s->show_position(end + 1.5).position_s, 0.5);
+}
+
+TEST(Show, LayersPassTheTransportToTheirShows) {
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  layers.push_back(load_show_source(write("a.yaml", kShow), joints()));
+  layers.push_back(load_show_source(write("b.yaml", kShow), joints()));
+  auto s = make_layered_source(std::move(layers));
+  EXPECT_TRUE(s->show_position(0.0).show);
+  s->control(ShowCommand{false, 1, 0.5}, 2.0);
+  EXPECT_DOUBLE_EQ(s->show_position(3.0).position_s, 0.5);
+  EXPECT_FALSE(s->show_position(3.0).playing);
+  // Both layers hold: every joint is at its 0.5 s value.
+  std::vector<double> at_half(3), now(3);
+  auto plain = load_show_source(write("c.yaml", kShow), joints());
+  plain->sample(0.5, at_half);
+  s->sample(3.0, now);
+  EXPECT_EQ(now, at_half);
+}
+
 TEST(Show, SampleDoesNotAllocate) {
   auto s = load_show_source(write("show.yaml", kShow), joints());
   std::vector<double> targets(3);

@@ -37,6 +37,8 @@ class ProbeSource final : public MotionSource {
     if (on_sample) on_sample(t);
     inner_->sample(t, targets);
   }
+  void control(const ShowCommand& command, double t) override { inner_->control(command, t); }
+  ShowPosition show_position(double t) const override { return inner_->show_position(t); }
   std::function<void(double)> on_sample;
 
  private:

@@ -2,6 +2,7 @@
 // A motion source turns time into joint targets. sample() runs inside the
 // real-time cycle: it must not allocate, lock, log or do I/O.
 
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,6 +14,25 @@ namespace animrt {
 struct MotionCommand {
   double speed_m_s = 0.0;   // forward speed
   double turn_rad_s = 0.0;  // turn rate, positive to the left
+};
+
+// A keyframe show's transport (a dashboard's play, pause and seek), handed
+// over by the cycle like a steering command. Each command states the whole
+// transport, so one that replaces another not yet taken loses nothing: the
+// playing state, and the latest seek (a seek count the source has not seen
+// yet moves the show to t_s first). Sources without a show ignore it.
+struct ShowCommand {
+  bool playing = true;
+  std::uint32_t seeks = 0;  // seeks so far; a new count is a seek to t_s
+  double t_s = 0.0;         // the latest seek's show time (clamped to the show)
+};
+
+// Where a show's playhead is. `show` is false for a source that plays none.
+struct ShowPosition {
+  bool show = false;
+  bool playing = false;     // its time advances (false: paused, or past a non-looping end)
+  double position_s = 0.0;  // time into the show, within [0, duration_s]
+  double duration_s = 0.0;
 };
 
 class MotionSource {
@@ -32,6 +52,15 @@ class MotionSource {
   // when one arrived (the cycle reads it from a lock-free mailbox). Same
   // rules as sample(): no allocation, lock, log or I/O.
   virtual void steer(const MotionCommand& /*command*/) {}
+
+  // A show's transport: a source that plays a show keeps its own playhead,
+  // which maps the motion's time `t` (as sample() gets it) to the show's.
+  // control() acts at motion time `t` (the cycle's, before sample()): a seek
+  // moves the show's time, a pause holds it, a play lets it advance again
+  // (a non-looping show that has ended plays again from its start). Same
+  // rules as sample().
+  virtual void control(const ShowCommand& /*command*/, double /*t*/) {}
+  virtual ShowPosition show_position(double /*t*/) const { return {}; }
 };
 
 }  // namespace animrt

@@ -1,11 +1,13 @@
-// Controls: stop, manual mode with a slider per joint, steering. Every
-// control needs the run's token; without it they are shown disabled.
+// Controls: stop, manual mode with a slider per joint, steering, a show's
+// play, pause and seek. Every control needs the run's token; without it
+// they are shown disabled.
 
 import { post, throttle, token } from './api.js';
 import { el, isNum, jointUnit } from './format.js';
 
 const JOG_INTERVAL_MS = 50;
 const STEER_INTERVAL_MS = 100;
+const SHOW_SEEK_INTERVAL_MS = 100;
 
 // A replay of a recording: play, pause and seek (no token needed: it
 // moves no robot).
@@ -88,7 +90,47 @@ export class Controls {
 
     this.buildJog(Array.isArray(info.joints) ? info.joints : []);
     this.buildSteer(info.motion || {});
+    this.buildShow(info.motion || {});
     this.refresh(null);
+  }
+
+  // A show: play/pause and a seek bar over its length (from the state).
+  buildShow(motion) {
+    if (!motion.show) return;
+    document.getElementById('show').hidden = false;
+    const play = document.getElementById('btn-show-play');
+    const seek = document.getElementById('show-seek');
+    const position = document.getElementById('show-position');
+    this.showInputs = { play, seek, position, playing: true };
+    const send = throttle((t_s) => this.send('/api/show', { action: 'seek', t_s }), SHOW_SEEK_INTERVAL_MS);
+    seek.addEventListener('input', () => {
+      this.showDragging = true;
+      position.textContent = `${Number(seek.value).toFixed(1)} s`;
+      send(Number(seek.value));
+    });
+    seek.addEventListener('change', () => {
+      this.showDragging = false;
+      this.send('/api/show', { action: 'seek', t_s: Number(seek.value) });
+    });
+    play.addEventListener('click', () => {
+      this.send('/api/show', { action: this.showInputs.playing ? 'pause' : 'play' });
+    });
+  }
+
+  refreshShow(state, can, phase) {
+    const s = this.showInputs;
+    if (!s) return;
+    s.play.disabled = !can || phase !== 'motion';
+    s.seek.disabled = !can || phase !== 'motion';
+    const m = state && state.motion;
+    if (!m) return;
+    if (isNum(m.duration_s)) s.seek.max = String(m.duration_s);
+    s.playing = !!m.playing || phase !== 'motion';
+    s.play.textContent = s.playing ? 'Pause' : 'Play';
+    if (!this.showDragging && isNum(m.position_s)) {
+      s.seek.value = String(m.position_s);
+      s.position.textContent = `${m.position_s.toFixed(1)} s`;
+    }
   }
 
   buildJog(joints) {
@@ -186,6 +228,7 @@ export class Controls {
       if (v !== null && document.activeElement !== s.input) s.input.value = String(v);
       s.show();
     }
+    this.refreshShow(state, can, phase);
     if (this.steerInputs) {
       for (const input of Object.values(this.steerInputs)) input.disabled = !can || !live || manualOn;
       const m = state && state.motion;

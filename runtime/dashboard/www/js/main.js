@@ -3,6 +3,7 @@
 import { getInfo, openStream } from './api.js';
 import { JitterHistogram, JointCharts, JointHistory } from './charts.js';
 import { makeControls } from './controls.js';
+import { startHerd } from './herd.js';
 import { DeviceTable, JointList, showFaults, showInfo, showLoop, showMotion, showPhase } from './panels.js';
 import { FigureView } from './view3d.js';
 
@@ -29,6 +30,10 @@ async function start() {
   } catch (e) {
     showPageError(`Cannot read the run: ${e.message}`);
     setStreamStatus('ended', 'no run');
+    return;
+  }
+  if (info.kind === 'herd') {
+    await startHerd(info, setStreamStatus);
     return;
   }
   showInfo(info);

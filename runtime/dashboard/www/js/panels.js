@@ -39,8 +39,11 @@ export function showMotion(info, state) {
     if (isNum(live.turn_rps)) text += ` · turn ${live.turn_rps.toFixed(2)} rad/s`;
   }
   if (isNum(live.position_s)) {
-    text += ` · at ${live.position_s.toFixed(1)} s`;
-    if (isNum(m.duration_s)) text += ` of ${m.duration_s.toFixed(1)} s`;
+    // A show's position is its playhead, out of the show's length; any
+    // other motion's is the time into the run's --duration.
+    const of = m.show ? live.duration_s : m.duration_s;
+    text += ` · ${m.show ? 'show ' : ''}at ${live.position_s.toFixed(1)} s`;
+    if (isNum(of)) text += ` of ${of.toFixed(1)} s`;
   }
   if (live.playing === false && state.phase === 'motion' && !manual) text += ' · paused';
   if (manual) text = `manual (was: ${text})`;

@@ -42,6 +42,10 @@ struct CycleInputs {
   bool abort = false;                    // torque off at once
   const MotionCommand* steer = nullptr;  // a new steering command, if one arrived
   const JogCommand* jog = nullptr;       // a new jog, if one arrived
+  // A show's transport (play, pause, seek), if a command arrived; acts in
+  // the motion phase only (handed to MotionSource::control() at the
+  // motion's time).
+  const ShowCommand* show = nullptr;
   // Manual mode (RunControls::manual) and the manual targets that arrived
   // since the last cycle, oldest first. Both act in the motion phase only.
   bool manual = false;
@@ -114,6 +118,8 @@ class CycleState {
   // Manual mode: on (in the motion phase) and the held pose it steers to.
   bool manual() const { return manual_; }
   std::span<const double> manual_pose() const { return manual_pose_; }
+  // The show's playhead as of this cycle (show false: the motion plays none).
+  const ShowPosition& show() const { return show_; }
 
  private:
   friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
@@ -135,6 +141,7 @@ class CycleState {
   std::vector<double> measured_, targets_, ramp_from_, ramp_to_, jog_;
   bool manual_ = false;
   std::vector<double> manual_pose_;
+  ShowPosition show_;
   std::vector<std::uint8_t> active_;            // per joint: its bus takes a write
   std::vector<std::vector<double>> last_sent_;  // per bus, per device
   std::vector<std::vector<std::uint8_t>> faulted_;

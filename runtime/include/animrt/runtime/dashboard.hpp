@@ -33,6 +33,8 @@ struct DashboardSetup {
   std::string motion_kind;                 // gait, show, head, layers
   std::string motion_name;                 // the motion file's stem
   std::optional<GaitSteering> steering;    // a steerable gait's range
+  bool show = false;                       // the motion plays a show: POST /api/show
+  double show_duration_s = 0.0;            // its length
   double duration_s = 0.0;                 // 0: until stopped
   FigureKinematics* figure = nullptr;      // the figure's model, if any
   // A replay (`animrt view`): POST /api/seek calls `seek` (no token: it
@@ -41,6 +43,11 @@ struct DashboardSetup {
   std::function<void(double t_s, bool playing)> seek;
   double replay_start_s = 0.0, replay_end_s = 0.0;  // the recording's times
 };
+
+// A new random token (32 hex characters), and whether `given` is `token`,
+// compared in time that depends only on the lengths.
+std::string new_dashboard_token();
+bool same_dashboard_token(const std::string& given, const std::string& token);
 
 // Whether `host` names the loopback interface (127.0.0.0/8, ::1, localhost).
 bool is_loopback_host(const std::string& host);

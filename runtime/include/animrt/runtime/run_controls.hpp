@@ -35,6 +35,8 @@ struct RunControls {
   // Speed and turn of a steered motion source.
   Mailbox<MotionCommand> steer;
   Mailbox<JogCommand> jog;
+  // A show's play, pause or seek (a dashboard's).
+  Mailbox<ShowCommand> show;
   // Manual mode (a dashboard's sliders): while on, the motion's targets are
   // replaced by a held pose that starts where the joints are and moves only
   // by manual targets; off returns to the motion through the safety filter.

@@ -37,6 +37,7 @@ struct RunView {
   bool manual = false;
   bool steered = false;                             // a steering command has reached the motion
   MotionCommand steer;                              // the last one
+  ShowPosition show;                                // a show's playhead (show false: none)
   std::vector<double> cmd, meas, vel, manual_pose;  // per joint
   std::vector<std::uint64_t> late;                  // per bus
   std::vector<DeviceStatus> devices;                // per device, bus after bus
