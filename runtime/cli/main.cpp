@@ -49,9 +49,15 @@ constexpr double kLockstepMinTimeoutS = 0.25;  // bus timeout floor with --locks
 animrt::RunControls g_controls;
 
 // The first SIGINT or SIGTERM ramps home; a second one switches torque off at
-// once. Both are lock-free atomic stores, safe in a signal handler.
+// once. The signals are counted on their own: a stop that came another way
+// (the dashboard, the herd thread) is not the first Ctrl-C, so one Ctrl-C
+// during its ramp does not drop the figure. Lock-free atomics only, safe in
+// a signal handler.
+std::atomic<int> g_stop_signals{0};
+static_assert(std::atomic<int>::is_always_lock_free);
+
 void on_signal(int) {
-  if (g_controls.stop.load()) g_controls.abort.store(true);
+  if (g_stop_signals.fetch_add(1) > 0) g_controls.abort.store(true);
   g_controls.stop.store(true);
 }
 

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Ctrl-C on a run of the simulated quadruped: the first SIGINT ramps home and
 # exits 0; a second one switches torque off at once and exits 5, saying so.
+# A stop from the dashboard is not a first Ctrl-C: one SIGINT during its
+# ramp leaves the ramp to finish.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -11,7 +13,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 
 # Starts a run until Ctrl-C and waits until its motion is under way.
 start_run() {
-  "$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --no-realtime \
+  "$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --no-realtime "${@:2}" \
     > "$tmp/out.txt" 2> "$tmp/err.txt" &
   pid=$!
   for _ in $(seq 100); do
@@ -42,4 +44,22 @@ pid=""
 [[ $code == 5 ]] || fail "two SIGINTs: exit $code, expected 5: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 grep -q "^TORQUE CUT second stop request" "$tmp/out.txt" || fail "two SIGINTs: $(head -4 "$tmp/out.txt")"
 grep -q "torque switched off at once" "$tmp/err.txt" || fail "two SIGINTs: $(cat "$tmp/err.txt")"
+start_run 2.5 --dashboard 127.0.0.1:0
+line=$(head -n 1 "$tmp/out.txt")
+[[ $line =~ ^dashboard:\ (http://127\.0\.0\.1:[0-9]+)/\?token=([0-9a-f]{32})$ ]] ||
+  fail "no dashboard line: '$line'"
+/usr/bin/python3 - "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" <<'PY' || fail "the dashboard's stop was refused"
+import sys, urllib.request
+req = urllib.request.Request(sys.argv[1] + "/api/stop", data=b"{}", method="POST")
+req.add_header("Authorization", "Bearer " + sys.argv[2])
+assert urllib.request.urlopen(req).status == 200
+PY
+sleep 0.3
+kill -INT $pid
+wait $pid
+code=$?
+pid=""
+[[ $code == 0 ]] || fail "dashboard stop, then one SIGINT: exit $code, expected 0: $(cat "$tmp/out.txt" "$tmp/err.txt")"
+grep -q "TORQUE CUT" "$tmp/out.txt" && fail "dashboard stop, then one SIGINT cut torque: $(head -4 "$tmp/out.txt")"
+grep -q "deactivate: torque off" "$tmp/err.txt" || fail "dashboard stop, then one SIGINT: $(cat "$tmp/err.txt")"
 echo "stop_signals: ok"
