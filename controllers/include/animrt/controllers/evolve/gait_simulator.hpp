@@ -6,6 +6,7 @@
 // A simulator is used by one thread at a time; a factory makes one per
 // worker thread (they may share the read-only model).
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,11 @@ struct WalkSettings {
   double settle_s = 0.5;   // standing still in the gait's first pose before walking
   int warmup_cycles = 1;   // stride cycles walked but not measured
   int measure_cycles = 3;  // stride cycles measured
+  // Nonzero: every joint starts off its standing angle by up to
+  // `perturb_rad`, drawn from this seed, so repeated walks show how robust a
+  // gait is rather than replaying one exact start.
+  std::uint64_t perturb_seed = 0;
+  double perturb_rad = 0.0;
 };
 
 struct GaitMeasures {
