@@ -119,6 +119,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   std::vector<std::vector<Landing>> landings(feet);
   const long min_swing = std::max(1L, steps_for(kMinSwingStrides / f));
   double energy = 0.0;
+  double max_tilt = 0.0;  // rad
   double x0 = 0.0;
 
   const long total = settle + warmup + measure;
@@ -164,6 +165,8 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     for (int a = 0; a < m->nu; ++a) {
       energy += std::fabs(d->actuator_force[a] * d->actuator_velocity[a]) * dt;
     }
+    const double up = std::clamp(d->xmat[9 * mm.torso_body + 8], -1.0, 1.0);
+    max_tilt = std::max(max_tilt, std::acos(up));
   }
   out.sim_time = static_cast<double>(out.steps) * dt;
   if (out.fell) return out;
@@ -188,6 +191,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   }
   out.stride_length = strides > 0 ? stride_sum / strides : 0.0;
   out.energy_per_cycle = energy / settings.measure_cycles;
+  out.max_tilt_deg = max_tilt * 180.0 / M_PI;
   return out;
 }
 

@@ -33,6 +33,7 @@ struct GaitMeasures {
   double stride_length = 0.0;     // m, mean forward advance of a foot between its touchdowns
   double duty_factor = 0.0;       // mean fraction of the stride each foot is on the ground
   double energy_per_cycle = 0.0;  // J, sum |actuator force x joint velocity| dt per cycle
+  double max_tilt_deg = 0.0;      // largest tilt of the torso from upright while measured
   double sim_time = 0.0;          // s simulated
   long steps = 0;                 // physics steps taken
 };
