@@ -11,6 +11,7 @@ packages=(
   libsndfile1-dev libsamplerate0-dev libaubio-dev libasound2-dev espeak-ng praat sptk sox
   libmodbus-dev mbpoll python3-pymodbus python3-serial-asyncio
   libmujoco-dev libqhull-dev libopenmpi-dev openmpi-bin gnuplot-nox
+  libgl-dev libopengl-dev  # MuJoCo's CMake package looks for OpenGL
   librecast-dev  # navigation-mesh crowds (controllers/herd)
   can-utils qemu-system-x86 busybox-static cpio  # HIL tier (tests/hil/run)
   clang libclang-rt-14-dev  # fuzz harnesses (tests/fuzz, make fuzz)

@@ -7,8 +7,6 @@
 #include <cmath>
 #include <numeric>
 
-#include "animrt/controllers/evolve/phenotype.hpp"
-
 namespace animrt::evolve {
 
 Search::Search(RunConfig config, Grammar grammar, GaitFile seed, ModelInfo model,
@@ -17,73 +15,15 @@ Search::Search(RunConfig config, Grammar grammar, GaitFile seed, ModelInfo model
       grammar_(std::move(grammar)),
       seed_(std::move(seed)),
       model_(std::move(model)),
-      evaluator_(evaluator) {
-  if (!seed_.froude) {
-    throw InputError({seed_.file, 0, 0}, "froude",
-                     "the seed gait of an evolve run needs froude timing (the fitness targets "
-                     "come from the Froude number)");
-  }
+      evaluator_(evaluator),
+      walker_(config_, grammar_, seed_) {
   targets_ = froude_targets(seed_.froude->number, seed_.froude->hip_height_m);
-  const auto means = curve_means(seed_);
-  for (const auto& stage : config_.freedom) {
-    std::vector<std::string> held = means;
-    for (const auto& name : stage.free) {
-      const auto it = std::find_if(seed_.curves.begin(), seed_.curves.end(),
-                                   [&](const GaitCurve& c) { return c.name == name; });
-      if (it == seed_.curves.end()) {
-        throw InputError(stage.where, "fitness.freedom.free",
-                         "no curve '" + name + "' in the seed gait " + seed_.file);
-      }
-      held[static_cast<std::size_t>(it - seed_.curves.begin())].clear();
-    }
-    held_.push_back(std::move(held));
-  }
-}
-
-int Search::stage_at(int generation) const {
-  int stage = 0;
-  for (std::size_t i = 0; i < config_.freedom.size(); ++i) {
-    if (config_.freedom[i].from_generation <= generation) stage = static_cast<int>(i);
-  }
-  return stage;
 }
 
 void Search::evaluate(std::vector<Individual>& pop, int generation, GenerationStats& stats) {
-  const int stage = stage_at(generation);
-  static const std::vector<std::string> kNoneHeld;
-  const auto& held = held_.empty() ? kNoneHeld : held_[static_cast<std::size_t>(stage)];
-  const MapLimits limits{config_.search.max_wraps};
-  std::vector<std::size_t> todo;
-  for (std::size_t i = 0; i < pop.size(); ++i) {
-    Individual& ind = pop[i];
-    if (ind.stage == stage) continue;  // an elite already walked under these rules
-    if (ind.stage < 0) {
-      const MapResult m = map_genome(grammar_, ind.genome, limits);
-      ind.mapped = m.valid;
-      ind.phenotype = m.phenotype;
-    }
-    ind.valid = ind.mapped;
-    ind.stage = stage;
-    if (ind.valid) {
-      PhenotypeGait pg = make_phenotype_gait(seed_, ind.phenotype, held);
-      ind.valid = pg.valid;
-      if (pg.valid) {
-        ind.gait = std::move(pg.gait);
-        ind.gait.name = config_.name;
-      }
-    }
-    ind.measures = GaitMeasures{};
-    if (ind.valid) todo.push_back(i);
-  }
-  std::vector<const GaitFile*> gaits;
-  for (auto i : todo) gaits.push_back(&pop[i].gait);
-  std::vector<GaitMeasures> measures(gaits.size());
-  const auto t0 = std::chrono::steady_clock::now();
-  evaluator_.walk_all(gaits, config_.walk, measures);
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  stats.evaluations = static_cast<int>(todo.size());
-  for (std::size_t k = 0; k < todo.size(); ++k) pop[todo[k]].measures = measures[k];
-
+  const WalkBatch batch = walker_.walk(pop, walker_.stage_at(generation), evaluator_);
+  stats.seconds = batch.seconds;
+  stats.evaluations = batch.evaluations;
   // Scores follow the generation's weights, also for elites walked earlier.
   const FitnessWeights& w = weights_at(config_.weights, generation);
   for (auto& ind : pop) {

@@ -15,8 +15,9 @@
 #include "animrt/controllers/evolve/search.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/error.hpp"
-#include "subcommand.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "evolve_pareto.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -32,6 +33,7 @@ struct EvolveArgs {
   std::string plot;
   bool mpi = false;
   bool quiet = false;
+  bool pareto = false;
 };
 
 std::string with_extension(const std::string& path, const std::string& ext) {
@@ -86,6 +88,10 @@ int run_evolve(const EvolveArgs& a) {
               << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
               << std::flush;
   }
+  if (a.pareto) {
+    return run_pareto_search(config, std::move(grammar), seed, info, evaluator,
+                             {a.out, lead, a.quiet});
+  }
   const int generations = config.search.generations;
   evolve::Search search(config, std::move(grammar), seed, info, evaluator);
   const evolve::SearchResult result = search.run([&](const evolve::GenerationStats& s) {
@@ -120,7 +126,8 @@ void add_evolve_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("evolve",
                                  "Evolve a gait with Grammatical Evolution against a MuJoCo model");
   cmd->add_option("RUN", args->run_file, "evolve run file (YAML)")->required();
-  cmd->add_option("--out", args->out, "gait file to write (best of the last generation)")
+  cmd->add_option("--out", args->out,
+                  "gait file to write (best of the last generation); with --pareto, a folder")
       ->required();
   cmd->add_option("--threads", args->threads, "evaluation threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
@@ -133,6 +140,9 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
   cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
+  cmd->add_flag("--pareto", args->pareto,
+                "multi-objective search (speed error, energy, tilt): write the Pareto front's "
+                "gaits, front.csv, front.svg and history.csv into the --out folder");
   set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }
 

@@ -15,9 +15,9 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/gait/walk_response.hpp"
 #include "animrt/core/error.hpp"
-#include "subcommand.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -132,6 +132,7 @@ void add_gait_command(CLI::App& app) {
       ->check(CLI::Range(0, 20));
   cmd->add_option("--seed", args->seed, "perturb the start pose (0: exact standing pose)");
   set_subcommand_body(cmd, [args] { return run_calibrate(*args); });
+  add_gait_measure_command(*gait);
 }
 
 }  // namespace animrt::cli

@@ -8,5 +8,7 @@
 namespace animrt::cli {
 
 void add_gait_command(CLI::App& app);
+// `animrt gait measure` (gait_measure_command.cpp), added under `gait`.
+void add_gait_measure_command(CLI::App& gait);
 
 }  // namespace animrt::cli

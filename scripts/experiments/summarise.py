@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Summarises evolve runs written by table5.sh: OUT/table.md and plots.
+"""Summarises evolve runs written by table5.sh: OUT/table.md, OUT/ranks.md
+(Mann-Whitney U tests of the paper's claims) and plots.
 
     summarise.py OUT_DIR RUNS GRAMMAR...
 """
@@ -9,6 +10,8 @@ import os
 import shutil
 import subprocess
 import sys
+
+import ranktest
 
 PAPER = {  # Murphy, O'Neill and Carr, Tables 4 and 5 (30 runs, 75 x 50)
     "hybrid": (95.3, 5.2729, 138.8273, 57.2904),
@@ -36,12 +39,37 @@ def mean_sd(xs):
     return m, sd
 
 
+def rank_claims(finals):
+    """The paper's claims as one-sided Mann-Whitney U tests on the last
+    generation's best fitness (lower is better) of every run."""
+    rows = ["| claim | against | U | p (one-sided) | test | holds at 0.05 |",
+            "|---|---|---|---|---|---|"]
+    others = lambda g: [o for o in finals if o != g]
+    if "hybrid" in finals:
+        for o in others("hybrid"):
+            r = ranktest.mann_whitney_u(finals["hybrid"], finals[o])
+            rows.append(f"| hybrid best: lower than | {o} | {r['u_a']:.1f} | {r['p_less']:.4f} | "
+                        f"{r['method']} | {'yes' if r['p_less'] < 0.05 else 'no'} |")
+    if "free" in finals:
+        for o in others("free"):
+            r = ranktest.mann_whitney_u(finals[o], finals["free"])
+            rows.append(f"| free worst: higher than | {o} | {r['u_b']:.1f} | {r['p_less']:.4f} | "
+                        f"{r['method']} | {'yes' if r['p_less'] < 0.05 else 'no'} |")
+        for o in others("free"):
+            r = ranktest.spread_test(finals["free"], finals[o])
+            rows.append(f"| free most variable: wider than | {o} | {r['u_b']:.1f} | "
+                        f"{r['p_less']:.4f} | {r['method']}, distances from the median | "
+                        f"{'yes' if r['p_less'] < 0.05 else 'no'} |")
+    return "\n".join(rows) + "\n"
+
+
 def main():
     out, runs, grammars = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
     rows = ["| Grammar | Avg. best | Std. dev. | Avg. avg. | Std. dev. | invalid (last gen, mean) "
             "| paper: avg. best (sd) | paper: avg. avg. (sd) |",
             "|---|---|---|---|---|---|---|---|"]
     curves = {}
+    finals = {}  # grammar -> last generation's best fitness of every run
     for g in grammars:
         best, avg, invalid, per_gen = [], [], [], []
         for r in range(1, runs + 1):
@@ -51,6 +79,7 @@ def main():
             avg.append(float(data[-1]["average"]))
             invalid.append(float(data[-1]["invalid"]))
             per_gen.append([(float(d["best"]), float(d["average"])) for d in data])
+        finals[g] = best
         b, bsd = mean_sd(best)
         a, asd = mean_sd(avg)
         p = PAPER.get(g)
@@ -61,6 +90,10 @@ def main():
         curves[g] = [(i, sum(run[i][0] for run in per_gen) / runs,
                       sum(run[i][1] for run in per_gen) / runs) for i in range(gens)]
     table = "\n".join(rows) + "\n"
+    ranks = rank_claims(finals)
+    with open(os.path.join(out, "ranks.md"), "w") as f:
+        f.write(ranks)
+    print(ranks)
     with open(os.path.join(out, "table.md"), "w") as f:
         f.write(table)
     print(table)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "animrt/controllers/gait/gait_source.hpp"
@@ -13,9 +14,12 @@
 namespace animrt::sim {
 namespace {
 
-// A foot must be off the ground this long before its next contact counts as
-// a touchdown (contacts chatter for a few steps when a foot lands).
-constexpr double kDebounceS = 0.02;
+// A landing counts only after the foot was in the air for this fraction of
+// a stride: a real swing. Contacts chatter when a foot lands, and a foot
+// that bounces or stumbles touches down again within a tenth of a stride;
+// counting those as strides made the stride length a fraction of what the
+// walk covers per cycle (measured against speed / frequency in docs/evolve.md).
+constexpr double kMinSwingStrides = 0.15;
 
 int root_qpos(const mjModel* m, int torso) {
   const int j = m->body_jntadr[torso];
@@ -83,6 +87,13 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     source->sample(static_cast<double>(i) / (kMeanSamples * f), targets);
     for (std::size_t a = 0; a < targets.size(); ++a) stand[a] += targets[a] / kMeanSamples;
   }
+  if (settings.perturb_seed != 0 && settings.perturb_rad > 0.0) {
+    // The standing pose itself is perturbed, so the feet are still placed on
+    // the floor and the blend into the gait starts from where the joints are.
+    std::mt19937_64 rng(settings.perturb_seed);
+    std::uniform_real_distribution<double> jitter(-settings.perturb_rad, settings.perturb_rad);
+    for (double& q : stand) q += jitter(rng);
+  }
   place_standing(mm, d, stand.data());
   const double dt = m->opt.timestep;
   const auto steps_for = [dt](double s) { return static_cast<long>(std::llround(s / dt)); };
@@ -98,11 +109,17 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   for (std::size_t i = 0; i < feet; ++i)
     foot_of[static_cast<std::size_t>(mm.foot_geoms[i])] = static_cast<int>(i);
   std::vector<char> contact(feet, 0);
-  std::vector<long> air_steps(feet, 1 << 30);
+  // A foot already down when measuring starts has not landed: only a foot
+  // that was in the air counts.
+  std::vector<long> air_steps(feet, 0);
   std::vector<long> contact_steps(feet, 0);
-  std::vector<std::vector<double>> touchdowns(feet);
-  const long debounce = std::max(1L, steps_for(kDebounceS));
+  struct Landing {
+    double t, x;
+  };
+  std::vector<std::vector<Landing>> landings(feet);
+  const long min_swing = std::max(1L, steps_for(kMinSwingStrides / f));
   double energy = 0.0;
+  double max_tilt = 0.0;  // rad
   double x0 = 0.0;
 
   const long total = settle + warmup + measure;
@@ -135,8 +152,9 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     }
     for (std::size_t i = 0; i < feet; ++i) {
       if (contact[i]) {
-        if (air_steps[i] >= debounce) {
-          touchdowns[i].push_back(d->geom_xpos[3 * mm.foot_geoms[i]]);
+        if (air_steps[i] >= min_swing) {
+          landings[i].push_back(
+              {static_cast<double>(step) * dt, d->geom_xpos[3 * mm.foot_geoms[i]]});
         }
         air_steps[i] = 0;
         ++contact_steps[i];
@@ -147,6 +165,8 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     for (int a = 0; a < m->nu; ++a) {
       energy += std::fabs(d->actuator_force[a] * d->actuator_velocity[a]) * dt;
     }
+    const double up = std::clamp(d->xmat[9 * mm.torso_body + 8], -1.0, 1.0);
+    max_tilt = std::max(max_tilt, std::acos(up));
   }
   out.sim_time = static_cast<double>(out.steps) * dt;
   if (out.fell) return out;
@@ -157,16 +177,21 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   double contact_sum = 0;
   for (long c : contact_steps) contact_sum += static_cast<double>(c);
   out.duty_factor = contact_sum / (static_cast<double>(feet) * static_cast<double>(measure));
+  // A foot's advance from its first landing to its last, per stride period
+  // between them. A foot that bounces or stumbles lands more than once a
+  // stride; counting each landing as a stride would shorten it.
   double stride_sum = 0;
-  int strides = 0;
-  for (const auto& td : touchdowns) {
-    for (std::size_t k = 1; k < td.size(); ++k) {
-      stride_sum += td[k] - td[k - 1];
-      ++strides;
-    }
+  double strides = 0;
+  for (const auto& l : landings) {
+    if (l.size() < 2) continue;
+    const double periods = std::round((l.back().t - l.front().t) * f);
+    if (periods < 1) continue;
+    stride_sum += l.back().x - l.front().x;
+    strides += periods;
   }
   out.stride_length = strides > 0 ? stride_sum / strides : 0.0;
   out.energy_per_cycle = energy / settings.measure_cycles;
+  out.max_tilt_deg = max_tilt * 180.0 / M_PI;
   return out;
 }
 

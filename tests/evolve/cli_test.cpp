@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 namespace {
 
@@ -100,6 +102,54 @@ TEST_F(EvolveCli, ThreadsAndMpiGiveTheSerialResultAndTheGaitPlays) {
   ASSERT_EQ(evolve("mpi.yaml", "--threads 1 --mpi", mpirun), 0) << read(path("mpi.yaml.log"));
   EXPECT_EQ(read(path("serial.yaml")), read(path("mpi.yaml")));
   EXPECT_EQ(csv_without_timing(path("serial.csv")), csv_without_timing(path("mpi.csv")));
+}
+
+// The CSV's column `column` on its data rows.
+std::vector<std::string> csv_column(const std::string& path, std::size_t column) {
+  std::istringstream in(read(path));
+  std::string line;
+  std::vector<std::string> out;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::string cell;
+    for (std::size_t i = 0; i <= column && std::getline(ls, cell, ','); ++i) {
+    }
+    out.push_back(cell);
+  }
+  return out;
+}
+
+TEST_F(EvolveCli, AParetoRunWritesPlayableGaitsAndMpiGivesTheSameFront) {
+  ASSERT_EQ(evolve("front", "--pareto --threads 1"), 0) << read(path("front.log"));
+  const auto files = csv_column(path("front/front.csv"), 8);
+  ASSERT_FALSE(files.empty()) << read(path("front.log"));
+  EXPECT_NE(read(path("front/front.svg")).find("<circle"), std::string::npos);
+  EXPECT_EQ(csv_column(path("front/history.csv"), 0), (std::vector<std::string>{"0", "1"}));
+
+  // The first member walks on the model what the front says it walked.
+  const auto speeds = csv_column(path("front/front.csv"), 4);
+  ASSERT_EQ(sh(kAnimrt + " gait measure " + path("front/" + files[0]) + " --physics " + kRoot +
+               "/configs/models/quadruped.xml --starts 1 --perturb-deg 0 --settle 0.1 "
+               "--warmup-cycles 1 --measure-cycles 1 > " +
+               path("measure.log") + " 2>&1"),
+            0)
+      << read(path("measure.log"));
+  char expected[32];
+  std::snprintf(expected, sizeof expected, "%.3f", std::stod(speeds[0]));
+  EXPECT_NE(read(path("measure.log")).find(std::string("speed ") + expected), std::string::npos)
+      << "front.csv speed " << speeds[0] << "\n"
+      << read(path("measure.log"));
+
+  const std::string mpirun =
+      "ASAN_OPTIONS=detect_leaks=0 OMPI_MCA_plm_rsh_agent=false mpirun --allow-run-as-root "
+      "--oversubscribe -np 2 ";
+  ASSERT_EQ(evolve("front_mpi", "--pareto --threads 1 --mpi", mpirun), 0)
+      << read(path("front_mpi.log"));
+  EXPECT_EQ(read(path("front/front.csv")), read(path("front_mpi/front.csv")));
+  for (const auto& f : files) {
+    EXPECT_EQ(read(path("front/" + f)), read(path("front_mpi/" + f))) << f;
+  }
 }
 
 TEST_F(EvolveCli, BadRunFileExitsTwoWithOneClearLine) {

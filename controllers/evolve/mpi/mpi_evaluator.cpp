@@ -11,7 +11,7 @@ namespace animrt::evolve {
 namespace {
 
 // GaitMeasures travel as doubles; the layout is ours on both ends.
-constexpr int kFields = 8;
+constexpr int kFields = 9;
 
 void pack(const GaitMeasures& m, double* out) {
   out[0] = m.fell ? 1.0 : 0.0;
@@ -22,6 +22,7 @@ void pack(const GaitMeasures& m, double* out) {
   out[5] = m.energy_per_cycle;
   out[6] = m.sim_time;
   out[7] = static_cast<double>(m.steps);
+  out[8] = m.max_tilt_deg;
 }
 
 GaitMeasures unpack(const double* in) {
@@ -34,6 +35,7 @@ GaitMeasures unpack(const double* in) {
   m.energy_per_cycle = in[5];
   m.sim_time = in[6];
   m.steps = static_cast<long>(in[7]);
+  m.max_tilt_deg = in[8];
   return m;
 }
 

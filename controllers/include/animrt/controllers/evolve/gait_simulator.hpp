@@ -6,6 +6,7 @@
 // A simulator is used by one thread at a time; a factory makes one per
 // worker thread (they may share the read-only model).
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,11 @@ struct WalkSettings {
   double settle_s = 0.5;   // standing still in the gait's first pose before walking
   int warmup_cycles = 1;   // stride cycles walked but not measured
   int measure_cycles = 3;  // stride cycles measured
+  // Nonzero: every joint starts off its standing angle by up to
+  // `perturb_rad`, drawn from this seed, so repeated walks show how robust a
+  // gait is rather than replaying one exact start.
+  std::uint64_t perturb_seed = 0;
+  double perturb_rad = 0.0;
 };
 
 struct GaitMeasures {
@@ -27,6 +33,7 @@ struct GaitMeasures {
   double stride_length = 0.0;     // m, mean forward advance of a foot between its touchdowns
   double duty_factor = 0.0;       // mean fraction of the stride each foot is on the ground
   double energy_per_cycle = 0.0;  // J, sum |actuator force x joint velocity| dt per cycle
+  double max_tilt_deg = 0.0;      // largest tilt of the torso from upright while measured
   double sim_time = 0.0;          // s simulated
   long steps = 0;                 // physics steps taken
 };

@@ -14,6 +14,7 @@
 #include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/evolve/grammar.hpp"
 #include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/controllers/evolve/population.hpp"
 #include "animrt/controllers/evolve/run_config.hpp"
 
 namespace animrt::evolve {
@@ -29,17 +30,6 @@ struct GenerationStats {
   double seconds = 0.0;  // wall time of this generation's evaluations
   std::string best_phenotype;
   GaitMeasures best_measures;
-};
-
-struct Individual {
-  Genome genome;
-  bool mapped = false;  // the genome mapped to a complete phenotype
-  bool valid = false;   // ... and that phenotype is a usable gait
-  std::string phenotype;
-  GaitFile gait;          // when valid
-  GaitMeasures measures;  // of the last walk
-  int stage = -1;         // freedom stage it was walked under (-1: not yet)
-  double fitness = kWorstFitness;
 };
 
 struct SearchResult {
@@ -58,7 +48,6 @@ class Search {
   SearchResult run(const std::function<void(const GenerationStats&)>& progress = {});
 
  private:
-  int stage_at(int generation) const;
   void evaluate(std::vector<Individual>& pop, int generation, GenerationStats& stats);
 
   RunConfig config_;
@@ -67,7 +56,7 @@ class Search {
   ModelInfo model_;
   Evaluator& evaluator_;
   GaitTargets targets_;
-  std::vector<std::vector<std::string>> held_;  // per freedom stage
+  PopulationWalker walker_;
 };
 
 }  // namespace animrt::evolve

@@ -5,10 +5,10 @@
 // actuators: warm-up cycles, then measured cycles.
 //
 // Measures: forward (+x) speed of the torso, stride length from successive
-// touchdowns of each foot, duty factor from foot contacts, energy as
-// sum |actuator force x velocity| dt per cycle. The walk counts as a fall
-// (and stops) when the torso drops below half its standing height, tilts
-// more than 60 degrees, or the physics goes unstable.
+// landings of each foot (first to last, per stride period), duty factor from foot contacts, energy
+// as sum |actuator force x velocity| dt per cycle. The walk counts as a fall (and stops) when the
+// torso drops below half its standing height, tilts more than 60 degrees, or the physics goes
+// unstable.
 
 #include <memory>
 

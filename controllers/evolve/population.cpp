@@ -1,0 +1,84 @@
+// Mapping and walking a population (see population.hpp).
+
+#include "animrt/controllers/evolve/population.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "animrt/controllers/evolve/phenotype.hpp"
+#include "animrt/core/error.hpp"
+
+namespace animrt::evolve {
+
+PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& grammar,
+                                   const GaitFile& seed)
+    : config_(config), grammar_(grammar), seed_(seed) {
+  if (!seed_.froude) {
+    throw InputError({seed_.file, 0, 0}, "froude",
+                     "the seed gait of an evolve run needs froude timing (the fitness targets "
+                     "come from the Froude number)");
+  }
+  const auto means = curve_means(seed_);
+  for (const auto& stage : config_.freedom) {
+    std::vector<std::string> held = means;
+    for (const auto& name : stage.free) {
+      const auto it = std::find_if(seed_.curves.begin(), seed_.curves.end(),
+                                   [&](const GaitCurve& c) { return c.name == name; });
+      if (it == seed_.curves.end()) {
+        throw InputError(stage.where, "fitness.freedom.free",
+                         "no curve '" + name + "' in the seed gait " + seed_.file);
+      }
+      held[static_cast<std::size_t>(it - seed_.curves.begin())].clear();
+    }
+    held_.push_back(std::move(held));
+  }
+}
+
+int PopulationWalker::stage_at(int generation) const {
+  int stage = 0;
+  for (std::size_t i = 0; i < config_.freedom.size(); ++i) {
+    if (config_.freedom[i].from_generation <= generation) stage = static_cast<int>(i);
+  }
+  return stage;
+}
+
+WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage,
+                                 Evaluator& evaluator) const {
+  static const std::vector<std::string> kNoneHeld;
+  const auto& held = held_.empty() ? kNoneHeld : held_[static_cast<std::size_t>(stage)];
+  const MapLimits limits{config_.search.max_wraps};
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < pop.size(); ++i) {
+    Individual& ind = pop[i];
+    if (ind.stage == stage) continue;  // already walked under these rules
+    if (ind.stage < 0) {
+      const MapResult m = map_genome(grammar_, ind.genome, limits);
+      ind.mapped = m.valid;
+      ind.phenotype = m.phenotype;
+    }
+    ind.valid = ind.mapped;
+    ind.stage = stage;
+    if (ind.valid) {
+      PhenotypeGait pg = make_phenotype_gait(seed_, ind.phenotype, held);
+      ind.valid = pg.valid;
+      if (pg.valid) {
+        ind.gait = std::move(pg.gait);
+        ind.gait.name = config_.name;
+      }
+    }
+    ind.measures = GaitMeasures{};
+    if (ind.valid) todo.push_back(i);
+  }
+  std::vector<const GaitFile*> gaits;
+  for (auto i : todo) gaits.push_back(&pop[i].gait);
+  std::vector<GaitMeasures> measures(gaits.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  evaluator.walk_all(gaits, config_.walk, measures);
+  WalkBatch batch;
+  batch.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  batch.evaluations = static_cast<int>(todo.size());
+  for (std::size_t k = 0; k < todo.size(); ++k) pop[todo[k]].measures = measures[k];
+  return batch;
+}
+
+}  // namespace animrt::evolve

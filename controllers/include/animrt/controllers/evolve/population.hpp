@@ -1,0 +1,54 @@
+#pragma once
+// What every search does with a population before it ranks it: map each new
+// genome through the grammar, turn the phenotype into a gait (curves that are
+// not free in the current freedom stage held at their seed mean), and walk
+// the valid gaits through the evaluator in one batch. Used by the
+// single-objective GE search and by the Pareto search.
+
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/evolve/evaluator.hpp"
+#include "animrt/controllers/evolve/grammar.hpp"
+#include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/controllers/evolve/run_config.hpp"
+
+namespace animrt::evolve {
+
+struct Individual {
+  Genome genome;
+  bool mapped = false;  // the genome mapped to a complete phenotype
+  bool valid = false;   // ... and that phenotype is a usable gait
+  std::string phenotype;
+  GaitFile gait;                   // when valid
+  GaitMeasures measures;           // of the last walk
+  int stage = -1;                  // freedom stage it was walked under (-1: not yet)
+  double fitness = kWorstFitness;  // the single-objective score (search.hpp)
+};
+
+struct WalkBatch {
+  int evaluations = 0;   // walks simulated
+  double seconds = 0.0;  // wall time of those walks
+};
+
+class PopulationWalker {
+ public:
+  // Checks the run's freedom stages against the seed gait's curves and the
+  // seed's froude timing; throws InputError on a mismatch.
+  PopulationWalker(const RunConfig& config, const Grammar& grammar, const GaitFile& seed);
+
+  // The freedom stage in effect at `generation` (0 without stages).
+  int stage_at(int generation) const;
+
+  // Maps and walks every individual not yet walked under `stage`; the others
+  // keep their measures.
+  WalkBatch walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator) const;
+
+ private:
+  const RunConfig& config_;
+  const Grammar& grammar_;
+  const GaitFile& seed_;
+  std::vector<std::vector<std::string>> held_;  // per freedom stage
+};
+
+}  // namespace animrt::evolve

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# animrt gait measure: walks a gait from perturbed starts and reports falls
+# and the walk beside the Froude predictions; a model that cannot stand is
+# reported as falling; bad input is exit 2 naming the file.
+set -uo pipefail
+animrt=$1
+root=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+gait=$root/configs/gaits/quadruped_evolved.yaml
+model=$root/configs/models/quadruped.xml
+out=$("$animrt" gait measure "$gait" --physics "$model" --starts 3 2>&1) || fail "measure failed: $out"
+[[ $out == *"falls: 0 of 3"* ]] || fail "the evolved quadruped gait fell: $out"
+[[ $out == *"Froude 0.060 predicts"* ]] || fail "no Froude prediction: $out"
+# Three different starts give three different walks.
+[[ $(grep -cE '^ +[123] +no ' <<< "$out") -eq 3 ]] || fail "not three walk rows: $out"
+[[ $(grep -E '^ +[123] +no ' <<< "$out" | awk '{print $4}' | sort -u | wc -l) -ge 2 ]] ||
+  fail "perturbed starts all walked the same: $out"
+
+# Legs too weak to carry the body: every walk falls.
+sed 's/forcerange="-[0-9.]* [0-9.]*"/forcerange="-0.05 0.05"/' "$model" > "$tmp/weak.xml"
+out=$("$animrt" gait measure "$gait" --physics "$tmp/weak.xml" --starts 2 2>&1) ||
+  fail "measure on the weak model failed: $out"
+[[ $out == *"falls: 2 of 2"* ]] || fail "a model that cannot stand did not fall: $out"
+
+out=$("$animrt" gait measure "$tmp/missing.yaml" --physics "$model" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"missing.yaml"* ]] || fail "missing gait (exit $code): $out"
+echo "gait_measure: ok"
