@@ -168,6 +168,60 @@ TEST(FeetechBusOnSim, ServoKeepsGoalsInsideTheJointLimitsTheBusWrote) {
   }
 }
 
+// A servo that rests outside its joint's limits (a hanging jaw) must not
+// snap to the nearest limit when torque comes on: the servo clamps its goal
+// into its angle limits, so the bus widens them to where the joint is, warns,
+// and leads the goals in from there.
+TEST(FeetechBusOnSim, JointRestingOutsideItsLimitsStartsAndIsLedInside) {
+  for (ft::Series series : {ft::Series::sts, ft::Series::scs}) {
+    SCOPED_TRACE(series == ft::Series::sts ? "sts" : "scs");
+    const BusConfig device_side = arm(series, {3, 4});  // the board knows no joint limits
+    BusConfig config = device_side;
+    config.actuators[1].min_position = 0.0;
+    config.actuators[1].max_position = 0.5;
+    const ActuatorBinding& jaw = config.actuators[1];
+    ManualClock clock{0};
+    sim::FeetechSimBus sim(device_side, series, clock);
+    sim.start();
+    const double rest = sim.device_position(4);
+    ASSERT_LT(rest, -0.04);
+    FeetechBus bus(config, series, open_serial(sim.endpoint(), config.baud));
+    ASSERT_NO_THROW(bus.configure());
+    EXPECT_NE(bus.outside_warning().find("id 4 (joint4) is at -"), std::string::npos)
+        << bus.outside_warning();
+    EXPECT_NE(bus.outside_warning().find("outside its limits 0.0..28.6 deg"), std::string::npos)
+        << bus.outside_warning();
+    ASSERT_NO_THROW(bus.activate());
+    // Torque on holds the joint where it rests.
+    clock.advance(1'000'000'000);
+    std::vector<double> q(2, 0.0);
+    bus.read(q);
+    const double tick = 2 * kPi / (series == ft::Series::sts ? 4096.0 : ft::kScsStepsPerRev);
+    EXPECT_NEAR(q[1], rest, 1.5 * tick);
+    EXPECT_NEAR(sim.device_position(4), rest, 1.5 * tick);
+
+    // Goals farther out than the rest pose are held at it; on the way in, a
+    // goal never goes back out past one already sent; inside, the limits rule.
+    const std::vector<double> wanted = {rest - 0.2, rest / 2, rest, 0.1, -0.3, 0.7};
+    const std::vector<double> sent = {rest, rest / 2, rest / 2, 0.1, 0.0, 0.5};
+    for (std::size_t k = 0; k < wanted.size(); ++k) {
+      const std::uint64_t before = sim.device_goals_received(4);
+      bus.write(std::vector<double>{0.0, wanted[k]});
+      bus.read(q);  // a round trip: the board has handled the write
+      ASSERT_EQ(sim.device_goals_received(4), before + 1) << "goal " << k;
+      EXPECT_EQ(sim.device_last_goal(4), jaw.to_ticks(sent[k])) << "goal " << k;
+    }
+    clock.advance(3'000'000'000);
+    bus.read(q);
+    EXPECT_NEAR(q[1], 0.5, 1.5 * tick);
+
+    // Back inside, the next bring-up writes the joint's own limits again.
+    bus.deactivate();
+    bus.configure();
+    EXPECT_TRUE(bus.outside_warning().empty()) << bus.outside_warning();
+  }
+}
+
 TEST(FeetechBusOnSim, ASilentServoIsCountedAndTheOthersStillServed) {
   Fixture f(arm(ft::Series::sts, {1, 2}), ft::Series::sts);
   f.bus.configure();

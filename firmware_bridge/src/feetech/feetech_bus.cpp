@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 #include "animrt/core/error.hpp"
@@ -83,6 +84,8 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
   status_.resize(n);
   present_ticks_.resize(n);
   goal_ticks_.resize(n);
+  limit_lo_.resize(n);
+  limit_hi_.resize(n);
   min_rad_.resize(n);
   max_rad_.resize(n);
   ids_.resize(n);
@@ -97,12 +100,14 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
     present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
     const double a = b.to_rad(min_ticks_);
     const double c = b.to_rad(max_ticks_);
-    min_rad_[i] = std::min(a, c);
-    max_rad_[i] = std::max(a, c);
+    limit_lo_[i] = std::min(a, c);
+    limit_hi_[i] = std::max(a, c);
     if (b.has_limits()) {
-      min_rad_[i] = std::max(min_rad_[i], b.min_position);
-      max_rad_[i] = std::min(max_rad_[i], b.max_position);
+      limit_lo_[i] = std::max(limit_lo_[i], b.min_position);
+      limit_hi_[i] = std::min(limit_hi_[i], b.max_position);
     }
+    min_rad_[i] = limit_lo_[i];
+    max_rad_[i] = limit_hi_[i];
   }
 }
 
@@ -338,19 +343,48 @@ void FeetechBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
-  for (std::size_t i = 0; i < n; ++i) write_angle_limits(i);
+  outside_warning_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const ActuatorBinding& b = config_.actuators[i];
+    min_rad_[i] = limit_lo_[i];
+    max_rad_[i] = limit_hi_[i];
+    const double at = b.to_rad(present_ticks_[i]);
+    const std::int32_t a = b.to_ticks(limit_lo_[i]);
+    const std::int32_t c = b.to_ticks(limit_hi_[i]);
+    if (b.has_limits() &&
+        (present_ticks_[i] < std::min(a, c) || present_ticks_[i] > std::max(a, c))) {
+      min_rad_[i] = std::min(min_rad_[i], at);
+      max_rad_[i] = std::max(max_rad_[i], at);
+      char text[160];
+      std::snprintf(text, sizeof text, "%.1f deg, outside its limits %.1f..%.1f deg",
+                    at * 180.0 / std::numbers::pi, limit_lo_[i] * 180.0 / std::numbers::pi,
+                    limit_hi_[i] * 180.0 / std::numbers::pi);
+      outside_warning_ += (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + text;
+    }
+    write_angle_limits(i);
+  }
+  if (!outside_warning_.empty()) {
+    outside_warning_ +=
+        ": its servo's angle limits now include where it is, so torque on holds it there, "
+        "and the start ramp brings it inside (check the joint's zero_ticks and limits if this "
+        "is not expected)";
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
+  }
   fresh_ = true;
 }
 
 void FeetechBus::write_angle_limits(std::size_t device) {
   const ActuatorBinding& b = config_.actuators[device];
   if (!b.has_limits()) return;
-  // The joint's limits in steps, inside the position-mode range.
+  // The joint's limits in steps, widened to where a joint resting outside
+  // them is (else torque on would snap it to a limit), inside the
+  // position-mode range.
   const std::int32_t top = series_ == ft::Series::sts ? ft::kStsMaxPosition : ft::kScsMaxPosition;
   const std::int32_t a = b.to_ticks(b.min_position);
   const std::int32_t c = b.to_ticks(b.max_position);
-  const auto lo = static_cast<std::uint16_t>(std::clamp(std::min(a, c), 0, top));
-  const auto hi = static_cast<std::uint16_t>(std::clamp(std::max(a, c), 0, top));
+  const std::int32_t at = present_ticks_[device];
+  const auto lo = static_cast<std::uint16_t>(std::clamp(std::min({a, c, at}), 0, top));
+  const auto hi = static_cast<std::uint16_t>(std::clamp(std::max({a, c, at}), 0, top));
   const auto id = static_cast<std::uint8_t>(b.device_id);
   const auto fail = [&](Answer answer, const std::string& what) {
     throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +
@@ -469,7 +503,16 @@ void FeetechBus::write(std::span<const double> positions) {
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
-    if (i < positions.size()) goal_ticks_[i] = goal_ticks(i, positions[i]);
+    if (i < positions.size()) {
+      goal_ticks_[i] = goal_ticks(i, positions[i]);
+      if (std::isfinite(positions[i])) {
+        // A joint that started outside its limits: the goals sent so far
+        // bound the way back out (a no-op for a joint inside its limits).
+        const double sent = std::clamp(positions[i], min_rad_[i], max_rad_[i]);
+        min_rad_[i] = std::max(min_rad_[i], std::min(sent, limit_lo_[i]));
+        max_rad_[i] = std::min(max_rad_[i], std::max(sent, limit_hi_[i]));
+      }
+    }
     ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
     ft::put_u16(series_, sync_data_.data() + 2 * count, from_position(goal_ticks_[i]));
     ++count;

@@ -44,7 +44,12 @@ class FeetechBus final : public ActuatorBus {
   // present position. Throws one DeviceError listing every servo that failed.
   // Then, for joints with limits, writes Min/Max Angle Limit (9/11) from
   // them when the values read back differ (EEPROM unlocked for the write and
-  // locked again), so the servo itself keeps its goals inside the joint.
+  // locked again), so the servo itself keeps its goals inside the joint. A
+  // joint that rests outside its limits (a hanging jaw) gets limits widened
+  // to where it is, with a warning (outside_warning()): the servo clamps its
+  // goal into its angle limits, so torque on would otherwise snap it to the
+  // nearest limit. Its goals then lead from where it rests to its limits and
+  // never back out past a goal already sent.
   void configure() override;
   // Per servo: goal position = present position, then torque on. On failure
   // (or a servo reporting a fault) turns torque off again and throws.
@@ -59,6 +64,9 @@ class FeetechBus final : public ActuatorBus {
   void write(std::span<const double> positions) override;
 
   std::span<DeviceStatus> devices() override { return status_; }
+  // The last configure()'s warning about joints resting outside their
+  // limits, empty when none did.
+  const std::string& outside_warning() const { return outside_warning_; }
 
  private:
   using Deadline = std::chrono::steady_clock::time_point;
@@ -94,7 +102,9 @@ class FeetechBus final : public ActuatorBus {
   std::array<std::int16_t, 256> device_of_id_{};
   std::vector<std::int32_t> present_ticks_;
   std::vector<std::int32_t> goal_ticks_;
-  std::vector<double> min_rad_, max_rad_;
+  std::vector<double> limit_lo_, limit_hi_;  // the joint's limits, inside the series' range
+  std::vector<double> min_rad_, max_rad_;    // what goals may be now (wider while outside)
+  std::string outside_warning_;
   bool fresh_ = false;
 
   // Per slot of the current transaction.
