@@ -8,27 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "text_output.hpp"
+
 namespace animrt::evolve {
-namespace {
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-std::ofstream open_out(const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
-  return out;
-}
-
-void close_out(std::ofstream& out, const std::string& path) {
-  out.close();
-  if (!out) throw std::runtime_error("cannot write " + path);
-}
-
-}  // namespace
 
 std::string format_pareto_progress(const ParetoGeneration& g, int generations) {
   const double rate = g.seconds > 0 ? g.evaluations / g.seconds : 0.0;

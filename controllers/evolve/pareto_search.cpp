@@ -7,8 +7,6 @@
 #include <limits>
 #include <numeric>
 
-#include "animrt/controllers/evolve/operators.hpp"
-
 namespace animrt::evolve {
 namespace {
 
@@ -77,12 +75,7 @@ ParetoSearch::ParetoSearch(RunConfig config, Grammar grammar, GaitFile seed, Mod
 ParetoResult ParetoSearch::run(const std::function<void(const ParetoGeneration&)>& progress) {
   const SearchSettings& s = config_.search;
   Rng rng(s.seed);
-  std::vector<Individual> pop;
-  for (auto& g : ramped_full_grow(grammar_, s.population, s.init, rng)) {
-    Individual ind;
-    ind.genome = std::move(g);
-    pop.push_back(std::move(ind));
-  }
+  std::vector<Individual> pop = initial_population(grammar_, s, rng);
   ParetoResult result;
   const auto objectives_of = [&](const std::vector<Individual>& p) {
     std::vector<Objectives> out;
@@ -106,21 +99,10 @@ ParetoResult ParetoSearch::run(const std::function<void(const ParetoGeneration&)
       // offspring together compete for the N places.
       std::vector<Individual> children;
       children.reserve(pop.size());
-      while (children.size() < pop.size()) {
-        Genome a =
-            pop[static_cast<std::size_t>(binary_tournament(ranking, pop.size(), rng))].genome;
-        Genome b =
-            pop[static_cast<std::size_t>(binary_tournament(ranking, pop.size(), rng))].genome;
-        fixed_point_crossover(a, b, s.crossover, rng);
-        int_flip_mutation(a, s.mutation, s.init.codon_size, rng);
-        int_flip_mutation(b, s.mutation, s.init.codon_size, rng);
-        for (Genome* g : {&a, &b}) {
-          if (children.size() >= pop.size()) break;
-          Individual child;
-          child.genome = std::move(*g);
-          children.push_back(std::move(child));
-        }
-      }
+      breed(
+          pop,
+          [&] { return static_cast<std::size_t>(binary_tournament(ranking, pop.size(), rng)); }, s,
+          pop.size(), children, rng);
       for (auto& c : children) pop.push_back(std::move(c));
       // Parents walked under an earlier freedom stage walk again.
       const WalkBatch b = walker_.walk(pop, stage, evaluator_);

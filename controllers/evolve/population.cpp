@@ -5,10 +5,39 @@
 #include <algorithm>
 #include <chrono>
 
+#include "animrt/controllers/evolve/operators.hpp"
 #include "animrt/controllers/evolve/phenotype.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt::evolve {
+
+std::vector<Individual> initial_population(const Grammar& grammar, const SearchSettings& s,
+                                           Rng& rng) {
+  std::vector<Individual> pop;
+  for (auto& g : ramped_full_grow(grammar, s.population, s.init, rng)) {
+    Individual ind;
+    ind.genome = std::move(g);
+    pop.push_back(std::move(ind));
+  }
+  return pop;
+}
+
+void breed(const std::vector<Individual>& parents, const std::function<std::size_t()>& pick,
+           const SearchSettings& s, std::size_t size, std::vector<Individual>& next, Rng& rng) {
+  while (next.size() < size) {
+    Genome a = parents[pick()].genome;
+    Genome b = parents[pick()].genome;
+    fixed_point_crossover(a, b, s.crossover, rng);
+    int_flip_mutation(a, s.mutation, s.init.codon_size, rng);
+    int_flip_mutation(b, s.mutation, s.init.codon_size, rng);
+    for (Genome* g : {&a, &b}) {
+      if (next.size() >= size) break;
+      Individual child;
+      child.genome = std::move(*g);
+      next.push_back(std::move(child));
+    }
+  }
+}
 
 PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& grammar,
                                    const GaitFile& seed)

@@ -9,22 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "text_output.hpp"
+
 namespace animrt::evolve {
-namespace {
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-std::ofstream open_out(const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
-  return out;
-}
-
-}  // namespace
 
 std::string format_progress(const GenerationStats& s, int generations) {
   const double rate = s.seconds > 0 ? s.evaluations / s.seconds : 0.0;

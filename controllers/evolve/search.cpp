@@ -34,12 +34,7 @@ void Search::evaluate(std::vector<Individual>& pop, int generation, GenerationSt
 SearchResult Search::run(const std::function<void(const GenerationStats&)>& progress) {
   const SearchSettings& s = config_.search;
   Rng rng(s.seed);
-  std::vector<Individual> pop;
-  for (auto& g : ramped_full_grow(grammar_, s.population, s.init, rng)) {
-    Individual ind;
-    ind.genome = std::move(g);
-    pop.push_back(std::move(ind));
-  }
+  std::vector<Individual> pop = initial_population(grammar_, s, rng);
   SearchResult result;
   for (int gen = 0;; ++gen) {
     GenerationStats st;
@@ -78,19 +73,9 @@ SearchResult Search::run(const std::function<void(const GenerationStats&)>& prog
     std::vector<Individual> next;
     next.reserve(pop.size());
     for (int e = 0; e < s.elites; ++e) next.push_back(pop[order[static_cast<std::size_t>(e)]]);
-    while (next.size() < pop.size()) {
-      Genome a = pop[static_cast<std::size_t>(tournament(fitness, s.tournament, rng))].genome;
-      Genome b = pop[static_cast<std::size_t>(tournament(fitness, s.tournament, rng))].genome;
-      fixed_point_crossover(a, b, s.crossover, rng);
-      int_flip_mutation(a, s.mutation, s.init.codon_size, rng);
-      int_flip_mutation(b, s.mutation, s.init.codon_size, rng);
-      for (Genome* g : {&a, &b}) {
-        if (next.size() >= pop.size()) break;
-        Individual child;
-        child.genome = std::move(*g);
-        next.push_back(std::move(child));
-      }
-    }
+    breed(
+        pop, [&] { return static_cast<std::size_t>(tournament(fitness, s.tournament, rng)); }, s,
+        pop.size(), next, rng);
     pop = std::move(next);
   }
   return result;

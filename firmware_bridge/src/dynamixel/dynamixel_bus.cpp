@@ -97,10 +97,7 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   status_.resize(n);
   present_ticks_.resize(n);
   goal_ticks_.resize(n);
-  limit_lo_.resize(n);
-  limit_hi_.resize(n);
-  min_rad_.resize(n);
-  max_rad_.resize(n);
+  window_.resize(n);
   alert_seen_.resize(n);
   status_pending_.resize(n);
   ids_.resize(n);
@@ -118,16 +115,8 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
     device_of_id_[static_cast<std::size_t>(b.device_id)] = static_cast<std::int16_t>(i);
     present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
     // One tick inside the int32 range so rounding cannot wrap.
-    const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
-    const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
-    limit_lo_[i] = std::min(a, c);
-    limit_hi_[i] = std::max(a, c);
-    if (b.has_limits()) {  // defence in depth: never a goal outside the joint
-      limit_lo_[i] = std::max(limit_lo_[i], b.min_position);
-      limit_hi_[i] = std::min(limit_hi_[i], b.max_position);
-    }
-    min_rad_[i] = limit_lo_[i];
-    max_rad_[i] = limit_hi_[i];
+    window_[i] = GoalWindow::for_joint(b, std::numeric_limits<std::int32_t>::min() + 1,
+                                       std::numeric_limits<std::int32_t>::max() - 1);
   }
 }
 
@@ -516,29 +505,15 @@ void DynamixelBus::configure() {
   outside_warning_.clear();
   for (std::size_t i = 0; i < n; ++i) {
     // Goals may lead from where the joint rests to its limits, never farther.
-    const ActuatorBinding& b = config_.actuators[i];
-    min_rad_[i] = limit_lo_[i];
-    max_rad_[i] = limit_hi_[i];
-    const std::int32_t a = b.to_ticks(min_rad_[i]);
-    const std::int32_t c = b.to_ticks(max_rad_[i]);
-    const std::int32_t ticks = present_ticks_[i];
-    if (ticks < std::min(a, c) || ticks > std::max(a, c)) {  // outside by a tick or more
-      const double at = b.to_rad(ticks);
-      min_rad_[i] = std::min(min_rad_[i], at);
-      max_rad_[i] = std::max(max_rad_[i], at);
-      char text[160];
-      std::snprintf(text, sizeof text, "%.1f deg, outside its limits %.1f..%.1f deg",
-                    at * 180.0 / std::numbers::pi, limit_lo_[i] * 180.0 / std::numbers::pi,
-                    limit_hi_[i] * 180.0 / std::numbers::pi);
-      outside_warning_ += (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + text;
+    const std::string outside = window_[i].start_at(config_.actuators[i], present_ticks_[i]);
+    if (!outside.empty()) {
+      outside_warning_ +=
+          (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + outside;
     }
     write_position_limits(i);
   }
   if (!outside_warning_.empty()) {
-    outside_warning_ +=
-        ": its servo's position limits now include where it is, so torque on holds it there, "
-        "and the start ramp brings it inside (check the joint's zero_ticks and limits if this "
-        "is not expected)";
+    outside_warning_ = outside_limits_warning(outside_warning_, "position limits");
     std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
   }
   choose_fast_read();
@@ -687,7 +662,7 @@ void DynamixelBus::read(std::span<double> positions) {
 
 std::int32_t DynamixelBus::goal_ticks(std::size_t device, double rad) const {
   if (!std::isfinite(rad)) return goal_ticks_[device];  // hold the last goal
-  return config_.actuators[device].to_ticks(std::clamp(rad, min_rad_[device], max_rad_[device]));
+  return config_.actuators[device].to_ticks(window_[device].clamp(rad));
 }
 
 void DynamixelBus::write(std::span<const double> positions) {
@@ -696,13 +671,7 @@ void DynamixelBus::write(std::span<const double> positions) {
     if (status_[i].faulted) continue;
     if (i < positions.size()) {
       goal_ticks_[i] = goal_ticks(i, positions[i]);
-      if (std::isfinite(positions[i])) {
-        // A joint that started outside its limits: the goals sent so far
-        // bound the way back out (a no-op for a joint inside its limits).
-        const double sent = std::clamp(positions[i], min_rad_[i], max_rad_[i]);
-        min_rad_[i] = std::max(min_rad_[i], std::min(sent, limit_lo_[i]));
-        max_rad_[i] = std::min(max_rad_[i], std::max(sent, limit_hi_[i]));
-      }
+      if (std::isfinite(positions[i])) window_[i].narrow(positions[i]);
     }
     ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
     dxl::put_u32(sync_data_.data() + 4 * count, static_cast<std::uint32_t>(goal_ticks_[i]));

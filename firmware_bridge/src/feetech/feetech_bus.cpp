@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
-#include <numbers>
 #include <utility>
 
 #include "animrt/core/error.hpp"
@@ -84,10 +83,7 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
   status_.resize(n);
   present_ticks_.resize(n);
   goal_ticks_.resize(n);
-  limit_lo_.resize(n);
-  limit_hi_.resize(n);
-  min_rad_.resize(n);
-  max_rad_.resize(n);
+  window_.resize(n);
   ids_.resize(n);
   asked_.resize(n);
   answer_.resize(n);
@@ -98,16 +94,7 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
     present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
-    const double a = b.to_rad(min_ticks_);
-    const double c = b.to_rad(max_ticks_);
-    limit_lo_[i] = std::min(a, c);
-    limit_hi_[i] = std::max(a, c);
-    if (b.has_limits()) {
-      limit_lo_[i] = std::max(limit_lo_[i], b.min_position);
-      limit_hi_[i] = std::min(limit_hi_[i], b.max_position);
-    }
-    min_rad_[i] = limit_lo_[i];
-    max_rad_[i] = limit_hi_[i];
+    window_[i] = GoalWindow::for_joint(b, min_ticks_, max_ticks_);
   }
 }
 
@@ -345,29 +332,15 @@ void FeetechBus::configure() {
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
   outside_warning_.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    const ActuatorBinding& b = config_.actuators[i];
-    min_rad_[i] = limit_lo_[i];
-    max_rad_[i] = limit_hi_[i];
-    const double at = b.to_rad(present_ticks_[i]);
-    const std::int32_t a = b.to_ticks(limit_lo_[i]);
-    const std::int32_t c = b.to_ticks(limit_hi_[i]);
-    if (b.has_limits() &&
-        (present_ticks_[i] < std::min(a, c) || present_ticks_[i] > std::max(a, c))) {
-      min_rad_[i] = std::min(min_rad_[i], at);
-      max_rad_[i] = std::max(max_rad_[i], at);
-      char text[160];
-      std::snprintf(text, sizeof text, "%.1f deg, outside its limits %.1f..%.1f deg",
-                    at * 180.0 / std::numbers::pi, limit_lo_[i] * 180.0 / std::numbers::pi,
-                    limit_hi_[i] * 180.0 / std::numbers::pi);
-      outside_warning_ += (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + text;
+    const std::string outside = window_[i].start_at(config_.actuators[i], present_ticks_[i]);
+    if (!outside.empty()) {
+      outside_warning_ +=
+          (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + outside;
     }
     write_angle_limits(i);
   }
   if (!outside_warning_.empty()) {
-    outside_warning_ +=
-        ": its servo's angle limits now include where it is, so torque on holds it there, "
-        "and the start ramp brings it inside (check the joint's zero_ticks and limits if this "
-        "is not expected)";
+    outside_warning_ = outside_limits_warning(outside_warning_, "angle limits");
     std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
   }
   fresh_ = true;
@@ -496,7 +469,7 @@ void FeetechBus::read(std::span<double> positions) {
 
 std::int32_t FeetechBus::goal_ticks(std::size_t device, double rad) const {
   if (!std::isfinite(rad)) return goal_ticks_[device];
-  return config_.actuators[device].to_ticks(std::clamp(rad, min_rad_[device], max_rad_[device]));
+  return config_.actuators[device].to_ticks(window_[device].clamp(rad));
 }
 
 void FeetechBus::write(std::span<const double> positions) {
@@ -505,13 +478,7 @@ void FeetechBus::write(std::span<const double> positions) {
     if (status_[i].faulted) continue;
     if (i < positions.size()) {
       goal_ticks_[i] = goal_ticks(i, positions[i]);
-      if (std::isfinite(positions[i])) {
-        // A joint that started outside its limits: the goals sent so far
-        // bound the way back out (a no-op for a joint inside its limits).
-        const double sent = std::clamp(positions[i], min_rad_[i], max_rad_[i]);
-        min_rad_[i] = std::max(min_rad_[i], std::min(sent, limit_lo_[i]));
-        max_rad_[i] = std::min(max_rad_[i], std::max(sent, limit_hi_[i]));
-      }
+      if (std::isfinite(positions[i])) window_[i].narrow(positions[i]);
     }
     ids_[count] = static_cast<std::uint8_t>(status_[i].device_id);
     ft::put_u16(series_, sync_data_.data() + 2 * count, from_position(goal_ticks_[i]));

@@ -5,12 +5,14 @@
 // the valid gaits through the evaluator in one batch. Used by the
 // single-objective GE search and by the Pareto search.
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/evolve/grammar.hpp"
 #include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/controllers/evolve/random.hpp"
 #include "animrt/controllers/evolve/run_config.hpp"
 
 namespace animrt::evolve {
@@ -30,6 +32,16 @@ struct WalkBatch {
   int evaluations = 0;   // walks simulated
   double seconds = 0.0;  // wall time of those walks
 };
+
+// The first generation: ramped full/grow genomes, not yet mapped or walked.
+std::vector<Individual> initial_population(const Grammar& grammar, const SearchSettings& s,
+                                           Rng& rng);
+
+// Appends children to `next` until it holds `size`: each pair of parents is
+// picked by `pick` (an index into `parents`), crossed over at one point and
+// mutated (int flip), as the run's settings say.
+void breed(const std::vector<Individual>& parents, const std::function<std::size_t()>& pick,
+           const SearchSettings& s, std::size_t size, std::vector<Individual>& next, Rng& rng);
 
 class PopulationWalker {
  public:

@@ -25,6 +25,7 @@
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
+#include "animrt/bridge/goal_window.hpp"
 
 namespace animrt {
 
@@ -151,8 +152,7 @@ class DynamixelBus final : public ActuatorBus {
   }
   std::vector<std::int32_t> present_ticks_;   // latest known, per device
   std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
-  std::vector<double> limit_lo_, limit_hi_;   // the joint's limits, inside int32 ticks
-  std::vector<double> min_rad_, max_rad_;     // goals allowed now (see write())
+  std::vector<GoalWindow> window_;            // the goals allowed now, per servo
   std::vector<std::uint8_t> alert_seen_;      // alert bit in the latest status
   std::vector<std::uint8_t> status_pending_;  // hardware error register to read
   bool fresh_ = false;                        // configure() values not yet handed out

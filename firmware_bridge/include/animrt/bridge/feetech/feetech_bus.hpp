@@ -21,6 +21,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
+#include "animrt/bridge/goal_window.hpp"
 
 namespace animrt {
 
@@ -102,8 +103,7 @@ class FeetechBus final : public ActuatorBus {
   std::array<std::int16_t, 256> device_of_id_{};
   std::vector<std::int32_t> present_ticks_;
   std::vector<std::int32_t> goal_ticks_;
-  std::vector<double> limit_lo_, limit_hi_;  // the joint's limits, inside the series' range
-  std::vector<double> min_rad_, max_rad_;    // what goals may be now (wider while outside)
+  std::vector<GoalWindow> window_;  // the goals allowed now, per servo
   std::string outside_warning_;
   bool fresh_ = false;
 
