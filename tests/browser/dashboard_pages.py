@@ -297,6 +297,9 @@ def main():
                         help="visit only these pages (default: all)")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    failure_shot = os.path.join(args.out, "dashboard_pages_failure.png")
+    if os.path.exists(failure_shot):
+        os.remove(failure_shot)  # from an earlier failing run
     try:
         import selenium  # noqa: F401
     except ImportError:
@@ -327,7 +330,7 @@ def main():
             print(f"FAIL: {e}")
             if driver:
                 try:
-                    driver.save_screenshot(os.path.join(args.out, "dashboard_pages_failure.png"))
+                    driver.save_screenshot(failure_shot)
                     errors = Page(driver).collect_errors()
                     if errors:
                         print("browser errors:\n  " + "\n  ".join(errors))

@@ -1,6 +1,7 @@
 // The evolve run's dashboard API, against a real search of the demo
 // quadruped (short walks, a small population): the snapshot has every
-// generation in order and the best gait so far playing on the figure; a
+// generation in order and the best gait so far playing on the figure (its
+// angles at the playback's time, the figure posed from them); a
 // stop without the token is refused and changes nothing; a stop with it
 // ends the search after the generation being evaluated, with that
 // generation's best as the result; a stream client that never reads holds
@@ -23,6 +24,8 @@
 #include <thread>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
+#include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 
@@ -130,10 +133,19 @@ struct EvolveRig {
     EXPECT_TRUE(res) << path;
     return res ? res->status : -1;
   }
-  // The sampler streams at 50 Hz: the state after the latest publish.
-  json settled_state() {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    return get("/api/state");
+  // The sampler builds the frames at 50 Hz: polls until the state shows
+  // `completed` generations (a bound for the wait, not a timing check).
+  json state_after(int completed) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    for (;;) {
+      json state = get("/api/state");
+      if (state["completed"] == completed) return state;
+      if (std::chrono::steady_clock::now() > give_up) {
+        ADD_FAILURE() << "never " << completed << " generations; last: " << state.dump().substr(0, 300);
+        return state;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
   }
 
   evolve::RunConfig config;
@@ -144,16 +156,6 @@ struct EvolveRig {
   sim::MujocoFigure figure;
   std::unique_ptr<EvolveDashboardServer> server;
 };
-
-double max_distance(const json& a, const json& b) {
-  double d = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      d = std::max(d, std::abs(a[i]["pos"][k].get<double>() - b[i]["pos"][k].get<double>()));
-    }
-  }
-  return d;
-}
 
 TEST(EvolveDashboard, TheSnapshotHasTheGenerationsInOrderAndTheBestGaitPlays) {
   EvolveRig rig(3);
@@ -174,7 +176,7 @@ TEST(EvolveDashboard, TheSnapshotHasTheGenerationsInOrderAndTheBestGaitPlays) {
   const evolve::SearchResult result = rig.search();
   ASSERT_FALSE(result.stopped);
   ASSERT_EQ(result.history.size(), 4u);
-  const json state = rig.settled_state();
+  const json state = rig.state_after(4);
   EXPECT_EQ(state["phase"], "running");  // the command has not finished it yet
   EXPECT_EQ(state["generation"], 3);
   EXPECT_EQ(state["completed"], 4);
@@ -207,10 +209,37 @@ TEST(EvolveDashboard, TheSnapshotHasTheGenerationsInOrderAndTheBestGaitPlays) {
   EXPECT_LT(state["playback"]["t_s"].get<double>(), period);
   EXPECT_EQ(state["playback"]["angles"].size(), rig.info.joints.size());
   ASSERT_EQ(state["bodies"]["measured"].size(), bodies);
-  // The figure moves as the gait loops (a quarter stride later).
+  // What plays is the best gait at the playback's time, and the figure is
+  // posed from those angles; a quarter stride later, again.
+  ASSERT_EQ(state["best"]["phenotype"], result.best.phenotype);
+  std::vector<JointSpec> specs;
+  for (const std::string& name : rig.info.joints) {
+    JointSpec spec;
+    spec.name = name;
+    spec.limits = {-kPi, kPi, 100.0, 10000.0};
+    specs.push_back(spec);
+  }
+  const auto gait = make_gait_source(result.best.gait, specs);
+  sim::MujocoFigure figure(rig.config.model, rig.info.joints, Location{});  // the sampler has its own
+  std::vector<BodyPose> poses(bodies);
+  const auto check_frame = [&](const json& s) {
+    std::vector<double> expected(specs.size(), 0.0);
+    gait->sample(s["playback"]["t_s"].get<double>(), expected);
+    const auto angles = s["playback"]["angles"].get<std::vector<double>>();
+    ASSERT_EQ(angles.size(), expected.size());
+    for (std::size_t j = 0; j < angles.size(); ++j) EXPECT_NEAR(angles[j], expected[j], 1e-12);
+    figure.pose(angles, poses);
+    for (std::size_t b = 0; b < bodies; ++b) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_NEAR(s["bodies"]["measured"][b]["pos"][k].get<double>(), poses[b].pos[k], 1e-12);
+      }
+    }
+  };
+  check_frame(state);
   std::this_thread::sleep_for(std::chrono::duration<double>(period / 4));
   const json later = rig.get("/api/state");
-  EXPECT_GT(max_distance(state["bodies"]["measured"], later["bodies"]["measured"]), 1e-3);
+  EXPECT_NE(later["playback"]["t_s"], state["playback"]["t_s"]);
+  check_frame(later);
 
   // The tail of the curves for a page that has the rest.
   const json tail = rig.get("/api/history?from=2");
@@ -238,12 +267,13 @@ TEST(EvolveDashboard, AStopWithoutTheTokenIsRefusedAndChangesNothing) {
   EXPECT_EQ(rig.post("/api/manual", rig.server->token()), 409);
   EXPECT_EQ(rig.post("/api/steer", rig.server->token()), 409);
   EXPECT_FALSE(rig.server->stop_requested());
-  EXPECT_EQ(rig.settled_state()["phase"], "running");
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // frames after the refusals
+  EXPECT_EQ(rig.get("/api/state")["phase"], "running");
   rig.gated.open();
   search.join();
   EXPECT_FALSE(result.stopped);
   ASSERT_EQ(result.history.size(), 3u);  // generations 0, 1 and 2
-  EXPECT_EQ(rig.settled_state()["completed"], 3);
+  EXPECT_EQ(rig.state_after(3)["phase"], "running");
 }
 
 TEST(EvolveDashboard, AStopWithTheTokenEndsTheRunAfterTheCurrentGeneration) {
@@ -254,7 +284,11 @@ TEST(EvolveDashboard, AStopWithTheTokenEndsTheRunAfterTheCurrentGeneration) {
   rig.gated.wait_held();  // generation 2 is being evaluated
   EXPECT_EQ(rig.post("/api/stop", rig.server->token()), 200);
   EXPECT_TRUE(rig.server->stop_requested());
-  const json stopping = rig.settled_state();
+  json stopping = rig.state_after(2);
+  for (int i = 0; i < 3000 && stopping["phase"] == "running"; ++i) {  // the next frame
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    stopping = rig.get("/api/state");
+  }
   EXPECT_EQ(stopping["phase"], "stopping");
   EXPECT_EQ(stopping["completed"], 2);
   EXPECT_EQ(stopping["evaluating"], 2);
@@ -314,7 +348,7 @@ TEST(EvolveDashboard, AStreamClientThatNeverReadsHoldsUpNeitherPublishingNorOthe
     rig.server->publish(stats, result.best);
   }
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
-  EXPECT_EQ(rig.settled_state()["completed"], 1002);
+  EXPECT_EQ(rig.state_after(1002)["history"].size(), 1002u);
   rig.server->finish(false);
   ::close(fd);
 }

@@ -53,7 +53,10 @@ class Curves {
           { label: 'invalid', data: [], backgroundColor: COLORS.invalid },
         ],
       },
-      options: { ...common, scales: { ...axes('linear', 'individuals'), x: { ...axes('linear', '').x, offset: true } } },
+      options: { ...common, scales: {
+        x: { ...axes('linear', '').x, offset: true },
+        y: { ...axes('linear', 'individuals').y, min: 0, suggestedMax: 1, ticks: { color: COLORS.tick, precision: 0 } },
+      } },
     });
   }
 
