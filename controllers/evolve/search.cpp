@@ -32,6 +32,14 @@ void Search::evaluate(std::vector<Individual>& pop, int generation, GenerationSt
 }
 
 SearchResult Search::run(const std::function<void(const GenerationStats&)>& progress) {
+  SearchHooks hooks;
+  if (progress) hooks.generation = [&progress](const GenerationStats& st, const Individual&) {
+    progress(st);
+  };
+  return run(hooks);
+}
+
+SearchResult Search::run(const SearchHooks& hooks) {
   const SearchSettings& s = config_.search;
   Rng rng(s.seed);
   std::vector<Individual> pop = initial_population(grammar_, s, rng);
@@ -61,9 +69,14 @@ SearchResult Search::run(const std::function<void(const GenerationStats&)>& prog
     result.evaluations += st.evaluations;
     result.invalid += st.invalid;
     result.history.push_back(st);
-    if (progress) progress(st);
+    if (hooks.generation) hooks.generation(st, best);
     if (gen >= s.generations) {
       result.best = best;
+      break;
+    }
+    if (hooks.stop && hooks.stop()) {
+      result.best = best;
+      result.stopped = true;
       break;
     }
 

@@ -38,6 +38,10 @@ class AlsaSink final : public AudioSink {
     if (snd_pcm_delay(pcm_, &delay) < 0 || delay < 0) return 0;
     return delay;
   }
+  void flush() override {
+    snd_pcm_drop(pcm_);
+    snd_pcm_prepare(pcm_);
+  }
   void write(std::span<const float> mono) override {
     std::size_t done = 0;
     while (done < mono.size()) {

@@ -55,7 +55,8 @@ ShowAudioPlayer::ShowAudioPlayer(const ShowFile& show, AudioTrack track,
       schedule_(show.audio, show.loop, show.duration_s, track_.rate,
                 static_cast<std::int64_t>(track_.samples.size())),
       sink_(std::move(sink)),
-      clock_(clock) {
+      clock_(clock),
+      playhead_(show.duration_s, show.loop) {
   thread_ = std::thread([this] { run(); });
 }
 
@@ -64,23 +65,56 @@ ShowAudioPlayer::~ShowAudioPlayer() {
   if (thread_.joinable()) thread_.join();
 }
 
+bool ShowAudioPlayer::control(const ShowCommand& command, double t) {
+  const std::uint64_t head = head_.load(std::memory_order_relaxed);
+  if (head - tail_.load(std::memory_order_acquire) >= kCommands) return false;
+  commands_[head % kCommands] = TimedCommand{command, t};
+  head_.store(head + 1, std::memory_order_release);
+  return true;
+}
+
 void ShowAudioPlayer::run() {
   const int rate = schedule_.rate();
   const std::int64_t block = std::max(1, rate / 100);  // 10 ms per write
   std::vector<float> buffer(static_cast<std::size_t>(block));
-  std::int64_t next = -1;  // show frame of the next block; -1: not playing yet
+  std::int64_t next = -1;  // show frame of the next block; -1: not in step yet
   while (!quit_.load(std::memory_order_acquire)) {
     const Nanos origin = origin_.load(std::memory_order_acquire);
     if (origin == kNotStarted || stopped_.load(std::memory_order_acquire)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
       continue;
     }
+    std::int64_t queued = sink_->queued_frames();
+    // The show's commands since the last block: what is queued belongs to
+    // the transport before them, so it goes.
+    bool moved = false;
+    for (std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+         tail != head_.load(std::memory_order_acquire); ++tail) {
+      const TimedCommand c = commands_[tail % kCommands];
+      tail_.store(tail + 1, std::memory_order_release);
+      const bool was_paused = playhead_.paused();
+      const double was_at = playhead_.time(c.t);
+      playhead_.control(c.command, c.t);
+      // A play while playing (the dashboard sends the whole transport) moves nothing.
+      moved = moved || playhead_.paused() != was_paused ||
+              std::abs(playhead_.time(c.t) - was_at) > 1e-9;
+    }
+    if (moved) {
+      sink_->flush();
+      queued = 0;
+      next = -1;
+    }
+    if (playhead_.paused()) {
+      std::fill(buffer.begin(), buffer.end(), 0.0f);
+      sink_->write(buffer);
+      next = -1;
+      continue;
+    }
     // The show frame that will be heard when the next written frame plays:
-    // now, plus what the output still holds.
-    const std::int64_t queued = sink_->queued_frames();
-    const Nanos since = clock_.now() - origin;
+    // the show's time now, plus what the output still holds.
+    const double motion_t = static_cast<double>(clock_.now() - origin) * 1e-9;
     const std::int64_t heard =
-        static_cast<std::int64_t>(std::floor(static_cast<double>(since) * 1e-9 * rate)) + queued;
+        static_cast<std::int64_t>(std::floor(playhead_.time(motion_t) * rate)) + queued;
     // Continuous blocks while in step; a jump when more than 20 ms apart (the
     // start, a stall of this thread, or drift between the clocks).
     if (next < 0 || std::llabs(heard - next) > rate / 50) next = heard;

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "animrt/controllers/show/show_file.hpp"
+#include "animrt/controllers/show/show_playhead.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
@@ -19,47 +20,18 @@ class ShowSource final : public MotionSource {
   };
 
   ShowSource(std::vector<Track> tracks, bool loop, double duration)
-      : tracks_(std::move(tracks)), loop_(loop), duration_(duration) {
+      : tracks_(std::move(tracks)), loop_(loop), duration_(duration), playhead_(duration, loop) {
     for (const Track& t : tracks_) driven_.push_back(t.joint);
   }
 
   std::span<const int> driven_joints() const override { return driven_; }
 
-  void control(const ShowCommand& command, double t) override {
-    const bool seek = command.seeks != seeks_;
-    if (seek) {
-      seeks_ = command.seeks;
-      const double to = std::isfinite(command.t_s) ? std::clamp(command.t_s, 0.0, duration_) : 0.0;
-      if (paused_) {
-        held_ = to;
-      } else {
-        offset_ = to - t;
-      }
-    }
-    if (command.playing) {
-      double from = playhead(t);
-      if (!seek && !loop_ && from >= duration_) from = 0.0;
-      offset_ = from - t;
-      paused_ = false;
-    } else if (!paused_) {
-      held_ = playhead(t);
-      paused_ = true;
-    }
-  }
+  void control(const ShowCommand& command, double t) override { playhead_.control(command, t); }
 
-  ShowPosition show_position(double t) const override {
-    const double raw = playhead(t);
-    double position = raw;
-    if (loop_) {
-      position = std::fmod(raw, duration_);
-      if (position < 0) position += duration_;
-    }
-    position = std::clamp(position, 0.0, duration_);
-    return ShowPosition{true, !paused_ && (loop_ || raw < duration_), position, duration_};
-  }
+  ShowPosition show_position(double t) const override { return playhead_.position(t); }
 
   void sample(double t, std::span<double> targets) const override {
-    t = playhead(t);
+    t = playhead_.time(t);
     if (loop_) {
       t = std::fmod(t, duration_);
       if (t < 0) t += duration_;
@@ -121,18 +93,11 @@ class ShowSource final : public MotionSource {
     return v0;
   }
 
-  // The show's time at motion time t: held while paused, else t moved by
-  // the seeks and pauses so far.
-  double playhead(double t) const { return paused_ ? held_ : t + offset_; }
-
   std::vector<Track> tracks_;
   bool loop_;
   double duration_;
   std::vector<int> driven_;
-  bool paused_ = false;
-  double held_ = 0.0;    // the show's time while paused
-  double offset_ = 0.0;  // show time minus motion time while playing
-  std::uint32_t seeks_ = 0;
+  ShowPlayhead playhead_;
 };
 
 // Slopes for cubic segments: the slope between the neighbours of each key

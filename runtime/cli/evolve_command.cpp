@@ -15,6 +15,9 @@
 #include "animrt/controllers/evolve/search.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/evolve_dashboard.hpp"
+#include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "evolve_pareto.hpp"
 #include "subcommand.hpp"
@@ -34,13 +37,38 @@ struct EvolveArgs {
   bool mpi = false;
   bool quiet = false;
   bool pareto = false;
+  std::string dashboard;  // HOST:PORT, "" for none
+  bool dashboard_remote = false;
+  double dashboard_rate = 30.0;
+  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
+
+constexpr int kExitUsage = 1;
 
 std::string with_extension(const std::string& path, const std::string& ext) {
   return std::filesystem::path(path).replace_extension(ext).string();
 }
 
 int run_evolve(const EvolveArgs& a) {
+  if (a.pareto && !a.dashboard.empty()) {
+    std::cerr << "--dashboard shows the single-objective search; it does not go with --pareto\n";
+    return kExitUsage;
+  }
+  // The dashboard's address is a usage error before any file is read.
+  std::optional<std::pair<std::string, int>> dashboard_at;
+  if (!a.dashboard.empty()) {
+    try {
+      dashboard_at = parse_host_port(a.dashboard);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "--dashboard: " << e.what() << '\n';
+      return kExitUsage;
+    }
+    if (!a.dashboard_remote && !is_loopback_host(dashboard_at->first)) {
+      std::cerr << "--dashboard: " << dashboard_at->first
+                << " is not a loopback address; serving other machines needs --dashboard-remote\n";
+      return kExitUsage;
+    }
+  }
   evolve::RunConfig config = evolve::load_run_config(a.run_file);
   if (a.seed) config.search.seed = *a.seed;
   if (a.population) config.search.population = *a.population;
@@ -79,6 +107,31 @@ int run_evolve(const EvolveArgs& a) {
       distributed ? static_cast<evolve::Evaluator&>(*distributed) : local;
 
   const int workers = evaluator.workers();
+  // The dashboard (rank 0's): its line comes first.
+  std::unique_ptr<sim::MujocoFigure> figure;
+  std::unique_ptr<EvolveDashboardServer> dashboard;
+  if (dashboard_at && lead) {
+    figure = std::make_unique<sim::MujocoFigure>(config.model, info.joints,
+                                                 Location{config.file, 0, 0});
+    EvolveDashboardSetup setup;
+    setup.host = dashboard_at->first;
+    setup.port = dashboard_at->second;
+    setup.remote = a.dashboard_remote;
+    setup.rate_hz = a.dashboard_rate;
+    setup.www_dir = a.dashboard_www;
+    setup.name = config.name;
+    setup.run_file = config.file;
+    setup.grammar = config.grammar;
+    setup.model_file = config.model;
+    setup.population = config.search.population;
+    setup.generations = config.search.generations;
+    setup.seed = config.search.seed;
+    setup.workers = workers;
+    setup.joints = info.joints;
+    setup.figure = figure.get();
+    dashboard = std::make_unique<EvolveDashboardServer>(setup);
+    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+  }
   if (lead && !a.quiet) {
     std::cout << "evolve " << config.name << ": grammar " << config.grammar << ", model "
               << config.model << " (" << info.joints.size() << " actuators, " << info.mass_kg
@@ -94,11 +147,25 @@ int run_evolve(const EvolveArgs& a) {
   }
   const int generations = config.search.generations;
   evolve::Search search(config, std::move(grammar), seed, info, evaluator);
-  const evolve::SearchResult result = search.run([&](const evolve::GenerationStats& s) {
-    if (lead && !a.quiet)
-      std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
-  });
+  evolve::SearchHooks hooks;
+  hooks.generation = [&](const evolve::GenerationStats& s, const evolve::Individual& best) {
+    if (lead && !a.quiet) std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
+    if (dashboard) dashboard->publish(s, best);
+  };
+  // A stop from the dashboard ends the search after the generation it
+  // arrived in; under MPI rank 0's answer is every rank's.
+  if (dashboard_at) {
+    hooks.stop = [&] {
+      const bool stop = dashboard && dashboard->stop_requested();
+      return session ? session->broadcast(stop) : stop;
+    };
+  }
+  const evolve::SearchResult result = search.run(hooks);
   if (!lead) return 0;
+  if (result.stopped) {
+    std::cout << "stopped from the dashboard after generation " << result.history.back().generation
+              << " of " << generations << '\n';
+  }
 
   const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
   const std::string plot = a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
@@ -106,10 +173,13 @@ int run_evolve(const EvolveArgs& a) {
   evolve::write_history_svg(result.history, config.name, plot);
   const auto& best = result.best;
   if (!best.valid) {
+    if (dashboard) dashboard->finish(result.stopped);
     std::cerr << "error: no valid individual in the last generation; no gait written\n";
     return 4;
   }
   write_gait_file(best.gait, a.out);
+  // The page shows the end once every file is written.
+  if (dashboard) dashboard->finish(result.stopped);
   const auto& m = best.measures;
   std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
             << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
@@ -143,6 +213,17 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_flag("--pareto", args->pareto,
                 "multi-objective search (speed error, energy, tilt): write the Pareto front's "
                 "gaits, front.csv, front.svg and history.csv into the --out folder");
+  cmd->add_option("--dashboard", args->dashboard,
+                  "serve a live page at HOST:PORT (port 0: a free one; loopback only unless "
+                  "--dashboard-remote): fitness curves, the best gait so far on the model, stop");
+  cmd->add_flag("--dashboard-remote", args->dashboard_remote,
+                "let the dashboard listen on an address other machines can reach");
+  cmd->add_option("--dashboard-rate", args->dashboard_rate,
+                  "dashboard stream rate in Hz (default 30)")
+      ->check(CLI::Range(0.5, 200.0));
+  cmd->add_option("--dashboard-www", args->dashboard_www,
+                  "folder of the dashboard's page (default: the source tree's)")
+      ->check(CLI::ExistingDirectory);
   set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }
 

@@ -268,6 +268,12 @@ int cmd_run(const RunArgs& args) {
     for (auto& player : audio) player->stop();
     if (p) p->mark_motion_end();
   };
+  // The sound track follows the show's pause, seek and play.
+  if (!audio.empty()) {
+    options.on_show_command = [&audio](const animrt::ShowCommand& command, double t) {
+      for (auto& player : audio) player->control(command, t);
+    };
+  }
 
   animrt::Runner runner(std::move(robot.config), std::move(buses), std::move(robot.motion));
   // The dashboard serves before the start ramp, so its line comes first.

@@ -106,6 +106,7 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   const double t = in.t;
   CycleOutputs& out = s.out_;
   out.events.clear();
+  out.show_controlled = false;
   std::fill(out.write.begin(), out.write.end(), 0);
   if (s.phase_ == Phase::done) return out;
 
@@ -250,7 +251,10 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   }
 
   // A show's transport acts at the motion's time, before it is sampled.
-  if (s.phase_ == Phase::motion && in.show) motion.control(*in.show, t - s.motion_start_);
+  if (s.phase_ == Phase::motion && in.show) {
+    motion.control(*in.show, t - s.motion_start_);
+    out.show_controlled = true;
+  }
 
   // Sample.
   if (s.phase_ == Phase::motion && s.manual_) {

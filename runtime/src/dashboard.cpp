@@ -13,11 +13,11 @@
 #include <condition_variable>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <stdexcept>
 #include <thread>
 
 #include "animrt/runtime/loop_stats.hpp"
+#include "dashboard_core.hpp"
 
 namespace animrt {
 namespace {
@@ -29,23 +29,6 @@ constexpr std::array<double, 10> kJitterEdgesMs{0.0, 0.025, 0.05, 0.1, 0.25,
                                                 0.5, 1.0,   2.5,  5.0, 10.0};
 constexpr std::size_t kRecentPeriods = 256;  // the rate is their mean's inverse
 constexpr std::size_t kFaultLogCapacity = 200;
-
-std::string random_token() {
-  std::random_device device;  // /dev/urandom on Linux
-  std::string token;
-  for (int i = 0; i < 4; ++i) token += fmt::format("{:08x}", device());
-  return token;
-}
-
-// Equal strings, in time that depends only on their lengths.
-bool same_token(const std::string& given, const std::string& token) {
-  if (given.size() != token.size()) return false;
-  unsigned char diff = 0;
-  for (std::size_t i = 0; i < token.size(); ++i) {
-    diff |= static_cast<unsigned char>(given[i] ^ token[i]);
-  }
-  return diff == 0;
-}
 
 json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
@@ -82,61 +65,25 @@ json timing_json(const MicrosHistogram& h) {
 
 }  // namespace
 
-std::string new_dashboard_token() { return random_token(); }
-bool same_dashboard_token(const std::string& given, const std::string& token) {
-  return same_token(given, token);
-}
-
-bool is_loopback_host(const std::string& host) {
-  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
-}
-
-std::pair<std::string, int> parse_host_port(const std::string& text) {
-  const auto colon = text.rfind(':');
-  const std::string expected =
-      "expected HOST:PORT (e.g. 127.0.0.1:8080, port 0 for a free one), found \"" + text + "\"";
-  if (colon == std::string::npos || colon == 0) throw std::invalid_argument(expected);
-  std::string host = text.substr(0, colon);
-  if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
-    host = host.substr(1, host.size() - 2);
-  }
-  const std::string port_text = text.substr(colon + 1);
-  if (port_text.empty() || port_text.size() > 5 ||
-      !std::all_of(port_text.begin(), port_text.end(),
-                   [](char c) { return c >= '0' && c <= '9'; })) {
-    throw std::invalid_argument(expected);
-  }
-  const int port = std::stoi(port_text);
-  if (port > 65535) throw std::invalid_argument(expected);
-  return {host, port};
-}
-
 struct DashboardServer::Impl {
   RunMonitor& monitor;
   RunControls& controls;
   DashboardSetup setup;
   const RobotModel& model;
-  std::string token;
-  int port = 0;
+  DashboardCore core;
   std::string info;  // /api/info, built once
-
-  httplib::Server server;
-  std::thread listener, sampler;
+  std::thread sampler;
 
   // The sampler's own state (its thread only).
   RunView view;
   LoopStats stats;
   std::vector<BodyPose> measured_bodies, commanded_bodies;
 
-  // Shared with the HTTP handlers.
+  // The sampler's end: it publishes a last frame and ends.
   std::mutex mutex;
   std::condition_variable changed;
-  std::shared_ptr<const std::string> state;  // the latest /api/state
-  std::uint64_t generation = 0;
-  bool sampler_quit = false;  // the sampler publishes a last frame and ends
-  bool quit = false;          // the streams end (after that frame)
-  int streams = 0;            // open /api/stream responses
-  std::vector<std::pair<double, std::string>> faults;  // also the sampler's, under mutex
+  bool sampler_quit = false;
+  std::vector<std::pair<double, std::string>> faults;  // the fault log (the sampler's)
 
   // Controls: one writer at a time for RunControls' single-writer channels.
   std::mutex controls_mutex;
@@ -145,7 +92,11 @@ struct DashboardServer::Impl {
   ShowCommand show;  // the show's transport as the controls last set it
 
   Impl(RunMonitor& m, RunControls& c, DashboardSetup s)
-      : monitor(m), controls(c), setup(std::move(s)), model(m.model()), token(random_token()) {}
+      : monitor(m),
+        controls(c),
+        setup(std::move(s)),
+        model(m.model()),
+        core(DashboardListen{setup.host, setup.port, setup.remote, setup.www_dir, setup.lib_dir}) {}
 
   std::string fault_text(const CycleEvent& e) const {
     const auto joint = [&](int j) {
@@ -253,7 +204,6 @@ struct DashboardServer::Impl {
     while (monitor.pop_event(event)) {
       std::string text = fault_text(event);
       if (text.empty()) continue;
-      std::lock_guard lock(mutex);
       if (faults.size() < kFaultLogCapacity) faults.emplace_back(event.t, std::move(text));
     }
     monitor.read(view);
@@ -295,16 +245,13 @@ struct DashboardServer::Impl {
       }
     }
     json fault_log = json::array();
-    {
-      std::lock_guard lock(mutex);
-      for (const auto& [t, text] : faults) {
-        fault_log.push_back({{"t_s", t}, {"text", text}});
-        // The device's latest fault, for its row.
-        for (json& d : devices) {
-          const std::string prefix =
-              fmt::format("{} id {} ", d["bus"].get<std::string>(), d["id"].get<int>());
-          if (text.rfind(prefix, 0) == 0) d["last_fault"] = text;
-        }
+    for (const auto& [t, text] : faults) {
+      fault_log.push_back({{"t_s", t}, {"text", text}});
+      // The device's latest fault, for its row.
+      for (json& d : devices) {
+        const std::string prefix =
+            fmt::format("{} id {} ", d["bus"].get<std::string>(), d["id"].get<int>());
+        if (text.rfind(prefix, 0) == 0) d["last_fault"] = text;
       }
     }
     json frame = {{"t_s", view.t_s},
@@ -345,45 +292,25 @@ struct DashboardServer::Impl {
     const auto period = std::chrono::duration<double>(1.0 / setup.rate_hz);
     auto next = std::chrono::steady_clock::now();
     for (bool last = false;;) {
-      auto frame = std::make_shared<const std::string>(build_state());
+      core.publish(build_state());
       std::unique_lock lock(mutex);
-      state = std::move(frame);
-      ++generation;
-      changed.notify_all();
       if (last) return;
       next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
       last = changed.wait_until(lock, next, [this] { return sampler_quit; });
     }
   }
 
-  std::shared_ptr<const std::string> latest() {
-    std::lock_guard lock(mutex);
-    return state;
-  }
-
-  bool authorized(const httplib::Request& req) const {
-    const std::string header = req.get_header_value("Authorization");
-    const std::string bearer = "Bearer ";
-    if (header.rfind(bearer, 0) == 0) return same_token(header.substr(bearer.size()), token);
-    return req.has_param("token") && same_token(req.get_param_value("token"), token);
-  }
-
   static void answer(httplib::Response& res, int status, const json& body) {
-    res.status = status;
-    res.set_content(body.dump(), "application/json");
+    DashboardCore::answer(res, status, body);
   }
   static void error(httplib::Response& res, int status, const std::string& message) {
-    answer(res, status, {{"ok", false}, {"error", message}});
+    DashboardCore::error(res, status, message);
   }
 
-  // A control: the token, then a JSON object body, then `act`.
+  // A control: the token, then a JSON object body, then `act` (one at a
+  // time; never in a replay).
   void control(const std::string& path, std::function<void(const json&, httplib::Response&)> act) {
-    server.Post(path, [this, act](const httplib::Request& req, httplib::Response& res) {
-      if (!authorized(req)) return error(res, 401, "a valid token is needed for controls");
-      json body = req.body.empty() ? json::object() : json::parse(req.body, nullptr, false);
-      if (body.is_discarded() || !body.is_object()) {
-        return error(res, 400, "expected a JSON object as the body");
-      }
+    core.control(path, [this, act](const json& body, httplib::Response& res) {
       if (setup.replay) return error(res, 409, "a replay controls no robot");
       std::lock_guard lock(controls_mutex);
       act(body, res);
@@ -399,52 +326,9 @@ struct DashboardServer::Impl {
   }
 
   void routes() {
-    // No compression: on loopback it only costs CPU (brotli at its slowest
-    // setting takes seconds for three.js), and the machine runs the loop.
-    server.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
-      // The request object itself is not const; httplib passes it so.
-      const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
-      return httplib::Server::HandlerResponse::Unhandled;
-    });
+    httplib::Server& server = core.server();
     server.Get("/api/info", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(info, "application/json");
-    });
-    server.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(*latest(), "application/json");
-    });
-    server.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_header("Cache-Control", "no-cache");
-      auto seen = std::make_shared<std::uint64_t>(0);
-      {
-        std::lock_guard lock(mutex);
-        ++streams;
-      }
-      res.set_chunked_content_provider(
-          "text/event-stream",
-          [this, seen](std::size_t, httplib::DataSink& sink) {
-            std::shared_ptr<const std::string> frame;
-            {
-              std::unique_lock lock(mutex);
-              changed.wait(lock, [&] { return quit || generation != *seen; });
-              if (generation == *seen) {
-                sink.done();  // the last chunk: the client sees a complete stream
-                return true;
-              }
-              *seen = generation;
-              frame = state;
-            }
-            const std::string event = "data: " + *frame + "\n\n";
-            // A client that does not read makes this fail after the write
-            // timeout; only this connection's thread waits for it.
-            return sink.write(event.data(), event.size());
-          },
-          [this](bool) {
-            {
-              std::lock_guard lock(mutex);
-              --streams;
-            }
-            changed.notify_all();
-          });
     });
 
     control("/api/stop", [this](const json&, httplib::Response& res) {
@@ -534,67 +418,27 @@ struct DashboardServer::Impl {
       answer(res, 200, {{"ok", true}});
     });
 
-    // The page, and Debian's three.js and Chart.js.
-    // Browsers load ES modules only with a JavaScript type.
-    server.set_file_extension_and_mimetype_mapping("js", "text/javascript");
-    server.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
-    if (!setup.www_dir.empty()) server.set_mount_point("/", setup.www_dir);
-    const std::string three = setup.lib_dir + "/three";
-    const std::string chart = setup.lib_dir + "/chart.js";
-    server.set_mount_point("/lib/three", three);
-    server.set_mount_point("/lib/chart.js", chart);
-    const auto file = [](const std::string& path) {
-      return [path](const httplib::Request&, httplib::Response& res) {
-        std::ifstream in(path, std::ios::binary);
-        if (!in) return error(res, 404, path + " is not installed");
-        res.set_content(std::string(std::istreambuf_iterator<char>(in), {}), "text/javascript");
-      };
-    };
-    server.Get("/lib/three.module.js", file(three + "/three.module.js"));
-    server.Get("/lib/chart.umd.js", file(chart + "/chart.min.js"));
   }
 };
 
 DashboardServer::DashboardServer(RunMonitor& monitor, RunControls& controls, DashboardSetup setup)
     : impl_(std::make_unique<Impl>(monitor, controls, std::move(setup))) {
   Impl& m = *impl_;
-  if (!m.setup.remote && !is_loopback_host(m.setup.host)) {
-    throw std::invalid_argument("--dashboard " + m.setup.host +
-                                " is not a loopback address; add --dashboard-remote to serve "
-                                "other machines");
-  }
   if (!(m.setup.rate_hz > 0.0) || !std::isfinite(m.setup.rate_hz)) {
     throw std::invalid_argument("the dashboard rate must be a positive number of Hz");
   }
   m.info = m.build_info();
-  m.state = std::make_shared<const std::string>(m.build_state());
+  m.core.publish(m.build_state());
   m.routes();
-  // A stream to a client that never reads gives up after this.
-  m.server.set_write_timeout(2, 0);
-  if (m.setup.port == 0) {
-    m.port = m.server.bind_to_any_port(m.setup.host);
-  } else {
-    m.port = m.server.bind_to_port(m.setup.host, m.setup.port) ? m.setup.port : -1;
-  }
-  if (m.port <= 0) {
-    throw std::runtime_error(
-        fmt::format("dashboard: cannot listen on {}:{}", m.setup.host, m.setup.port));
-  }
+  m.core.start();
   m.sampler = std::thread([&m] { m.sample_loop(); });
-  m.listener = std::thread([&m] { m.server.listen_after_bind(); });
 }
 
 DashboardServer::~DashboardServer() { stop(); }
 
-int DashboardServer::port() const { return impl_->port; }
-const std::string& DashboardServer::token() const { return impl_->token; }
-
-std::string DashboardServer::url() const {
-  const std::string& host = impl_->setup.host;
-  const bool v6 = host.find(':') != std::string::npos;
-  return fmt::format("http://{}:{}/?token={}", v6 ? "[" + host + "]" : host, impl_->port,
-                     impl_->token);
-}
+int DashboardServer::port() const { return impl_->core.port(); }
+const std::string& DashboardServer::token() const { return impl_->core.token(); }
+std::string DashboardServer::url() const { return impl_->core.url(); }
 
 void DashboardServer::stop() {
   Impl& m = *impl_;
@@ -604,16 +448,7 @@ void DashboardServer::stop() {
   }
   m.changed.notify_all();
   if (m.sampler.joinable()) m.sampler.join();  // after its last frame
-  {
-    std::unique_lock lock(m.mutex);
-    m.quit = true;
-    m.changed.notify_all();
-    // Open streams end with their last chunk before the server closes; a
-    // client that does not read is not waited for long.
-    m.changed.wait_for(lock, std::chrono::seconds(1), [&m] { return m.streams == 0; });
-  }
-  m.server.stop();
-  if (m.listener.joinable()) m.listener.join();
+  m.core.stop();
 }
 
 }  // namespace animrt

@@ -365,6 +365,9 @@ RunSummary Runner::run(const RunOptions& options) {
                        summary.skipped_cycles, in.steer);
       for (const CycleEvent& e : out.events) monitor->push_event(e);
     }
+    if (out.show_controlled && options.on_show_command) {
+      options.on_show_command(show, in.t - state.motion_start());
+    }
     for (const CycleEvent& e : out.events) {
       if (e.kind == EventKind::motion_started && options.on_motion_start) {
         options.on_motion_start(deadline);

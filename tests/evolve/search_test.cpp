@@ -128,6 +128,40 @@ TEST(Search, InvalidIndividualsScoreWorstAndAreCounted) {
               ((n - expected_invalid) * valid_score + expected_invalid * kWorstFitness) / n, 1e-6);
 }
 
+TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {
+  RunConfig c = tiny_run();
+  c.search.generations = 10;
+  FakeEvaluator fake;
+  Search search(c, Grammar::load_file(c.grammar), load_gait_file(c.seed_gait), {{}, 0.18, 1.6},
+                fake);
+  std::vector<int> seen;
+  int asked = 0;
+  SearchHooks hooks;
+  hooks.generation = [&](const GenerationStats& st, const Individual& best) {
+    seen.push_back(st.generation);
+    EXPECT_EQ(best.fitness, st.best);
+    EXPECT_EQ(best.phenotype, st.best_phenotype);
+  };
+  hooks.stop = [&] { return ++asked == 3; };  // after generation 2
+  const SearchResult r = search.run(hooks);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_EQ(seen, (std::vector<int>{0, 1, 2}));
+  ASSERT_EQ(r.history.size(), 3u);
+  EXPECT_EQ(r.best.fitness, r.history.back().best);
+  EXPECT_TRUE(r.best.valid);
+  // Never asked after the last generation: a run that is not stopped ends as before.
+  c.search.generations = 1;
+  Search whole(c, Grammar::load_file(c.grammar), load_gait_file(c.seed_gait), {{}, 0.18, 1.6},
+               fake);
+  asked = 0;
+  hooks.generation = {};
+  hooks.stop = [&] { return ++asked > 1; };
+  const SearchResult w = whole.run(hooks);
+  EXPECT_FALSE(w.stopped);
+  EXPECT_EQ(w.history.size(), 2u);
+  EXPECT_EQ(asked, 1);
+}
+
 TEST(Phenotype, WrongCurveCountOrBadExpressionIsInvalid) {
   const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/quadruped_seed.yaml");
   EXPECT_FALSE(make_phenotype_gait(seed, "1;2").valid);

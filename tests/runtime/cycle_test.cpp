@@ -583,12 +583,19 @@ TEST(Cycle, ShowCommandsOutsideTheMotionPhaseAreIgnored) {
   bench.begin();
   const ShowCommand command{false, 1, 3.0};
   bench.in.show = &command;
-  bench.cycle();
+  EXPECT_FALSE(bench.cycle().show_controlled);  // nothing for a sound track to follow
   bench.in.show = nullptr;
   bench.run_until(Phase::motion);
-  bench.cycle();
+  EXPECT_FALSE(bench.cycle().show_controlled);
   EXPECT_TRUE(bench.state.show().playing);
   EXPECT_NEAR(bench.state.show().position_s, 1.0 / kRate, 1e-9);
+  // In the motion phase the command acts, and the cycle says so.
+  bench.in.show = &command;
+  EXPECT_TRUE(bench.cycle().show_controlled);
+  bench.in.show = nullptr;
+  EXPECT_FALSE(bench.cycle().show_controlled);
+  EXPECT_FALSE(bench.state.show().playing);
+  EXPECT_EQ(bench.state.show().position_s, 3.0);
 }
 
 TEST(Cycle, StepDoesNotAllocate) {

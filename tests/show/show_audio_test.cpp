@@ -1,20 +1,29 @@
 // A show's sound track: which track sample sounds at which show time (offset,
 // end of track, looping), the player feeding a sink from that schedule once
-// the show starts, and the no-sound-card path. No sound card is needed.
+// the show starts and following the show's pause, seek and play, the run
+// handing the show's commands to it, and the no-sound-card path. No sound
+// card is needed: the player writes into a sink that records its blocks.
 
 #include "animrt/controllers/show/show_audio.hpp"
 
 #include <gtest/gtest.h>
 #include <sndfile.h>
 
+#include <atomic>
+#include <cmath>
+#include <chrono>
 #include <condition_variable>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/show/show_playhead.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/run_monitor.hpp"
+#include "support/sim_rig.hpp"
 
 namespace animrt {
 namespace {
@@ -63,8 +72,8 @@ TEST(ShowAudioSchedule, RenderFillsSilenceAroundTheTrack) {
   EXPECT_EQ(out, (std::vector<float>{0.0f, 0.0f, 0.5f, -0.25f, 0.75f, 0.0f, 0.0f, 0.0f}));
 }
 
-// A sink that plays nothing (everything written stays queued) and lets the
-// test decide how many blocks the player may write.
+// A sink that plays nothing (everything written stays queued until a
+// flush) and lets the test decide how many blocks the player may write.
 class RecordingSink final : public AudioSink {
  public:
   struct Shared {
@@ -72,6 +81,8 @@ class RecordingSink final : public AudioSink {
     std::condition_variable changed;
     std::vector<std::vector<float>> blocks;
     std::size_t allowed = 0;
+    std::size_t flushed_at = 0;  // blocks written before the last flush
+    std::vector<std::size_t> flushes;  // the block count at each flush
   };
   explicit RecordingSink(Shared& shared) : s_(shared) {}
   // The player asks this first in every block, before it reads the clock:
@@ -80,13 +91,20 @@ class RecordingSink final : public AudioSink {
     std::unique_lock lock(s_.mutex);
     s_.changed.wait(lock, [&] { return s_.blocks.size() < s_.allowed; });
     std::int64_t n = 0;
-    for (const auto& b : s_.blocks) n += static_cast<std::int64_t>(b.size());
+    for (std::size_t i = s_.flushed_at; i < s_.blocks.size(); ++i) {
+      n += static_cast<std::int64_t>(s_.blocks[i].size());
+    }
     return n;
   }
   void write(std::span<const float> mono) override {
     std::lock_guard lock(s_.mutex);
     s_.blocks.emplace_back(mono.begin(), mono.end());
     s_.changed.notify_all();
+  }
+  void flush() override {
+    std::lock_guard lock(s_.mutex);
+    s_.flushed_at = s_.blocks.size();
+    s_.flushes.push_back(s_.blocks.size());
   }
 
  private:
@@ -143,6 +161,147 @@ TEST(ShowAudioPlayer, PlaysFromTheShowTimeItIsHeardAtAndResyncsAfterAJump) {
     shared.allowed = SIZE_MAX;  // let the thread leave any write it is in
     shared.changed.notify_all();
   }
+}
+
+// The dashboard's transport, through the player: a pause drops what is
+// queued and writes silence while the clock runs on; a seek while paused
+// stays silent; play goes on from the sought time; a seek while playing
+// jumps there; a play while playing changes nothing.
+TEST(ShowAudioPlayer, PauseSilencesItSeekMovesItAndPlayResumesFromThePlayhead) {
+  ShowFile show;
+  show.duration_s = 10.0;
+  show.audio = audio_at(0.0);
+  AudioTrack track;
+  track.rate = 1000;
+  for (int i = 0; i < 9000; ++i) track.samples.push_back(static_cast<float>(i + 1));
+  const ShowAudioSchedule schedule(show.audio, false, show.duration_s, 1000, 9000);
+  auto expected = [&](std::int64_t first) {
+    std::vector<float> out(10);
+    schedule.render(track.samples, first, out);
+    return out;
+  };
+  const std::vector<float> silence(10, 0.0f);
+
+  RecordingSink::Shared shared;
+  ManualClock clock(from_seconds(100.0));
+  {
+    ShowAudioPlayer player(show, track, std::make_unique<RecordingSink>(shared), clock);
+    const Nanos origin = from_seconds(99.5);  // motion time 0.5 s now
+    player.start(origin);
+    wait_for_blocks(shared, 2);
+    const auto block = [&](std::size_t i) {
+      std::lock_guard lock(shared.mutex);
+      return shared.blocks.at(i);
+    };
+    const auto flushes = [&] {
+      std::lock_guard lock(shared.mutex);
+      return shared.flushes;
+    };
+    EXPECT_EQ(block(0), expected(500));
+    EXPECT_EQ(block(1), expected(510));
+    // Pause at motion time 0.5 s: the 20 frames queued go, silence follows,
+    // also a second later.
+    ASSERT_TRUE(player.control(ShowCommand{false, 0, 0.0}, 0.5));
+    wait_for_blocks(shared, 3);
+    EXPECT_EQ(block(2), silence);
+    EXPECT_EQ(flushes(), (std::vector<std::size_t>{2}));
+    clock.set(from_seconds(101.0));
+    wait_for_blocks(shared, 4);
+    EXPECT_EQ(block(3), silence);
+    // Seek to 4 s while paused (at motion time 1.5 s): still silent.
+    ASSERT_TRUE(player.control(ShowCommand{false, 1, 4.0}, 1.5));
+    wait_for_blocks(shared, 5);
+    EXPECT_EQ(block(4), silence);
+    // Play at motion time 2 s: the track from show time 4 s on, in step.
+    clock.set(from_seconds(101.5));
+    ASSERT_TRUE(player.control(ShowCommand{true, 1, 4.0}, 2.0));
+    wait_for_blocks(shared, 6);
+    EXPECT_EQ(block(5), expected(4000));
+    wait_for_blocks(shared, 7);
+    EXPECT_EQ(block(6), expected(4010));  // the 10 frames queued since the flush
+    EXPECT_EQ(flushes(), (std::vector<std::size_t>{2, 4, 5}));
+    // A play while playing moves nothing: no flush, no jump.
+    ASSERT_TRUE(player.control(ShowCommand{true, 1, 4.0}, 2.0));
+    wait_for_blocks(shared, 8);
+    EXPECT_EQ(block(7), expected(4020));
+    EXPECT_EQ(flushes().size(), 3u);
+    // Seek to 0.25 s while playing (at motion time 2 s): it jumps there.
+    ASSERT_TRUE(player.control(ShowCommand{true, 2, 0.25}, 2.0));
+    wait_for_blocks(shared, 9);
+    EXPECT_EQ(block(8), expected(250));
+    EXPECT_EQ(flushes().size(), 4u);
+    player.stop();
+    std::lock_guard lock(shared.mutex);
+    shared.allowed = SIZE_MAX;  // let the thread leave any write it is in
+    shared.changed.notify_all();
+  }
+}
+
+// The run hands a show's commands to its sound track (RunOptions::
+// on_show_command) at the motion time the show took them: a playhead fed
+// those commands at those times is where the show's own is, after a pause,
+// a seek while paused and a play (configs/robots/animatronic.yaml: hello.yaml
+// over a gait, lockstep).
+TEST(ShowAudio, TheRunHandsTheShowsCommandsToItsSoundTrackAtTheTimesTheyActed) {
+  test::SimRig rig(std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/animatronic.yaml");
+  RunMonitor monitor(rig.runner().model());
+  RunControls controls;
+  struct Taken {
+    ShowCommand command;
+    double t;
+  };
+  std::array<Taken, 8> taken{};  // filled in the cycle: no allocation
+  std::atomic<int> count{0};
+  std::atomic<bool> started{false};
+  RunOptions options = rig.options(0.0);
+  options.controls = &controls;
+  options.monitor = &monitor;
+  options.on_motion_start = [&](Nanos) { started = true; };
+  options.on_show_command = [&](const ShowCommand& command, double t) {
+    const int i = count.load();
+    if (i < static_cast<int>(taken.size())) taken[static_cast<std::size_t>(i)] = {command, t};
+    count = i + 1;
+  };
+  RunSummary summary;
+  std::thread run([&] { summary = rig.run(options); });
+  const auto wait = [&](const std::function<bool()>& done) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!done() && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return done();
+  };
+  ASSERT_TRUE(wait([&] { return started.load(); }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  controls.show.post(ShowCommand{false, 0, 0.0});  // pause
+  EXPECT_TRUE(wait([&] { return count == 1; }));
+  controls.show.post(ShowCommand{false, 1, 2.5});  // seek while paused
+  EXPECT_TRUE(wait([&] { return count == 2; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  controls.show.post(ShowCommand{true, 1, 2.5});  // play
+  EXPECT_TRUE(wait([&] { return count == 3; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  controls.stop = true;
+  run.join();
+  ASSERT_EQ(count, 3);
+  EXPECT_FALSE(taken[0].command.playing);
+  EXPECT_EQ(taken[1].command.seeks, 1u);
+  EXPECT_TRUE(taken[2].command.playing);
+  EXPECT_LT(taken[0].t, taken[1].t);
+  EXPECT_LT(taken[1].t, taken[2].t);
+
+  // The show's playhead as the run last published it (the end of the
+  // motion), and the sound track's, fed the same commands.
+  RunView view;
+  monitor.read(view);
+  ASSERT_TRUE(view.show.show);
+  ShowPlayhead playhead(view.show.duration_s, true);  // hello.yaml loops
+  for (int i = 0; i < 3; ++i) playhead.control(taken[i].command, taken[i].t);
+  const ShowPosition sound = playhead.position(view.motion_time_s);
+  EXPECT_NEAR(sound.position_s, view.show.position_s, 1e-9);
+  EXPECT_GT(view.motion_time_s, taken[2].t);
+  EXPECT_NEAR(sound.position_s,
+              std::fmod(2.5 + (view.motion_time_s - taken[2].t), view.show.duration_s), 1e-9);
 }
 
 std::string write_show_with_audio(const std::string& name) {
@@ -247,6 +406,10 @@ TEST(ShowAudio, TheAlsaSinkWritesToTheNullDevice) {
   const std::vector<float> block(80, 0.25f);
   for (int i = 0; i < 3; ++i) sink->write(block);
   EXPECT_EQ(sink->queued_frames(), 0);
+  // A pause or a seek drops what is queued; writing goes on after it.
+  sink->flush();
+  EXPECT_EQ(sink->queued_frames(), 0);
+  sink->write(block);
 }
 
 }  // namespace

@@ -52,6 +52,12 @@ MpiSession::MpiSession(int* argc, char*** argv) {
 
 MpiSession::~MpiSession() { MPI_Finalize(); }
 
+bool MpiSession::broadcast(bool value) const {
+  int flag = value ? 1 : 0;
+  MPI_Bcast(&flag, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return flag != 0;
+}
+
 MpiEvaluator::MpiEvaluator(const MpiSession& session, Evaluator& local)
     : rank_(session.rank()), size_(session.size()), local_(local) {}
 

@@ -3,6 +3,7 @@
 import { getInfo, openStream } from './api.js';
 import { JitterHistogram, JointCharts, JointHistory } from './charts.js';
 import { makeControls } from './controls.js';
+import { startEvolve } from './evolve.js';
 import { startHerd } from './herd.js';
 import { DeviceTable, JointList, showFaults, showInfo, showLoop, showMotion, showPhase } from './panels.js';
 import { FigureView } from './view3d.js';
@@ -34,6 +35,10 @@ async function start() {
   }
   if (info.kind === 'herd') {
     await startHerd(info, setStreamStatus);
+    return;
+  }
+  if (info.kind === 'evolve') {
+    await startEvolve(info, setStreamStatus, showPageError);
     return;
   }
   showInfo(info);

@@ -229,6 +229,14 @@ export class FigureView {
     if (!this.ok || !this.measured || !bodies) return;
     applyPoses(this.measured, bodies.measured);
     applyPoses(this.commanded, bodies.commanded);
+    // A digest of the measured pose, for tests: it changes as the figure moves.
+    if (Array.isArray(bodies.measured)) {
+      let sum = 0;
+      bodies.measured.forEach((p, i) => {
+        if (p && Array.isArray(p.pos)) sum += (i + 1) * (p.pos[0] + 2 * p.pos[1] + 3 * p.pos[2]);
+      });
+      this.container.dataset.pose = sum.toFixed(6);
+    }
     this.follow();
     this.requestRender();
   }

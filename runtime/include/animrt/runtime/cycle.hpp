@@ -78,6 +78,9 @@ struct CycleOutputs {
   std::vector<std::uint8_t> write;                // per bus: write bus_commands this cycle
   std::vector<CycleEvent> events;                 // this cycle's
   bool torque_off_now = false;                    // end without a ramp (deadline, abort)
+  // CycleInputs::show acted this cycle (MotionSource::control at motion time
+  // t - motion_start()), so a show's sound track can follow it.
+  bool show_controlled = false;
 };
 
 // What ended the run, as far as the cycle knows.

@@ -42,6 +42,11 @@ struct RunOptions {
   // a show's sound track can follow it. Must not block, lock or allocate.
   std::function<void(Nanos)> on_motion_start;
   std::function<void()> on_motion_end;
+  // Called from inside the cycle when the show took a transport command (a
+  // dashboard's play, pause or seek), with the motion time it acted at (as
+  // MotionSource::control got it), so a show's sound track can follow it.
+  // Same rules as on_motion_start.
+  std::function<void(const ShowCommand&, double)> on_show_command;
   // Readers of the run (a dashboard): the cycle publishes its state, timing
   // and events here, lock-free. Built on this runner's model().
   RunMonitor* monitor = nullptr;

@@ -24,6 +24,9 @@ class MpiSession {
   MpiSession& operator=(const MpiSession&) = delete;
   int rank() const { return rank_; }
   int size() const { return size_; }
+  // Rank 0's `value` on every rank (a collective: every rank calls it, in
+  // the same order), e.g. a stop request only rank 0's dashboard receives.
+  bool broadcast(bool value) const;
 
  private:
   int rank_ = 0;

@@ -37,6 +37,19 @@ struct SearchResult {
   Individual best;  // best of the last generation
   long evaluations = 0;
   long invalid = 0;
+  bool stopped = false;  // SearchHooks::stop ended the run before its last generation
+};
+
+// What a run tells its caller and asks it, between generations, on the
+// search's thread (never while a generation is being evaluated).
+struct SearchHooks {
+  // After each generation: its statistics (as in SearchResult::history) and
+  // its best individual.
+  std::function<void(const GenerationStats&, const Individual& best)> generation;
+  // Asked after each generation but the last: true ends the run there, that
+  // generation's best being the result (SearchResult::stopped). Under MPI
+  // every rank must give the same answer.
+  std::function<bool()> stop;
 };
 
 class Search {
@@ -46,6 +59,7 @@ class Search {
   Search(RunConfig config, Grammar grammar, GaitFile seed, ModelInfo model, Evaluator& evaluator);
 
   SearchResult run(const std::function<void(const GenerationStats&)>& progress = {});
+  SearchResult run(const SearchHooks& hooks);
 
  private:
   void evaluate(std::vector<Individual>& pop, int generation, GenerationStats& stats);

@@ -2,13 +2,16 @@
 // A show's sound track, played in step with the show. The schedule says which
 // sample of the track sounds at which show time (pure arithmetic on frame
 // counts, tested without a sound card); the player is a normal-priority
-// thread that feeds ALSA from that schedule once the show has started.
+// thread that feeds ALSA from that schedule once the show has started, and
+// follows the show's transport (a dashboard's pause, seek and play): it keeps
+// a ShowPlayhead that gets the show's commands at the same motion times.
 //
 // Show frame f is show time f / rate. Track frame (f - offset) sounds at show
 // frame f: silence before the offset and after the track's end. A looping
 // show restarts its track on every pass (show frames wrap at the show's
 // duration), so a track longer than a pass is cut at the wrap.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "animrt/controllers/show/show_file.hpp"
+#include "animrt/controllers/show/show_playhead.hpp"
 #include "animrt/core/clock.hpp"
 
 namespace animrt {
@@ -57,6 +61,9 @@ class AudioSink {
   virtual std::int64_t queued_frames() = 0;
   // Blocks until the frames are queued.
   virtual void write(std::span<const float> mono) = 0;
+  // Drops what is queued and not yet heard (a pause or a seek is heard at
+  // once); queued_frames() is 0 after it.
+  virtual void flush() {}
 };
 // Opens an ALSA playback device (e.g. "default") for mono float at `rate`.
 // Throws DeviceError with ALSA's reason (no sound card, busy, ...); ALSA's
@@ -74,9 +81,17 @@ class ShowAudioPlayer {
   ShowAudioPlayer(const ShowAudioPlayer&) = delete;
   ShowAudioPlayer& operator=(const ShowAudioPlayer&) = delete;
 
-  // From the control loop: no lock, no allocation, no blocking.
+  // From the control loop: no lock, no allocation, no blocking. start()
+  // gives the clock time of motion time 0 (the show's time 0 until a
+  // command moves it).
   void start(Nanos show_origin) { origin_.store(show_origin, std::memory_order_release); }
   void stop() { stopped_.store(true, std::memory_order_release); }
+  // The show's transport command as the show took it, at motion time `t`
+  // (RunOptions::on_show_command). While paused the player writes silence;
+  // a pause or a seek drops what the sink still holds; a play goes on from
+  // the playhead. From one thread (the cycle); false when the player has
+  // fallen kCommands behind (the command is lost).
+  bool control(const ShowCommand& command, double t);
 
   // Show frames written to the sink so far (for tests and the report).
   std::int64_t frames_played() const { return played_.load(std::memory_order_acquire); }
@@ -93,6 +108,17 @@ class ShowAudioPlayer {
   std::atomic<bool> stopped_{false};
   std::atomic<bool> quit_{false};
   std::atomic<std::int64_t> played_{0};
+  // The commands in order, from the cycle to the player's thread (one
+  // producer, one consumer; a slot is the producer's until `head_` passes
+  // it, then the consumer's until `tail_` does).
+  static constexpr std::size_t kCommands = 64;
+  struct TimedCommand {
+    ShowCommand command;
+    double t = 0.0;
+  };
+  std::array<TimedCommand, kCommands> commands_{};
+  std::atomic<std::uint64_t> head_{0}, tail_{0};
+  ShowPlayhead playhead_;  // the player thread's
   std::thread thread_;
 };
 

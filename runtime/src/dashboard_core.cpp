@@ -1,0 +1,226 @@
+// The plumbing the dashboards share (see dashboard_core.hpp).
+
+#include "dashboard_core.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <stdexcept>
+
+#include "animrt/runtime/dashboard.hpp"
+
+namespace animrt {
+
+using nlohmann::json;
+
+std::string new_dashboard_token() {
+  std::random_device device;  // /dev/urandom on Linux
+  std::string token;
+  for (int i = 0; i < 4; ++i) token += fmt::format("{:08x}", device());
+  return token;
+}
+
+// Equal strings, in time that depends only on their lengths.
+bool same_dashboard_token(const std::string& given, const std::string& token) {
+  if (given.size() != token.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < token.size(); ++i) {
+    diff |= static_cast<unsigned char>(given[i] ^ token[i]);
+  }
+  return diff == 0;
+}
+
+bool is_loopback_host(const std::string& host) {
+  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
+}
+
+std::pair<std::string, int> parse_host_port(const std::string& text) {
+  const auto colon = text.rfind(':');
+  const std::string expected =
+      "expected HOST:PORT (e.g. 127.0.0.1:8080, port 0 for a free one), found \"" + text + "\"";
+  if (colon == std::string::npos || colon == 0) throw std::invalid_argument(expected);
+  std::string host = text.substr(0, colon);
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  const std::string port_text = text.substr(colon + 1);
+  if (port_text.empty() || port_text.size() > 5 ||
+      !std::all_of(port_text.begin(), port_text.end(),
+                   [](char c) { return c >= '0' && c <= '9'; })) {
+    throw std::invalid_argument(expected);
+  }
+  const int port = std::stoi(port_text);
+  if (port > 65535) throw std::invalid_argument(expected);
+  return {host, port};
+}
+
+DashboardCore::DashboardCore(DashboardListen listen)
+    : listen_(std::move(listen)), token_(new_dashboard_token()) {
+  if (!listen_.remote && !is_loopback_host(listen_.host)) {
+    throw std::invalid_argument("--dashboard " + listen_.host +
+                                " is not a loopback address; add --dashboard-remote to serve "
+                                "other machines");
+  }
+  // A stream to a client that never reads gives up after this.
+  server_.set_write_timeout(2, 0);
+  // An idle keep-alive connection (a browser keeps some) holds up the
+  // server's stop until it times out: 1 s, not httplib's 5 s, so the
+  // program ends soon after its run.
+  server_.set_keep_alive_timeout(1);
+}
+
+DashboardCore::~DashboardCore() { stop(); }
+
+bool DashboardCore::authorized(const httplib::Request& req) const {
+  const std::string header = req.get_header_value("Authorization");
+  const std::string bearer = "Bearer ";
+  if (header.rfind(bearer, 0) == 0) return same_dashboard_token(header.substr(bearer.size()), token_);
+  return req.has_param("token") && same_dashboard_token(req.get_param_value("token"), token_);
+}
+
+void DashboardCore::publish(std::shared_ptr<const std::string> frame) {
+  std::lock_guard lock(mutex_);
+  frame_ = std::move(frame);
+  ++generation_;
+  changed_.notify_all();
+}
+
+std::shared_ptr<const std::string> DashboardCore::latest() const {
+  std::lock_guard lock(mutex_);
+  return frame_;
+}
+
+void DashboardCore::answer(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+void DashboardCore::error(httplib::Response& res, int status, const std::string& message) {
+  answer(res, status, {{"ok", false}, {"error", message}});
+}
+
+void DashboardCore::control(const std::string& path,
+                            std::function<void(const json&, httplib::Response&)> act) {
+  server_.Post(path, [this, act](const httplib::Request& req, httplib::Response& res) {
+    if (!authorized(req)) return error(res, 401, "a valid token is needed for controls");
+    json body = req.body.empty() ? json::object() : json::parse(req.body, nullptr, false);
+    if (body.is_discarded() || !body.is_object()) {
+      return error(res, 400, "expected a JSON object as the body");
+    }
+    act(body, res);
+  });
+}
+
+void DashboardCore::refuse(const std::string& path, const std::string& why) {
+  server_.Post(path, [why](const httplib::Request&, httplib::Response& res) {
+    error(res, 409, why);
+  });
+}
+
+void DashboardCore::routes() {
+  // No compression: on loopback it only costs CPU (brotli at its slowest
+  // setting takes seconds for three.js), and the machine runs the loop.
+  server_.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
+    // The request object itself is not const; httplib passes it so.
+    const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  server_.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
+    const auto frame = latest();
+    res.set_content(state_from_ ? state_from_(*frame) : *frame, "application/json");
+  });
+  server_.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    auto seen = std::make_shared<std::uint64_t>(0);
+    {
+      std::lock_guard lock(mutex_);
+      ++streams_;
+    }
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [this, seen](std::size_t, httplib::DataSink& sink) {
+          std::shared_ptr<const std::string> frame;
+          {
+            std::unique_lock lock(mutex_);
+            changed_.wait(lock, [&] { return quit_ || generation_ != *seen; });
+            if (generation_ == *seen) {
+              sink.done();  // the last chunk: the client sees a complete stream
+              return true;
+            }
+            *seen = generation_;
+            frame = frame_;
+          }
+          const std::string event = "data: " + *frame + "\n\n";
+          // A client that does not read makes this fail after the write
+          // timeout; only this connection's thread waits for it.
+          return sink.write(event.data(), event.size());
+        },
+        [this](bool) {
+          {
+            std::lock_guard lock(mutex_);
+            --streams_;
+          }
+          changed_.notify_all();
+        });
+  });
+
+  // The page, and Debian's three.js and Chart.js.
+  // Browsers load ES modules only with a JavaScript type.
+  server_.set_file_extension_and_mimetype_mapping("js", "text/javascript");
+  server_.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
+  if (!listen_.www_dir.empty()) server_.set_mount_point("/", listen_.www_dir);
+  const std::string three = listen_.lib_dir + "/three";
+  const std::string chart = listen_.lib_dir + "/chart.js";
+  server_.set_mount_point("/lib/three", three);
+  server_.set_mount_point("/lib/chart.js", chart);
+  const auto file = [](const std::string& path) {
+    return [path](const httplib::Request&, httplib::Response& res) {
+      std::ifstream in(path, std::ios::binary);
+      if (!in) return error(res, 404, path + " is not installed");
+      res.set_content(std::string(std::istreambuf_iterator<char>(in), {}), "text/javascript");
+    };
+  };
+  server_.Get("/lib/three.module.js", file(three + "/three.module.js"));
+  server_.Get("/lib/chart.umd.js", file(chart + "/chart.min.js"));
+}
+
+void DashboardCore::start() {
+  routes();
+  if (listen_.port == 0) {
+    port_ = server_.bind_to_any_port(listen_.host);
+  } else {
+    port_ = server_.bind_to_port(listen_.host, listen_.port) ? listen_.port : -1;
+  }
+  if (port_ <= 0) {
+    throw std::runtime_error(
+        fmt::format("dashboard: cannot listen on {}:{}", listen_.host, listen_.port));
+  }
+  listener_ = std::thread([this] { server_.listen_after_bind(); });
+}
+
+std::string DashboardCore::url() const {
+  const std::string& host = listen_.host;
+  const bool v6 = host.find(':') != std::string::npos;
+  return fmt::format("http://{}:{}/?token={}", v6 ? "[" + host + "]" : host, port_, token_);
+}
+
+void DashboardCore::stop() {
+  {
+    std::unique_lock lock(mutex_);
+    if (stopped_) return;
+    stopped_ = true;
+    quit_ = true;
+    changed_.notify_all();
+    // Open streams end with their last chunk before the server closes; a
+    // client that does not read is not waited for long.
+    changed_.wait_for(lock, std::chrono::seconds(1), [this] { return streams_ == 0; });
+  }
+  server_.stop();
+  if (listener_.joinable()) listener_.join();
+}
+
+}  // namespace animrt
