@@ -26,23 +26,57 @@ constexpr int kSearchPasses = 3;
 WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* calibration)
     : steering_(steering), calibrated_(calibration != nullptr) {
   if (!calibration) return;
+  // Every measured point, by commanded speed and then turn.
+  std::vector<Level> all;
   for (const CalibrationPoint& p : calibration->points) {
-    if (!p.usable) continue;
-    auto it = std::find_if(levels_.begin(), levels_.end(),
+    auto it = std::find_if(all.begin(), all.end(),
                            [&](const Level& l) { return l.speed == p.commanded.speed_m_s; });
-    if (it == levels_.end()) {
-      levels_.push_back(Level{p.commanded.speed_m_s, {}});
-      it = levels_.end() - 1;
+    if (it == all.end()) {
+      all.push_back(Level{p.commanded.speed_m_s, {}});
+      it = all.end() - 1;
     }
     it->points.push_back(p);
   }
-  std::sort(levels_.begin(), levels_.end(),
+  std::sort(all.begin(), all.end(),
             [](const Level& a, const Level& b) { return a.speed < b.speed; });
-  for (Level& l : levels_) {
+  for (Level& l : all) {
     std::sort(l.points.begin(), l.points.end(), [](const auto& a, const auto& b) {
       return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
     });
+    // Keep the usable turns that reach the straight walk without crossing
+    // an unusable one: a turn rate between two usable points is only
+    // trusted when nothing measured between them failed.
+    const auto straight = std::find_if(l.points.begin(), l.points.end(), [](const auto& p) {
+      return p.commanded.turn_rad_s == 0.0 && p.usable;
+    });
+    if (straight == l.points.end()) {
+      l.points.clear();
+      continue;
+    }
+    auto lo = straight, hi = straight + 1;
+    while (lo != l.points.begin() && (lo - 1)->usable) --lo;
+    while (hi != l.points.end() && hi->usable) ++hi;
+    l.points = std::vector<CalibrationPoint>(lo, hi);
   }
+  // The longest run of speeds whose straight walk is usable (the faster
+  // one on a tie): the herd interpolates between neighbouring speeds, so a
+  // speed that failed in between must not be bridged.
+  std::size_t best_begin = 0, best_len = 0;
+  for (std::size_t i = 0; i < all.size();) {
+    if (all[i].points.empty()) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < all.size() && !all[j].points.empty()) ++j;
+    if (j - i >= best_len) {
+      best_begin = i;
+      best_len = j - i;
+    }
+    i = j;
+  }
+  levels_.assign(all.begin() + static_cast<std::ptrdiff_t>(best_begin),
+                 all.begin() + static_cast<std::ptrdiff_t>(best_begin + best_len));
 }
 
 double WalkResponse::min_speed() const {
