@@ -18,8 +18,10 @@ MotionCommand lerp(const MotionCommand& a, const MotionCommand& b, double u) {
 }
 
 // Candidates per axis in each pass of command_for's search.
-constexpr int kSearchSteps = 24;
-constexpr int kSearchPasses = 3;
+constexpr int kSearchSteps = 4;
+constexpr int kSearchPasses = 5;
+// Nodes per axis of the precomputed grid the search starts from.
+constexpr int kGridNodes = 17;
 
 }  // namespace
 
@@ -77,6 +79,18 @@ WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* 
   }
   levels_.assign(all.begin() + static_cast<std::ptrdiff_t>(best_begin),
                  all.begin() + static_cast<std::ptrdiff_t>(best_begin + best_len));
+  // What every node of a grid over the usable commands achieves: a herd
+  // asks command_for for every figure at every step, and starting its search
+  // from the closest node keeps that cheap.
+  if (levels_.empty()) return;
+  for (int i = 0; i < kGridNodes; ++i) {
+    const double v = min_speed() + (max_speed() - min_speed()) * i / (kGridNodes - 1);
+    const double limit = max_turn(v);
+    for (int k = 0; k < kGridNodes; ++k) {
+      const MotionCommand c{v, limit * (2.0 * k / (kGridNodes - 1) - 1.0)};
+      grid_.push_back({c, achieved(c)});
+    }
+  }
 }
 
 double WalkResponse::min_speed() const {
@@ -172,9 +186,22 @@ MotionCommand WalkResponse::command_for(const MotionCommand& wanted) const {
   double best_error = error(best);
   if (max_speed() <= 0.0 || !std::isfinite(wanted.speed_m_s) || !std::isfinite(wanted.turn_rad_s))
     return best;
-  double v_lo = min_speed(), v_hi = max_speed();
-  double w_span = steering_.max_turn_rad_s;
-  double w_mid = 0.0;
+  // The closest grid node, then a finer search around it.
+  for (const auto& [c, a] : grid_) {
+    const double dv = a.speed_m_s - wanted.speed_m_s;
+    const double dw = (a.turn_rad_s - wanted.turn_rad_s) * arm;
+    const double e = dv * dv + dw * dw;
+    if (e < best_error) {
+      best_error = e;
+      best = c;
+    }
+  }
+  if (best.speed_m_s <= 0.0) return best;
+  const double grid_dv = (max_speed() - min_speed()) / (kGridNodes - 1);
+  double v_lo = std::max(min_speed(), best.speed_m_s - grid_dv);
+  double v_hi = std::min(max_speed(), best.speed_m_s + grid_dv);
+  double w_span = 2.0 * steering_.max_turn_rad_s / (kGridNodes - 1);
+  double w_mid = best.turn_rad_s;
   for (int pass = 0; pass < kSearchPasses; ++pass) {
     for (int i = 0; i <= kSearchSteps; ++i) {
       const double v = v_lo + (v_hi - v_lo) * i / kSearchSteps;

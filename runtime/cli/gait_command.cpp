@@ -76,7 +76,8 @@ int run_calibrate(const CalibrateArgs& a) {
     const double u = a.speeds == 1 ? 0.5 : static_cast<double>(i) / (a.speeds - 1);
     const double fr = st.min_froude + u * (st.max_froude - st.min_froude);
     const double v = froude_velocity(fr, st.hip_height_m);
-    const double stride_s = 1.0 / froude_stride_frequency(fr, st.hip_height_m);
+    const double stride_s = 1.0 / (st.fixed_cadence ? gait.stride_frequency()
+                                                    : froude_stride_frequency(fr, st.hip_height_m));
     const double ramp_s = v / st.max_acceleration_m_s2 + stride_s;
     for (int k = -a.turns; k <= a.turns; ++k) {
       const double sign = k < 0 ? -1.0 : 1.0;

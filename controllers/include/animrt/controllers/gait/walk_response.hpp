@@ -94,6 +94,10 @@ class WalkResponse {
   GaitSteering steering_;
   bool calibrated_ = false;
   std::vector<Level> levels_;  // by commanded speed
+  struct Node {
+    MotionCommand commanded, achieved;
+  };
+  std::vector<Node> grid_;  // calibrated only: where command_for starts
 };
 
 // The walk response of a steerable gait: its steering section, and its
