@@ -1,5 +1,6 @@
 // Reading and writing walk calibration tables (format: docs/gait.md).
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -57,8 +58,13 @@ bool operator==(const GaitCalibration& a, const GaitCalibration& b) {
 
 bool calibration_usable(const CalibrationPoint& p, double tolerance) {
   const double v = p.commanded.speed_m_s;
+  const double w = p.commanded.turn_rad_s;
+  const double turn_allowed =
+      std::max(tolerance * std::abs(w), deg_to_rad(kCalibrationTurnFloorDps));
   return !p.fell && v > 0.0 && std::isfinite(p.achieved.speed_m_s) &&
-         std::abs(p.achieved.speed_m_s - v) <= tolerance * v;
+         std::abs(p.achieved.speed_m_s - v) <= tolerance * v &&
+         std::isfinite(p.achieved.turn_rad_s) &&
+         std::abs(p.achieved.turn_rad_s - w) <= turn_allowed;
 }
 
 std::string calibration_path_for(const std::string& gait_path) {
@@ -93,7 +99,7 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
     if (const auto u = node.find("usable"); u && u->as_bool() != p.usable) {
       u->fail(std::string("usable is ") + (p.usable ? "false" : "true") + " but the point is " +
               (p.usable ? "" : "not ") + "within tolerance " + shortest(cal.tolerance) +
-              " without a fall");
+              " (speed and turn) without a fall");
     }
     cal.points.push_back(p);
   }

@@ -269,7 +269,8 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
   const auto node = root.find("steering");
   if (!node) return;
   node->allow_only({"min_froude", "max_froude", "max_turn_dps", "max_acceleration_m_s2",
-                    "hip_height_m", "track_width_m", "sides", "yaw_joints"});
+                    "hip_height_m", "track_width_m", "sides", "yaw_joints", "lift_curves",
+                    "swing_offset", "fixed_cadence"});
   GaitSteering s;
   s.where = node->location();
   const YamlNode min_fr = node->at("min_froude");
@@ -318,6 +319,17 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
         items[i].fail("yaw joint '" + s.yaw_joints[i] +
                       "' is not one of the gait's joints (map it under joints)");
       }
+    }
+  }
+  if (const auto off = node->find("swing_offset")) s.swing_offset = off->as_double_in(-5.0, 0.9);
+  if (const auto fixed = node->find("fixed_cadence")) s.fixed_cadence = fixed->as_bool();
+  if (const auto lift = node->find("lift_curves")) {
+    s.lift_curves = read_names(*lift);
+    const auto items = lift->items();
+    for (std::size_t i = 0; i < s.lift_curves.size(); ++i) {
+      bool defined = false;
+      for (const auto& c : gait.curves) defined = defined || c.name == s.lift_curves[i];
+      if (!defined) items[i].fail("undefined curve '" + s.lift_curves[i] + "'");
     }
   }
   gait.steering = std::move(s);
@@ -403,6 +415,12 @@ void validate_steering(const GaitFile& gait) {
     for (const auto& j : gait.joints) mapped = mapped || j.name == y;
     if (!mapped) fail("yaw_joints", "yaw joint '" + y + "' is not one of the gait's joints");
   }
+  if (!in(s.swing_offset, -5.0, 0.9)) fail("swing_offset", "expected a number from -5 to 0.9");
+  for (const auto& c : s.lift_curves) {
+    bool defined = false;
+    for (const auto& gc : gait.curves) defined = defined || gc.name == c;
+    if (!defined) fail("lift_curves", "undefined curve '" + c + "'");
+  }
 }
 
 std::string names_text(const std::vector<std::string>& names) {
@@ -469,7 +487,8 @@ bool operator==(const GaitSteering& a, const GaitSteering& b) {
          a.max_turn_rad_s == b.max_turn_rad_s &&
          a.max_acceleration_m_s2 == b.max_acceleration_m_s2 && a.hip_height_m == b.hip_height_m &&
          a.track_width_m == b.track_width_m && a.left == b.left && a.right == b.right &&
-         a.yaw_joints == b.yaw_joints;
+         a.yaw_joints == b.yaw_joints && a.lift_curves == b.lift_curves &&
+         a.swing_offset == b.swing_offset && a.fixed_cadence == b.fixed_cadence;
 }
 
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
@@ -608,6 +627,9 @@ std::string format_gait_file(const GaitFile& gait) {
     out += "  track_width_m: " + shortest_exact(s.track_width_m) + "\n";
     out += "  sides: {left: " + names_text(s.left) + ", right: " + names_text(s.right) + "}\n";
     if (!s.yaw_joints.empty()) out += "  yaw_joints: " + names_text(s.yaw_joints) + "\n";
+    if (!s.lift_curves.empty()) out += "  lift_curves: " + names_text(s.lift_curves) + "\n";
+    if (s.swing_offset != 0.0) out += "  swing_offset: " + shortest_exact(s.swing_offset) + "\n";
+    if (s.fixed_cadence) out += "  fixed_cadence: true\n";
   }
   return out;
 }

@@ -100,6 +100,7 @@ std::unique_ptr<MotionSource> bind(const GaitFile& gait, std::span<const JointSp
     if (has(steering.left, gj.limb)) d.side = SteeredGaitSource::kLeft;
     if (has(steering.right, gj.limb)) d.side = SteeredGaitSource::kRight;
     if (has(steering.yaw_joints, gj.name)) d.side = SteeredGaitSource::kYaw;
+    d.lift = has(steering.lift_curves, gj.curve);
     steered.push_back(d);
   }
   return std::make_unique<SteeredGaitSource>(steering, gait.stride_frequency(), std::move(curves),

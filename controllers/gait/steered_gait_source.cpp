@@ -40,8 +40,21 @@ SteeredGaitSource::SteeredGaitSource(const GaitSteering& steering, double native
   native_length_ = froude_stride_length(native_froude, h);
   min_speed_ = steering_.min_speed_m_s();
   max_speed_ = steering_.max_speed_m_s();
-  blend_time_s_ = 1.0 / froude_stride_frequency(steering_.min_froude, h);
+  native_frequency_hz_ = native_frequency_hz;
+  blend_time_s_ = 1.0 / frequency_at(min_speed_);
   target_speed_ = std::clamp(native_speed_, min_speed_, max_speed_);
+}
+
+double SteeredGaitSource::frequency_at(double speed) const {
+  if (steering_.fixed_cadence) return native_frequency_hz_;
+  const double h = steering_.hip_height_m;
+  return froude_stride_frequency(speed / std::sqrt(kStandardGravity * h), h);
+}
+
+double SteeredGaitSource::length_ratio_at(double speed) const {
+  if (steering_.fixed_cadence) return speed / native_speed_;
+  const double h = steering_.hip_height_m;
+  return froude_stride_length(speed / std::sqrt(kStandardGravity * h), h) / native_length_;
 }
 
 void SteeredGaitSource::steer(const MotionCommand& command) {
@@ -65,8 +78,7 @@ void SteeredGaitSource::reset(double t) const {
   blend_ = walking ? 1.0 : 0.0;
   // As if it had walked at this command since t = 0 (the unsteered gait's
   // phase at a constant speed).
-  const double h = steering_.hip_height_m;
-  phase_ = froude_stride_frequency(speed_ / std::sqrt(kStandardGravity * h), h) * blend_ * t;
+  phase_ = frequency_at(speed_) * blend_ * t;
   last_t_ = t;
 }
 
@@ -83,31 +95,36 @@ void SteeredGaitSource::advance(double t) const {
   blend_ = std::clamp(blend_ + (walking ? dt : -dt) / blend_time_s_, 0.0, 1.0);
   turn_ = step_toward(turn_, walking ? target_turn_ : 0.0,
                       steering_.max_turn_rad_s * dt / blend_time_s_);
-  const double h = steering_.hip_height_m;
-  const double fr = speed_ / std::sqrt(kStandardGravity * h);
-  phase_ += froude_stride_frequency(fr, h) * smoothstep(blend_) * dt;
+  phase_ += frequency_at(speed_) * smoothstep(blend_) * dt;
 }
 
 void SteeredGaitSource::sample(double t, std::span<double> targets) const {
   advance(t);
-  const double h = steering_.hip_height_m;
   const double s = smoothstep(blend_);
-  const double fr = speed_ / std::sqrt(kStandardGravity * h);
-  const double amplitude = s * froude_stride_length(fr, h) / native_length_;
+  const double a0 = steering_.swing_offset;
+  const double amplitude = s * (a0 + (1.0 - a0) * length_ratio_at(speed_));
   const double half_track = 0.5 * steering_.track_width_m;
   // Positive turn is to the left: the left side is inside.
   const double left = std::max(0.0, (speed_ - turn_ * half_track) / speed_);
   const double right = std::max(0.0, (speed_ + turn_ * half_track) / speed_);
-  const double yaw = steering_.max_turn_rad_s > 0.0 ? s * turn_ / steering_.max_turn_rad_s : 0.0;
+  // A yaw angle d turns the walk at about v tan(d) / wheelbase: the same turn
+  // rate at a faster walk needs a smaller angle.
+  const double yaw = steering_.max_turn_rad_s > 0.0
+                         ? s * (turn_ / steering_.max_turn_rad_s) * (min_speed_ / speed_)
+                         : 0.0;
   for (const Drive& d : drives_) {
     if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
     const auto c = static_cast<std::size_t>(d.curve);
-    double scale = amplitude;
-    if (d.side == kLeft) scale *= left;
-    if (d.side == kRight) scale *= right;
-    if (d.side == kYaw) scale = yaw;
-    const double deviation = curves_[c].eval(phase_ - d.phase) - means_[c];
-    const double deg = d.gain * (means_[c] + scale * deviation) + d.offset_deg;
+    const double value = curves_[c].eval(phase_ - d.phase);
+    double deg = 0.0;
+    if (d.side == kYaw) {
+      deg = d.gain * yaw * value + d.offset_deg;
+    } else {
+      double scale = d.lift ? s : amplitude;
+      if (!d.lift && d.side == kLeft) scale *= left;
+      if (!d.lift && d.side == kRight) scale *= right;
+      deg = d.gain * (means_[c] + scale * (value - means_[c])) + d.offset_deg;
+    }
     targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);
   }
 }

@@ -18,30 +18,78 @@ MotionCommand lerp(const MotionCommand& a, const MotionCommand& b, double u) {
 }
 
 // Candidates per axis in each pass of command_for's search.
-constexpr int kSearchSteps = 24;
-constexpr int kSearchPasses = 3;
+constexpr int kSearchSteps = 4;
+constexpr int kSearchPasses = 5;
+// Nodes per axis of the precomputed grid the search starts from.
+constexpr int kGridNodes = 17;
 
 }  // namespace
 
 WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* calibration)
     : steering_(steering), calibrated_(calibration != nullptr) {
   if (!calibration) return;
+  // Every measured point, by commanded speed and then turn.
+  std::vector<Level> all;
   for (const CalibrationPoint& p : calibration->points) {
-    if (!p.usable) continue;
-    auto it = std::find_if(levels_.begin(), levels_.end(),
+    auto it = std::find_if(all.begin(), all.end(),
                            [&](const Level& l) { return l.speed == p.commanded.speed_m_s; });
-    if (it == levels_.end()) {
-      levels_.push_back(Level{p.commanded.speed_m_s, {}});
-      it = levels_.end() - 1;
+    if (it == all.end()) {
+      all.push_back(Level{p.commanded.speed_m_s, {}});
+      it = all.end() - 1;
     }
     it->points.push_back(p);
   }
-  std::sort(levels_.begin(), levels_.end(),
+  std::sort(all.begin(), all.end(),
             [](const Level& a, const Level& b) { return a.speed < b.speed; });
-  for (Level& l : levels_) {
+  for (Level& l : all) {
     std::sort(l.points.begin(), l.points.end(), [](const auto& a, const auto& b) {
       return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
     });
+    // Keep the usable turns that reach the straight walk without crossing
+    // an unusable one: a turn rate between two usable points is only
+    // trusted when nothing measured between them failed.
+    const auto straight = std::find_if(l.points.begin(), l.points.end(), [](const auto& p) {
+      return p.commanded.turn_rad_s == 0.0 && p.usable;
+    });
+    if (straight == l.points.end()) {
+      l.points.clear();
+      continue;
+    }
+    auto lo = straight, hi = straight + 1;
+    while (lo != l.points.begin() && (lo - 1)->usable) --lo;
+    while (hi != l.points.end() && hi->usable) ++hi;
+    l.points = std::vector<CalibrationPoint>(lo, hi);
+  }
+  // The longest run of speeds whose straight walk is usable (the faster
+  // one on a tie): the herd interpolates between neighbouring speeds, so a
+  // speed that failed in between must not be bridged.
+  std::size_t best_begin = 0, best_len = 0;
+  for (std::size_t i = 0; i < all.size();) {
+    if (all[i].points.empty()) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < all.size() && !all[j].points.empty()) ++j;
+    if (j - i >= best_len) {
+      best_begin = i;
+      best_len = j - i;
+    }
+    i = j;
+  }
+  levels_.assign(all.begin() + static_cast<std::ptrdiff_t>(best_begin),
+                 all.begin() + static_cast<std::ptrdiff_t>(best_begin + best_len));
+  // What every node of a grid over the usable commands achieves: a herd
+  // asks command_for for every figure at every step, and starting its search
+  // from the closest node keeps that cheap.
+  if (levels_.empty()) return;
+  for (int i = 0; i < kGridNodes; ++i) {
+    const double v = min_speed() + (max_speed() - min_speed()) * i / (kGridNodes - 1);
+    const double limit = max_turn(v);
+    for (int k = 0; k < kGridNodes; ++k) {
+      const MotionCommand c{v, limit * (2.0 * k / (kGridNodes - 1) - 1.0)};
+      grid_.push_back({c, achieved(c)});
+    }
   }
 }
 
@@ -138,9 +186,22 @@ MotionCommand WalkResponse::command_for(const MotionCommand& wanted) const {
   double best_error = error(best);
   if (max_speed() <= 0.0 || !std::isfinite(wanted.speed_m_s) || !std::isfinite(wanted.turn_rad_s))
     return best;
-  double v_lo = min_speed(), v_hi = max_speed();
-  double w_span = steering_.max_turn_rad_s;
-  double w_mid = 0.0;
+  // The closest grid node, then a finer search around it.
+  for (const auto& [c, a] : grid_) {
+    const double dv = a.speed_m_s - wanted.speed_m_s;
+    const double dw = (a.turn_rad_s - wanted.turn_rad_s) * arm;
+    const double e = dv * dv + dw * dw;
+    if (e < best_error) {
+      best_error = e;
+      best = c;
+    }
+  }
+  if (best.speed_m_s <= 0.0) return best;
+  const double grid_dv = (max_speed() - min_speed()) / (kGridNodes - 1);
+  double v_lo = std::max(min_speed(), best.speed_m_s - grid_dv);
+  double v_hi = std::min(max_speed(), best.speed_m_s + grid_dv);
+  double w_span = 2.0 * steering_.max_turn_rad_s / (kGridNodes - 1);
+  double w_mid = best.turn_rad_s;
   for (int pass = 0; pass < kSearchPasses; ++pass) {
     for (int i = 0; i <= kSearchSteps; ++i) {
       const double v = v_lo + (v_hi - v_lo) * i / kSearchSteps;

@@ -73,7 +73,8 @@ void Crowd::make_active(int i, double max_speed) {
   dtCrowdAgentParams ap = crowd_->getAgent(i)->params;
   ap.maxSpeed = static_cast<float>(max_speed);
   ap.maxAcceleration =
-      static_cast<float>(max_speed * params_.figure_turn_rad_s * params_.accel_factor);
+      static_cast<float>(std::max(max_speed * params_.figure_turn_rad_s * params_.accel_factor,
+                                  params_.figure_start_speed_m_s / params_.step_s));
   ap.updateFlags = DT_CROWD_ANTICIPATE_TURNS | DT_CROWD_OBSTACLE_AVOIDANCE | DT_CROWD_OPTIMIZE_VIS |
                    DT_CROWD_OPTIMIZE_TOPO;
   if (params_.separation_weight > 0.0) ap.updateFlags |= DT_CROWD_SEPARATION;

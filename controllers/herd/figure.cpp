@@ -25,6 +25,11 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
   const double reachable = std::clamp(want.speed_m_s, agent.speed - dv, agent.speed + dv);
   if (want.speed_m_s > 0.0 && reachable < walk.min_speed()) {
     want.speed_m_s = walk.min_speed();  // starting from standing: the gait's slowest walk
+  } else if (want.speed_m_s == 0.0 && reachable < walk.min_speed()) {
+    // Stopping: below the slowest walk the gait stands (it blends to
+    // standing over a stride), where walking on at the slowest speed would
+    // come closer to the ramp and never stop.
+    return walk.command_for({0.0, 0.0});
   } else {
     want.speed_m_s = std::max(reachable, 0.0);
   }

@@ -124,7 +124,10 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
     const Figure& f =
         figures[static_cast<std::size_t>(figure_of[static_cast<std::size_t>(members[g].front())])];
     crowd_turn = std::min(crowd_turn, f.walk.max_turn(spec.speed_mps->second));
+    crowd_params.figure_start_speed_m_s =
+        std::max(crowd_params.figure_start_speed_m_s, f.walk.min_speed());
   }
+  crowd_params.step_s = scene.step_s;
   for (std::size_t g = 0; g < scene.groups.size(); ++g) {
     const GroupSpec& spec = scene.groups[g];
     const std::uint64_t seed = group_seed(scene.seed, g);

@@ -70,13 +70,14 @@ int run_calibrate(const CalibrateArgs& a) {
   cal.model_file = relative_to(a.physics, out);
   std::printf("calibrating %s on %s: %d speeds x %d turn rates\n", gait_path.c_str(),
               a.physics.c_str(), a.speeds, 1 + 2 * a.turns);
-  std::printf("%10s %9s | %10s %9s %7s  %s\n", "cmd m/s", "cmd deg/s", "got m/s", "got deg/s",
-              "err %", "");
+  std::printf("%10s %9s | %10s %9s %7s %9s  %s\n", "cmd m/s", "cmd deg/s", "got m/s", "got deg/s",
+              "err %", "err deg/s", "");
   for (int i = 0; i < a.speeds; ++i) {
     const double u = a.speeds == 1 ? 0.5 : static_cast<double>(i) / (a.speeds - 1);
     const double fr = st.min_froude + u * (st.max_froude - st.min_froude);
     const double v = froude_velocity(fr, st.hip_height_m);
-    const double stride_s = 1.0 / froude_stride_frequency(fr, st.hip_height_m);
+    const double stride_s = 1.0 / (st.fixed_cadence ? gait.stride_frequency()
+                                                    : froude_stride_frequency(fr, st.hip_height_m));
     const double ramp_s = v / st.max_acceleration_m_s2 + stride_s;
     for (int k = -a.turns; k <= a.turns; ++k) {
       const double sign = k < 0 ? -1.0 : 1.0;
@@ -94,8 +95,9 @@ int run_calibrate(const CalibrateArgs& a) {
       p.fell = trace.fell;
       p.usable = calibration_usable(p, cal.tolerance);
       cal.points.push_back(p);
-      std::printf("%10.4f %9.2f | %10.4f %9.2f %7.1f  %s\n", v, rad_to_deg(w), p.achieved.speed_m_s,
-                  rad_to_deg(p.achieved.turn_rad_s), 100.0 * (p.achieved.speed_m_s - v) / v,
+      std::printf("%10.4f %9.2f | %10.4f %9.2f %7.1f %9.2f  %s\n", v, rad_to_deg(w),
+                  p.achieved.speed_m_s, rad_to_deg(p.achieved.turn_rad_s),
+                  100.0 * (p.achieved.speed_m_s - v) / v, rad_to_deg(p.achieved.turn_rad_s - w),
                   p.fell ? "FELL" : (p.usable ? "usable" : "off"));
     }
   }
@@ -109,8 +111,10 @@ int run_calibrate(const CalibrateArgs& a) {
   int usable = 0;
   for (const auto& p : cal.points) usable += p.usable ? 1 : 0;
   std::printf(
-      "%d of %zu points usable (within %.0f %% of the commanded speed, no fall)\nwrote %s\n",
-      usable, cal.points.size(), 100.0 * cal.tolerance, out.c_str());
+      "%d of %zu points usable (speed within %.0f %% of the commanded one, turn within %.0f %% or "
+      "%g deg/s, no fall)\nwrote %s\n",
+      usable, cal.points.size(), 100.0 * cal.tolerance, 100.0 * cal.tolerance,
+      kCalibrationTurnFloorDps, out.c_str());
   return 0;
 }
 

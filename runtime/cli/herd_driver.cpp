@@ -57,7 +57,6 @@ void EmbodiedHerd::step_until_quit() {
   const double dt = herd_->scene().step_s;
   const long steps_per_output = std::max(1L, std::lround(1.0 / (herd_->scene().output_hz * dt)));
   long steps = 0;
-  herd::Vec2 last_position = spawn_;
   double last_heading = spawn_heading_;
   while (!quit_.load()) {
     const Nanos t0 = t0_.load();
@@ -71,10 +70,16 @@ void EmbodiedHerd::step_until_quit() {
           const herd::Vec2 left{-ahead.y, ahead.x};
           const herd::Vec2 position = spawn_ + ahead * p.x_m + left * p.y_m;
           const double heading = spawn_heading_ + p.yaw_rad;
-          const double speed = herd::norm(position - last_position) / dt;
+          // The speed its gait achieves under the herd's last command, not
+          // the track's: over one herd step a trot's track jitters by more
+          // than the figure's acceleration, and steering ramps the speed
+          // from this one.
+          const double speed =
+              herd_->figure(agent_)
+                  .walk.achieved(herd_->commands()[static_cast<std::size_t>(agent_)])
+                  .speed_m_s;
           const double turn = std::remainder(heading - last_heading, 2 * M_PI) / dt;
           herd_->set_pose(agent_, position, heading, speed, turn);
-          last_position = position;
           last_heading = heading;
         }
         herd_->step();

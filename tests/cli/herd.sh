@@ -2,7 +2,8 @@
 # animrt herd: a flock run writes the CSV (header, one row per agent per
 # output step), the top view and the summary; a bad scene is refused with
 # exit 2 naming the file, line and key. animrt run --herd: the quadruped,
-# walking on physics as one agent of a crowd, is steered toward its goal.
+# walking on physics as one agent of a crowd, is steered toward its goal; the
+# pony (configs/robots/pony.yaml) turns round a wall to reach its goal.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -27,7 +28,7 @@ grep -q '<svg' "$tmp/h.svg" || fail "no SVG"
 
 # A bad scene: one error line with file, line and key, exit 2.
 sed 's/count: 30/count: thirty/' "$root/configs/herd/flock.yaml" > "$tmp/bad.yaml"
-sed -i "s|../gaits/pony.yaml|$root/configs/gaits/pony.yaml|" "$tmp/bad.yaml"
+sed -i "s|../gaits/herd_pony.yaml|$root/configs/gaits/herd_pony.yaml|" "$tmp/bad.yaml"
 out=$("$animrt" herd "$tmp/bad.yaml" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"bad.yaml:13:"*"groups[0].count"* ]] || fail "bad scene (exit $code): $out"
@@ -41,6 +42,18 @@ read -r before after < <(sed 's/distance to its goal \([0-9.]*\) -> \([0-9.]*\) 
 /usr/bin/python3 -c "import sys; b,a=map(float,sys.argv[1:]); sys.exit(0 if a < b - 0.8 else 1)" "$before" "$after" ||
   fail "the robot did not close on its goal: $line"
 [[ $out == *"measured by physics"* ]] || fail "the agent's pose is not the physics': $out"
+
+# The pony, which turns: a wall stands between it and its goal, so the herd
+# walks it round the wall (off its heading and back) to the goal, on physics.
+out=$("$animrt" run "$root/configs/robots/pony.yaml" --lockstep --no-realtime --duration 50 \
+  --physics "$root/configs/models/pony.xml" --herd "$root/configs/herd/pony_walker.yaml" \
+  --agent pony.0 2>&1) || fail "pony run --herd failed: $out"
+line=$(grep -o 'heading [-0-9.]* rad, .*distance to its goal [0-9.]* -> [0-9.]* m' <<< "$out") ||
+  fail "no pony herd report: $out"
+read -r heading before after < <(sed 's/heading \([-0-9.]*\) rad, .*distance to its goal \([0-9.]*\) -> \([0-9.]*\) m/\1 \2 \3/' <<< "$line")
+/usr/bin/python3 -c "import sys; h,b,a=map(float,sys.argv[1:]); sys.exit(0 if b > 3.9 and a < 0.5 and abs(h) > 0.15 else 1)" \
+  "$heading" "$before" "$after" || fail "the pony did not turn its way to its goal: $line"
+[[ $out == *"falls 0"* ]] || fail "the pony fell: $out"
 
 out=$("$animrt" run "$root/configs/robots/quadruped.yaml" --lockstep --duration 1 \
   --herd "$root/configs/herd/walker.yaml" --agent nobody.3 2>&1)

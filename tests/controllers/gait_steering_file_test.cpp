@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/joint.hpp"
@@ -107,6 +108,43 @@ TEST(GaitSteeringFile, RoundTripsThroughTheWriter) {
   other.steering->right = {"lf"};
   other.steering->left = {"rf"};
   EXPECT_FALSE(other == g);
+}
+
+TEST(GaitSteeringFile, LiftCurvesSwingOffsetAndFixedCadence) {
+  const GaitFile plain = parse_gait_file(steering(kGood), "g.yaml");
+  EXPECT_TRUE(plain.steering->lift_curves.empty());
+  EXPECT_EQ(plain.steering->swing_offset, 0.0);
+  EXPECT_FALSE(plain.steering->fixed_cadence);
+  const std::string extra =
+      "  lift_curves: [hip]\n"    // 18
+      "  swing_offset: -0.4\n"    // 19
+      "  fixed_cadence: true\n";  // 20
+  const GaitFile g = parse_gait_file(steering(kGood + extra), "g.yaml");
+  EXPECT_EQ(g.steering->lift_curves, std::vector<std::string>{"hip"});
+  EXPECT_EQ(g.steering->swing_offset, -0.4);
+  EXPECT_TRUE(g.steering->fixed_cadence);
+  const GaitFile back = parse_gait_file(format_gait_file(g), "back.yaml");
+  EXPECT_EQ(back, g);
+  GaitFile other = g;
+  other.steering->fixed_cadence = false;
+  EXPECT_FALSE(other == g);
+  other = g;
+  other.steering->swing_offset = 0.1;
+  EXPECT_FALSE(other == g);
+
+  const std::string curve = error_of(steering(kGood + "  lift_curves: [knee]\n"));
+  EXPECT_NE(curve.find("g.yaml:18:17: steering.lift_curves"), std::string::npos) << curve;
+  EXPECT_NE(curve.find("undefined curve 'knee'"), std::string::npos) << curve;
+  const std::string offset = error_of(steering(kGood + "  swing_offset: 0.95\n"));
+  EXPECT_NE(offset.find("g.yaml:18:17: steering.swing_offset"), std::string::npos) << offset;
+  const std::string cadence = error_of(steering(kGood + "  fixed_cadence: 2\n"));
+  EXPECT_NE(cadence.find("g.yaml:18:18: steering.fixed_cadence"), std::string::npos) << cadence;
+  GaitFile bad = g;
+  bad.steering->lift_curves = {"nope"};
+  EXPECT_THROW(validate_gait(bad), InputError);
+  bad = g;
+  bad.steering->swing_offset = 1.0;
+  EXPECT_THROW(validate_gait(bad), InputError);
 }
 
 TEST(GaitSteeringFile, ValidateChecksASteeringBuiltInMemory) {

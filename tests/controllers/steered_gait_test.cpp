@@ -221,44 +221,167 @@ TEST(SteeredGait, UncommandedPlaysTheGaitsOwnTiming) {
   EXPECT_NEAR(rad_to_deg(tg[0]), kMeanDeg + kSwingDeg, 1e-6);
 }
 
-TEST(SteeredGait, YawJointsSwingWithTheTurn) {
-  std::string text = kGait;
-  const std::string last = "  rh_hip: {curve: hip, limb: rh}";
-  text.replace(text.find(last), last.size(), last + "\n  yaw: {curve: hip, limb: lf}");
-  text += "  yaw_joints: [yaw]\n";
-  const GaitFile gait = parse_gait_file(text, "yaw.yaml");
-  auto joints = specs();
-  JointSpec yaw;
-  yaw.name = "yaw";
-  yaw.limits = {-kPi, kPi, 100.0, 10000.0};
-  joints.push_back(yaw);
-  auto source = make_gait_source(gait, joints);
-  const double v = gait.steering->max_speed_m_s(), w = gait.steering->max_turn_rad_s;
-  std::vector<double> tg(5);
+// kGait with extra lines under `joints` and `steering`, and robot joints for
+// every joint it maps (the four hips first).
+struct ExtendedRig {
+  GaitFile gait;
+  std::vector<JointSpec> joints = specs();
+  std::unique_ptr<MotionSource> source;
+  std::vector<double> targets;
   double t = 0.0;
-  // Swing of the yaw joint (deg) and its value a quarter stride after the
-  // lf hip's peak, over 3 s after 4 s under `command`.
-  const auto swing_under = [&](MotionCommand command) {
-    source->steer(command);
-    for (int k = 0; k < 800; ++k, t += kDt) source->sample(t, tg);
-    double lo = 1e9, hi = -1e9, corr = 0.0;
-    for (int k = 0; k < 600; ++k, t += kDt) {
-      source->sample(t, tg);
-      const double y = rad_to_deg(tg[4]) - kMeanDeg, hip = rad_to_deg(tg[0]) - kMeanDeg;
-      lo = std::min(lo, y);
-      hi = std::max(hi, y);
-      corr += y * hip;
+  ExtendedRig(const std::string& curves, const std::string& more_joints,
+              const std::vector<std::string>& names, const std::string& more_steering) {
+    std::string text = kGait;
+    const std::string curve_at = "  hip: \"10 + 20*sin(2*PI*t)\"";
+    text.replace(text.find(curve_at), curve_at.size(), curve_at + curves);
+    const std::string last = "  rh_hip: {curve: hip, limb: rh}";
+    text.replace(text.find(last), last.size(), last + more_joints);
+    text += more_steering;
+    gait = parse_gait_file(text, "extended.yaml");
+    for (const std::string& n : names) {
+      JointSpec j;
+      j.name = n;
+      j.limits = {-kPi, kPi, 100.0, 10000.0};
+      joints.push_back(j);
     }
-    return std::pair<double, double>{hi - lo, corr};
+    source = make_gait_source(gait, joints);
+    targets.assign(joints.size(), 0.0);
+  }
+  const GaitSteering& st() const { return *gait.steering; }
+  // Steers, settles 4 s, then samples 3 s: per joint the lowest, highest and
+  // mean target (deg), and the sum of joint j's target times lf_hip's
+  // deviation from its mean (positive: in phase with the hip).
+  struct Stats {
+    std::vector<double> lo, hi, mean, corr;
   };
-  const auto straight = swing_under({v, 0.0});
-  EXPECT_LT(straight.first, 1e-9);  // at its mean when walking straight
-  const auto left = swing_under({v, w});
-  EXPECT_GT(left.first, 30.0);  // the full curve at the fastest turn
-  EXPECT_GT(left.second, 0.0);  // in phase with its curve
-  const auto right = swing_under({v, -w});
-  EXPECT_NEAR(right.first, left.first, 1.0);
-  EXPECT_LT(right.second, 0.0);  // the other way round
+  Stats under(MotionCommand command) {
+    source->steer(command);
+    for (int k = 0; k < 800; ++k, t += kDt) source->sample(t, targets);
+    const std::size_t n = targets.size();
+    Stats out{std::vector<double>(n, 1e9), std::vector<double>(n, -1e9), std::vector<double>(n),
+              std::vector<double>(n)};
+    constexpr int kSteps = 600;
+    for (int k = 0; k < kSteps; ++k, t += kDt) {
+      source->sample(t, targets);
+      const double hip = rad_to_deg(targets[0]) - kMeanDeg;
+      for (std::size_t j = 0; j < n; ++j) {
+        const double d = rad_to_deg(targets[j]);
+        out.lo[j] = std::min(out.lo[j], d);
+        out.hi[j] = std::max(out.hi[j], d);
+        out.mean[j] += d / kSteps;
+        out.corr[j] += d * hip;
+      }
+    }
+    return out;
+  }
+};
+
+TEST(SteeredGait, YawJointsSwingWithTheTurn) {
+  ExtendedRig rig("", "\n  yaw: {curve: hip, limb: lf}", {"yaw"}, "  yaw_joints: [yaw]\n");
+  const double lo = rig.st().min_speed_m_s(), hi = rig.st().max_speed_m_s();
+  const double w = rig.st().max_turn_rad_s;
+  const auto straight = rig.under({lo, 0.0});
+  EXPECT_EQ(straight.lo[4], 0.0);  // at its offset (home) when walking straight
+  EXPECT_EQ(straight.hi[4], 0.0);
+  // At the fastest turn at the slowest walk: the whole curve, 10 +- 20 deg,
+  // in phase with it.
+  const auto left = rig.under({lo, w});
+  EXPECT_NEAR(left.hi[4] - left.lo[4], 2.0 * kSwingDeg, 0.5);
+  EXPECT_NEAR(0.5 * (left.hi[4] + left.lo[4]), kMeanDeg, 0.5);
+  EXPECT_GT(left.corr[4], 0.0);
+  const auto right = rig.under({lo, -w});
+  EXPECT_NEAR(right.hi[4] - right.lo[4], 2.0 * kSwingDeg, 0.5);
+  EXPECT_NEAR(0.5 * (right.hi[4] + right.lo[4]), -kMeanDeg, 0.5);  // the other way round
+  EXPECT_LT(right.corr[4], 0.0);
+  // Half the turn at the fastest walk: scaled by 1/2 x slowest / fastest speed.
+  const auto fast = rig.under({hi, 0.5 * w});
+  EXPECT_NEAR(0.5 * (fast.hi[4] + fast.lo[4]), kMeanDeg * 0.5 * lo / hi, 0.1);
+  EXPECT_NEAR(fast.hi[4] - fast.lo[4], 2.0 * kSwingDeg * 0.5 * lo / hi, 0.2);
+}
+
+// A constant yaw curve steers the legs like wheels: the angle for a turn
+// rate w at speed v is the curve x (w / max turn) x (slowest / v).
+TEST(SteeredGait, ConstantYawCurveSteersByTurnOverSpeed) {
+  ExtendedRig rig("\n  steer: \"8\"",
+                  "\n  front: {curve: steer, limb: lf}\n  hind: {curve: steer, limb: lh, sign: -1}",
+                  {"front", "hind"}, "  yaw_joints: [front, hind]\n");
+  const double lo = rig.st().min_speed_m_s(), w = rig.st().max_turn_rad_s;
+  auto a = rig.under({lo, w});
+  EXPECT_NEAR(a.lo[4], 8.0, 1e-9);
+  EXPECT_NEAR(a.hi[4], 8.0, 1e-9);
+  EXPECT_NEAR(a.lo[5], -8.0, 1e-9);
+  a = rig.under({2.0 * lo, -0.5 * w});
+  EXPECT_NEAR(a.mean[4], -2.0, 1e-9);
+  EXPECT_NEAR(a.mean[5], 2.0, 1e-9);
+  a = rig.under({2.0 * lo, 0.0});
+  EXPECT_EQ(a.hi[4], 0.0);
+}
+
+TEST(SteeredGait, LiftCurvesKeepTheirWholeSwing) {
+  ExtendedRig rig("\n  lift: \"-20 + 10*sin(2*PI*t)\"", "\n  lf_knee: {curve: lift, limb: lf}",
+                  {"lf_knee"}, "  lift_curves: [lift]\n");
+  const double lo = rig.st().min_speed_m_s(), hi = rig.st().max_speed_m_s();
+  const double w = rig.st().max_turn_rad_s;
+  for (const MotionCommand c : {MotionCommand{lo, 0.0}, MotionCommand{hi, 0.0},
+                                MotionCommand{lo, w}, MotionCommand{hi, -w}}) {
+    const auto s = rig.under(c);
+    EXPECT_NEAR(s.hi[4] - s.lo[4], 20.0, 0.05) << c.speed_m_s << " " << c.turn_rad_s;
+  }
+  // The hip of the same left leg follows the stride length and the turn.
+  const auto slow = rig.under({lo, 0.0});
+  const auto turning = rig.under({lo, 0.5 * w});
+  EXPECT_LT(slow.hi[0] - slow.lo[0], 2.0 * kSwingDeg * 0.9);
+  EXPECT_LT(turning.hi[0] - turning.lo[0], slow.hi[0] - slow.lo[0] - 1.0);
+  // Standing still stands the lift curves too, at their mean.
+  const auto stand = rig.under({0.0, 0.0});
+  EXPECT_NEAR(stand.lo[4], -20.0, 1e-6);
+  EXPECT_NEAR(stand.hi[4], -20.0, 1e-6);
+}
+
+// Time between the first and the last upward crossing of lf_hip's mean over
+// `seconds`, divided by the crossings between them: the stride period.
+double stride_period(ExtendedRig& rig, MotionCommand command, double seconds) {
+  rig.under(command);
+  double prev = rad_to_deg(rig.targets[0]) - kMeanDeg;
+  double first = -1.0, last = -1.0;
+  int crossings = 0;
+  for (long k = 0; k < std::lround(seconds / kDt); ++k, rig.t += kDt) {
+    rig.source->sample(rig.t, rig.targets);
+    const double d = rad_to_deg(rig.targets[0]) - kMeanDeg;
+    if (prev < 0.0 && d >= 0.0) {
+      if (first < 0.0) first = rig.t;
+      last = rig.t;
+      ++crossings;
+    }
+    prev = d;
+  }
+  return crossings > 1 ? (last - first) / (crossings - 1) : 0.0;
+}
+
+TEST(SteeredGait, FixedCadenceKeepsTheStrideFrequencyAndScalesTheSwingBySpeed) {
+  ExtendedRig fixed("", "", {}, "  fixed_cadence: true\n");
+  ExtendedRig froude("", "", {}, "");
+  const double lo = fixed.st().min_speed_m_s(), hi = fixed.st().max_speed_m_s();
+  // The gait's own 1 Hz at every speed; the Froude timing is slower at the
+  // slowest walk and faster at the fastest.
+  EXPECT_NEAR(stride_period(fixed, {lo, 0.0}, 8.0), 1.0, 0.01);
+  EXPECT_NEAR(stride_period(fixed, {hi, 0.0}, 8.0), 1.0, 0.01);
+  const double h = fixed.st().hip_height_m;
+  const double fr_lo = lo / std::sqrt(kStandardGravity * h);
+  EXPECT_NEAR(stride_period(froude, {lo, 0.0}, 8.0), 1.0 / froude_stride_frequency(fr_lo, h), 0.01);
+  // Swing proportional to speed: stride length v / f at a fixed f.
+  const double native = dynamic_cast<SteeredGaitSource&>(*fixed.source).native_speed_m_s();
+  const auto s = fixed.under({lo, 0.0});
+  EXPECT_NEAR(s.hi[0] - s.lo[0], 2.0 * kSwingDeg * lo / native, 0.1);
+}
+
+TEST(SteeredGait, SwingOffsetShiftsTheSwingForASpeed) {
+  ExtendedRig rig("", "", {}, "  fixed_cadence: true\n  swing_offset: -0.5\n");
+  const double v = rig.st().max_speed_m_s();
+  const double native = dynamic_cast<SteeredGaitSource&>(*rig.source).native_speed_m_s();
+  const auto s = rig.under({v, 0.0});
+  // swing_offset + (1 - swing_offset) v / v_native of the curve's swing.
+  EXPECT_NEAR(s.hi[0] - s.lo[0], 2.0 * kSwingDeg * (-0.5 + 1.5 * v / native), 0.1);
 }
 
 TEST(SteeredGait, SteerAndSampleDoNotAllocate) {

@@ -41,10 +41,10 @@ GaitCalibration table() {
   GaitCalibration c;
   c.gait_file = "walk.yaml";
   c.model_file = "quadruped.xml";
-  c.points = {point(0.1, -0.2, 0.09, -0.1),  point(0.1, 0.0, 0.1, 0.0),
-              point(0.1, 0.2, 0.11, 0.1),    point(0.2, -0.4, 0.1, -0.3, true),
-              point(0.2, -0.1, 0.19, -0.05), point(0.2, 0.0, 0.18, 0.0),
-              point(0.2, 0.1, 0.21, 0.05),   point(0.3, 0.0, 0.1, 0.0)};  // 67 % slow: not usable
+  c.points = {point(0.1, -0.2, 0.09, -0.19),  point(0.1, 0.0, 0.1, 0.0),
+              point(0.1, 0.2, 0.11, 0.21),    point(0.2, -0.4, 0.1, -0.3, true),
+              point(0.2, -0.1, 0.19, -0.095), point(0.2, 0.0, 0.18, 0.0),
+              point(0.2, 0.1, 0.21, 0.105),   point(0.3, 0.0, 0.1, 0.0)};  // 67 % slow: not usable
   return c;
 }
 
@@ -52,6 +52,23 @@ TEST(Calibration, UsableMeansNoFallAndWithinTolerance) {
   EXPECT_TRUE(point(0.1, 0, 0.114, 0).usable);
   EXPECT_FALSE(point(0.1, 0, 0.116, 0).usable);
   EXPECT_FALSE(point(0.1, 0, 0.1, 0, true).usable);
+}
+
+TEST(Calibration, UsableJudgesTheTurnToo) {
+  const double w = deg_to_rad(20.0);
+  EXPECT_TRUE(point(0.1, w, 0.1, 0.86 * w).usable);   // 14 % short
+  EXPECT_TRUE(point(0.1, w, 0.1, 1.14 * w).usable);   // 14 % over
+  EXPECT_FALSE(point(0.1, w, 0.1, 0.84 * w).usable);  // 16 % short
+  EXPECT_FALSE(point(0.1, -w, 0.1, w).usable);        // the wrong way
+  // The demo quadruped's turn points: 4 deg/s commanded, under 1 achieved.
+  EXPECT_FALSE(point(0.0704, deg_to_rad(4.0), 0.0728, deg_to_rad(0.57)).usable);
+  EXPECT_FALSE(point(0.0704, deg_to_rad(-4.0), 0.0734, deg_to_rad(-0.15)).usable);
+  // Near zero the floor (kCalibrationTurnFloorDps) rules: a straight walk
+  // may drift, a slow turn may miss, by up to 1 deg/s.
+  EXPECT_TRUE(point(0.1, 0.0, 0.1, deg_to_rad(0.9)).usable);
+  EXPECT_FALSE(point(0.1, 0.0, 0.1, deg_to_rad(-1.1)).usable);
+  EXPECT_TRUE(point(0.1, deg_to_rad(2.0), 0.1, deg_to_rad(1.1)).usable);
+  EXPECT_FALSE(point(0.1, deg_to_rad(2.0), 0.1, deg_to_rad(0.9)).usable);
 }
 
 TEST(Calibration, FileRoundTrips) {
@@ -95,6 +112,13 @@ TEST(Calibration, BadFilesNameLineAndKey) {
                "fell: false, usable: true}\n");
   EXPECT_NE(liar.find("c.yaml:5:"), std::string::npos) << liar;
   EXPECT_NE(liar.find("points[0].usable"), std::string::npos) << liar;
+  // A missed turn called usable: the speed is right, the turn is not.
+  const std::string turn_liar =
+      error_of(head +
+               "  - {speed_m_s: 0.1, turn_dps: 4, achieved_speed_m_s: 0.1, achieved_turn_dps: 0.5, "
+               "fell: false, usable: true}\n");
+  EXPECT_NE(turn_liar.find("c.yaml:5:"), std::string::npos) << turn_liar;
+  EXPECT_NE(turn_liar.find("points[0].usable"), std::string::npos) << turn_liar;
   const std::string tol = error_of("gait: w\nmodel: m\ntolerance: 2\npoints: []\n");
   EXPECT_NE(tol.find("c.yaml:3:12: tolerance"), std::string::npos) << tol;
   EXPECT_THROW(load_gait_calibration("/nonexistent/x.calibration.yaml"), InputError);
@@ -137,11 +161,11 @@ TEST(WalkResponse, InterpolatesTheUsablePoints) {
   // On a point, between turns, between speeds.
   EXPECT_NEAR(r.achieved({0.2, 0.0}).speed_m_s, 0.18, 1e-12);
   EXPECT_NEAR(r.achieved({0.1, 0.1}).speed_m_s, 0.105, 1e-12);
-  EXPECT_NEAR(r.achieved({0.1, 0.1}).turn_rad_s, 0.05, 1e-12);
+  EXPECT_NEAR(r.achieved({0.1, 0.1}).turn_rad_s, 0.105, 1e-12);
   EXPECT_NEAR(r.achieved({0.15, 0.0}).speed_m_s, 0.14, 1e-12);
   // Clamped first: too fast is max speed, too tight is the usable turn.
   EXPECT_NEAR(r.achieved({0.5, 0.0}).speed_m_s, 0.18, 1e-12);
-  EXPECT_NEAR(r.achieved({0.2, -1.0}).turn_rad_s, -0.05, 1e-12);
+  EXPECT_NEAR(r.achieved({0.2, -1.0}).turn_rad_s, -0.095, 1e-12);
   EXPECT_EQ(r.achieved({0.05, 0.0}).speed_m_s, 0.0);
 }
 
@@ -153,7 +177,7 @@ TEST(WalkResponse, CommandForFindsTheCommandThatAchievesTheWish) {
   EXPECT_NEAR(c.speed_m_s, 0.2, 2e-3);
   EXPECT_NEAR(c.turn_rad_s, 0.0, 2e-3);
   EXPECT_NEAR(r.achieved(c).speed_m_s, 0.18, 1e-3);
-  // A turn of 0.05 rad/s at 0.105 m/s is commanded as 0.1 rad/s at 0.1 m/s.
+  // A turn of 0.05 rad/s at 0.105 m/s is commanded a little slower, turning a little less.
   c = r.command_for({0.105, 0.05});
   EXPECT_NEAR(r.achieved(c).speed_m_s, 0.105, 2e-3);
   EXPECT_NEAR(r.achieved(c).turn_rad_s, 0.05, 2e-3);
@@ -164,6 +188,52 @@ TEST(WalkResponse, CommandForFindsTheCommandThatAchievesTheWish) {
   EXPECT_LE(c.speed_m_s, r.max_speed());
   // The fastest the table achieves: 0.21 m/s, at 0.2 m/s turning 0.1 rad/s.
   EXPECT_NEAR(r.achieved(c).speed_m_s, 0.21, 1e-3);
+}
+
+// Usable turns that do not reach the straight walk, and a usable speed cut
+// off from the others by one that failed, are never commanded.
+TEST(WalkResponse, NeverCommandsAnUnusableTurn) {
+  GaitCalibration cal;
+  cal.points = {// 0.1 m/s: straight and -0.2 usable; +0.2 hardly turns, so +0.4 (usable
+                // on its own) is cut off, and -0.4 turns a quarter of what it was told.
+                point(0.1, -0.4, 0.1, -0.1), point(0.1, -0.2, 0.1, -0.2), point(0.1, 0.0, 0.1, 0.0),
+                point(0.1, 0.2, 0.1, 0.02), point(0.1, 0.4, 0.1, 0.4),
+                // 0.2 m/s: straight and +-0.2 usable.
+                point(0.2, -0.2, 0.2, -0.2), point(0.2, 0.0, 0.2, 0.0), point(0.2, 0.2, 0.2, 0.2),
+                // 0.3 m/s: turns fine but the straight walk drifts 2 deg/s.
+                point(0.3, -0.2, 0.3, -0.2), point(0.3, 0.0, 0.3, deg_to_rad(2.0)),
+                point(0.3, 0.2, 0.3, 0.2),
+                // 0.4 m/s: usable, but beyond the failed 0.3.
+                point(0.4, 0.0, 0.4, 0.0)};
+  ASSERT_FALSE(cal.points[0].usable);
+  ASSERT_TRUE(cal.points[4].usable);
+  ASSERT_FALSE(cal.points[9].usable);
+  const WalkResponse r(steering(), &cal);
+  EXPECT_EQ(r.min_speed(), 0.1);
+  EXPECT_EQ(r.max_speed(), 0.2);
+  EXPECT_EQ(r.max_turn(0.1), 0.0);  // the fastest turn both ways: none to the left
+  EXPECT_NEAR(r.max_turn(0.2), 0.2, 1e-12);
+  EXPECT_EQ(r.max_turn(0.15), 0.0);
+  int turning = 0;
+  for (double v = 0.0; v <= 0.5; v += 0.025) {
+    for (double w = -1.0; w <= 1.0; w += 0.05) {
+      const MotionCommand c = r.command_for({v, w});
+      if (c.speed_m_s == 0.0) {
+        EXPECT_EQ(c.turn_rad_s, 0.0);
+        continue;
+      }
+      EXPECT_GE(c.speed_m_s, 0.1) << v << " " << w;
+      EXPECT_LE(c.speed_m_s, 0.2) << v << " " << w;
+      // Only the 0.2 m/s level turns, and only up to its usable 0.2 rad/s:
+      // between speeds the slower level (no turns) caps it.
+      EXPECT_LE(std::abs(c.turn_rad_s), r.max_turn(c.speed_m_s) + 1e-12) << v << " " << w;
+      if (c.speed_m_s < 0.2) {
+        EXPECT_EQ(c.turn_rad_s, 0.0) << v << " " << w;
+      }
+      turning += c.turn_rad_s != 0.0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(turning, 0);  // it does turn where it can
 }
 
 TEST(WalkResponse, LoadsTheGaitAndItsCalibration) {

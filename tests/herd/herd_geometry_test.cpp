@@ -22,7 +22,7 @@ std::string write(const std::string& name, const std::string& text) {
 std::string scene_text(bool with_block) {
   return std::string("bounds_m: [-5, -5, 5, 5]\n") +
          (with_block ? "geometry_obj: block.obj\n" : "") +
-         "figures:\n  pony: {gait: " + ANIMRT_SOURCE_DIR + "/configs/gaits/pony.yaml}\n" +
+         "figures:\n  pony: {gait: " + ANIMRT_SOURCE_DIR + "/configs/gaits/herd_pony.yaml}\n" +
          "groups:\n  - {name: team, kind: crowd, figure: pony, count: 2, spawn_m: [-4, -4, -3, "
          "-3],\n"
          "     target_m: [0, 0], speed_mps: [0.1, 0.2]}\n";

@@ -76,6 +76,18 @@ TEST(GaitCalibrate, ShippedCalibrationIsUsableOverTheStraightRange) {
   }
   EXPECT_GE(straight, 2);
   EXPECT_GT(response.max_speed(), response.min_speed());
+  // The demo quadruped hardly turns on physics (under 1 deg/s of the 2 and 4
+  // commanded): its table says so, and the herd is never offered a turn.
+  int turning = 0;
+  for (const CalibrationPoint& p : cal.points) {
+    if (p.commanded.turn_rad_s == 0.0) continue;
+    ++turning;
+    EXPECT_FALSE(p.usable) << p.commanded.speed_m_s << " " << p.commanded.turn_rad_s;
+  }
+  EXPECT_GE(turning, 2);
+  const double mid = 0.5 * (response.min_speed() + response.max_speed());
+  EXPECT_EQ(response.max_turn(mid), 0.0);
+  EXPECT_EQ(response.command_for({mid, 0.05}).turn_rad_s, 0.0);
 }
 
 TEST(GaitCalibrate, ValidateRefusesASteeringRangeBeyondTheJointLimits) {

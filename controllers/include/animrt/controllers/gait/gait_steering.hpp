@@ -19,9 +19,24 @@ struct GaitSteering {
   double track_width_m = 0.0;          // between the left and the right feet
   std::vector<std::string> left;       // limb names on the left side
   std::vector<std::string> right;      // and on the right
-  // Hip yaw joints (robot joints the gait maps): their curve is the motion at
-  // the fastest turn to the left, scaled by turn / max turn.
+  // Hip yaw (or abduction) joints, robot joints the gait maps: their curve is
+  // the motion at the fastest turn to the left at the slowest walk, scaled by
+  // (turn / max turn) x (slowest speed / speed), so they rest at their offset
+  // when walking straight.
   std::vector<std::string> yaw_joints;
+  // Curves that lift the feet (names from `curves`): they keep their whole
+  // swing at every walking speed and on both sides; only the other curves'
+  // swing follows the stride length and the turn. Empty: every curve follows.
+  std::vector<std::string> lift_curves;
+  // Fraction of the native swing at which the figure would no longer
+  // advance (its feet slip that much each stride): the swing for stride
+  // length lambda is swing_offset + (1 - swing_offset) lambda / lambda_native.
+  // 0 (the default): the swing is proportional to the stride length.
+  double swing_offset = 0.0;
+  // Walk at the gait's own stride frequency at every speed (the stride
+  // length alone follows the speed, lambda = v / f) instead of the Froude
+  // f(Fr): for a figure whose walk only works at one cadence.
+  bool fixed_cadence = false;
   Location where;  // of the `steering` key; ignored by ==
 
   double min_speed_m_s() const;

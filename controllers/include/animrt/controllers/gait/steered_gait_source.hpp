@@ -4,9 +4,11 @@
 //
 // Speed v sets Fr = v / sqrt(g h); the stride frequency and stride length
 // follow the Froude relations (froude.hpp). Each joint swings about its
-// curve's stride mean, with the swing scaled by lambda(Fr) / lambda(Fr_native);
-// a turn scales the inner side's swing by (v - w track / 2) / v and the outer
-// side's by (v + w track / 2) / v, and swings the yaw joints. Speed ramps at
+// curve's stride mean, with the swing scaled by lambda(Fr) / lambda(Fr_native)
+// (foot-lift curves keep their whole swing); a turn scales the inner side's
+// swing by (v - w track / 2) / v and the outer side's by (v + w track / 2) / v,
+// and turns the yaw joints by their curve scaled by (w / max turn) x
+// (slowest speed / v). Speed ramps at
 // the steering acceleration, turn rate and walk/stand blend over one stride
 // at the slowest speed, and the phase is integrated, so no command makes a
 // joint jump. A command below the slowest speed stands: the swing blends
@@ -31,6 +33,7 @@ class SteeredGaitSource final : public MotionSource {
     double gain = 1.0;   // sign * scale
     double offset_deg = 0.0;
     Side side = kNoSide;
+    bool lift = false;  // a foot-lift curve: whole swing at every speed and turn
   };
 
   // `native_frequency_hz` is the gait's own timing; before any command the
@@ -51,6 +54,9 @@ class SteeredGaitSource final : public MotionSource {
 
  private:
   void advance(double t) const;
+  // Stride frequency at a walking speed, and stride length over the native one.
+  double frequency_at(double speed) const;
+  double length_ratio_at(double speed) const;
   void reset(double t) const;
 
   GaitSteering steering_;
@@ -60,7 +66,8 @@ class SteeredGaitSource final : public MotionSource {
   std::vector<int> driven_;
   double native_speed_ = 0.0;
   double native_length_ = 0.0;  // stride length at the native Froude number
-  double blend_time_s_ = 1.0;   // walk/stand blend and full-turn ramp time
+  double native_frequency_hz_ = 1.0;
+  double blend_time_s_ = 1.0;  // walk/stand blend and full-turn ramp time
   double min_speed_ = 0.0, max_speed_ = 0.0;
 
   double target_speed_ = 0.0;  // 0 or within [min_speed_, max_speed_]

@@ -18,14 +18,15 @@ struct CalibrationPoint {
   MotionCommand commanded;
   MotionCommand achieved;
   bool fell = false;
-  // achieved speed within the tolerance of the commanded one, no fall
+  // achieved speed and turn within the tolerance of the commanded ones, no
+  // fall (calibration_usable)
   bool usable = false;
 };
 
 struct GaitCalibration {
   std::string gait_file;    // the gait it was measured for
   std::string model_file;   // the MJCF model it walked on
-  double tolerance = 0.15;  // relative speed error accepted as usable
+  double tolerance = 0.15;  // relative speed and turn error accepted as usable
   std::vector<CalibrationPoint> points;
 };
 
@@ -34,8 +35,15 @@ bool operator==(const MotionCommand& a, const MotionCommand& b);
 bool operator==(const CalibrationPoint& a, const CalibrationPoint& b);
 bool operator==(const GaitCalibration& a, const GaitCalibration& b);
 
-// Whether a measured point counts as usable under `tolerance`: no fall, and
-// achieved speed within tolerance x commanded of the commanded speed.
+// The smallest turn-rate error a usable point may have, degrees/s: a
+// straight walk (turn command 0) may drift this much, and a slow turn may
+// miss by this much, without being judged unusable.
+inline constexpr double kCalibrationTurnFloorDps = 1.0;
+
+// Whether a measured point counts as usable under `tolerance`: no fall, the
+// achieved speed within tolerance x commanded of the commanded speed, and the
+// achieved turn rate within max(tolerance x |commanded turn|,
+// kCalibrationTurnFloorDps) of the commanded turn rate.
 bool calibration_usable(const CalibrationPoint& point, double tolerance);
 
 // walk.yaml -> walk.calibration.yaml (next to the gait).
@@ -53,7 +61,10 @@ class WalkResponse {
  public:
   // Without a calibration the figure walks exactly what it is told, within
   // the steering limits. With one, only commands the table marks usable are
-  // given, and achieved() interpolates the table.
+  // given, and achieved() interpolates the table: the speeds are the longest
+  // run of measured speeds whose straight walk is usable, and at each speed
+  // the turn rates those usable points reach from the straight walk without
+  // crossing an unusable one.
   explicit WalkResponse(const GaitSteering& steering, const GaitCalibration* calibration = nullptr);
 
   // Walking speeds the figure can be asked for: 0 (standing) or
@@ -83,6 +94,10 @@ class WalkResponse {
   GaitSteering steering_;
   bool calibrated_ = false;
   std::vector<Level> levels_;  // by commanded speed
+  struct Node {
+    MotionCommand commanded, achieved;
+  };
+  std::vector<Node> grid_;  // calibrated only: where command_for starts
 };
 
 // The walk response of a steerable gait: its steering section, and its

@@ -32,6 +32,12 @@ struct CrowdParams {
   // so the plan stays one the figures can follow.
   double figure_turn_rad_s = 0.6;
   double accel_factor = 2.0;
+  // A standing figure walks off only when the crowd plans at least half its
+  // gait's slowest walk (figure.cpp); the crowd's velocity starts from the
+  // figure's every step, so its acceleration is at least this speed per
+  // herd step, or a figure with a fast slowest walk would never start.
+  double figure_start_speed_m_s = 0.0;
+  double step_s = 0.1;
   // Separation pushes members apart over the whole collision query range
   // (12 radii): in a packed start it drives the outer ones away from their
   // goal, so it is off unless asked for; avoidance keeps them apart.

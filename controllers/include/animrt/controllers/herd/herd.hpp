@@ -63,6 +63,9 @@ class Herd {
   const NavWorld* nav() const { return nav_.get(); }
   std::optional<Vec2> leader(int group) const;
   bool arrived(int agent) const;
+  const Figure& figure(int agent) const {
+    return figures_[static_cast<std::size_t>(figure_of_[static_cast<std::size_t>(agent)])];
+  }
 
   // One step of scene().step_s: steer every group, command every figure,
   // walk it (an embodied agent is left where set_pose() put it). A figure

@@ -1,0 +1,62 @@
+// A figure's command from its group's wish: stopping and starting a
+// calibrated figure whose slowest walk is fast.
+
+#include <gtest/gtest.h>
+
+#include "animrt/controllers/gait/walk_response.hpp"
+#include "animrt/controllers/herd/figure.hpp"
+
+namespace animrt::herd {
+namespace {
+
+// A figure that walks 0.1-0.2 m/s straight and turns 0.2 rad/s either way,
+// as measured; it cannot walk slower than 0.1 m/s.
+Figure calibrated_figure() {
+  GaitSteering s;
+  s.min_froude = 0.05;
+  s.max_froude = 0.2;
+  s.max_turn_rad_s = 0.2;
+  s.max_acceleration_m_s2 = 0.1;
+  s.hip_height_m = 0.2;
+  s.track_width_m = 0.2;
+  s.left = {"l"};
+  s.right = {"r"};
+  GaitCalibration cal;
+  for (double v : {0.1, 0.2}) {
+    for (double w : {-0.2, 0.0, 0.2}) {
+      CalibrationPoint p;
+      p.commanded = {v, w};
+      p.achieved = {v, w};
+      p.usable = calibration_usable(p, cal.tolerance);
+      cal.points.push_back(p);
+    }
+  }
+  return Figure{"pony", 0.25, WalkResponse(s, &cal)};
+}
+
+TEST(FigureSteer, ASlowingFigureStandsBelowItsSlowestWalk) {
+  const Figure f = calibrated_figure();
+  Agent a;
+  a.speed = 0.1;  // walking its slowest
+  // Its group wants nothing: the ramp (0.1 - 0.01 m/s) is below the slowest
+  // walk, so it stands instead of walking on at 0.1.
+  MotionCommand c = steer_figure(f, a, Vec2{0.0, 0.0}, 0.1);
+  EXPECT_EQ(c.speed_m_s, 0.0);
+  EXPECT_EQ(c.turn_rad_s, 0.0);
+  // Faster, it slows at its acceleration first.
+  a.speed = 0.2;
+  c = steer_figure(f, a, Vec2{0.0, 0.0}, 0.1);
+  EXPECT_NEAR(c.speed_m_s, 0.19, 1e-3);
+}
+
+TEST(FigureSteer, AStandingFigureWalksOffAtItsSlowestWalkAndTurns) {
+  const Figure f = calibrated_figure();
+  Agent a;  // standing, heading +x
+  // Wanted: 0.15 m/s to the left of its heading.
+  const MotionCommand c = steer_figure(f, a, Vec2{0.0, 0.15}, 0.1);
+  EXPECT_NEAR(c.speed_m_s, 0.1, 1e-3);
+  EXPECT_NEAR(c.turn_rad_s, 0.2, 1e-3);  // its fastest usable turn, to the left
+}
+
+}  // namespace
+}  // namespace animrt::herd
