@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # animrt seq train on a tiny joint-angle CSV: exit code, progress lines,
 # model, checkpoint and plot written, a resume from the checkpoint, and bad
-# input refused with exit 2 and the file named.
+# input refused with exit 2 and the file named; then a mesh model trained on a
+# bending plate and seq generate from it.
 set -uo pipefail
 animrt=$1
 tmp=$(mktemp -d)
@@ -41,4 +42,29 @@ printf 'time_s,hip\n0,zero\n' > "$tmp/bad.csv"
 out=$("$animrt" seq train "$tmp/bad.csv" --out "$tmp/n.model" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/bad.csv:2:3: hip:"* ]] || fail "bad CSV: exit $code: $out"
+# A 6 x 6 plate bending to and fro, 30 OBJ frames.
+mkdir "$tmp/plate"
+awk -v dir="$tmp/plate" 'BEGIN { n = 6;
+  for (f = 0; f < 30; f++) {
+    file = sprintf("%s/frame_%04d.obj", dir, f); a = 0.5 * sin(6.2832 * f / 12);
+    for (i = 0; i < n; i++) for (j = 0; j < n; j++) { x = i / (n - 1); y = j / (n - 1);
+      printf "v %g %g %g\n", x * cos(a * x), y, x * sin(a * x) > file }
+    for (i = 0; i < n - 1; i++) for (j = 0; j < n - 1; j++) { v = i * n + j + 1;
+      printf "f %d %d %d\nf %d %d %d\n", v, v + n, v + 1, v + 1, v + n, v + n + 1 > file }
+    close(file) } }'
+"$animrt" seq features "$tmp/plate" --out "$tmp/plate.bin" >/dev/null || fail "features of the plate"
+out=$("$animrt" seq train "$tmp/plate.bin" --out "$tmp/plate.model" --iterations 4 "${small[@]}" 2>&1) ||
+  fail "mesh training failed: $out"
+out=$("$animrt" seq generate "$tmp/plate.model" --init "$tmp/plate/frame_0000.obj" "$tmp/plate/frame_0001.obj" \
+  --frames 12 --out "$tmp/gen" 2>&1) || fail "generate failed: $out"
+[[ $(ls "$tmp/gen" | wc -l) -eq 14 ]] || fail "generate wrote $(ls "$tmp/gen" | wc -l) frames, expected 14"
+cmp -s <(grep '^v ' "$tmp/gen/frame_0000.obj") <(grep '^v ' "$tmp/gen/frame_0013.obj") &&
+  fail "the last generated frame has the first frame's vertices"
+cmp -s <(grep '^v ' "$tmp/gen/frame_0001.obj") <(grep '^v ' "$tmp/plate/frame_0001.obj") ||
+  fail "the second initial frame is not kept"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/other.obj"
+out=$("$animrt" seq generate "$tmp/plate.model" --init "$tmp/other.obj" --frames 2 --out "$tmp/gen2" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/plate.model: mesh: trained on a mesh of 36 vertices, the data has 3"* ]] ||
+  fail "other mesh: exit $code: $out"
 echo ok
