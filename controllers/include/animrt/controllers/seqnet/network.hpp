@@ -1,0 +1,139 @@
+#pragma once
+// The share-weight bidirectional LSTM of "bdlstm-mesh-sequences" (sections
+// 3.2-3.4) on libtorch: mesh convolutions (Eq. 2) encode a frame's features
+// to a latent vector (mean and log-variance), a multi-layer LSTM steps it,
+// transpose convolutions decode the change to the next frame. The joint-space
+// variant puts dense layers where the mesh layers are. One parameter set runs
+// the forward chain (state +s0) and the backward chain (state -s0).
+// Only targets that link animrt_seqnet_torch include this header.
+
+#include <torch/nn/module.h>
+#include <torch/nn/modules/container/sequential.h>
+#include <torch/nn/modules/linear.h>
+#include <torch/nn/modules/rnn.h>
+
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "animrt/controllers/seqnet/model_file.hpp"
+
+namespace animrt::seqnet {
+
+// The directed 1-ring pairs (i, j) of a mesh with weight 1 / d_i, so that
+// sum_j w_ij x_j is the mean of vertex i's neighbours.
+struct MeshGraph {
+  int vertex_count = 0;
+  torch::Tensor rows;     // i, int64
+  torch::Tensor cols;     // j, int64
+  torch::Tensor weights;  // 1 / d_i, float
+};
+MeshGraph mesh_graph(int vertex_count, const std::vector<std::array<int, 3>>& triangles);
+
+// Eq. 2 on [B, V, C] inputs: y_i = W1 x_i + W2 mean_{j in N(i)} x_j + b.
+// The transpose spreads instead of gathering: y_j = W1 x_j + W2 sum_{i: j in
+// N(i)} x_i / d_i + b (the adjoint of the neighbour mean).
+class MeshConvImpl : public torch::nn::Module {
+ public:
+  MeshConvImpl(int in, int out, MeshGraph graph, bool transpose);
+  torch::Tensor forward(const torch::Tensor& x);
+  // The neighbour mean (or its adjoint) alone.
+  torch::Tensor ring(const torch::Tensor& x) const;
+
+  torch::nn::Linear self{nullptr};
+  torch::nn::Linear neighbours{nullptr};
+
+ private:
+  MeshGraph graph_;
+  bool transpose_;
+};
+TORCH_MODULE(MeshConv);
+
+using LstmState = std::tuple<torch::Tensor, torch::Tensor>;  // h, c: [layers, B, hidden]
+
+struct Chain {
+  torch::Tensor frames;  // [n, B, D]: the given frames, then the generated ones
+  torch::Tensor mu;      // [n - 1, B, latent]
+  torch::Tensor logvar;  // [n - 1, B, latent]
+};
+
+class SeqNetImpl : public torch::nn::Module {
+ public:
+  SeqNetImpl(const NetShape& shape, MeshGraph graph);
+
+  const NetShape& shape() const { return shape_; }
+  // [B, D] -> mean and log-variance [B, latent].
+  std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& x);
+  // [B, hidden] -> feature change [B, D].
+  torch::Tensor decode(const torch::Tensor& h);
+  // Every state entry sign * s0 (sign +1 forward, -1 backward).
+  LstmState initial_state(int batch, double sign) const;
+  // Runs the chain from `given` ([u, B, D], u >= 1) to n frames: the given
+  // frames are fed in order, then each output is the next input. With
+  // `sample` the latent is drawn (training), else its mean is used.
+  Chain run(const torch::Tensor& given, int n, LstmState state, bool sample);
+
+  torch::nn::Sequential encoder{nullptr};  // mesh convolutions or dense layers, tanh
+  torch::nn::Linear to_mu{nullptr};
+  torch::nn::Linear to_logvar{nullptr};
+  torch::nn::LSTM lstm{nullptr};
+  torch::nn::Linear from_hidden{nullptr};
+  torch::nn::Sequential decoder{nullptr};  // transpose convolutions or dense layers
+
+ private:
+  NetShape shape_;
+};
+TORCH_MODULE(SeqNet);
+
+// Loss terms (docs/seqnet.md, "Losses"). S^f, S^b and X are [n, B, D]; a
+// frame's distance is the mean squared difference over its B x D entries.
+// sum_i |S^f_i - X_i| + |S^b_i - X_{n+1-i}|
+torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& backward,
+                         const torch::Tensor& truth);
+// sum_i |S^f_i - S^b_{n+1-i}|
+torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward);
+// KL(N(mu, exp(logvar)) || N(0, 1)), mean over all latent entries.
+torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar);
+// Mean square of the weights (matrices, not biases) of the module.
+torch::Tensor l2_loss(const torch::nn::Module& net);
+
+struct LossTerms {
+  torch::Tensor recon, bidir, kl, l2, total;
+};
+// L_recon + 0.5 L_bidir + 0.1 (L_KL + L2) for one batch of ground-truth
+// windows X [n, B, D]: the forward chain from X_1 with +s0, the backward
+// chain from X_n with -s0. `kl_weight` and `bidir` switch terms off for
+// ablations (1 and true: the paper).
+LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight = 1.0,
+                     bool bidirectional = true);
+
+// Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
+// that a checkpoint saves and restores exactly.
+class Adam {
+ public:
+  Adam(std::vector<torch::Tensor> parameters, double learning_rate);
+  void step();  // uses each parameter's grad; then zeroes the grads
+  std::int64_t steps() const { return steps_; }
+  std::vector<NamedArray> state(const std::vector<std::string>& names) const;
+  // Throws InputError (naming `file`) when the state does not fit.
+  void restore(const std::vector<NamedArray>& state, const std::vector<std::string>& names,
+               const std::string& file);
+
+ private:
+  std::vector<torch::Tensor> params_, m_, v_;
+  double lr_;
+  std::int64_t steps_ = 0;
+};
+
+// Parameters as named arrays (model file) and back. load_parameters throws
+// InputError naming the file and the parameter that is missing or of
+// another shape.
+std::vector<NamedArray> save_parameters(const SeqNetImpl& net);
+void load_parameters(SeqNetImpl& net, const std::vector<NamedArray>& arrays,
+                     const std::string& file);
+
+// A network for a model file (its shape and mesh), parameters loaded.
+SeqNet network_for(const ModelFile& model, const std::string& file);
+
+}  // namespace animrt::seqnet

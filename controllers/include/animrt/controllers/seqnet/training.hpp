@@ -1,0 +1,90 @@
+#pragma once
+// Training the sequence network (docs/seqnet.md, "Training"): the data (a
+// mesh feature file, or joint-angle CSVs), the held-out split, the batch
+// sampling, checkpoints and the loss plot. The API needs no libtorch; the
+// implementation is in animrt_seqnet_torch.
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/seqnet/model_file.hpp"
+
+namespace animrt::seqnet {
+
+// Frames of one clip piece, all training or all held out; `values` is
+// count x D, row-major, normalised to [-0.95, 0.95].
+struct Segment {
+  int dataset = 0;
+  bool held_out = false;
+  int count = 0;
+  std::vector<float> values;
+};
+
+struct TrainingSet {
+  ModelKind kind = ModelKind::mesh;
+  int dims = 0;
+  // Mesh data: the template and connectivity. Joint data: the joints.
+  ModelFile description;  // shape.kind, vertex/joint count, rest, triangles, joint_names, low, high
+  std::vector<std::string> sources;
+  std::vector<Segment> segments;
+};
+
+// Joint columns of a telemetry or corpus CSV: every column but time_s and
+// the torso_* columns.
+bool is_joint_column(const std::string& name);
+
+// DATA: one mesh feature file (animrt seq features), or one or more joint
+// CSVs with the same joints. Each file is a dataset: one contiguous block
+// of `held_out` of its frames, placed by the seed, is held out. Throws
+// InputError for bad files (naming file, line, column).
+TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
+                              double held_out = 0.2);
+
+struct TrainOptions {
+  std::vector<std::string> data;
+  std::string out;        // the model; OUT.ckpt is the checkpoint, OUT.svg the loss plot
+  std::string resume;     // a checkpoint to continue from
+  int iterations = 1000;  // total, counting those before a resume
+  std::uint64_t seed = 1;
+  int threads = 1;
+  int batch = 8;
+  int window = 32;
+  int stride = 1;
+  double learning_rate = 1e-3;
+  int checkpoint_every = 100;
+  int report_every = 10;
+  double held_out = 0.2;
+  // Network size (paper values by default).
+  int latent = 128;
+  int hidden = 128;
+  int lstm_layers = 3;
+  int channels = 9;
+  int dense_width = 64;
+  // Ablations: the KL term's weight (1: the paper) and bidirectional training.
+  double kl_weight = 1.0;
+  bool bidirectional = true;
+};
+
+struct LossRecord {
+  double recon = 0, bidir = 0, kl = 0, l2 = 0, total = 0;
+};
+
+struct TrainResult {
+  int iterations = 0;    // total trained
+  int run = 0;           // trained in this call
+  LossRecord last;       // last iteration's batch
+  double held_out = -1;  // held-out reconstruction loss (-1: no held-out window)
+  double seconds = 0;
+};
+
+// Trains, printing a progress line every report_every iterations to
+// `progress`; writes the model, checkpoint and plot. Throws InputError for
+// bad data or a checkpoint that does not fit the data.
+TrainResult train(const TrainOptions& options, std::ostream& progress);
+
+// The loss history as an SVG line plot (log scale), one line per term.
+std::string loss_plot_svg(const std::vector<LossRecord>& history);
+
+}  // namespace animrt::seqnet

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# animrt seq train on a tiny joint-angle CSV: exit code, progress lines,
+# model, checkpoint and plot written, a resume from the checkpoint, and bad
+# input refused with exit 2 and the file named; then a mesh model trained on a
+# bending plate and seq generate from it.
+set -uo pipefail
+animrt=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+awk 'BEGIN { print "time_s,hip,knee,torso_x";
+  for (f = 0; f < 60; f++) { t = f / 25; printf "%g,%g,%g,%g\n", t, 0.5 * sin(7.85 * t), 0.3 * cos(7.85 * t), t } }' \
+  > "$tmp/walk.csv"
+small=(--window 8 --batch 2 --hidden 16 --latent 8 --lstm-layers 2 --threads 1)
+
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --checkpoint-every 5 \
+  --report-every 5 "${small[@]}" 2>&1) || fail "train failed: $out"
+line='iteration 5/10  recon [0-9.e+-]+  bidir [0-9.e+-]+  KL [0-9.e+-]+  L2 [0-9.e+-]+  total [0-9.e+-]+  [0-9.]+ it/s  left [0-9]+:[0-9][0-9]'
+[[ $out =~ $line ]] || fail "no progress line: $out"
+[[ $out == *"iteration 10/10 "* ]] || fail "no last progress line: $out"
+[[ $out == *"held-out reconstruction loss per frame"* ]] || fail "no held-out loss: $out"
+for f in m.model m.model.ckpt m.model.svg; do
+  [[ -s $tmp/$f ]] || fail "$f not written"
+done
+grep -q '<svg' "$tmp/m.model.svg" || fail "plot is not SVG"
+
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 14 --resume "$tmp/m.model.ckpt" \
+  --report-every 2 "${small[@]}" 2>&1) || fail "resume failed: $out"
+[[ $out == *"iteration 12/14 "* && $out == *"iteration 14/14 "* ]] || fail "resume did not continue: $out"
+[[ $out != *"iteration 2/14 "* ]] || fail "resume started over: $out"
+[[ $out == *"trained 4 iterations (14 in all)"* ]] || fail "resume count: $out"
+
+printf 'ANSEQNN\nrubbish' > "$tmp/bad.ckpt"
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/n.model" --resume "$tmp/bad.ckpt" 2>&1)
+code=$?
+[[ $code -eq 2 ]] || fail "corrupt checkpoint: exit $code, expected 2: $out"
+[[ $out == *"$tmp/bad.ckpt"* ]] || fail "corrupt checkpoint not named: $out"
+[[ $(echo "$out" | wc -l) -eq 1 ]] || fail "more than one line: $out"
+
+printf 'time_s,hip\n0,zero\n' > "$tmp/bad.csv"
+out=$("$animrt" seq train "$tmp/bad.csv" --out "$tmp/n.model" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/bad.csv:2:3: hip:"* ]] || fail "bad CSV: exit $code: $out"
+# A 6 x 6 plate bending to and fro, 30 OBJ frames.
+mkdir "$tmp/plate"
+awk -v dir="$tmp/plate" 'BEGIN { n = 6;
+  for (f = 0; f < 30; f++) {
+    file = sprintf("%s/frame_%04d.obj", dir, f); a = 0.5 * sin(6.2832 * f / 12);
+    for (i = 0; i < n; i++) for (j = 0; j < n; j++) { x = i / (n - 1); y = j / (n - 1);
+      printf "v %g %g %g\n", x * cos(a * x), y, x * sin(a * x) > file }
+    for (i = 0; i < n - 1; i++) for (j = 0; j < n - 1; j++) { v = i * n + j + 1;
+      printf "f %d %d %d\nf %d %d %d\n", v, v + n, v + 1, v + 1, v + n, v + n + 1 > file }
+    close(file) } }'
+"$animrt" seq features "$tmp/plate" --out "$tmp/plate.bin" >/dev/null || fail "features of the plate"
+out=$("$animrt" seq train "$tmp/plate.bin" --out "$tmp/plate.model" --iterations 4 "${small[@]}" 2>&1) ||
+  fail "mesh training failed: $out"
+out=$("$animrt" seq generate "$tmp/plate.model" --init "$tmp/plate/frame_0000.obj" "$tmp/plate/frame_0001.obj" \
+  --frames 12 --out "$tmp/gen" 2>&1) || fail "generate failed: $out"
+[[ $(ls "$tmp/gen" | wc -l) -eq 14 ]] || fail "generate wrote $(ls "$tmp/gen" | wc -l) frames, expected 14"
+cmp -s <(grep '^v ' "$tmp/gen/frame_0000.obj") <(grep '^v ' "$tmp/gen/frame_0013.obj") &&
+  fail "the last generated frame has the first frame's vertices"
+cmp -s <(grep '^v ' "$tmp/gen/frame_0001.obj") <(grep '^v ' "$tmp/plate/frame_0001.obj") ||
+  fail "the second initial frame is not kept"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/other.obj"
+out=$("$animrt" seq generate "$tmp/plate.model" --init "$tmp/other.obj" --frames 2 --out "$tmp/gen2" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/plate.model: mesh: trained on a mesh of 36 vertices, the data has 3"* ]] ||
+  fail "other mesh: exit $code: $out"
+echo ok

@@ -1,0 +1,201 @@
+// Training: the loss falls on tiny data (joints and mesh), runs repeat for a
+// seed, a resumed run equals an uninterrupted one, the held-out split, and
+// data or checkpoints that do not fit are refused.
+
+#include "animrt/controllers/seqnet/training.hpp"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "animrt/controllers/seqnet/model_file.hpp"
+#include "animrt/core/error.hpp"
+#include "net_test_util.hpp"
+
+namespace animrt::seqnet {
+namespace {
+
+TrainOptions tiny(const std::string& data, const std::string& out) {
+  TrainOptions o;
+  o.data = {data};
+  o.out = nettest::temp_path(out);
+  o.threads = 1;
+  o.batch = 4;
+  o.window = 8;
+  o.latent = 8;
+  o.hidden = 16;
+  o.dense_width = 16;
+  o.learning_rate = 3e-3;
+  o.report_every = 0;
+  o.checkpoint_every = 1000;
+  return o;
+}
+
+double mean_total(const std::vector<LossRecord>& h, std::size_t from, std::size_t count) {
+  double s = 0;
+  for (std::size_t i = from; i < from + count; ++i) s += h[i].total;
+  return s / static_cast<double>(count);
+}
+
+std::vector<LossRecord> history_of(const std::string& checkpoint) {
+  const ModelFile m = read_model_file(checkpoint);
+  for (const NamedArray& a : m.optimiser) {
+    if (a.name != "history") continue;
+    std::vector<LossRecord> out;
+    for (std::size_t i = 0; i < a.values.size(); i += 5) {
+      out.push_back(
+          {a.values[i + 1], a.values[i + 2], a.values[i + 3], a.values[i + 4], a.values[i]});
+    }
+    return out;
+  }
+  return {};
+}
+
+TEST(SeqTraining, JointLossFallsOnATinyCorpus) {
+  TrainOptions o = tiny(nettest::write_joint_csv("swing.csv", 80), "swing.model");
+  o.iterations = 60;
+  std::ostringstream log;
+  const TrainResult r = train(o, log);
+  EXPECT_EQ(r.iterations, 60);
+  const std::vector<LossRecord> h = history_of(o.out + ".ckpt");
+  ASSERT_EQ(h.size(), 60U);
+  const double first = mean_total(h, 0, 5), last = mean_total(h, 55, 5);
+  EXPECT_LT(last, 0.5 * first) << "first " << first << " last " << last;
+  EXPECT_GE(r.held_out, 0.0);
+  const ModelFile m = read_model_file(o.out);
+  EXPECT_EQ(m.joint_names, (std::vector<std::string>{"hip", "knee", "ankle"}));
+  EXPECT_TRUE(m.optimiser.empty());
+  std::ifstream svg(o.out + ".svg");
+  std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("<polyline"), std::string::npos);
+}
+
+TEST(SeqTraining, MeshLossFallsOnATinyBar) {
+  TrainOptions o = tiny(nettest::write_bar_features("bar.features", 5, 6, 48), "bar.model");
+  o.iterations = 40;
+  o.channels = 9;
+  std::ostringstream log;
+  train(o, log);
+  const std::vector<LossRecord> h = history_of(o.out + ".ckpt");
+  ASSERT_EQ(h.size(), 40U);
+  const double first = mean_total(h, 0, 5), last = mean_total(h, 35, 5);
+  EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
+  const ModelFile m = read_model_file(o.out);
+  EXPECT_EQ(m.shape.kind, ModelKind::mesh);
+  EXPECT_EQ(m.shape.vertex_count, 5 * 6 + 2);
+}
+
+TEST(SeqTraining, SameSeedRepeatsAndAResumeEqualsOneRun) {
+  const std::string data = nettest::write_joint_csv("repeat.csv", 60);
+  std::ostringstream log;
+  TrainOptions a = tiny(data, "a.model");
+  a.iterations = 6;
+  train(a, log);
+  TrainOptions b = tiny(data, "b.model");
+  b.iterations = 6;
+  train(b, log);
+  TrainOptions c = tiny(data, "c.model");
+  c.iterations = 3;
+  c.checkpoint_every = 3;
+  train(c, log);
+  c.resume = c.out + ".ckpt";
+  c.iterations = 6;
+  train(c, log);
+  TrainOptions d = tiny(data, "d.model");
+  d.iterations = 6;
+  d.seed = 2;
+  train(d, log);
+  const ModelFile ma = read_model_file(a.out), mb = read_model_file(b.out),
+                  mc = read_model_file(c.out), md = read_model_file(d.out);
+  ASSERT_EQ(ma.parameters.size(), mc.parameters.size());
+  for (std::size_t k = 0; k < ma.parameters.size(); ++k) {
+    EXPECT_EQ(ma.parameters[k].values, mb.parameters[k].values) << ma.parameters[k].name;
+    EXPECT_EQ(ma.parameters[k].values, mc.parameters[k].values) << ma.parameters[k].name;
+  }
+  EXPECT_EQ(mc.iteration, 6U);
+  EXPECT_NE(ma.parameters[0].values, md.parameters[0].values);
+}
+
+TEST(SeqTraining, OneFifthOfEachDatasetIsHeldOutInOneBlock) {
+  const std::string one = nettest::write_joint_csv("split1.csv", 50);
+  const std::string two = nettest::write_joint_csv("split2.csv", 30);
+  const TrainingSet set = load_training_set({one, two}, 5);
+  int held[2] = {0, 0}, total[2] = {0, 0}, blocks[2] = {0, 0};
+  for (const Segment& s : set.segments) {
+    total[s.dataset] += s.count;
+    if (s.held_out) {
+      held[s.dataset] += s.count;
+      ++blocks[s.dataset];
+    }
+  }
+  EXPECT_EQ(total[0], 50);
+  EXPECT_EQ(total[1], 30);
+  EXPECT_EQ(held[0], 10);
+  EXPECT_EQ(held[1], 6);
+  EXPECT_EQ(blocks[0], 1);
+  EXPECT_EQ(blocks[1], 1);
+  // Values normalised to [-0.95, 0.95] with both ends reached.
+  float lo = 1, hi = -1;
+  for (const Segment& s : set.segments) {
+    for (float v : s.values) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  EXPECT_NEAR(lo, -0.95F, 1e-6);
+  EXPECT_NEAR(hi, 0.95F, 1e-6);
+}
+
+TEST(SeqTraining, CheckpointOfOtherDataIsRefused) {
+  std::ostringstream log;
+  TrainOptions o = tiny(nettest::write_joint_csv("ck.csv", 40), "ck.model");
+  o.iterations = 2;
+  train(o, log);
+  TrainOptions other =
+      tiny(nettest::write_joint_csv("ck_other.csv", 40, "hip,knee,toe"), "ck_other.model");
+  other.resume = o.out + ".ckpt";
+  other.iterations = 4;
+  try {
+    train(other, log);
+    FAIL() << "resumed from another joint set";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(o.out + ".ckpt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the data lacks ankle; the model lacks toe"),
+              std::string::npos)
+        << e.what();
+  }
+  // A final model is not a checkpoint.
+  TrainOptions from_model = tiny(o.data.front(), "ck2.model");
+  from_model.resume = o.out;
+  from_model.iterations = 4;
+  EXPECT_THROW(train(from_model, log), InputError);
+}
+
+TEST(SeqTraining, BadCsvAndTooShortDataAreClearErrors) {
+  const std::string bad = nettest::temp_path("bad.csv");
+  std::ofstream(bad) << "time_s,hip\n0,0.1\n0.04,oops\n";
+  try {
+    load_training_set({bad}, 1);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + ":3:6: hip: \"oops\" is not a finite number"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ostringstream log;
+  TrainOptions o = tiny(nettest::write_joint_csv("short.csv", 10), "short.model");
+  o.iterations = 1;
+  try {
+    train(o, log);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no training piece has 8 frames"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace animrt::seqnet
