@@ -380,7 +380,8 @@ int main(int argc, char** argv) {
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
   animrt::cli::add_view_command(app);
-  auto* seq = app.add_subcommand("seq", "Mesh sequences: generated corpus, deformation features");
+  auto* seq = app.add_subcommand(
+      "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
   seq->require_subcommand(1);
   animrt::cli::add_seq_corpus_command(*seq);
   animrt::cli::add_seq_command(*seq);

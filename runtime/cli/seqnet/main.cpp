@@ -1,0 +1,21 @@
+// animrt-seqnet: the sequence network's training and generation, the part
+// of animrt that needs libtorch. Run through `animrt seq train|generate`,
+// which hands its arguments over unchanged, or on its own.
+
+#include <CLI/CLI.hpp>
+
+#include "seq_net_commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"animrt-seqnet: train the sequence network and generate with it"};
+  app.require_subcommand(1);
+  animrt::cli::add_seq_net_commands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own result (subcommand.hpp)
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == static_cast<int>(CLI::ExitCodes::Success) ? 0 : 1;
+  }
+  return 1;
+}
