@@ -55,6 +55,10 @@ fi
 # -- CAN: SocketCAN on vcan0, simulated motors and drive in another process ------
 candump -L vcan0 > /tmp/vcan0.log 2>/tmp/candump.err &
 dump=$!
+# The file exists before the wait looks at it: a grep of a missing file
+# made the wait end at once, and the check fail, when the background start
+# had not created it yet.
+: > /tmp/can_sim.txt
 animrt sim /configs/robots/quadruped_can_vcan0.yaml > /tmp/can_sim.txt 2>&1 &
 sim=$!
 n=0
