@@ -19,6 +19,7 @@
 #include "animrt/runtime/evolve_dashboard.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "dashboard_address.hpp"
 #include "evolve_pareto.hpp"
 #include "subcommand.hpp"
 
@@ -55,20 +56,9 @@ int run_evolve(const EvolveArgs& a) {
     return kExitUsage;
   }
   // The dashboard's address is a usage error before any file is read.
-  std::optional<std::pair<std::string, int>> dashboard_at;
-  if (!a.dashboard.empty()) {
-    try {
-      dashboard_at = parse_host_port(a.dashboard);
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "--dashboard: " << e.what() << '\n';
-      return kExitUsage;
-    }
-    if (!a.dashboard_remote && !is_loopback_host(dashboard_at->first)) {
-      std::cerr << "--dashboard: " << dashboard_at->first
-                << " is not a loopback address; serving other machines needs --dashboard-remote\n";
-      return kExitUsage;
-    }
-  }
+  const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
+  if (!address.ok) return kExitUsage;
+  const auto& dashboard_at = address.at;
   evolve::RunConfig config = evolve::load_run_config(a.run_file);
   if (a.seed) config.search.seed = *a.seed;
   if (a.population) config.search.population = *a.population;
@@ -111,8 +101,8 @@ int run_evolve(const EvolveArgs& a) {
   std::unique_ptr<sim::MujocoFigure> figure;
   std::unique_ptr<EvolveDashboardServer> dashboard;
   if (dashboard_at && lead) {
-    figure = std::make_unique<sim::MujocoFigure>(config.model, info.joints,
-                                                 Location{config.file, 0, 0});
+    figure =
+        std::make_unique<sim::MujocoFigure>(config.model, info.joints, Location{config.file, 0, 0});
     EvolveDashboardSetup setup;
     setup.host = dashboard_at->first;
     setup.port = dashboard_at->second;
@@ -149,7 +139,8 @@ int run_evolve(const EvolveArgs& a) {
   evolve::Search search(config, std::move(grammar), seed, info, evaluator);
   evolve::SearchHooks hooks;
   hooks.generation = [&](const evolve::GenerationStats& s, const evolve::Individual& best) {
-    if (lead && !a.quiet) std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
+    if (lead && !a.quiet)
+      std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
     if (dashboard) dashboard->publish(s, best);
   };
   // A stop from the dashboard ends the search after the generation it

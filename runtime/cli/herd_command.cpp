@@ -17,6 +17,7 @@
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "dashboard_address.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -80,20 +81,9 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
 int run_herd(const HerdArgs& a) {
   herd::HerdScene scene = herd::load_herd_scene(a.scene);
   if (a.duration) scene.duration_s = *a.duration;
-  std::optional<std::pair<std::string, int>> dashboard_at;
-  if (!a.dashboard.empty()) {
-    try {
-      dashboard_at = parse_host_port(a.dashboard);
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "--dashboard: " << e.what() << '\n';
-      return kExitUsage;
-    }
-    if (!a.dashboard_remote && !is_loopback_host(dashboard_at->first)) {
-      std::cerr << "--dashboard: " << dashboard_at->first
-                << " is not a loopback address; serving other machines needs --dashboard-remote\n";
-      return kExitUsage;
-    }
-  }
+  const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
+  if (!address.ok) return kExitUsage;
+  const auto& dashboard_at = address.at;
   herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
   const herd::HerdScene& s = herd.scene();
   // With a dashboard the herd walks at real time (or a multiple of it), so

@@ -107,6 +107,11 @@ EOF
 "$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/g.yaml" --dashboard 0.0.0.0:0 > "$tmp/o" 2> "$tmp/e"
 [[ $? -eq 1 ]] || fail "evolve: a non-loopback dashboard without --dashboard-remote was not a usage error"
 grep -q "dashboard-remote" "$tmp/e" || fail "evolve: the message does not name --dashboard-remote: $(cat "$tmp/e")"
+# The Pareto search has no dashboard: asking for both is a usage error.
+"$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/front" --pareto --dashboard 127.0.0.1:0 > "$tmp/o" 2> "$tmp/e"
+[[ $? -eq 1 ]] || fail "evolve --pareto --dashboard was not a usage error"
+grep -q -- "--pareto" "$tmp/e" || fail "the message does not name --pareto: $(cat "$tmp/e")"
+[[ ! -e "$tmp/front" ]] || fail "evolve --pareto --dashboard wrote results"
 [[ ! -e $tmp/g.yaml ]] || fail "evolve: a usage error wrote a gait"
 # The search's stop under MPI: rank 0 serves the page, every rank must stop.
 command -v mpirun > /dev/null 2>&1 || fail "mpirun not found (scripts/install-deps.sh installs Open MPI)"
