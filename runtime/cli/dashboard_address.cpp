@@ -1,4 +1,4 @@
-// The --dashboard option of evolve and herd (see dashboard_address.hpp).
+// The --dashboard option of run, evolve and herd (see dashboard_address.hpp).
 
 #include "dashboard_address.hpp"
 
@@ -21,7 +21,8 @@ DashboardAddress check_dashboard_address(const std::string& text, bool remote) {
   }
   if (!remote && !is_loopback_host(out.at->first)) {
     std::cerr << "--dashboard: " << out.at->first
-              << " is not a loopback address; serving other machines needs --dashboard-remote\n";
+              << " is not a loopback address; the dashboard takes controls, so serving other "
+                 "machines needs --dashboard-remote\n";
     out.ok = false;
   }
   return out;

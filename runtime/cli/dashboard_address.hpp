@@ -1,5 +1,5 @@
 #pragma once
-// The --dashboard HOST:PORT option of evolve and herd, checked before the
+// The --dashboard HOST:PORT option of run, evolve and herd, checked before the
 // work starts: a bad address, or a non-loopback one without
 // --dashboard-remote, is one line on stderr and a usage error.
 

@@ -28,6 +28,7 @@
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "dashboard_address.hpp"
 #include "evolve_command.hpp"
 #include "gait_command.hpp"
 #include "head_command.hpp"
@@ -137,22 +138,11 @@ void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>&
 
 int cmd_run(const RunArgs& args) {
   // The dashboard's address is a usage error before any file is read.
-  std::pair<std::string, int> dashboard_at;
-  if (!args.dashboard.empty()) {
-    try {
-      dashboard_at = animrt::parse_host_port(args.dashboard);
-    } catch (const std::invalid_argument& e) {
-      spdlog::error("--dashboard: {}", e.what());
-      return kExitUsage;
-    }
-    if (!args.dashboard_remote && !animrt::is_loopback_host(dashboard_at.first)) {
-      spdlog::error(
-          "--dashboard: {} is not a loopback address; the dashboard takes controls, so serving "
-          "other machines needs --dashboard-remote",
-          dashboard_at.first);
-      return kExitUsage;
-    }
-  }
+  const animrt::cli::DashboardAddress address =
+      animrt::cli::check_dashboard_address(args.dashboard, args.dashboard_remote);
+  if (!address.ok) return kExitUsage;
+  const std::pair<std::string, int> dashboard_at =
+      address.at.value_or(std::pair<std::string, int>{});
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
   // The figure: the robot file's model, or else the physics model.
   std::unique_ptr<animrt::sim::MujocoFigure> figure = load_figure(robot.config);
