@@ -6,7 +6,9 @@
 // iteration at the paper's size (batch 8, 32 frames, both chains, Adam) on
 // meshes of about 500 and 2,500 vertices, against a bare libtorch LSTM of
 // the same size (3 x 128, linear maps in and out of the 9 V features) doing
-// the same chains; and generation time per frame, mesh and joint space.
+// the same chains; and generation time per frame, mesh and joint space, on
+// libtorch and on the plain C++ inference that animrt runs (the same
+// randomly initialised network).
 
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
@@ -14,6 +16,7 @@
 #include <numbers>
 
 #include "animrt/controllers/seqnet/features.hpp"
+#include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/seqnet/network.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/controllers/seqnet/shapes.hpp"
@@ -148,6 +151,45 @@ void BM_GenerateJointFrame(benchmark::State& state) {
   generate_frames(state, s, MeshGraph{});
 }
 
+// The same step on the plain inference (SeqNetInference::step).
+void plain_frames(benchmark::State& state, const NetShape& shape, const MeshSequence* mesh) {
+  torch::manual_seed(1);
+  ModelFile model;
+  model.shape = shape;
+  MeshGraph graph;
+  if (mesh != nullptr) {
+    model.rest = mesh->frames.front();
+    model.triangles = mesh->triangles;
+    graph = mesh_graph(mesh->vertex_count(), mesh->triangles);
+  } else {
+    for (int j = 0; j < shape.joint_count; ++j) model.joint_names.push_back("j" + std::to_string(j));
+  }
+  model.low.assign(static_cast<std::size_t>(shape.input_dims()), -1.0);
+  model.high.assign(static_cast<std::size_t>(shape.input_dims()), 1.0);
+  SeqNet net(shape, graph);
+  model.parameters = save_parameters(*net);
+  SeqNetInference plain(model, "bench");
+  Eigen::VectorXf x = Eigen::VectorXf::Zero(shape.input_dims());
+  LstmCellState s = plain.initial_state(1.0);
+  for (auto _ : state) {
+    plain.step(x, s);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+
+void BM_PlainMeshFrame(benchmark::State& state) {
+  const MeshSequence bar = bar_for(static_cast<int>(state.range(0)));
+  plain_frames(state, mesh_shape(bar), &bar);
+  state.counters["vertices"] = bar.vertex_count();
+}
+
+void BM_PlainJointFrame(benchmark::State& state) {
+  NetShape s;
+  s.kind = ModelKind::joints;
+  s.joint_count = static_cast<int>(state.range(0));
+  plain_frames(state, s, nullptr);
+}
+
 }  // namespace
 
 BENCHMARK(BM_Factorise)->Arg(500)->Arg(2500)->Arg(10000)->Unit(benchmark::kMillisecond);
@@ -157,4 +199,6 @@ BENCHMARK(BM_TrainIteration)->Arg(500)->Arg(2500)->Iterations(3)->Unit(benchmark
 BENCHMARK(BM_BareLstmIteration)->Arg(500)->Arg(2500)->Iterations(3)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GenerateMeshFrame)->Arg(500)->Arg(2500)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GenerateJointFrame)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlainMeshFrame)->Arg(500)->Arg(2500)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlainJointFrame)->Arg(12)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -16,6 +16,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
+#include "seq_model_commands.hpp"
 #include "seq_net_forward.hpp"
 #include "subcommand.hpp"
 
@@ -108,6 +109,7 @@ void add_seq_command(CLI::App& seq_group) {
   set_subcommand_body(reconstruct, [args] { return run_reconstruct(*args); });
 
   add_seq_net_forwarders(*seq);
+  add_seq_model_commands(*seq);
 }
 
 }  // namespace animrt::cli

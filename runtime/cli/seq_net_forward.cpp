@@ -1,4 +1,4 @@
-// Handing `seq train` and `seq generate` over to animrt-seqnet (see
+// Handing `seq train` over to animrt-seqnet (see
 // seq_net_forward.hpp).
 
 #include "seq_net_forward.hpp"
@@ -52,7 +52,6 @@ void add_forwarder(CLI::App& seq, const std::string& name, const std::string& de
 void add_seq_net_forwarders(CLI::App& seq) {
   add_forwarder(seq, "train",
                 "Train the bidirectional sequence network on mesh features or joint CSVs");
-  add_forwarder(seq, "generate", "Generate a mesh sequence from initial frames");
 }
 
 }  // namespace animrt::cli

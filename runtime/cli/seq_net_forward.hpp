@@ -1,7 +1,6 @@
 #pragma once
-// `animrt seq train` and `animrt seq generate` run animrt-seqnet, the
-// executable beside animrt that holds the libtorch part, with the same
-// arguments (docs/seqnet.md).
+// `animrt seq train` runs animrt-seqnet, the executable beside animrt that
+// holds the libtorch part, with the same arguments (docs/seqnet.md).
 
 #include <CLI/CLI.hpp>
 

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
+#include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/controllers/seqnet/network.hpp"
 #include "animrt/core/error.hpp"
 
@@ -22,60 +23,6 @@ namespace {
 [[noreturn]] void fail(const std::string& file, int line, int column, const std::string& key,
                        const std::string& message) {
   throw InputError(Location{file, line, column}, key, message);
-}
-
-struct Table {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> rows;
-};
-
-Table read_csv(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) fail(file, 0, 0, "", "cannot open");
-  Table t;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> cells;
-    std::vector<int> columns;
-    std::size_t start = 0;
-    while (true) {
-      const std::size_t comma = line.find(',', start);
-      cells.push_back(line.substr(start, comma == std::string::npos ? comma : comma - start));
-      columns.push_back(static_cast<int>(start) + 1);
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
-    if (t.names.empty()) {
-      t.names = cells;
-      continue;
-    }
-    if (cells.size() != t.names.size()) {
-      fail(file, number, 1, "",
-           std::to_string(cells.size()) + " columns, the header has " +
-               std::to_string(t.names.size()));
-    }
-    std::vector<double> row;
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      std::size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(cells[c], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != cells[c].size() || !std::isfinite(v)) {
-        fail(file, number, columns[c], t.names[c], "\"" + cells[c] + "\" is not a finite number");
-      }
-      row.push_back(v);
-    }
-    t.rows.push_back(std::move(row));
-  }
-  if (t.names.empty()) fail(file, 0, 0, "", "empty file: no header line");
-  return t;
 }
 
 // The held-out block of a dataset of n frames: [first, first + count).
@@ -136,10 +83,6 @@ std::vector<std::string> parameter_names(const SeqNetImpl& net) {
 
 }  // namespace
 
-bool is_joint_column(const std::string& name) {
-  return name != "time_s" && name.rfind("torso_", 0) != 0;
-}
-
 TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
                               double held_out) {
   if (files.empty()) throw InputError(Location{}, "DATA", "no data files given");
@@ -177,27 +120,13 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
   std::vector<std::vector<std::vector<double>>> per_file;
   std::vector<std::string> joints;
   for (std::size_t k = 0; k < files.size(); ++k) {
-    const Table t = read_csv(files[k]);
-    std::vector<std::size_t> use;
-    std::vector<std::string> names;
-    for (std::size_t c = 0; c < t.names.size(); ++c) {
-      if (is_joint_column(t.names[c])) {
-        use.push_back(c);
-        names.push_back(t.names[c]);
-      }
-    }
-    if (names.empty()) fail(files[k], 1, 1, "", "no joint columns (only time_s and torso_*)");
+    JointCsv t = read_joint_csv(files[k]);
     if (k == 0) {
-      joints = names;
-    } else if (names != joints) {
+      joints = t.joints;
+    } else if (t.joints != joints) {
       fail(files[k], 1, 1, "", "joint columns differ from those of " + files[0]);
     }
-    std::vector<std::vector<double>> rows;
-    for (const auto& r : t.rows) {
-      std::vector<double> row;
-      for (std::size_t c : use) row.push_back(r[c]);
-      rows.push_back(std::move(row));
-    }
+    std::vector<std::vector<double>> rows = std::move(t.rows);
     per_file.push_back(std::move(rows));
   }
   const std::size_t j = joints.size();

@@ -1,5 +1,5 @@
-// animrt-seqnet: the sequence network's training and generation, the part
-// of animrt that needs libtorch. Run through `animrt seq train|generate`,
+// animrt-seqnet: the sequence network's training, the part
+// of animrt that needs libtorch. Run through `animrt seq train`,
 // which hands its arguments over unchanged, or on its own.
 
 #include <CLI/CLI.hpp>
@@ -7,7 +7,7 @@
 #include "seq_net_commands.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"animrt-seqnet: train the sequence network and generate with it"};
+  CLI::App app{"animrt-seqnet: train the sequence network"};
   app.require_subcommand(1);
   animrt::cli::add_seq_net_commands(app);
   try {

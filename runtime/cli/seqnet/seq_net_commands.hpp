@@ -1,5 +1,5 @@
 #pragma once
-// `train` and `generate` of the sequence network (docs/seqnet.md), added to
+// `train` of the sequence network (docs/seqnet.md), added to
 // animrt-seqnet's command line.
 
 #include <CLI/CLI.hpp>

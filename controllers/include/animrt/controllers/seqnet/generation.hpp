@@ -1,15 +1,18 @@
 #pragma once
-// Sequence generation from initial frames (paper section 4.3) with a trained
-// mesh model: the initial frames' features are fed to the forward chain,
-// which then runs on its own output; long sequences chain windows of the
-// model's length, each run started from the last frames of the one before.
-// The API needs no libtorch; the implementation is in animrt_seqnet_torch.
+// Mesh frames in and out of the sequence network, and generation from
+// initial frames (paper section 4.3) with a trained mesh model: the initial
+// frames' features are fed to the forward chain, which then runs on its own
+// output; long sequences chain windows of the model's length, each run
+// started from the last frames of the one before. Plain C++ on
+// SeqNetInference; no libtorch.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
 #include "animrt/controllers/seqnet/model_file.hpp"
 
@@ -20,13 +23,23 @@ struct GenerateOptions {
   // Unset: every run starts from the trained state s0. Set: every state
   // entry of every run is drawn from N(s0, s0^2) with this seed.
   std::optional<std::uint64_t> random_state;
-  int threads = 1;
 };
 
+// Raw deformation features (9 V x frames, vertex-major) of frames of the
+// model's mesh against the model's template, rotations followed from frame
+// to frame in the given order. Throws InputError naming `model_path` when
+// the frames are of another mesh.
+FrameMatrix mesh_features(const ModelFile& model, const std::string& model_path,
+                          const std::vector<Positions>& frames,
+                          const std::vector<std::array<int, 3>>& triangles);
+// Vertex positions of raw feature columns, each connected piece placed by
+// its lowest vertex at the template (as reconstruction does).
+std::vector<Positions> mesh_positions(const ModelFile& model, const FrameMatrix& features);
+
 // The initial frames (1 or more, of the model's mesh) followed by the
-// generated ones, as vertex positions (each connected piece placed by its
-// lowest vertex, as reconstruction does). Throws InputError naming
-// `model_path` when the frames are of another mesh.
+// generated ones, as vertex positions; the initial frames are returned
+// unchanged. Throws InputError naming `model_path` when the frames are of
+// another mesh or as many as the model's window.
 std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& model_path,
                                      const std::vector<Positions>& initial,
                                      const std::vector<std::array<int, 3>>& triangles,

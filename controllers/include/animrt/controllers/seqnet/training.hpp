@@ -31,10 +31,6 @@ struct TrainingSet {
   std::vector<Segment> segments;
 };
 
-// Joint columns of a telemetry or corpus CSV: every column but time_s and
-// the torso_* columns.
-bool is_joint_column(const std::string& name);
-
 // DATA: one mesh feature file (animrt seq features), or one or more joint
 // CSVs with the same joints. Each file is a dataset: one contiguous block
 // of `held_out` of its frames, placed by the seed, is held out. Throws

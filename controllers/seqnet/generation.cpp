@@ -1,0 +1,59 @@
+#include "animrt/controllers/seqnet/generation.hpp"
+
+#include "animrt/controllers/seqnet/features.hpp"
+#include "animrt/controllers/seqnet/reconstruction.hpp"
+#include "animrt/core/error.hpp"
+
+namespace animrt::seqnet {
+
+FrameMatrix mesh_features(const ModelFile& model, const std::string& model_path,
+                          const std::vector<Positions>& frames,
+                          const std::vector<std::array<int, 3>>& triangles) {
+  for (const Positions& p : frames) {
+    check_model_mesh(model, model_path, static_cast<int>(p.cols()), triangles);
+  }
+  MeshSequence seq;
+  seq.triangles = model.triangles;
+  seq.frames.push_back(model.rest);
+  for (const Positions& p : frames) seq.frames.push_back(p);
+  const SequenceFeatures f = compute_features(seq);
+  FrameMatrix out(model.shape.input_dims(), static_cast<Eigen::Index>(frames.size()));
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const FeatureFrame raw = f.raw(static_cast<int>(k) + 1);
+    out.col(static_cast<Eigen::Index>(k)) = Eigen::Map<const Eigen::VectorXd>(raw.data(), raw.size());
+  }
+  return out;
+}
+
+std::vector<Positions> mesh_positions(const ModelFile& model, const FrameMatrix& features) {
+  const Reconstructor solver(model.rest, model.triangles);
+  std::vector<Positions> out;
+  for (Eigen::Index k = 0; k < features.cols(); ++k) {
+    const FrameMatrix column = features.col(k);
+    out.push_back(solver.solve(
+        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count)));
+  }
+  return out;
+}
+
+std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& model_path,
+                                     const std::vector<Positions>& initial,
+                                     const std::vector<std::array<int, 3>>& triangles,
+                                     const GenerateOptions& options) {
+  const auto u = static_cast<int>(initial.size());
+  if (u < 1) throw InputError(Location{model_path, 0, 0}, "--init", "no initial frame");
+  if (u >= model.shape.window) {
+    throw InputError(Location{model_path, 0, 0}, "--init",
+                     std::to_string(u) + " initial frames, the model's window is " +
+                         std::to_string(model.shape.window) + " frames");
+  }
+  const FrameMatrix given = mesh_features(model, model_path, initial, triangles);
+  SeqNetInference net(model, model_path);
+  const FrameMatrix all = net.generate(given, options.frames, options.random_state);
+  std::vector<Positions> out = initial;
+  const std::vector<Positions> generated = mesh_positions(model, all.rightCols(options.frames));
+  out.insert(out.end(), generated.begin(), generated.end());
+  return out;
+}
+
+}  // namespace animrt::seqnet

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# animrt seq complete and seq generate on tiny trained models, run by animrt
+# itself (which must not link libtorch): keys reproduced exactly, the per-gap
+# report printed, joint-space generation from a CSV, a model of another
+# joint set and a corrupt model refused with exit 2 and one line naming the
+# file; then completion between OBJ keys with a mesh model.
+set -uo pipefail
+animrt=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+if ldd "$animrt" | grep -q torch; then fail "animrt links libtorch: $(ldd "$animrt" | grep torch)"; fi
+
+awk 'BEGIN { print "time_s,hip,knee,torso_x";
+  for (f = 0; f < 60; f++) { t = f / 25; printf "%g,%g,%g,%g\n", t, 0.5 * sin(7.85 * t), 0.3 * cos(7.85 * t), t } }' \
+  > "$tmp/walk.csv"
+small=(--window 8 --batch 2 --hidden 16 --latent 8 --lstm-layers 2 --threads 1)
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --report-every 10 \
+  "${small[@]}" 2>&1) || fail "train failed: $out"
+
+printf 'time_s,hip,knee\n0,0.25,-0.125\n1,-0.4,0.3\n2,0.1,0.2\n' > "$tmp/keys.csv"
+out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/keys.csv" --gap 4 --out "$tmp/done.csv" 2>&1) ||
+  fail "complete failed: $out"
+gap='gap 1 \(keys 1-2, 4 frames\): (merged at frame [1-4] \(output frame [1-4]\), difference [0-9.]+ %, [0-9]+ tr(y|ies)|not merged below 5 %, best difference [0-9.]+ % at frame [1-4] \(output frame [1-4]\) used, 21 tries)'
+[[ $out =~ $gap ]] || fail "no report for gap 1: $out"
+[[ $out == *"gap 2 (keys 2-3, 4 frames): "* ]] || fail "no report for gap 2: $out"
+[[ $(head -1 "$tmp/done.csv") == "hip,knee" ]] || fail "header: $(head -1 "$tmp/done.csv")"
+[[ $(wc -l < "$tmp/done.csv") -eq 12 ]] || fail "$(wc -l < "$tmp/done.csv") lines, expected 1 + 11"
+[[ $(sed -n 2p "$tmp/done.csv") == "0.25,-0.125" ]] || fail "key 1: $(sed -n 2p "$tmp/done.csv")"
+[[ $(sed -n 7p "$tmp/done.csv") == "-0.4,0.3" ]] || fail "key 2: $(sed -n 7p "$tmp/done.csv")"
+[[ $(sed -n 12p "$tmp/done.csv") == "0.1,0.2" ]] || fail "key 3: $(sed -n 12p "$tmp/done.csv")"
+[[ $(sed -n 4p "$tmp/done.csv") != "0.25,-0.125" ]] || fail "an in-between is a copy of the key"
+
+# A tiny threshold: every gap retried up to the limit, and said so.
+out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/keys.csv" --gap 4 --out "$tmp/done2.csv" \
+  --threshold 1e-9 --retries 3 --seed 5 2>&1) || fail "complete with a tiny threshold failed: $out"
+[[ $out == *"gap 1 (keys 1-2, 4 frames): not merged below 1e-07 %, best difference"*"used, 4 tries"* ]] ||
+  fail "no retries reported: $out"
+
+out=$("$animrt" seq generate "$tmp/m.model" --init "$tmp/keys.csv" --frames 9 --out "$tmp/gen.csv" 2>&1) ||
+  fail "joint generate failed: $out"
+[[ $(wc -l < "$tmp/gen.csv") -eq 13 ]] || fail "generate wrote $(wc -l < "$tmp/gen.csv") lines, expected 1 + 12"
+[[ $(sed -n 2,4p "$tmp/gen.csv") == $'0.25,-0.125\n-0.4,0.3\n0.1,0.2' ]] || fail "initial frames not kept"
+
+printf 'hip,ankle\n0,0\n1,1\n' > "$tmp/other.csv"
+out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/other.csv" --gap 4 --out "$tmp/x.csv" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/m.model: joints: trained on another joint set: the data lacks knee; the model lacks ankle"* ]] ||
+  fail "other joint set: exit $code: $out"
+[[ $(echo "$out" | wc -l) -eq 1 ]] || fail "more than one line: $out"
+
+printf 'ANSEQNN\nrubbish' > "$tmp/bad.model"
+out=$("$animrt" seq complete "$tmp/bad.model" --keys "$tmp/keys.csv" --gap 4 --out "$tmp/x.csv" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/bad.model"* ]] || fail "corrupt model: exit $code: $out"
+[[ $(echo "$out" | wc -l) -eq 1 ]] || fail "more than one line: $out"
+
+printf 'time_s,hip,knee\n0,0.25,-0.125\n' > "$tmp/one.csv"
+out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/one.csv" --gap 4 --out "$tmp/x.csv" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/one.csv: --keys: 1 rows, at least 2 needed"* ]] || fail "one key: exit $code: $out"
+
+# A 6 x 6 plate bending to and fro, 30 OBJ frames; keys 0, 10 and 20.
+mkdir "$tmp/plate"
+awk -v dir="$tmp/plate" 'BEGIN { n = 6;
+  for (f = 0; f < 30; f++) {
+    file = sprintf("%s/frame_%04d.obj", dir, f); a = 0.5 * sin(6.2832 * f / 12);
+    for (i = 0; i < n; i++) for (j = 0; j < n; j++) { x = i / (n - 1); y = j / (n - 1);
+      printf "v %g %g %g\n", x * cos(a * x), y, x * sin(a * x) > file }
+    for (i = 0; i < n - 1; i++) for (j = 0; j < n - 1; j++) { v = i * n + j + 1;
+      printf "f %d %d %d\nf %d %d %d\n", v, v + n, v + 1, v + 1, v + n, v + n + 1 > file }
+    close(file) } }'
+"$animrt" seq features "$tmp/plate" --out "$tmp/plate.bin" >/dev/null || fail "features of the plate"
+out=$("$animrt" seq train "$tmp/plate.bin" --out "$tmp/plate.model" --iterations 4 "${small[@]}" 2>&1) ||
+  fail "mesh training failed: $out"
+out=$("$animrt" seq complete "$tmp/plate.model" --keys "$tmp/plate/frame_0000.obj" "$tmp/plate/frame_0010.obj" \
+  "$tmp/plate/frame_0020.obj" --gap 3 --out "$tmp/filled" 2>&1) || fail "mesh complete failed: $out"
+[[ $out == *"gap 2 (keys 2-3, 3 frames): "* ]] || fail "no mesh report: $out"
+[[ $(ls "$tmp/filled" | wc -l) -eq 9 ]] || fail "complete wrote $(ls "$tmp/filled" | wc -l) frames, expected 9"
+for pair in 0000:0000 0004:0010 0008:0020; do
+  cmp -s <(grep '^v ' "$tmp/filled/frame_${pair%:*}.obj") <(grep '^v ' "$tmp/plate/frame_${pair#*:}.obj") ||
+    fail "key ${pair#*:} is not reproduced as frame ${pair%:*}"
+done
+cmp -s <(grep '^v ' "$tmp/filled/frame_0002.obj") <(grep '^v ' "$tmp/filled/frame_0000.obj") &&
+  fail "an in-between mesh is a copy of the key"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/other.obj"
+out=$("$animrt" seq complete "$tmp/plate.model" --keys "$tmp/other.obj" "$tmp/other.obj" --gap 2 --out "$tmp/f2" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/plate.model: mesh: trained on a mesh of 36 vertices, the data has 3"* ]] ||
+  fail "other mesh: exit $code: $out"
+echo ok
