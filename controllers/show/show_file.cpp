@@ -6,25 +6,130 @@
 #include <filesystem>
 #include <optional>
 
+#include "animrt/controllers/seqnet/model_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
 namespace {
 
-Interpolation parse_interpolation(const YamlNode& node) {
+// `learned` is a whole track's interpolation: the model completes the
+// track between all its keys at once.
+Interpolation parse_interpolation(const YamlNode& node, bool track) {
   const std::string s = node.as_string();
   if (s == "step") return Interpolation::step;
   if (s == "linear") return Interpolation::linear;
   if (s == "cubic") return Interpolation::cubic;
-  node.fail("expected step, linear or cubic, found " + node.describe());
+  if (s == "learned" && track) return Interpolation::learned;
+  if (s == "learned") node.fail("learned is set for a whole track, not for one key");
+  node.fail(std::string(track ? "expected step, linear, cubic or learned"
+                              : "expected step, linear or cubic") +
+            ", found " + node.describe());
+}
+
+// The `learned` section: the model is read now, so a missing, corrupt or
+// mismatched model stops the show at load with the show's line.
+void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::path& folder) {
+  std::vector<const ShowTrack*> learned;
+  for (const ShowTrack& t : show.tracks) {
+    if (t.keys.front().interpolation == Interpolation::learned) learned.push_back(&t);
+  }
+  const auto section = root.find("learned");
+  if (!section) {
+    if (learned.empty()) return;
+    throw InputError(learned.front()->where, "joints." + learned.front()->joint + ".interpolation",
+                     "interpolation learned needs a `learned: {model: FILE, frame_s: S}` section "
+                     "naming the joint-space model");
+  }
+  section->allow_only({"model", "frame_s"});
+  if (learned.empty()) {
+    section->fail("no joint uses interpolation: learned");
+  }
+  const YamlNode model_node = section->at("model");
+  const std::string given = model_node.as_string();
+  const std::filesystem::path resolved =
+      std::filesystem::path(given).is_absolute() ? std::filesystem::path(given) : folder / given;
+  show.has_learned = true;
+  show.learned.model_file = resolved.string();
+  show.learned.where = section->location();
+  const YamlNode frame_node = section->at("frame_s");
+  show.learned.frame_s = frame_node.as_positive_double();
+
+  seqnet::ModelFile model;
+  try {
+    model = seqnet::read_model_file(show.learned.model_file);
+  } catch (const InputError& e) {
+    model_node.fail("model \"" + show.learned.model_file + "\": " + e.what());
+  } catch (const std::exception& e) {
+    model_node.fail("cannot read model \"" + show.learned.model_file + "\": " + e.what());
+  }
+  if (model.shape.kind != seqnet::ModelKind::joints) {
+    model_node.fail("model \"" + show.learned.model_file + "\" is a " +
+                    seqnet::kind_name(model.shape.kind) +
+                    " model; a show needs a joint-space model (animrt seq train on joint CSVs)");
+  }
+  std::vector<std::string> names;
+  for (const ShowTrack* t : learned) names.push_back(t->joint);
+  try {
+    seqnet::check_model_joints(model, show.learned.model_file, names);
+  } catch (const InputError& e) {
+    model_node.fail(std::string(e.what()) +
+                    " (the show's learned tracks must be the model's joints)");
+  }
+  show.learned.joints = model.joint_names;
+  show.learned.model = std::make_shared<const seqnet::ModelFile>(std::move(model));
+
+  // One key frame holds every learned joint: the tracks share their times.
+  const ShowTrack& first = *learned.front();
+  for (const ShowTrack* t : learned) {
+    const std::string key = "joints." + t->joint + ".keys";
+    if (t->keys.size() != first.keys.size()) {
+      throw InputError(t->where, key,
+                       "learned tracks share their key times: " + t->joint + " has " +
+                           std::to_string(t->keys.size()) + " keys, " + first.joint + " has " +
+                           std::to_string(first.keys.size()));
+    }
+    for (std::size_t k = 0; k < t->keys.size(); ++k) {
+      if (std::abs(t->keys[k].t - first.keys[k].t) > 1e-9) {
+        throw InputError(t->keys[k].where, key,
+                         "learned tracks share their key times: this key is at " +
+                             format_number(t->keys[k].t) + " s, " + first.joint + "'s key " +
+                             std::to_string(k + 1) + " at " + format_number(first.keys[k].t) +
+                             " s");
+      }
+    }
+  }
+  // Every gap is a whole number of the model's frames.
+  const double frame = show.learned.frame_s;
+  auto check_gap = [&](double t0, double t1, const ShowKey& key) {
+    const double frames = (t1 - t0) / frame;
+    if (std::abs(frames - std::round(frames)) > 1e-6 * std::max(1.0, frames)) {
+      throw InputError(key.where, "joints." + first.joint + ".keys",
+                       "learned keys lie on the model's frames: " + format_number(t0) + " s to " +
+                           format_number(t1) + " s is " + format_number(frames) +
+                           " frames of frame_s " + format_number(frame) + " s, not a whole number");
+    }
+    if (std::round(frames) < 2) {
+      throw InputError(key.where, "joints." + first.joint + ".keys",
+                       "learned keys are at least two frames apart, so the model has a frame "
+                       "to fill: " +
+                           format_number(t0) + " s to " + format_number(t1) +
+                           " s is one frame of frame_s " + format_number(frame) + " s");
+    }
+  };
+  for (std::size_t k = 0; k + 1 < first.keys.size(); ++k) {
+    check_gap(first.keys[k].t, first.keys[k + 1].t, first.keys[k + 1]);
+  }
+  if (show.loop && first.keys.size() > 1) {
+    check_gap(first.keys.back().t, first.keys.front().t + show.duration_s, first.keys.front());
+  }
 }
 
 }  // namespace
 
 ShowFile load_show_file(const std::string& path) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"name", "loop", "duration_s", "audio", "joints"});
+  root.allow_only({"name", "loop", "duration_s", "audio", "joints", "learned"});
   ShowFile show;
   show.file = path;
   show.name = root.get_string("name", "");
@@ -53,7 +158,7 @@ ShowFile load_show_file(const std::string& path) {
       track.unit_where = u->location();
     }
     Interpolation fallback = Interpolation::cubic;
-    if (auto i = node.find("interpolation")) fallback = parse_interpolation(*i);
+    if (auto i = node.find("interpolation")) fallback = parse_interpolation(*i, true);
     const YamlNode keys = node.at("keys");
     const auto items = keys.items();
     if (items.empty()) keys.fail("expected at least one key, found an empty list");
@@ -74,7 +179,12 @@ ShowFile load_show_file(const std::string& path) {
         item.allow_only({"t", "value", "interpolation"});
         t_node.emplace(item.at("t"));
         v_node.emplace(item.at("value"));
-        if (auto i = item.find("interpolation")) key.interpolation = parse_interpolation(*i);
+        if (auto i = item.find("interpolation")) {
+          if (fallback == Interpolation::learned) {
+            i->fail("a learned track's keys take no interpolation of their own");
+          }
+          key.interpolation = parse_interpolation(*i, false);
+        }
       } else {
         item.fail("expected [time_s, value] or {t, value, interpolation}, found " +
                   item.describe());
@@ -100,6 +210,8 @@ ShowFile load_show_file(const std::string& path) {
   }
   if (show.loop && !(show.duration_s > 0.0))
     root.at("loop").fail("a looping show needs a duration > 0");
+
+  load_learned(root, show, folder);
 
   if (auto a = root.find("audio")) {
     a->allow_only({"file", "offset_s"});

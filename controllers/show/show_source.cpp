@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/controllers/show/show_playhead.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -84,7 +85,8 @@ class ShowSource final : public MotionSource {
         return v0;
       case Interpolation::linear:
         return v0 + (v1 - v0) * u;
-      case Interpolation::cubic: {
+      case Interpolation::cubic:
+      case Interpolation::learned: {  // learned tracks hold the model's frames as cubic keys
         const double u2 = u * u, u3 = u2 * u;
         return (2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * h * s0 + (-2 * u3 + 3 * u2) * v1 +
                (u3 - u2) * h * s1;
@@ -130,6 +132,60 @@ std::vector<double> slopes(const std::vector<ShowKey>& k, bool loop, double dura
     s[i] = tn > tp ? (vn - vp) / (tn - tp) : 0.0;
   }
   return s;
+}
+
+// The learned tracks' in-betweens: the model completes every gap between the
+// shared key frames (looping: also the wrap back to the first key) and its
+// frames become the tracks' keys, played with cubic interpolation like any
+// other keys. Frames outside a joint's limits are clamped to them, as the
+// safety filter would.
+void complete_learned(const ShowFile& show, std::span<const JointSpec> joints,
+                      std::vector<ShowSource::Track>& tracks) {
+  const ShowLearned& learned = show.learned;
+  std::vector<ShowSource::Track*> by_input;  // the tracks in the model's joint order
+  for (const std::string& name : learned.joints) {
+    for (ShowSource::Track& t : tracks) {
+      if (joints[static_cast<std::size_t>(t.joint)].name == name) by_input.push_back(&t);
+    }
+  }
+  const std::vector<ShowKey>& first = by_input.front()->keys;
+  const std::size_t key_count = first.size();
+  if (key_count < 2) return;  // one key: nothing between
+  const std::size_t columns = key_count + (show.loop ? 1 : 0);
+  seqnet::FrameMatrix keys(static_cast<Eigen::Index>(by_input.size()),
+                           static_cast<Eigen::Index>(columns));
+  std::vector<double> times(columns);
+  for (std::size_t k = 0; k < columns; ++k) {
+    const std::size_t key = k % key_count;
+    times[k] = first[key].t + (k < key_count ? 0.0 : show.duration_s);
+    for (std::size_t j = 0; j < by_input.size(); ++j) {
+      keys(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)) =
+          by_input[j]->keys[key].value;
+    }
+  }
+  std::vector<int> gaps;
+  for (std::size_t k = 0; k + 1 < columns; ++k) {
+    gaps.push_back(static_cast<int>(std::lround((times[k + 1] - times[k]) / learned.frame_s)) - 1);
+  }
+  seqnet::SeqNetInference net(*learned.model, learned.model_file);
+  const seqnet::Completion done = net.complete(keys, gaps);
+  // Looping: the last column is the first key again, played by the wrap.
+  const Eigen::Index frames = done.frames.cols() - (show.loop ? 1 : 0);
+  for (std::size_t j = 0; j < by_input.size(); ++j) {
+    ShowSource::Track& track = *by_input[j];
+    const JointLimits& lim = joints[static_cast<std::size_t>(track.joint)].limits;
+    const Location where = track.keys.front().where;
+    track.keys.clear();
+    for (Eigen::Index f = 0; f < frames; ++f) {
+      ShowKey key;
+      key.t = times[0] + static_cast<double>(f) * learned.frame_s;
+      key.value = std::clamp(done.frames(static_cast<Eigen::Index>(j), f), lim.min_position,
+                             lim.max_position);
+      key.interpolation = Interpolation::cubic;
+      key.where = where;
+      track.keys.push_back(key);
+    }
+  }
 }
 
 class LayeredSource final : public MotionSource {
@@ -205,9 +261,10 @@ std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
                              format_number(as_written(lim.max_position)) + unit);
       }
     }
-    t.slope = slopes(t.keys, show.loop, show.duration_s);
     tracks.push_back(std::move(t));
   }
+  if (show.has_learned) complete_learned(show, joints, tracks);
+  for (ShowSource::Track& t : tracks) t.slope = slopes(t.keys, show.loop, show.duration_s);
   return std::make_unique<ShowSource>(std::move(tracks), show.loop, show.duration_s);
 }
 

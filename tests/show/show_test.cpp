@@ -262,7 +262,8 @@ TEST(Show, ErrorsNameFileLineAndKey) {
             std::string::npos)
       << error_of("joints:\n  jaw:\n    keys:\n      - [0, 0]\n      - [0, 5]\n");
   EXPECT_NE(error_of("joints:\n  jaw: {interpolation: spline, keys: [[0, 0]]}\n")
-                .find("joints.jaw.interpolation: expected step, linear or cubic, found \"spline\""),
+                .find("joints.jaw.interpolation: expected step, linear, cubic or learned, found "
+                      "\"spline\""),
             std::string::npos);
   EXPECT_NE(
       error_of("joints:\n  tail: {keys: [[0, 0]]}\n").find("no joint named 'tail' in the robot"),

@@ -24,6 +24,18 @@
 // revolute joint, metres for a prismatic one. A track may state its unit
 // (`unit: deg` or `unit: m`); a unit that contradicts the joint's type is an
 // error, so a show written for another robot is not silently misread.
+//
+// Learned in-betweens: tracks with `interpolation: learned` are completed
+// between their keys by a joint-space sequence model (animrt seq train on
+// joint-angle CSVs) when the show is bound to the robot, never in the cycle:
+//
+//   learned: {model: gait_joints.seqnn, frame_s: 0.04}
+//   joints:
+//     lf_hip: {interpolation: learned, keys: [[0, 10], [0.4, -8], [0.8, 10]]}
+//
+// The learned tracks must be exactly the model's joints and share their key
+// times, each gap a whole number of frame_s. The model's frames are then
+// played as keys with cubic interpolation.
 
 #include <memory>
 #include <span>
@@ -31,12 +43,13 @@
 #include <vector>
 
 #include "animrt/controllers/motion_source.hpp"
+#include "animrt/controllers/seqnet/model_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
 
 namespace animrt {
 
-enum class Interpolation { step, linear, cubic };
+enum class Interpolation { step, linear, cubic, learned };
 
 // Sample rates a show's sound track may have.
 inline constexpr int kMinShowAudioRate = 4000;
@@ -67,6 +80,15 @@ struct ShowAudio {
   double length_s = 0.0;
 };
 
+// The joint-space model that completes the learned tracks.
+struct ShowLearned {
+  std::string model_file;  // resolved against the show file's folder
+  std::shared_ptr<const seqnet::ModelFile> model;
+  double frame_s = 0.0;             // the model's frame period
+  std::vector<std::string> joints;  // the model's joints, in its input order
+  Location where;                   // of the `learned` section
+};
+
 struct ShowFile {
   std::string file;
   std::string name;
@@ -75,6 +97,8 @@ struct ShowFile {
   bool has_audio = false;
   ShowAudio audio;
   std::vector<ShowTrack> tracks;
+  bool has_learned = false;
+  ShowLearned learned;
 };
 
 // Loads and validates a show file (InputError with file, line, column, key).
@@ -82,7 +106,8 @@ ShowFile load_show_file(const std::string& path);
 
 // Binds a show to the robot's joints, converting its values to SI by each
 // joint's type (an unknown joint, a unit that contradicts the joint's type,
-// or a key outside the joint's limits, is an InputError at the key).
+// or a key outside the joint's limits, is an InputError at the key), and
+// computes the learned in-betweens.
 // sample() is allocation-free.
 std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
                                                std::span<const JointSpec> joints);
