@@ -237,7 +237,13 @@ Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
   if (urge <= 0.0) return v;
   const double turn = -params_.keep_right_rad * urge;  // negative: to the right
   const double c = std::cos(turn), s = std::sin(turn);
-  return {v.x * c - v.y * s, v.x * s + v.y * c};
+  const Vec2 turned{v.x * c - v.y * s, v.x * s + v.y * c};
+  // In the open only: near a wall the crowd's own plan keeps clear of it.
+  const Vec2 probe = a.position + turned / speed * lane;
+  if (world_.in_wall(a.position, a.radius + lane) || world_.in_wall(probe, a.radius + lane) ||
+      !world_.on_mesh(probe, a.radius))
+    return v;
+  return turned;
 }
 
 CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<int> members,
@@ -464,7 +470,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
                           m, crowd_.params().unstick &&
                                  (norm(agents[static_cast<std::size_t>(m)].position - target) <
                                       assign_distance_ ||
-                                  t - stall_since_[k] >= crowd_.params().unstick_after_s)),
+                                  (crowd_.params().unstick_after_s > 0.0 &&
+                                   t - stall_since_[k] >= crowd_.params().unstick_after_s))),
                       agents),
                   agents);
   }

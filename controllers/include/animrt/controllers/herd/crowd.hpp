@@ -48,10 +48,12 @@ struct CrowdParams {
   // sliding along neighbours in contact (see planned_velocity).
   bool unstick = true;
   // Anywhere else, a member that has not moved 0.1 m for this long follows
-  // its path the same way: the avoidance can hold a figure still for good
-  // where it touches a wall corner (its avoidance radius is larger than
-  // the radius the mesh keeps it from the walls by).
-  double unstick_after_s = 5.0;
+  // its path the same way (0: never): the avoidance can hold a figure still
+  // for good where it touches a wall corner (its avoidance radius is larger
+  // than the radius the mesh keeps it from the walls by). The path may
+  // graze a wall there, so only for figures kept out of walls otherwise
+  // (the herd sets 5 s: it stops a figure at a wall's surface).
+  double unstick_after_s = 0.0;
   // Figures closer than the sum of their radii plus this never walk
   // toward each other (see safe_velocity); 0 turns the rule off.
   double contact_margin_m = 0.1;
