@@ -3,8 +3,10 @@
 #include <DetourCommon.h>
 #include <DetourCrowd.h>
 #include <DetourNavMeshQuery.h>
+#include <DetourProximityGrid.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -204,6 +206,46 @@ Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
   return v;
 }
 
+Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
+  const double speed = norm(v);
+  if (params_.keep_right_rad <= 0.0 || speed <= 0.0) return v;
+  const Agent& a = agents[static_cast<std::size_t>(i)];
+  const Vec2 way = v / speed;
+  const Vec2 right{way.y, -way.x};
+  const double range = params_.keep_right_range_m;
+  const double lane = 2.0 * (a.radius + params_.avoidance_margin_m);
+  // Agents near the figure, from the crowd's own grid (built at its last update).
+  std::array<unsigned short, 64> near{};
+  const auto p = NavWorld::to_recast(a.position);
+  const int n = crowd_->getGrid()->queryItems(
+      p[0] - static_cast<float>(range), p[2] - static_cast<float>(range),
+      p[0] + static_cast<float>(range), p[2] + static_cast<float>(range), near.data(),
+      static_cast<int>(near.size()));
+  double urge = 0.0;  // 0..1: how hard to keep right
+  for (int k = 0; k < n; ++k) {
+    const int j = near[static_cast<std::size_t>(k)];
+    if (j == i || static_cast<std::size_t>(j) >= agents.size()) continue;
+    const Agent& b = agents[static_cast<std::size_t>(j)];
+    const Vec2 d = b.position - a.position;
+    const double ahead = dot(d, way);
+    // Oncoming: ahead, within range, facing more than 120 degrees away
+    // from this way, and in the lane (not already passing to the side).
+    if (ahead <= 0.0 || ahead > range || dot(heading_vector(b.heading), way) > -0.5) continue;
+    if (std::abs(dot(d, right)) >= lane) continue;
+    urge = std::max(urge, 1.0 - ahead / range);
+  }
+  if (urge <= 0.0) return v;
+  const double turn = -params_.keep_right_rad * urge;  // negative: to the right
+  const double c = std::cos(turn), s = std::sin(turn);
+  const Vec2 turned{v.x * c - v.y * s, v.x * s + v.y * c};
+  // In the open only: near a wall the crowd's own plan keeps clear of it.
+  const Vec2 probe = a.position + turned / speed * lane;
+  if (world_.in_wall(a.position, a.radius + lane) || world_.in_wall(probe, a.radius + lane) ||
+      !world_.on_mesh(probe, a.radius))
+    return v;
+  return turned;
+}
+
 CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<int> members,
                        CrowdGroupParams params)
     : crowd_(crowd), members_(std::move(members)), params_(params) {
@@ -380,8 +422,15 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   }
   for (std::size_t k = 0; k < members_.size(); ++k) {
     const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
+    // A member also arrives when it stands within half a spacing of its
+    // slot: the crowd slows a member down as it nears its goal, and a
+    // figure whose slowest walk is fast stands once the plan is under half
+    // of it, short of the slot.
+    const double to_slot =
+        state_[k] == State::kToSlot ? norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) : 0.0;
+    const bool standing = agents[static_cast<std::size_t>(members_[k])].speed == 0.0;
     if (state_[k] == State::kToSlot &&
-        norm(p - slots_[static_cast<std::size_t>(slot_of_[k])]) < params_.arrive_tolerance_m) {
+        (to_slot < params_.arrive_tolerance_m || (standing && to_slot < 0.5 * spacing_))) {
       state_[k] = State::kArrived;
       crowd_.stop(members_[k]);
       continue;
@@ -415,9 +464,15 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
             ? Vec2{}
             : crowd_.safe_velocity(
                   m,
-                  crowd_.planned_velocity(m, crowd_.params().unstick &&
-                                                 norm(agents[static_cast<std::size_t>(m)].position -
-                                                      target) < assign_distance_),
+                  crowd_.keep_right(
+                      m,
+                      crowd_.planned_velocity(
+                          m, crowd_.params().unstick &&
+                                 (norm(agents[static_cast<std::size_t>(m)].position - target) <
+                                      assign_distance_ ||
+                                  (crowd_.params().unstick_after_s > 0.0 &&
+                                   t - stall_since_[k] >= crowd_.params().unstick_after_s))),
+                      agents),
                   agents);
   }
 }

@@ -9,9 +9,12 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
   const WalkResponse& walk = figure.walk;
   const double wanted = norm(desired);
   MotionCommand want;
-  if (wanted >= 0.5 * walk.min_speed() && wanted > 1e-9) {
-    const Vec2 h = heading_vector(agent.heading);
-    const double error = std::atan2(cross(h, desired), dot(h, desired));
+  const Vec2 h = heading_vector(agent.heading);
+  const double error = std::atan2(cross(h, desired), dot(h, desired));
+  // A figure that cannot turn only walks toward a velocity ahead of it:
+  // walking on could never bring it round to one behind.
+  const bool reachable_way = walk.max_turn(walk.min_speed()) > 0.0 || std::cos(error) > 0.0;
+  if (wanted >= 0.5 * walk.min_speed() && wanted > 1e-9 && reachable_way) {
     // Walk on at no less than the slowest gait while turning toward a
     // velocity behind the figure: a gait turns only while it walks.
     want.speed_m_s =

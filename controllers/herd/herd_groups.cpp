@@ -128,6 +128,7 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
         std::max(crowd_params.figure_start_speed_m_s, f.walk.min_speed());
   }
   crowd_params.step_s = scene.step_s;
+  crowd_params.unstick_after_s = 5.0;  // the herd keeps figures out of walls (Herd::step)
   for (std::size_t g = 0; g < scene.groups.size(); ++g) {
     const GroupSpec& spec = scene.groups[g];
     const std::uint64_t seed = group_seed(scene.seed, g);

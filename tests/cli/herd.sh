@@ -28,7 +28,7 @@ grep -q '<svg' "$tmp/h.svg" || fail "no SVG"
 
 # A bad scene: one error line with file, line and key, exit 2.
 sed 's/count: 30/count: thirty/' "$root/configs/herd/flock.yaml" > "$tmp/bad.yaml"
-sed -i "s|../gaits/herd_pony.yaml|$root/configs/gaits/herd_pony.yaml|" "$tmp/bad.yaml"
+sed -i "s|../gaits/pony.yaml|$root/configs/gaits/pony.yaml|" "$tmp/bad.yaml"
 out=$("$animrt" herd "$tmp/bad.yaml" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"bad.yaml:13:"*"groups[0].count"* ]] || fail "bad scene (exit $code): $out"

@@ -58,5 +58,39 @@ TEST(FigureSteer, AStandingFigureWalksOffAtItsSlowestWalkAndTurns) {
   EXPECT_NEAR(c.turn_rad_s, 0.2, 1e-3);  // its fastest usable turn, to the left
 }
 
+TEST(FigureSteer, AFigureThatCannotTurnStandsRatherThanWalkAwayFromItsWay) {
+  // The same figure with every turning point unusable: it walks straight only.
+  GaitSteering s;
+  s.min_froude = 0.05;
+  s.max_froude = 0.2;
+  s.max_turn_rad_s = 0.2;
+  s.max_acceleration_m_s2 = 0.1;
+  s.hip_height_m = 0.2;
+  s.track_width_m = 0.2;
+  s.left = {"l"};
+  s.right = {"r"};
+  GaitCalibration cal;
+  for (double v : {0.1, 0.2}) {
+    for (double w : {-0.2, 0.0, 0.2}) {
+      CalibrationPoint p;
+      p.commanded = {v, w};
+      p.achieved = {v, 0.0};
+      p.usable = calibration_usable(p, cal.tolerance);
+      cal.points.push_back(p);
+    }
+  }
+  const Figure f{"straight", 0.25, WalkResponse(s, &cal)};
+  ASSERT_EQ(f.walk.max_turn(0.1), 0.0);
+  Agent a;
+  a.speed = 0.1;  // walking its slowest, heading +x
+  // Its way is behind it (it walked past its goal): it stands.
+  EXPECT_EQ(steer_figure(f, a, Vec2{-0.15, 0.02}, 0.1).speed_m_s, 0.0);
+  // Ahead of it, it walks on.
+  EXPECT_GT(steer_figure(f, a, Vec2{0.15, 0.02}, 0.1).speed_m_s, 0.0);
+  // A figure that turns walks on while it turns toward a way behind it.
+  const Figure turning = calibrated_figure();
+  EXPECT_GT(steer_figure(turning, a, Vec2{-0.15, 0.02}, 0.1).speed_m_s, 0.0);
+}
+
 }  // namespace
 }  // namespace animrt::herd

@@ -47,11 +47,27 @@ struct CrowdParams {
   // the avoidance holds still while its path leads on follows the path,
   // sliding along neighbours in contact (see planned_velocity).
   bool unstick = true;
+  // Anywhere else, a member that has not moved 0.1 m for this long follows
+  // its path the same way (0: never): the avoidance can hold a figure still
+  // for good where it touches a wall corner (its avoidance radius is larger
+  // than the radius the mesh keeps it from the walls by). The path may
+  // graze a wall there, so only for figures kept out of walls otherwise
+  // (the herd sets 5 s: it stops a figure at a wall's surface).
+  double unstick_after_s = 0.0;
   // Figures closer than the sum of their radii plus this never walk
   // toward each other (see safe_velocity); 0 turns the rule off.
   double contact_margin_m = 0.1;
   // Neighbours within this many avoidance radii are avoided.
   double query_range_radii = 5.0;
+  // Keep right: a member meeting an oncoming figure (heading more than
+  // 120 degrees from its own way) ahead of it and less than the sum of
+  // their avoidance radii to the side turns its way to the right, by up to
+  // this angle (rad) as the figure comes closer (see keep_right); 0 turns
+  // the rule off. Both turn, so they pass each other on the left, and in a
+  // gap two opposing streams form two lanes instead of meeting head on.
+  double keep_right_rad = 0.6;
+  // How far ahead (m) an oncoming figure is looked for.
+  double keep_right_range_m = 3.0;
 };
 
 class CrowdGroup;
@@ -83,6 +99,7 @@ class Crowd {
   void stop(int i);
   Vec2 planned_velocity(int i, bool unstick) const;
   Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
+  Vec2 keep_right(int i, Vec2 v, std::span<const Agent> agents) const;
 
   NavWorld& world_;
   CrowdParams params_;
