@@ -35,33 +35,103 @@ HALF_PI = 1.5708
 # (positive turns the distal segment forward), t in stride cycles with t = 0
 # mid-swing of that limb.
 #
-# Where the numbers come from: the ranges of motion of the walk reported in
-# the equine kinematics literature summarised by Back and Clayton, "Equine
-# Locomotion" (2001), rounded (scapula about 20 deg, shoulder 25, elbow 55,
-# carpus 70, fore fetlock 80, hip 30, stifle 35, tarsus 35, hind fetlock 70;
-# the head and neck nod twice per stride by a few degrees). We did not have
-# the published angle-time plots, so the curves are not Fourier fits of
-# measured data: each is built from one to three harmonics with the phase
-# relations of a walk (proximal joints swing sinusoidally, distal joints flex
-# in mid-swing, the fetlock extends in stance). Distal ranges are reduced by
-# about half (elbow 30, carpus 50, fetlocks 40) because the model's legs are
-# straight at rest and a full-range carpus folds the leg under it. The small
-# terms listed below the threshold stand for the higher harmonics a Fourier
-# fit would find; they are dropped, as in the paper.
-HORSE = [
-    ("scapula", 0.0, [(10.0, 1, 0.0), (1.5, 2, 1.0), (0.6, 3, 0.4)]),
-    ("shoulder", 0.0, [(12.0, 1, -0.3), (2.0, 2, 0.8), (0.5, 3, 2.0)]),
-    ("elbow", 12.0, [(15.0, 1, HALF_PI), (3.0, 2, HALF_PI), (0.7, 3, 0.2)]),
-    ("carpal", -20.0, [(25.0, 1, -HALF_PI), (8.0, 2, -HALF_PI), (0.8, 4, 1.1)]),
-    ("fore_fetlock", -10.0, [(20.0, 1, -HALF_PI), (2.5, 2, 0.6), (0.4, 3, 1.9)]),
-    ("hip", 0.0, [(12.0, 1, 0.0), (1.8, 2, 0.9), (0.5, 3, -0.7)]),
-    ("stifle", -8.0, [(12.0, 1, -HALF_PI), (3.0, 2, -HALF_PI), (0.6, 3, 0.3)]),
-    ("tarsal", 8.0, [(12.0, 1, HALF_PI), (3.0, 2, HALF_PI), (0.9, 3, -1.2)]),
-    ("hind_fetlock", -10.0, [(18.0, 1, -HALF_PI), (2.2, 2, 0.5), (0.3, 4, 0.0)]),
-    ("neck_proximal", 0.0, [(3.0, 2, 0.5), (0.6, 1, 0.0)]),
-    ("neck_mid", 0.0, [(2.5, 2, 1.0), (0.5, 1, 0.3)]),
-    ("atlas", 0.0, [(4.0, 2, 1.5), (0.8, 1, -0.4)]),
-]
+# The leg curves are designed for the model's geometry, as a walking robot's
+# are: each foot follows a path in its hip's frame, and the joint angles come
+# from inverse kinematics of the model's segment lengths. An earlier seed
+# built from rounded ranges of motion of real horses (Back and Clayton,
+# "Equine Locomotion", 2001) fell in 9 of 10 walks on this model: its carpus
+# flexed against the model's range and its hind stance began in protraction
+# (docs/evolve.md).
+#
+# The foot path: a stance of HORSE_DUTY of the cycle in which the foot moves
+# straight back by HORSE_STRIDE * HORSE_DUTY at a constant height (the body
+# moves HORSE_STRIDE per cycle), centred under the hip; a swing that brings it
+# forward on a half-cosine, lifted HORSE_LIFT on a half-sine. The body is
+# carried HORSE_CROUCH below full leg length, so the leg reaches the ends of
+# the stance without locking straight. The hoof stays level.
+#
+# Inverse kinematics, each leg as two links:
+#   fore  scapula and humerus as one link (shoulder held at 0), radius and
+#         cannon as the other (carpus held at 0); the elbow is the knee and
+#         flexes forward, as a horse's does; the fetlock keeps the pastern
+#         vertical.
+#   hind  femur and cannon stay parallel (tarsal = -stifle), as a horse's
+#         reciprocal apparatus couples stifle and hock, so the leg is a
+#         two-link chain of femur + cannon (0.85 m) and tibia (0.45 m); the
+#         stifle flexes backward; the fetlock keeps the pastern vertical.
+# Each curve is then written as its Fourier series up to HORSE_HARMONICS
+# (terms under THRESHOLD dropped). Fewer harmonics leave ripples of a few
+# centimetres in the stance path, and rigid legs then bounce from foot to
+# foot: with 4 harmonics every walk fell, with 8 none did.
+HORSE_STRIDE = 1.8      # m per cycle: 1.39 m/s at 0.77 Hz, 90 % of the Froude speed
+HORSE_DUTY = 0.8        # designed; the measured duty is lower (feet land late, lift early)
+HORSE_CROUCH = 0.25     # m below full leg length
+HORSE_LIFT = 0.15       # m
+HORSE_HARMONICS = 8
+HORSE_FORE = (0.65, 0.75, 1.6)   # upper link, lower link, attachment to sole (m)
+HORSE_HIND = (0.85, 0.45, 1.5)
+HORSE_PASTERN = 0.2     # fetlock joint to sole (m)
+
+
+def horse_foot(s):
+    """Foot position (forward, height above stance, 0..1 of swing) at phase s."""
+    d, ls = HORSE_DUTY, HORSE_STRIDE * HORSE_DUTY
+    s0 = 0.5 - d / 2
+    if s0 <= s < s0 + d:
+        return ls / 2 - ls * (s - s0) / d, 0.0
+    u = ((s - s0 - d) % 1.0) / (1 - d)
+    return -ls / 2 + ls * (1 - math.cos(math.pi * u)) / 2, HORSE_LIFT * math.sin(math.pi * u)
+
+
+def two_link(x, z, l1, l2, knee_sign):
+    """Segment angle of the upper link from vertical and knee angle (rad) that put the
+    chain's end at (x forward, z down negative)."""
+    c = (x * x + z * z - l1 * l1 - l2 * l2) / (2 * l1 * l2)
+    q2 = knee_sign * math.acos(max(-1.0, min(1.0, c)))
+    q1 = math.atan2(x, -z) - math.atan2(l2 * math.sin(q2), l1 + l2 * math.cos(q2))
+    return q1, q2
+
+
+def horse_leg_angles(s):
+    x, lift = horse_foot(s)
+    out = {}
+    l1, l2, full = HORSE_FORE
+    q1, q2 = two_link(x, -(full - HORSE_CROUCH) + lift + HORSE_PASTERN, l1, l2, +1)
+    out.update(scapula=q1, shoulder=0.0, elbow=q2, carpal=0.0, fore_fetlock=-(q1 + q2))
+    l1, l2, full = HORSE_HIND
+    q1, q2 = two_link(x, -(full - HORSE_CROUCH) + lift + HORSE_PASTERN, l1, l2, -1)
+    out.update(hip=q1, stifle=q2, tarsal=-q2, hind_fetlock=-q1)
+    return {k: math.degrees(v) for k, v in out.items()}
+
+
+def fourier(values, harmonics):
+    """(constant, [(amplitude, k, phase)]) with v(s) = c + sum a sin(2 pi k s + p)."""
+    n = len(values)
+    terms = []
+    for k in range(1, harmonics + 1):
+        c = 2 / n * sum(v * math.cos(2 * math.pi * k * i / n) for i, v in enumerate(values))
+        s = 2 / n * sum(v * math.sin(2 * math.pi * k * i / n) for i, v in enumerate(values))
+        terms.append((round(math.hypot(c, s), 2), k, round(math.atan2(c, s), 3)))
+    return round(sum(values) / n, 2), terms
+
+
+def horse_curves():
+    samples = [horse_leg_angles(i / 256) for i in range(256)]
+    legs = [(name, *fourier([a[name] for a in samples], HORSE_HARMONICS))
+            for name in ("scapula", "shoulder", "elbow", "carpal", "fore_fetlock",
+                         "hip", "stifle", "tarsal", "hind_fetlock")]
+    # The head and neck nod twice per stride by a few degrees (rounded from
+    # the walking horse); the small terms stand for higher harmonics a fit
+    # would find, and are dropped like every term under THRESHOLD.
+    neck = [
+        ("neck_proximal", 0.0, [(3.0, 2, 0.5), (0.6, 1, 0.0)]),
+        ("neck_mid", 0.0, [(2.5, 2, 1.0), (0.5, 1, 0.3)]),
+        ("atlas", 0.0, [(4.0, 2, 1.5), (0.8, 1, -0.4)]),
+    ]
+    return legs + neck
+
+
+HORSE = horse_curves()
 HORSE_JOINTS = [
     # robot joint, curve, limb
     *[(f"{s}_{j}", c, s) for s in ("lf", "rf") for j, c in
@@ -73,8 +143,13 @@ HORSE_JOINTS = [
     ("neck_mid", "neck_mid", "neck"),
     ("atlas", "atlas", "neck"),
 ]
-# Lateral-sequence walk: each limb a quarter stride after the previous.
-HORSE_LIMBS = [("lh", 0.0), ("lf", 0.25), ("rh", 0.5), ("rf", 0.75), ("neck", 0.0)]
+# Diagonal couplets: each hind foot a tenth of a stride before the opposite
+# fore foot, the two diagonals half a stride apart. Support alternates
+# between four, three and the two feet of a diagonal, whose line passes
+# under the centre of mass; never the two feet of one side, on which the
+# lateral-sequence walk (lh 0, lf 0.25, rh 0.5, rf 0.75) rolled this model
+# over in every fall traced (docs/evolve.md).
+HORSE_LIMBS = [("lh", 0.0), ("lf", 0.6), ("rh", 0.5), ("rf", 0.1), ("neck", 0.0)]
 # Fr = v / sqrt(g h) = 0.4 at h = 1.5 m: 1.53 m/s, 2.0 m strides at 0.77 Hz,
 # a brisk walk.
 HORSE_FROUDE = (0.4, 1.5)
