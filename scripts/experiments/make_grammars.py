@@ -4,7 +4,9 @@
     /usr/bin/python3 scripts/experiments/make_grammars.py   (from the repository root)
 
 Outputs (checked in; rerun after changing the seed data below):
-  configs/gaits/horse_seed.yaml, configs/gaits/quadruped_seed.yaml
+  configs/gaits/horse_seed.yaml, configs/gaits/horse_walk.yaml (the seed for
+  the runtime), configs/robots/horse.yaml (the horse as a robot playing
+  it), configs/gaits/quadruped_seed.yaml
   configs/grammars/{horse,quadruped}_{numerical,concatenating,hybrid,sinusoidal,free}.bnf
 
 Grammar styles (after Murphy, O'Neill and Carr, "Exploring Grammatical
@@ -150,6 +152,14 @@ HORSE_JOINTS = [
 # lateral-sequence walk (lh 0, lf 0.25, rh 0.5, rf 0.75) rolled this model
 # over in every fall traced (docs/evolve.md).
 HORSE_LIMBS = [("lh", 0.0), ("lf", 0.6), ("rh", 0.5), ("rf", 0.1), ("neck", 0.0)]
+# The same walk for the runtime (configs/gaits/horse_walk.yaml, played by
+# configs/robots/horse.yaml) starts a fifth of a stride later. `animrt run`
+# ramps from standing to the gait's first pose and then plays the gait at
+# full swing, where the evolver's walk blends the swing in over a cycle; the
+# start is the fragile part of this walk, and measured in lockstep runs of
+# 20 s only this start phase (of 20 tried) walked without a fall, start and
+# stop included (docs/evolve.md).
+HORSE_RUNTIME_SHIFT = 0.2
 # Fr = v / sqrt(g h) = 0.4 at h = 1.5 m: 1.53 m/s, 2.0 m strides at 0.77 Hz,
 # a brisk walk.
 HORSE_FROUDE = (0.4, 1.5)
@@ -165,6 +175,97 @@ QUAD_LIMBS = [("lh", 0.0), ("lf", 0.25), ("rh", 0.5), ("rf", 0.75)]
 # Fr 0.06 at h = 0.18 m: 0.08 m/s, 0.077 m strides at 1.04 Hz, about the
 # 1 Hz of walk.yaml (a slow walk; the light model slips at faster ones).
 QUAD_FROUDE = (0.06, 0.18)
+
+
+# ---- the horse as a robot on the runtime -----------------------------------
+# configs/robots/horse.yaml: every joint of the model on two simulated
+# Dynamixel buses, limits from the model's joint ranges, home in the first
+# pose of horse_walk.yaml (all four feet down), so the figure starts standing
+# where the walk begins.
+HORSE_RANGES = {"scapula": (-70, 40), "shoulder": (-40, 40), "elbow": (-30, 120),
+                "carpal": (-90, 10), "fetlock": (-90, 60), "hip": (-60, 60),
+                "stifle": (-120, 30), "tarsal": (-30, 120), "neck_proximal": (-30, 30),
+                "neck_mid": (-30, 30), "atlas": (-45, 45)}
+
+HORSE_ROBOT_HEADER = """# The horse of configs/models/horse.xml as a robot: 21 joints on two
+# simulated Dynamixel Protocol 2.0 buses (fore legs and neck; hind legs),
+# playing the horse's seed walk (horse_walk.yaml). Written by
+# scripts/experiments/make_grammars.py. Run it on the physics model:
+#
+#   animrt run configs/robots/horse.yaml --backend sim --physics configs/models/horse.xml
+#
+# A servo's goal position becomes the target of the model's position
+# actuator of the same name (docs/evolve.md, "Playing an evolved gait on
+# physics"); the model's actuators, not a Dynamixel's, carry the 540 kg
+# figure, so the limits are the model's joint ranges and the speeds a leg of
+# this size needs (the walk reaches about 770 deg/s and 18,000 deg/s^2 at
+# stifle and tarsus), not an X-series servo's.
+# Reference of every key: docs/config.md.
+
+name: horse
+
+loop:
+  # 13 and 8 servos: a Sync Write and a Sync Read per bus at 1 Mbaud fit a
+  # 5 ms period. At 100 Hz the stiff leg actuators see steps of up to 8
+  # degrees every cycle, and lockstep runs fell in 3 of 9 starts.
+  rate_hz: 200
+
+safety:
+  watchdog_timeout_s: 0.2
+  start_ramp_s: 2.0        # home is the walk's first pose: the ramp is short
+  # A quick stop plants the feet where they are and brakes the body; over
+  # 2 s or 4 s the figure walked on while its legs slowed and tipped over in
+  # 5 of 6 lockstep runs (0 of 7 with 0.5 s).
+  stop_ramp_s: 0.5
+
+buses:
+  fore:
+    protocol: dynamixel2
+    port: /dev/ttyUSB0
+    baud: 1000000
+    timeout_ms: 4
+    sim:
+      wire_time: true
+  hind:
+    protocol: dynamixel2
+    port: /dev/ttyUSB1
+    baud: 1000000
+    timeout_ms: 4
+    sim:
+      wire_time: true
+
+# Joint order is the robot's joint order (telemetry columns). Right-side
+# servos are mounted mirrored (direction -1).
+joints:
+"""
+
+
+def horse_robot_yaml():
+    curves = {name: (const, kept(terms)) for name, const, terms in HORSE}
+    phase = {l: (p + HORSE_RUNTIME_SHIFT) % 1.0 for l, p in HORSE_LIMBS}
+
+    def first(curve, limb):
+        const, terms = curves[curve]
+        s = -phase[limb]
+        return const + sum(a * math.sin(k * 2 * math.pi * s + p) for a, k, p in terms)
+
+    out = HORSE_ROBOT_HEADER
+    ids = {"fore": 0, "hind": 0}
+    for joint, curve, limb in HORSE_JOINTS:
+        bus = "hind" if limb in ("lh", "rh") else "fore"
+        ids[bus] += 1
+        kind = joint.split("_", 1)[1] if limb != "neck" else joint
+        lo, hi = HORSE_RANGES[kind]
+        fast = limb != "neck"
+        out += (f"  {joint}:\n"
+                f"    limits: {{min_deg: {lo}, max_deg: {hi}, velocity_dps: {1000 if fast else 200}, "
+                f"acceleration_dps2: {30000 if fast else 2000}}}\n"
+                f"    home_deg: {num(round(first(curve, limb), 2))}\n"
+                f"    actuator: {{bus: {bus}, id: {ids[bus]}, ticks_per_rev: 4096, zero_ticks: 2048, "
+                f"direction: {-1 if limb in ('rf', 'rh') else 1}}}\n")
+    out += ("\nmotion:\n  type: gait\n  file: ../gaits/horse_walk.yaml  # relative to this file's folder\n"
+            "\n# The figure's MJCF model, for the dashboard's 3-D view.\nmodel: ../models/horse.xml\n")
+    return out
 
 
 def num(v):
@@ -295,6 +396,11 @@ HORSE_COMMENT = """# Seed walk of the horse model (configs/models/horse.xml), wr
 # stride cycles; left and right legs share a curve half a stride apart.
 # Terms below 1 degree of amplitude were dropped."""
 
+HORSE_WALK_COMMENT = """# The horse's seed walk (horse_seed.yaml) for the runtime: the same curves
+# and limb offsets, started a fifth of a stride later so that the figure
+# starting from standing (configs/robots/horse.yaml) gets into the walk.
+# Written by scripts/experiments/make_grammars.py."""
+
 QUAD_COMMENT = """# Seed walk of the demo quadruped for gait evolution: the curves of
 # configs/gaits/walk.yaml with Froude timing (the fitness targets come from
 # the Froude number). Written by scripts/experiments/make_grammars.py."""
@@ -303,6 +409,11 @@ QUAD_COMMENT = """# Seed walk of the demo quadruped for gait evolution: the curv
 def main():
     with open(os.path.join(ROOT, "configs/gaits/horse_seed.yaml"), "w") as f:
         f.write(gait_yaml("horse_seed", HORSE_COMMENT, HORSE, HORSE_FROUDE, HORSE_LIMBS, HORSE_JOINTS))
+    shifted = [(l, round((p + HORSE_RUNTIME_SHIFT) % 1.0, 4)) for l, p in HORSE_LIMBS]
+    with open(os.path.join(ROOT, "configs/gaits/horse_walk.yaml"), "w") as f:
+        f.write(gait_yaml("horse_walk", HORSE_WALK_COMMENT, HORSE, HORSE_FROUDE, shifted, HORSE_JOINTS))
+    with open(os.path.join(ROOT, "configs/robots/horse.yaml"), "w") as f:
+        f.write(horse_robot_yaml())
     with open(os.path.join(ROOT, "configs/gaits/quadruped_seed.yaml"), "w") as f:
         f.write(gait_yaml("quadruped_seed", QUAD_COMMENT, QUAD, QUAD_FROUDE, QUAD_LIMBS, QUAD_JOINTS))
     for model, curves in (("horse", HORSE), ("quadruped", QUAD)):
