@@ -59,7 +59,18 @@ bool has_fallen(const MujocoModel& mm, const mjData* d, double standing_z) {
       d->warning[mjWARN_BADQVEL].number > 0) {
     return true;
   }
-  return z < 0.5 * standing_z || up < 0.5;
+  if (z < 0.5 * standing_z || up < 0.5) return true;
+  // The trunk on the ground: a figure whose legs fold under it can rest on
+  // its belly above half its standing height (the horse, whose trunk hangs
+  // between its legs).
+  const mjModel* m = mm.model.get();
+  for (int c = 0; c < d->ncon; ++c) {
+    if (m->geom_bodyid[d->contact[c].geom1] == mm.torso_body ||
+        m->geom_bodyid[d->contact[c].geom2] == mm.torso_body) {
+      return true;
+    }
+  }
+  return false;
 }
 
 MujocoGaitSimulator::MujocoGaitSimulator(std::shared_ptr<const MujocoModel> model)

@@ -9,7 +9,8 @@
 //
 // It also watches the figure: forward (+x) and sideways travel of the torso,
 // and falls by the same criterion as the gait fitness (has_fallen: torso
-// below half its standing height, tilted more than 60 degrees, or unstable).
+// below half its standing height, tilted more than 60 degrees, the trunk on
+// the ground, or unstable).
 
 #include <atomic>
 #include <cstdint>
