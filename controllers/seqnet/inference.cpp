@@ -82,8 +82,9 @@ SeqNetInference::SeqNetInference(const ModelFile& model, const std::string& file
                      std::to_string(low_.size()) + " dimensions, the shape has " +
                          std::to_string(d));
   }
-  if (shape_.conv_layers < 1 || shape_.lstm_layers < 1) {
-    throw InputError(Location{file, 0, 0}, "shape", "no encoder layer or no LSTM layer");
+  if (shape_.conv_layers < 1 || shape_.lstm_layers < 1 || d < 1) {
+    throw InputError(Location{file, 0, 0}, "shape",
+                     "no input dimension, no encoder layer or no LSTM layer");
   }
   vertices_ = mesh ? shape_.vertex_count : 1;
   if (mesh) {
