@@ -291,6 +291,7 @@ int cmd_run(const RunArgs& args) {
     report.average_speed_m_s = m.motion_s > 0 ? m.motion_forward_m / m.motion_s : 0.0;
     report.falls = m.falls;
     report.first_fall_s = m.first_fall_s;
+    report.lockstep_waits_timed_out = m.lockstep_waits_timed_out;
     summary.physics = report;
   }
   std::cout << animrt::format_summary(summary) << std::flush;

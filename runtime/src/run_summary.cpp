@@ -91,6 +91,11 @@ std::string format_summary(const RunSummary& s) {
         p.falls > 0 ? fmt::format(" (first at {:.2f} s)", p.first_fall_s) : std::string()));
     line(fmt::format("physics, motion only: forward {:.3f} m in {:.2f} s, average speed {:.3f} m/s",
                      p.motion_forward_m, p.motion_s, p.average_speed_m_s));
+    if (p.lockstep_waits_timed_out > 0) {
+      line(fmt::format("physics: a bus kept the others waiting {} time(s); this lockstep run may "
+                       "not repeat exactly",
+                       p.lockstep_waits_timed_out));
+    }
   }
   if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
@@ -163,7 +168,8 @@ nlohmann::json to_json(const RunSummary& s) {
                     {"motion_forward_m", p.motion_forward_m},
                     {"average_speed_m_s", p.average_speed_m_s},
                     {"falls", p.falls},
-                    {"first_fall_s", p.first_fall_s}};
+                    {"first_fall_s", p.first_fall_s},
+                    {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
   }
   return j;
 }

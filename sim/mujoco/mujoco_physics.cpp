@@ -3,7 +3,9 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "animrt/core/error.hpp"
@@ -66,9 +68,56 @@ int MujocoJointPhysics::joint_index(const std::string& joint) const {
 
 void MujocoJointPhysics::advance(Nanos now) {
   std::lock_guard lock(mutex_);
+  step_towards(now);
+}
+
+void MujocoJointPhysics::step_towards(Nanos now) {
+  now = std::min(now, slowest_party());
   if (now <= start_) return;
   const auto due = static_cast<std::uint64_t>((now - start_) / step_ns_);
   while (steps_ < due) step();
+}
+
+Nanos MujocoJointPhysics::slowest_party() const {
+  Nanos slowest = std::numeric_limits<Nanos>::max();
+  for (const Party& p : parties_) {
+    if (p.waited_for) slowest = std::min(slowest, p.time);
+  }
+  return slowest;
+}
+
+int MujocoJointPhysics::join_lockstep() {
+  std::lock_guard lock(mutex_);
+  parties_.push_back({start_, true});
+  return static_cast<int>(parties_.size()) - 1;
+}
+
+void MujocoJointPhysics::leave_lockstep(int party) {
+  {
+    std::lock_guard lock(mutex_);
+    parties_.at(static_cast<std::size_t>(party)).waited_for = false;
+  }
+  party_moved_.notify_all();
+}
+
+void MujocoJointPhysics::reach(int party, Nanos now) {
+  std::unique_lock lock(mutex_);
+  Party& self = parties_.at(static_cast<std::size_t>(party));
+  self.time = std::max(self.time, now);
+  self.waited_for = true;
+  step_towards(now);
+  party_moved_.notify_all();
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::nanoseconds(kLockstepWait);
+  while (slowest_party() < now) {
+    if (party_moved_.wait_until(lock, give_up) == std::cv_status::timeout &&
+        slowest_party() < now) {
+      for (Party& p : parties_) {
+        if (p.time < now) p.waited_for = false;
+      }
+      ++waits_timed_out_;
+    }
+  }
+  step_towards(now);
 }
 
 void MujocoJointPhysics::step() {
@@ -147,6 +196,7 @@ PhysicsMeasures MujocoJointPhysics::measures() const {
   out.falls = falls_;
   out.first_fall_s = first_fall_s_;
   out.fallen = fallen_;
+  out.lockstep_waits_timed_out = waits_timed_out_;
   return out;
 }
 

@@ -69,8 +69,10 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
     : config_(config),
       clock_(clock),
       firmware_(config, clock.now(), physics),
+      physics_(physics),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
+  if (lockstep_ && physics_ != nullptr) party_ = physics_->join_lockstep();
   try {
     master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
     if (master_ < 0) fail(config_, "posix_openpt", errno);
@@ -128,6 +130,7 @@ void DynamixelSimBus::start() {
 void DynamixelSimBus::stop() {
   if (!thread_.joinable()) return;
   stop_ = true;
+  if (party_ >= 0) physics_->leave_lockstep(party_);
   const std::uint8_t wake = 1;
   [[maybe_unused]] const ssize_t n = ::write(wake_[1], &wake, 1);
   thread_.join();
@@ -200,6 +203,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   Nanos now = clock_.now();
   if (lockstep_ && !may_answer(packet)) now = last_time_;
   last_time_ = now;
+  if (party_ >= 0) physics_->reach(party_, now);
   answers_.clear();
   {
     std::lock_guard lock(mutex_);

@@ -8,12 +8,15 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "animrt/core/error.hpp"
@@ -238,6 +241,19 @@ TEST_F(PhysicsBackend, SeedHorseWalksInALockstepRunWithoutFalling) {
       << "sideways " << walk.physics.sideways_m;
 }
 
+// The horse's two buses run on their own threads; their lockstep runs still
+// agree to the last bit (the physics waits for both buses' goals each cycle).
+TEST_F(PhysicsBackend, TwoBusLockstepRunsOfTheHorseAreIdentical) {
+  files_.push_back(write_horse_robot("horse_twice"));
+  const Outcome a = run_on_physics(files_.back(), 1.5, false, kHorseModel);
+  const Outcome b = run_on_physics(files_.back(), 1.5, false, kHorseModel);
+  EXPECT_EQ(a.physics.lockstep_waits_timed_out, 0);
+  EXPECT_EQ(a.physics.steps, b.physics.steps);
+  EXPECT_EQ(a.physics.forward_m, b.physics.forward_m);
+  EXPECT_EQ(a.physics.sideways_m, b.physics.sideways_m);
+  EXPECT_EQ(a.joints_at_end, b.joints_at_end);
+}
+
 // A horse whose actuators cannot carry it, commanded to stand in its home
 // pose: its legs fold and the trunk lands on the ground, and the runtime's
 // physics reports that as a fall.
@@ -280,6 +296,45 @@ TEST(PhysicsModel, StepsAtItsOwnTimestepAsTheClockMoves) {
   physics.advance(1'000'000'000 + 6'000'000);
   EXPECT_EQ(physics.measures().steps, 3u);
   EXPECT_DOUBLE_EQ(physics.measures().timestep_s, 0.002);
+}
+
+// Two buses drive one figure in a lockstep run, each on its own thread: the
+// physics steps to a time only once every bus has reached it, so a goal one
+// bus hands over for a cycle is in before another bus's next cycle steps past
+// it, whichever thread runs first.
+TEST(PhysicsModel, InLockstepABusAheadWaitsForTheOthersGoals) {
+  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
+  const int a = physics.join_lockstep();
+  const int b = physics.join_lockstep();
+  std::atomic<bool> a_back{false};
+  std::thread ahead([&] {
+    physics.reach(a, 10'000'000);  // a's next cycle, before b has handed over its goals
+    a_back = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(a_back.load());
+  physics.advance(10'000'000);  // a servo's own advance does not step past b either
+  EXPECT_EQ(physics.measures().steps, 0u);
+  physics.command(0, 0.3, true);  // b's goal for the step to 10 ms
+  physics.reach(b, 10'000'000);   // b's next cycle: now both are there (5 steps of 2 ms)
+  ahead.join();
+  EXPECT_TRUE(a_back.load());
+  EXPECT_EQ(physics.measures().steps, 5u);
+  EXPECT_EQ(physics.measures().lockstep_waits_timed_out, 0);
+
+  // A bus that stops talking is waited for once, then passed over until it
+  // reports again; one that leaves is not waited for.
+  physics.reach(a, 20'000'000);
+  EXPECT_EQ(physics.measures().steps, 10u);
+  EXPECT_EQ(physics.measures().lockstep_waits_timed_out, 1);
+  physics.reach(a, 30'000'000);
+  EXPECT_EQ(physics.measures().steps, 15u);
+  physics.reach(b, 30'000'000);
+  physics.leave_lockstep(b);
+  physics.reach(a, 40'000'000);
+  EXPECT_EQ(physics.measures().steps, 20u);
+  EXPECT_EQ(physics.measures().lockstep_waits_timed_out, 1);
 }
 
 TEST(PhysicsModel, TorqueOffLetsTheFigureSagAndTorqueOnHoldsIt) {

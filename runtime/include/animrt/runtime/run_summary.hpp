@@ -51,6 +51,7 @@ struct PhysicsReport {
   double average_speed_m_s = 0.0;  // motion_forward_m / motion_s
   int falls = 0;                   // upright -> fallen transitions (the gait fitness's criterion)
   double first_fall_s = -1.0;      // physics time of the first fall, -1 if none
+  int lockstep_waits_timed_out = 0;  // a bus was late to a lockstep step: the run may not repeat
 };
 
 enum class EndReason { duration, signal, fault };

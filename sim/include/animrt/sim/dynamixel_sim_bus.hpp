@@ -101,6 +101,9 @@ class DynamixelSimBus final : public SimulatedBus {
   mutable std::mutex mutex_;  // guards firmware_
   DynamixelFirmware firmware_;
 
+  JointPhysics* physics_ = nullptr;
+  int party_ = -1;  // lockstep with physics: this bus's party (JointPhysics::reach)
+
   // Serving thread only.
   bool lockstep_ = false;
   Nanos last_time_ = 0;  // when the previous packet took effect

@@ -22,6 +22,20 @@ class JointPhysics {
   virtual void command(int index, double goal_rad, bool torque_on) = 0;
   virtual double position(int index) const = 0;  // rad
   virtual double velocity(int index) const = 0;  // rad/s
+
+  // Lockstep runs (a simulated clock). Several buses drive one figure, each
+  // on its own thread: a bus that steps the physics on to the next cycle
+  // before another bus has handed over that bus's goals of this cycle would
+  // make the run depend on thread timing. So each bus joins as a party and
+  // reports the time of every packet it handles (reach); the physics never
+  // steps past the party furthest behind, and a party ahead waits for the
+  // others, at most `kLockstepWait` of wall time (then the others are passed
+  // over until they report again, so a bus that stopped talking costs one
+  // wait, not one per packet). A party that leaves is no longer waited for.
+  static constexpr Nanos kLockstepWait = 500'000'000;
+  virtual int join_lockstep() { return -1; }
+  virtual void reach([[maybe_unused]] int party, [[maybe_unused]] Nanos now) {}
+  virtual void leave_lockstep([[maybe_unused]] int party) {}
 };
 
 }  // namespace animrt::sim

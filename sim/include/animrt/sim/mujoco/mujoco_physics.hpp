@@ -13,6 +13,7 @@
 // the ground, or unstable).
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -47,6 +48,7 @@ struct PhysicsMeasures {
   int falls = 0;                  // times the figure went from upright to fallen
   double first_fall_s = -1.0;     // simulated time of the first fall, -1 if none
   bool fallen = false;            // fallen at the end
+  int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past kLockstepWait
 };
 
 class MujocoJointPhysics final : public JointPhysics {
@@ -67,6 +69,9 @@ class MujocoJointPhysics final : public JointPhysics {
   void command(int index, double goal_rad, bool torque_on) override;
   double position(int index) const override;
   double velocity(int index) const override;
+  int join_lockstep() override;
+  void reach(int party, Nanos now) override;
+  void leave_lockstep(int party) override;
 
   // Marks the start and the end of the motion (after the start ramp, before
   // the stop ramp): the next physics step records the torso's position.
@@ -80,6 +85,9 @@ class MujocoJointPhysics final : public JointPhysics {
 
  private:
   void step();  // one mj_step and the fall watch; mutex held
+  // Steps on to `now`, never past a lockstep party's time; mutex held.
+  void step_towards(Nanos now);
+  Nanos slowest_party() const;  // mutex held; the largest Nanos without parties
 
   MujocoModel meta_;  // names and addresses (shares nothing mutable)
   std::unique_ptr<mjModel, void (*)(mjModel*)> model_;  // own copy: torque off edits its gains
@@ -95,6 +103,13 @@ class MujocoJointPhysics final : public JointPhysics {
   double yaw0_ = 0.0;
 
   mutable std::mutex mutex_;
+  std::condition_variable party_moved_;
+  struct Party {
+    Nanos time = 0;
+    bool waited_for = true;  // false: left, or passed over after a wait timed out
+  };
+  std::vector<Party> parties_;
+  int waits_timed_out_ = 0;
   std::uint64_t steps_ = 0;
   int falls_ = 0;
   double first_fall_s_ = -1.0;
