@@ -129,6 +129,63 @@ TEST(MujocoGaitSimulator, AHorseThatCannotCarryItselfIsReportedAsAFall) {
   EXPECT_EQ(score(m, t, {}, sim->info().mass_kg), kWorstFitness);
 }
 
+// The trunk counts as fallen when it touches the ground, not when it touches
+// the figure's own limbs: a figure whose leg rubs its trunk (self-collision
+// on) is standing; the same trunk resting on the floor has fallen.
+TEST(MujocoGaitSimulator, OnlyTheTrunkOnTheGroundIsAFallNotOnItsOwnLeg) {
+  const std::string path = ::testing::TempDir() + "/animrt_self_contact.xml";
+  std::ofstream(path) << R"(<mujoco>
+  <default><geom contype="1" conaffinity="1"/></default>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 0.1"/>
+    <body name="torso" pos="0 0 1">
+      <freejoint/>
+      <geom name="trunk" type="sphere" size="0.2"/>
+      <body name="upper">
+        <joint name="hip" type="hinge" axis="0 1 0"/>
+        <geom type="sphere" size="0.01" pos="0 0.5 0"/>
+        <body name="lower">
+          <joint name="knee" type="hinge" axis="0 1 0"/>
+          <geom name="shin" type="sphere" size="0.05" pos="0.22 0 0"/>
+          <geom name="foot" type="sphere" size="0.05" pos="0 0 -0.9"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <position joint="hip" kp="10"/>
+    <position joint="knee" kp="10"/>
+  </actuator>
+</mujoco>)";
+  const sim::MujocoModel mm = sim::load_mujoco_model(path);
+  std::remove(path.c_str());
+  const mjModel* m = mm.model.get();
+  sim::MujocoData data = sim::make_mujoco_data(mm);
+  mjData* d = data.get();
+  const double standing[2] = {0.0, 0.0};
+  sim::place_standing(mm, d, standing);
+  const double standing_z = d->xpos[3 * mm.torso_body + 2];
+  const int trunk = mj_name2id(m, mjOBJ_GEOM, "trunk");
+  const int shin = mj_name2id(m, mjOBJ_GEOM, "shin");
+  const auto touching = [&](int a, int b) {
+    for (int c = 0; c < d->ncon; ++c) {
+      const int g1 = d->contact[c].geom1, g2 = d->contact[c].geom2;
+      if ((g1 == a && g2 == b) || (g1 == b && g2 == a)) return true;
+    }
+    return false;
+  };
+  const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
+  ASSERT_TRUE(touching(trunk, shin));
+  ASSERT_FALSE(touching(trunk, floor));
+  EXPECT_FALSE(sim::has_fallen(mm, d, standing_z));
+
+  // The trunk lowered onto the floor, with the fall height out of the way.
+  d->qpos[2] = 0.15;
+  mj_forward(m, d);
+  ASSERT_TRUE(touching(trunk, floor));
+  EXPECT_TRUE(sim::has_fallen(mm, d, 0.1));
+}
+
 TEST(MujocoGaitSimulator, APerturbedStartIsRepeatableAndDiffersFromTheExactOne) {
   sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/quadruped.xml");
   auto sim = factory.make();
