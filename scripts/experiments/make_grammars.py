@@ -11,8 +11,9 @@ Outputs (checked in; rerun after changing the seed data below):
 
 Grammar styles (after Murphy, O'Neill and Carr, "Exploring Grammatical
 Evolution for Horse Gait Optimisation"):
-  numerical      every seed term's amplitude, frequency and phase (and the
-                 constant) chosen within 25 % of its seed value
+  numerical      every seed term's amplitude and phase (and the constant)
+                 chosen within 25 % of its seed value, its frequency among
+                 the whole harmonics within 25 % of its own
   concatenating  the seed curve plus appended sine/cosine functions (Fig. 2)
   hybrid         numerical seed terms plus appended functions
   sinusoidal     appended functions only, no seed data ("free-style sinusoidal")
@@ -294,6 +295,22 @@ def range_rule(value, fraction=0.25, steps=5):
     return f"{num(lo)} | {num(lo + s)} | ... | {num(round(value + steps * s, 4))}"
 
 
+def harmonic_rule(k, fraction=0.25):
+    """The whole harmonics of the stride within +-fraction of harmonic k.
+
+    The paper varies a term's frequency within 25 % of itself. A frequency
+    that is not a whole harmonic makes the curve non-periodic over a stride:
+    its phase drifts against the other legs' from cycle to cycle, left and
+    right legs (one curve half a stride apart) drift apart, and the looping
+    playback jumps at the loop. Every one of 20 seed neighbours with the
+    frequencies varied that way fell (docs/evolve.md); whole harmonics keep
+    every phenotype a gait that repeats each stride, and harmonic k itself
+    is always one of them.
+    """
+    lo, hi = k * (1 - fraction), k * (1 + fraction)
+    return " | ".join(str(h) for h in range(max(1, math.ceil(lo - 1e-9)), math.floor(hi + 1e-9) + 1))
+
+
 FUNCS = """
 <funcs> ::= <funcs> <op> <funcs>
           | <function>
@@ -351,7 +368,7 @@ def numerical_rules(curves):
         for j, (a, k, p) in enumerate(kept(terms)):
             body += f" + <c{i}_a{j}>*sin(<c{i}_f{j}>*2*PI*t + <c{i}_p{j}>)"
             rules += f"<c{i}_a{j}> ::= {range_rule(a)}\n"
-            rules += f"<c{i}_f{j}> ::= {range_rule(float(k))}\n"
+            rules += f"<c{i}_f{j}> ::= {harmonic_rule(k)}\n"
             rules += f"<c{i}_p{j}> ::= {range_rule(p)}\n"
         out += f"# {name}\n<ncurve{i}> ::= {body}\n{rules}"
     return out

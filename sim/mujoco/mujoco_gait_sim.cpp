@@ -62,13 +62,13 @@ bool has_fallen(const MujocoModel& mm, const mjData* d, double standing_z) {
   if (z < 0.5 * standing_z || up < 0.5) return true;
   // The trunk on the ground: a figure whose legs fold under it can rest on
   // its belly above half its standing height (the horse, whose trunk hangs
-  // between its legs).
+  // between its legs). Only a contact between a trunk geom and a geom of the
+  // world body counts; the trunk touching the figure's own legs is no fall.
   const mjModel* m = mm.model.get();
   for (int c = 0; c < d->ncon; ++c) {
-    if (m->geom_bodyid[d->contact[c].geom1] == mm.torso_body ||
-        m->geom_bodyid[d->contact[c].geom2] == mm.torso_body) {
-      return true;
-    }
+    const int b1 = m->geom_bodyid[d->contact[c].geom1];
+    const int b2 = m->geom_bodyid[d->contact[c].geom2];
+    if ((b1 == mm.torso_body && b2 == 0) || (b2 == mm.torso_body && b1 == 0)) return true;
   }
   return false;
 }

@@ -5,6 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <sstream>
+
+#include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/controllers/evolve/random.hpp"
+#include "animrt/controllers/gait/expression.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt::evolve {
@@ -86,6 +92,39 @@ TEST(Grammar, LoadsEveryShippedGrammar) {
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("low_amp_var"))].productions.size(), 81u);
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("med_amp_var"))].productions.size(), 41u);
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("hi_amp_var"))].productions.size(), 21u);
+}
+
+// Every curve a sine-based grammar can build repeats each stride (t is in
+// stride cycles): the fitness measures whole cycles, left and right legs play
+// one curve half a stride apart, and the runtime loops the gait. A frequency
+// that is not a whole harmonic (the numerical grammars once varied 1 to
+// 0.75..1.25) breaks all three.
+TEST(Grammar, EveryCurveOfTheSeededAndSinusoidalGrammarsRepeatsEachStride) {
+  for (const char* model : {"horse", "quadruped"}) {
+    for (const char* style : {"numerical", "concatenating", "hybrid", "sinusoidal"}) {
+      const std::string path = kRoot + "/configs/grammars/" + model + "_" + style + ".bnf";
+      const Grammar g = Grammar::load_file(path);
+      Rng rng(11);
+      int checked = 0;
+      for (int individual = 0; individual < 40; ++individual) {
+        Genome genome(400);
+        for (auto& codon : genome) codon = static_cast<std::uint32_t>(rng.below(65536));
+        const MapResult r = map_genome(g, genome);
+        if (!r.valid) continue;
+        std::stringstream curves(r.phenotype);
+        std::string text;
+        while (std::getline(curves, text, ';')) {
+          const Expression curve = Expression::compile(text);
+          for (double t : {0.0, 0.13, 0.5, 0.77}) {
+            EXPECT_NEAR(curve.eval(t + 1.0), curve.eval(t), 1e-6) << path << ": " << text;
+            EXPECT_NEAR(curve.eval(t + 3.0), curve.eval(t), 1e-6) << path << ": " << text;
+          }
+        }
+        ++checked;
+      }
+      EXPECT_GE(checked, 10) << path;
+    }
+  }
 }
 
 TEST(Grammar, MissingFileIsAnInputError) {

@@ -44,7 +44,8 @@ class MujocoGaitSimulatorFactory final : public evolve::GaitSimulatorFactory {
 void place_standing(const MujocoModel& model, mjData* d, const double* targets);
 
 // Whether the model has fallen: torso below half of `standing_z`, tilted
-// more than 60 degrees, a geom of the torso body touching anything, or
+// more than 60 degrees, a geom of the torso body touching a geom of the
+// world body (the floor; not the figure's own limbs), or
 // non-finite state.
 bool has_fallen(const MujocoModel& model, const mjData* d, double standing_z);
 
