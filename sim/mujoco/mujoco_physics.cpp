@@ -107,7 +107,7 @@ void MujocoJointPhysics::reach(int party, Nanos now) {
   self.waited_for = true;
   step_towards(now);
   party_moved_.notify_all();
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::nanoseconds(kLockstepWait);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::nanoseconds(lockstep_wait_);
   while (slowest_party() < now) {
     if (party_moved_.wait_until(lock, give_up) == std::cv_status::timeout &&
         slowest_party() < now) {

@@ -307,6 +307,7 @@ TEST(PhysicsModel, InLockstepABusAheadWaitsForTheOthersGoals) {
   sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
   const int a = physics.join_lockstep();
   const int b = physics.join_lockstep();
+  physics.set_lockstep_wait(60'000'000'000);  // however slow this machine, a waits for b
   std::atomic<bool> a_back{false};
   std::thread ahead([&] {
     physics.reach(a, 10'000'000);  // a's next cycle, before b has handed over its goals
@@ -325,6 +326,7 @@ TEST(PhysicsModel, InLockstepABusAheadWaitsForTheOthersGoals) {
 
   // A bus that stops talking is waited for once, then passed over until it
   // reports again; one that leaves is not waited for.
+  physics.set_lockstep_wait(50'000'000);
   physics.reach(a, 20'000'000);
   EXPECT_EQ(physics.measures().steps, 10u);
   EXPECT_EQ(physics.measures().lockstep_waits_timed_out, 1);

@@ -29,10 +29,9 @@ class JointPhysics {
   // make the run depend on thread timing. So each bus joins as a party and
   // reports the time of every packet it handles (reach); the physics never
   // steps past the party furthest behind, and a party ahead waits for the
-  // others, at most `kLockstepWait` of wall time (then the others are passed
-  // over until they report again, so a bus that stopped talking costs one
-  // wait, not one per packet). A party that leaves is no longer waited for.
-  static constexpr Nanos kLockstepWait = 500'000'000;
+  // others for a bounded wall time (then the others are passed over until
+  // they report again, so a bus that stopped talking costs one wait, not one
+  // per packet). A party that leaves is no longer waited for.
   virtual int join_lockstep() { return -1; }
   virtual void reach([[maybe_unused]] int party, [[maybe_unused]] Nanos now) {}
   virtual void leave_lockstep([[maybe_unused]] int party) {}

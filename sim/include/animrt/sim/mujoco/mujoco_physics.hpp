@@ -48,7 +48,7 @@ struct PhysicsMeasures {
   int falls = 0;                  // times the figure went from upright to fallen
   double first_fall_s = -1.0;     // simulated time of the first fall, -1 if none
   bool fallen = false;            // fallen at the end
-  int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past kLockstepWait
+  int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
 };
 
 class MujocoJointPhysics final : public JointPhysics {
@@ -72,6 +72,9 @@ class MujocoJointPhysics final : public JointPhysics {
   int join_lockstep() override;
   void reach(int party, Nanos now) override;
   void leave_lockstep(int party) override;
+  // How long a lockstep party ahead waits for the others (wall time).
+  static constexpr Nanos kDefaultLockstepWait = 500'000'000;
+  void set_lockstep_wait(Nanos wait) { lockstep_wait_ = wait; }  // before the buses start
 
   // Marks the start and the end of the motion (after the start ramp, before
   // the stop ramp): the next physics step records the torso's position.
@@ -109,6 +112,7 @@ class MujocoJointPhysics final : public JointPhysics {
     bool waited_for = true;  // false: left, or passed over after a wait timed out
   };
   std::vector<Party> parties_;
+  Nanos lockstep_wait_ = kDefaultLockstepWait;
   int waits_timed_out_ = 0;
   std::uint64_t steps_ = 0;
   int falls_ = 0;
