@@ -263,7 +263,7 @@ def evolve_page(args, page, tmp):
         if page.js("return document.getElementById('evolve-view3d').dataset.webgl;") == "1":
             pose = "return document.getElementById('evolve-view3d').dataset.pose || '';"
             p0 = page.js(pose)
-            page.wait("the best gait playing on the figure", lambda: page.js(pose) not in ("", p0), 5)
+            page.wait("the best gait playing on the figure", lambda: page.js(pose) not in ("", p0), 15)
         time.sleep(0.3)
         page.driver.save_screenshot(os.path.join(args.out, "dashboard_evolve.png"))
         step(f"evolve: curves with {page.js(points)} points, generation {page.js(generation)}, "
