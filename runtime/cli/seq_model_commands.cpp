@@ -150,19 +150,10 @@ int run_complete(const CompleteArgs& a) {
         seqnet::mesh_features(model, a.model, keys.frames, keys.triangles);
     seqnet::SeqNetInference net(model, a.model);
     c = net.complete(features, std::vector<int>(keys.frames.size() - 1, a.gap), a.options);
-    // Keys as read, the in-betweens reconstructed.
+    // Keys as read, the in-betweens reconstructed and placed between them.
     seqnet::MeshSequence out;
     out.triangles = keys.triangles;
-    for (std::size_t k = 0; k < keys.frames.size(); ++k) {
-      if (k > 0) {
-        const seqnet::FrameMatrix gap =
-            c.frames.middleCols(static_cast<Eigen::Index>(k - 1) * (a.gap + 1) + 1, a.gap);
-        for (seqnet::Positions& p : seqnet::mesh_positions(model, gap)) {
-          out.frames.push_back(std::move(p));
-        }
-      }
-      out.frames.push_back(keys.frames[k]);
-    }
+    out.frames = seqnet::completed_mesh(model, keys.frames, features, c, a.gap);
     seqnet::write_obj_sequence(a.out, out);
   }
   print_report(c.gaps, a.options.threshold);
