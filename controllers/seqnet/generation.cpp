@@ -50,9 +50,47 @@ std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& 
   const FrameMatrix given = mesh_features(model, model_path, initial, triangles);
   SeqNetInference net(model, model_path);
   const FrameMatrix all = net.generate(given, options.frames, options.random_state);
+  const Reconstructor solver(model.rest, model.triangles);
+  const Neighbourhood& ring = solver.neighbourhood();
+  auto solve = [&](Eigen::Index k) {
+    const FrameMatrix column = all.col(k);
+    return solver.solve(
+        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count));
+  };
+  const Eigen::Matrix3Xd offsets = piece_offsets(ring, initial.back(), solve(u - 1));
   std::vector<Positions> out = initial;
-  const std::vector<Positions> generated = mesh_positions(model, all.rightCols(options.frames));
-  out.insert(out.end(), generated.begin(), generated.end());
+  for (Eigen::Index k = u; k < all.cols(); ++k) {
+    out.push_back(solve(k));
+    move_pieces(ring, out.back(), offsets);
+  }
+  return out;
+}
+
+std::vector<Positions> completed_mesh(const ModelFile& model, const std::vector<Positions>& keys,
+                                      const FrameMatrix& keys_features, const Completion& completion,
+                                      int gap) {
+  const Reconstructor solver(model.rest, model.triangles);
+  const Neighbourhood& ring = solver.neighbourhood();
+  auto solve = [&](const FrameMatrix& features, Eigen::Index k) {
+    const FrameMatrix column = features.col(k);
+    return solver.solve(
+        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count));
+  };
+  std::vector<Eigen::Matrix3Xd> offsets;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    offsets.push_back(piece_offsets(ring, keys[k], solve(keys_features, static_cast<Eigen::Index>(k))));
+  }
+  std::vector<Positions> out;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    if (k > 0) {
+      for (int t = 1; t <= gap; ++t) {
+        out.push_back(solve(completion.frames, static_cast<Eigen::Index>(k - 1) * (gap + 1) + t));
+        const double s = static_cast<double>(t) / (gap + 1);
+        move_pieces(ring, out.back(), (1.0 - s) * offsets[k - 1] + s * offsets[k]);
+      }
+    }
+    out.push_back(keys[k]);
+  }
   return out;
 }
 

@@ -147,20 +147,30 @@ std::vector<Positions> reconstruct_all(const SequenceFeatures& features) {
   return out;
 }
 
-FrameError error_up_to_translation(const Positions& expected, const Positions& got,
-                                   const Neighbourhood& ring) {
-  const int pieces = ring.piece_count;
-  Eigen::Matrix3Xd shift = Eigen::Matrix3Xd::Zero(3, pieces);
-  std::vector<int> size(static_cast<std::size_t>(pieces), 0);
+Eigen::Matrix3Xd piece_offsets(const Neighbourhood& ring, const Positions& placed,
+                               const Positions& frame) {
+  Eigen::Matrix3Xd shift = Eigen::Matrix3Xd::Zero(3, ring.piece_count);
+  std::vector<int> size(static_cast<std::size_t>(ring.piece_count), 0);
   for (int i = 0; i < ring.vertex_count; ++i) {
-    shift.col(ring.piece[i]) += expected.col(i) - got.col(i);
+    shift.col(ring.piece[i]) += placed.col(i) - frame.col(i);
     ++size[ring.piece[i]];
   }
-  for (int p = 0; p < pieces; ++p) shift.col(p) /= std::max(1, size[p]);
+  for (int p = 0; p < ring.piece_count; ++p) shift.col(p) /= std::max(1, size[p]);
+  return shift;
+}
+
+void move_pieces(const Neighbourhood& ring, Positions& frame, const Eigen::Matrix3Xd& offsets) {
+  for (int i = 0; i < ring.vertex_count; ++i) frame.col(i) += offsets.col(ring.piece[i]);
+}
+
+FrameError error_up_to_translation(const Positions& expected, const Positions& got,
+                                   const Neighbourhood& ring) {
+  Positions moved = got;
+  move_pieces(ring, moved, piece_offsets(ring, expected, got));
   const double diagonal = (expected.rowwise().maxCoeff() - expected.rowwise().minCoeff()).norm();
   FrameError out;
   for (int i = 0; i < ring.vertex_count; ++i) {
-    const double d = (got.col(i) + shift.col(ring.piece[i]) - expected.col(i)).norm() / diagonal;
+    const double d = (moved.col(i) - expected.col(i)).norm() / diagonal;
     out.mean += d;
     out.max = std::max(out.max, d);
   }

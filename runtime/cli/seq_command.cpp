@@ -10,6 +10,8 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
@@ -25,13 +27,48 @@ namespace {
 
 struct SeqArgs {
   std::string input;
+  std::vector<std::string> inputs;
   std::string out;
   std::string clip;
   bool plain = false;
 };
 
+// Several inputs become one sequence: each input is a clip of its own (named
+// after its file or folder) or keeps its clips; all must share the first
+// input's connectivity.
+seqnet::MeshSequence read_inputs(const std::vector<std::string>& inputs) {
+  seqnet::MeshSequence all = seqnet::read_mesh_sequence(inputs.front());
+  if (inputs.size() == 1) return all;
+  std::vector<seqnet::Clip> clips;
+  auto add_clips = [&clips](const seqnet::MeshSequence& s, const std::string& path, int offset) {
+    if (s.clips.empty()) {
+      clips.push_back(seqnet::Clip{std::filesystem::path(path).filename().string(), offset,
+                                   s.frame_count(), 0.0});
+    }
+    for (seqnet::Clip c : s.clips) {
+      c.first += offset;
+      clips.push_back(c);
+    }
+  };
+  add_clips(all, inputs.front(), 0);
+  for (std::size_t k = 1; k < inputs.size(); ++k) {
+    seqnet::MeshSequence s = seqnet::read_mesh_sequence(inputs[k]);
+    if (s.vertex_count() != all.vertex_count() || s.triangles != all.triangles) {
+      throw InputError(Location{inputs[k], 0, 0}, "connectivity",
+                       "differs from " + inputs.front() + " (" + std::to_string(s.vertex_count()) +
+                           " vertices, " + std::to_string(s.triangles.size()) + " triangles against " +
+                           std::to_string(all.vertex_count()) + " and " +
+                           std::to_string(all.triangles.size()) + ")");
+    }
+    add_clips(s, inputs[k], all.frame_count());
+    for (auto& f : s.frames) all.frames.push_back(std::move(f));
+  }
+  all.clips = std::move(clips);
+  return all;
+}
+
 int run_features(const SeqArgs& a) {
-  const seqnet::MeshSequence sequence = seqnet::read_mesh_sequence(a.input);
+  const seqnet::MeshSequence sequence = read_inputs(a.inputs);
   int first = 0, count = sequence.frame_count();
   if (!a.clip.empty()) {
     const seqnet::Clip* found = nullptr;
@@ -42,7 +79,7 @@ int run_features(const SeqArgs& a) {
       std::string names;
       for (const auto& c : sequence.clips) names += (names.empty() ? "" : ", ") + c.name;
       throw InputError(
-          Location{a.input, 0, 0}, "--clip",
+          Location{a.inputs.front(), 0, 0}, "--clip",
           "no clip \"" + a.clip + "\" (clips: " + (names.empty() ? "none" : names) + ")");
     }
     first = found->first;
@@ -51,7 +88,9 @@ int run_features(const SeqArgs& a) {
   const seqnet::SequenceFeatures features =
       seqnet::compute_features(sequence, first, count, !a.plain);
   seqnet::write_feature_file(a.out, features);
-  std::cout << a.input << ": " << sequence.vertex_count() << " vertices, "
+  std::cout << (a.inputs.size() == 1 ? a.inputs.front()
+                                     : std::to_string(a.inputs.size()) + " inputs")
+            << ": " << sequence.vertex_count() << " vertices, "
             << sequence.triangles.size() << " triangles, frames " << first << ".."
             << first + count - 1 << " -> " << a.out << '\n';
   // Round trip per clip (or the whole range when it has none).
@@ -96,13 +135,21 @@ void add_seq_command(CLI::App& seq_group) {
   auto args = std::make_shared<SeqArgs>();
   auto* features = seq->add_subcommand("features", "Deformation features of a mesh sequence");
   features
-      ->add_option("SEQ", args->input, "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs")
+      ->add_option("SEQ", args->inputs,
+                   "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs; several become one "
+                   "file with a clip per input")
       ->required();
   features->add_option("--out", args->out, "feature file to write")->required();
   features->add_option("--clip", args->clip, "only this clip's frames");
   features->add_flag("--plain", args->plain,
                      "per-vertex fits only (no exact round-trip correction)");
-  set_subcommand_body(features, [args] { return run_features(*args); });
+  set_subcommand_body(features, [args] {
+    if (args->inputs.size() > 1 && !args->clip.empty()) {
+      throw InputError(Location{args->inputs.front(), 0, 0}, "--clip",
+                       "--clip takes one input, not " + std::to_string(args->inputs.size()));
+    }
+    return run_features(*args);
+  });
   auto* reconstruct = seq->add_subcommand("reconstruct", "Mesh frames from a feature file");
   reconstruct->add_option("FEATURES", args->input, "feature file")->required();
   reconstruct->add_option("--out", args->out, "folder for frame_NNNN.obj")->required();

@@ -1,5 +1,7 @@
 #include "seq_model_commands.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/seqnet/evaluation.hpp"
+#include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/generation.hpp"
 #include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
@@ -146,25 +150,66 @@ int run_complete(const CompleteArgs& a) {
         seqnet::mesh_features(model, a.model, keys.frames, keys.triangles);
     seqnet::SeqNetInference net(model, a.model);
     c = net.complete(features, std::vector<int>(keys.frames.size() - 1, a.gap), a.options);
-    // Keys as read, the in-betweens reconstructed.
+    // Keys as read, the in-betweens reconstructed and placed between them.
     seqnet::MeshSequence out;
     out.triangles = keys.triangles;
-    for (std::size_t k = 0; k < keys.frames.size(); ++k) {
-      if (k > 0) {
-        const seqnet::FrameMatrix gap =
-            c.frames.middleCols(static_cast<Eigen::Index>(k - 1) * (a.gap + 1) + 1, a.gap);
-        for (seqnet::Positions& p : seqnet::mesh_positions(model, gap)) {
-          out.frames.push_back(std::move(p));
-        }
-      }
-      out.frames.push_back(keys.frames[k]);
-    }
+    out.frames = seqnet::completed_mesh(model, keys.frames, features, c, a.gap);
     seqnet::write_obj_sequence(a.out, out);
   }
   print_report(c.gaps, a.options.threshold);
   std::cout << a.model << ": " << c.gaps.size() + 1 << " keys, " << c.frames.cols()
             << " frames -> " << a.out
             << (model.shape.kind == seqnet::ModelKind::mesh ? "/frame_*.obj" : "") << '\n';
+  return 0;
+}
+
+struct EvaluateArgs {
+  std::string model;
+  std::string data;
+  seqnet::EvaluationOptions options;
+};
+
+int run_evaluate(const EvaluateArgs& a) {
+  const seqnet::ModelFile model = seqnet::read_model_file(a.model);
+  const seqnet::SequenceFeatures data = seqnet::read_feature_file(a.data);
+  const seqnet::Evaluation e = seqnet::evaluate(model, a.model, data, a.options);
+  int held = 0;
+  for (const auto& p : e.pieces) held += p.count;
+  std::printf("%s: %llu iterations; held out (seed %llu, %g %%): %d of %zu frames of %s in %zu "
+              "pieces\n",
+              a.model.c_str(), static_cast<unsigned long long>(model.iteration),
+              static_cast<unsigned long long>(model.seed), 100.0 * a.options.held_out, held,
+              data.frames.size(), a.data.c_str(), e.pieces.size());
+  for (const auto& p : e.pieces) {
+    std::printf("  %s frames %d..%d\n", p.name.c_str(), p.first, p.first + p.count - 1);
+  }
+  std::printf(
+      "mean per-vertex error after removing each piece's mean offset, in the data's units "
+      "(mean bounding-box diagonal %.4g)\n",
+      e.diagonal);
+  for (const auto& r : e.generation) {
+    std::printf("generate from %d initial frame%s, frame %2d (%d starts): learned %.4g  linear "
+                "extrapolation in feature space %.4g\n",
+                r.initial, r.initial == 1 ? " " : "s", r.horizon, r.frames, r.learned,
+                r.extrapolated);
+  }
+  const seqnet::CompletionRow& c = e.completion;
+  if (c.frames > 0) {
+    const double best = std::min(c.feature_linear, c.vertex_linear);
+    std::printf("complete %d gaps of %d frames (%d merged below %g %%): learned %.4g  linear in "
+                "feature space %.4g  linear in vertex space %.4g  (learned %.1f %% %s the best "
+                "interpolation)\n",
+                c.gaps, a.options.gap, c.merged, 100.0 * a.options.completion.threshold,
+                c.learned, c.feature_linear, c.vertex_linear,
+                100.0 * std::abs(1.0 - c.learned / best), c.learned <= best ? "below" : "above");
+  }
+  if (!e.change_generated.empty()) {
+    std::printf("change per frame |x(t+1) - x(t)| / |x(t)| (normalised features), %d starts, "
+                "held-out frames %.4g; generated t = 1..%zu:",
+                e.change_starts, e.change_truth, e.change_generated.size());
+    for (double v : e.change_generated) std::printf(" %.4g", v);
+    std::printf("\n");
+  }
   return 0;
 }
 
@@ -216,6 +261,25 @@ void add_seq_model_commands(CLI::App& seq) {
       ->check(CLI::Range(0, 100000));
   complete->add_option("--seed", c->options.seed, "seed of the random initial states");
   set_subcommand_body(complete, [c] { return run_complete(*c); });
+
+  auto ev = std::make_shared<EvaluateArgs>();
+  auto* evaluate = seq.add_subcommand(
+      "evaluate", "Measure a mesh model on the held-out frames of its training feature file: "
+                  "generation, completion, change per frame");
+  evaluate->add_option("MODEL", ev->model, "mesh model file (animrt seq train)")->required();
+  evaluate->add_option("FEATURES", ev->data, "the feature file it was trained on")->required();
+  evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
+      ->check(CLI::Range(0.0, 1.0));
+  evaluate->add_option("--gap", ev->options.gap, "completion: frames between keys")
+      ->check(CLI::Range(1, 100000));
+  evaluate->add_option("--threshold", ev->options.completion.threshold, "completion: merge threshold")
+      ->check(CLI::Range(1e-12, 10.0));
+  evaluate->add_option("--retries", ev->options.completion.retries, "completion: random retries")
+      ->check(CLI::Range(0, 100000));
+  evaluate->add_option("--change-frames", ev->options.change_frames,
+                       "frames generated for the change per frame (0: skip)")
+      ->check(CLI::Range(0, 100000));
+  set_subcommand_body(evaluate, [ev] { return run_evaluate(*ev); });
 }
 
 }  // namespace animrt::cli

@@ -3,7 +3,8 @@
 # itself (which must not link libtorch): keys reproduced exactly, the per-gap
 # report printed, joint-space generation from a CSV, a model of another
 # joint set and a corrupt model refused with exit 2 and one line naming the
-# file; then completion between OBJ keys with a mesh model.
+# file; then completion between OBJ keys with a mesh model, two folders as
+# one feature file of two clips, and seq evaluate on a model trained on it.
 set -uo pipefail
 animrt=$1
 tmp=$(mktemp -d)
@@ -89,4 +90,30 @@ out=$("$animrt" seq complete "$tmp/plate.model" --keys "$tmp/other.obj" "$tmp/ot
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/plate.model: mesh: trained on a mesh of 36 vertices, the data has 3"* ]] ||
   fail "other mesh: exit $code: $out"
+
+# Two folders as one feature file, a clip each; a model trained on it
+# measured on its held-out frames.
+mkdir "$tmp/plate_a" "$tmp/plate_b"
+for f in $(seq 0 29); do
+  n=$(printf %04d "$f")
+  if ((f < 15)); then cp "$tmp/plate/frame_$n.obj" "$tmp/plate_a/"; else cp "$tmp/plate/frame_$n.obj" "$tmp/plate_b/"; fi
+done
+out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --out "$tmp/two.bin" 2>&1) || fail "features of two folders: $out"
+[[ $out == *"2 inputs: 36 vertices, 50 triangles, frames 0..29"* && $out == *"clip plate_a "*"15 frames"* &&
+  $out == *"clip plate_b "*"15 frames"* ]] || fail "two folders: $out"
+out=$("$animrt" seq features "$tmp/plate_a" "$tmp/other.obj" --out "$tmp/bad.bin" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/other.obj: connectivity: differs from $tmp/plate_a"* ]] ||
+  fail "other connectivity: exit $code: $out"
+out=$("$animrt" seq train "$tmp/two.bin" --out "$tmp/two.model" --iterations 2 --seed 4 "${small[@]}" 2>&1) ||
+  fail "training on two clips failed: $out"
+out=$("$animrt" seq evaluate "$tmp/two.model" "$tmp/two.bin" --gap 1 --change-frames 3 2>&1) ||
+  fail "evaluate failed: $out"
+[[ $out == *"2 iterations; held out (seed 4, 20 %): 6 of 30 frames"* && $out == *"complete "*" gaps of 1 frames"* &&
+  $out == *"generated t = 1..3: "* ]] || fail "evaluate: $out"
+"$animrt" seq features "$tmp/plate_b" --out "$tmp/b.bin" >/dev/null || fail "features of plate_b"
+out=$("$animrt" seq evaluate "$tmp/plate.model" "$tmp/b.bin" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/plate.model: template: trained on another template"* ]] ||
+  fail "other template: exit $code: $out"
 echo ok

@@ -1,6 +1,7 @@
 // Generation from initial frames with a tiny trained mesh model: frame
 // counts over chained windows, the initial frames kept, repeatable for a
-// random-state seed and different between seeds, other meshes refused.
+// random-state seed and different between seeds, other meshes refused;
+// generated and completed frames follow the given frames' translation.
 
 #include "animrt/controllers/seqnet/generation.hpp"
 
@@ -89,6 +90,47 @@ TEST_F(SeqGeneration, FramesOfAnotherMeshOrTooManyAreRefused) {
   }
   std::vector<Positions> many(8, bar_.frames[0]);
   EXPECT_THROW(generate_mesh(model_, model_path_, many, bar_.triangles, o), InputError);
+}
+
+}  // namespace
+}  // namespace animrt::seqnet
+
+namespace animrt::seqnet {
+namespace {
+
+TEST_F(SeqGeneration, GeneratedFramesFollowTheInitialFramesTranslation) {
+  GenerateOptions o;
+  o.frames = 5;
+  const Positions first = bar_.frames[0];
+  const Eigen::Vector3d d(1.5, -2.0, 0.25);
+  Positions moved = first;
+  moved.colwise() += d;
+  const auto here = generate_mesh(model_, model_path_, {first}, bar_.triangles, o);
+  const auto there = generate_mesh(model_, model_path_, {moved}, bar_.triangles, o);
+  ASSERT_EQ(here.size(), there.size());
+  for (std::size_t k = 1; k < here.size(); ++k) {
+    const Positions shift = there[k] - here[k];
+    EXPECT_LT((shift.colwise() - d).cwiseAbs().maxCoeff(), 1e-6) << k;
+  }
+}
+
+TEST_F(SeqGeneration, CompletedFramesFollowTheKeysTranslation) {
+  const Positions key = bar_.frames[0];
+  const Eigen::Vector3d d(0.0, 3.0, -1.0);
+  Positions moved = key;
+  moved.colwise() += d;
+  const FrameMatrix features = mesh_features(model_, model_path_, {key, moved}, bar_.triangles);
+  SeqNetInference net(model_, model_path_);
+  const Completion c = net.complete(features, {4}, {.threshold = 0.05, .retries = 0, .seed = 1});
+  const auto still = completed_mesh(model_, {key, key}, features, c, 4);
+  const auto going = completed_mesh(model_, {key, moved}, features, c, 4);
+  ASSERT_EQ(going.size(), 6U);
+  EXPECT_TRUE(going.front().isApprox(key, 0.0));
+  EXPECT_TRUE(going.back().isApprox(moved, 0.0));
+  for (int t = 1; t <= 4; ++t) {
+    const Positions shift = going[static_cast<std::size_t>(t)] - still[static_cast<std::size_t>(t)];
+    EXPECT_LT((shift.colwise() - d * (t / 5.0)).cwiseAbs().maxCoeff(), 1e-6) << t;
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
+#include "animrt/controllers/seqnet/held_out.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/controllers/seqnet/network.hpp"
 #include "animrt/core/error.hpp"
@@ -23,15 +24,6 @@ namespace {
 [[noreturn]] void fail(const std::string& file, int line, int column, const std::string& key,
                        const std::string& message) {
   throw InputError(Location{file, line, column}, key, message);
-}
-
-// The held-out block of a dataset of n frames: [first, first + count).
-std::pair<int, int> held_out_block(int n, double fraction, std::uint64_t seed, int dataset) {
-  const int count = std::clamp(static_cast<int>(std::lround(fraction * n)), 0, n);
-  if (count == 0) return {0, 0};
-  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(dataset) + 1);
-  const int first = std::uniform_int_distribution<int>(0, n - count)(rng);
-  return {first, count};
 }
 
 // Cuts the frames [first, first + count) of one clip into training and

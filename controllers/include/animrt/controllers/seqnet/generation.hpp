@@ -38,11 +38,22 @@ std::vector<Positions> mesh_positions(const ModelFile& model, const FrameMatrix&
 
 // The initial frames (1 or more, of the model's mesh) followed by the
 // generated ones, as vertex positions; the initial frames are returned
-// unchanged. Throws InputError naming `model_path` when the frames are of
+// unchanged. Each piece of a generated frame is moved by the mean offset of
+// that piece of the last initial frame from its own reconstruction, so the
+// generated frames stay where the initial ones are. Throws InputError naming `model_path` when the frames are of
 // another mesh or as many as the model's window.
 std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& model_path,
                                      const std::vector<Positions>& initial,
                                      const std::vector<std::array<int, 3>>& triangles,
                                      const GenerateOptions& options);
+
+// A completed mesh sequence (`completion` of these keys with `gap` frames
+// between each two): the keys as given, the in-betweens reconstructed, each
+// piece moved by the blend, (1 - s) o_a + s o_b at s = t / (gap + 1), of the
+// two keys' offsets from their own reconstructions, so the in-betweens
+// follow the keys' translation.
+std::vector<Positions> completed_mesh(const ModelFile& model, const std::vector<Positions>& keys,
+                                      const FrameMatrix& keys_features, const Completion& completion,
+                                      int gap);
 
 }  // namespace animrt::seqnet

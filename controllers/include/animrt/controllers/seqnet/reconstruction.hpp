@@ -45,6 +45,14 @@ class Reconstructor {
 // Every frame of a feature set back to positions.
 std::vector<Positions> reconstruct_all(const SequenceFeatures& features);
 
+// The mean offset of every connected piece of `placed` from the same piece
+// of `frame` (3 x pieces), and `frame` with its pieces moved by such offsets:
+// how reconstructed frames, which sit at the template's pinned vertices, are
+// put where given frames are.
+Eigen::Matrix3Xd piece_offsets(const Neighbourhood& ring, const Positions& placed,
+                               const Positions& frame);
+void move_pieces(const Neighbourhood& ring, Positions& frame, const Eigen::Matrix3Xd& offsets);
+
 // Distance between two frames after moving every piece of `got` so that
 // its centroid matches `expected`'s, as fractions of expected's bounding-box
 // diagonal.

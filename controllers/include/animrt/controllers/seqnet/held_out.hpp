@@ -1,0 +1,25 @@
+#pragma once
+// The held-out part of a training data set (paper section 4.1: a contiguous
+// subsequence of 20 % of each dataset), shared by the trainer, which leaves
+// it out, and the evaluation, which measures on it.
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "animrt/controllers/seqnet/mesh_sequence.hpp"
+
+namespace animrt::seqnet {
+
+// The held-out block of dataset number `dataset` (its position among the
+// training files) of n frames: [first, first + count), count =
+// round(fraction * n), placed by the seed.
+std::pair<int, int> held_out_block(int n, double fraction, std::uint64_t seed, int dataset);
+
+// The held-out frames of one data set cut at its clips (a clip is one
+// motion): the pieces of every clip that lie in the block, in frame order.
+// Without clips the whole set is one clip. `name` is the clip's.
+std::vector<Clip> held_out_pieces(int n, const std::vector<Clip>& clips, double fraction,
+                                  std::uint64_t seed, int dataset);
+
+}  // namespace animrt::seqnet

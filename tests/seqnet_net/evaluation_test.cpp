@@ -1,0 +1,163 @@
+// Evaluation on held-out frames: the pieces are the trainer's held-out
+// segments; on features that move linearly in time a model that adds that
+// very step each frame generates the truth, linear extrapolation from three
+// frames is exact and from one is not, feature-space interpolation is exact
+// and vertex-space is not; the change per frame is the step's, and 0 for a
+// model that never moves; a model of another template is refused.
+
+#include "animrt/controllers/seqnet/evaluation.hpp"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "animrt/controllers/seqnet/feature_file.hpp"
+#include "animrt/controllers/seqnet/network.hpp"
+#include "animrt/controllers/seqnet/training.hpp"
+#include "animrt/core/error.hpp"
+#include "net_test_util.hpp"
+
+namespace animrt::seqnet {
+namespace {
+
+constexpr int kFrames = 60;
+constexpr float kStep[kFeatureDims] = {0.1F, -0.06F, 0.08F, 0.03F, -0.05F, 0.04F,
+                                       0.06F, -0.02F, 0.05F};
+
+// The bending bar's template and scale, its frames replaced by frame 0 plus
+// t steps (normalised units, the same step at every vertex), two clips.
+SequenceFeatures linear_features() {
+  SequenceFeatures f = nettest::bending_bar(3, 5, 16);
+  const FeatureFrame start = f.frames.front() * 0.5;
+  f.frames.clear();
+  for (int t = 0; t < kFrames; ++t) {
+    FeatureFrame x = start;
+    for (int c = 0; c < kFeatureDims; ++c) x.row(c).array() += static_cast<double>(kStep[c]) * t;
+    f.frames.push_back(x);
+  }
+  f.clips = {Clip{"a", 0, kFrames / 2, 25.0}, Clip{"b", kFrames / 2, kFrames / 2, 25.0}};
+  return f;
+}
+
+// Every parameter 0 but the last decoder layer's bias: dX = step everywhere.
+ModelFile step_model(const SequenceFeatures& f, float scale) {
+  torch::manual_seed(3);
+  ModelFile m;
+  m.shape.kind = ModelKind::mesh;
+  m.shape.vertex_count = f.vertex_count();
+  m.shape.latent = 5;
+  m.shape.hidden = 6;
+  m.shape.window = 12;
+  m.rest = f.rest;
+  m.triangles = f.triangles;
+  m.low.assign(f.scale.low.data(), f.scale.low.data() + f.scale.low.size());
+  m.high.assign(f.scale.high.data(), f.scale.high.data() + f.scale.high.size());
+  m.seed = 7;
+  SeqNet net(m.shape, mesh_graph(m.shape.vertex_count, m.triangles));
+  m.parameters = save_parameters(*net);
+  for (NamedArray& a : m.parameters) {
+    std::fill(a.values.begin(), a.values.end(), 0.0F);
+    if (a.name == "decoder.4.self.bias") {
+      for (int c = 0; c < kFeatureDims; ++c) a.values[static_cast<std::size_t>(c)] = scale * kStep[c];
+    }
+  }
+  return m;
+}
+
+EvaluationOptions options() {
+  EvaluationOptions o;
+  o.held_out = 0.5;
+  o.horizons = {2, 4};
+  o.gap = 4;
+  o.completion.retries = 0;
+  o.change_frames = 14;  // more than a window: generation chains two
+  return o;
+}
+
+TEST(SeqEvaluation, PiecesAreTheTrainersHeldOutSegments) {
+  const SequenceFeatures f = linear_features();
+  const std::string path = nettest::temp_path("evaluation_linear.feat");
+  write_feature_file(path, f);
+  const ModelFile m = step_model(f, 1.0F);
+  const Evaluation e = evaluate(m, "m.model", f, options());
+  const TrainingSet set = load_training_set({path}, m.seed, 0.5);
+  std::vector<int> held;
+  for (const Segment& s : set.segments) {
+    if (s.held_out) held.push_back(s.count);
+  }
+  ASSERT_EQ(held.size(), e.pieces.size());
+  int total = 0;
+  for (std::size_t k = 0; k < held.size(); ++k) {
+    EXPECT_EQ(e.pieces[k].count, held[k]);
+    const Clip& p = e.pieces[k];
+    const Clip& clip = p.first < kFrames / 2 ? f.clips[0] : f.clips[1];
+    EXPECT_EQ(p.name, clip.name);
+    EXPECT_LE(p.first + p.count, clip.first + clip.count);
+    total += p.count;
+  }
+  EXPECT_EQ(total, kFrames / 2);
+}
+
+TEST(SeqEvaluation, TheTrueStepGeneratesTheTruthAndBaselinesBehave) {
+  const SequenceFeatures f = linear_features();
+  const Evaluation e = evaluate(step_model(f, 1.0F), "m.model", f, options());
+  ASSERT_EQ(e.generation.size(), 4U);
+  const double tiny = 1e-5 * e.diagonal;
+  for (const GenerationRow& r : e.generation) {
+    EXPECT_GT(r.frames, 0);
+    EXPECT_LT(r.learned, tiny) << r.initial << " " << r.horizon;
+    if (r.initial == 3) {
+      EXPECT_LT(r.extrapolated, tiny) << r.horizon;
+    } else {
+      EXPECT_GT(r.extrapolated, 100 * tiny) << r.horizon;  // the first frame repeated
+    }
+  }
+  EXPECT_GT(e.generation[1].extrapolated, e.generation[0].extrapolated);  // further, worse
+  ASSERT_GT(e.completion.frames, 0);
+  EXPECT_EQ(e.completion.frames, 4 * e.completion.gaps);
+  EXPECT_LT(e.completion.feature_linear, tiny);
+  EXPECT_GT(e.completion.vertex_linear, 100 * tiny);
+
+  // The step model against a wrong step: generation errs.
+  const Evaluation wrong = evaluate(step_model(f, 1.5F), "m.model", f, options());
+  EXPECT_GT(wrong.generation[1].learned, 100 * tiny);
+}
+
+TEST(SeqEvaluation, ChangePerFrameIsTheStepsAndZeroWhenFrozen) {
+  const SequenceFeatures f = linear_features();
+  const EvaluationOptions o = options();
+  const Evaluation e = evaluate(step_model(f, 1.0F), "m.model", f, o);
+  ASSERT_EQ(e.change_generated.size(), 14U);
+  Eigen::Map<const Eigen::VectorXf> step(kStep, kFeatureDims);
+  const double step_norm = step.cast<double>().norm() * std::sqrt(f.vertex_count());
+  for (int t : {0, 5, 13}) {
+    double expected = 0;
+    int starts = 0;
+    for (const Clip& p : e.pieces) {
+      for (int s = p.first; s < p.first + p.count; ++s, ++starts) {
+        FeatureFrame x = f.frames[static_cast<std::size_t>(s)];
+        for (int c = 0; c < kFeatureDims; ++c) x.row(c).array() += static_cast<double>(kStep[c]) * t;
+        expected += step_norm / x.norm();
+      }
+    }
+    EXPECT_NEAR(e.change_generated[static_cast<std::size_t>(t)], expected / starts, 1e-4) << t;
+  }
+  EXPECT_EQ(e.change_starts, kFrames / 2);
+  EXPECT_GT(e.change_truth, 0.0);
+  const Evaluation frozen = evaluate(step_model(f, 0.0F), "m.model", f, o);
+  for (double c : frozen.change_generated) EXPECT_EQ(c, 0.0);
+}
+
+TEST(SeqEvaluation, AnotherTemplateIsRefused) {
+  const SequenceFeatures f = linear_features();
+  ModelFile m = step_model(f, 1.0F);
+  m.rest(0, 0) += 0.1;
+  try {
+    evaluate(m, "m.model", f, options());
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another template"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace animrt::seqnet
