@@ -25,16 +25,18 @@ FrameMatrix mesh_features(const ModelFile& model, const std::string& model_path,
   return out;
 }
 
-std::vector<Positions> mesh_positions(const ModelFile& model, const FrameMatrix& features) {
-  const Reconstructor solver(model.rest, model.triangles);
-  std::vector<Positions> out;
-  for (Eigen::Index k = 0; k < features.cols(); ++k) {
-    const FrameMatrix column = features.col(k);
-    out.push_back(solver.solve(
-        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count)));
-  }
-  return out;
+namespace {
+
+// Vertex positions of one raw feature column, each connected piece placed by
+// its lowest vertex at the template (as reconstruction does).
+Positions solve_column(const Reconstructor& solver, const ModelFile& model,
+                       const FrameMatrix& features, Eigen::Index k) {
+  const FrameMatrix column = features.col(k);
+  return solver.solve(
+      Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count));
 }
+
+}  // namespace
 
 std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& model_path,
                                      const std::vector<Positions>& initial,
@@ -52,15 +54,11 @@ std::vector<Positions> generate_mesh(const ModelFile& model, const std::string& 
   const FrameMatrix all = net.generate(given, options.frames, options.random_state);
   const Reconstructor solver(model.rest, model.triangles);
   const Neighbourhood& ring = solver.neighbourhood();
-  auto solve = [&](Eigen::Index k) {
-    const FrameMatrix column = all.col(k);
-    return solver.solve(
-        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count));
-  };
-  const Eigen::Matrix3Xd offsets = piece_offsets(ring, initial.back(), solve(u - 1));
+  const Eigen::Matrix3Xd offsets =
+      piece_offsets(ring, initial.back(), solve_column(solver, model, all, u - 1));
   std::vector<Positions> out = initial;
   for (Eigen::Index k = u; k < all.cols(); ++k) {
-    out.push_back(solve(k));
+    out.push_back(solve_column(solver, model, all, k));
     move_pieces(ring, out.back(), offsets);
   }
   return out;
@@ -71,20 +69,17 @@ std::vector<Positions> completed_mesh(const ModelFile& model, const std::vector<
                                       int gap) {
   const Reconstructor solver(model.rest, model.triangles);
   const Neighbourhood& ring = solver.neighbourhood();
-  auto solve = [&](const FrameMatrix& features, Eigen::Index k) {
-    const FrameMatrix column = features.col(k);
-    return solver.solve(
-        Eigen::Map<const FeatureFrame>(column.data(), kFeatureDims, model.shape.vertex_count));
-  };
   std::vector<Eigen::Matrix3Xd> offsets;
   for (std::size_t k = 0; k < keys.size(); ++k) {
-    offsets.push_back(piece_offsets(ring, keys[k], solve(keys_features, static_cast<Eigen::Index>(k))));
+    offsets.push_back(piece_offsets(
+        ring, keys[k], solve_column(solver, model, keys_features, static_cast<Eigen::Index>(k))));
   }
   std::vector<Positions> out;
   for (std::size_t k = 0; k < keys.size(); ++k) {
     if (k > 0) {
       for (int t = 1; t <= gap; ++t) {
-        out.push_back(solve(completion.frames, static_cast<Eigen::Index>(k - 1) * (gap + 1) + t));
+        out.push_back(solve_column(solver, model, completion.frames,
+                                   static_cast<Eigen::Index>(k - 1) * (gap + 1) + t));
         const double s = static_cast<double>(t) / (gap + 1);
         move_pieces(ring, out.back(), (1.0 - s) * offsets[k - 1] + s * offsets[k]);
       }

@@ -72,7 +72,6 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
       physics_(physics),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
-  if (lockstep_ && physics_ != nullptr) party_ = physics_->join_lockstep();
   try {
     master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
     if (master_ < 0) fail(config_, "posix_openpt", errno);
@@ -102,6 +101,8 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
   due_.reserve(firmware_.size() + 1);
+  // Joined last: a bus whose pty could not be opened never holds the others up.
+  if (lockstep_ && physics_ != nullptr) party_ = physics_->join_lockstep();
 }
 
 DynamixelSimBus::~DynamixelSimBus() {

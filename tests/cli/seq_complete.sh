@@ -101,6 +101,10 @@ done
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --out "$tmp/two.bin" 2>&1) || fail "features of two folders: $out"
 [[ $out == *"2 inputs: 36 vertices, 50 triangles, frames 0..29"* && $out == *"clip plate_a "*"15 frames"* &&
   $out == *"clip plate_b "*"15 frames"* ]] || fail "two folders: $out"
+out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --clip plate_a --out "$tmp/bad.bin" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"$tmp/plate_a: --clip: --clip takes one input, not 2"* ]] ||
+  fail "--clip with two inputs: exit $code: $out"
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/other.obj" --out "$tmp/bad.bin" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/other.obj: connectivity: differs from $tmp/plate_a"* ]] ||

@@ -92,12 +92,6 @@ TEST_F(SeqGeneration, FramesOfAnotherMeshOrTooManyAreRefused) {
   EXPECT_THROW(generate_mesh(model_, model_path_, many, bar_.triangles, o), InputError);
 }
 
-}  // namespace
-}  // namespace animrt::seqnet
-
-namespace animrt::seqnet {
-namespace {
-
 TEST_F(SeqGeneration, GeneratedFramesFollowTheInitialFramesTranslation) {
   GenerateOptions o;
   o.frames = 5;

@@ -32,9 +32,6 @@ struct GenerateOptions {
 FrameMatrix mesh_features(const ModelFile& model, const std::string& model_path,
                           const std::vector<Positions>& frames,
                           const std::vector<std::array<int, 3>>& triangles);
-// Vertex positions of raw feature columns, each connected piece placed by
-// its lowest vertex at the template (as reconstruction does).
-std::vector<Positions> mesh_positions(const ModelFile& model, const FrameMatrix& features);
 
 // The initial frames (1 or more, of the model's mesh) followed by the
 // generated ones, as vertex positions; the initial frames are returned
