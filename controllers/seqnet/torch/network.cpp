@@ -174,7 +174,7 @@ torch::Tensor l2_loss(const torch::nn::Module& net) {
 }
 
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                     bool bidirectional) {
+                     bool bidirectional, double l2_weight) {
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
@@ -192,7 +192,7 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
   }
   l.kl = kl;
   l.l2 = l2_loss(*net);
-  l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l.l2);
+  l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l2_weight * l.l2);
   return l;
 }
 

@@ -362,7 +362,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     }
     const torch::Tensor truth =
         torch::from_blob(values.data(), {shape.window, o.batch, set.dims}, torch::kFloat32);
-    const LossTerms l = batch_loss(net, truth, true, o.kl_weight, o.bidirectional);
+    const LossTerms l = batch_loss(net, truth, true, o.kl_weight, o.bidirectional, o.l2_weight);
     l.total.backward();
     adam.step();
     ++iteration;

@@ -68,6 +68,8 @@ void add_seq_net_commands(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   train->add_option("--kl-weight", train_args->kl_weight, "0 turns L_KL off (ablation)")
       ->check(CLI::Range(0.0, 100.0));
+  train->add_option("--l2-weight", train_args->l2_weight, "0 turns the L2 term off (ablation)")
+      ->check(CLI::Range(0.0, 100.0));
   train->add_flag("!--unidirectional", train_args->bidirectional,
                   "forward chain only, no L_bidir (ablation)");
   set_subcommand_body(train, [train_args] { return run_train(*train_args); });

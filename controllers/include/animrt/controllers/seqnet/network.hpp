@@ -103,10 +103,10 @@ struct LossTerms {
 };
 // L_recon + 0.5 L_bidir + 0.1 (L_KL + L2) for one batch of ground-truth
 // windows X [n, B, D]: the forward chain from X_1 with +s0, the backward
-// chain from X_n with -s0. `kl_weight` and `bidir` switch terms off for
-// ablations (1 and true: the paper).
+// chain from X_n with -s0. `kl_weight`, `l2_weight` and `bidirectional`
+// switch terms off for ablations (1, 1 and true: the paper).
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight = 1.0,
-                     bool bidirectional = true);
+                     bool bidirectional = true, double l2_weight = 1.0);
 
 // Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
 // that a checkpoint saves and restores exactly.

@@ -58,8 +58,10 @@ struct TrainOptions {
   int lstm_layers = 3;
   int channels = 9;
   int dense_width = 64;
-  // Ablations: the KL term's weight (1: the paper) and bidirectional training.
+  // Ablations: the KL and L2 terms' weights (1: the paper) and bidirectional
+  // training.
   double kl_weight = 1.0;
+  double l2_weight = 1.0;
   bool bidirectional = true;
 };
 
