@@ -91,10 +91,20 @@ WalkRecord walk_sequence(const MujocoModel& mm, const Skin& skin, const WalkConf
   const double hip = gait.froude ? gait.froude->hip_height_m : mm.hip_height_m;
   gait.stride_frequency_hz.reset();
   gait.froude = FroudeTiming{out.timing.froude, hip};
+  const double speed = froude_velocity(out.timing.froude, hip);
+  if (gait.steering) {
+    // The walk's speed joins a steerable gait's walking range: a command
+    // below its slowest walk would stop the figure, above its fastest would
+    // be cut to it.
+    GaitSteering& range = *gait.steering;
+    const double fr = speed / std::sqrt(kStandardGravity * range.hip_height_m);
+    range.min_froude = std::min(range.min_froude, 0.999 * fr);
+    range.max_froude = std::max(range.max_froude, 1.001 * fr);
+  }
   const auto specs = model_joint_specs(mm);
   const auto source =
       options.make_source ? options.make_source(gait, specs) : make_gait_source(gait, specs);
-  source->steer(MotionCommand{froude_velocity(out.timing.froude, hip), config.turn_rad_s});
+  source->steer(MotionCommand{speed, config.turn_rad_s});
   const double f = gait.stride_frequency();
 
   MujocoData data = make_mujoco_data(mm);

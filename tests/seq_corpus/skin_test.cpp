@@ -260,6 +260,22 @@ TEST(Walk, TheTurnRateGoesToTheGaitThroughSteer) {
   EXPECT_NEAR(seen[0].speed_m_s, animrt::froude_velocity(walk.timing.froude, 0.18), 1e-12);
 }
 
+// walk.yaml walks Froude 0.053 to 0.056 when steered, and a command below
+// that stops a steered gait; the corpus asks it for 0.04 (and the quadruped
+// stood still in those clips): its walks below the range must walk.
+TEST(Walk, AFroudeNumberBelowTheGaitsSteeringRangeStillWalks) {
+  const ModelSkin& s = quadruped_skin();
+  WalkOptions options;
+  options.frames = 101;  // 4 s
+  for (double fr : {0.03, 0.04}) {
+    const WalkConfig c{kRoot + "/configs/gaits/walk.yaml", fr, 1, 0.0};
+    const WalkRecord walk = walk_sequence(s.model, s.skin, c, options);
+    ASSERT_FALSE(walk.fell) << fr;
+    const double commanded = animrt::froude_velocity(walk.timing.froude, 0.18);
+    EXPECT_GT(walk.speed_m_s, 0.5 * commanded) << "Froude " << fr;
+  }
+}
+
 TEST(Walk, RejectsAFrameRateOffThePhysicsSteps) {
   const ModelSkin& s = quadruped_skin();
   WalkOptions options;
