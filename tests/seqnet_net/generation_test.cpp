@@ -20,15 +20,10 @@ namespace {
 class SeqGeneration : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    TrainOptions o;
-    o.data = {nettest::write_bar_features("gen_bar.features", 4, 6, 40)};
-    o.out = nettest::temp_path("gen_bar.model");
+    TrainOptions o = nettest::tiny_options(
+        nettest::write_bar_features("gen_bar.features", 4, 6, 40), "gen_bar.model");
     o.iterations = 5;
     o.batch = 2;
-    o.window = 8;
-    o.latent = 8;
-    o.hidden = 16;
-    o.report_every = 0;
     std::ostringstream log;
     train(o, log);
     model_path_ = o.out;

@@ -57,16 +57,11 @@ ModelFile random_joint_model() {
 }
 
 ModelFile trained(const std::vector<std::string>& data, const std::string& name) {
-  TrainOptions o;
+  TrainOptions o = nettest::tiny_options(data.front(), name);
   o.data = data;
-  o.out = nettest::temp_path(name);
   o.iterations = 15;
   o.batch = 2;
-  o.window = 8;
-  o.latent = 8;
   o.hidden = 12;
-  o.report_every = 0;
-  o.checkpoint_every = 1000;
   std::ostringstream log;
   train(o, log);
   return read_model_file(o.out);

@@ -24,18 +24,8 @@ namespace {
 // One tiny joint model (hip, knee, ankle; 8-frame windows) for every test.
 const std::string& model_path() {
   static const std::string path = [] {
-    seqnet::TrainOptions o;
-    o.data = {nettest::write_joint_csv("learned_show_swing.csv", 120)};
-    o.out = nettest::temp_path("learned_show.model");
-    o.threads = 1;
-    o.batch = 4;
-    o.window = 8;
-    o.latent = 8;
-    o.hidden = 16;
-    o.dense_width = 16;
-    o.learning_rate = 3e-3;
-    o.report_every = 0;
-    o.checkpoint_every = 1000;
+    seqnet::TrainOptions o = nettest::tiny_options(
+        nettest::write_joint_csv("learned_show_swing.csv", 120), "learned_show.model");
     o.iterations = 40;
     std::ostringstream log;
     seqnet::train(o, log);

@@ -13,6 +13,7 @@
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/controllers/seqnet/training.hpp"
 
 namespace nettest {
 
@@ -21,6 +22,24 @@ inline std::string temp_path(const std::string& name) {
   const std::filesystem::path dir = std::filesystem::path(base ? base : "/tmp") / "seqnet_net";
   std::filesystem::create_directories(dir);
   return (dir / name).string();
+}
+
+// Training options of a tiny network (one thread, 8-frame windows, a few
+// thousand parameters) that learns in a few dozen iterations.
+inline animrt::seqnet::TrainOptions tiny_options(const std::string& data, const std::string& out) {
+  animrt::seqnet::TrainOptions o;
+  o.data = {data};
+  o.out = temp_path(out);
+  o.threads = 1;
+  o.batch = 4;
+  o.window = 8;
+  o.latent = 8;
+  o.hidden = 16;
+  o.dense_width = 16;
+  o.learning_rate = 3e-3;
+  o.report_every = 0;
+  o.checkpoint_every = 1000;
+  return o;
 }
 
 // Three joints swinging with phase offsets, plus the corpus's extra columns

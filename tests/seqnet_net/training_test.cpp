@@ -18,21 +18,7 @@
 namespace animrt::seqnet {
 namespace {
 
-TrainOptions tiny(const std::string& data, const std::string& out) {
-  TrainOptions o;
-  o.data = {data};
-  o.out = nettest::temp_path(out);
-  o.threads = 1;
-  o.batch = 4;
-  o.window = 8;
-  o.latent = 8;
-  o.hidden = 16;
-  o.dense_width = 16;
-  o.learning_rate = 3e-3;
-  o.report_every = 0;
-  o.checkpoint_every = 1000;
-  return o;
-}
+using nettest::tiny_options;
 
 double mean_total(const std::vector<LossRecord>& h, std::size_t from, std::size_t count) {
   double s = 0;
@@ -55,7 +41,7 @@ std::vector<LossRecord> history_of(const std::string& checkpoint) {
 }
 
 TEST(SeqTraining, JointLossFallsOnATinyCorpus) {
-  TrainOptions o = tiny(nettest::write_joint_csv("swing.csv", 80), "swing.model");
+  TrainOptions o = tiny_options(nettest::write_joint_csv("swing.csv", 80), "swing.model");
   o.iterations = 60;
   std::ostringstream log;
   const TrainResult r = train(o, log);
@@ -74,7 +60,7 @@ TEST(SeqTraining, JointLossFallsOnATinyCorpus) {
 }
 
 TEST(SeqTraining, MeshLossFallsOnATinyBar) {
-  TrainOptions o = tiny(nettest::write_bar_features("bar.features", 5, 6, 48), "bar.model");
+  TrainOptions o = tiny_options(nettest::write_bar_features("bar.features", 5, 6, 48), "bar.model");
   o.iterations = 40;
   o.channels = 9;
   std::ostringstream log;
@@ -91,20 +77,20 @@ TEST(SeqTraining, MeshLossFallsOnATinyBar) {
 TEST(SeqTraining, SameSeedRepeatsAndAResumeEqualsOneRun) {
   const std::string data = nettest::write_joint_csv("repeat.csv", 60);
   std::ostringstream log;
-  TrainOptions a = tiny(data, "a.model");
+  TrainOptions a = tiny_options(data, "a.model");
   a.iterations = 6;
   train(a, log);
-  TrainOptions b = tiny(data, "b.model");
+  TrainOptions b = tiny_options(data, "b.model");
   b.iterations = 6;
   train(b, log);
-  TrainOptions c = tiny(data, "c.model");
+  TrainOptions c = tiny_options(data, "c.model");
   c.iterations = 3;
   c.checkpoint_every = 3;
   train(c, log);
   c.resume = c.out + ".ckpt";
   c.iterations = 6;
   train(c, log);
-  TrainOptions d = tiny(data, "d.model");
+  TrainOptions d = tiny_options(data, "d.model");
   d.iterations = 6;
   d.seed = 2;
   train(d, log);
@@ -151,11 +137,11 @@ TEST(SeqTraining, OneFifthOfEachDatasetIsHeldOutInOneBlock) {
 
 TEST(SeqTraining, CheckpointOfOtherDataIsRefused) {
   std::ostringstream log;
-  TrainOptions o = tiny(nettest::write_joint_csv("ck.csv", 40), "ck.model");
+  TrainOptions o = tiny_options(nettest::write_joint_csv("ck.csv", 40), "ck.model");
   o.iterations = 2;
   train(o, log);
   TrainOptions other =
-      tiny(nettest::write_joint_csv("ck_other.csv", 40, "hip,knee,toe"), "ck_other.model");
+      tiny_options(nettest::write_joint_csv("ck_other.csv", 40, "hip,knee,toe"), "ck_other.model");
   other.resume = o.out + ".ckpt";
   other.iterations = 4;
   try {
@@ -168,7 +154,7 @@ TEST(SeqTraining, CheckpointOfOtherDataIsRefused) {
         << e.what();
   }
   // A final model is not a checkpoint.
-  TrainOptions from_model = tiny(o.data.front(), "ck2.model");
+  TrainOptions from_model = tiny_options(o.data.front(), "ck2.model");
   from_model.resume = o.out;
   from_model.iterations = 4;
   EXPECT_THROW(train(from_model, log), InputError);
@@ -186,7 +172,7 @@ TEST(SeqTraining, BadCsvAndTooShortDataAreClearErrors) {
         << e.what();
   }
   std::ostringstream log;
-  TrainOptions o = tiny(nettest::write_joint_csv("short.csv", 10), "short.model");
+  TrainOptions o = tiny_options(nettest::write_joint_csv("short.csv", 10), "short.model");
   o.iterations = 1;
   try {
     train(o, log);
