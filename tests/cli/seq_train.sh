@@ -9,10 +9,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-awk 'BEGIN { print "time_s,hip,knee,torso_x";
-  for (f = 0; f < 60; f++) { t = f / 25; printf "%g,%g,%g,%g\n", t, 0.5 * sin(7.85 * t), 0.3 * cos(7.85 * t), t } }' \
-  > "$tmp/walk.csv"
-small=(--window 8 --batch 2 --hidden 16 --latent 8 --lstm-layers 2 --threads 1)
+source "$(dirname "$0")/seq_data.bash"
+write_walk_csv "$tmp/walk.csv"
 
 out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --checkpoint-every 5 \
   --report-every 5 "${small[@]}" 2>&1) || fail "train failed: $out"
@@ -43,15 +41,7 @@ out=$("$animrt" seq train "$tmp/bad.csv" --out "$tmp/n.model" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/bad.csv:2:3: hip:"* ]] || fail "bad CSV: exit $code: $out"
 # A 6 x 6 plate bending to and fro, 30 OBJ frames.
-mkdir "$tmp/plate"
-awk -v dir="$tmp/plate" 'BEGIN { n = 6;
-  for (f = 0; f < 30; f++) {
-    file = sprintf("%s/frame_%04d.obj", dir, f); a = 0.5 * sin(6.2832 * f / 12);
-    for (i = 0; i < n; i++) for (j = 0; j < n; j++) { x = i / (n - 1); y = j / (n - 1);
-      printf "v %g %g %g\n", x * cos(a * x), y, x * sin(a * x) > file }
-    for (i = 0; i < n - 1; i++) for (j = 0; j < n - 1; j++) { v = i * n + j + 1;
-      printf "f %d %d %d\nf %d %d %d\n", v, v + n, v + 1, v + 1, v + n, v + n + 1 > file }
-    close(file) } }'
+write_plate "$tmp/plate"
 "$animrt" seq features "$tmp/plate" --out "$tmp/plate.bin" >/dev/null || fail "features of the plate"
 out=$("$animrt" seq train "$tmp/plate.bin" --out "$tmp/plate.model" --iterations 4 "${small[@]}" 2>&1) ||
   fail "mesh training failed: $out"
