@@ -9,9 +9,10 @@
 namespace animrt::herd {
 namespace {
 
-// A figure that walks 0.1-0.2 m/s straight and turns 0.2 rad/s either way,
-// as measured; it cannot walk slower than 0.1 m/s.
-Figure calibrated_figure() {
+// A figure that walks 0.1-0.2 m/s straight and, where it `turns`, 0.2 rad/s
+// either way, as measured; it cannot walk slower than 0.1 m/s. One that does
+// not turn reaches no turn rate at any point of its table.
+Figure calibrated_figure(bool turns = true) {
   GaitSteering s;
   s.min_froude = 0.05;
   s.max_froude = 0.2;
@@ -26,12 +27,12 @@ Figure calibrated_figure() {
     for (double w : {-0.2, 0.0, 0.2}) {
       CalibrationPoint p;
       p.commanded = {v, w};
-      p.achieved = {v, w};
+      p.achieved = {v, turns ? w : 0.0};
       p.usable = calibration_usable(p, cal.tolerance);
       cal.points.push_back(p);
     }
   }
-  return Figure{"pony", 0.25, WalkResponse(s, &cal)};
+  return Figure{turns ? "pony" : "straight", 0.25, WalkResponse(s, &cal)};
 }
 
 TEST(FigureSteer, ASlowingFigureStandsBelowItsSlowestWalk) {
@@ -60,26 +61,7 @@ TEST(FigureSteer, AStandingFigureWalksOffAtItsSlowestWalkAndTurns) {
 
 TEST(FigureSteer, AFigureThatCannotTurnStandsRatherThanWalkAwayFromItsWay) {
   // The same figure with every turning point unusable: it walks straight only.
-  GaitSteering s;
-  s.min_froude = 0.05;
-  s.max_froude = 0.2;
-  s.max_turn_rad_s = 0.2;
-  s.max_acceleration_m_s2 = 0.1;
-  s.hip_height_m = 0.2;
-  s.track_width_m = 0.2;
-  s.left = {"l"};
-  s.right = {"r"};
-  GaitCalibration cal;
-  for (double v : {0.1, 0.2}) {
-    for (double w : {-0.2, 0.0, 0.2}) {
-      CalibrationPoint p;
-      p.commanded = {v, w};
-      p.achieved = {v, 0.0};
-      p.usable = calibration_usable(p, cal.tolerance);
-      cal.points.push_back(p);
-    }
-  }
-  const Figure f{"straight", 0.25, WalkResponse(s, &cal)};
+  const Figure f = calibrated_figure(false);
   ASSERT_EQ(f.walk.max_turn(0.1), 0.0);
   Agent a;
   a.speed = 0.1;  // walking its slowest, heading +x
