@@ -95,7 +95,7 @@ WalkRecord walk_sequence(const MujocoModel& mm, const Skin& skin, const WalkConf
   if (gait.steering) {
     // The walk's speed joins a steerable gait's walking range: a command
     // below its slowest walk would stop the figure, above its fastest would
-    // be cut to it.
+    // be cut to it. The 0.1 % margins keep the speed inside after rounding.
     GaitSteering& range = *gait.steering;
     const double fr = speed / std::sqrt(kStandardGravity * range.hip_height_m);
     range.min_froude = std::min(range.min_froude, 0.999 * fr);
