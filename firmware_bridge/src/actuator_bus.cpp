@@ -1,5 +1,8 @@
 #include "animrt/bridge/actuator_bus.hpp"
 
+#include <chrono>
+#include <thread>
+
 namespace animrt {
 
 const char* to_string(DeviceHealth health) {
@@ -14,6 +17,21 @@ const char* to_string(DeviceHealth health) {
       return "hardware_error";
   }
   return "unknown";
+}
+
+std::vector<bool> ping_until_answered(std::size_t devices,
+                                      const std::function<bool(std::size_t)>& ping) {
+  std::vector<bool> answered(devices, false);
+  for (int round = 0; round < kPingRounds; ++round) {
+    if (round > 0) std::this_thread::sleep_for(std::chrono::milliseconds(kPingPauseMs));
+    bool all = true;
+    for (std::size_t i = 0; i < devices; ++i) {
+      if (!answered[i]) answered[i] = ping(i);
+      all = all && answered[i];
+    }
+    if (all) break;
+  }
+  return answered;
 }
 
 }  // namespace animrt

@@ -53,6 +53,7 @@ struct FakeServo {
   std::uint32_t max_limit = 0, min_limit = 0;  // registers 48 and 52
   std::uint8_t hardware_error = 0;             // register 70; nonzero sets the alert bit
   Fault fault = Fault::none;
+  int booting_pings = 0;  // pings it ignores before it answers (still booting)
 };
 
 // One instruction as the fake received it.
@@ -139,7 +140,9 @@ class FakeDevices {
     const auto& p = packet.params;
     switch (packet.instruction) {
       case dxl::inst::ping:
-        if (servos_.count(packet.id) != 0) answer(packet.id, {0x60, 0x04, 0x2E});  // XL430
+        if (servos_.count(packet.id) != 0 && servos_[packet.id].booting_pings-- <= 0) {
+          answer(packet.id, {0x60, 0x04, 0x2E});  // XL430
+        }
         break;
       case dxl::inst::read:
         if (servos_.count(packet.id) != 0) {
@@ -373,10 +376,27 @@ TEST(DynamixelBus, ConfigureListsEveryMissingDeviceInOneError) {
   EXPECT_EQ(
       error_of([&] { bus.configure(); }),
       "bus legs (" + fake.port() + "): no answer to ping from id 2 (lf_knee), id 3 (lf_ankle)");
-  // Each silent device was tried three times.
+  // Each silent device was tried three times in each round.
   int pings_to_2 = 0;
   for (const auto& r : fake.log_of(dxl::inst::ping)) pings_to_2 += r.id == 2 ? 1 : 0;
-  EXPECT_EQ(pings_to_2, DynamixelBus::kTries);
+  EXPECT_EQ(pings_to_2, DynamixelBus::kTries * kPingRounds);
+}
+
+TEST(DynamixelBus, ConfigureWaitsForAServoThatIsStillBooting) {
+  // Servo 2 ignores more pings than one round's retries; the next round
+  // finds it, and the others are not asked again.
+  auto servos = three_servos();
+  servos[2].booting_pings = DynamixelBus::kTries + 1;
+  FakeDevices fake(servos);
+  DynamixelBus bus(make_config(fake.port()), open_serial(fake.port(), 1'000'000));
+  bus.configure();
+  int pings_to_1 = 0, pings_to_2 = 0;
+  for (const auto& r : fake.log_of(dxl::inst::ping)) {
+    pings_to_1 += r.id == 1 ? 1 : 0;
+    pings_to_2 += r.id == 2 ? 1 : 0;
+  }
+  EXPECT_EQ(pings_to_1, 1);
+  EXPECT_EQ(pings_to_2, DynamixelBus::kTries + 2);
 }
 
 TEST(DynamixelBus, ConfigureReportsARejectedPositionRead) {

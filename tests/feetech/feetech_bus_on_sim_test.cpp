@@ -270,7 +270,8 @@ TEST(FeetechBusOnSim, ConfigureNamesTheServoThatDoesNotAnswer) {
     EXPECT_NE(std::string(e.what()).find("no answer to ping from id 2 (joint2)"), std::string::npos)
         << e.what();
   }
-  EXPECT_EQ(f.bus.devices()[1].timeouts, static_cast<std::uint64_t>(FeetechBus::kTries));
+  EXPECT_EQ(f.bus.devices()[1].timeouts,
+            static_cast<std::uint64_t>(FeetechBus::kTries * kPingRounds));
 }
 
 TEST(FeetechBusOnSim, FaultBitsInTheErrorByteAreHardwareErrors) {

@@ -451,16 +451,21 @@ void DynamixelBus::configure() {
   }
   fresh_ = false;
 
-  std::string silent, garbled;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<Answer> pinged(n, Answer::timeout);
+  ping_until_answered(n, [&](std::size_t i) {
     const auto id = static_cast<std::uint8_t>(status_[i].device_id);
     const Answer a = unicast(i, dxl::encode_ping(id, tx_), kAnyLength);
     if (a == Answer::ok) {  // model number (2 bytes), firmware version
       model_[i] = static_cast<std::uint16_t>(value_[0] & 0xFFFF);
       firmware_[i] = static_cast<std::uint8_t>((value_[0] >> 16) & 0xFF);
     }
-    std::string& list = a == Answer::timeout ? silent : garbled;
-    if (a == Answer::ok || a == Answer::rejected) continue;  // it answered: it is there
+    pinged[i] = a;
+    return a == Answer::ok || a == Answer::rejected;  // it answered: it is there
+  });
+  std::string silent, garbled;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (pinged[i] == Answer::ok || pinged[i] == Answer::rejected) continue;
+    std::string& list = pinged[i] == Answer::timeout ? silent : garbled;
     list += (list.empty() ? "" : ", ") + describe(i);
   }
   if (transport_->failure() != nullptr) {

@@ -301,12 +301,16 @@ void FeetechBus::configure() {
   }
   fresh_ = false;
 
+  std::vector<Answer> pinged(n, Answer::timeout);
+  ping_until_answered(n, [&](std::size_t i) {
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    pinged[i] = unicast(i, ft::encode_ping(id, tx_), kAnyLength);
+    return pinged[i] == Answer::ok;
+  });
   std::string silent, garbled;
   for (std::size_t i = 0; i < n; ++i) {
-    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
-    const Answer a = unicast(i, ft::encode_ping(id, tx_), kAnyLength);
-    if (a == Answer::ok) continue;
-    std::string& list = a == Answer::timeout ? silent : garbled;
+    if (pinged[i] == Answer::ok) continue;
+    std::string& list = pinged[i] == Answer::timeout ? silent : garbled;
     list += (list.empty() ? "" : ", ") + describe(i);
   }
   if (transport_->failure() != nullptr) throw DeviceError(prefix() + describe_failure(*transport_));

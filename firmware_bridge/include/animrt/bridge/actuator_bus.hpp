@@ -4,9 +4,11 @@
 // whether the other end is hardware or a simulated device.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
 
@@ -57,6 +59,17 @@ class ActuatorBus {
   // Per device status, indexed like config().actuators.
   virtual std::span<DeviceStatus> devices() = 0;
 };
+
+// configure()'s search for its devices. ping(i) asks device i once (with the
+// bus's own retries) and returns whether it answered at all. Devices still
+// silent are asked again after a pause, for kPingRounds rounds: a servo
+// powered up together with the adapter answers only once it has booted, and
+// one scheduling hiccup of the machine must not fail a whole start-up.
+// Returns, per device, whether it ever answered.
+inline constexpr int kPingRounds = 5;
+inline constexpr int kPingPauseMs = 40;
+std::vector<bool> ping_until_answered(std::size_t devices,
+                                      const std::function<bool(std::size_t)>& ping);
 
 // Builds the bus for config.protocol on a transport opened on config.port.
 std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config);

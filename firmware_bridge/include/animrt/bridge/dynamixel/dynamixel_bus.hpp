@@ -46,7 +46,8 @@ class DynamixelBus final : public ActuatorBus {
 
   const BusConfig& config() const override { return config_; }
 
-  // Resets the counters, pings every device (kTries each) and reads its
+  // Resets the counters, pings every device (kTries each, silent ones again
+  // for kPingRounds rounds: ping_until_answered) and reads its
   // present position. Throws one DeviceError listing every device that failed,
   // or naming a device whose model number is not the configured `model`.
   // Decides the cycle's read: with `fast_read: auto`, Fast Sync Read when

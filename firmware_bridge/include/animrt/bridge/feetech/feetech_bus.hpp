@@ -41,7 +41,8 @@ class FeetechBus final : public ActuatorBus {
   const BusConfig& config() const override { return config_; }
   ft::Series series() const { return series_; }
 
-  // Resets the counters, pings every servo (kTries each) and reads its
+  // Resets the counters, pings every servo (kTries each, silent ones again
+  // for kPingRounds rounds: ping_until_answered) and reads its
   // present position. Throws one DeviceError listing every servo that failed.
   // Then, for joints with limits, writes Min/Max Angle Limit (9/11) from
   // them when the values read back differ (EEPROM unlocked for the write and
