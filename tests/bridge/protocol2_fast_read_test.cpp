@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "bridge/encoded.hpp"
 
 namespace animrt::dxl {
 namespace {
@@ -46,10 +47,6 @@ const Bytes kBulkRead = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x92, 0x01, 0
                          0x00, 0x02, 0x00, 0x02, 0x92, 0x00, 0x01, 0x00, 0x1A, 0x05};
 
 const BulkReadEntry kFastBulkEntries[] = {{3, 132, 4}, {7, 124, 2}, {4, 146, 1}};
-
-Bytes encoded(std::size_t n, const std::array<std::uint8_t, kMaxPacket>& buf) {
-  return Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
-}
 
 Bytes build_fast_status(std::span<const FastSlice> slices, std::size_t asked,
                         std::size_t data_bytes) {

@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "bridge/encoded.hpp"
+
 namespace animrt::dxl {
 namespace {
 
@@ -59,10 +61,6 @@ const Bytes kStuffedWriteId1 = {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x0A, 0x00, 0x03, 
 // Computed: status of ID 1 with the alert bit and Access Error (0x80 | 7).
 const Bytes kAlertAccessStatusId1 = {0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x04,
                                      0x00, 0x55, 0x87, 0xB3, 0x0F};
-
-Bytes encoded(std::size_t n, const std::array<std::uint8_t, kMaxPacket>& buf) {
-  return Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
-}
 
 // Feeds everything and collects results until need_more.
 struct Drained {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -159,12 +160,6 @@ class Generator {
   std::mt19937 rng_;
 };
 
-std::uint64_t bits(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-
 const double kTimes[] = {0.0, 0.25, 0.5, 1.0, -0.3, 3.7, 1e-9, 123.456, -1e6, 0.123456789};
 
 TEST(ExpressionRandom, EqualsTreeEvaluationBitForBit) {
@@ -177,7 +172,7 @@ TEST(ExpressionRandom, EqualsTreeEvaluationBitForBit) {
     for (double t : kTimes) {
       const double want = reference(*tree, t);
       const double got = e.eval(t);
-      ASSERT_EQ(bits(got), bits(want))
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(got), std::bit_cast<std::uint64_t>(want))
           << text << "\n  at t = " << t << ": " << got << " vs " << want;
       ++compared;
     }
@@ -196,7 +191,8 @@ TEST(ExpressionRandom, ToStringRoundTrips) {
     ASSERT_EQ(back.to_string(), printed) << text;
     ASSERT_EQ(back.size(), e.size()) << text;
     for (double t : kTimes) {
-      ASSERT_EQ(bits(back.eval(t)), bits(e.eval(t))) << text << "\n  printed " << printed;
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(back.eval(t)), std::bit_cast<std::uint64_t>(e.eval(t)))
+          << text << "\n  printed " << printed;
     }
   }
 }

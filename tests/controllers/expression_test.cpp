@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -14,12 +15,6 @@ namespace animrt {
 namespace {
 
 double eval(const std::string& text, double t) { return Expression::compile(text).eval(t); }
-
-std::uint64_t bits(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
 
 // Keeps the compiler from folding libm calls at build time (with a
 // different rounding than the run-time libm the evaluator uses).
@@ -113,7 +108,8 @@ TEST(Expression, SeedCurve) {
     const double x = opaque(t);
     const double want = 6.97 + 7.7 * std::sin(1.0 * 2.0 * kPi * x + -1.07) +
                         2.56 * std::sin(2.0 * 2.0 * kPi * x + 2.97);
-    EXPECT_EQ(bits(e.eval(t)), bits(want)) << "t = " << t;
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(e.eval(t)), std::bit_cast<std::uint64_t>(want))
+        << "t = " << t;
   }
 }
 
@@ -160,7 +156,8 @@ TEST(Expression, ToStringRoundTripsBitForBit) {
     EXPECT_EQ(back.to_string(), e.to_string()) << text;
     EXPECT_EQ(back.size(), e.size()) << text;
     for (double t : {0.0, 0.3, -2.5, 0.999, 1e6}) {
-      EXPECT_EQ(bits(back.eval(t)), bits(e.eval(t))) << text << " at " << t;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(back.eval(t)), std::bit_cast<std::uint64_t>(e.eval(t)))
+          << text << " at " << t;
     }
   }
 }
@@ -174,7 +171,9 @@ TEST(Expression, LongRunOfUnaryMinusesPrintsBackToACompilableProgram) {
   const Expression e = Expression::compile(text);
   const Expression back = Expression::compile(e.to_string());
   EXPECT_EQ(back.to_string(), e.to_string());
-  for (double t : {0.5, -3.0}) EXPECT_EQ(bits(back.eval(t)), bits(e.eval(t))) << t;
+  for (double t : {0.5, -3.0})
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(back.eval(t)), std::bit_cast<std::uint64_t>(e.eval(t)))
+        << t;
 }
 
 struct ErrorCase {

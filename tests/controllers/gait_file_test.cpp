@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "controllers/gait_file_error.hpp"
+
 namespace animrt {
 namespace {
 
@@ -40,15 +42,6 @@ std::string with_lines(int first, int last, const std::string& text) {
 }
 
 std::string with_line(int line, const std::string& text) { return with_lines(line, line, text); }
-
-std::string error_of(const std::string& text) {
-  try {
-    (void)parse_gait_file(text, "g.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
-}
 
 TEST(GaitFile, ReadsAValidFile) {
   const GaitFile g = parse_gait_file(join(kBase), "g.yaml");
@@ -99,37 +92,37 @@ TEST(GaitFile, FroudeTiming) {
 }
 
 TEST(GaitFile, UnknownKeys) {
-  EXPECT_EQ(error_of(with_line(1, "name: test\nspeed: 3")),
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nspeed: 3")),
             "g.yaml:2:1: speed: unknown key (expected one of: name, stride_frequency_hz, froude, "
             "curves, limbs, joints, steering)");
-  EXPECT_EQ(error_of(with_line(10, "  j1: {curve: hip, limb: a, gain: 2}")),
+  EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: hip, limb: a, gain: 2}")),
             "g.yaml:10:29: joints.j1.gain: unknown key (expected one of: curve, limb, sign, scale, "
             "offset_deg)");
-  EXPECT_EQ(error_of(with_line(2, "froude: {number: 0.25, hip_height_m: 0.18, g: 9.8}")),
+  EXPECT_EQ(gait_file_error(with_line(2, "froude: {number: 0.25, hip_height_m: 0.18, g: 9.8}")),
             "g.yaml:2:44: froude.g: unknown key (expected one of: number, hip_height_m)");
 }
 
 TEST(GaitFile, WrongTypes) {
-  EXPECT_EQ(error_of(with_line(2, "stride_frequency_hz: fast")),
+  EXPECT_EQ(gait_file_error(with_line(2, "stride_frequency_hz: fast")),
             "g.yaml:2:22: stride_frequency_hz: expected a number, found \"fast\"");
-  EXPECT_EQ(error_of(with_lines(3, 5, "curves: [1, 2]")),
+  EXPECT_EQ(gait_file_error(with_lines(3, 5, "curves: [1, 2]")),
             "g.yaml:3:9: curves: expected a map, found a list");
-  EXPECT_EQ(error_of(with_line(4, "  hip: [t]")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: [t]")),
             "g.yaml:4:8: curves.hip: expected a string, found a list");
-  EXPECT_EQ(error_of(with_line(7, "  a: early")),
+  EXPECT_EQ(gait_file_error(with_line(7, "  a: early")),
             "g.yaml:7:6: limbs.a: expected a number, found \"early\"");
-  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, scale: big}")),
+  EXPECT_EQ(gait_file_error(with_line(11, "  j2: {curve: knee, limb: b, scale: big}")),
             "g.yaml:11:37: joints.j2.scale: expected a number, found \"big\"");
-  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, sign: 2}")),
+  EXPECT_EQ(gait_file_error(with_line(11, "  j2: {curve: knee, limb: b, sign: 2}")),
             "g.yaml:11:36: joints.j2.sign: expected 1 or -1, found \"2\"");
-  EXPECT_EQ(error_of(with_line(10, "  j1: hip")),
+  EXPECT_EQ(gait_file_error(with_line(10, "  j1: hip")),
             "g.yaml:10:7: joints.j1: expected a map, found \"hip\"");
 }
 
 TEST(GaitFile, ImplausibleScaleAndOffset) {
-  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, scale: 1e30}")),
+  EXPECT_EQ(gait_file_error(with_line(11, "  j2: {curve: knee, limb: b, scale: 1e30}")),
             "g.yaml:11:37: joints.j2.scale: expected a number from -100 to 100, found \"1e30\"");
-  EXPECT_EQ(error_of(with_line(11, "  j2: {curve: knee, limb: b, offset_deg: -4000}")),
+  EXPECT_EQ(gait_file_error(with_line(11, "  j2: {curve: knee, limb: b, offset_deg: -4000}")),
             "g.yaml:11:42: joints.j2.offset_deg: expected a number from -3600 to 3600, found "
             "\"-4000\"");
   // A gait built in memory gets the same check.
@@ -146,89 +139,93 @@ TEST(GaitFile, ImplausibleScaleAndOffset) {
 }
 
 TEST(GaitFile, MissingKeys) {
-  EXPECT_EQ(error_of(with_line(1, "# no name")), "g.yaml:2:1: name: required key is missing");
-  EXPECT_EQ(error_of(with_line(10, "  j1: {curve: hip}")),
+  EXPECT_EQ(gait_file_error(with_line(1, "# no name")),
+            "g.yaml:2:1: name: required key is missing");
+  EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: hip}")),
             "g.yaml:10:7: joints.j1.limb: required key is missing");
-  EXPECT_EQ(error_of(with_line(2, "froude: {number: 0.25}")),
+  EXPECT_EQ(gait_file_error(with_line(2, "froude: {number: 0.25}")),
             "g.yaml:2:9: froude.hip_height_m: required key is missing");
-  EXPECT_EQ(error_of(with_line(1, "name: \"\"")), "g.yaml:1:7: name: expected a non-empty name");
+  EXPECT_EQ(gait_file_error(with_line(1, "name: \"\"")),
+            "g.yaml:1:7: name: expected a non-empty name");
 }
 
 TEST(GaitFile, StrideTiming) {
-  EXPECT_EQ(
-      error_of(with_line(2, "stride_frequency_hz: 1\nfroude: {number: 0.25, hip_height_m: 0.18}")),
-      "g.yaml:3:9: froude: give exactly one of stride_frequency_hz or froude, not both");
-  EXPECT_EQ(error_of(with_line(2, "# none")),
+  EXPECT_EQ(gait_file_error(
+                with_line(2, "stride_frequency_hz: 1\nfroude: {number: 0.25, hip_height_m: 0.18}")),
+            "g.yaml:3:9: froude: give exactly one of stride_frequency_hz or froude, not both");
+  EXPECT_EQ(gait_file_error(with_line(2, "# none")),
             "g.yaml:1:1: missing stride timing: give exactly one of stride_frequency_hz or froude");
-  EXPECT_EQ(error_of(with_line(2, "stride_frequency_hz: 0")),
+  EXPECT_EQ(gait_file_error(with_line(2, "stride_frequency_hz: 0")),
             "g.yaml:2:22: stride_frequency_hz: expected a positive number, found \"0\"");
-  EXPECT_EQ(error_of(with_line(2, "stride_frequency_hz: -1.5")),
+  EXPECT_EQ(gait_file_error(with_line(2, "stride_frequency_hz: -1.5")),
             "g.yaml:2:22: stride_frequency_hz: expected a positive number, found \"-1.5\"");
-  EXPECT_EQ(error_of(with_line(2, "froude: {number: 0, hip_height_m: 0.18}")),
+  EXPECT_EQ(gait_file_error(with_line(2, "froude: {number: 0, hip_height_m: 0.18}")),
             "g.yaml:2:18: froude.number: expected a positive number, found \"0\"");
 }
 
 TEST(GaitFile, ExpressionErrorsAtTheirColumnInTheFile) {
   // Double-quoted: the expression starts at column 9, after the quote.
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"10 + 5*sin(2*PI*t\"")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"10 + 5*sin(2*PI*t\"")),
             "g.yaml:4:26: curves.hip: expected ')' to close '(' at column 19");
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"10 + 5*sin(2*PI*x)\"")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"10 + 5*sin(2*PI*x)\"")),
             "g.yaml:4:25: curves.hip: unknown name 'x' (expected t, PI, sin, cos)");
   // Plain: the expression starts where the scalar does.
-  EXPECT_EQ(error_of(with_line(5, "  knee: -t * x")),
+  EXPECT_EQ(gait_file_error(with_line(5, "  knee: -t * x")),
             "g.yaml:5:14: curves.knee: unknown name 'x' (expected t, PI, sin, cos)");
-  EXPECT_EQ(error_of(with_line(5, "  knee: 1e999 + t")),
+  EXPECT_EQ(gait_file_error(with_line(5, "  knee: 1e999 + t")),
             "g.yaml:5:9: curves.knee: number out of range");
   // Single-quoted.
-  EXPECT_EQ(error_of(with_line(4, "  hip: '1 + )'")), "g.yaml:4:13: curves.hip: unexpected ')'");
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: '1 + )'")),
+            "g.yaml:4:13: curves.hip: unexpected ')'");
   // In a flow map, with extra spaces before the value.
-  EXPECT_EQ(error_of(with_lines(3, 5, "curves: {hip:   \"(t\", knee: t}")),
+  EXPECT_EQ(gait_file_error(with_lines(3, 5, "curves: {hip:   \"(t\", knee: t}")),
             "g.yaml:3:20: curves.hip: expected ')' to close '(' at column 18");
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"\"")), "g.yaml:4:9: curves.hip: empty expression");
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"\"")),
+            "g.yaml:4:9: curves.hip: empty expression");
 }
 
 TEST(GaitFile, ExpressionErrorsInTextThatDoesNotMapOneToOne) {
   // An escape or a line break between the start and the error: the error is
   // reported at the scalar with the column inside the expression.
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"1 +\\t)\"")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"1 +\\t)\"")),
             "g.yaml:4:8: curves.hip: unexpected ')' (column 5 of the expression)");
-  EXPECT_EQ(error_of(with_line(4, "  hip: 1 +\n    x")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: 1 +\n    x")),
             "g.yaml:4:8: curves.hip: unknown name 'x' (expected t, PI, sin, cos) (column 5 of the "
             "expression)");
   // Before the escape the columns still map.
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"1 + ) \\t\"")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"1 + ) \\t\"")),
             "g.yaml:4:13: curves.hip: unexpected ')'");
 }
 
 TEST(GaitFile, UndefinedCurveOrLimb) {
-  EXPECT_EQ(error_of(with_line(10, "  j1: {curve: foot, limb: a}")),
+  EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: foot, limb: a}")),
             "g.yaml:10:15: joints.j1.curve: undefined curve 'foot' (curves: hip, knee)");
-  EXPECT_EQ(error_of(with_line(10, "  j1: {curve: hip, limb: c}")),
+  EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: hip, limb: c}")),
             "g.yaml:10:26: joints.j1.limb: undefined limb 'c' (limbs: a, b)");
 }
 
 TEST(GaitFile, CurveMustBeFinite) {
   // 1e308 * (1 + t) overflows from t = 817/1024 on.
-  EXPECT_EQ(error_of(with_line(4, "  hip: \"1e308 * (1 + t)\"")),
+  EXPECT_EQ(gait_file_error(with_line(4, "  hip: \"1e308 * (1 + t)\"")),
             "g.yaml:4:9: curves.hip: curve is not finite at t = 0.7978515625 stride cycles (value "
             "inf); it must be finite over the whole stride");
-  EXPECT_EQ(error_of(with_line(5, "  knee: 1e308 * 10 * 0")),
+  EXPECT_EQ(gait_file_error(with_line(5, "  knee: 1e308 * 10 * 0")),
             "g.yaml:5:9: curves.knee: curve is not finite at t = 0 stride cycles (value nan); it "
             "must be finite over the whole stride");
 }
 
 TEST(GaitFile, NeedsJoints) {
-  EXPECT_EQ(error_of(with_lines(9, 11, "joints: {}")),
+  EXPECT_EQ(gait_file_error(with_lines(9, 11, "joints: {}")),
             "g.yaml:9:9: joints: a gait needs at least one joint");
 }
 
 TEST(GaitFile, LimbPhaseRange) {
-  EXPECT_EQ(error_of(with_line(8, "  b: 1.5")),
+  EXPECT_EQ(gait_file_error(with_line(8, "  b: 1.5")),
             "g.yaml:8:6: limbs.b: expected a number from 0 to 1, found \"1.5\"");
 }
 
 TEST(GaitFile, DuplicateKeys) {
-  EXPECT_EQ(error_of(with_line(8, "  a: 0.5")), "g.yaml:8:3: limbs.a: duplicate key");
+  EXPECT_EQ(gait_file_error(with_line(8, "  a: 0.5")), "g.yaml:8:3: limbs.a: duplicate key");
 }
 
 TEST(GaitFile, MissingFile) {

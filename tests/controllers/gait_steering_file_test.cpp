@@ -8,6 +8,7 @@
 
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/joint.hpp"
+#include "controllers/gait_file_error.hpp"
 
 namespace animrt {
 namespace {
@@ -33,15 +34,6 @@ const std::string kGood =
     "  track_width_m: 0.15\n"               // 15
     "  sides: {left: [lf], right: [rf]}\n"  // 16
     "  yaw_joints: [yaw]\n";                // 17
-
-std::string error_of(const std::string& text) {
-  try {
-    (void)parse_gait_file(text, "g.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
-}
 
 std::string replace(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
@@ -74,26 +66,26 @@ TEST(GaitSteeringFile, HipHeightDefaultsToTheFroudeTiming) {
 
 TEST(GaitSteeringFile, ErrorsNameFileLineAndKey) {
   const std::string good = steering(kGood);
-  EXPECT_EQ(error_of(replace(good, "max_froude: 0.1", "max_froude: 0.01")),
+  EXPECT_EQ(gait_file_error(replace(good, "max_froude: 0.1", "max_froude: 0.01")),
             "g.yaml:11:15: steering.max_froude: max_froude (0.01) is below min_froude (0.05)");
   // Required with stride_frequency_hz; reported at the section.
-  EXPECT_EQ(error_of(replace(good, "  hip_height_m: 0.2\n", "")),
+  EXPECT_EQ(gait_file_error(replace(good, "  hip_height_m: 0.2\n", "")),
             "g.yaml:10:3: steering.hip_height_m: required key is missing");
   const std::string unknown =
-      error_of(replace(good, "  track_width_m", "  speed: 1\n  track_width_m"));
+      gait_file_error(replace(good, "  track_width_m", "  speed: 1\n  track_width_m"));
   EXPECT_NE(unknown.find("g.yaml:15:3: steering.speed"), std::string::npos) << unknown;
-  const std::string limb = error_of(replace(good, "left: [lf]", "left: [xx]"));
+  const std::string limb = gait_file_error(replace(good, "left: [lf]", "left: [xx]"));
   EXPECT_NE(limb.find("g.yaml:16:18: steering.sides.left"), std::string::npos) << limb;
   EXPECT_NE(limb.find("undefined limb 'xx'"), std::string::npos) << limb;
-  const std::string both = error_of(replace(good, "right: [rf]", "right: [rf, lf]"));
+  const std::string both = gait_file_error(replace(good, "right: [rf]", "right: [rf, lf]"));
   EXPECT_NE(both.find("g.yaml:16:"), std::string::npos) << both;
   EXPECT_NE(both.find("on both sides"), std::string::npos) << both;
-  const std::string yaw = error_of(replace(good, "[yaw]", "[neck]"));
+  const std::string yaw = gait_file_error(replace(good, "[yaw]", "[neck]"));
   EXPECT_NE(yaw.find("g.yaml:17:"), std::string::npos) << yaw;
   EXPECT_NE(yaw.find("steering.yaw_joints"), std::string::npos) << yaw;
-  const std::string turn = error_of(replace(good, "max_turn_dps: 30", "max_turn_dps: -5"));
+  const std::string turn = gait_file_error(replace(good, "max_turn_dps: 30", "max_turn_dps: -5"));
   EXPECT_NE(turn.find("g.yaml:12:17: steering.max_turn_dps"), std::string::npos) << turn;
-  const std::string acc = error_of(replace(good, "0.3\n", "0\n"));
+  const std::string acc = gait_file_error(replace(good, "0.3\n", "0\n"));
   EXPECT_NE(acc.find("g.yaml:13:26: steering.max_acceleration_m_s2"), std::string::npos) << acc;
 }
 
@@ -132,12 +124,12 @@ TEST(GaitSteeringFile, LiftCurvesSwingOffsetAndFixedCadence) {
   other.steering->swing_offset = 0.1;
   EXPECT_FALSE(other == g);
 
-  const std::string curve = error_of(steering(kGood + "  lift_curves: [knee]\n"));
+  const std::string curve = gait_file_error(steering(kGood + "  lift_curves: [knee]\n"));
   EXPECT_NE(curve.find("g.yaml:18:17: steering.lift_curves"), std::string::npos) << curve;
   EXPECT_NE(curve.find("undefined curve 'knee'"), std::string::npos) << curve;
-  const std::string offset = error_of(steering(kGood + "  swing_offset: 0.95\n"));
+  const std::string offset = gait_file_error(steering(kGood + "  swing_offset: 0.95\n"));
   EXPECT_NE(offset.find("g.yaml:18:17: steering.swing_offset"), std::string::npos) << offset;
-  const std::string cadence = error_of(steering(kGood + "  fixed_cadence: 2\n"));
+  const std::string cadence = gait_file_error(steering(kGood + "  fixed_cadence: 2\n"));
   EXPECT_NE(cadence.find("g.yaml:18:18: steering.fixed_cadence"), std::string::npos) << cadence;
   GaitFile bad = g;
   bad.steering->lift_curves = {"nope"};

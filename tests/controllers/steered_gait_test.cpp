@@ -23,7 +23,7 @@ constexpr double kDt = 0.005;  // the quadruped's 200 Hz cycle
 constexpr double kMeanDeg = 10.0;
 constexpr double kSwingDeg = 20.0;
 
-const char* const kGait = R"yaml(name: steer
+const char* const kSteeredGait = R"yaml(name: steer
 stride_frequency_hz: 1.0
 curves:
   hip: "10 + 20*sin(2*PI*t)"
@@ -55,7 +55,7 @@ std::vector<JointSpec> specs() {
 }
 
 struct Rig {
-  GaitFile gait = parse_gait_file(kGait, "steer.yaml");
+  GaitFile gait = parse_gait_file(kSteeredGait, "steer.yaml");
   std::vector<JointSpec> joints = specs();
   std::unique_ptr<MotionSource> source = make_gait_source(gait, joints);
   SteeredGaitSource& steered = dynamic_cast<SteeredGaitSource&>(*source);
@@ -196,7 +196,7 @@ TEST(SteeredGait, RestartsWhenTimeGoesBack) {
 }
 
 TEST(SteeredGait, WithoutASteeringSectionCommandsAreIgnored) {
-  GaitFile gait = parse_gait_file(kGait, "steer.yaml");
+  GaitFile gait = parse_gait_file(kSteeredGait, "steer.yaml");
   gait.steering.reset();
   const auto joints = specs();
   auto a = make_gait_source(gait, joints);
@@ -221,7 +221,7 @@ TEST(SteeredGait, UncommandedPlaysTheGaitsOwnTiming) {
   EXPECT_NEAR(rad_to_deg(tg[0]), kMeanDeg + kSwingDeg, 1e-6);
 }
 
-// kGait with extra lines under `joints` and `steering`, and robot joints for
+// kSteeredGait with extra lines under `joints` and `steering`, and robot joints for
 // every joint it maps (the four hips first).
 struct ExtendedRig {
   GaitFile gait;
@@ -231,7 +231,7 @@ struct ExtendedRig {
   double t = 0.0;
   ExtendedRig(const std::string& curves, const std::string& more_joints,
               const std::vector<std::string>& names, const std::string& more_steering) {
-    std::string text = kGait;
+    std::string text = kSteeredGait;
     const std::string curve_at = "  hip: \"10 + 20*sin(2*PI*t)\"";
     text.replace(text.find(curve_at), curve_at.size(), curve_at + curves);
     const std::string last = "  rh_hip: {curve: hip, limb: rh}";

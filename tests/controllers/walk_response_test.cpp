@@ -83,7 +83,7 @@ TEST(Calibration, FileRoundTrips) {
   std::filesystem::remove(path);
 }
 
-std::string error_of(const std::string& text) {
+std::string calibration_error(const std::string& text) {
   try {
     (void)parse_gait_calibration(text, "c.yaml");
   } catch (const InputError& e) {
@@ -97,29 +97,29 @@ TEST(Calibration, BadFilesNameLineAndKey) {
   const std::string ok =
       "  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.1, achieved_turn_dps: 0, "
       "fell: false}\n";
-  EXPECT_EQ(error_of(head + ok), "no error");
-  const std::string unknown = error_of(head + "  - {speed_m_s: 0.1, turn: 0}\n");
+  EXPECT_EQ(calibration_error(head + ok), "no error");
+  const std::string unknown = calibration_error(head + "  - {speed_m_s: 0.1, turn: 0}\n");
   EXPECT_NE(unknown.find("c.yaml:5:"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("points[0].turn"), std::string::npos) << unknown;
-  const std::string missing = error_of(head + ok + "  - {speed_m_s: 0.1, turn_dps: 0}\n");
+  const std::string missing = calibration_error(head + ok + "  - {speed_m_s: 0.1, turn_dps: 0}\n");
   EXPECT_NE(missing.find("c.yaml:6:"), std::string::npos) << missing;
   EXPECT_NE(missing.find("points[1]."), std::string::npos) << missing;
   EXPECT_NE(missing.find("required key is missing"), std::string::npos) << missing;
   // A usable flag the numbers contradict.
-  const std::string liar =
-      error_of(head +
-               "  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.5, achieved_turn_dps: 0, "
-               "fell: false, usable: true}\n");
+  const std::string liar = calibration_error(
+      head +
+      "  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.5, achieved_turn_dps: 0, "
+      "fell: false, usable: true}\n");
   EXPECT_NE(liar.find("c.yaml:5:"), std::string::npos) << liar;
   EXPECT_NE(liar.find("points[0].usable"), std::string::npos) << liar;
   // A missed turn called usable: the speed is right, the turn is not.
-  const std::string turn_liar =
-      error_of(head +
-               "  - {speed_m_s: 0.1, turn_dps: 4, achieved_speed_m_s: 0.1, achieved_turn_dps: 0.5, "
-               "fell: false, usable: true}\n");
+  const std::string turn_liar = calibration_error(
+      head +
+      "  - {speed_m_s: 0.1, turn_dps: 4, achieved_speed_m_s: 0.1, achieved_turn_dps: 0.5, "
+      "fell: false, usable: true}\n");
   EXPECT_NE(turn_liar.find("c.yaml:5:"), std::string::npos) << turn_liar;
   EXPECT_NE(turn_liar.find("points[0].usable"), std::string::npos) << turn_liar;
-  const std::string tol = error_of("gait: w\nmodel: m\ntolerance: 2\npoints: []\n");
+  const std::string tol = calibration_error("gait: w\nmodel: m\ntolerance: 2\npoints: []\n");
   EXPECT_NE(tol.find("c.yaml:3:12: tolerance"), std::string::npos) << tol;
   EXPECT_THROW(load_gait_calibration("/nonexistent/x.calibration.yaml"), InputError);
 }

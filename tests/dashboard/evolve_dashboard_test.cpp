@@ -28,15 +28,16 @@
 #include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
 
 using nlohmann::json;
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 
 evolve::RunConfig tiny_run(int generations) {
-  evolve::RunConfig c = evolve::load_run_config(kRoot + "/configs/evolve/quadruped_sinusoidal.yaml");
+  evolve::RunConfig c =
+      evolve::load_run_config(kSourceRoot + "/configs/evolve/quadruped_sinusoidal.yaml");
   c.search.population = 8;
   c.search.generations = generations;
   c.search.elites = 2;
@@ -141,7 +142,8 @@ struct EvolveRig {
       json state = get("/api/state");
       if (state["completed"] == completed) return state;
       if (std::chrono::steady_clock::now() > give_up) {
-        ADD_FAILURE() << "never " << completed << " generations; last: " << state.dump().substr(0, 300);
+        ADD_FAILURE() << "never " << completed
+                      << " generations; last: " << state.dump().substr(0, 300);
         return state;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -220,7 +222,8 @@ TEST(EvolveDashboard, TheSnapshotHasTheGenerationsInOrderAndTheBestGaitPlays) {
     specs.push_back(spec);
   }
   const auto gait = make_gait_source(result.best.gait, specs);
-  sim::MujocoFigure figure(rig.config.model, rig.info.joints, Location{});  // the sampler has its own
+  sim::MujocoFigure figure(rig.config.model, rig.info.joints,
+                           Location{});  // the sampler has its own
   std::vector<BodyPose> poses(bodies);
   const auto check_frame = [&](const json& s) {
     std::vector<double> expected(specs.size(), 0.0);

@@ -11,10 +11,13 @@
 #include <sstream>
 #include <vector>
 
+#include "support/files.hpp"
+
 namespace {
 
+using animrt::kSourceRoot;
+
 namespace fs = std::filesystem;
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
 
 std::string read(const std::string& path) {
@@ -52,9 +55,9 @@ class EvolveCli : public ::testing::Test {
     fs::create_directories(dir_);
     std::ofstream run(dir_ / "run.yaml");
     run << "name: tiny\n"
-        << "grammar: " << kRoot << "/configs/grammars/quadruped_concatenating.bnf\n"
-        << "model: " << kRoot << "/configs/models/quadruped.xml\n"
-        << "seed_gait: " << kRoot << "/configs/gaits/quadruped_seed.yaml\n"
+        << "grammar: " << kSourceRoot << "/configs/grammars/quadruped_concatenating.bnf\n"
+        << "model: " << kSourceRoot << "/configs/models/quadruped.xml\n"
+        << "seed_gait: " << kSourceRoot << "/configs/gaits/quadruped_seed.yaml\n"
         << "search: {seed: 5, population: 6, generations: 1, elites: 1, max_depth: 5}\n"
         << "walk: {settle_s: 0.1, warmup_cycles: 1, measure_cycles: 1}\n";
   }
@@ -78,14 +81,14 @@ TEST_F(EvolveCli, ThreadsAndMpiGiveTheSerialResultAndTheGaitPlays) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
 
   // The evolved gait on the runtime's quadruped.
-  std::string robot = read(kRoot + "/configs/robots/quadruped.yaml");
+  std::string robot = read(kSourceRoot + "/configs/robots/quadruped.yaml");
   const std::string from = "file: ../gaits/walk.yaml";
   ASSERT_NE(robot.find(from), std::string::npos);
   robot.replace(robot.find(from), from.size(), "file: " + path("serial.yaml"));
   const std::string model = "model: ../models/quadruped.xml";  // relative: the copy's is absolute
   ASSERT_NE(robot.find(model), std::string::npos);
   robot.replace(robot.find(model), model.size(),
-                "model: " + kRoot + "/configs/models/quadruped.xml");
+                "model: " + kSourceRoot + "/configs/models/quadruped.xml");
   std::ofstream(path("robot.yaml")) << robot;
   EXPECT_EQ(sh(kAnimrt + " validate " + path("robot.yaml") + " > /dev/null"), 0);
   EXPECT_EQ(sh(kAnimrt + " run " + path("robot.yaml") +
@@ -129,11 +132,12 @@ TEST_F(EvolveCli, AParetoRunWritesPlayableGaitsAndMpiGivesTheSameFront) {
 
   // The first member walks on the model what the front says it walked.
   const auto speeds = csv_column(path("front/front.csv"), 4);
-  ASSERT_EQ(sh(kAnimrt + " gait measure " + path("front/" + files[0]) + " --physics " + kRoot +
-               "/configs/models/quadruped.xml --starts 1 --perturb-deg 0 --settle 0.1 "
-               "--warmup-cycles 1 --measure-cycles 1 > " +
-               path("measure.log") + " 2>&1"),
-            0)
+  ASSERT_EQ(
+      sh(kAnimrt + " gait measure " + path("front/" + files[0]) + " --physics " + kSourceRoot +
+         "/configs/models/quadruped.xml --starts 1 --perturb-deg 0 --settle 0.1 "
+         "--warmup-cycles 1 --measure-cycles 1 > " +
+         path("measure.log") + " 2>&1"),
+      0)
       << read(path("measure.log"));
   char expected[32];
   std::snprintf(expected, sizeof expected, "%.3f", std::stod(speeds[0]));

@@ -12,11 +12,10 @@
 #include "animrt/controllers/evolve/random.hpp"
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/core/error.hpp"
+#include "support/files.hpp"
 
 namespace animrt::evolve {
 namespace {
-
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 
 std::string error_of(const std::string& text) {
   try {
@@ -84,11 +83,11 @@ TEST(Grammar, ErrorsNameFileLineColumnAndRule) {
 TEST(Grammar, LoadsEveryShippedGrammar) {
   for (const char* model : {"horse", "quadruped"}) {
     for (const char* style : {"numerical", "concatenating", "hybrid", "sinusoidal", "free"}) {
-      const std::string path = kRoot + "/configs/grammars/" + model + "_" + style + ".bnf";
+      const std::string path = kSourceRoot + "/configs/grammars/" + model + "_" + style + ".bnf";
       EXPECT_NO_THROW(Grammar::load_file(path)) << path;
     }
   }
-  const Grammar g = Grammar::load_file(kRoot + "/configs/grammars/horse_concatenating.bnf");
+  const Grammar g = Grammar::load_file(kSourceRoot + "/configs/grammars/horse_concatenating.bnf");
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("low_amp_var"))].productions.size(), 81u);
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("med_amp_var"))].productions.size(), 41u);
   EXPECT_EQ(g.rules()[static_cast<std::size_t>(g.find("hi_amp_var"))].productions.size(), 21u);
@@ -102,7 +101,7 @@ TEST(Grammar, LoadsEveryShippedGrammar) {
 TEST(Grammar, EveryCurveOfTheSeededAndSinusoidalGrammarsRepeatsEachStride) {
   for (const char* model : {"horse", "quadruped"}) {
     for (const char* style : {"numerical", "concatenating", "hybrid", "sinusoidal"}) {
-      const std::string path = kRoot + "/configs/grammars/" + model + "_" + style + ".bnf";
+      const std::string path = kSourceRoot + "/configs/grammars/" + model + "_" + style + ".bnf";
       const Grammar g = Grammar::load_file(path);
       Rng rng(11);
       int checked = 0;

@@ -15,11 +15,10 @@
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "support/files.hpp"
 
 namespace animrt::evolve {
 namespace {
-
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 
 struct ModelCase {
   const char* model;
@@ -29,9 +28,9 @@ struct ModelCase {
 class SeedGait : public ::testing::TestWithParam<ModelCase> {};
 
 TEST_P(SeedGait, StandsAndMovesForward) {
-  sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/" + GetParam().model);
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/" + GetParam().model);
   auto sim = factory.make();
-  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/" + GetParam().seed);
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/" + GetParam().seed);
   WalkSettings w;
   w.settle_s = 0.3;
   w.warmup_cycles = 1;
@@ -61,13 +60,13 @@ INSTANTIATE_TEST_SUITE_P(Models, SeedGait,
 // reported a fraction of that (0.025 m for the quadruped's seed walk, which
 // covers 0.06 m a cycle).
 TEST(MujocoGaitSimulator, StrideLengthIsTheAdvancePerCycle) {
-  sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/quadruped.xml");
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/quadruped.xml");
   auto sim = factory.make();
   WalkSettings w;
   w.warmup_cycles = 1;
   w.measure_cycles = 3;
   for (const char* name : {"quadruped_seed.yaml", "quadruped_evolved.yaml", "walk.yaml"}) {
-    const GaitFile gait = load_gait_file(kRoot + "/configs/gaits/" + name);
+    const GaitFile gait = load_gait_file(kSourceRoot + "/configs/gaits/" + name);
     const GaitMeasures m = sim->walk(gait, w);
     ASSERT_FALSE(m.fell) << name;
     const double per_cycle = m.speed / gait.stride_frequency();
@@ -82,9 +81,9 @@ TEST(MujocoGaitSimulator, StrideLengthIsTheAdvancePerCycle) {
 // of the lateral-sequence walk from rounded ranges of motion fell in 9 of 10
 // (docs/evolve.md).
 TEST(MujocoGaitSimulator, HorseSeedWalksFromTenStartsWithoutFalling) {
-  sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/horse.xml");
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/horse.xml");
   auto sim = factory.make();
-  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/horse_seed.yaml");
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/horse_seed.yaml");
   const GaitTargets t = froude_targets(seed.froude->number, seed.froude->hip_height_m);
   WalkSettings w;
   w.warmup_cycles = 2;
@@ -145,9 +144,9 @@ std::string near_neighbour(const std::string& curve, double fraction, Rng& rng) 
 // as wide as a real horse's, and friction 1.0) 1 of these 20 walked; on the
 // current model 14 (docs/evolve.md, "Why the seed's neighbours fell").
 TEST(MujocoGaitSimulator, MostNearNeighboursOfTheHorseSeedWalk) {
-  sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/horse.xml");
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/horse.xml");
   auto sim = factory.make();
-  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/horse_seed.yaml");
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/horse_seed.yaml");
   Rng rng(5);
   int walked = 0;
   constexpr int kNeighbours = 20;
@@ -169,7 +168,7 @@ TEST(MujocoGaitSimulator, MostNearNeighboursOfTheHorseSeedWalk) {
 // fold and the trunk lands, and the walk must be reported as a fall, not
 // scored as a slow walk.
 TEST(MujocoGaitSimulator, AHorseThatCannotCarryItselfIsReportedAsAFall) {
-  std::ifstream in(kRoot + "/configs/models/horse.xml");
+  std::ifstream in(kSourceRoot + "/configs/models/horse.xml");
   std::stringstream xml;
   xml << in.rdbuf();
   // Every actuator's force range becomes -100..100.
@@ -185,7 +184,7 @@ TEST(MujocoGaitSimulator, AHorseThatCannotCarryItselfIsReportedAsAFall) {
   std::ofstream(path) << weak;
   sim::MujocoGaitSimulatorFactory factory(path);
   auto sim = factory.make();
-  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/horse_seed.yaml");
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/horse_seed.yaml");
   WalkSettings w;
   const GaitMeasures m = sim->walk(seed, w);
   std::remove(path.c_str());
@@ -252,9 +251,9 @@ TEST(MujocoGaitSimulator, OnlyTheTrunkOnTheGroundIsAFallNotOnItsOwnLeg) {
 }
 
 TEST(MujocoGaitSimulator, APerturbedStartIsRepeatableAndDiffersFromTheExactOne) {
-  sim::MujocoGaitSimulatorFactory factory(kRoot + "/configs/models/quadruped.xml");
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/quadruped.xml");
   auto sim = factory.make();
-  const GaitFile gait = load_gait_file(kRoot + "/configs/gaits/quadruped_seed.yaml");
+  const GaitFile gait = load_gait_file(kSourceRoot + "/configs/gaits/quadruped_seed.yaml");
   WalkSettings w;
   w.measure_cycles = 2;
   const GaitMeasures exact = sim->walk(gait, w);

@@ -12,11 +12,11 @@
 #include "animrt/controllers/evolve/pareto_search.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "support/files.hpp"
 
 namespace animrt::evolve {
 namespace {
 
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 TEST(Pareto, Dominance) {
@@ -78,9 +78,9 @@ class ParetoRun : public ::testing::Test {
   static RunConfig config() {
     RunConfig c;
     c.name = "tiny";
-    c.grammar = kRoot + "/configs/grammars/quadruped_hybrid.bnf";
-    c.model = kRoot + "/configs/models/quadruped.xml";
-    c.seed_gait = kRoot + "/configs/gaits/quadruped_seed.yaml";
+    c.grammar = kSourceRoot + "/configs/grammars/quadruped_hybrid.bnf";
+    c.model = kSourceRoot + "/configs/models/quadruped.xml";
+    c.seed_gait = kSourceRoot + "/configs/gaits/quadruped_seed.yaml";
     c.search.seed = 3;
     c.search.population = 8;
     c.search.generations = 2;

@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <cmath>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -24,13 +24,13 @@
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kRoot = ANIMRT_SOURCE_DIR;
-const std::string kModel = kRoot + "/configs/models/quadruped.xml";
+const std::string kModel = kSourceRoot + "/configs/models/quadruped.xml";
 const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
 
 std::string read(const std::string& path) {
@@ -49,7 +49,7 @@ void replace_once(std::string& text, const std::string& from, const std::string&
 // The demo quadruped playing `gait`, without wire-time emulation (lockstep
 // needs no real-time pacing) and with a generous answer timeout.
 std::string write_robot(const std::string& name, const std::string& gait) {
-  std::string robot = read(kRoot + "/configs/robots/quadruped.yaml");
+  std::string robot = read(kSourceRoot + "/configs/robots/quadruped.yaml");
   replace_once(robot, "file: ../gaits/walk.yaml", "file: " + gait);
   replace_once(robot, "model: ../models/quadruped.xml", "model: " + kModel);
   replace_once(robot, "wire_time: true", "wire_time: false");
@@ -70,13 +70,13 @@ void replace_all(std::string& text, const std::string& from, const std::string& 
   ASSERT_GT(n, 0u) << from;
 }
 
-const std::string kHorseModel = kRoot + "/configs/models/horse.xml";
+const std::string kHorseModel = kSourceRoot + "/configs/models/horse.xml";
 
 // configs/robots/horse.yaml (the horse's seed walk on two simulated buses)
 // with absolute paths, no wire-time emulation and a generous answer timeout.
 std::string write_horse_robot(const std::string& name) {
-  std::string robot = read(kRoot + "/configs/robots/horse.yaml");
-  replace_once(robot, "file: ../gaits/", "file: " + kRoot + "/configs/gaits/");
+  std::string robot = read(kSourceRoot + "/configs/robots/horse.yaml");
+  replace_once(robot, "file: ../gaits/", "file: " + kSourceRoot + "/configs/gaits/");
   replace_once(robot, "model: ../models/horse.xml", "model: " + kHorseModel);
   replace_all(robot, "wire_time: true", "wire_time: false");
   replace_all(robot, "timeout_ms: 4\n", "timeout_ms: 50\n");
@@ -176,7 +176,7 @@ constexpr double kMotionS = 6.0;
 
 TEST_F(PhysicsBackend, EvolvedGaitCarriesTheFigureForwardWithoutFalling) {
   const Outcome walk = run_on_physics(
-      robot("evolved", kRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, false);
+      robot("evolved", kSourceRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, false);
   EXPECT_EQ(walk.summary.exit_code(), 0);
   EXPECT_EQ(walk.summary.end_reason, EndReason::duration);
   // The physics ran for the whole run: start ramp, motion, stop ramp.
@@ -198,7 +198,7 @@ TEST_F(PhysicsBackend, EvolvedGaitCarriesTheFigureForwardWithoutFalling) {
 
 TEST_F(PhysicsBackend, HoldingTheHomePoseGoesNowhere) {
   const Outcome still = run_on_physics(
-      robot("home", kRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, true);
+      robot("home", kSourceRoot + "/configs/gaits/quadruped_evolved.yaml"), kMotionS, true);
   EXPECT_EQ(still.summary.exit_code(), 0);
   EXPECT_GT(still.physics.simulated_s, kMotionS);
   EXPECT_EQ(still.physics.falls, 0);
@@ -209,7 +209,7 @@ TEST_F(PhysicsBackend, HoldingTheHomePoseGoesNowhere) {
 }
 
 TEST_F(PhysicsBackend, LockstepRunsAreIdentical) {
-  const std::string file = robot("twice", kRoot + "/configs/gaits/quadruped_evolved.yaml");
+  const std::string file = robot("twice", kSourceRoot + "/configs/gaits/quadruped_evolved.yaml");
   const Outcome a = run_on_physics(file, 1.0, false);
   const Outcome b = run_on_physics(file, 1.0, false);
   EXPECT_EQ(a.physics.steps, b.physics.steps);
@@ -267,7 +267,7 @@ TEST_F(PhysicsBackend, AHorseThatCannotCarryItselfIsReportedAsAFall) {
                            ("animrt_physics_" + std::to_string(getpid()) + "_weak_horse.xml");
   files_.push_back(weak);
   std::ofstream(weak) << xml;
-  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/horse.yaml");
+  const LoadedRobot robot = load_robot(kSourceRoot + "/configs/robots/horse.yaml");
   auto stands_for_3_s = [&robot](const std::string& model) {
     sim::MujocoJointPhysics physics(model, robot.config.joints, robot.config.file, 0);
     for (int j = 0; j < static_cast<int>(robot.config.joints.size()); ++j) {
@@ -287,7 +287,7 @@ TEST_F(PhysicsBackend, AHorseThatCannotCarryItselfIsReportedAsAFall) {
 }
 
 TEST(PhysicsModel, StepsAtItsOwnTimestepAsTheClockMoves) {
-  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  const LoadedRobot robot = load_robot(kSourceRoot + "/configs/robots/quadruped.yaml");
   sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 1'000'000'000);
   physics.advance(1'000'000'000 + 4'999'999);  // 2 ms steps: two are due, the third is not
   EXPECT_EQ(physics.measures().steps, 2u);
@@ -303,7 +303,7 @@ TEST(PhysicsModel, StepsAtItsOwnTimestepAsTheClockMoves) {
 // bus hands over for a cycle is in before another bus's next cycle steps past
 // it, whichever thread runs first.
 TEST(PhysicsModel, InLockstepABusAheadWaitsForTheOthersGoals) {
-  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  const LoadedRobot robot = load_robot(kSourceRoot + "/configs/robots/quadruped.yaml");
   sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
   const int a = physics.join_lockstep();
   const int b = physics.join_lockstep();
@@ -340,7 +340,7 @@ TEST(PhysicsModel, InLockstepABusAheadWaitsForTheOthersGoals) {
 }
 
 TEST(PhysicsModel, TorqueOffLetsTheFigureSagAndTorqueOnHoldsIt) {
-  const LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  const LoadedRobot robot = load_robot(kSourceRoot + "/configs/robots/quadruped.yaml");
   const int n = static_cast<int>(robot.config.joints.size());
   // A crouch (knees and ankles bent) held for 1 s, then 1 s with torque on or off.
   std::vector<double> crouch(static_cast<std::size_t>(n), 0.0);
@@ -364,7 +364,7 @@ TEST(PhysicsModel, TorqueOffLetsTheFigureSagAndTorqueOnHoldsIt) {
 }
 
 TEST(PhysicsModel, AJointTheModelLacksNamesTheModelFileAndTheJoint) {
-  LoadedRobot robot = load_robot(kRoot + "/configs/robots/quadruped.yaml");
+  LoadedRobot robot = load_robot(kSourceRoot + "/configs/robots/quadruped.yaml");
   robot.config.joints[4].name = "rf_knee_x";
   try {
     sim::MujocoJointPhysics physics(kModel, robot.config.joints, robot.config.file, 0);
@@ -385,7 +385,7 @@ int sh(const std::string& cmd) {
 }
 
 TEST_F(PhysicsBackend, CliReportsDistanceSpeedAndFalls) {
-  const std::string file = robot("cli", kRoot + "/configs/gaits/quadruped_evolved.yaml");
+  const std::string file = robot("cli", kSourceRoot + "/configs/gaits/quadruped_evolved.yaml");
   const std::string base =
       fs::temp_directory_path() / ("animrt_physics_cli_" + std::to_string(getpid()));
   files_.push_back(base + ".json");

@@ -13,15 +13,14 @@
 #include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/evolve/phenotype.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "support/files.hpp"
 
 namespace animrt::evolve {
 namespace {
 
-const std::string kRoot = ANIMRT_SOURCE_DIR;
-
 // A tiny run on the demo quadruped: short walks, few individuals.
 RunConfig tiny_run() {
-  RunConfig c = load_run_config(kRoot + "/configs/evolve/quadruped_concatenating.yaml");
+  RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/quadruped_concatenating.yaml");
   c.search.population = 8;
   c.search.generations = 2;
   c.search.elites = 2;
@@ -163,7 +162,7 @@ TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {
 }
 
 TEST(Phenotype, WrongCurveCountOrBadExpressionIsInvalid) {
-  const GaitFile seed = load_gait_file(kRoot + "/configs/gaits/quadruped_seed.yaml");
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/quadruped_seed.yaml");
   EXPECT_FALSE(make_phenotype_gait(seed, "1;2").valid);
   EXPECT_FALSE(make_phenotype_gait(seed, "1;2;(3").valid);
   const PhenotypeGait ok = make_phenotype_gait(seed, "1 + 2*t; 2; 3", {"", "7", ""});
@@ -201,10 +200,10 @@ TEST(RunConfig, MissingModelIsReportedAtItsKey) {
   const std::string dir = ::testing::TempDir() + "/run_config_missing_model";
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/run.yaml";
-  std::ofstream(path) << "name: x\ngrammar: " << kRoot
+  std::ofstream(path) << "name: x\ngrammar: " << kSourceRoot
                       << "/configs/grammars/quadruped_free.bnf\nmodel: ../models/nope.xml\n"
                          "seed_gait: "
-                      << kRoot << "/configs/gaits/quadruped_seed.yaml\n";
+                      << kSourceRoot << "/configs/gaits/quadruped_seed.yaml\n";
   try {
     (void)load_run_config(path);
     ADD_FAILURE() << "missing model accepted";
@@ -220,18 +219,18 @@ TEST(RunConfig, ShippedRunFilesLoad) {
   for (const char* f : {"horse_numerical", "horse_concatenating", "horse_hybrid",
                         "horse_sinusoidal", "horse_free", "horse_concatenating_varying_weights",
                         "horse_concatenating_varying_freedom", "quadruped_concatenating"}) {
-    const RunConfig c = load_run_config(kRoot + "/configs/evolve/" + f + ".yaml");
+    const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;
   }
   const RunConfig w =
-      load_run_config(kRoot + "/configs/evolve/horse_concatenating_varying_weights.yaml");
+      load_run_config(kSourceRoot + "/configs/evolve/horse_concatenating_varying_weights.yaml");
   ASSERT_EQ(w.weights.size(), 5u);
   EXPECT_EQ(weights_at(w.weights, 15).distance, 2.0);
   EXPECT_EQ(weights_at(w.weights, 25).duty_factor, 2.0);
   EXPECT_EQ(weights_at(w.weights, 50).stride_length, 1.0);
   const RunConfig f =
-      load_run_config(kRoot + "/configs/evolve/horse_concatenating_varying_freedom.yaml");
+      load_run_config(kSourceRoot + "/configs/evolve/horse_concatenating_varying_freedom.yaml");
   ASSERT_EQ(f.freedom.size(), 4u);
   EXPECT_EQ(f.freedom[0].free.size(), 3u);
   EXPECT_EQ(f.freedom[3].free.size(), 12u);

@@ -15,12 +15,11 @@
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/feetech/feetech_bus.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/core/joint.hpp"
 #include "animrt/sim/feetech/feetech_sim_bus.hpp"
 
 namespace animrt {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 BusConfig arm(ft::Series series, std::initializer_list<int> ids, double timeout_s = 0.05) {
   BusConfig config;

@@ -124,7 +124,7 @@ TEST(SpatialGrid, RebuildingDoesNotAllocate) {
   out.reserve(1000);
   std::vector<std::vector<Vec2>> sets;
   for (int k = 0; k < 5; ++k) sets.push_back(points(1000 - k * 100, 0.7, rng));
-  test::AllocationCounter c;
+  animrt::test::AllocationCounter c;
   for (const auto& s : sets) {
     g.build(s, 0.7);
     g.query_near(3, 0.7, out);

@@ -21,7 +21,7 @@ using test::still_leader;
 
 // Every force zero, no minimum speed, turning free: a test turns on the rule
 // it checks.
-UnityFlockParams none() {
+UnityFlockParams no_rules() {
   UnityFlockParams p;
   p.min_speed = 0.0;
   p.turn_speed = 1000.0;
@@ -38,7 +38,7 @@ UnityFlockParams none() {
 }
 
 TEST(UnityFlock, SeparationPushesApartAcrossGroupsInsideTheRadius) {
-  UnityFlockParams p = none();
+  UnityFlockParams p = no_rules();
   p.avoidance_force = 2.0;
   std::vector<Agent> a{agent({0, 0}), agent({0.5, 0}), agent({0, 0.75}, 0, 0, 1)};
   std::vector<Vec2> d(3);
@@ -57,7 +57,7 @@ TEST(UnityFlock, SeparationPushesApartAcrossGroupsInsideTheRadius) {
 }
 
 TEST(UnityFlock, AlignmentFollowsOwnGroupNeighboursOnly) {
-  UnityFlockParams p = none();
+  UnityFlockParams p = no_rules();
   p.follow_velocity = 1.0;
   const double pi = std::numbers::pi;
   // Agent 1 (same group) walks +y at 1.5 m; agent 2 (other group) walks -x.
@@ -92,7 +92,7 @@ TEST(UnityFlock, AlignmentFollowsOwnGroupNeighboursOnly) {
 }
 
 TEST(UnityFlock, CohesionPullsTowardTheOthersMeanPosition) {
-  UnityFlockParams p = none();
+  UnityFlockParams p = no_rules();
   p.gravity = 0.5;
   std::vector<Agent> a{agent({0, 0}), agent({0, 2}), agent({6, 1}), agent({-20, 0}, 0, 0, 1)};
   std::vector<Vec2> d(4);
@@ -106,7 +106,7 @@ TEST(UnityFlock, CohesionPullsTowardTheOthersMeanPosition) {
 }
 
 TEST(UnityFlock, OriginPushClosesOnTheLeader) {
-  UnityFlockParams p = none();
+  UnityFlockParams p = no_rules();
   p.to_origin_force = 0.05;
   p.turn_speed = 0.6;
   std::vector<Agent> a{agent({0, 0}, 0.0), agent({0, 2}, 2.5)};
@@ -146,7 +146,7 @@ TEST(UnityFlock, MinSpeedAndTurnLimitHold) {
 }
 
 TEST(UnityFlock, RandomPushIsRenewedAtRandomIntervals) {
-  UnityFlockParams p = none();
+  UnityFlockParams p = no_rules();
   p.random_force = 1.0;
   p.random_freq = 2.0;  // renewed every 0.25-0.75 s
   std::vector<Agent> a{agent({0, 0}), agent({9, 9})};

@@ -20,6 +20,7 @@
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/files.hpp"
 #include "support/sim_rig.hpp"
 
 namespace animrt {
@@ -29,8 +30,6 @@ using test::RunAllocationWatch;
 using test::RunPhase;
 using test::RunThread;
 using test::SimRig;
-
-const std::string kConfigs = std::string(ANIMRT_SOURCE_DIR) + "/configs";
 
 // Short ramps keep each run to about 1.5 s of simulated time.
 test::RigSettings short_ramps() {
@@ -44,7 +43,7 @@ test::RigSettings short_ramps() {
 
 // The animatronic figure with its torso drive on Modbus RTU (a pty).
 std::string animatronic_on_rtu() {
-  std::ifstream in(kConfigs + "/robots/animatronic.yaml");
+  std::ifstream in(kConfigsDir + "/robots/animatronic.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   auto replace = [&](const std::string& from, const std::string& to) {
     for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
@@ -53,7 +52,7 @@ std::string animatronic_on_rtu() {
   replace("protocol: modbus-tcp", "protocol: modbus-rtu");
   replace("port: 192.168.1.50:502", "port: /dev/null");
   replace("    reconnect_ms: 100", "    parity: none\n    baud: 230400");
-  replace("../", kConfigs + "/");
+  replace("../", kConfigsDir + "/");
   const std::string path = ::testing::TempDir() + "/animatronic_rtu.yaml";
   std::ofstream(path) << text;
   return path;
@@ -109,7 +108,7 @@ void expect_no_allocation(SimRig& rig, double motion_s, const Expect& expect,
 // thread inside the window is seen, one on a thread that is not the run's
 // (as the simulated devices' threads are not) is not.
 TEST(CycleAllocation, TheWatchSeesTheIoThreadsAndNotTheSimulators) {
-  SimRig rig(kConfigs + "/robots/quadruped.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
   // A thread of the test's own, started before the watch as the simulated
   // devices' threads are, allocating all through the run.
   std::atomic<bool> stop{false};
@@ -159,12 +158,12 @@ TEST(CycleAllocation, TheWatchSeesTheIoThreadsAndNotTheSimulators) {
 }
 
 TEST(CycleAllocation, DynamixelStartMotionStopWithTelemetry) {
-  SimRig rig(kConfigs + "/robots/quadruped.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
   expect_no_allocation(rig, 1.0, {});
 }
 
 TEST(CycleAllocation, DynamixelDeviceDyingMidRun) {
-  SimRig rig(kConfigs + "/robots/quadruped.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
     if (!done && t >= 0.3) rig.sim("legs").set_device_responding(5, false);
@@ -173,7 +172,7 @@ TEST(CycleAllocation, DynamixelDeviceDyingMidRun) {
 }
 
 TEST(CycleAllocation, DynamixelHardwareError) {
-  SimRig rig(kConfigs + "/robots/quadruped.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
     if (!done && t >= 0.3) rig.sim("legs").set_device_hardware_error(9, 0x04);
@@ -182,12 +181,12 @@ TEST(CycleAllocation, DynamixelHardwareError) {
 }
 
 TEST(CycleAllocation, DynamixelMaestroModbusTcpWithTelemetry) {
-  SimRig rig(kConfigs + "/robots/animatronic.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/animatronic.yaml", short_ramps());
   expect_no_allocation(rig, 1.0, {});
 }
 
 TEST(CycleAllocation, MaestroErrorBits) {
-  SimRig rig(kConfigs + "/robots/animatronic.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/animatronic.yaml", short_ramps());
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
     if (!done && t >= 0.3) rig.sim("face").set_device_hardware_error(0, 0x10);
@@ -198,7 +197,7 @@ TEST(CycleAllocation, MaestroErrorBits) {
 // The TCP connection drops: the bus reconnects with backoff inside the
 // cycle until the watchdog faults the drive.
 TEST(CycleAllocation, ModbusTcpDroppedConnection) {
-  SimRig rig(kConfigs + "/robots/animatronic.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/animatronic.yaml", short_ramps());
   auto& torso = dynamic_cast<sim::ModbusSimBus&>(rig.sim("torso"));
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
@@ -235,12 +234,12 @@ TEST(CycleAllocation, ModbusRtuDriveFaultBits) {
 }
 
 TEST(CycleAllocation, MitAndCia402WithTelemetry) {
-  SimRig rig(kConfigs + "/robots/quadruped_can.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped_can.yaml", short_ramps());
   expect_no_allocation(rig, 1.0, {});
 }
 
 TEST(CycleAllocation, Cia402Emcy) {
-  SimRig rig(kConfigs + "/robots/quadruped_can.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped_can.yaml", short_ramps());
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
     if (!done && t >= 0.3) rig.sim("hip_drive").set_device_hardware_error(32, 0x20);
@@ -249,7 +248,7 @@ TEST(CycleAllocation, Cia402Emcy) {
 }
 
 TEST(CycleAllocation, MitSilentMotor) {
-  SimRig rig(kConfigs + "/robots/quadruped_can.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped_can.yaml", short_ramps());
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
     if (!done && t >= 0.3) rig.sim("legs_left").set_device_responding(2, false);
@@ -258,7 +257,7 @@ TEST(CycleAllocation, MitSilentMotor) {
 }
 
 TEST(CycleAllocation, CanBusOff) {
-  SimRig rig(kConfigs + "/robots/quadruped_can.yaml", short_ramps());
+  SimRig rig(kConfigsDir + "/robots/quadruped_can.yaml", short_ramps());
   auto& left = dynamic_cast<sim::CanSimBus&>(rig.sim("legs_left"));
   bool done = false;
   expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {

@@ -9,12 +9,11 @@
 #include <string>
 
 #include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
+#include "support/files.hpp"
 #include "support/sim_rig.hpp"
 
 namespace animrt {
 namespace {
-
-const std::string kConfigs = std::string(ANIMRT_SOURCE_DIR) + "/configs";
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const std::size_t at = text.find(from);
@@ -26,16 +25,16 @@ std::string replaced(std::string text, const std::string& from, const std::strin
 // configs/robots/quadruped.yaml with XL430-W250 servos on firmware 46 and
 // the given fast_read setting.
 std::string quadruped_with(const std::string& fast_read) {
-  std::ifstream in(kConfigs + "/robots/quadruped.yaml");
+  std::ifstream in(kConfigsDir + "/robots/quadruped.yaml");
   std::stringstream ss;
   ss << in.rdbuf();
   std::string text = ss.str();
   text = replaced(text, "    timeout_ms: 4",
                   "    fast_read: " + fast_read + "\n    model: XL430-W250\n    timeout_ms: 4");
   text = replaced(text, "    sim:", "    sim:\n      firmware_version: 46");
-  text = replaced(text, "file: ../gaits/walk.yaml", "file: " + kConfigs + "/gaits/walk.yaml");
+  text = replaced(text, "file: ../gaits/walk.yaml", "file: " + kConfigsDir + "/gaits/walk.yaml");
   text = replaced(text, "model: ../models/quadruped.xml",
-                  "model: " + kConfigs + "/models/quadruped.xml");
+                  "model: " + kConfigsDir + "/models/quadruped.xml");
   const std::string path = ::testing::TempDir() + "/quadruped_fast_" + fast_read + ".yaml";
   std::ofstream(path) << text;
   return path;

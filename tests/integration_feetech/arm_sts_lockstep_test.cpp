@@ -17,7 +17,7 @@
 namespace animrt {
 namespace {
 
-const std::string kArm = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/arm_sts.yaml";
+const std::string kArmConfig = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/arm_sts.yaml";
 
 struct Csv {
   std::vector<std::string> header;
@@ -48,7 +48,7 @@ Csv read_csv(const std::string& path) {
 }
 
 TEST(ArmStsLockstep, PlaysTheShowAndTracksWithinTheServoModel) {
-  test::SimRig rig(kArm);
+  test::SimRig rig(kArmConfig);
   const std::string csv_path = ::testing::TempDir() + "/arm_sts.csv";
   const RunSummary s = rig.run(5.0, csv_path);
   EXPECT_EQ(s.end_reason, EndReason::duration);
@@ -117,7 +117,7 @@ void expect_fault_stop(const RunSummary& s, const RobotConfig& config, const std
 }
 
 TEST(ArmStsLockstep, AServoThatDiesIsFaultedByTheWatchdogAndTheOthersRampHome) {
-  test::SimRig rig(kArm);
+  test::SimRig rig(kArmConfig);
   rig.probe->on_sample = [&](double t) {
     if (t >= 1.0) rig.sims[0]->set_device_responding(4, false);  // wrist_flex
   };
@@ -137,7 +137,7 @@ TEST(ArmStsLockstep, AServoThatDiesIsFaultedByTheWatchdogAndTheOthersRampHome) {
 }
 
 TEST(ArmStsLockstep, AnOverloadFaultsTheServoAtOnce) {
-  test::SimRig rig(kArm);
+  test::SimRig rig(kArmConfig);
   rig.probe->on_sample = [&](double t) {
     if (t >= 0.5) rig.sims[0]->set_device_hardware_error(6, 0x20);  // gripper overload
   };

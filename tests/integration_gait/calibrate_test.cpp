@@ -17,13 +17,13 @@
 #include "animrt/core/input_file.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
 
-const std::string kRoot = ANIMRT_SOURCE_DIR;
-const std::string kWalk = kRoot + "/configs/gaits/walk.yaml";
-const std::string kModel = kRoot + "/configs/models/quadruped.xml";
+const std::string kWalk = kSourceRoot + "/configs/gaits/walk.yaml";
+const std::string kModel = kSourceRoot + "/configs/models/quadruped.xml";
 
 struct Walk {
   GaitFile gait = load_gait_file(kWalk);
@@ -99,7 +99,7 @@ TEST(GaitCalibrate, ValidateRefusesASteeringRangeBeyondTheJointLimits) {
   gait.replace(at, gait.find('\n', at) - at, max_key + "2.0");
   const auto dir = std::filesystem::temp_directory_path();
   std::ofstream(dir / "wide.yaml") << gait;
-  std::string robot = read_input_file(kRoot + "/configs/robots/quadruped.yaml");
+  std::string robot = read_input_file(kSourceRoot + "/configs/robots/quadruped.yaml");
   const std::string file_key = "file: ../gaits/walk.yaml";
   const auto file_at = robot.find(file_key);
   ASSERT_NE(file_at, std::string::npos);

@@ -13,13 +13,16 @@
 #include <sstream>
 #include <string>
 
+#include "support/files.hpp"
+
 extern char** environ;
 
 namespace {
 
+using animrt::kConfigsDir;
+
 const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
-const std::string kConfigs = std::string(ANIMRT_SOURCE_DIR) + "/configs";
-const std::string kFigure = kConfigs + "/robots/animatronic.yaml";
+const std::string kFigure = kConfigsDir + "/robots/animatronic.yaml";
 
 std::string run(const std::string& command, int* status) {
   std::string out;
@@ -35,7 +38,7 @@ TEST(MixedCli, ValidateNamesEveryLayerFile) {
   int status = -1;
   const std::string out = run(kAnimrt + " validate " + kFigure, &status);
   EXPECT_EQ(WEXITSTATUS(status), 0) << out;
-  const std::string robots = kConfigs + "/robots/";
+  const std::string robots = kConfigsDir + "/robots/";
   EXPECT_EQ(out, kFigure + ": ok (6 joints, 3 buses, 6 devices, layers [gait " + robots +
                      "../shows/neck_idle_gait.yaml, show " + robots + "../shows/hello.yaml])\n");
 }
@@ -59,7 +62,7 @@ std::string patient_figure() {
     }
     for (const std::string folder : {"../shows/", "../modbus/"}) {
       if (auto at = line.find(folder); at != std::string::npos) {
-        line.replace(at, folder.size(), kConfigs + "/" + folder.substr(3));
+        line.replace(at, folder.size(), kConfigsDir + "/" + folder.substr(3));
       }
     }
     out += line + "\n";

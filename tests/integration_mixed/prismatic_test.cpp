@@ -11,11 +11,10 @@
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
-
-const std::string kConfigs = std::string(ANIMRT_SOURCE_DIR) + "/configs";
 
 std::string write(const std::string& name, const std::string& text) {
   const std::string path =
@@ -52,7 +51,7 @@ std::string robot(const std::string& show_path, const std::string& joint_extra =
          limits +
          "\n"
          "    home_m: 0.05\n" +
-         joint_extra + "    actuator: {bus: drive, slave: 1, map: " + kConfigs +
+         joint_extra + "    actuator: {bus: drive, slave: 1, map: " + kConfigsDir +
          "/modbus/linear_actuator.yaml" + actuator_extra +
          "}\n"
          "motion: {type: show, file: " +

@@ -16,7 +16,7 @@
 namespace animrt {
 namespace {
 
-const std::string kMaps = std::string(ANIMRT_SOURCE_DIR) + "/configs/modbus/";
+const std::string kMapsDir = std::string(ANIMRT_SOURCE_DIR) + "/configs/modbus/";
 
 RobotConfig drives(const std::string& protocol) {
   const std::string path = ::testing::TempDir() + "/peer_" +
@@ -31,11 +31,11 @@ RobotConfig drives(const std::string& protocol) {
       << "joints:\n  pan:\n"
          "    limits: {min_deg: -90, max_deg: 90, velocity_dps: 100, acceleration_dps2: 500}\n"
          "    actuator: {bus: drives, slave: 1, map: "
-      << kMaps
+      << kMapsDir
       << "position_drive.yaml}\n  lean:\n"
          "    limits: {min_deg: -20, max_deg: 20, velocity_dps: 20, acceleration_dps2: 100}\n"
          "    actuator: {bus: drives, slave: 2, map: "
-      << kMaps << "linear_actuator.yaml, m_per_rad: 0.1, zero_m: 0.05}\n"
+      << kMapsDir << "linear_actuator.yaml, m_per_rad: 0.1, zero_m: 0.05}\n"
       << "motion: {type: gait, file: " << path << "}\n";
   std::string text;
   if (protocol == "modbus-tcp") {

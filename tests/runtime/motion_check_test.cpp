@@ -10,23 +10,12 @@
 #include <string>
 
 #include "animrt/runtime/robot_loader.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
 
 namespace fs = std::filesystem;
-
-const std::string kSourceDir = ANIMRT_SOURCE_DIR;
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void write_file(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
 
 int line_of(const std::string& text, const std::string& what) {
   const auto at = text.find(what);
@@ -44,10 +33,10 @@ class MotionCheckTest : public ::testing::Test {
     dir_ = fs::temp_directory_path() /
            ("animrt_motion_check_" + std::to_string(::getpid()) + "_" + info->name());
     fs::remove_all(dir_);
-    robot_text_ = read_file(kSourceDir + "/configs/robots/quadruped.yaml");
+    robot_text_ = read_file(kSourceRoot + "/configs/robots/quadruped.yaml");
     write_file(robot(), robot_text_);
     write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
-    gait_text_ = read_file(kSourceDir + "/configs/gaits/walk.yaml");
+    gait_text_ = read_file(kSourceRoot + "/configs/gaits/walk.yaml");
   }
   void TearDown() override { fs::remove_all(dir_); }
 

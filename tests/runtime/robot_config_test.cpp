@@ -10,24 +10,12 @@
 #include <string>
 
 #include "animrt/bridge/dynamixel/x_models.hpp"
+#include "support/files.hpp"
 
 namespace animrt {
 namespace {
 
 namespace fs = std::filesystem;
-
-const std::string kSourceDir = ANIMRT_SOURCE_DIR;
-
-void write_file(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // Each test gets its own folder holding robots/robot.yaml and gaits/gait.yaml
 // (the loader only checks that the gait file exists).
@@ -83,7 +71,7 @@ TEST_F(RobotConfigTest, ShippedQuadrupedHasTheDocumentedValues) {
   // A copy next to a stand-in gait, so the robot file itself is checked even
   // before configs/gaits/walk.yaml exists.
   const fs::path copy = dir_ / "robots" / "quadruped.yaml";
-  write_file(copy, read_file(kSourceDir + "/configs/robots/quadruped.yaml"));
+  write_file(copy, read_file(kSourceRoot + "/configs/robots/quadruped.yaml"));
   write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
   write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
   const RobotConfig c = load_robot_config(copy.string());
@@ -149,14 +137,14 @@ TEST_F(RobotConfigTest, ShippedQuadrupedHasTheDocumentedValues) {
 }
 
 TEST_F(RobotConfigTest, ShippedQuadrupedLoadsInPlace) {
-  const std::string walk = kSourceDir + "/configs/gaits/walk.yaml";
+  const std::string walk = kSourceRoot + "/configs/gaits/walk.yaml";
   ASSERT_TRUE(fs::exists(walk)) << walk << " is missing";
-  const std::string path = kSourceDir + "/configs/robots/quadruped.yaml";
+  const std::string path = kSourceRoot + "/configs/robots/quadruped.yaml";
   const RobotConfig c = load_robot_config(path);
   EXPECT_EQ(c.joints.size(), 12u);
-  EXPECT_EQ(c.motion.file, kSourceDir + "/configs/robots/../gaits/walk.yaml");
+  EXPECT_EQ(c.motion.file, kSourceRoot + "/configs/robots/../gaits/walk.yaml");
   EXPECT_TRUE(fs::equivalent(c.motion.file, walk));
-  EXPECT_TRUE(fs::equivalent(c.model, kSourceDir + "/configs/models/quadruped.xml"));
+  EXPECT_TRUE(fs::equivalent(c.model, kSourceRoot + "/configs/models/quadruped.xml"));
 }
 
 TEST_F(RobotConfigTest, TheFigureModelIsOptionalAndMustExist) {
@@ -836,7 +824,7 @@ TEST_F(RobotConfigTest, BusTimeoutMustBeBelowTheWatchdog) {
 
 TEST_F(RobotConfigTest, LoopRateTheBusCannotCarry) {
   const fs::path copy = dir_ / "robots" / "quadruped.yaml";
-  std::string text = read_file(kSourceDir + "/configs/robots/quadruped.yaml");
+  std::string text = read_file(kSourceRoot + "/configs/robots/quadruped.yaml");
   write_file(dir_ / "gaits" / "walk.yaml", "# stand-in\n");
   write_file(dir_ / "models" / "quadruped.xml", "<!-- stand-in -->\n");
   const auto rate = text.find("rate_hz: 200");

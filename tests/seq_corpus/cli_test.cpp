@@ -11,10 +11,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "support/files.hpp"
+
 namespace {
 
+using animrt::kSourceRoot;
+
 namespace fs = std::filesystem;
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
 
 std::string read(const fs::path& path) {
@@ -38,7 +41,7 @@ class SeqCorpusCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir); }
   int corpus(const std::string& out, const std::string& extra) {
-    return sh(kAnimrt + " seq corpus --quiet --model quadruped --configs " + kRoot +
+    return sh(kAnimrt + " seq corpus --quiet --model quadruped --configs " + kSourceRoot +
               "/configs --frames 4 --vertices 250 --seeds 2 --froude 0.06 --out " +
               (dir / out).string() + " " + extra + " > " + (dir / (out + ".log")).string() +
               " 2>&1");
@@ -113,7 +116,7 @@ TEST_F(SeqCorpusCli, BadInputIsAClearError) {
   EXPECT_NE(read(dir / "log").find("horse, quadruped"), std::string::npos) << read(dir / "log");
   EXPECT_EQ(
       sh(kAnimrt + " seq corpus --out " + (dir / "y").string() + " --model quadruped --configs " +
-         kRoot + "/configs --fps 30 > " + (dir / "log").string() + " 2>&1"),
+         kSourceRoot + "/configs --fps 30 > " + (dir / "log").string() + " 2>&1"),
       1);
   EXPECT_NE(read(dir / "log").find("30"), std::string::npos) << read(dir / "log");
 }

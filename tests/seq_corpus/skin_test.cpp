@@ -16,12 +16,14 @@
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/seq_corpus/body_field.hpp"
 #include "animrt/sim/seq_corpus/generator.hpp"
+#include "support/files.hpp"
 
 namespace {
 
+using animrt::kSourceRoot;
+
 using namespace animrt::sim;
 using namespace animrt::sim::seq_corpus;
-const std::string kRoot = ANIMRT_SOURCE_DIR;
 
 TEST(MarchingTetrahedra, SphereIsClosedOrientedAndHasItsVolume) {
   const double r = 0.5, step = 0.05;
@@ -82,7 +84,7 @@ struct ModelSkin {
 
 const ModelSkin& quadruped_skin() {
   static const ModelSkin s = [] {
-    ModelSkin out{load_mujoco_model(kRoot + "/configs/models/quadruped.xml"), {}};
+    ModelSkin out{load_mujoco_model(kSourceRoot + "/configs/models/quadruped.xml"), {}};
     out.skin = bind_pose_skin(out.model, 400);
     return out;
   }();
@@ -91,7 +93,7 @@ const ModelSkin& quadruped_skin() {
 
 const ModelSkin& horse_skin() {
   static const ModelSkin s = [] {
-    ModelSkin out{load_mujoco_model(kRoot + "/configs/models/horse.xml"), {}};
+    ModelSkin out{load_mujoco_model(kSourceRoot + "/configs/models/horse.xml"), {}};
     out.skin = bind_pose_skin(out.model, 1500);
     return out;
   }();
@@ -163,7 +165,7 @@ TEST(Skin, BindPoseGivesTheRestMeshBack) {
 TEST(Skin, WalkedFramesCarryFootVerticesWithTheirFeet) {
   const ModelSkin& s = quadruped_skin();
   const mjModel* m = s.model.model.get();
-  const WalkConfig config{kRoot + "/configs/gaits/walk.yaml", 0.054, 3, 0.0};
+  const WalkConfig config{kSourceRoot + "/configs/gaits/walk.yaml", 0.054, 3, 0.0};
   WalkOptions options;
   options.frames = 12;
   const WalkRecord walk = walk_sequence(s.model, s.skin, config, options);
@@ -207,7 +209,7 @@ TEST(Walk, SameSeedSameFramesOtherSeedOtherFrames) {
   const ModelSkin& s = quadruped_skin();
   WalkOptions options;
   options.frames = 6;
-  const WalkConfig a{kRoot + "/configs/gaits/quadruped_evolved.yaml", 0.06, 7, 0.0};
+  const WalkConfig a{kSourceRoot + "/configs/gaits/quadruped_evolved.yaml", 0.06, 7, 0.0};
   WalkConfig b = a;
   b.seed = 8;
   const WalkRecord a1 = walk_sequence(s.model, s.skin, a, options);
@@ -253,7 +255,7 @@ TEST(Walk, TheTurnRateGoesToTheGaitThroughSteer) {
   options.make_source = [&seen](const animrt::GaitFile& g, std::span<const animrt::JointSpec> j) {
     return std::make_unique<SteerRecorder>(animrt::make_gait_source(g, j), &seen);
   };
-  const WalkConfig c{kRoot + "/configs/gaits/walk.yaml", 0.05, 1, -0.25};
+  const WalkConfig c{kSourceRoot + "/configs/gaits/walk.yaml", 0.05, 1, -0.25};
   const WalkRecord walk = walk_sequence(s.model, s.skin, c, options);
   ASSERT_EQ(seen.size(), 1u);
   EXPECT_EQ(seen[0].turn_rad_s, -0.25);
@@ -268,7 +270,7 @@ TEST(Walk, AFroudeNumberBelowTheGaitsSteeringRangeStillWalks) {
   WalkOptions options;
   options.frames = 101;  // 4 s
   for (double fr : {0.03, 0.04}) {
-    const WalkConfig c{kRoot + "/configs/gaits/walk.yaml", fr, 1, 0.0};
+    const WalkConfig c{kSourceRoot + "/configs/gaits/walk.yaml", fr, 1, 0.0};
     const WalkRecord walk = walk_sequence(s.model, s.skin, c, options);
     ASSERT_FALSE(walk.fell) << fr;
     const double commanded = animrt::froude_velocity(walk.timing.froude, 0.18);
@@ -280,12 +282,12 @@ TEST(Walk, RejectsAFrameRateOffThePhysicsSteps) {
   const ModelSkin& s = quadruped_skin();
   WalkOptions options;
   options.fps = 30.0;  // 16.67 steps of 2 ms
-  const WalkConfig c{kRoot + "/configs/gaits/walk.yaml", 0.054, 1, 0.0};
+  const WalkConfig c{kSourceRoot + "/configs/gaits/walk.yaml", 0.054, 1, 0.0};
   EXPECT_THROW(walk_sequence(s.model, s.skin, c, options), std::invalid_argument);
 }
 
 TEST(Schedule, EveryGaitFroudeTurnAndSeed) {
-  CorpusOptions o = model_preset("quadruped", kRoot + "/configs");
+  CorpusOptions o = model_preset("quadruped", kSourceRoot + "/configs");
   o.turns = {0.0, 0.3};
   o.seeds = 2;
   o.first_seed = 5;
@@ -308,7 +310,7 @@ namespace {
 // bounding-box diagonal, up to a translation.
 TEST(Skin, WalkedFramesComeBackFromTheirFeatures) {
   const ModelSkin& s = quadruped_skin();
-  const WalkConfig config{kRoot + "/configs/gaits/walk.yaml", 0.054, 5, 0.0};
+  const WalkConfig config{kSourceRoot + "/configs/gaits/walk.yaml", 0.054, 5, 0.0};
   WalkOptions options;
   options.frames = 10;
   const WalkRecord walk = walk_sequence(s.model, s.skin, config, options);

@@ -40,8 +40,8 @@ BusConfig servos(std::initializer_list<int> ids, int firmware, const char* model
 }
 
 // Feeds encoded packets to the firmware as the sim bus would (decoded).
-struct Rig {
-  explicit Rig(const BusConfig& config) : firmware(config, 0) {}
+struct FirmwareRig {
+  explicit FirmwareRig(const BusConfig& config) : firmware(config, 0) {}
 
   Answers send(const Bytes& packet, Nanos now) {
     dxl::Decoder d;
@@ -84,10 +84,10 @@ const Bytes kFastBulkRead = {0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x12, 0x00, 0x9A, 0x0
                              0x84, 0x00, 0x04, 0x00, 0x07, 0x7C, 0x00, 0x02, 0x00,
                              0x04, 0x92, 0x00, 0x01, 0x00, 0xDA, 0x2D};
 
-Rig manual_rig(int firmware = 46) { return Rig(servos({3, 7, 4}, firmware)); }
+FirmwareRig manual_rig(int firmware = 46) { return FirmwareRig(servos({3, 7, 4}, firmware)); }
 
 TEST(DynamixelSimFastRead, AnswersTheManualFastSyncReadByteForByte) {
-  Rig rig = manual_rig();
+  FirmwareRig rig = manual_rig();
   rig.hold_at(3, 166);
   rig.hold_at(7, 2079);
   rig.hold_at(4, 1023);
@@ -101,7 +101,7 @@ TEST(DynamixelSimFastRead, AnswersTheManualFastSyncReadByteForByte) {
 }
 
 TEST(DynamixelSimFastRead, AnswersTheManualFastBulkReadInTheManualsLayout) {
-  Rig rig = manual_rig();
+  FirmwareRig rig = manual_rig();
   rig.hold_at(3, 166);
   const Answers a = rig.send(kFastBulkRead, kLater);
   // The manual's ID 7 PWM (421) and ID 4 temperature (31) are not what the
@@ -121,7 +121,7 @@ TEST(DynamixelSimFastRead, AnswersTheManualFastBulkReadInTheManualsLayout) {
 }
 
 TEST(DynamixelSimFastRead, SilentServoInTheMiddleLeavesItsSliceOut) {
-  Rig rig = manual_rig();
+  FirmwareRig rig = manual_rig();
   rig.hold_at(3, 166);
   rig.hold_at(4, 1023);
   rig.firmware.find_configured(7)->set_responding(false);
@@ -141,7 +141,7 @@ TEST(DynamixelSimFastRead, SilentServoInTheMiddleLeavesItsSliceOut) {
 }
 
 TEST(DynamixelSimFastRead, SilentFirstServoLetsTheNextSendTheHeader) {
-  Rig rig = manual_rig();
+  FirmwareRig rig = manual_rig();
   rig.firmware.find_configured(3)->set_responding(false);
   const Answers a = rig.send(kFastSyncRead, kLater);
   dxl::FastStatusReader r(a.bytes);
@@ -153,7 +153,7 @@ TEST(DynamixelSimFastRead, SilentFirstServoLetsTheNextSendTheHeader) {
 }
 
 TEST(DynamixelSimFastRead, ErrorSliceKeepsItsLengthWithZeroData) {
-  Rig rig = manual_rig();
+  FirmwareRig rig = manual_rig();
   const std::uint8_t ids[] = {3, 7};
   // 660..663 runs past the table's end (661): Access Error from both.
   const Answers a = rig.send(dxl::encode_fast_sync_read(660, 4, ids, rig.buf), kLater);
@@ -170,14 +170,14 @@ TEST(DynamixelSimFastRead, ErrorSliceKeepsItsLengthWithZeroData) {
 }
 
 TEST(DynamixelSimFastRead, FirmwareBeforeFastReadStaysSilent) {
-  Rig old = manual_rig(44);  // X430 fast read needs firmware 45
+  FirmwareRig old = manual_rig(44);  // X430 fast read needs firmware 45
   EXPECT_TRUE(old.send(kFastSyncRead, kLater).bytes.empty());
-  Rig dual(servos({3, 7, 4}, 46, "2XL430-W250"));  // never on 2XL/2XC
+  FirmwareRig dual(servos({3, 7, 4}, 46, "2XL430-W250"));  // never on 2XL/2XC
   EXPECT_TRUE(dual.send(kFastSyncRead, kLater).bytes.empty());
 }
 
 TEST(DynamixelSimFastRead, ReportsTheConfiguredModelAndFirmware) {
-  Rig rig(servos({1}, 46, "XH540-W270"));
+  FirmwareRig rig(servos({1}, 46, "XH540-W270"));
   std::array<std::uint8_t, 3> info{};
   ASSERT_EQ(rig.firmware.find_configured(1)->read(xreg::model_number, 2, info), StatusError::none);
   EXPECT_EQ(dxl::get_u16(info.data()), 1100);
@@ -202,7 +202,7 @@ struct Table : ::testing::Test {
     for (std::size_t i = 0; i < length; ++i) v |= std::uint32_t{out[i]} << (8 * i);
     return v;
   }
-  Rig rig;
+  FirmwareRig rig;
   sim::DynamixelServo& servo;
 };
 
