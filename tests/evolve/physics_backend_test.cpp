@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -135,6 +136,10 @@ Outcome run_on_physics(const std::string& robot_file, double duration, bool hold
                        const std::string& model = kModel) {
   ManualClock clock;
   LoadedRobot robot = load_robot(robot_file);
+  // As `animrt run --lockstep` does: bus timeouts are wall-clock time, and an
+  // answer past 50 ms on a loaded machine (a parallel sanitizer run) once
+  // made two lockstep runs differ.
+  for (auto& bus : robot.config.buses) bus.timeout_s = std::max(bus.timeout_s, 0.25);
   sim::MujocoJointPhysics physics(model, robot.config.joints, robot.config.file, clock.now());
   auto sims = start_simulated_devices(robot.config.buses, clock, &physics);
   std::vector<std::unique_ptr<ActuatorBus>> buses;
