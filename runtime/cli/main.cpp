@@ -45,7 +45,6 @@ constexpr int kExitOk = 0;
 constexpr int kExitUsage = 1;
 constexpr int kExitInvalidInput = 2;
 constexpr int kExitDeviceError = 3;
-constexpr double kLockstepMinTimeoutS = 0.25;  // bus timeout floor with --lockstep
 
 animrt::RunControls g_controls;
 
@@ -207,13 +206,7 @@ int cmd_run(const RunArgs& args) {
     simulated = animrt::start_simulated_devices(robot.config.buses, clock, physics.get());
     for (const auto& sim : simulated) spdlog::info("simulated devices: {}", sim->describe());
   }
-  if (args.lockstep) {
-    // Simulated devices answer in no simulated time, so in lockstep a bus
-    // timeout measures only how busy the host is: a loaded machine must not
-    // make a device look silent.
-    for (auto& bus : robot.config.buses)
-      bus.timeout_s = std::max(bus.timeout_s, kLockstepMinTimeoutS);
-  }
+  if (args.lockstep) animrt::widen_timeouts_for_lockstep(robot.config.buses);
   std::vector<std::unique_ptr<animrt::ActuatorBus>> buses;
   for (const auto& bus : robot.config.buses) buses.push_back(animrt::make_bus(bus));
 

@@ -1,5 +1,7 @@
 #include "animrt/sim/simulated_backend.hpp"
 
+#include <algorithm>
+
 namespace animrt {
 
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
@@ -13,6 +15,10 @@ std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<B
     simulated.push_back(std::move(sim));
   }
   return simulated;
+}
+
+void widen_timeouts_for_lockstep(std::vector<BusConfig>& buses) {
+  for (BusConfig& bus : buses) bus.timeout_s = std::max(bus.timeout_s, kLockstepMinTimeoutS);
 }
 
 }  // namespace animrt

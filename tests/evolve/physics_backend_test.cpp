@@ -136,10 +136,9 @@ Outcome run_on_physics(const std::string& robot_file, double duration, bool hold
                        const std::string& model = kModel) {
   ManualClock clock;
   LoadedRobot robot = load_robot(robot_file);
-  // As `animrt run --lockstep` does: bus timeouts are wall-clock time, and an
-  // answer past 50 ms on a loaded machine (a parallel sanitizer run) once
-  // made two lockstep runs differ.
-  for (auto& bus : robot.config.buses) bus.timeout_s = std::max(bus.timeout_s, 0.25);
+  // As `animrt run --lockstep` does (with 50 ms, an answer late under a
+  // parallel sanitizer run once made two lockstep runs differ).
+  widen_timeouts_for_lockstep(robot.config.buses);
   sim::MujocoJointPhysics physics(model, robot.config.joints, robot.config.file, clock.now());
   auto sims = start_simulated_devices(robot.config.buses, clock, &physics);
   std::vector<std::unique_ptr<ActuatorBus>> buses;

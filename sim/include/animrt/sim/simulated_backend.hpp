@@ -17,4 +17,11 @@ namespace animrt {
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(
     std::vector<BusConfig>& buses, const Clock& clock, sim::JointPhysics* physics = nullptr);
 
+// Simulated devices answer in no simulated time, so in a lockstep run a bus
+// timeout measures only how busy the host is: every bus's timeout is raised
+// to at least kLockstepMinTimeoutS, so that a loaded machine does not make
+// a device look silent (and two lockstep runs differ).
+inline constexpr double kLockstepMinTimeoutS = 0.25;
+void widen_timeouts_for_lockstep(std::vector<BusConfig>& buses);
+
 }  // namespace animrt
