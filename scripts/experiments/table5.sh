@@ -44,8 +44,10 @@ if [ "$ranks" -gt 1 ]; then
 fi
 
 start_all=$(date +%s)
-for g in $grammars; do
-  for ((r = 1; r <= runs; r++)); do
+# Run by run across the grammars, so that a comparison stopped early still
+# has as many runs of every grammar (give or take one).
+for ((r = 1; r <= runs; r++)); do
+  for g in $grammars; do
     name="${g}_$r"
     if [ -f "$out/$name.csv" ]; then
       echo "== $name: done earlier, skipped"

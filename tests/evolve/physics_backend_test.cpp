@@ -34,13 +34,6 @@ namespace fs = std::filesystem;
 const std::string kModel = kSourceRoot + "/configs/models/quadruped.xml";
 const std::string kAnimrt = std::string(ANIMRT_BINARY_DIR) + "/bin/animrt";
 
-std::string read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void replace_once(std::string& text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   ASSERT_NE(at, std::string::npos) << from;
@@ -48,14 +41,13 @@ void replace_once(std::string& text, const std::string& from, const std::string&
 }
 
 // The demo quadruped playing `gait`, without wire-time emulation (lockstep
-// needs no real-time pacing) and with a generous answer timeout.
+// needs no real-time pacing). Lockstep runs widen the bus timeouts
+// themselves (widen_timeouts_for_lockstep).
 std::string write_robot(const std::string& name, const std::string& gait) {
-  std::string robot = read(kSourceRoot + "/configs/robots/quadruped.yaml");
+  std::string robot = read_file(kSourceRoot + "/configs/robots/quadruped.yaml");
   replace_once(robot, "file: ../gaits/walk.yaml", "file: " + gait);
   replace_once(robot, "model: ../models/quadruped.xml", "model: " + kModel);
   replace_once(robot, "wire_time: true", "wire_time: false");
-  // Bus timeouts are wall-clock time even in lockstep; a loaded machine must not hit them.
-  replace_once(robot, "timeout_ms: 4 ", "timeout_ms: 50 ");
   const fs::path path = fs::temp_directory_path() /
                         ("animrt_physics_" + std::to_string(getpid()) + "_" + name + ".yaml");
   std::ofstream(path) << robot;
@@ -74,13 +66,12 @@ void replace_all(std::string& text, const std::string& from, const std::string& 
 const std::string kHorseModel = kSourceRoot + "/configs/models/horse.xml";
 
 // configs/robots/horse.yaml (the horse's seed walk on two simulated buses)
-// with absolute paths, no wire-time emulation and a generous answer timeout.
+// with absolute paths and no wire-time emulation.
 std::string write_horse_robot(const std::string& name) {
-  std::string robot = read(kSourceRoot + "/configs/robots/horse.yaml");
+  std::string robot = read_file(kSourceRoot + "/configs/robots/horse.yaml");
   replace_once(robot, "file: ../gaits/", "file: " + kSourceRoot + "/configs/gaits/");
   replace_once(robot, "model: ../models/horse.xml", "model: " + kHorseModel);
   replace_all(robot, "wire_time: true", "wire_time: false");
-  replace_all(robot, "timeout_ms: 4\n", "timeout_ms: 50\n");
   const fs::path path = fs::temp_directory_path() /
                         ("animrt_physics_" + std::to_string(getpid()) + "_" + name + ".yaml");
   std::ofstream(path) << robot;
@@ -115,7 +106,7 @@ struct Outcome {
 
 // The last row's *_meas_rad columns of a telemetry CSV.
 std::vector<double> last_measured(const std::string& csv) {
-  std::istringstream in(read(csv));
+  std::istringstream in(read_file(csv));
   std::string header, line, last;
   std::getline(in, header);
   while (std::getline(in, line)) last = line;
@@ -262,7 +253,7 @@ TEST_F(PhysicsBackend, TwoBusLockstepRunsOfTheHorseAreIdentical) {
 // pose: its legs fold and the trunk lands on the ground, and the runtime's
 // physics reports that as a fall.
 TEST_F(PhysicsBackend, AHorseThatCannotCarryItselfIsReportedAsAFall) {
-  std::string xml = read(kHorseModel);
+  std::string xml = read_file(kHorseModel);
   for (const char* limit : {"15000", "9000", "6000", "4500"}) {
     replace_all(xml, std::string("forcerange=\"-") + limit + " " + limit + "\"",
                 "forcerange=\"-100 100\"");
@@ -397,11 +388,11 @@ TEST_F(PhysicsBackend, CliReportsDistanceSpeedAndFalls) {
   ASSERT_EQ(sh(kAnimrt + " run " + file + " --lockstep --no-realtime --duration 2 --physics " +
                kModel + " --summary-json " + base + ".json > " + base + ".log 2>&1"),
             0)
-      << read(base + ".log");
-  const std::string log = read(base + ".log");
+      << read_file(base + ".log");
+  const std::string log = read_file(base + ".log");
   EXPECT_NE(log.find("physics: " + kModel + " (2 ms steps)"), std::string::npos) << log;
   EXPECT_NE(log.find("falls 0"), std::string::npos) << log;
-  const std::string json = read(base + ".json");
+  const std::string json = read_file(base + ".json");
   EXPECT_NE(log.find("physics, motion only: forward "), std::string::npos) << log;
   EXPECT_NE(log.find(" in 2.00 s, average speed "), std::string::npos) << log;
   for (const char* key :
@@ -410,7 +401,7 @@ TEST_F(PhysicsBackend, CliReportsDistanceSpeedAndFalls) {
   }
 
   // A model without one of the robot's joints: exit 2, one line naming both.
-  std::string xml = read(kModel);
+  std::string xml = read_file(kModel);
   replace_once(xml, "<position name=\"lh_ankle\" joint=\"lh_ankle\" class=\"ankle\"/>", "");
   const std::string bad = base + "_bad.xml";
   files_.push_back(bad);
@@ -418,7 +409,7 @@ TEST_F(PhysicsBackend, CliReportsDistanceSpeedAndFalls) {
   EXPECT_EQ(sh(kAnimrt + " run " + file + " --lockstep --duration 1 --physics " + bad + " 2> " +
                base + ".log"),
             2);
-  const std::string err = read(base + ".log");
+  const std::string err = read_file(base + ".log");
   EXPECT_EQ(err.rfind("error: " + bad + ": actuator: joint 'lh_ankle' of " + file, 0), 0u) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
