@@ -133,6 +133,33 @@ TEST(FeetechBus, TheAdaptersEchoIsNoAnswer) {
   EXPECT_NEAR(q[1], (2050 - 2048) * 2 * 3.14159265358979 / 4096, 1e-9);
 }
 
+TEST(FeetechBus, ConfigureWaitsForAServoThatIsStillBooting) {
+  // Servo 2 ignores more pings than one round's retries (as one powered
+  // together with the adapter does while it boots); the next round finds
+  // it, and servo 1, which answered at once, is not asked again.
+  Rig rig;
+  int ignored = 0;
+  rig.line->answer = [&](const Bytes& packet) {
+    if (packet[2] == 2 && packet[4] == ft::inst::ping && ignored < FeetechBus::kTries + 1) {
+      ++ignored;
+      return Bytes{};
+    }
+    return healthy(packet);
+  };
+  rig.bus->configure();
+  int pings_to_1 = 0, pings_to_2 = 0;
+  for (const Bytes& p : rig.line->written) {
+    if (p[4] != ft::inst::ping) continue;
+    pings_to_1 += p[2] == 1 ? 1 : 0;
+    pings_to_2 += p[2] == 2 ? 1 : 0;
+  }
+  EXPECT_EQ(pings_to_1, 1);
+  EXPECT_EQ(pings_to_2, FeetechBus::kTries + 2);
+  std::vector<double> q(2, 0.0);
+  rig.bus->read(q);
+  EXPECT_NEAR(q[1], (2050 - 2048) * 2 * 3.14159265358979 / 4096, 1e-9);
+}
+
 TEST(FeetechBus, DamagedTruncatedAndStrayAnswersAreCountedPerServo) {
   Rig rig;
   rig.bus->configure();
