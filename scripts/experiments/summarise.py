@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Summarises evolve runs written by table5.sh: OUT/table.md, OUT/ranks.md
-(Mann-Whitney U tests of the paper's claims) and plots.
+(Mann-Whitney U tests of the paper's claims), OUT/falls.md (falls from
+generation 10 on, and the best gaits against the Froude targets) and plots.
+Runs not finished yet are left out, and each table says how many it has.
 
-    summarise.py OUT_DIR RUNS GRAMMAR...
+    POPULATION=75 summarise.py OUT_DIR RUNS GRAMMAR...
 """
 import csv
 import math
@@ -31,6 +33,38 @@ NAMES = {
     "concatenating_varying_weights": "Concatenating, varying fitness weights",
     "concatenating_varying_freedom": "Concatenating, varying joint freedom",
 }
+
+
+# The horse seed's targets from Fr 0.4 (docs/evolve.md, Fitness): speed m/s,
+# stride length m, duty factor.
+TARGETS = (1.534, 1.991, 0.67)
+SETTLED_FROM = 10  # the generation from which falls are counted against the 20 % goal
+
+
+def falls_row(g, datas, population):
+    """Walks that fell from generation SETTLED_FROM on, as a share of the
+    population, and the last best gait of each run against TARGETS."""
+    shares = []  # per run, per generation
+    for data in datas:
+        shares.append([int(d["fell"]) / population
+                       for d in data if int(d["generation"]) >= SETTLED_FROM])
+    gens = min(len(r) for r in shares)
+    per_gen = [sum(r[i] for r in shares) / len(shares) for i in range(gens)]
+    if not per_gen:
+        return None
+    worst_run_gen = max(max(r) for r in shares)
+    off = []
+    for data in datas:
+        last = data[-1]
+        got = (float(last["best_speed"]), float(last["best_stride_length"]),
+               float(last["best_duty_factor"]))
+        off.append(max(abs(v - t) / t for v, t in zip(got, TARGETS)))
+    measures = [mean_sd([float(d[-1][k]) for d in datas])[0]
+                for k in ("best_speed", "best_stride_length", "best_duty_factor")]
+    within = sum(1 for o in off if o <= 0.15)
+    return (f"| {NAMES.get(g, g)} | {len(datas)} | {100 * sum(per_gen) / gens:.1f} | "
+            f"{100 * max(per_gen):.1f} | {100 * worst_run_gen:.1f} | "
+            f"{measures[0]:.3f} / {measures[1]:.3f} / {measures[2]:.3f} | {within} of {len(datas)} |")
 
 
 def mean_sd(xs):
@@ -65,30 +99,44 @@ def rank_claims(finals):
 
 def main():
     out, runs, grammars = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
-    rows = ["| Grammar | Avg. best | Std. dev. | Avg. avg. | Std. dev. | invalid (last gen, mean) "
-            "| paper: avg. best (sd) | paper: avg. avg. (sd) |",
-            "|---|---|---|---|---|---|---|---|"]
+    population = int(os.environ.get("POPULATION", "75"))
+    rows = ["| Grammar | runs | Avg. best | Std. dev. | Avg. avg. | Std. dev. | invalid (last gen, "
+            "mean) | paper: avg. best (sd) | paper: avg. avg. (sd) |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    fall_rows = [f"| Grammar | runs | fell from gen {SETTLED_FROM}: mean % | worst generation "
+                 "(mean over runs) % | worst generation of a run % | last best gait: speed / "
+                 "stride / duty (mean) | best gaits within 15 % of every target |",
+                 "|---|---|---|---|---|---|---|"]
     curves = {}
     finals = {}  # grammar -> last generation's best fitness of every run
     for g in grammars:
-        best, avg, invalid, per_gen = [], [], [], []
+        best, avg, invalid, per_gen, datas = [], [], [], [], []
         for r in range(1, runs + 1):
-            with open(os.path.join(out, f"{g}_{r}.csv")) as f:
+            path = os.path.join(out, f"{g}_{r}.csv")
+            if not os.path.exists(path):
+                continue  # not run yet
+            with open(path) as f:
                 data = list(csv.DictReader(f))
+            datas.append(data)
             best.append(float(data[-1]["best"]))
             avg.append(float(data[-1]["average"]))
             invalid.append(float(data[-1]["invalid"]))
             per_gen.append([(float(d["best"]), float(d["average"])) for d in data])
+        if not datas:
+            continue
         finals[g] = best
         b, bsd = mean_sd(best)
         a, asd = mean_sd(avg)
         p = PAPER.get(g)
         paper = (f"{p[0]} ({p[1]}) | {p[2]} ({p[3]})" if p else "- | -")
-        rows.append(f"| {NAMES.get(g, g)} | {b:.1f} | {bsd:.1f} | {a:.1f} | {asd:.1f} | "
-                    f"{sum(invalid) / len(invalid):.1f} | {paper} |")
-        gens = len(per_gen[0])
-        curves[g] = [(i, sum(run[i][0] for run in per_gen) / runs,
-                      sum(run[i][1] for run in per_gen) / runs) for i in range(gens)]
+        rows.append(f"| {NAMES.get(g, g)} | {len(datas)} | {b:.1f} | {bsd:.1f} | {a:.1f} | "
+                    f"{asd:.1f} | {sum(invalid) / len(invalid):.1f} | {paper} |")
+        falls = falls_row(g, datas, population)
+        if falls:
+            fall_rows.append(falls)
+        gens = min(len(run) for run in per_gen)
+        curves[g] = [(i, sum(run[i][0] for run in per_gen) / len(per_gen),
+                      sum(run[i][1] for run in per_gen) / len(per_gen)) for i in range(gens)]
     table = "\n".join(rows) + "\n"
     ranks = rank_claims(finals)
     with open(os.path.join(out, "ranks.md"), "w") as f:
@@ -97,6 +145,10 @@ def main():
     with open(os.path.join(out, "table.md"), "w") as f:
         f.write(table)
     print(table)
+    falls = "\n".join(fall_rows) + "\n"
+    with open(os.path.join(out, "falls.md"), "w") as f:
+        f.write(falls)
+    print(falls)
     for g, pts in curves.items():
         with open(os.path.join(out, f"mean_{g}.dat"), "w") as f:
             for i, b, a in pts:

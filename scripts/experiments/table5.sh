@@ -19,7 +19,8 @@
 #
 # Output: OUT_DIR/table.md (mean and standard deviation over runs of the last
 # generation's best and average fitness, beside the paper's), OUT_DIR/ranks.md
-# (Mann-Whitney U tests of the paper's claims), OUT_DIR/best.svg and
+# (Mann-Whitney U tests of the paper's claims), OUT_DIR/falls.md (falls from
+# generation 10 on; the best gaits against the Froude targets), OUT_DIR/best.svg and
 # average.svg (gnuplot), OUT_DIR/timing.txt (wall time of every run).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -74,4 +75,4 @@ for ((r = 1; r <= runs; r++)); do
   done
 done
 echo "this call: $(($(date +%s) - start_all)) s; every run's time in $out/timing.txt"
-/usr/bin/python3 "$root/scripts/experiments/summarise.py" "$out" "$runs" $grammars
+POPULATION="$population" /usr/bin/python3 "$root/scripts/experiments/summarise.py" "$out" "$runs" $grammars
