@@ -9,7 +9,7 @@
 namespace animrt::evolve {
 namespace {
 
-std::string trim(const std::string& s) {
+std::string strip_blanks(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\n");
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t\r\n");
@@ -25,7 +25,7 @@ PhenotypeGait make_phenotype_gait(const GaitFile& seed, const std::string& pheno
   std::size_t start = 0;
   for (;;) {
     const auto semi = phenotype.find(';', start);
-    pieces.push_back(trim(phenotype.substr(start, semi - start)));
+    pieces.push_back(strip_blanks(phenotype.substr(start, semi - start)));
     if (semi == std::string::npos) break;
     start = semi + 1;
   }

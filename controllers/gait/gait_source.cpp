@@ -55,7 +55,7 @@ std::string joint_names(std::span<const JointSpec> joints) {
 }
 
 // `gait` has been validated.
-std::unique_ptr<MotionSource> bind(const GaitFile& gait, std::span<const JointSpec> joints) {
+std::unique_ptr<MotionSource> source_for(const GaitFile& gait, std::span<const JointSpec> joints) {
   std::vector<Expression> curves;
   curves.reserve(gait.curves.size());
   for (const auto& c : gait.curves) curves.push_back(Expression::compile(c.expression));
@@ -111,13 +111,13 @@ std::unique_ptr<MotionSource> bind(const GaitFile& gait, std::span<const JointSp
 
 std::unique_ptr<MotionSource> load_gait_source(const std::string& gait_path,
                                                std::span<const JointSpec> joints) {
-  return bind(load_gait_file(gait_path), joints);
+  return source_for(load_gait_file(gait_path), joints);
 }
 
 std::unique_ptr<MotionSource> make_gait_source(const GaitFile& gait,
                                                std::span<const JointSpec> joints) {
   validate_gait(gait);
-  return bind(gait, joints);
+  return source_for(gait, joints);
 }
 
 }  // namespace animrt

@@ -16,7 +16,7 @@ namespace {
 constexpr std::uint32_t kMaxName = 256;
 constexpr std::uint32_t kMaxRank = 4;
 
-struct Writer {
+struct ModelWriter {
   std::vector<std::uint8_t> bytes;
   void u32(std::uint32_t v) {
     for (int k = 0; k < 4; ++k) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
@@ -51,7 +51,7 @@ struct Writer {
   }
 };
 
-struct Reader {
+struct ModelReader {
   const detail::ByteView& in;
   std::uint64_t at = 0;
   std::uint32_t u32(const std::string& key, const std::string& what) {
@@ -160,7 +160,7 @@ std::uint64_t connectivity_hash(int vertex_count,
 }
 
 std::vector<std::uint8_t> model_file_bytes(const ModelFile& m) {
-  Writer w;
+  ModelWriter w;
   w.bytes.insert(w.bytes.end(), kModelFileMagic, kModelFileMagic + 8);
   w.u32(kModelFileVersion);
   w.u32(static_cast<std::uint32_t>(m.shape.kind));
@@ -210,7 +210,7 @@ void write_model_file(const std::string& file, const ModelFile& model) {
 
 ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::string& file) {
   const detail::ByteView in(bytes, file);
-  Reader r{in};
+  ModelReader r{in};
   in.need(0, 8, 1, "header", "magic");
   if (std::memcmp(bytes.data(), kModelFileMagic, 8) != 0) {
     detail::fail(file, "header", "not an animrt sequence model (magic is not ANSEQNN)");

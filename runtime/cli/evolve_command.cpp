@@ -44,8 +44,6 @@ struct EvolveArgs {
   std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
-constexpr int kExitUsage = 1;
-
 std::string with_extension(const std::string& path, const std::string& ext) {
   return std::filesystem::path(path).replace_extension(ext).string();
 }

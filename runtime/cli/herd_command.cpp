@@ -23,8 +23,6 @@
 namespace animrt::cli {
 namespace {
 
-constexpr int kExitUsage = 1;  // as the run command's
-
 struct HerdArgs {
   std::string scene;
   std::optional<double> duration;

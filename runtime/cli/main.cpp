@@ -36,15 +36,15 @@
 #include "herd_driver.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "subcommand.hpp"
 #include "view_command.hpp"
 
 namespace {
 
-// Exit codes (documented in the README).
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 1;
-constexpr int kExitInvalidInput = 2;
-constexpr int kExitDeviceError = 3;
+using animrt::cli::kExitDeviceError;
+using animrt::cli::kExitInvalidInput;
+using animrt::cli::kExitOk;
+using animrt::cli::kExitUsage;
 
 animrt::RunControls g_controls;
 

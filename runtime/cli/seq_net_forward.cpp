@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "subcommand.hpp"
+
 namespace animrt::cli {
 namespace {
-
-constexpr int kExitUsage = 1;
 
 // animrt-seqnet in the folder of the running animrt.
 std::string tool_path() {

@@ -9,6 +9,12 @@
 
 namespace animrt::cli {
 
+// Exit codes (documented in the README).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitUsage = 1;
+inline constexpr int kExitInvalidInput = 2;
+inline constexpr int kExitDeviceError = 3;
+
 void set_subcommand_body(CLI::App* cmd, std::function<int()> body);
 
 }  // namespace animrt::cli

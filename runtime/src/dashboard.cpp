@@ -30,8 +30,6 @@ constexpr std::array<double, 10> kJitterEdgesMs{0.0, 0.025, 0.05, 0.1, 0.25,
 constexpr std::size_t kRecentPeriods = 256;  // the rate is their mean's inverse
 constexpr std::size_t kFaultLogCapacity = 200;
 
-json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
 // The loop's statistics, from every cycle's timing as the reader drains it.
 struct LoopStats {
   MicrosHistogram period, jitter;

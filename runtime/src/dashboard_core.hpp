@@ -13,6 +13,7 @@
 
 #include <httplib.h>
 
+#include <cmath>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -23,6 +24,11 @@
 #include <thread>
 
 namespace animrt {
+
+// A number for the page; NaN and infinity (no value) become null.
+inline nlohmann::json nullable(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
 
 struct DashboardListen {
   std::string host = "127.0.0.1";

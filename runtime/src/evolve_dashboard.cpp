@@ -25,9 +25,7 @@ namespace animrt {
 namespace {
 
 using nlohmann::json;
-using Clock = std::chrono::steady_clock;
-
-json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+using SteadyClock = std::chrono::steady_clock;
 
 json generation_json(const evolve::GenerationStats& s) {
   return {{"generation", s.generation},
@@ -69,7 +67,7 @@ struct EvolveDashboardServer::Impl {
   DashboardCore core;
   std::string info;  // /api/info, built once
   std::thread sampler;
-  const Clock::time_point started = Clock::now();
+  const SteadyClock::time_point started = SteadyClock::now();
   std::atomic<bool> stop_requested{false};
 
   // Shared between the search's thread, the sampler and the handlers.
@@ -78,7 +76,7 @@ struct EvolveDashboardServer::Impl {
   std::vector<json> history;               // one entry per generation, in order
   std::shared_ptr<const BestGait> best;    // the best so far (null: none valid yet)
   std::uint64_t best_version = 0;          // bumped with every new best
-  Clock::time_point generation_started = started;
+  SteadyClock::time_point generation_started = started;
   bool ended = false;  // finish(): the sampler publishes a last frame and ends
   bool stopped = false;
   bool finished = false;
@@ -87,7 +85,7 @@ struct EvolveDashboardServer::Impl {
   std::uint64_t playing_version = 0;
   std::unique_ptr<MotionSource> source;
   double period_s = 1.0;
-  Clock::time_point play_started = started;
+  SteadyClock::time_point play_started = started;
   std::vector<JointSpec> specs;
   std::vector<double> angles;
   std::vector<BodyPose> bodies;
@@ -151,7 +149,7 @@ struct EvolveDashboardServer::Impl {
       source.reset();
       play_error = e.what();
     }
-    play_started = Clock::now();
+    play_started = SteadyClock::now();
   }
 
   std::string build_state() {
@@ -160,7 +158,7 @@ struct EvolveDashboardServer::Impl {
     json last = nullptr;
     std::size_t completed = 0;
     bool is_ended = false, is_stopped = false;
-    Clock::time_point since;
+    SteadyClock::time_point since;
     {
       std::lock_guard lock(mutex);
       b = best;
@@ -175,7 +173,7 @@ struct EvolveDashboardServer::Impl {
       playing_version = version;
       play(*b);
     }
-    const auto now = Clock::now();
+    const auto now = SteadyClock::now();
     const double t_s = std::chrono::duration<double>(now - started).count();
     double gait_t = 0.0;
     if (source) {
@@ -215,12 +213,12 @@ struct EvolveDashboardServer::Impl {
 
   void sample_loop() {
     const auto period = std::chrono::duration<double>(1.0 / setup.rate_hz);
-    auto next = Clock::now();
+    auto next = SteadyClock::now();
     for (bool last = false;;) {
       core.publish(build_state());
       std::unique_lock lock(mutex);
       if (last) return;
-      next += std::chrono::duration_cast<Clock::duration>(period);
+      next += std::chrono::duration_cast<SteadyClock::duration>(period);
       last = changed.wait_until(lock, next, [this] { return ended; });
     }
   }
@@ -304,7 +302,7 @@ void EvolveDashboardServer::publish(const evolve::GenerationStats& stats,
         best.valid && std::isfinite(best.fitness) && (!m.best || best.fitness < m.best->fitness);
     if (!improves) {
       m.history.push_back(std::move(entry));
-      m.generation_started = Clock::now();
+      m.generation_started = SteadyClock::now();
       return;
     }
   }
@@ -313,7 +311,7 @@ void EvolveDashboardServer::publish(const evolve::GenerationStats& stats,
       BestGait{stats.generation, best.fitness, best.phenotype, best.measures, best.gait});
   std::lock_guard lock(m.mutex);
   m.history.push_back(std::move(entry));
-  m.generation_started = Clock::now();
+  m.generation_started = SteadyClock::now();
   m.best = std::move(better);
   ++m.best_version;
 }

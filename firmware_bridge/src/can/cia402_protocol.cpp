@@ -13,17 +13,17 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kBusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
+constexpr std::string_view kCia402BusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
                                          "heartbeat_timeout_ms"};
-constexpr std::string_view kActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
+constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
                                               "direction"};
 
 class Cia402 final : public Protocol {
  public:
   std::string_view name() const override { return "cia402"; }
   bool shares_port() const override { return true; }
-  std::span<const std::string_view> bus_keys() const override { return kBusKeys; }
-  std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+  std::span<const std::string_view> bus_keys() const override { return kCia402BusKeys; }
+  std::span<const std::string_view> actuator_keys() const override { return kCia402ActuatorKeys; }
 
   void read_bus(const YamlNode& node, BusConfig& bus) const override {
     can_config::read_common_bus(node, bus);

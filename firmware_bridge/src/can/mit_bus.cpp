@@ -7,10 +7,6 @@
 #include "animrt/core/error.hpp"
 
 namespace animrt {
-namespace {
-constexpr int kMaxId = 0x7FF;
-}
-
 MitBus::MitBus(BusConfig config, std::unique_ptr<CanFrameTransport> transport)
     : config_(std::move(config)),
       bus_options_(options_of<MitBusOptions>(config_.options)),

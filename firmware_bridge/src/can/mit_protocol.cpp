@@ -10,8 +10,8 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kBusKeys[] = {"interface", "bitrate", "timeout_ms", "master_id"};
-constexpr std::string_view kActuatorKeys[] = {"id",
+constexpr std::string_view kMitBusKeys[] = {"interface", "bitrate", "timeout_ms", "master_id"};
+constexpr std::string_view kMitActuatorKeys[] = {"id",
                                               "model",
                                               "kp",
                                               "kd",
@@ -20,20 +20,19 @@ constexpr std::string_view kActuatorKeys[] = {"id",
                                               "position_max_rad",
                                               "velocity_max_rad_s",
                                               "torque_max_nm"};
-constexpr int kMaxId = 0x7FF;
 
 class Mit final : public Protocol {
  public:
   std::string_view name() const override { return "mit"; }
   bool shares_port() const override { return true; }
-  std::span<const std::string_view> bus_keys() const override { return kBusKeys; }
-  std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+  std::span<const std::string_view> bus_keys() const override { return kMitBusKeys; }
+  std::span<const std::string_view> actuator_keys() const override { return kMitActuatorKeys; }
 
   void read_bus(const YamlNode& node, BusConfig& bus) const override {
     can_config::read_common_bus(node, bus);
     MitBusOptions options;
     if (auto n = node.find("master_id"))
-      options.master_id = static_cast<canid_t>(n->as_int_in(0, kMaxId));
+      options.master_id = static_cast<canid_t>(n->as_int_in(0, MitBus::kMaxId));
     bus.options = options;
   }
 
@@ -42,8 +41,8 @@ class Mit final : public Protocol {
     const MitBusOptions bus_options = options_of<MitBusOptions>(bus.options);
     const YamlNode id_node = node.at("id");
     const std::int64_t id = id_node.as_int();
-    if (id < 1 || id > kMaxId || id == bus_options.master_id) {
-      id_node.fail("expected a motor id from 1 to " + std::to_string(kMaxId) +
+    if (id < 1 || id > MitBus::kMaxId || id == bus_options.master_id) {
+      id_node.fail("expected a motor id from 1 to " + std::to_string(MitBus::kMaxId) +
                    ", other than the bus's master_id " + std::to_string(bus_options.master_id) +
                    ", found " + id_node.describe());
     }
