@@ -14,6 +14,7 @@ SimRig::SimRig(const std::string& robot_file, const RigSettings& settings)
     bus.timeout_s = std::max(bus.timeout_s, settings.min_bus_timeout_s);
     bus.sim.wire_time = settings.wire_time;
   }
+  if (lockstep_) widen_timeouts_for_lockstep(robot.config.buses);  // as `animrt run --lockstep`
   if (settings.edit) settings.edit(robot.config);
   sims = start_simulated_devices(robot.config.buses, clock(), settings.physics);
   hook_ = [this](std::size_t bus, BusCall call, std::uint64_t index) {

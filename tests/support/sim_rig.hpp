@@ -94,8 +94,9 @@ class WatchedBus final : public ActuatorBus {
 
 struct RigSettings {
   bool lockstep = true;
-  // Every bus's answer timeout is raised to at least this: a loaded CI
-  // machine must not cause timeouts.
+  // Every bus's answer timeout is raised to at least this, and in lockstep
+  // to at least kLockstepMinTimeoutS: a loaded CI machine must not cause
+  // timeouts.
   double min_bus_timeout_s = 0.05;
   bool wire_time = false;                         // emulate Dynamixel wire time
   std::function<void(RobotConfig&)> edit;         // before the devices start
