@@ -40,11 +40,11 @@ int run_seq_corpus(const SeqCorpusArgs& a) {
     if (a.model.size() < 4 || a.model.compare(a.model.size() - 4, 4, ".xml") != 0) {
       std::cerr << "error: --model " << a.model
                 << ": expected horse, quadruped or an MJCF file (.xml)\n";
-      return 1;
+      return kExitUsage;
     }
     if (a.gaits.empty() || a.froude.empty()) {
       std::cerr << "error: --model " << a.model << " needs --gait and --froude\n";
-      return 1;
+      return kExitUsage;
     }
   }
   if (!a.gaits.empty()) o.gaits = a.gaits;

@@ -13,10 +13,10 @@ void set_subcommand_body(CLI::App* cmd, std::function<int()> body) {
       code = body();
     } catch (const InputError& e) {
       std::cerr << "error: " << e.what() << '\n';
-      code = 2;
+      code = kExitInvalidInput;
     } catch (const std::exception& e) {
       std::cerr << "error: " << e.what() << '\n';
-      code = 1;
+      code = kExitUsage;
     }
     if (code != 0) throw CLI::RuntimeError(code);
     throw CLI::Success();

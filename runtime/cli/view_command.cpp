@@ -29,7 +29,7 @@ int run_view(const ViewArgs& args) {
   if (!args.remote && !is_loopback_host(host)) {
     std::cerr << "error: --dashboard: " << host
               << " is not a loopback address; serving other machines needs --dashboard-remote\n";
-    return 1;
+    return kExitUsage;
   }
   const TelemetryRecording recording = load_telemetry_csv(args.csv);
   std::unique_ptr<RobotConfig> robot;

@@ -11,10 +11,9 @@ import summarise  # noqa: E402
 def run(fell_by_generation, speed, stride, duty):
     """One run's CSV rows as csv.DictReader gives them: the last row carries
     the best gait's measures."""
-    rows = [{"generation": str(g), "fell": str(f), "best_speed": str(speed),
+    return [{"generation": str(g), "fell": str(f), "best_speed": str(speed),
              "best_stride_length": str(stride), "best_duty_factor": str(duty)}
             for g, f in enumerate(fell_by_generation)]
-    return rows
 
 
 class FallsRow(unittest.TestCase):

@@ -14,9 +14,9 @@ namespace animrt {
 namespace {
 
 constexpr std::string_view kCia402BusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
-                                         "heartbeat_timeout_ms"};
+                                               "heartbeat_timeout_ms"};
 constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
-                                              "direction"};
+                                                    "direction"};
 
 class Cia402 final : public Protocol {
  public:

@@ -12,14 +12,14 @@ namespace {
 
 constexpr std::string_view kMitBusKeys[] = {"interface", "bitrate", "timeout_ms", "master_id"};
 constexpr std::string_view kMitActuatorKeys[] = {"id",
-                                              "model",
-                                              "kp",
-                                              "kd",
-                                              "zero_deg",
-                                              "direction",
-                                              "position_max_rad",
-                                              "velocity_max_rad_s",
-                                              "torque_max_nm"};
+                                                 "model",
+                                                 "kp",
+                                                 "kd",
+                                                 "zero_deg",
+                                                 "direction",
+                                                 "position_max_rad",
+                                                 "velocity_max_rad_s",
+                                                 "torque_max_nm"};
 
 class Mit final : public Protocol {
  public:
