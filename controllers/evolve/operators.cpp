@@ -74,6 +74,46 @@ std::vector<Genome> ramped_full_grow(const Grammar& grammar, int count,
   return out;
 }
 
+std::vector<Genome> ramped_structured(const Grammar& grammar, int count,
+                                      const InitSettings& settings, Rng& rng) {
+  const int lo = grammar.start().min_depth;
+  const int hi = std::max(lo, settings.max_depth);
+  const int depths = hi - lo + 1;
+  std::vector<int> segment_rules;
+  for (const std::size_t i : structured_segment_symbols(grammar)) {
+    segment_rules.push_back(grammar.start().productions.front().symbols[i].rule);
+  }
+  std::vector<std::vector<Genome>> derived(static_cast<std::size_t>(count));
+  std::size_t longest = 1;
+  for (int i = 0; i < count; ++i) {
+    const int depth = lo + i % depths;
+    const bool grow = rng.chance(settings.grow_probability);
+    for (const int rule : segment_rules) {
+      Genome segment;
+      derive(grammar, rule, 2, depth, grow, settings, rng, segment);
+      longest = std::max(longest, segment.size());
+      derived[static_cast<std::size_t>(i)].push_back(std::move(segment));
+    }
+  }
+  // Every segment of every genome gets the same length, so that fixed-point
+  // crossover and mutation keep segments where the mapping looks for them.
+  const auto length = static_cast<std::size_t>(
+      std::ceil((1.0 + settings.tail_ratio) * static_cast<double>(longest)));
+  std::vector<Genome> out;
+  out.reserve(derived.size());
+  for (auto& segments : derived) {
+    Genome g;
+    for (auto& segment : segments) {
+      while (segment.size() < length) {
+        segment.push_back(static_cast<std::uint32_t>(rng.below(settings.codon_size)));
+      }
+      g.insert(g.end(), segment.begin(), segment.end());
+    }
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
 int tournament(std::span<const double> fitness, int size, Rng& rng) {
   int best = rng.index(fitness.size());
   for (int k = 1; k < size; ++k) {

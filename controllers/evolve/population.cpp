@@ -14,7 +14,10 @@ namespace animrt::evolve {
 std::vector<Individual> initial_population(const Grammar& grammar, const SearchSettings& s,
                                            Rng& rng) {
   std::vector<Individual> pop;
-  for (auto& g : ramped_full_grow(grammar, s.population, s.init, rng)) {
+  auto genomes = s.mapping == Mapping::structured
+                     ? ramped_structured(grammar, s.population, s.init, rng)
+                     : ramped_full_grow(grammar, s.population, s.init, rng);
+  for (auto& g : genomes) {
     Individual ind;
     ind.genome = std::move(g);
     pop.push_back(std::move(ind));
@@ -42,6 +45,13 @@ void breed(const std::vector<Individual>& parents, const std::function<std::size
 PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& grammar,
                                    const GaitFile& seed)
     : config_(config), grammar_(grammar), seed_(seed) {
+  if (config_.search.mapping == Mapping::structured && structured_segments(grammar_) == 0) {
+    throw InputError(config_.search.mapping_where, "search.mapping",
+                     "structured mapping needs a grammar whose start rule has a single production "
+                     "with non-terminals in it, one codon segment each; <" +
+                         grammar_.start().name + "> in " + grammar_.file() + " has " +
+                         std::to_string(grammar_.start().productions.size()) + " production(s)");
+  }
   if (!seed_.froude) {
     throw InputError({seed_.file, 0, 0}, "froude",
                      "the seed gait of an evolve run needs froude timing (the fitness targets "
@@ -81,7 +91,9 @@ WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage,
     Individual& ind = pop[i];
     if (ind.stage == stage) continue;  // already walked under these rules
     if (ind.stage < 0) {
-      const MapResult m = map_genome(grammar_, ind.genome, limits);
+      const MapResult m = config_.search.mapping == Mapping::structured
+                              ? map_structured(grammar_, ind.genome, limits)
+                              : map_genome(grammar_, ind.genome, limits);
       ind.mapped = m.valid;
       ind.phenotype = m.phenotype;
     }

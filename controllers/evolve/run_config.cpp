@@ -41,7 +41,7 @@ RunConfig from_root(const YamlNode& root) {
 
   if (auto s = root.find("search")) {
     s->allow_only({"seed", "population", "generations", "elites", "tournament", "crossover",
-                   "mutation", "max_wraps", "max_depth", "grow_probability", "tail_ratio",
+                   "mutation", "max_wraps", "mapping", "max_depth", "grow_probability", "tail_ratio",
                    "codon_size"});
     SearchSettings& ss = c.search;
     if (auto v = s->find("seed")) ss.seed = static_cast<std::uint64_t>(v->as_int_in(0, INT64_MAX));
@@ -52,6 +52,15 @@ RunConfig from_root(const YamlNode& root) {
     ss.crossover = get_in(*s, "crossover", ss.crossover, 0, 1);
     ss.mutation = get_in(*s, "mutation", ss.mutation, 0, 1);
     ss.max_wraps = get_int(*s, "max_wraps", ss.max_wraps, 0, 100);
+    if (auto v = s->find("mapping")) {
+      const std::string m = v->as_string();
+      if (m == "structured") {
+        ss.mapping = Mapping::structured;
+      } else if (m != "standard") {
+        v->fail("expected standard or structured, got '" + m + "'");
+      }
+      ss.mapping_where = v->location();
+    }
     ss.init.max_depth = get_int(*s, "max_depth", ss.init.max_depth, 1, 100);
     ss.init.grow_probability = get_in(*s, "grow_probability", ss.init.grow_probability, 0, 1);
     ss.init.tail_ratio = get_in(*s, "tail_ratio", ss.init.tail_ratio, 0, 10);

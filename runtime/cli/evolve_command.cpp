@@ -121,8 +121,10 @@ int run_evolve(const EvolveArgs& a) {
     std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
   }
   if (lead && !a.quiet) {
-    std::cout << "evolve " << config.name << ": grammar " << config.grammar << ", model "
-              << config.model << " (" << info.joints.size() << " actuators, " << info.mass_kg
+    std::cout << "evolve " << config.name << ": grammar " << config.grammar
+              << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)"
+                                                                       : "")
+              << ", model " << config.model << " (" << info.joints.size() << " actuators, " << info.mass_kg
               << " kg), population " << config.search.population << ", "
               << config.search.generations << " generations, seed " << config.search.seed << ", "
               << workers << " worker" << (workers == 1 ? "" : "s")

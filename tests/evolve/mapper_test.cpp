@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
+#include <string>
 
 #include "animrt/controllers/evolve/operators.hpp"
 #include "animrt/controllers/gait/expression.hpp"
@@ -55,6 +57,103 @@ TEST(Mapper, WrapsAndGivesUpAfterMaxWraps) {
   EXPECT_FALSE(map_genome(g, Genome{}).valid);
   // No wrapping allowed: the wrapped genome above becomes invalid.
   EXPECT_FALSE(map_genome(g, Genome{0, 1, 2}, MapLimits{0}).valid);
+}
+
+// Two curves, as the horse grammars' twelve: <c> takes one codon, <f> is
+// recursive and so reads a variable number of codons; <sep> (the grammars'
+// <newline>) makes no choice and gets no segment.
+const char* kTwoCurves =
+    "<p> ::= <c><sep><c>\n"
+    "<sep> ::= ;\n"
+    "<c> ::= <v> | <v>+<f>\n"
+    "<f> ::= <f>+<f> | sin(<v>*t)\n"
+    "<v> ::= 1 | 2 | 3\n";
+
+TEST(Mapper, StructuredMapsEachCurveFromItsOwnSegment) {
+  const Grammar g = Grammar::parse(kTwoCurves, "two.bnf");
+  EXPECT_EQ(structured_segments(g), 2);
+  // Segment 1 {1, 2, 1, 0}: <c> 1 -> <v>+<f>; <v> 2 -> 3; <f> 1 -> sin(<v>*t); <v> 0 -> 1.
+  // Segment 2 {0, 1, 7, 7}: <c> 0 -> <v>; <v> 1 -> 2.
+  const MapResult r = map_structured(g, Genome{1, 2, 1, 0, 0, 1, 7, 7});
+  ASSERT_TRUE(r.valid);
+  EXPECT_EQ(r.phenotype, "3+sin(1*t);2");
+  EXPECT_EQ(r.codons_used, 6);
+  EXPECT_EQ(r.wraps, 0);
+  EXPECT_EQ(r.depth, 4);  // p, c, f, v
+  // Standard GE reads the same codons as one string: the second curve starts
+  // where the first one stopped, at the 5th codon.
+  EXPECT_EQ(map_genome(g, Genome{1, 2, 1, 0, 0, 1, 7, 7}).phenotype, "3+sin(1*t);2");
+  // Make the first curve a plain number (codon 1: 1 -> 0), so that it reads two
+  // codons instead of four. Standard GE's second curve now starts at the third
+  // codon; structured GE's still reads its own segment.
+  EXPECT_EQ(map_genome(g, Genome{0, 2, 1, 0, 0, 1, 7, 7}).phenotype, "3;1+sin(2*t)+sin(1*t)");
+  EXPECT_EQ(map_structured(g, Genome{0, 2, 1, 0, 0, 1, 7, 7}).phenotype, "3;2");
+}
+
+TEST(Mapper, StructuredWrapsWithinASegmentAndRejectsBadShapes) {
+  const Grammar g = Grammar::parse(kTwoCurves, "two.bnf");
+  // Segment 1 {1, 2}: <c> 1 -> <v>+<f>; <v> 2 -> 3; wrap: <f> 1 -> sin(<v>*t);
+  // <v> 2 -> 3. Segment 2 {0, 0}: <c> 0 -> <v>; <v> 0 -> 1.
+  const MapResult r = map_structured(g, Genome{1, 2, 0, 0});
+  ASSERT_TRUE(r.valid);
+  EXPECT_EQ(r.phenotype, "3+sin(3*t);1");
+  EXPECT_EQ(r.wraps, 1);
+  EXPECT_FALSE(map_structured(g, Genome{1, 2, 0, 0}, MapLimits{0}).valid);
+  // A segment that never finishes ({1, 0, 0} keeps <f> recursive) fails the
+  // genome, although the other segment maps.
+  EXPECT_FALSE(map_structured(g, Genome{1, 0, 0, 0, 0, 0}).valid);
+  EXPECT_TRUE(map_structured(g, Genome{0, 0, 0, 0, 0, 0}).valid);
+  // The genome must split into whole segments.
+  EXPECT_FALSE(map_structured(g, Genome{0, 0, 0}).valid);
+  EXPECT_FALSE(map_structured(g, Genome{}).valid);
+  // A start rule with several productions has no segments.
+  const Grammar small = Grammar::parse(
+      "<e> ::= <e>+<e> | <v>\n<v> ::= 1 | 2\n", "choice.bnf");
+  EXPECT_EQ(structured_segments(small), 0);
+  EXPECT_FALSE(map_structured(small, Genome{0, 1, 1, 0}).valid);
+}
+
+TEST(Operators, StructuredInitialisationAlignsSegmentsThroughCrossover) {
+  const Grammar g = Grammar::parse(kTwoCurves, "two.bnf");
+  Rng rng(5);
+  InitSettings s;
+  s.max_depth = 6;
+  const auto pop = ramped_structured(g, 30, s, rng);
+  ASSERT_EQ(pop.size(), 30u);
+  const std::size_t length = pop.front().size();
+  ASSERT_EQ(length % 2, 0u);
+  std::set<std::string> phenotypes;
+  for (const auto& genome : pop) {
+    EXPECT_EQ(genome.size(), length);
+    const MapResult r = map_structured(g, genome, MapLimits{0});
+    ASSERT_TRUE(r.valid);
+    EXPECT_LE(r.depth, 6);
+    phenotypes.insert(r.phenotype);
+  }
+  EXPECT_GT(phenotypes.size(), 10u);
+  // Equal lengths: crossover keeps them, so a child's second curve is one of
+  // its parents' second curves whenever the cut is in the first segment.
+  Genome a = pop[0], b = pop[1];
+  const std::string b_phenotype = map_structured(g, b).phenotype;
+  const std::string second_b = b_phenotype.substr(b_phenotype.find(';'));
+  int cuts_in_first = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    Genome x = a, y = b;
+    fixed_point_crossover(x, y, 1.0, rng);
+    ASSERT_EQ(x.size(), length);
+    ASSERT_EQ(y.size(), length);
+    // x took b's codons from the cut on; when its whole second segment is
+    // b's, so is its second curve.
+    if (!std::equal(x.begin() + static_cast<std::ptrdiff_t>(length / 2), x.end(),
+                    b.begin() + static_cast<std::ptrdiff_t>(length / 2))) {
+      continue;
+    }
+    ++cuts_in_first;
+    const MapResult rx = map_structured(g, x);
+    ASSERT_TRUE(rx.valid);
+    EXPECT_EQ(rx.phenotype.substr(rx.phenotype.find(';')), second_b);
+  }
+  EXPECT_GT(cuts_in_first, 10);
 }
 
 TEST(Operators, InitialisationRampsDepthAndMapsValid) {

@@ -26,6 +26,7 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "support/files.hpp"
+#include "support/sim_rig.hpp"
 
 namespace animrt {
 namespace {
@@ -207,6 +208,8 @@ TEST_F(PhysicsBackend, LockstepRunsAreIdentical) {
   const std::string file = robot("twice", kSourceRoot + "/configs/gaits/quadruped_evolved.yaml");
   const Outcome a = run_on_physics(file, 1.0, false);
   const Outcome b = run_on_physics(file, 1.0, false);
+  EXPECT_EQ(test::lockstep_problems(a.summary), "");
+  EXPECT_EQ(test::lockstep_problems(b.summary), "");
   EXPECT_EQ(a.physics.steps, b.physics.steps);
   EXPECT_EQ(a.physics.forward_m, b.physics.forward_m);
   EXPECT_EQ(a.physics.motion_s, b.physics.motion_s);
@@ -242,6 +245,8 @@ TEST_F(PhysicsBackend, TwoBusLockstepRunsOfTheHorseAreIdentical) {
   files_.push_back(write_horse_robot("horse_twice"));
   const Outcome a = run_on_physics(files_.back(), 1.5, false, kHorseModel);
   const Outcome b = run_on_physics(files_.back(), 1.5, false, kHorseModel);
+  EXPECT_EQ(test::lockstep_problems(a.summary), "");
+  EXPECT_EQ(test::lockstep_problems(b.summary), "");
   EXPECT_EQ(a.physics.lockstep_waits_timed_out, 0);
   EXPECT_EQ(a.physics.steps, b.physics.steps);
   EXPECT_EQ(a.physics.forward_m, b.physics.forward_m);

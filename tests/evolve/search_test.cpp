@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -127,6 +128,37 @@ TEST(Search, InvalidIndividualsScoreWorstAndAreCounted) {
               ((n - expected_invalid) * valid_score + expected_invalid * kWorstFitness) / n, 1e-6);
 }
 
+TEST(Search, StructuredMappingNeedsOneStartProductionAndMapsEveryCurve) {
+  RunConfig c = tiny_run();
+  c.search.population = 12;
+  c.search.generations = 1;
+  c.search.mapping = Mapping::structured;
+  const GaitFile seed = load_gait_file(c.seed_gait);
+  // Every curve's segment maps, so nobody is invalid, and the children of
+  // crossover still split into three segments.
+  const Grammar g = Grammar::parse(
+      "<p> ::= <c>;<c>;<c>\n<c> ::= <c>+<c> | sin(2*PI*t) | 2*sin(2*PI*t)\n", "three.bnf");
+  FakeEvaluator fake;
+  const SearchResult r = Search(c, g, seed, {{}, 0.18, 1.6}, fake).run();
+  ASSERT_EQ(r.history.size(), 2u);
+  EXPECT_EQ(r.history[0].invalid, 0);
+  EXPECT_EQ(r.history[1].invalid, 0);
+  EXPECT_EQ(std::count(r.best.phenotype.begin(), r.best.phenotype.end(), ';'), 2);
+  // A start rule with a choice cannot be cut into curves.
+  const Grammar choice = Grammar::parse(
+      "<p> ::= <c>;<c>;<c> | <c>;<c>;<c>\n<c> ::= sin(2*PI*t) | 2*sin(2*PI*t)\n", "choice.bnf");
+  c.search.mapping_where = {"run.yaml", 7, 12};
+  try {
+    Search(c, choice, seed, {{}, 0.18, 1.6}, fake);
+    ADD_FAILURE() << "structured mapping accepted a start rule with two productions";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "search.mapping");
+    EXPECT_EQ(e.where().line, 7);
+    EXPECT_NE(std::string(e.what()).find("choice.bnf has 2 production(s)"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {
   RunConfig c = tiny_run();
   c.search.generations = 10;
@@ -189,7 +221,12 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 3}]}\n"),
             "run.yaml:5:39: fitness.weights[0].from_generation: the first stage must start at "
             "generation 0");
+  EXPECT_EQ(error_of(head + "search: {mapping: tree}\n"),
+            "run.yaml:5:19: search.mapping: expected standard or structured, got 'tree'");
+  EXPECT_EQ(parse_run_config(head + "search: {mapping: structured}\n", "run.yaml").search.mapping,
+            Mapping::structured);
   const RunConfig ok = parse_run_config(head, "/a/b/run.yaml");
+  EXPECT_EQ(ok.search.mapping, Mapping::standard);
   EXPECT_EQ(ok.grammar, "/a/b/g.bnf");
   EXPECT_EQ(ok.search.population, 75);
   EXPECT_EQ(ok.search.elites, 7);
@@ -218,11 +255,15 @@ TEST(RunConfig, MissingModelIsReportedAtItsKey) {
 TEST(RunConfig, ShippedRunFilesLoad) {
   for (const char* f : {"horse_numerical", "horse_concatenating", "horse_hybrid",
                         "horse_sinusoidal", "horse_free", "horse_concatenating_varying_weights",
-                        "horse_concatenating_varying_freedom", "quadruped_concatenating"}) {
+                        "horse_concatenating_varying_freedom", "horse_hybrid_structured",
+                        "quadruped_concatenating"}) {
     const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;
   }
+  const RunConfig h = load_run_config(kSourceRoot + "/configs/evolve/horse_hybrid_structured.yaml");
+  EXPECT_EQ(h.search.mapping, Mapping::structured);
+  EXPECT_EQ(structured_segments(Grammar::load_file(h.grammar)), 12);
   const RunConfig w =
       load_run_config(kSourceRoot + "/configs/evolve/horse_concatenating_varying_weights.yaml");
   ASSERT_EQ(w.weights.size(), 5u);

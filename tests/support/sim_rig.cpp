@@ -1,5 +1,6 @@
 #include "support/sim_rig.hpp"
 
+#include <fstream>
 #include <stdexcept>
 
 #include "animrt/sim/simulated_backend.hpp"
@@ -115,6 +116,40 @@ RunSummary SimRig::run_watching(RunAllocationWatch& watch, const RunOptions& opt
     }
   } reset{*this};
   return runner_->run(watched);
+}
+
+std::string lockstep_problems(const RunSummary& s) {
+  std::string out;
+  for (const auto& bus : s.buses) {
+    if (bus.late_cycles != 0) {
+      out += "bus " + bus.name + ": " + std::to_string(bus.late_cycles) + " late cycles\n";
+    }
+  }
+  for (const auto& d : s.devices) {
+    const std::uint64_t errors = d.status.timeouts + d.status.crc_errors + d.status.protocol_errors;
+    if (errors != 0) {
+      out += d.joint + ": " + std::to_string(d.status.timeouts) + " timeouts, " +
+             std::to_string(d.status.crc_errors) + " CRC errors, " +
+             std::to_string(d.status.protocol_errors) + " protocol errors\n";
+    }
+  }
+  return out;
+}
+
+std::string first_difference(const std::string& file_a, const std::string& file_b) {
+  std::ifstream a(file_a), b(file_b);
+  std::string la, lb;
+  for (int line = 1;; ++line) {
+    const bool more_a = static_cast<bool>(std::getline(a, la));
+    const bool more_b = static_cast<bool>(std::getline(b, lb));
+    if (!more_a && !more_b) return "";
+    if (!more_a) la = "(end of file)";
+    if (!more_b) lb = "(end of file)";
+    if (la != lb) {
+      return "line " + std::to_string(line) + ":\n  " + file_a + ": " + la + "\n  " + file_b +
+             ": " + lb;
+    }
+  }
 }
 
 }  // namespace animrt::test

@@ -32,6 +32,16 @@ Genome derive_genome(const Grammar& grammar, int depth, bool grow, const InitSet
 std::vector<Genome> ramped_full_grow(const Grammar& grammar, int count,
                                      const InitSettings& settings, Rng& rng);
 
+// Genomes for structured mapping (mapper.hpp): the same ramp, each segment
+// derived from its own non-terminal of the start rule's production, then every
+// segment of every genome padded with random codons to one length,
+// (1 + tail_ratio) times the longest derived segment. Equal lengths keep the
+// segments aligned through fixed-point crossover, which then swaps whole
+// later segments and splits at most one. Empty genomes when the start rule has
+// several productions.
+std::vector<Genome> ramped_structured(const Grammar& grammar, int count,
+                                      const InitSettings& settings, Rng& rng);
+
 // Index of the best (lowest fitness; earlier index on ties) of `size`
 // individuals drawn uniformly with replacement.
 int tournament(std::span<const double> fitness, int size, Rng& rng);

@@ -13,6 +13,11 @@
 
 namespace animrt::evolve {
 
+// How a genome becomes a phenotype (mapper.hpp): standard GE reads one codon
+// string for the whole derivation; structured reads each top-level
+// non-terminal from its own segment.
+enum class Mapping { standard, structured };
+
 struct SearchSettings {
   std::uint64_t seed = 1;
   int population = 75;
@@ -22,6 +27,8 @@ struct SearchSettings {
   double crossover = 0.9;
   double mutation = 0.02;
   int max_wraps = 3;
+  Mapping mapping = Mapping::standard;
+  Location mapping_where;  // of the `mapping` key, for errors that need the grammar
   InitSettings init;
 };
 
