@@ -19,7 +19,8 @@
 #
 # Output: OUT_DIR/table.md (mean and standard deviation over runs of the last
 # generation's best and average fitness, beside the paper's), OUT_DIR/ranks.md
-# (Mann-Whitney U tests of the paper's claims), OUT_DIR/falls.md (falls from
+# (Mann-Whitney U tests of the paper's claims, and of structured mapping's
+# falls against the hybrid's), OUT_DIR/falls.md (falls from
 # generation 10 on; the best gaits against the Froude targets), OUT_DIR/best.svg and
 # average.svg (gnuplot), OUT_DIR/timing.txt (wall time of every run).
 set -euo pipefail
@@ -31,7 +32,9 @@ population="${POPULATION:-75}"
 generations="${GENERATIONS:-50}"
 ranks="${RANKS:-1}"
 threads="${THREADS:-0}"
-grammars="${GRAMMARS:-hybrid concatenating sinusoidal numerical free concatenating_varying_weights concatenating_varying_freedom}"
+# The paper's seven configurations, then the hybrid grammar with structured
+# mapping (ours, beyond the paper: configs/evolve/horse_hybrid_structured.yaml).
+grammars="${GRAMMARS:-hybrid concatenating sinusoidal numerical free concatenating_varying_weights concatenating_varying_freedom hybrid_structured}"
 mkdir -p "$out"
 
 launch=()

@@ -1,5 +1,5 @@
-"""The falls summary of scripts/experiments/summarise.py (falls.md) against
-an example worked by hand."""
+"""The falls summary of scripts/experiments/summarise.py (falls.md) and the
+structured-mapping rank test (ranks.md) against examples worked by hand."""
 import os
 import sys
 import unittest
@@ -35,6 +35,35 @@ class FallsRow(unittest.TestCase):
 
     def test_a_run_that_ended_before_generation_ten_gives_no_row(self):
         self.assertIsNone(summarise.falls_row("free", [run([1] * 5, 1, 1, 1)], 4))
+
+
+class RankClaims(unittest.TestCase):
+    def rows(self, text):
+        return [[c.strip() for c in line.strip("|").split("|")]
+                for line in text.strip().splitlines()[2:]]
+
+    def test_structured_mapping_against_the_hybrid_on_each_runs_falls(self):
+        # Every structured run falls less than every standard one: U = 0, and
+        # of the C(8, 4) = 70 ways to rank 4 + 4 runs only this one gives it,
+        # p = 1/70 = 0.0143.
+        falls = {"hybrid": [0.5, 0.4, 0.3, 0.45], "hybrid_structured": [0.1, 0.2, 0.05, 0.15]}
+        rows = self.rows(summarise.rank_claims({}, falls))
+        self.assertEqual(len(rows), 1)
+        self.assertEqual(rows[0][0], "structured mapping: fewer falls from gen 10 than")
+        self.assertEqual(rows[0][2:4], ["0.0", "0.0143"])
+        self.assertEqual(rows[0][5], "yes")
+        # Swapped, the claim does not hold: U = 16, p = 1.
+        swapped = {"hybrid": falls["hybrid_structured"], "hybrid_structured": falls["hybrid"]}
+        rows = self.rows(summarise.rank_claims({}, swapped))
+        self.assertEqual(rows[0][2:4], ["16.0", "1.0000"])
+        self.assertEqual(rows[0][5], "no")
+
+    def test_the_papers_claims_compare_only_the_papers_configurations(self):
+        finals = {"hybrid": [90, 91], "free": [100, 120], "hybrid_structured": [80, 81]}
+        rows = self.rows(summarise.rank_claims(finals))
+        against = [r[1] for r in rows]
+        self.assertEqual(against, ["free", "hybrid", "hybrid"])  # best; worst; most variable
+        self.assertNotIn("hybrid_structured", against)
 
 
 if __name__ == "__main__":
