@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string_view>
 
 #include "animrt/controllers/evolve/operators.hpp"
 #include "animrt/controllers/evolve/phenotype.hpp"
@@ -81,12 +82,19 @@ int PopulationWalker::stage_at(int generation) const {
   return stage;
 }
 
-WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage,
-                                 Evaluator& evaluator) const {
+WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator) {
   static const std::vector<std::string> kNoneHeld;
   const auto& held = held_.empty() ? kNoneHeld : held_[static_cast<std::size_t>(stage)];
+  if (walked_.size() <= static_cast<std::size_t>(stage)) {
+    walked_.resize(static_cast<std::size_t>(stage) + 1);
+  }
+  auto& walked = walked_[static_cast<std::size_t>(stage)];
+  if (walked.size() > kRememberedWalks) walked.clear();
   const MapLimits limits{config_.search.max_wraps};
-  std::vector<std::size_t> todo;
+  WalkBatch batch;
+  std::vector<std::size_t> todo;     // the first individual of each phenotype to walk
+  std::vector<std::size_t> repeats;  // later individuals with one of those phenotypes
+  std::unordered_map<std::string_view, std::size_t> first_of;
   for (std::size_t i = 0; i < pop.size(); ++i) {
     Individual& ind = pop[i];
     if (ind.stage == stage) continue;  // already walked under these rules
@@ -99,26 +107,36 @@ WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage,
     }
     ind.valid = ind.mapped;
     ind.stage = stage;
-    if (ind.valid) {
-      PhenotypeGait pg = make_phenotype_gait(seed_, ind.phenotype, held);
-      ind.valid = pg.valid;
-      if (pg.valid) {
-        ind.gait = std::move(pg.gait);
-        ind.gait.name = config_.name;
-      }
-    }
     ind.measures = GaitMeasures{};
-    if (ind.valid) todo.push_back(i);
+    if (!ind.valid) continue;
+    PhenotypeGait pg = make_phenotype_gait(seed_, ind.phenotype, held);
+    ind.valid = pg.valid;
+    if (!pg.valid) continue;
+    ind.gait = std::move(pg.gait);
+    ind.gait.name = config_.name;
+    if (const auto it = walked.find(ind.phenotype); it != walked.end()) {
+      ind.measures = it->second;
+      ++batch.reused;
+    } else if (first_of.contains(ind.phenotype)) {
+      repeats.push_back(i);
+      ++batch.reused;
+    } else {
+      first_of.emplace(ind.phenotype, i);
+      todo.push_back(i);
+    }
   }
   std::vector<const GaitFile*> gaits;
   for (auto i : todo) gaits.push_back(&pop[i].gait);
   std::vector<GaitMeasures> measures(gaits.size());
   const auto t0 = std::chrono::steady_clock::now();
   evaluator.walk_all(gaits, config_.walk, measures);
-  WalkBatch batch;
   batch.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   batch.evaluations = static_cast<int>(todo.size());
-  for (std::size_t k = 0; k < todo.size(); ++k) pop[todo[k]].measures = measures[k];
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    pop[todo[k]].measures = measures[k];
+    walked.emplace(pop[todo[k]].phenotype, measures[k]);
+  }
+  for (auto i : repeats) pop[i].measures = pop[first_of.at(pop[i].phenotype)].measures;
   return batch;
 }
 

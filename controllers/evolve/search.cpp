@@ -24,6 +24,7 @@ void Search::evaluate(std::vector<Individual>& pop, int generation, GenerationSt
   const WalkBatch batch = walker_.walk(pop, walker_.stage_at(generation), evaluator_);
   stats.seconds = batch.seconds;
   stats.evaluations = batch.evaluations;
+  stats.reused = batch.reused;
   // Scores follow the generation's weights, also for elites walked earlier.
   const FitnessWeights& w = weights_at(config_.weights, generation);
   for (auto& ind : pop) {
@@ -67,6 +68,7 @@ SearchResult Search::run(const SearchHooks& hooks) {
     st.best_phenotype = best.phenotype;
     st.best_measures = best.measures;
     result.evaluations += st.evaluations;
+    result.reused += st.reused;
     result.invalid += st.invalid;
     result.history.push_back(st);
     if (hooks.generation) hooks.generation(st, best);

@@ -175,7 +175,8 @@ int run_evolve(const EvolveArgs& a) {
   std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
             << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
             << ", energy " << m.energy_per_cycle << " J/cycle\n"
-            << "evaluations " << result.evaluations << ", invalid " << result.invalid << '\n'
+            << "evaluations " << result.evaluations << " (and " << result.reused
+            << " repeated gaits not walked again), invalid " << result.invalid << '\n'
             << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
   return 0;
 }

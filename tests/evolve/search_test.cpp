@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/evolve/phenotype.hpp"
@@ -110,17 +111,26 @@ TEST(Search, InvalidIndividualsScoreWorstAndAreCounted) {
       "<p> ::= <c>;<c>;<c>\n<c> ::= 1e308*1e308 | sin(2*PI*t) | 2*sin(2*PI*t)\n", "inv.bnf");
   Rng rng(c.search.seed);
   int expected_invalid = 0;
+  std::set<std::string> valid_phenotypes;  // each is walked once
   for (const auto& genome : ramped_full_grow(g, c.search.population, c.search.init, rng)) {
     const MapResult r = map_genome(g, genome);
-    expected_invalid += r.phenotype.find("1e308") != std::string::npos;
+    if (r.phenotype.find("1e308") != std::string::npos) {
+      ++expected_invalid;
+    } else {
+      valid_phenotypes.insert(r.phenotype);
+    }
   }
   ASSERT_GT(expected_invalid, 0);
   ASSERT_LT(expected_invalid, c.search.population);
+  const int valid = c.search.population - expected_invalid;
+  ASSERT_LT(static_cast<int>(valid_phenotypes.size()), valid);  // some repeat (8 possible)
   FakeEvaluator fake;
   Search search(c, g, load_gait_file(c.seed_gait), {{}, 0.18, 1.6}, fake);
   const SearchResult r = search.run();
   EXPECT_EQ(r.history[0].invalid, expected_invalid);
-  EXPECT_EQ(fake.walked, c.search.population - expected_invalid);
+  EXPECT_EQ(fake.walked, static_cast<int>(valid_phenotypes.size()));
+  EXPECT_EQ(r.history[0].evaluations, fake.walked);
+  EXPECT_EQ(r.history[0].reused, valid - fake.walked);
   const double valid_score = r.history[0].best;
   EXPECT_LT(valid_score, kWorstFitness);
   const double n = c.search.population;
@@ -157,6 +167,51 @@ TEST(Search, StructuredMappingNeedsOneStartProductionAndMapsEveryCurve) {
     EXPECT_NE(std::string(e.what()).find("choice.bnf has 2 production(s)"), std::string::npos)
         << e.what();
   }
+}
+
+// Measures that follow the gait's first curve, so that a walk's result can be
+// told apart from another's; counts the walks.
+class CurveEvaluator final : public Evaluator {
+ public:
+  void walk_all(std::span<const GaitFile* const> gaits, const WalkSettings&,
+                std::span<GaitMeasures> out) override {
+    for (std::size_t i = 0; i < gaits.size(); ++i) {
+      out[i] = GaitMeasures{};
+      out[i].speed = 0.01 * static_cast<double>(gaits[i]->curves.front().expression.size());
+      out[i].stride_length = 0.05;
+      out[i].duty_factor = 0.7;
+      ++walked;
+    }
+  }
+  int workers() const override { return 1; }
+  int walked = 0;
+};
+
+TEST(Search, ARepeatedGaitIsNotWalkedAgainAndKeepsItsMeasures) {
+  RunConfig c = tiny_run();
+  c.search.population = 30;
+  c.search.generations = 6;
+  const Grammar g = Grammar::parse(
+      "<p> ::= <c>;<c>;<c>\n<c> ::= <c>+<c> | sin(2*PI*t) | 2*sin(2*PI*t) | 0.5\n", "four.bnf");
+  const GaitFile seed = load_gait_file(c.seed_gait);
+  CurveEvaluator fake;
+  const SearchResult r = Search(c, g, seed, {{}, 0.18, 1.6}, fake).run();
+  long evaluations = 0, reused = 0;
+  for (const auto& st : r.history) {
+    evaluations += st.evaluations;
+    reused += st.reused;
+  }
+  EXPECT_EQ(evaluations, fake.walked);
+  EXPECT_EQ(r.evaluations, evaluations);
+  EXPECT_EQ(r.reused, reused);
+  EXPECT_GT(reused, 0);
+  // Every individual that was walked or reused counts once per generation
+  // (elites keep their walk and count in neither).
+  EXPECT_EQ(r.history[0].evaluations + r.history[0].reused + r.history[0].invalid,
+            c.search.population);
+  // The best's measures are its own gait's, whether walked or reused.
+  EXPECT_DOUBLE_EQ(r.best.measures.speed, 0.01 * static_cast<double>(
+                                                      r.best.gait.curves.front().expression.size()));
 }
 
 TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {

@@ -5,8 +5,10 @@
 // the valid gaits through the evaluator in one batch. Used by the
 // single-objective GE search and by the Pareto search.
 
+#include <cstddef>
 #include <functional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
@@ -30,6 +32,7 @@ struct Individual {
 
 struct WalkBatch {
   int evaluations = 0;   // walks simulated
+  int reused = 0;        // gaits not walked again: the same phenotype was walked before
   double seconds = 0.0;  // wall time of those walks
 };
 
@@ -53,14 +56,22 @@ class PopulationWalker {
   int stage_at(int generation) const;
 
   // Maps and walks every individual not yet walked under `stage`; the others
-  // keep their measures.
-  WalkBatch walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator) const;
+  // keep their measures. A phenotype walked before under the same stage (in
+  // this batch or an earlier one) is not walked again: a walk depends only
+  // on its gait, so its measures are the same. Children often repeat a
+  // parent (a mutation in codons the mapping never reads, a crossover of two
+  // equal parents), more so as a population converges.
+  WalkBatch walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator);
+
+  // Phenotypes remembered per stage before the memory starts afresh.
+  static constexpr std::size_t kRememberedWalks = 50000;
 
  private:
   const RunConfig& config_;
   const Grammar& grammar_;
   const GaitFile& seed_;
   std::vector<std::vector<std::string>> held_;  // per freedom stage
+  std::vector<std::unordered_map<std::string, GaitMeasures>> walked_;  // per stage
 };
 
 }  // namespace animrt::evolve

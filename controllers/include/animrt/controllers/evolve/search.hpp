@@ -27,6 +27,7 @@ struct GenerationStats {
   int invalid = 0;       // individuals that did not map to a usable gait
   int fell = 0;          // valid individuals whose walk fell
   int evaluations = 0;   // walks simulated this generation
+  int reused = 0;        // gaits whose phenotype was walked before (population.hpp)
   double seconds = 0.0;  // wall time of this generation's evaluations
   std::string best_phenotype;
   GaitMeasures best_measures;
@@ -36,6 +37,7 @@ struct SearchResult {
   std::vector<GenerationStats> history;
   Individual best;  // best of the last generation
   long evaluations = 0;
+  long reused = 0;
   long invalid = 0;
   bool stopped = false;  // SearchHooks::stop ended the run before its last generation
 };
