@@ -46,17 +46,21 @@ void breed(const std::vector<Individual>& parents, const std::function<std::size
 PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& grammar,
                                    const GaitFile& seed)
     : config_(config), grammar_(grammar), seed_(seed) {
-  if (config_.search.mapping == Mapping::structured && structured_segments(grammar_) == 0) {
-    throw InputError(config_.search.mapping_where, "search.mapping",
-                     "structured mapping needs a grammar whose start rule has a single production "
-                     "with non-terminals in it, one codon segment each; <" +
-                         grammar_.start().name + "> in " + grammar_.file() + " has " +
-                         std::to_string(grammar_.start().productions.size()) + " production(s)");
-  }
-  if (!seed_.froude) {
-    throw InputError({seed_.file, 0, 0}, "froude",
-                     "the seed gait of an evolve run needs froude timing (the fitness targets "
-                     "come from the Froude number)");
+  if (config_.search.mapping == Mapping::structured) {
+    const Rule& start = grammar_.start();
+    if (start.productions.size() != 1) {
+      throw InputError(config_.search.mapping_where, "search.mapping",
+                       "structured mapping needs a start rule with a single production (one "
+                       "codon segment per curve in it); <" +
+                           start.name + "> in " + grammar_.file() + " has " +
+                           std::to_string(start.productions.size()) + " productions");
+    }
+    if (structured_segments(grammar_) == 0) {
+      throw InputError(config_.search.mapping_where, "search.mapping",
+                       "structured mapping found nothing to map: no non-terminal of <" +
+                           start.name + ">'s production in " + grammar_.file() +
+                           " makes a choice, so there are no codon segments");
+    }
   }
   const auto means = curve_means(seed_);
   for (const auto& stage : config_.freedom) {
@@ -85,11 +89,10 @@ int PopulationWalker::stage_at(int generation) const {
 WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator) {
   static const std::vector<std::string> kNoneHeld;
   const auto& held = held_.empty() ? kNoneHeld : held_[static_cast<std::size_t>(stage)];
-  if (walked_.size() <= static_cast<std::size_t>(stage)) {
-    walked_.resize(static_cast<std::size_t>(stage) + 1);
-  }
-  auto& walked = walked_[static_cast<std::size_t>(stage)];
-  if (walked.size() > kRememberedWalks) walked.clear();
+  // Stages only move forward: the walks of earlier ones are not needed again.
+  if (stage != walked_stage_) walked_.clear();
+  walked_stage_ = stage;
+  if (walked_.size() > kRememberedWalks || !config_.search.remember_walks) walked_.clear();
   const MapLimits limits{config_.search.max_wraps};
   WalkBatch batch;
   std::vector<std::size_t> todo;     // the first individual of each phenotype to walk
@@ -114,10 +117,10 @@ WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage, Evalua
     if (!pg.valid) continue;
     ind.gait = std::move(pg.gait);
     ind.gait.name = config_.name;
-    if (const auto it = walked.find(ind.phenotype); it != walked.end()) {
+    if (const auto it = walked_.find(ind.phenotype); it != walked_.end()) {
       ind.measures = it->second;
       ++batch.reused;
-    } else if (first_of.contains(ind.phenotype)) {
+    } else if (config_.search.remember_walks && first_of.contains(ind.phenotype)) {
       repeats.push_back(i);
       ++batch.reused;
     } else {
@@ -134,7 +137,7 @@ WalkBatch PopulationWalker::walk(std::vector<Individual>& pop, int stage, Evalua
   batch.evaluations = static_cast<int>(todo.size());
   for (std::size_t k = 0; k < todo.size(); ++k) {
     pop[todo[k]].measures = measures[k];
-    walked.emplace(pop[todo[k]].phenotype, measures[k]);
+    if (config_.search.remember_walks) walked_.emplace(pop[todo[k]].phenotype, measures[k]);
   }
   for (auto i : repeats) pop[i].measures = pop[first_of.at(pop[i].phenotype)].measures;
   return batch;

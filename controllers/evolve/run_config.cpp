@@ -41,8 +41,8 @@ RunConfig from_root(const YamlNode& root) {
 
   if (auto s = root.find("search")) {
     s->allow_only({"seed", "population", "generations", "elites", "tournament", "crossover",
-                   "mutation", "max_wraps", "mapping", "max_depth", "grow_probability", "tail_ratio",
-                   "codon_size"});
+                   "mutation", "max_wraps", "mapping", "remember_walks", "max_depth",
+                   "grow_probability", "tail_ratio", "codon_size"});
     SearchSettings& ss = c.search;
     if (auto v = s->find("seed")) ss.seed = static_cast<std::uint64_t>(v->as_int_in(0, INT64_MAX));
     ss.population = get_int(*s, "population", ss.population, 2, 1000000);
@@ -61,6 +61,7 @@ RunConfig from_root(const YamlNode& root) {
       }
       ss.mapping_where = v->location();
     }
+    if (auto v = s->find("remember_walks")) ss.remember_walks = v->as_bool();
     ss.init.max_depth = get_int(*s, "max_depth", ss.init.max_depth, 1, 100);
     ss.init.grow_probability = get_in(*s, "grow_probability", ss.init.grow_probability, 0, 1);
     ss.init.tail_ratio = get_in(*s, "tail_ratio", ss.init.tail_ratio, 0, 10);

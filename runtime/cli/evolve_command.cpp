@@ -124,8 +124,8 @@ int run_evolve(const EvolveArgs& a) {
     std::cout << "evolve " << config.name << ": grammar " << config.grammar
               << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)"
                                                                        : "")
-              << ", model " << config.model << " (" << info.joints.size() << " actuators, " << info.mass_kg
-              << " kg), population " << config.search.population << ", "
+              << ", model " << config.model << " (" << info.joints.size() << " actuators, "
+              << info.mass_kg << " kg), population " << config.search.population << ", "
               << config.search.generations << " generations, seed " << config.search.seed << ", "
               << workers << " worker" << (workers == 1 ? "" : "s")
               << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'

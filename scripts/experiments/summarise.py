@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Summarises evolve runs written by table5.sh: OUT/table.md, OUT/ranks.md
-(Mann-Whitney U tests of the paper's claims), OUT/falls.md (falls from
+(Mann-Whitney U tests of the paper's claims, and of structured mapping's
+falls against the hybrid's), OUT/falls.md (falls from
 generation 10 on, and the best gaits against the Froude targets) and plots.
 Runs not finished yet are left out, and each table says how many it has.
 
@@ -139,8 +140,8 @@ def main():
         if not datas:
             continue
         finals[g] = best
-        settled = [settled_falls(data, population) for data in datas]
-        if all(settled):
+        settled = [x for x in (settled_falls(data, population) for data in datas) if x]
+        if settled:  # runs that ended before SETTLED_FROM are left out
             run_falls[g] = [sum(x) / len(x) for x in settled]
         b, bsd = mean_sd(best)
         a, asd = mean_sd(avg)

@@ -54,6 +54,8 @@ TEST(Mapper, WrapsAndGivesUpAfterMaxWraps) {
   const MapResult bad = map_genome(g, Genome{0, 0, 0}, MapLimits{3});
   EXPECT_FALSE(bad.valid);
   EXPECT_EQ(bad.codons_used, 12);  // 3 codons read 4 times
+  EXPECT_EQ(bad.wraps, 3);
+  EXPECT_EQ(bad.phenotype, "");
   EXPECT_FALSE(map_genome(g, Genome{}).valid);
   // No wrapping allowed: the wrapped genome above becomes invalid.
   EXPECT_FALSE(map_genome(g, Genome{0, 1, 2}, MapLimits{0}).valid);
@@ -107,8 +109,7 @@ TEST(Mapper, StructuredWrapsWithinASegmentAndRejectsBadShapes) {
   EXPECT_FALSE(map_structured(g, Genome{0, 0, 0}).valid);
   EXPECT_FALSE(map_structured(g, Genome{}).valid);
   // A start rule with several productions has no segments.
-  const Grammar small = Grammar::parse(
-      "<e> ::= <e>+<e> | <v>\n<v> ::= 1 | 2\n", "choice.bnf");
+  const Grammar small = Grammar::parse("<e> ::= <e>+<e> | <v>\n<v> ::= 1 | 2\n", "choice.bnf");
   EXPECT_EQ(structured_segments(small), 0);
   EXPECT_FALSE(map_structured(small, Genome{0, 1, 1, 0}).valid);
 }

@@ -210,6 +210,7 @@ TEST_F(PhysicsBackend, LockstepRunsAreIdentical) {
   const Outcome b = run_on_physics(file, 1.0, false);
   EXPECT_EQ(test::lockstep_problems(a.summary), "");
   EXPECT_EQ(test::lockstep_problems(b.summary), "");
+  EXPECT_EQ(a.physics.lockstep_waits_timed_out, 0);
   EXPECT_EQ(a.physics.steps, b.physics.steps);
   EXPECT_EQ(a.physics.forward_m, b.physics.forward_m);
   EXPECT_EQ(a.physics.motion_s, b.physics.motion_s);

@@ -153,33 +153,43 @@ TEST(Search, StructuredMappingNeedsOneStartProductionAndMapsEveryCurve) {
   ASSERT_EQ(r.history.size(), 2u);
   EXPECT_EQ(r.history[0].invalid, 0);
   EXPECT_EQ(r.history[1].invalid, 0);
-  EXPECT_EQ(std::count(r.best.phenotype.begin(), r.best.phenotype.end(), ';'), 2);
+  EXPECT_EQ(r.best.genome.size() % 3, 0u);
+  EXPECT_EQ(map_structured(g, r.best.genome).phenotype, r.best.phenotype);
+  EXPECT_NE(map_genome(g, r.best.genome).phenotype, r.best.phenotype);
   // A start rule with a choice cannot be cut into curves.
   const Grammar choice = Grammar::parse(
       "<p> ::= <c>;<c>;<c> | <c>;<c>;<c>\n<c> ::= sin(2*PI*t) | 2*sin(2*PI*t)\n", "choice.bnf");
   c.search.mapping_where = {"run.yaml", 7, 12};
-  try {
-    Search(c, choice, seed, {{}, 0.18, 1.6}, fake);
-    ADD_FAILURE() << "structured mapping accepted a start rule with two productions";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.key(), "search.mapping");
-    EXPECT_EQ(e.where().line, 7);
-    EXPECT_NE(std::string(e.what()).find("choice.bnf has 2 production(s)"), std::string::npos)
-        << e.what();
-  }
+  const auto error_of = [&](const Grammar& grammar) {
+    try {
+      Search(c, grammar, seed, {{}, 0.18, 1.6}, fake);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), "search.mapping");
+      EXPECT_EQ(e.where().line, 7);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of(choice).find("<p> in choice.bnf has 2 productions"), std::string::npos)
+      << error_of(choice);
+  // Nothing in the start rule makes a choice: there is nothing to segment.
+  const Grammar fixed = Grammar::parse("<p> ::= <c>;<c>;<c>\n<c> ::= sin(2*PI*t)\n", "fixed.bnf");
+  EXPECT_NE(error_of(fixed).find("no codon segments"), std::string::npos) << error_of(fixed);
 }
 
-// Measures that follow the gait's first curve, so that a walk's result can be
-// told apart from another's; counts the walks.
-class CurveEvaluator final : public Evaluator {
+// Measures from every curve of the gait, held ones included, so that one
+// phenotype walks differently under another freedom stage; counts the walks.
+class CurvesEvaluator final : public Evaluator {
  public:
   void walk_all(std::span<const GaitFile* const> gaits, const WalkSettings&,
                 std::span<GaitMeasures> out) override {
     for (std::size_t i = 0; i < gaits.size(); ++i) {
+      std::size_t chars = 0;
+      for (const auto& curve : gaits[i]->curves) chars += curve.expression.size();
       out[i] = GaitMeasures{};
-      out[i].speed = 0.01 * static_cast<double>(gaits[i]->curves.front().expression.size());
+      out[i].speed = 0.001 * static_cast<double>(chars);
       out[i].stride_length = 0.05;
-      out[i].duty_factor = 0.7;
+      out[i].duty_factor = 0.7 - 0.001 * static_cast<double>(gaits[i]->curves[0].expression.size());
       ++walked;
     }
   }
@@ -187,31 +197,36 @@ class CurveEvaluator final : public Evaluator {
   int walked = 0;
 };
 
-TEST(Search, ARepeatedGaitIsNotWalkedAgainAndKeepsItsMeasures) {
+TEST(Search, RepeatedGaitsAreNotWalkedAgainAndTheRunIsTheSame) {
   RunConfig c = tiny_run();
   c.search.population = 30;
   c.search.generations = 6;
+  const GaitFile seed = load_gait_file(c.seed_gait);
+  ASSERT_EQ(seed.curves.size(), 3u);
+  // First one curve free, the others held at their seed means; all from 3 on.
+  c.freedom = {{0, {seed.curves[0].name}, {}},
+               {3, {seed.curves[0].name, seed.curves[1].name, seed.curves[2].name}, {}}};
   const Grammar g = Grammar::parse(
       "<p> ::= <c>;<c>;<c>\n<c> ::= <c>+<c> | sin(2*PI*t) | 2*sin(2*PI*t) | 0.5\n", "four.bnf");
-  const GaitFile seed = load_gait_file(c.seed_gait);
-  CurveEvaluator fake;
-  const SearchResult r = Search(c, g, seed, {{}, 0.18, 1.6}, fake).run();
-  long evaluations = 0, reused = 0;
-  for (const auto& st : r.history) {
-    evaluations += st.evaluations;
-    reused += st.reused;
+  CurvesEvaluator remembering;
+  const SearchResult a = Search(c, g, seed, {{}, 0.18, 1.6}, remembering).run();
+  c.search.remember_walks = false;
+  CurvesEvaluator walking_all;
+  const SearchResult b = Search(c, g, seed, {{}, 0.18, 1.6}, walking_all).run();
+  expect_same(a, b);
+  for (std::size_t gen = 0; gen < a.history.size(); ++gen) {
+    EXPECT_EQ(a.history[gen].fell, b.history[gen].fell) << gen;
+    EXPECT_EQ(a.history[gen].evaluations + a.history[gen].reused, b.history[gen].evaluations)
+        << gen;
+    EXPECT_EQ(b.history[gen].reused, 0) << gen;
   }
-  EXPECT_EQ(evaluations, fake.walked);
-  EXPECT_EQ(r.evaluations, evaluations);
-  EXPECT_EQ(r.reused, reused);
-  EXPECT_GT(reused, 0);
-  // Every individual that was walked or reused counts once per generation
-  // (elites keep their walk and count in neither).
-  EXPECT_EQ(r.history[0].evaluations + r.history[0].reused + r.history[0].invalid,
-            c.search.population);
-  // The best's measures are its own gait's, whether walked or reused.
-  EXPECT_DOUBLE_EQ(r.best.measures.speed, 0.01 * static_cast<double>(
-                                                      r.best.gait.curves.front().expression.size()));
+  EXPECT_EQ(remembering.walked, a.evaluations);
+  EXPECT_GT(a.reused, 0);
+  EXPECT_LT(remembering.walked, walking_all.walked);
+  // Elites keep their walk, except at the change of stage: under the new one
+  // they are walked again.
+  EXPECT_EQ(b.history[2].evaluations + b.history[2].invalid, c.search.population - c.search.elites);
+  EXPECT_EQ(b.history[3].evaluations + b.history[3].invalid, c.search.population);
 }
 
 TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {
@@ -280,8 +295,11 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
             "run.yaml:5:19: search.mapping: expected standard or structured, got 'tree'");
   EXPECT_EQ(parse_run_config(head + "search: {mapping: structured}\n", "run.yaml").search.mapping,
             Mapping::structured);
+  EXPECT_FALSE(parse_run_config(head + "search: {remember_walks: false}\n", "run.yaml")
+                   .search.remember_walks);
   const RunConfig ok = parse_run_config(head, "/a/b/run.yaml");
   EXPECT_EQ(ok.search.mapping, Mapping::standard);
+  EXPECT_TRUE(ok.search.remember_walks);
   EXPECT_EQ(ok.grammar, "/a/b/g.bnf");
   EXPECT_EQ(ok.search.population, 75);
   EXPECT_EQ(ok.search.elites, 7);
@@ -308,10 +326,10 @@ TEST(RunConfig, MissingModelIsReportedAtItsKey) {
 }
 
 TEST(RunConfig, ShippedRunFilesLoad) {
-  for (const char* f : {"horse_numerical", "horse_concatenating", "horse_hybrid",
-                        "horse_sinusoidal", "horse_free", "horse_concatenating_varying_weights",
-                        "horse_concatenating_varying_freedom", "horse_hybrid_structured",
-                        "quadruped_concatenating"}) {
+  for (const char* f :
+       {"horse_numerical", "horse_concatenating", "horse_hybrid", "horse_sinusoidal", "horse_free",
+        "horse_concatenating_varying_weights", "horse_concatenating_varying_freedom",
+        "horse_hybrid_structured", "quadruped_concatenating"}) {
     const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;

@@ -120,17 +120,20 @@ RunSummary SimRig::run_watching(RunAllocationWatch& watch, const RunOptions& opt
 
 std::string lockstep_problems(const RunSummary& s) {
   std::string out;
+  for (const auto& fault : s.faults) out += "fault: " + fault + "\n";
   for (const auto& bus : s.buses) {
     if (bus.late_cycles != 0) {
       out += "bus " + bus.name + ": " + std::to_string(bus.late_cycles) + " late cycles\n";
     }
   }
   for (const auto& d : s.devices) {
-    const std::uint64_t errors = d.status.timeouts + d.status.crc_errors + d.status.protocol_errors;
-    if (errors != 0) {
-      out += d.joint + ": " + std::to_string(d.status.timeouts) + " timeouts, " +
-             std::to_string(d.status.crc_errors) + " CRC errors, " +
-             std::to_string(d.status.protocol_errors) + " protocol errors\n";
+    const DeviceStatus& st = d.status;
+    if (st.timeouts + st.crc_errors + st.protocol_errors + st.hardware_errors + st.exceptions !=
+        0) {
+      out += d.joint + ": " + std::to_string(st.timeouts) + " timeouts, " +
+             std::to_string(st.crc_errors) + " CRC errors, " + std::to_string(st.protocol_errors) +
+             " protocol errors, " + std::to_string(st.hardware_errors) + " hardware errors, " +
+             std::to_string(st.exceptions) + " exceptions\n";
     }
   }
   return out;
@@ -138,6 +141,7 @@ std::string lockstep_problems(const RunSummary& s) {
 
 std::string first_difference(const std::string& file_a, const std::string& file_b) {
   std::ifstream a(file_a), b(file_b);
+  if (!a || !b) return "cannot open " + (!a ? file_a : file_b);
   std::string la, lb;
   for (int line = 1;; ++line) {
     const bool more_a = static_cast<bool>(std::getline(a, la));

@@ -156,12 +156,13 @@ class SimRig {
 };
 
 // What a lockstep run compared bit for bit with another must not have had: a
-// bus cycle without a fresh read (late) or a device's timeout, CRC or
-// protocol error. One line per problem; empty when the run was clean.
+// fault, a bus cycle without a fresh read (late), or a device's timeout,
+// CRC, protocol or hardware error or exception. One line per problem; empty
+// when the run was clean.
 std::string lockstep_problems(const RunSummary& s);
 
 // The first line at which two text files differ, both lines quoted; empty
-// when they are the same.
+// when they are the same (and both could be opened).
 std::string first_difference(const std::string& file_a, const std::string& file_b);
 
 }  // namespace test

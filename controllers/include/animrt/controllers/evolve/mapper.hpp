@@ -9,8 +9,8 @@
 // grammars whose start rule has one production, like the horse grammars'
 // twelve curves: the genome is cut into equal segments, one per non-terminal
 // of that production whose derivation makes choices, and each is expanded
-// from its own segment, wrapping within it. A change in one curve's derivation then no longer shifts the
-// codons every later curve reads (GE's ripple effect).
+// from its own segment, wrapping within it. A change in one curve's derivation then no longer
+// shifts the codons every later curve reads (GE's ripple effect).
 
 #include <cstdint>
 #include <span>
@@ -23,11 +23,12 @@ namespace animrt::evolve {
 
 using Genome = std::vector<std::uint32_t>;
 
+// For an invalid result, the counts say how far the mapping got.
 struct MapResult {
   bool valid = false;
   std::string phenotype;  // complete only when valid
   int codons_used = 0;    // codons read, counting re-reads after wrapping
-  int wraps = 0;          // times the genome (structured: a segment, at most) was wrapped
+  int wraps = 0;          // times the genome (structured: any one segment) was wrapped
   int depth = 0;          // depth of the derivation tree (root = 1)
 };
 

@@ -57,21 +57,23 @@ class PopulationWalker {
 
   // Maps and walks every individual not yet walked under `stage`; the others
   // keep their measures. A phenotype walked before under the same stage (in
-  // this batch or an earlier one) is not walked again: a walk depends only
-  // on its gait, so its measures are the same. Children often repeat a
+  // this batch or an earlier one) is not walked again unless the run file
+  // says so (search.remember_walks): a walk depends only on its gait, so
+  // its measures are the same. Children often repeat a
   // parent (a mutation in codons the mapping never reads, a crossover of two
   // equal parents), more so as a population converges.
   WalkBatch walk(std::vector<Individual>& pop, int stage, Evaluator& evaluator);
 
-  // Phenotypes remembered per stage before the memory starts afresh.
+  // Phenotypes remembered before the memory starts afresh.
   static constexpr std::size_t kRememberedWalks = 50000;
 
  private:
   const RunConfig& config_;
   const Grammar& grammar_;
   const GaitFile& seed_;
-  std::vector<std::vector<std::string>> held_;  // per freedom stage
-  std::vector<std::unordered_map<std::string, GaitMeasures>> walked_;  // per stage
+  std::vector<std::vector<std::string>> held_;            // per freedom stage
+  std::unordered_map<std::string, GaitMeasures> walked_;  // phenotype -> measures, this stage
+  int walked_stage_ = -1;
 };
 
 }  // namespace animrt::evolve

@@ -29,6 +29,10 @@ struct SearchSettings {
   int max_wraps = 3;
   Mapping mapping = Mapping::standard;
   Location mapping_where;  // of the `mapping` key, for errors that need the grammar
+  // A phenotype walked before in the same freedom stage takes that walk's
+  // measures instead of being walked again (population.hpp). Off walks every
+  // child: the same run, slower; there to check exactly that.
+  bool remember_walks = true;
   InitSettings init;
 };
 
