@@ -45,6 +45,14 @@ void derive(const Grammar& g, int rule_index, int depth, int max_depth, bool gro
   }
 }
 
+// The depth of individual i of a ramp from the start rule's minimum depth to
+// max_depth (or to that minimum, when it is deeper).
+int ramp_depth(const Grammar& grammar, const InitSettings& settings, int i) {
+  const int lo = grammar.start().min_depth;
+  const int hi = std::max(lo, settings.max_depth);
+  return lo + i % (hi - lo + 1);
+}
+
 }  // namespace
 
 Genome derive_genome(const Grammar& grammar, int depth, bool grow, const InitSettings& settings,
@@ -61,13 +69,10 @@ Genome derive_genome(const Grammar& grammar, int depth, bool grow, const InitSet
 
 std::vector<Genome> ramped_full_grow(const Grammar& grammar, int count,
                                      const InitSettings& settings, Rng& rng) {
-  const int lo = grammar.start().min_depth;
-  const int hi = std::max(lo, settings.max_depth);
-  const int depths = hi - lo + 1;
   std::vector<Genome> out;
   out.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) {
-    const int depth = lo + i % depths;
+    const int depth = ramp_depth(grammar, settings, i);
     const bool grow = rng.chance(settings.grow_probability);
     out.push_back(derive_genome(grammar, depth, grow, settings, rng));
   }
@@ -76,9 +81,6 @@ std::vector<Genome> ramped_full_grow(const Grammar& grammar, int count,
 
 std::vector<Genome> ramped_structured(const Grammar& grammar, int count,
                                       const InitSettings& settings, Rng& rng) {
-  const int lo = grammar.start().min_depth;
-  const int hi = std::max(lo, settings.max_depth);
-  const int depths = hi - lo + 1;
   std::vector<int> segment_rules;
   for (const std::size_t i : structured_segment_symbols(grammar)) {
     segment_rules.push_back(grammar.start().productions.front().symbols[i].rule);
@@ -86,7 +88,7 @@ std::vector<Genome> ramped_structured(const Grammar& grammar, int count,
   std::vector<std::vector<Genome>> derived(static_cast<std::size_t>(count));
   std::size_t longest = 1;
   for (int i = 0; i < count; ++i) {
-    const int depth = lo + i % depths;
+    const int depth = ramp_depth(grammar, settings, i);
     const bool grow = rng.chance(settings.grow_probability);
     for (const int rule : segment_rules) {
       Genome segment;

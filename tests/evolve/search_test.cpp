@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include "animrt/controllers/evolve/evaluator.hpp"
@@ -85,21 +86,31 @@ TEST(Search, FallingPhenotypeGetsTheWorstScore) {
   EXPECT_LT(score(sim->walk(seed, c.walk), t, {}, sim->info().mass_kg), kWorstFitness);
 }
 
-// Walks nothing: every valid gait gets the same measures.
+// Walks nothing: each gait's measures come from `measure` (by default the
+// same for every gait); counts the walks.
 class FakeEvaluator final : public Evaluator {
  public:
+  using Measure = std::function<GaitMeasures(const GaitFile&)>;
+  FakeEvaluator() = default;
+  explicit FakeEvaluator(Measure measure) : measure_(std::move(measure)) {}
   void walk_all(std::span<const GaitFile* const> gaits, const WalkSettings&,
                 std::span<GaitMeasures> out) override {
     for (std::size_t i = 0; i < gaits.size(); ++i) {
-      out[i] = GaitMeasures{};
-      out[i].speed = 0.05;
-      out[i].stride_length = 0.05;
-      out[i].duty_factor = 0.7;
+      out[i] = measure_(*gaits[i]);
       ++walked;
     }
   }
   int workers() const override { return 1; }
   int walked = 0;
+
+ private:
+  Measure measure_ = [](const GaitFile&) {
+    GaitMeasures m;
+    m.speed = 0.05;
+    m.stride_length = 0.05;
+    m.duty_factor = 0.7;
+    return m;
+  };
 };
 
 TEST(Search, InvalidIndividualsScoreWorstAndAreCounted) {
@@ -178,24 +189,16 @@ TEST(Search, StructuredMappingNeedsOneStartProductionAndMapsEveryCurve) {
 }
 
 // Measures from every curve of the gait, held ones included, so that one
-// phenotype walks differently under another freedom stage; counts the walks.
-class CurvesEvaluator final : public Evaluator {
- public:
-  void walk_all(std::span<const GaitFile* const> gaits, const WalkSettings&,
-                std::span<GaitMeasures> out) override {
-    for (std::size_t i = 0; i < gaits.size(); ++i) {
-      std::size_t chars = 0;
-      for (const auto& curve : gaits[i]->curves) chars += curve.expression.size();
-      out[i] = GaitMeasures{};
-      out[i].speed = 0.001 * static_cast<double>(chars);
-      out[i].stride_length = 0.05;
-      out[i].duty_factor = 0.7 - 0.001 * static_cast<double>(gaits[i]->curves[0].expression.size());
-      ++walked;
-    }
-  }
-  int workers() const override { return 1; }
-  int walked = 0;
-};
+// phenotype walks differently under another freedom stage.
+GaitMeasures from_curves(const GaitFile& gait) {
+  std::size_t chars = 0;
+  for (const auto& curve : gait.curves) chars += curve.expression.size();
+  GaitMeasures m;
+  m.speed = 0.001 * static_cast<double>(chars);
+  m.stride_length = 0.05;
+  m.duty_factor = 0.7 - 0.001 * static_cast<double>(gait.curves[0].expression.size());
+  return m;
+}
 
 TEST(Search, RepeatedGaitsAreNotWalkedAgainAndTheRunIsTheSame) {
   RunConfig c = tiny_run();
@@ -208,10 +211,10 @@ TEST(Search, RepeatedGaitsAreNotWalkedAgainAndTheRunIsTheSame) {
                {3, {seed.curves[0].name, seed.curves[1].name, seed.curves[2].name}, {}}};
   const Grammar g = Grammar::parse(
       "<p> ::= <c>;<c>;<c>\n<c> ::= <c>+<c> | sin(2*PI*t) | 2*sin(2*PI*t) | 0.5\n", "four.bnf");
-  CurvesEvaluator remembering;
+  FakeEvaluator remembering(from_curves);
   const SearchResult a = Search(c, g, seed, {{}, 0.18, 1.6}, remembering).run();
   c.search.remember_walks = false;
-  CurvesEvaluator walking_all;
+  FakeEvaluator walking_all(from_curves);
   const SearchResult b = Search(c, g, seed, {{}, 0.18, 1.6}, walking_all).run();
   expect_same(a, b);
   for (std::size_t gen = 0; gen < a.history.size(); ++gen) {
