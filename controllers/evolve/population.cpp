@@ -46,6 +46,11 @@ void breed(const std::vector<Individual>& parents, const std::function<std::size
 PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& grammar,
                                    const GaitFile& seed)
     : config_(config), grammar_(grammar), seed_(seed) {
+  if (!seed_.froude) {
+    throw InputError({seed_.file, 0, 0}, "froude",
+                     "the seed gait of an evolve run needs froude timing (the fitness targets "
+                     "come from the Froude number)");
+  }
   if (config_.search.mapping == Mapping::structured) {
     const Rule& start = grammar_.start();
     if (start.productions.size() != 1) {

@@ -232,6 +232,20 @@ TEST(Search, RepeatedGaitsAreNotWalkedAgainAndTheRunIsTheSame) {
   EXPECT_EQ(b.history[3].evaluations + b.history[3].invalid, c.search.population);
 }
 
+TEST(Search, ASeedGaitWithoutFroudeTimingIsRefused) {
+  const RunConfig c = tiny_run();
+  GaitFile seed = load_gait_file(c.seed_gait);
+  seed.froude.reset();
+  FakeEvaluator fake;
+  try {
+    Search(c, Grammar::load_file(c.grammar), seed, {{}, 0.18, 1.6}, fake);
+    ADD_FAILURE() << "a seed without froude timing was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "froude");
+    EXPECT_EQ(e.where().file, c.seed_gait);
+  }
+}
+
 TEST(Search, HooksSeeEveryGenerationAndItsBestAndStopEndsTheRunThere) {
   RunConfig c = tiny_run();
   c.search.generations = 10;
