@@ -9,8 +9,9 @@
 // grammars whose start rule has one production, like the horse grammars'
 // twelve curves: the genome is cut into equal segments, one per non-terminal
 // of that production whose derivation makes choices, and each is expanded
-// from its own segment, wrapping within it. A change in one curve's derivation then no longer
-// shifts the codons every later curve reads (GE's ripple effect).
+// from its own segment, wrapping within it. A change in one curve's
+// derivation then no longer shifts the codons every later curve reads (GE's
+// ripple effect).
 
 #include <cstdint>
 #include <span>
