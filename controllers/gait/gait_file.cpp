@@ -169,6 +169,25 @@ void read_timing(const YamlNode& root, GaitFile& gait) {
   gait.froude = timing;
 }
 
+// Larger gains than this move a leg by more than it is long for a small tilt.
+constexpr double kMaxBalanceGain = 2.0;
+
+void read_balance(const YamlNode& root, GaitFile& gait) {
+  const auto node = root.find("balance");
+  if (!node) return;
+  node->allow_only({"tilt_m", "tilt_rate_m_s"});
+  GaitBalance b;
+  b.where = node->location();
+  if (auto v = node->find("tilt_m")) b.tilt_m = v->as_double_in(0.0, kMaxBalanceGain);
+  if (auto v = node->find("tilt_rate_m_s")) {
+    b.tilt_rate_m_s = v->as_double_in(0.0, kMaxBalanceGain);
+  }
+  if (b.tilt_m == 0.0 && b.tilt_rate_m_s == 0.0) {
+    node->fail("give tilt_m or tilt_rate_m_s above 0 (or leave balance out)");
+  }
+  gait.balance = b;
+}
+
 void read_curves(const YamlNode& root, const std::string& text, GaitFile& gait) {
   const YamlNode curves = root.at("curves");
   const auto entries = curves.entries();
@@ -476,7 +495,10 @@ bool operator==(const FroudeTiming& a, const FroudeTiming& b) {
 bool operator==(const GaitFile& a, const GaitFile& b) {
   return a.name == b.name && a.stride_frequency_hz == b.stride_frequency_hz &&
          a.froude == b.froude && a.curves == b.curves && a.limbs == b.limbs &&
-         a.joints == b.joints && a.steering == b.steering;
+         a.joints == b.joints && a.steering == b.steering && a.balance == b.balance;
+}
+bool operator==(const GaitBalance& a, const GaitBalance& b) {
+  return a.tilt_m == b.tilt_m && a.tilt_rate_m_s == b.tilt_rate_m_s;
 }
 
 double GaitSteering::min_speed_m_s() const { return froude_velocity(min_froude, hip_height_m); }
@@ -494,7 +516,7 @@ bool operator==(const GaitSteering& a, const GaitSteering& b) {
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
   const YamlNode root = YamlNode::load_string(text, file_name);
   root.allow_only(
-      {"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering"});
+      {"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering", "balance"});
   GaitFile gait;
   gait.file = file_name;
   const YamlNode name = root.at("name");
@@ -505,6 +527,7 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
   read_limbs(root, gait);
   read_joints(root, gait);
   read_steering(root, gait);
+  read_balance(root, gait);
   return gait;
 }
 
@@ -588,6 +611,13 @@ void validate_gait(const GaitFile& gait) {
     }
   }
   validate_steering(gait);
+  if (gait.balance) {
+    const GaitBalance& b = *gait.balance;
+    const auto gain = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= kMaxBalanceGain; };
+    if (!gain(b.tilt_m) || !gain(b.tilt_rate_m_s) || (b.tilt_m == 0.0 && b.tilt_rate_m_s == 0.0)) {
+      throw InputError(b.where, "balance", "expected tilt_m and tilt_rate_m_s from 0 to 2, not both 0");
+    }
+  }
 }
 
 std::string format_gait_file(const GaitFile& gait) {
@@ -630,6 +660,10 @@ std::string format_gait_file(const GaitFile& gait) {
     if (!s.lift_curves.empty()) out += "  lift_curves: " + names_text(s.lift_curves) + "\n";
     if (s.swing_offset != 0.0) out += "  swing_offset: " + shortest_exact(s.swing_offset) + "\n";
     if (s.fixed_cadence) out += "  fixed_cadence: true\n";
+  }
+  if (gait.balance) {
+    out += "balance: {tilt_m: " + shortest_exact(gait.balance->tilt_m) +
+           ", tilt_rate_m_s: " + shortest_exact(gait.balance->tilt_rate_m_s) + "}\n";
   }
   return out;
 }

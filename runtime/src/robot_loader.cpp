@@ -46,6 +46,14 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     std::unique_ptr<MotionSource> source;
     if (motion.type == "gait") {
       gait = std::make_unique<GaitFile>(load_gait_file(motion.file));
+      if (gait->balance) {
+        // Played without its reflex the gait would not be the walk it was
+        // made for: refused before anything moves.
+        throw InputError(gait->balance->where, "balance",
+                         "this gait balances through the trunk's attitude, which the runtime "
+                         "cannot read yet; walk it with `animrt gait measure --physics` or "
+                         "remove balance");
+      }
       source = make_gait_source(*gait, joints);
     } else {
       source = head::make_head_source(*motion.head, joints);

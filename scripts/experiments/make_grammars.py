@@ -418,6 +418,15 @@ HORSE_WALK_COMMENT = """# The horse's seed walk (horse_seed.yaml) for the runtim
 # starting from standing (configs/robots/horse.yaml) gets into the walk.
 # Written by scripts/experiments/make_grammars.py."""
 
+HORSE_BALANCE_COMMENT = """# The horse's seed walk (horse_seed.yaml) with the balance reflex: each leg
+# on the ground stretches along the trunk's vertical by 0.3 m per unit of sine
+# of its side's or end's tilt and 0.1 m per unit per second of its rate (docs/evolve.md,
+# "A balance reflex"). Walks in `animrt evolve` and `animrt gait measure`;
+# the runtime refuses it until it can read the trunk's attitude.
+# Written by scripts/experiments/make_grammars.py."""
+
+HORSE_BALANCE = "\nbalance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}\n"
+
 QUAD_COMMENT = """# Seed walk of the demo quadruped for gait evolution: the curves of
 # configs/gaits/walk.yaml with Froude timing (the fitness targets come from
 # the Froude number). Written by scripts/experiments/make_grammars.py."""
@@ -426,6 +435,9 @@ QUAD_COMMENT = """# Seed walk of the demo quadruped for gait evolution: the curv
 def main():
     with open(os.path.join(ROOT, "configs/gaits/horse_seed.yaml"), "w") as f:
         f.write(gait_yaml("horse_seed", HORSE_COMMENT, HORSE, HORSE_FROUDE, HORSE_LIMBS, HORSE_JOINTS))
+    with open(os.path.join(ROOT, "configs/gaits/horse_seed_balance.yaml"), "w") as f:
+        f.write(gait_yaml("horse_seed_balance", HORSE_BALANCE_COMMENT, HORSE, HORSE_FROUDE,
+                          HORSE_LIMBS, HORSE_JOINTS) + HORSE_BALANCE)
     shifted = [(l, round((p + HORSE_RUNTIME_SHIFT) % 1.0, 4)) for l, p in HORSE_LIMBS]
     with open(os.path.join(ROOT, "configs/gaits/horse_walk.yaml"), "w") as f:
         f.write(gait_yaml("horse_walk", HORSE_WALK_COMMENT, HORSE, HORSE_FROUDE, shifted, HORSE_JOINTS))

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -94,7 +95,7 @@ TEST(GaitFile, FroudeTiming) {
 TEST(GaitFile, UnknownKeys) {
   EXPECT_EQ(gait_file_error(with_line(1, "name: test\nspeed: 3")),
             "g.yaml:2:1: speed: unknown key (expected one of: name, stride_frequency_hz, froude, "
-            "curves, limbs, joints, steering)");
+            "curves, limbs, joints, steering, balance)");
   EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: hip, limb: a, gain: 2}")),
             "g.yaml:10:29: joints.j1.gain: unknown key (expected one of: curve, limb, sign, scale, "
             "offset_deg)");
@@ -260,6 +261,43 @@ GaitFile odd_gait() {
   g.joints.push_back({"x: y", "curve with spaces", "1", 1, -99.99999999999999, 5e-324, {}});
   g.joints.push_back({"z", "null", "front", 1, 1.0, 0.0, {}});
   return g;
+}
+
+TEST(GaitFile, Balance) {
+  const GaitFile g =
+      parse_gait_file(with_line(1, "name: test\nbalance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}"), "g.yaml");
+  ASSERT_TRUE(g.balance.has_value());
+  EXPECT_EQ(g.balance->tilt_m, 0.3);
+  EXPECT_EQ(g.balance->tilt_rate_m_s, 0.1);
+  const GaitFile back = parse_gait_file(format_gait_file(g), "back.yaml");
+  EXPECT_TRUE(back == g) << format_gait_file(g);
+  GaitFile other = g;
+  other.balance->tilt_m = 0.2;
+  EXPECT_FALSE(other == g);
+  // One gain is enough; the other defaults to 0.
+  EXPECT_EQ(parse_gait_file(with_line(1, "name: test\nbalance: {tilt_rate_m_s: 0.1}"), "g.yaml")
+                .balance->tilt_m,
+            0.0);
+
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nbalance: {}")),
+            "g.yaml:2:10: balance: give tilt_m or tilt_rate_m_s above 0 (or leave balance out)");
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nbalance: {tilt_m: 3}")),
+            "g.yaml:2:19: balance.tilt_m: expected a number from 0 to 2, found \"3\"");
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nbalance: {tilt_m: -0.1}")),
+            "g.yaml:2:19: balance.tilt_m: expected a number from 0 to 2, found \"-0.1\"");
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nbalance: {gain: 1}")),
+            "g.yaml:2:11: balance.gain: unknown key (expected one of: tilt_m, tilt_rate_m_s)");
+
+  GaitFile bad = g;
+  bad.balance->tilt_m = std::nan("");
+  try {
+    validate_gait(bad);
+    ADD_FAILURE() << "a balance gain that is not a number was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("balance: expected tilt_m and tilt_rate_m_s from 0 to 2"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(GaitFile, FormatReadsBackEqual) {

@@ -346,10 +346,14 @@ TEST(RunConfig, ShippedRunFilesLoad) {
   for (const char* f :
        {"horse_numerical", "horse_concatenating", "horse_hybrid", "horse_sinusoidal", "horse_free",
         "horse_concatenating_varying_weights", "horse_concatenating_varying_freedom",
-        "horse_hybrid_structured", "quadruped_concatenating"}) {
+        "horse_hybrid_structured", "horse_numerical_balance", "horse_hybrid_structured_balance",
+        "quadruped_concatenating"}) {
     const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;
+    // The balance runs walk their seed with the reflex, and only they.
+    const bool balance = std::string(f).find("_balance") != std::string::npos;
+    EXPECT_EQ(load_gait_file(c.seed_gait).balance.has_value(), balance) << f;
   }
   const RunConfig h = load_run_config(kSourceRoot + "/configs/evolve/horse_hybrid_structured.yaml");
   EXPECT_EQ(h.search.mapping, Mapping::structured);

@@ -48,6 +48,20 @@ struct FroudeTiming {
   double hip_height_m = 0.0;  // h
 };
 
+// A balance reflex through leg length, for a figure whose legs cannot step
+// sideways: each leg on the ground is lengthened along the trunk's vertical by
+//   tilt_m * d + tilt_rate_m_s * d'
+// where d is how far its side or end of the trunk is down (the sine of the
+// roll for left and right, of the pitch for front and back) and d' its rate,
+// so the low side is pushed back up and a swaying trunk is damped. It needs
+// the trunk's attitude, which the fitness walk and `gait measure` read from
+// the physics; the runtime has no attitude input yet and refuses such a gait.
+struct GaitBalance {
+  double tilt_m = 0.0;         // m of leg length per unit of tilt sine
+  double tilt_rate_m_s = 0.0;  // m of leg length per unit of tilt sine per second
+  Location where;              // of the balance key
+};
+
 struct GaitFile {
   std::string name;
   // Exactly one of these is set.
@@ -59,6 +73,7 @@ struct GaitFile {
   // Present when the gait can be steered (speed and turn commands); without
   // it the gait plays at its own timing and ignores commands.
   std::optional<GaitSteering> steering;
+  std::optional<GaitBalance> balance;
   std::string file;  // where it was loaded from ("" when built in memory)
 
   // Stride cycles per second, from whichever timing is set (0 if neither).
@@ -72,6 +87,7 @@ bool operator==(const GaitCurve& a, const GaitCurve& b);
 bool operator==(const GaitLimb& a, const GaitLimb& b);
 bool operator==(const GaitJoint& a, const GaitJoint& b);
 bool operator==(const FroudeTiming& a, const FroudeTiming& b);
+bool operator==(const GaitBalance& a, const GaitBalance& b);
 // Compares content; `file` and locations are ignored.
 bool operator==(const GaitFile& a, const GaitFile& b);
 
