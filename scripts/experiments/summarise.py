@@ -34,6 +34,9 @@ NAMES = {
     "concatenating_varying_weights": "Concatenating, varying fitness weights",
     "concatenating_varying_freedom": "Concatenating, varying joint freedom",
     "hybrid_structured": "Numerical & concatenating, structured mapping (ours)",
+    "numerical_balance": "Numerical only, balance reflex (ours)",
+    "hybrid_balance": "Numerical & concatenating, balance reflex (ours)",
+    "hybrid_structured_balance": "Numerical & concatenating, structured mapping, balance reflex (ours)",
 }
 
 

@@ -28,10 +28,6 @@ int root_qpos(const mjModel* m, int torso) {
 }
 
 
-// A leg stretches by at most this much for balance: more lifts a foot off
-// the ground or folds the leg.
-constexpr double kMaxBalanceStretchM = 0.1;
-
 // The gait file's balance reflex (GaitBalance): each leg on the ground is
 // lengthened along the trunk's vertical by tilt_m * d + tilt_rate_m_s * d',
 // d being how far its side (roll) or end (pitch) of the trunk is down. A leg's stretch goes

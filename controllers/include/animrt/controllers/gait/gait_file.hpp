@@ -56,6 +56,10 @@ struct FroudeTiming {
 // so the low side is pushed back up and a swaying trunk is damped. It needs
 // the trunk's attitude, which the fitness walk and `gait measure` read from
 // the physics; the runtime has no attitude input yet and refuses such a gait.
+// A leg stretches by at most this much for balance: more lifts a foot off
+// the ground or folds the leg.
+constexpr double kMaxBalanceStretchM = 0.1;
+
 struct GaitBalance {
   double tilt_m = 0.0;         // m of leg length per unit of tilt sine
   double tilt_rate_m_s = 0.0;  // m of leg length per unit of tilt sine per second
