@@ -27,7 +27,6 @@ int root_qpos(const mjModel* m, int torso) {
   return (j >= 0 && m->jnt_type[j] == mjJNT_FREE) ? m->jnt_qposadr[j] : -1;
 }
 
-
 // The gait file's balance reflex (GaitBalance): each leg on the ground is
 // lengthened along the trunk's vertical by tilt_m * d + tilt_rate_m_s * d',
 // d being how far its side (roll) or end (pitch) of the trunk is down. A leg's stretch goes

@@ -2,7 +2,9 @@
 // The evolver's GaitSimulator on MuJoCo: one mjData per simulator over a
 // shared read-only model. A walk starts standing in the gait's first pose
 // (feet on the floor), settles, then plays the gait through the position
-// actuators: warm-up cycles, then measured cycles.
+// actuators: warm-up cycles, then measured cycles. A gait with `balance:`
+// walks with its balance reflex added to the curves (legs on the ground
+// stretched against the trunk's roll and pitch; gait_file.hpp).
 //
 // Measures: forward (+x) speed of the torso, stride length from successive
 // landings of each foot (first to last, per stride period), duty factor from foot contacts, energy
