@@ -515,8 +515,8 @@ bool operator==(const GaitSteering& a, const GaitSteering& b) {
 
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
   const YamlNode root = YamlNode::load_string(text, file_name);
-  root.allow_only(
-      {"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering", "balance"});
+  root.allow_only({"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering",
+                   "balance"});
   GaitFile gait;
   gait.file = file_name;
   const YamlNode name = root.at("name");
@@ -615,7 +615,8 @@ void validate_gait(const GaitFile& gait) {
     const GaitBalance& b = *gait.balance;
     const auto gain = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= kMaxBalanceGain; };
     if (!gain(b.tilt_m) || !gain(b.tilt_rate_m_s) || (b.tilt_m == 0.0 && b.tilt_rate_m_s == 0.0)) {
-      throw InputError(b.where, "balance", "expected tilt_m and tilt_rate_m_s from 0 to 2, not both 0");
+      throw InputError(b.where, "balance",
+                       "expected tilt_m and tilt_rate_m_s from 0 to 2, not both 0");
     }
   }
 }

@@ -59,8 +59,9 @@ int run_measure(const MeasureArgs& a) {
   std::printf("walking %s on %s: %d starts, %.2f Hz, hip height %.3f m\n", a.gait.c_str(),
               a.physics.c_str(), a.seeds, f, h);
   if (gait.balance) {
-    std::printf("balance reflex: tilt_m %g, tilt_rate_m_s %g (legs on the ground stretch up to %g m)\n",
-                gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
+    std::printf(
+        "balance reflex: tilt_m %g, tilt_rate_m_s %g (legs on the ground stretch up to %g m)\n",
+        gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
   }
   std::printf("%5s %6s %9s %9s %8s %9s %10s\n", "start", "fell", "fall s", "m/s", "stride m",
               "duty", "J/cycle");

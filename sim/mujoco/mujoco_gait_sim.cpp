@@ -29,9 +29,9 @@ int root_qpos(const mjModel* m, int torso) {
 
 // The gait file's balance reflex (GaitBalance): each leg on the ground is
 // lengthened along the trunk's vertical by tilt_m * d + tilt_rate_m_s * d',
-// d being how far its side (roll) or end (pitch) of the trunk is down. A leg's stretch goes
-// to its joints through the foot's Jacobian (least-norm joint change), so it
-// needs no knowledge of how the leg is built.
+// d being how far its side (roll) or end (pitch) of the trunk is down. A
+// leg's stretch goes to its joints through the foot's Jacobian (least-norm
+// joint change), so it needs no knowledge of how the leg is built.
 class LegBalance {
  public:
   LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains)
@@ -85,7 +85,8 @@ class LegBalance {
       down_per_rad_.assign(leg.actuators.size(), 0.0);
       for (std::size_t i = 0; i < leg.actuators.size(); ++i) {
         const int dof = mm_.actuator_dof[static_cast<std::size_t>(leg.actuators[i])];
-        down_per_rad_[i] = -(r[2] * jacp_[dof] + r[5] * jacp_[nv + dof] + r[8] * jacp_[2 * nv + dof]);
+        down_per_rad_[i] =
+            -(r[2] * jacp_[dof] + r[5] * jacp_[nv + dof] + r[8] * jacp_[2 * nv + dof]);
         norm += down_per_rad_[i] * down_per_rad_[i];
       }
       if (norm < 1e-12) continue;

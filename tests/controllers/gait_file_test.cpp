@@ -264,8 +264,8 @@ GaitFile odd_gait() {
 }
 
 TEST(GaitFile, Balance) {
-  const GaitFile g =
-      parse_gait_file(with_line(1, "name: test\nbalance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}"), "g.yaml");
+  const GaitFile g = parse_gait_file(
+      with_line(1, "name: test\nbalance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}"), "g.yaml");
   ASSERT_TRUE(g.balance.has_value());
   EXPECT_EQ(g.balance->tilt_m, 0.3);
   EXPECT_EQ(g.balance->tilt_rate_m_s, 0.1);

@@ -174,8 +174,8 @@ TEST(MujocoGaitSimulator, MostNearNeighboursOfTheHorseSeedWalk) {
 // horse seed with every constant, amplitude and phase within 25 % of its seed
 // value (the numerical grammar's range, harmonics kept), clearly more walk
 // the fitness's walk with the reflex than without, and the seed with the
-// reflex still walks. A reflex pushing the wrong way, or stretching swing
-// legs, loses walks instead (docs/evolve.md, "A balance reflex").
+// reflex still walks; a reflex that does nothing fails it (docs/evolve.md,
+// "A balance reflex").
 TEST(MujocoGaitSimulator, TheBalanceReflexKeepsMoreNeighboursOfTheHorseSeedOnTheirFeet) {
   sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/horse.xml");
   auto sim = factory.make();
@@ -194,8 +194,8 @@ TEST(MujocoGaitSimulator, TheBalanceReflexKeepsMoreNeighboursOfTheHorseSeedOnThe
   }
   RecordProperty("walked_plain", walked_plain);
   RecordProperty("walked_balanced", walked_balanced);
-  std::cout << "of " << kNeighbours << " neighbours, " << walked_plain << " walk without the reflex, "
-            << walked_balanced << " with it\n";
+  std::cout << "of " << kNeighbours << " neighbours, " << walked_plain
+            << " walk without the reflex, " << walked_balanced << " with it\n";
   EXPECT_GE(walked_balanced, walked_plain + kNeighbours / 6);
 }
 

@@ -77,13 +77,14 @@ TEST_F(MotionCheckTest, ShippedWalkPasses) {
   EXPECT_EQ(error(), "no error");
 }
 
-// A gait made with the balance reflex falls without it, and the runtime
+// A gait made with the balance reflex was scored with it, and the runtime
 // cannot read the trunk's attitude: refused at its balance key.
 TEST_F(MotionCheckTest, AGaitWithTheBalanceReflexIsRefused) {
   const std::string text = gait_text_ + "balance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}\n";
   write_file(dir_ / "gaits" / "walk.yaml", text);
   const std::string e = error();
-  EXPECT_NE(e.find(gait() + ":" + std::to_string(line_of(text, "balance:")) + ":"), std::string::npos)
+  EXPECT_NE(e.find(gait() + ":" + std::to_string(line_of(text, "balance:")) + ":"),
+            std::string::npos)
       << e;
   EXPECT_NE(e.find("balance: this gait balances through the trunk's attitude"), std::string::npos)
       << e;

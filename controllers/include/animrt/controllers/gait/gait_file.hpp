@@ -48,6 +48,10 @@ struct FroudeTiming {
   double hip_height_m = 0.0;  // h
 };
 
+// A leg stretches by at most this much for balance: more lifts a foot off
+// the ground or folds the leg.
+constexpr double kMaxBalanceStretchM = 0.1;
+
 // A balance reflex through leg length, for a figure whose legs cannot step
 // sideways: each leg on the ground is lengthened along the trunk's vertical by
 //   tilt_m * d + tilt_rate_m_s * d'
@@ -56,10 +60,6 @@ struct FroudeTiming {
 // so the low side is pushed back up and a swaying trunk is damped. It needs
 // the trunk's attitude, which the fitness walk and `gait measure` read from
 // the physics; the runtime has no attitude input yet and refuses such a gait.
-// A leg stretches by at most this much for balance: more lifts a foot off
-// the ground or folds the leg.
-constexpr double kMaxBalanceStretchM = 0.1;
-
 struct GaitBalance {
   double tilt_m = 0.0;         // m of leg length per unit of tilt sine
   double tilt_rate_m_s = 0.0;  // m of leg length per unit of tilt sine per second
