@@ -42,6 +42,12 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
+// Plausible achieved motion (docs/gait.md): 100 m/s is three times the
+// fastest land animal; 100 turns a second is more than a tumbling figure
+// spins.
+constexpr double kMaxAchievedSpeed = 100.0;
+constexpr double kMaxAchievedTurnDps = 36000.0;
+
 }  // namespace
 
 bool operator==(const MotionCommand& a, const MotionCommand& b) {
@@ -77,8 +83,14 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
   const YamlNode root = YamlNode::load_string(text, file_name);
   root.allow_only({"gait", "model", "tolerance", "points"});
   GaitCalibration cal;
-  cal.gait_file = root.at("gait").as_string();
-  cal.model_file = root.at("model").as_string();
+  const YamlNode gait = root.at("gait");
+  cal.gait_file = gait.as_string();
+  cal.gait_where = gait.location();
+  if (cal.gait_file.empty()) gait.fail("expected the gait file it was measured for, found \"\"");
+  const YamlNode model = root.at("model");
+  cal.model_file = model.as_string();
+  cal.model_where = model.location();
+  if (cal.model_file.empty()) model.fail("expected the model file it walked on, found \"\"");
   cal.tolerance = root.at("tolerance").as_double_in(0.0, 1.0);
   const YamlNode points = root.at("points");
   if (!points.is_sequence()) points.fail("expected a list of points, found " + points.describe());
@@ -89,12 +101,12 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
     p.commanded.speed_m_s = node.at("speed_m_s").as_double_in(0.0, 100.0);
     p.commanded.turn_rad_s = deg_to_rad(node.at("turn_dps").as_double_in(-3600.0, 3600.0));
     p.fell = node.at("fell").as_bool();
-    // A fall leaves the achieved motion meaningless; it may be any number.
-    p.achieved.speed_m_s = node.at("achieved_speed_m_s").as_double();
-    p.achieved.turn_rad_s = deg_to_rad(node.at("achieved_turn_dps").as_double());
-    if (!p.fell && !(std::isfinite(p.achieved.speed_m_s) && std::isfinite(p.achieved.turn_rad_s))) {
-      node.fail("achieved motion of a point without a fall must be finite");
-    }
+    // A fall leaves the achieved motion meaningless, but a figure that fell
+    // still moved as a body can: backwards too, a tumble spinning fast.
+    p.achieved.speed_m_s =
+        node.at("achieved_speed_m_s").as_double_in(-kMaxAchievedSpeed, kMaxAchievedSpeed);
+    p.achieved.turn_rad_s = deg_to_rad(
+        node.at("achieved_turn_dps").as_double_in(-kMaxAchievedTurnDps, kMaxAchievedTurnDps));
     p.usable = calibration_usable(p, cal.tolerance);
     if (const auto u = node.find("usable"); u && u->as_bool() != p.usable) {
       u->fail(std::string("usable is ") + (p.usable ? "false" : "true") + " but the point is " +
@@ -108,6 +120,36 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
 
 GaitCalibration load_gait_calibration(const std::string& path) {
   return parse_gait_calibration(read_input_file(path), path);
+}
+
+void check_calibration_references(const GaitCalibration& cal, const std::string& calibration_path,
+                                  const std::string& gait_path) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(calibration_path).parent_path();
+  const auto resolve = [&](const std::string& given) {
+    return (fs::path(given).is_absolute() ? fs::path(given) : folder / given).string();
+  };
+  const auto where = [](const Location& at) { return at.line > 0 ? at : Location{at.file, 0, 0}; };
+  const std::string gait = resolve(cal.gait_file);
+  const std::string against = " (resolved against the table's folder to \"" + gait + "\")";
+  if (const std::string problem = input_file_problem(gait); !problem.empty()) {
+    throw InputError(where(cal.gait_where), "gait",
+                     "gait file \"" + cal.gait_file + "\"" + against + " " + problem);
+  }
+  std::error_code ec;
+  if (!fs::equivalent(gait, gait_path, ec)) {
+    throw InputError(where(cal.gait_where), "gait",
+                     "this table was measured for \"" + cal.gait_file + "\"" + against +
+                         ", not for the gait beside it (\"" + gait_path +
+                         "\"); measure it again with animrt gait calibrate");
+  }
+  const std::string model = resolve(cal.model_file);
+  if (const std::string problem = input_file_problem(model, kMaxMediaFileBytes); !problem.empty()) {
+    throw InputError(where(cal.model_where), "model",
+                     "model file \"" + cal.model_file +
+                         "\" (resolved against the table's folder to \"" + model + "\") " +
+                         problem);
+  }
 }
 
 std::string format_gait_calibration(const GaitCalibration& cal) {

@@ -27,6 +27,21 @@ constexpr double kMaxOffsetDeg = 3600.0;
 constexpr double kMaxFroude = 10.0;
 constexpr double kMaxTurnDps = 3600.0;
 
+// Plausible ranges of the timing and size keys (docs/gait.md lists them).
+// A stride beyond 10 Hz reverses each joint 20 times a second, faster than
+// any hobby or industrial servo follows and than any animal steps; one
+// stride in more than 1000 s is a pose held, not a gait.
+constexpr double kMinStrideHz = 0.001;
+constexpr double kMaxStrideHz = 10.0;
+// From a 1 cm toy to a 10 m figure, taller at the hip than any animal.
+constexpr double kMinHipHeightM = 0.01;
+constexpr double kMaxHipHeightM = 10.0;
+constexpr double kMinTrackWidthM = 0.001;
+constexpr double kMaxTrackWidthM = 10.0;
+// Five times gravity: more than any legged animal's start (about 13 m/s^2
+// for a cheetah), far more than a walking figure can take.
+constexpr double kMaxAccelerationMs2 = 50.0;
+
 // A curve must be finite over one stride; it is sampled this many times.
 constexpr int kFiniteSamples = 1024;
 
@@ -142,6 +157,16 @@ std::vector<Location> key_locations(const YamlNode& map) {
   return out;
 }
 
+// A number > 0 (the usual message below that) within lo..hi.
+double positive_in(const YamlNode& node, double lo, double hi) {
+  const double v = node.as_positive_double();
+  if (v < lo || v > hi) {
+    node.fail("expected a number from " + format_number(lo) + " to " + format_number(hi) +
+              ", found " + node.describe());
+  }
+  return v;
+}
+
 int read_sign(const YamlNode& node) {
   const double v = node.as_double();
   if (v != 1.0 && v != -1.0) node.fail("expected 1 or -1, found \"" + node.as_string() + "\"");
@@ -159,13 +184,22 @@ void read_timing(const YamlNode& root, GaitFile& gait) {
                      "missing stride timing: give exactly one of stride_frequency_hz or froude");
   }
   if (freq) {
-    gait.stride_frequency_hz = freq->as_positive_double();
+    gait.stride_frequency_hz = positive_in(*freq, kMinStrideHz, kMaxStrideHz);
     return;
   }
   froude->allow_only({"number", "hip_height_m"});
   FroudeTiming timing;
-  timing.number = froude->at("number").as_positive_double();
-  timing.hip_height_m = froude->at("hip_height_m").as_positive_double();
+  timing.number = positive_in(froude->at("number"), 1e-6, kMaxFroude);
+  timing.hip_height_m = positive_in(froude->at("hip_height_m"), kMinHipHeightM, kMaxHipHeightM);
+  // Both in range can still give a stride no figure can follow (Fr 10 at
+  // 1 cm is 34 Hz).
+  const double f = froude_stride_frequency(timing.number, timing.hip_height_m);
+  if (f < kMinStrideHz || f > kMaxStrideHz) {
+    froude->fail("number " + format_number(timing.number) + " at hip_height_m " +
+                 format_number(timing.hip_height_m) + " is a stride frequency of " +
+                 format_number(f) + " Hz, expected " + format_number(kMinStrideHz) + " to " +
+                 format_number(kMaxStrideHz) + " Hz");
+  }
   gait.froude = timing;
 }
 
@@ -301,15 +335,16 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
                 shortest_exact(s.min_froude) + ")");
   }
   s.max_turn_rad_s = deg_to_rad(node->at("max_turn_dps").as_double_in(0.0, kMaxTurnDps));
-  s.max_acceleration_m_s2 = node->at("max_acceleration_m_s2").as_positive_double();
+  s.max_acceleration_m_s2 =
+      positive_in(node->at("max_acceleration_m_s2"), 1e-6, kMaxAccelerationMs2);
   if (const auto h = node->find("hip_height_m")) {
-    s.hip_height_m = h->as_positive_double();
+    s.hip_height_m = positive_in(*h, kMinHipHeightM, kMaxHipHeightM);
   } else if (gait.froude) {
     s.hip_height_m = gait.froude->hip_height_m;
   } else {
     node->at("hip_height_m");  // throws: required with stride_frequency_hz
   }
-  s.track_width_m = node->at("track_width_m").as_positive_double();
+  s.track_width_m = positive_in(node->at("track_width_m"), kMinTrackWidthM, kMaxTrackWidthM);
   const YamlNode sides = node->at("sides");
   sides.allow_only({"left", "right"});
   for (const char* side : {"left", "right"}) {
@@ -409,11 +444,15 @@ void validate_steering(const GaitFile& gait) {
     fail("max_froude", "expected a number from min_froude to 10");
   if (!in(s.max_turn_rad_s, 0.0, deg_to_rad(kMaxTurnDps)))
     fail("max_turn_dps", "expected a number from 0 to 3600");
-  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (!positive(s.max_acceleration_m_s2))
-    fail("max_acceleration_m_s2", "expected a positive number");
-  if (!positive(s.hip_height_m)) fail("hip_height_m", "expected a positive number");
-  if (!positive(s.track_width_m)) fail("track_width_m", "expected a positive number");
+  const auto range = [](double lo, double hi) {
+    return "expected a number from " + format_number(lo) + " to " + format_number(hi);
+  };
+  if (!in(s.max_acceleration_m_s2, 1e-6, kMaxAccelerationMs2))
+    fail("max_acceleration_m_s2", range(1e-6, kMaxAccelerationMs2));
+  if (!in(s.hip_height_m, kMinHipHeightM, kMaxHipHeightM))
+    fail("hip_height_m", range(kMinHipHeightM, kMaxHipHeightM));
+  if (!in(s.track_width_m, kMinTrackWidthM, kMaxTrackWidthM))
+    fail("track_width_m", range(kMinTrackWidthM, kMaxTrackWidthM));
   if (s.left.empty() || s.right.empty()) fail("sides", "each side needs at least one limb");
   for (const auto* side : {&s.left, &s.right}) {
     for (std::size_t i = 0; i < side->size(); ++i) {
@@ -547,8 +586,27 @@ void validate_gait(const GaitFile& gait) {
         top, "stride_frequency_hz",
         "expected a positive number, found " + shortest_exact(*gait.stride_frequency_hz));
   }
+  if (gait.stride_frequency_hz &&
+      !(*gait.stride_frequency_hz >= kMinStrideHz && *gait.stride_frequency_hz <= kMaxStrideHz)) {
+    throw InputError(top, "stride_frequency_hz",
+                     "expected a number from " + format_number(kMinStrideHz) + " to " +
+                         format_number(kMaxStrideHz) + ", found " +
+                         shortest_exact(*gait.stride_frequency_hz));
+  }
   if (gait.froude && !(positive(gait.froude->number) && positive(gait.froude->hip_height_m))) {
     throw InputError(top, "froude", "number and hip_height_m must be positive");
+  }
+  if (gait.froude) {
+    const FroudeTiming& f = *gait.froude;
+    const double hz = froude_stride_frequency(f.number, f.hip_height_m);
+    if (f.number > kMaxFroude || f.hip_height_m < kMinHipHeightM ||
+        f.hip_height_m > kMaxHipHeightM || !(hz >= kMinStrideHz && hz <= kMaxStrideHz)) {
+      throw InputError(top, "froude",
+                       "expected number up to " + format_number(kMaxFroude) + ", hip_height_m " +
+                           format_number(kMinHipHeightM) + " to " + format_number(kMaxHipHeightM) +
+                           " and a stride frequency of " + format_number(kMinStrideHz) + " to " +
+                           format_number(kMaxStrideHz) + " Hz");
+    }
   }
   for (std::size_t i = 0; i < gait.curves.size(); ++i) {
     const GaitCurve& c = gait.curves[i];

@@ -237,6 +237,7 @@ WalkResponse load_walk_response(const std::string& gait_path) {
   std::error_code ec;
   if (std::filesystem::exists(cal_path, ec)) {
     const GaitCalibration cal = load_gait_calibration(cal_path);
+    check_calibration_references(cal, cal_path, gait_path);
     return WalkResponse(*gait.steering, &cal);
   }
   return WalkResponse(*gait.steering);

@@ -9,6 +9,14 @@
 namespace animrt::herd {
 namespace {
 
+// Plausible scene sizes (docs/herd.md lists them). A herd walks a paddock,
+// a show floor or a plaza: 200 m a side is wider than a football pitch, and
+// the navigation mesh (10 cm cells) of a larger ground would take minutes
+// and gigabytes to build. Coordinates may sit anywhere within 1 km of the
+// origin.
+constexpr double kMaxCoordinateM = 1000.0;
+constexpr double kMaxSideM = 200.0;
+
 std::vector<double> numbers(const YamlNode& node, std::size_t n) {
   if (!node.is_sequence()) {
     node.fail("expected a list of " + std::to_string(n) + " numbers, found " + node.describe());
@@ -19,30 +27,49 @@ std::vector<double> numbers(const YamlNode& node, std::size_t n) {
   }
   std::vector<double> out;
   for (const YamlNode& item : items) {
-    const double v = item.as_double();
-    if (!std::isfinite(v)) item.fail("expected a finite number, found " + item.describe());
-    out.push_back(v);
+    out.push_back(item.as_double());
   }
   return out;
 }
 
+// Numbers that are positions in the scene, metres.
+std::vector<double> coordinates(const YamlNode& node, std::size_t n) {
+  const auto v = numbers(node, n);
+  const auto items = node.items();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::abs(v[i]) > kMaxCoordinateM) {
+      items[i].fail("expected a coordinate from -" + format_number(kMaxCoordinateM) + " to " +
+                    format_number(kMaxCoordinateM) + " m, found " + items[i].describe());
+    }
+  }
+  return v;
+}
+
 Vec2 point(const YamlNode& node) {
-  const auto v = numbers(node, 2);
+  const auto v = coordinates(node, 2);
   return {v[0], v[1]};
 }
 
 Rect rect(const YamlNode& node) {
-  const auto v = numbers(node, 4);
+  const auto v = coordinates(node, 4);
   if (!(v[0] < v[2]) || !(v[1] < v[3])) {
     node.fail("expected [xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax, found " +
               node.describe());
+  }
+  if (v[2] - v[0] > kMaxSideM || v[3] - v[1] > kMaxSideM) {
+    node.fail("expected an area at most " + format_number(kMaxSideM) + " m a side, found " +
+              format_number(v[2] - v[0]) + " x " + format_number(v[3] - v[1]) + " m");
   }
   return {v[0], v[1], v[2], v[3]};
 }
 
 Vec2 positive_size(const YamlNode& node) {
-  const Vec2 s = point(node);
+  const auto v = numbers(node, 2);
+  const Vec2 s{v[0], v[1]};
   if (!(s.x > 0) || !(s.y > 0)) node.fail("expected two sizes > 0, found " + node.describe());
+  if (s.x > kMaxSideM || s.y > kMaxSideM) {
+    node.fail("expected sizes up to " + format_number(kMaxSideM) + " m, found " + node.describe());
+  }
   return s;
 }
 

@@ -7,11 +7,20 @@
 #include <optional>
 
 #include "animrt/controllers/seqnet/model_file.hpp"
+#include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
 namespace {
+
+// Plausible show sizes (docs/show.md lists them): key times and the
+// duration up to 1e6 s (11 days, longer than any show runs unattended);
+// a learned show completes at most an hour of frames at 25 per second.
+constexpr double kMaxShowS = 1e6;
+constexpr double kMinLearnedFrameS = 0.001;
+constexpr double kMaxLearnedFrameS = 1.0;
+constexpr double kMaxLearnedFrames = 100000.0;
 
 // `learned` is a whole track's interpolation: the model completes the
 // track between all its keys at once.
@@ -54,6 +63,18 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
   show.learned.where = section->location();
   const YamlNode frame_node = section->at("frame_s");
   show.learned.frame_s = frame_node.as_positive_double();
+  // A model's frame is from 1 ms (a fast capture) to 1 s; every frame of
+  // the show is completed and stored at load, so their count is bounded too.
+  if (show.learned.frame_s < kMinLearnedFrameS || show.learned.frame_s > kMaxLearnedFrameS) {
+    frame_node.fail("expected a number from " + format_number(kMinLearnedFrameS) + " to " +
+                    format_number(kMaxLearnedFrameS) + ", found " + frame_node.describe());
+  }
+  if (const double frames = show.duration_s / show.learned.frame_s; frames > kMaxLearnedFrames) {
+    frame_node.fail("the learned tracks span " + format_number(show.duration_s) + " s, " +
+                    format_number(std::ceil(frames)) + " frames of " + frame_node.describe() +
+                    " s; expected at most " + format_number(kMaxLearnedFrames) +
+                    " frames (a longer frame_s, or a shorter show)");
+  }
 
   seqnet::ModelFile model;
   try {
@@ -75,6 +96,13 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
   } catch (const InputError& e) {
     model_node.fail(std::string(e.what()) +
                     " (the show's learned tracks must be the model's joints)");
+  }
+  // A model that computes inf or NaN from its own range would play them
+  // (inf clamped to a limit unnoticed): refused here, with the show's line.
+  try {
+    seqnet::check_model_output(model, show.learned.model_file);
+  } catch (const InputError& e) {
+    model_node.fail(e.what());
   }
   show.learned.joints = model.joint_names;
   show.learned.model = std::make_shared<const seqnet::ModelFile>(std::move(model));
@@ -189,7 +217,7 @@ ShowFile load_show_file(const std::string& path) {
         item.fail("expected [time_s, value] or {t, value, interpolation}, found " +
                   item.describe());
       }
-      key.t = t_node->as_double_in(0.0, 1e6);
+      key.t = t_node->as_double_in(0.0, kMaxShowS);
       key.value = v_node->as_double();
       if (!track.keys.empty() && !(key.t > track.keys.back().t)) {
         t_node->fail("expected a time after the previous key's " +
@@ -203,6 +231,9 @@ ShowFile load_show_file(const std::string& path) {
   show.duration_s = last;
   if (auto d = root.find("duration_s")) {
     show.duration_s = d->as_positive_double();
+    if (show.duration_s > kMaxShowS) {
+      d->fail("expected at most " + format_number(kMaxShowS) + " s, found " + d->describe());
+    }
     if (show.duration_s < last) {
       d->fail("expected at least the last key's time (" + format_number(last) + " s), found " +
               d->describe());

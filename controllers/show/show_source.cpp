@@ -179,6 +179,16 @@ void complete_learned(const ShowFile& show, std::span<const JointSpec> joints,
     for (Eigen::Index f = 0; f < frames; ++f) {
       ShowKey key;
       key.t = times[0] + static_cast<double>(f) * learned.frame_s;
+      // Clamping would turn inf into a limit unnoticed; NaN and inf are
+      // both the model's fault, refused with the track's line.
+      if (const double v = done.frames(static_cast<Eigen::Index>(j), f); !std::isfinite(v)) {
+        throw InputError(where, "joints." + joints[static_cast<std::size_t>(track.joint)].name,
+                         "the learned model \"" + learned.model_file + "\" completed " +
+                             (std::isnan(v) ? std::string("nan")
+                              : v > 0       ? "inf"
+                                            : "-inf") +
+                             " at " + format_number(key.t) + " s; a learned track must be finite");
+      }
       key.value = std::clamp(done.frames(static_cast<Eigen::Index>(j), f), lim.min_position,
                              lim.max_position);
       key.interpolation = Interpolation::cubic;

@@ -17,6 +17,7 @@
 #include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/error.hpp"
 #include "subcommand.hpp"
 
@@ -64,6 +65,17 @@ seqnet::FrameMatrix read_joint_frames(const seqnet::ModelFile& model, const std:
   return frames;
 }
 
+// A mesh frame with a non-finite position is refused before any file is
+// written (a viewer would draw nothing, or everything at infinity).
+void require_finite_mesh(const std::vector<seqnet::Positions>& frames, const std::string& model) {
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    if (frames[f].allFinite()) continue;
+    throw InputError(Location{model, 0, 0}, "output",
+                     "the model computed a non-finite vertex position at frame " +
+                         std::to_string(f) + "; nothing was written");
+  }
+}
+
 struct GenerateArgs {
   std::string model;
   std::vector<std::string> init;
@@ -73,7 +85,7 @@ struct GenerateArgs {
 };
 
 int run_generate(const GenerateArgs& a) {
-  const seqnet::ModelFile model = seqnet::read_model_file(a.model);
+  const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
   if (model.shape.kind == seqnet::ModelKind::joints) {
     const seqnet::FrameMatrix initial = read_joint_frames(model, a.model, a.init, "--init", 1);
     if (initial.cols() >= model.shape.window) {
@@ -82,8 +94,9 @@ int run_generate(const GenerateArgs& a) {
                            std::to_string(model.shape.window) + " frames");
     }
     seqnet::SeqNetInference net(model, a.model);
-    seqnet::write_joint_csv(a.out, model.joint_names,
-                            net.generate(initial, a.frames, a.random_state));
+    const seqnet::FrameMatrix frames = net.generate(initial, a.frames, a.random_state);
+    seqnet::require_finite_frames(frames, a.model, model.joint_names);
+    seqnet::write_joint_csv(a.out, model.joint_names, frames);
     std::cout << a.model << ": " << initial.cols() << " initial + " << a.frames
               << " generated frames -> " << a.out << '\n';
     return 0;
@@ -95,6 +108,7 @@ int run_generate(const GenerateArgs& a) {
   seqnet::MeshSequence out;
   out.triangles = init.triangles;
   out.frames = seqnet::generate_mesh(model, a.model, init.frames, init.triangles, o);
+  require_finite_mesh(out.frames, a.model);
   seqnet::write_obj_sequence(a.out, out);
   std::cout << a.model << ": " << init.frames.size() << " initial + " << a.frames
             << " generated frames -> " << a.out << "/frame_*.obj\n";
@@ -133,13 +147,14 @@ void print_report(const std::vector<seqnet::GapReport>& gaps, double threshold) 
 }
 
 int run_complete(const CompleteArgs& a) {
-  const seqnet::ModelFile model = seqnet::read_model_file(a.model);
+  const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
   seqnet::Completion c;
   if (model.shape.kind == seqnet::ModelKind::joints) {
     const seqnet::FrameMatrix keys = read_joint_frames(model, a.model, a.keys, "--keys", 2);
     seqnet::SeqNetInference net(model, a.model);
     c = net.complete(keys, std::vector<int>(static_cast<std::size_t>(keys.cols() - 1), a.gap),
                      a.options);
+    seqnet::require_finite_frames(c.frames, a.model, model.joint_names);
     seqnet::write_joint_csv(a.out, model.joint_names, c.frames);
   } else {
     if (a.keys.size() < 2) {
@@ -154,12 +169,12 @@ int run_complete(const CompleteArgs& a) {
     seqnet::MeshSequence out;
     out.triangles = keys.triangles;
     out.frames = seqnet::completed_mesh(model, keys.frames, features, c, a.gap);
+    require_finite_mesh(out.frames, a.model);
     seqnet::write_obj_sequence(a.out, out);
   }
   print_report(c.gaps, a.options.threshold);
-  std::cout << a.model << ": " << c.gaps.size() + 1 << " keys, " << c.frames.cols()
-            << " frames -> " << a.out
-            << (model.shape.kind == seqnet::ModelKind::mesh ? "/frame_*.obj" : "") << '\n';
+  std::cout << a.model << ": " << c.gaps.size() + 1 << " keys, " << c.frames.cols() << " frames -> "
+            << a.out << (model.shape.kind == seqnet::ModelKind::mesh ? "/frame_*.obj" : "") << '\n';
   return 0;
 }
 
@@ -170,16 +185,17 @@ struct EvaluateArgs {
 };
 
 int run_evaluate(const EvaluateArgs& a) {
-  const seqnet::ModelFile model = seqnet::read_model_file(a.model);
+  const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
   const seqnet::SequenceFeatures data = seqnet::read_feature_file(a.data);
   const seqnet::Evaluation e = seqnet::evaluate(model, a.model, data, a.options);
   int held = 0;
   for (const auto& p : e.pieces) held += p.count;
-  std::printf("%s: %llu iterations; held out (seed %llu, %g %%): %d of %zu frames of %s in %zu "
-              "pieces\n",
-              a.model.c_str(), static_cast<unsigned long long>(model.iteration),
-              static_cast<unsigned long long>(model.seed), 100.0 * a.options.held_out, held,
-              data.frames.size(), a.data.c_str(), e.pieces.size());
+  std::printf(
+      "%s: %llu iterations; held out (seed %llu, %g %%): %d of %zu frames of %s in %zu "
+      "pieces\n",
+      a.model.c_str(), static_cast<unsigned long long>(model.iteration),
+      static_cast<unsigned long long>(model.seed), 100.0 * a.options.held_out, held,
+      data.frames.size(), a.data.c_str(), e.pieces.size());
   for (const auto& p : e.pieces) {
     std::printf("  %s frames %d..%d\n", p.name.c_str(), p.first, p.first + p.count - 1);
   }
@@ -188,25 +204,27 @@ int run_evaluate(const EvaluateArgs& a) {
       "(mean bounding-box diagonal %.4g)\n",
       e.diagonal);
   for (const auto& r : e.generation) {
-    std::printf("generate from %d initial frame%s, frame %2d (%d starts): learned %.4g  linear "
-                "extrapolation in feature space %.4g\n",
-                r.initial, r.initial == 1 ? " " : "s", r.horizon, r.frames, r.learned,
-                r.extrapolated);
+    std::printf(
+        "generate from %d initial frame%s, frame %2d (%d starts): learned %.4g  linear "
+        "extrapolation in feature space %.4g\n",
+        r.initial, r.initial == 1 ? " " : "s", r.horizon, r.frames, r.learned, r.extrapolated);
   }
   const seqnet::CompletionRow& c = e.completion;
   if (c.frames > 0) {
     const double best = std::min(c.feature_linear, c.vertex_linear);
-    std::printf("complete %d gaps of %d frames (%d merged below %g %%): learned %.4g  linear in "
-                "feature space %.4g  linear in vertex space %.4g  (learned %.1f %% %s the best "
-                "interpolation)\n",
-                c.gaps, a.options.gap, c.merged, 100.0 * a.options.completion.threshold,
-                c.learned, c.feature_linear, c.vertex_linear,
-                100.0 * std::abs(1.0 - c.learned / best), c.learned <= best ? "below" : "above");
+    std::printf(
+        "complete %d gaps of %d frames (%d merged below %g %%): learned %.4g  linear in "
+        "feature space %.4g  linear in vertex space %.4g  (learned %.1f %% %s the best "
+        "interpolation)\n",
+        c.gaps, a.options.gap, c.merged, 100.0 * a.options.completion.threshold, c.learned,
+        c.feature_linear, c.vertex_linear, 100.0 * std::abs(1.0 - c.learned / best),
+        c.learned <= best ? "below" : "above");
   }
   if (!e.change_generated.empty()) {
-    std::printf("change per frame |x(t+1) - x(t)| / |x(t)| (normalised features), %d starts, "
-                "held-out frames %.4g; generated t = 1..%zu:",
-                e.change_starts, e.change_truth, e.change_generated.size());
+    std::printf(
+        "change per frame |x(t+1) - x(t)| / |x(t)| (normalised features), %d starts, "
+        "held-out frames %.4g; generated t = 1..%zu:",
+        e.change_starts, e.change_truth, e.change_generated.size());
     for (double v : e.change_generated) std::printf(" %.4g", v);
     std::printf("\n");
   }
@@ -226,8 +244,7 @@ void add_seq_model_commands(CLI::App& seq) {
                    "initial frame")
       ->required()
       ->expected(1, 8);
-  generate->add_option("--frames", g->frames, "frames to generate")
-      ->check(CLI::Range(1, 1000000));
+  generate->add_option("--frames", g->frames, "frames to generate")->check(CLI::Range(1, 1000000));
   generate
       ->add_option("--out", g->out,
                    "mesh model: folder for frame_NNNN.obj; joint model: CSV file to write")
@@ -237,9 +254,9 @@ void add_seq_model_commands(CLI::App& seq) {
   set_subcommand_body(generate, [g] { return run_generate(*g); });
 
   auto c = std::make_shared<CompleteArgs>();
-  auto* complete =
-      seq.add_subcommand("complete", "Complete the frames between keys (forward and backward "
-                                     "chains merged where they meet)");
+  auto* complete = seq.add_subcommand("complete",
+                                      "Complete the frames between keys (forward and backward "
+                                      "chains merged where they meet)");
   complete->add_option("MODEL", c->model, "model file (animrt seq train)")->required();
   complete
       ->add_option("--keys", c->keys,
@@ -264,20 +281,23 @@ void add_seq_model_commands(CLI::App& seq) {
 
   auto ev = std::make_shared<EvaluateArgs>();
   auto* evaluate = seq.add_subcommand(
-      "evaluate", "Measure a mesh model on the held-out frames of its training feature file: "
-                  "generation, completion, change per frame");
+      "evaluate",
+      "Measure a mesh model on the held-out frames of its training feature file: "
+      "generation, completion, change per frame");
   evaluate->add_option("MODEL", ev->model, "mesh model file (animrt seq train)")->required();
   evaluate->add_option("FEATURES", ev->data, "the feature file it was trained on")->required();
   evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
       ->check(CLI::Range(0.0, 1.0));
   evaluate->add_option("--gap", ev->options.gap, "completion: frames between keys")
       ->check(CLI::Range(1, 100000));
-  evaluate->add_option("--threshold", ev->options.completion.threshold, "completion: merge threshold")
+  evaluate
+      ->add_option("--threshold", ev->options.completion.threshold, "completion: merge threshold")
       ->check(CLI::Range(1e-12, 10.0));
   evaluate->add_option("--retries", ev->options.completion.retries, "completion: random retries")
       ->check(CLI::Range(0, 100000));
-  evaluate->add_option("--change-frames", ev->options.change_frames,
-                       "frames generated for the change per frame (0: skip)")
+  evaluate
+      ->add_option("--change-frames", ev->options.change_frames,
+                   "frames generated for the change per frame (0: skip)")
       ->check(CLI::Range(0, 100000));
   set_subcommand_body(evaluate, [ev] { return run_evaluate(*ev); });
 }

@@ -42,6 +42,10 @@ constexpr double kMaxWatchdogS = 5.0;
 constexpr double kMaxStartRampMaxS = 120.0;
 constexpr double kMaxStopDeadlineS = 30.0;
 constexpr double kMaxFollowingWindowS = 5.0;
+// Every layer is sampled every cycle; a figure has a few parts that move on
+// their own (a neck, a jaw, eyes), so more than 16 is a mistake that costs
+// cycle time.
+constexpr std::size_t kMaxMotionLayers = 16;
 
 std::string seconds(double s) { return format_number(s) + " s"; }
 
@@ -375,6 +379,10 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
     const YamlNode list = node.at("layers");
     const auto items = list.items();
     if (items.empty()) list.fail("expected at least one motion source, found an empty list");
+    if (items.size() > kMaxMotionLayers) {
+      list.fail("expected at most " + std::to_string(kMaxMotionLayers) + " motion sources, found " +
+                std::to_string(items.size()));
+    }
     for (const YamlNode& item : items)
       motion.layers.push_back(parse_motion(item, robot_path, true));
     return motion;

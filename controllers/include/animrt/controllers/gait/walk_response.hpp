@@ -28,6 +28,8 @@ struct GaitCalibration {
   std::string model_file;   // the MJCF model it walked on
   double tolerance = 0.15;  // relative speed and turn error accepted as usable
   std::vector<CalibrationPoint> points;
+  // Where the gait and model keys are (read from a file), for messages.
+  Location gait_where, model_where;
 };
 
 bool operator==(const MotionCommand& a, const MotionCommand& b);
@@ -53,6 +55,13 @@ std::string calibration_path_for(const std::string& gait_path);
 // the tolerance).
 GaitCalibration load_gait_calibration(const std::string& path);
 GaitCalibration parse_gait_calibration(const std::string& text, const std::string& file_name);
+// The table's references, resolved against `calibration_path`'s folder:
+// `gait` must be the gait at `gait_path` (a table measured for another gait
+// would steer this one wrongly) and `model` a readable file. Throws
+// InputError at the key.
+void check_calibration_references(const GaitCalibration& calibration,
+                                  const std::string& calibration_path,
+                                  const std::string& gait_path);
 std::string format_gait_calibration(const GaitCalibration& calibration);
 // Throws std::runtime_error when the file cannot be written.
 void write_gait_calibration(const std::string& path, const GaitCalibration& calibration);
