@@ -69,12 +69,7 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
     frame_node.fail("expected a number from " + format_number(kMinLearnedFrameS) + " to " +
                     format_number(kMaxLearnedFrameS) + ", found " + frame_node.describe());
   }
-  if (const double frames = show.duration_s / show.learned.frame_s; frames > kMaxLearnedFrames) {
-    frame_node.fail("the learned tracks span " + format_number(show.duration_s) + " s, " +
-                    format_number(std::ceil(frames)) + " frames of " + frame_node.describe() +
-                    " s; expected at most " + format_number(kMaxLearnedFrames) +
-                    " frames (a longer frame_s, or a shorter show)");
-  }
+
 
   seqnet::ModelFile model;
   try {
@@ -126,6 +121,15 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
                              " s");
       }
     }
+  }
+  // Every completed frame is stored: a looping show completes its whole
+  // duration, another from its first learned key to its last.
+  const double span = show.loop ? show.duration_s : first.keys.back().t - first.keys.front().t;
+  if (const double frames = span / show.learned.frame_s; frames > kMaxLearnedFrames) {
+    frame_node.fail("the learned tracks span " + format_number(span) + " s, " +
+                    format_number(std::ceil(frames)) + " frames of " + frame_node.describe() +
+                    " s; expected at most " + format_number(kMaxLearnedFrames) +
+                    " frames (a longer frame_s, or a shorter show)");
   }
   // Every gap is a whole number of the model's frames.
   const double frame = show.learned.frame_s;

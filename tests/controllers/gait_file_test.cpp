@@ -251,7 +251,7 @@ TEST(GaitFile, BadFixtureFile) {
 GaitFile odd_gait() {
   GaitFile g;
   g.name = "evolved #7: \"best\"";
-  g.froude = FroudeTiming{0.1 + 0.2, 1e-3};
+  g.froude = FroudeTiming{0.1 + 0.2, 0.1 + 0.07};
   g.curves.push_back({"c0", "6.97 + 7.7*sin(1*2*PI*t + -1.07)", {}});
   g.curves.push_back({"curve with spaces", "0.1*t/(t - t) - 1e-300", {}});
   g.curves.push_back({"null", "cos(t)", {}});

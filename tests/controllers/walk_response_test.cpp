@@ -252,7 +252,12 @@ TEST(WalkResponse, LoadsTheGaitAndItsCalibration) {
                           " track_width_m: 0.2, sides: {left: [l], right: [r]}}\n";
   const WalkResponse uncalibrated = load_walk_response(steer);
   EXPECT_DOUBLE_EQ(uncalibrated.min_speed(), 0.05 * std::sqrt(9.81 * 0.2));
-  write_gait_calibration(calibration_path_for(steer), table());
+  // The table names the gait beside it and a model that exists.
+  GaitCalibration beside = table();
+  beside.gait_file = "steer.yaml";
+  beside.model_file = "steer_model.xml";
+  std::ofstream(dir / "steer_model.xml") << "<mujoco/>\n";
+  write_gait_calibration(calibration_path_for(steer), beside);
   const WalkResponse calibrated = load_walk_response(steer);
   EXPECT_EQ(calibrated.min_speed(), 0.1);
   EXPECT_NEAR(calibrated.max_turn(0.1), deg_to_rad(10.0), 1e-12);  // capped by the steering

@@ -977,5 +977,19 @@ TEST_F(RobotConfigTest, DynamixelBadFastReadOrModelIsNamed) {
             std::string::npos);
 }
 
+// Every layer is sampled every cycle: 16 load, 17 are refused at the list.
+TEST_F(RobotConfigTest, MotionLayersAreAtMostSixteen) {
+  std::string base = kMinimal;
+  base = base.substr(0, base.find("motion:"));
+  const auto layers = [&](int n) {
+    std::string text = base + "motion:\n  type: layers\n  layers:\n";
+    for (int i = 0; i < n; ++i) text += "    - {type: gait, file: ../gaits/gait.yaml}\n";
+    return text;
+  };
+  EXPECT_EQ(error_of(layers(16)), "no error");
+  EXPECT_EQ(error_of(layers(17)),
+            at("11:5: motion.layers: expected at most 16 motion sources, found 17"));
+}
+
 }  // namespace
 }  // namespace animrt
