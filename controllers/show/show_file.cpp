@@ -70,7 +70,6 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
                     format_number(kMaxLearnedFrameS) + ", found " + frame_node.describe());
   }
 
-
   seqnet::ModelFile model;
   try {
     model = seqnet::read_model_file(show.learned.model_file);

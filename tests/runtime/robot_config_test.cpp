@@ -988,7 +988,7 @@ TEST_F(RobotConfigTest, MotionLayersAreAtMostSixteen) {
   };
   EXPECT_EQ(error_of(layers(16)), "no error");
   EXPECT_EQ(error_of(layers(17)),
-            at("11:5: motion.layers: expected at most 16 motion sources, found 17"));
+            at("12:5: motion.layers: expected at most 16 motion sources, found 17"));
 }
 
 }  // namespace

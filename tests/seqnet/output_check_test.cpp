@@ -95,8 +95,8 @@ TEST_F(ModelOutput, GenerateAndCompleteRefuseAnOverflowingModelAndWriteNothing) 
 TEST_F(ModelOutput, GenerateAndCompleteNeverWriteANonFiniteNumber) {
   const std::string model = path("small.model");
   write_model_file(model, test::tiny_joint_model(0.1F));
-  write("init.csv", "hip,knee\n3e38,0.2\n");
-  write("keys.csv", "hip,knee\n3e38,0.2\n0.3,-0.1\n");
+  write("init.csv", "hip,knee\n1e300,0.2\n");
+  write("keys.csv", "hip,knee\n1e300,0.2\n0.3,-0.1\n");
   std::string err;
   int code = animrt("seq generate " + model + " --init " + path("init.csv") + " --frames 4 --out " +
                         path("gen.csv"),

@@ -70,7 +70,7 @@ std::vector<JointSpec> joints() {
 TEST_F(ShowRanges, DurationAndLearnedFramesJustPastTheirBoundsAreRefused) {
   EXPECT_EQ(error_of("name: s\nduration_s: 1e6\njoints: {j: {keys: [[0, 1]]}}\n"), "no error");
   EXPECT_EQ(error_of("name: s\nduration_s: 1.000001e6\njoints: {j: {keys: [[0, 1]]}}\n"),
-            at("2:13: duration_s: expected at most 1000000 s, found \"1.000001e6\""));
+            at("2:13: duration_s: expected at most 1e+06 s, found \"1.000001e6\""));
   EXPECT_EQ(error_of(learned_show("small.model")), "no error");
   EXPECT_EQ(error_of(learned_show("small.model", "0.0009")),
             at("2:40: learned.frame_s: expected a number from 0.001 to 1, found \"0.0009\""));
