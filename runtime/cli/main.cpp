@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "animrt/bridge/protocol.hpp"
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
@@ -87,6 +88,11 @@ int cmd_validate(const std::string& path) {
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
+  // What stops each bus's devices if animrt dies: the user must know where there is nothing.
+  for (const auto& bus : robot.config.buses) {
+    std::cout << "  bus " << bus.name << ": "
+              << animrt::find_protocol(bus.protocol)->device_guard(bus) << '\n';
+  }
   return kExitOk;
 }
 

@@ -312,6 +312,25 @@ void check_bus_timeouts(const YamlNode& buses, const RobotConfig& config,
   }
 }
 
+// The devices' guard against a dead host: the default for the loop rate
+// where the robot file says nothing. One the file sets must outlast three
+// loop periods, or the host's own cycle (which feeds it) would trip it.
+void resolve_device_watchdogs(const YamlNode& buses, RobotConfig& config) {
+  const double period_ms = 1000.0 / config.rate_hz;
+  for (BusConfig& bus : config.buses) {
+    if (bus.device_watchdog_ms == kDeviceWatchdogDefault) {
+      bus.device_watchdog_ms = default_device_watchdog_ms(config.rate_hz);
+      continue;
+    }
+    if (bus.device_watchdog_ms == 0 || bus.device_watchdog_ms >= 3.0 * period_ms) continue;
+    const YamlNode n = buses.at(bus.name).at("device_watchdog_ms");
+    std::ostringstream msg;
+    msg << "expected off or at least three loop periods (" << std::ceil(3.0 * period_ms)
+        << " ms at loop.rate_hz " << config.rate_hz << "), found " << n.describe();
+    n.fail(msg.str());
+  }
+}
+
 // The loop cannot run faster than the slowest bus carries one cycle's
 // traffic. Buses sharing a port (CAN) add up.
 void check_bus_load(const YamlNode& rate_node, const RobotConfig& config) {
@@ -442,6 +461,7 @@ RobotConfig load_robot_config(const std::string& path) {
   const YamlNode buses = root.at("buses");
   config.buses = parse_buses(buses);
   check_bus_timeouts(buses, config, safety);
+  resolve_device_watchdogs(buses, config);
   parse_joints(root.at("joints"), config);
   check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and

@@ -2,6 +2,8 @@
 
 #include <net/if.h>
 
+#include <charconv>
+
 namespace animrt::can_config {
 
 void read_common_bus(const YamlNode& node, BusConfig& bus) {
@@ -21,6 +23,25 @@ void read_common_bus(const YamlNode& node, BusConfig& bus) {
     }
     bus.timeout_s = ms / 1000.0;
   }
+}
+
+void read_device_watchdog(const YamlNode& node, BusConfig& bus, int max_ms) {
+  const auto n = node.find("device_watchdog_ms");
+  if (!n) return;
+  if (n->is_scalar() && (n->raw().Scalar() == "off" || n->raw().Scalar() == "0")) {
+    bus.device_watchdog_ms = 0;
+    return;
+  }
+  const std::string expected =
+      "expected off, 0 (off) or milliseconds from 1 to " + std::to_string(max_ms);
+  std::int64_t ms = 0;
+  if (n->is_scalar()) {
+    const std::string& s = n->raw().Scalar();
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), ms);
+    if (ec != std::errc() || end != s.data() + s.size()) ms = -1;
+  }
+  if (!n->is_scalar() || ms < 1 || ms > max_ms) n->fail(expected + ", found " + n->describe());
+  bus.device_watchdog_ms = static_cast<int>(ms);
 }
 
 int read_direction(const YamlNode& node) {

@@ -2,6 +2,7 @@
 // protocol module.
 
 #include <cmath>
+#include <string>
 #include <limits>
 
 #include "animrt/bridge/can/can_options.hpp"
@@ -13,8 +14,17 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kCia402BusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
-                                               "heartbeat_timeout_ms"};
+constexpr std::string_view kCia402BusKeys[] = {"interface",
+                                               "bitrate",
+                                               "timeout_ms",
+                                               "heartbeat_ms",
+                                               "heartbeat_timeout_ms",
+                                               "device_watchdog_ms",
+                                               "abort_connection",
+                                               "host_node_id"};
+
+// The consumer time of 1016h is 16 bits of milliseconds.
+constexpr int kMaxConsumerMs = 65535;
 constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
                                                     "direction"};
 
@@ -38,6 +48,24 @@ class Cia402 final : public Protocol {
                 "), found " + n->describe());
       }
     }
+    can_config::read_device_watchdog(node, bus, kMaxConsumerMs);
+    if (auto n = node.find("abort_connection")) {
+      const std::string s = n->is_scalar() ? n->raw().Scalar() : "";
+      if (s == "quick_stop") {
+        options.abort_connection = AbortConnection::quick_stop;
+      } else if (s == "disable_voltage") {
+        options.abort_connection = AbortConnection::disable_voltage;
+      } else if (s == "fault") {
+        options.abort_connection = AbortConnection::fault;
+      } else {
+        n->fail("expected quick_stop, disable_voltage or fault (the drive's reaction to a "
+                "missed host heartbeat, object 6007h), found " +
+                n->describe());
+      }
+    }
+    if (auto n = node.find("host_node_id")) {
+      options.host_node_id = static_cast<int>(n->as_int_in(1, canopen::kMaxNodeId));
+    }
     bus.options = options;
   }
 
@@ -53,6 +81,11 @@ class Cia402 final : public Protocol {
         id_node.fail("node id " + std::to_string(id) + " is already used by joint " + other.joint +
                      " on bus " + bus.name);
       }
+    }
+    const int host = options_of<Cia402BusOptions>(bus.options).host_node_id;
+    if (id == host) {
+      id_node.fail("node id " + std::to_string(id) + " is the host's (bus " + bus.name +
+                   " host_node_id, default 127): its heartbeats would be taken for the drive's");
     }
     out.device_id = static_cast<int>(id);
     double counts_per_rev = 4096.0;
@@ -86,6 +119,20 @@ class Cia402 final : public Protocol {
       return 47.0 + 8.0 * data_bytes + std::floor((stuffed - 1.0) / 4.0);
     };
     return frame(0) + 2.0 * frame(6) * static_cast<double>(bus.actuators.size());
+  }
+
+  std::string device_guard(const BusConfig& bus) const override {
+    const auto o = options_of<Cia402BusOptions>(bus.options);
+    if (bus.device_watchdog_ms == 0) {
+      return "no device-side guard (device_watchdog_ms: off): the drives stay in Operation "
+             "Enabled at their last target if animrt dies";
+    }
+    return "each drive's heartbeat consumer (1016h) expects the host's heartbeat (node " +
+           std::to_string(o.host_node_id) + ", every " +
+           std::to_string(Cia402Bus::host_heartbeat_ms(bus.device_watchdog_ms)) +
+           " ms) and after " + std::to_string(bus.device_watchdog_ms) + " ms without one does " +
+           to_string(o.abort_connection) + " (6007h = " +
+           std::to_string(static_cast<int>(o.abort_connection)) + ")";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

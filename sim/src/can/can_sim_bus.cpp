@@ -1,5 +1,6 @@
 #include "animrt/sim/can/can_sim_bus.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "animrt/bridge/can/can_options.hpp"
@@ -24,8 +25,10 @@ CanSimBus::CanSimBus(const BusConfig& config, const Clock& clock, CanSimAttach a
   const Nanos now = clock.now();
   for (const ActuatorBinding& b : config_.actuators) {
     if (config_.protocol == "mit") {
+      // The motors' CAN timeout is what the bus says their setup menu holds.
       nodes_.push_back(std::make_unique<MitMotorNode>(
-          b, options_of<MitBusOptions>(config_.options).master_id, config_.sim, now));
+          b, options_of<MitBusOptions>(config_.options).master_id, config_.sim, now,
+          std::max(0, config_.device_watchdog_ms)));
     } else if (config_.protocol == "cia402") {
       nodes_.push_back(std::make_unique<Cia402DriveNode>(b, config_.sim, now));
     } else {
@@ -94,9 +97,10 @@ void CanSimBus::serve() {
     if (got) {
       ++frames_handled_;
       for (CanNode* n : listeners_[frame.can_id & CAN_SFF_MASK]) n->handle(frame, now, out_);
-    } else {
-      for (const auto& n : nodes_) n->poll(now, out_);
     }
+    // Time-driven behaviour (heartbeats, the guards against a dead host)
+    // must not wait for a quiet bus.
+    for (const auto& n : nodes_) n->poll(now, out_);
     flush(out_);
   }
 }

@@ -55,6 +55,14 @@ class Protocol {
     return 0.0;
   }
 
+  // What the bus's devices do by themselves when the host goes silent (the
+  // guard against a dead host, BusConfig::device_watchdog_ms), in one line
+  // for validate.
+  virtual std::string device_guard(const BusConfig& bus) const {
+    (void)bus;
+    return "no device-side guard: the devices keep their last command if animrt dies";
+  }
+
   // Opens the bus (transport included). Throws DeviceError.
   virtual std::unique_ptr<ActuatorBus> make_bus(const BusConfig& bus) const = 0;
 };
