@@ -214,8 +214,8 @@ void Cia402Bus::produce_heartbeat() {
   if (!producing_) return;
   const Nanos now = transport_->now();
   if (now < next_host_heartbeat_) return;
-  transport_->send(canopen::heartbeat(static_cast<std::uint8_t>(options_.host_node_id),
-                                      NmtState::operational));
+  transport_->send(
+      canopen::heartbeat(static_cast<std::uint8_t>(options_.host_node_id), NmtState::operational));
   next_host_heartbeat_ += host_heartbeat_ns_;
   if (next_host_heartbeat_ <= now) next_host_heartbeat_ = now + host_heartbeat_ns_;
 }

@@ -2,8 +2,8 @@
 // protocol module.
 
 #include <cmath>
-#include <string>
 #include <limits>
+#include <string>
 
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/can_protocols.hpp"
@@ -14,14 +14,9 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kCia402BusKeys[] = {"interface",
-                                               "bitrate",
-                                               "timeout_ms",
-                                               "heartbeat_ms",
-                                               "heartbeat_timeout_ms",
-                                               "device_watchdog_ms",
-                                               "abort_connection",
-                                               "host_node_id"};
+constexpr std::string_view kCia402BusKeys[] = {
+    "interface",          "bitrate",          "timeout_ms",  "heartbeat_ms", "heartbeat_timeout_ms",
+    "device_watchdog_ms", "abort_connection", "host_node_id"};
 
 // The consumer time of 1016h is 16 bits of milliseconds.
 constexpr int kMaxConsumerMs = 65535;
@@ -58,9 +53,10 @@ class Cia402 final : public Protocol {
       } else if (s == "fault") {
         options.abort_connection = AbortConnection::fault;
       } else {
-        n->fail("expected quick_stop, disable_voltage or fault (the drive's reaction to a "
-                "missed host heartbeat, object 6007h), found " +
-                n->describe());
+        n->fail(
+            "expected quick_stop, disable_voltage or fault (the drive's reaction to a "
+            "missed host heartbeat, object 6007h), found " +
+            n->describe());
       }
     }
     if (auto n = node.find("host_node_id")) {
@@ -131,8 +127,8 @@ class Cia402 final : public Protocol {
            std::to_string(o.host_node_id) + ", every " +
            std::to_string(Cia402Bus::host_heartbeat_ms(bus.device_watchdog_ms)) +
            " ms) and after " + std::to_string(bus.device_watchdog_ms) + " ms without one does " +
-           to_string(o.abort_connection) + " (6007h = " +
-           std::to_string(static_cast<int>(o.abort_connection)) + ")";
+           to_string(o.abort_connection) +
+           " (6007h = " + std::to_string(static_cast<int>(o.abort_connection)) + ")";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

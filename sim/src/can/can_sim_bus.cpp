@@ -132,6 +132,11 @@ void CanSimBus::reboot_device(int device_id) {
   flush(out);
 }
 
+bool CanSimBus::device_guard_fired(int device_id) const {
+  std::lock_guard lock(mutex_);
+  return node(device_id).guard_fired();
+}
+
 double CanSimBus::device_position(int device_id) const {
   std::lock_guard lock(mutex_);
   return node(device_id).joint_position(clock_.now());

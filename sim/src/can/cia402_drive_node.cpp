@@ -15,7 +15,7 @@ namespace obj = cia402::obj;
 
 constexpr std::int32_t kTargetWindow = 20;  // counts: "target reached"
 constexpr std::uint16_t kEmcyRpdoLength = 0x8210;
-constexpr std::uint16_t kEmcyHeartbeat = 0x8130;  // life guard or heartbeat error
+constexpr std::uint16_t kEmcyHeartbeat = 0x8130;    // life guard or heartbeat error
 constexpr std::uint8_t kCommunicationError = 0x10;  // error register bit 4
 
 // Error register (1001h) bits for an EMCY code's class.

@@ -70,6 +70,7 @@ class Cia402DriveNode final : public CanNode {
   std::uint16_t statusword(Nanos now) const;
   // Times the heartbeat consumer fired since power-on.
   std::uint64_t heartbeat_events() const { return heartbeat_events_; }
+  bool guard_fired() const override { return heartbeat_error_; }
   // The EMCY error code an injected fault condition produces.
   static std::uint16_t emcy_code_for(std::uint8_t bits);
 

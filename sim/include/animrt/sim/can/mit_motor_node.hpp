@@ -37,6 +37,7 @@ class MitMotorNode final : public CanNode {
   const mit::Command& command() const { return command_; }
   // Limp after a CAN timeout (until the next command), and how often.
   bool timed_out() const { return timed_out_; }
+  bool guard_fired() const override { return timed_out_; }
   std::uint64_t timeouts() const { return timeouts_; }
   double motor_position(Nanos now) const { return motor_.position(now) - zero_; }
 
