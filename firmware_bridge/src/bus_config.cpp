@@ -1,6 +1,5 @@
 #include "animrt/bridge/bus_config.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 namespace animrt {
@@ -22,15 +21,6 @@ bool ActuatorBinding::has_limits() const {
 
 double ActuatorBinding::to_rad(std::int32_t ticks) const {
   return direction * (static_cast<double>(ticks) - zero_ticks) / ticks_per_rad;
-}
-
-}  // namespace animrt
-
-namespace animrt {
-
-int default_device_watchdog_ms(double rate_hz) {
-  const int five_periods = static_cast<int>(std::ceil(5000.0 / rate_hz));
-  return std::max(50, five_periods);
 }
 
 }  // namespace animrt

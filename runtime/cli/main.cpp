@@ -18,7 +18,6 @@
 #include <string>
 #include <thread>
 
-#include "animrt/bridge/protocol.hpp"
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
@@ -88,10 +87,9 @@ int cmd_validate(const std::string& path) {
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
-  // What stops each bus's devices if animrt dies: the user must know where there is nothing.
-  for (const auto& bus : robot.config.buses) {
-    std::cout << "  bus " << bus.name << ": "
-              << animrt::find_protocol(bus.protocol)->device_guard(bus) << '\n';
+  // What stops the figure if animrt itself dies, where the user must know.
+  for (const std::string& note : animrt::device_guard_notes(robot.config)) {
+    std::cout << note << "\n";
   }
   return kExitOk;
 }

@@ -127,9 +127,11 @@ SimBusSettings parse_sim(const YamlNode& node) {
   return sim;
 }
 
-BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses) {
+BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses,
+                    double rate_hz) {
   BusConfig bus;
   bus.name = name;
+  bus.loop_period_s = 1.0 / rate_hz;
   bus.where = key_location(buses, name);
 
   const YamlNode protocol_node = node.at("protocol");
@@ -149,12 +151,12 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   return bus;
 }
 
-std::vector<BusConfig> parse_buses(const YamlNode& node) {
+std::vector<BusConfig> parse_buses(const YamlNode& node, double rate_hz) {
   const auto entries = node.entries();
   if (entries.empty()) node.fail("expected at least one bus, found an empty map");
   std::vector<BusConfig> buses;
   for (const auto& [name, value] : entries) {
-    BusConfig bus = parse_bus(name, value, node);
+    BusConfig bus = parse_bus(name, value, node, rate_hz);
     // Two buses on one port would fight over the line.
     for (const auto& other : buses) {
       if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
@@ -312,25 +314,6 @@ void check_bus_timeouts(const YamlNode& buses, const RobotConfig& config,
   }
 }
 
-// The devices' guard against a dead host: the default for the loop rate
-// where the robot file says nothing. One the file sets must outlast three
-// loop periods, or the host's own cycle (which feeds it) would trip it.
-void resolve_device_watchdogs(const YamlNode& buses, RobotConfig& config) {
-  const double period_ms = 1000.0 / config.rate_hz;
-  for (BusConfig& bus : config.buses) {
-    if (bus.device_watchdog_ms == kDeviceWatchdogDefault) {
-      bus.device_watchdog_ms = default_device_watchdog_ms(config.rate_hz);
-      continue;
-    }
-    if (bus.device_watchdog_ms == 0 || bus.device_watchdog_ms >= 3.0 * period_ms) continue;
-    const YamlNode n = buses.at(bus.name).at("device_watchdog_ms");
-    std::ostringstream msg;
-    msg << "expected off or at least three loop periods (" << std::ceil(3.0 * period_ms)
-        << " ms at loop.rate_hz " << config.rate_hz << "), found " << n.describe();
-    n.fail(msg.str());
-  }
-}
-
 // The loop cannot run faster than the slowest bus carries one cycle's
 // traffic. Buses sharing a port (CAN) add up.
 void check_bus_load(const YamlNode& rate_node, const RobotConfig& config) {
@@ -459,9 +442,8 @@ RobotConfig load_robot_config(const std::string& path) {
   if (safety) config.safety = parse_safety(*safety, config.rate_hz);
 
   const YamlNode buses = root.at("buses");
-  config.buses = parse_buses(buses);
+  config.buses = parse_buses(buses, config.rate_hz);
   check_bus_timeouts(buses, config, safety);
-  resolve_device_watchdogs(buses, config);
   parse_joints(root.at("joints"), config);
   check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and

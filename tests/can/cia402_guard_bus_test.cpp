@@ -46,8 +46,8 @@ struct Rig {
     config.protocol = "cia402";
     config.port = "virtual:" + name;
     config.timeout_s = 0.5;  // a loaded machine must not time out
-    config.device_watchdog_ms = watchdog_ms;
     Cia402BusOptions options;
+    options.device_watchdog_ms = watchdog_ms;
     options.abort_connection = action;
     config.options = options;
     ActuatorBinding b;

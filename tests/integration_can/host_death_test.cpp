@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/robot_loader.hpp"
@@ -104,13 +105,21 @@ struct Figure {
   explicit Figure(int watchdog_override_ms = -1) : robot(load_robot(kRobot)) {
     widen_timeouts_for_lockstep(robot.config.buses);  // as `animrt run --lockstep`
     if (watchdog_override_ms >= 0) {
-      for (BusConfig& bus : robot.config.buses) bus.device_watchdog_ms = watchdog_override_ms;
+      auto mit = std::any_cast<MitBusOptions>(robot.config.buses[0].options);
+      mit.device_watchdog_ms = watchdog_override_ms;
+      robot.config.buses[0].options = mit;
+      robot.config.buses[1].options = mit;
+      auto drive = std::any_cast<Cia402BusOptions>(robot.config.buses[2].options);
+      drive.device_watchdog_ms = watchdog_override_ms;
+      robot.config.buses[2].options = drive;
     }
     clock.set(1000 * kMs);
     sims = start_simulated_devices(robot.config.buses, clock);
   }
   sim::CanSimBus& can(std::size_t i) { return dynamic_cast<sim::CanSimBus&>(*sims[i]); }
-  int watchdog_ms() const { return robot.config.buses[2].device_watchdog_ms; }
+  int watchdog_ms() const {
+    return std::any_cast<Cia402BusOptions>(robot.config.buses[2].options).device_watchdog_ms;
+  }
   bool any_motor_limp() {
     for (int id : kLeft)
       if (can(0).device_guard_fired(id)) return true;

@@ -2,7 +2,9 @@
 
 #include <net/if.h>
 
-#include <charconv>
+#include <cmath>
+
+#include "animrt/bridge/device_watchdog.hpp"
 
 namespace animrt::can_config {
 
@@ -25,23 +27,18 @@ void read_common_bus(const YamlNode& node, BusConfig& bus) {
   }
 }
 
-void read_device_watchdog(const YamlNode& node, BusConfig& bus, int max_ms) {
-  const auto n = node.find("device_watchdog_ms");
-  if (!n) return;
-  if (n->is_scalar() && (n->raw().Scalar() == "off" || n->raw().Scalar() == "0")) {
-    bus.device_watchdog_ms = 0;
-    return;
+int read_device_watchdog(const YamlNode& node, const BusConfig& bus, int max_ms,
+                         std::string_view device) {
+  const int ms = static_cast<int>(
+      read_device_watchdog_ms(node, bus.loop_period_s, 1.0, static_cast<double>(max_ms), device));
+  const double three_periods_ms = 3.0 * bus.loop_period_s * 1000.0;
+  if (ms != 0 && ms < three_periods_ms) {
+    const YamlNode n = node.at(kDeviceWatchdogKey);
+    n.fail("expected off or at least three loop periods (" +
+           format_number(std::ceil(three_periods_ms)) + " ms at loop.rate_hz " +
+           format_number(1.0 / bus.loop_period_s) + "), found " + n.describe());
   }
-  const std::string expected =
-      "expected off, 0 (off) or milliseconds from 1 to " + std::to_string(max_ms);
-  std::int64_t ms = 0;
-  if (n->is_scalar()) {
-    const std::string& s = n->raw().Scalar();
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), ms);
-    if (ec != std::errc() || end != s.data() + s.size()) ms = -1;
-  }
-  if (!n->is_scalar() || ms < 1 || ms > max_ms) n->fail(expected + ", found " + n->describe());
-  bus.device_watchdog_ms = static_cast<int>(ms);
+  return ms;
 }
 
 int read_direction(const YamlNode& node) {

@@ -48,7 +48,7 @@ Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transp
       timeout_(std::chrono::ceil<std::chrono::microseconds>(std::chrono::duration<double>(
           options_.sync_timeout_ms > 0 ? options_.sync_timeout_ms / 1000.0 : config_.timeout_s))),
       heartbeat_timeout_ns_(static_cast<Nanos>(options_.heartbeat_timeout_ms) * 1'000'000),
-      host_heartbeat_ns_(static_cast<Nanos>(host_heartbeat_ms(config_.device_watchdog_ms)) *
+      host_heartbeat_ns_(static_cast<Nanos>(host_heartbeat_ms(options_.device_watchdog_ms)) *
                          1'000'000) {
   const std::string bus = "bus " + config_.name + ": ";
   if (!transport_) throw DeviceError(bus + "no transport");
@@ -109,7 +109,7 @@ std::string Cia402Bus::fault_text(std::size_t device) const {
   if (d.heartbeat_lost) out += (out.empty() ? "" : "; ") + std::string("heartbeat lost");
   if (d.last_emcy.code == kHeartbeatErrorEmcy) {
     out += "; the drive missed the host's heartbeat for more than " +
-           std::to_string(config_.device_watchdog_ms) + " ms (device_watchdog_ms) and did " +
+           std::to_string(options_.device_watchdog_ms) + " ms (device_watchdog_ms) and did " +
            to_string(options_.abort_connection);
   }
   return out;
@@ -422,7 +422,7 @@ void Cia402Bus::activate() {
     target_counts_[i] = actual_counts_[i];
     hw_fault_[i] = 0;
   }
-  if (config_.device_watchdog_ms > 0) {
+  if (options_.device_watchdog_ms > 0) {
     // Armed before the drives are enabled; a drive starts watching at the
     // first heartbeat after the consumer is set, sent at once.
     try {
@@ -430,7 +430,7 @@ void Cia402Bus::activate() {
         sdo_write(i, cia402::obj::abort_connection_option, 0,
                   static_cast<std::uint16_t>(options_.abort_connection), 2);
         sdo_write(i, cia402::obj::heartbeat_consumer, 1,
-                  consumer_entry(options_.host_node_id, config_.device_watchdog_ms), 4);
+                  consumer_entry(options_.host_node_id, options_.device_watchdog_ms), 4);
       }
     } catch (const DeviceError& e) {
       deactivate();
@@ -472,7 +472,7 @@ void Cia402Bus::deactivate() {
 }
 
 void Cia402Bus::clear_device_guard() {
-  if (config_.device_watchdog_ms <= 0) return;
+  if (options_.device_watchdog_ms <= 0) return;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     try {
       sdo_write(i, cia402::obj::heartbeat_consumer, 1, 0, 4);

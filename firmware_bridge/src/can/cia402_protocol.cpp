@@ -43,7 +43,8 @@ class Cia402 final : public Protocol {
                 "), found " + n->describe());
       }
     }
-    can_config::read_device_watchdog(node, bus, kMaxConsumerMs);
+    options.device_watchdog_ms =
+        can_config::read_device_watchdog(node, bus, kMaxConsumerMs, "CiA 402 consumer time");
     if (auto n = node.find("abort_connection")) {
       const std::string s = n->is_scalar() ? n->raw().Scalar() : "";
       if (s == "quick_stop") {
@@ -117,18 +118,11 @@ class Cia402 final : public Protocol {
     return frame(0) + 2.0 * frame(6) * static_cast<double>(bus.actuators.size());
   }
 
-  std::string device_guard(const BusConfig& bus) const override {
-    const auto o = options_of<Cia402BusOptions>(bus.options);
-    if (bus.device_watchdog_ms == 0) {
-      return "no device-side guard (device_watchdog_ms: off): the drives stay in Operation "
-             "Enabled at their last target if animrt dies";
-    }
-    return "each drive's heartbeat consumer (1016h) expects the host's heartbeat (node " +
-           std::to_string(o.host_node_id) + ", every " +
-           std::to_string(Cia402Bus::host_heartbeat_ms(bus.device_watchdog_ms)) +
-           " ms) and after " + std::to_string(bus.device_watchdog_ms) + " ms without one does " +
-           to_string(o.abort_connection) +
-           " (6007h = " + std::to_string(static_cast<int>(o.abort_connection)) + ")";
+  // With the guard on the drives are set at activate: nothing to say.
+  std::string device_guard_note(const BusConfig& bus) const override {
+    if (options_of<Cia402BusOptions>(bus.options).device_watchdog_ms != 0) return {};
+    return "no device-side guard (device_watchdog_ms: off): if the host dies, the drives stay "
+           "in Operation Enabled at their last target";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

@@ -40,7 +40,8 @@ class Mit final : public Protocol {
       options.master_id = static_cast<canid_t>(n->as_int_in(0, MitBus::kMaxId));
     // Not settable over CAN: it states what each motor's setup menu holds,
     // and the simulated motors use it as theirs.
-    can_config::read_device_watchdog(node, bus, kMaxTimeoutMs);
+    options.device_watchdog_ms =
+        can_config::read_device_watchdog(node, bus, kMaxTimeoutMs, "the motors' CAN timeout");
     bus.options = options;
   }
 
@@ -117,16 +118,17 @@ class Mit final : public Protocol {
     return 2.0 * frame * static_cast<double>(bus.actuators.size());
   }
 
-  std::string device_guard(const BusConfig& bus) const override {
-    if (bus.device_watchdog_ms == 0) {
-      return "no device-side guard (device_watchdog_ms: off): the motors keep their last command "
-             "(position, gains, torque) if animrt dies";
+  // The guard lives in each motor's setup menu: always worth a line.
+  std::string device_guard_note(const BusConfig& bus) const override {
+    const int ms = options_of<MitBusOptions>(bus.options).device_watchdog_ms;
+    if (ms == 0) {
+      return "no device-side guard (device_watchdog_ms: off): if the host dies, the motors keep "
+             "their last command (position, gains, torque)";
     }
-    const int ms = bus.device_watchdog_ms;
     return "the motors go limp " + std::to_string(ms) +
-           " ms after the last command, only if each motor's CAN timeout is set to that in its "
+           " ms after the last command only if each motor's CAN timeout is set to that in its "
            "serial setup menu (" +
-           std::to_string(ms * mit::kCurrentLoopHz / 1000) + " cycles at " +
+           std::to_string(ms * (mit::kCurrentLoopHz / 1000)) + " cycles at " +
            std::to_string(mit::kCurrentLoopHz / 1000) +
            " kHz): animrt cannot set or read it over CAN";
   }

@@ -26,9 +26,9 @@ CanSimBus::CanSimBus(const BusConfig& config, const Clock& clock, CanSimAttach a
   for (const ActuatorBinding& b : config_.actuators) {
     if (config_.protocol == "mit") {
       // The motors' CAN timeout is what the bus says their setup menu holds.
-      nodes_.push_back(std::make_unique<MitMotorNode>(
-          b, options_of<MitBusOptions>(config_.options).master_id, config_.sim, now,
-          std::max(0, config_.device_watchdog_ms)));
+      const MitBusOptions options = options_of<MitBusOptions>(config_.options);
+      nodes_.push_back(std::make_unique<MitMotorNode>(b, options.master_id, config_.sim, now,
+                                                      options.device_watchdog_ms));
     } else if (config_.protocol == "cia402") {
       nodes_.push_back(std::make_unique<Cia402DriveNode>(b, config_.sim, now));
     } else {

@@ -47,8 +47,6 @@ struct SimBusSettings {
   int firmware_version = 0;       // Dynamixel: firmware the servos report (0: the default, 38)
 };
 
-inline constexpr int kDeviceWatchdogDefault = -1;
-
 struct BusConfig {
   std::string name;
   std::string protocol;  // a registered Protocol's name, e.g. "dynamixel2"
@@ -59,18 +57,9 @@ struct BusConfig {
   std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
   std::any options;                        // protocol-specific, see ActuatorBinding::options
   Location where;                          // where the bus is declared
-  // The devices' own guard against a dead host (robot-file key
-  // device_watchdog_ms): how long a device goes without hearing from the
-  // host before it stops by itself. 0: off; kDeviceWatchdogDefault until
-  // the loader sets the default for the loop rate.
-  int device_watchdog_ms = kDeviceWatchdogDefault;
+  // The loop period (s) the bus will run at, known before its keys are read
+  // (defaults such as device_watchdog_ms depend on it); 0 when not known.
+  double loop_period_s = 0.0;
 };
-
-// The default device watchdog for a loop at `rate_hz`: the larger of 50 ms
-// and five loop periods. Not shorter: on a host without SCHED_FIFO an
-// ordinary scheduling delay or a page fault can hold the loop for tens of
-// milliseconds, and a device guard that fires then faults a healthy run;
-// five periods let a late cycle or two pass at slow loop rates.
-int default_device_watchdog_ms(double rate_hz);
 
 }  // namespace animrt

@@ -55,12 +55,13 @@ class Protocol {
     return 0.0;
   }
 
-  // What the bus's devices do by themselves when the host goes silent (the
-  // guard against a dead host, BusConfig::device_watchdog_ms), in one line
-  // for validate.
-  virtual std::string device_guard(const BusConfig& bus) const {
+  // What stops this bus's actuators when the host dies (kill -9, a crash, a
+  // power cut), for `animrt validate`, when the user should hear of it: no
+  // device-side guard, or one that must be set outside animrt. Empty: the
+  // bus sets its guard itself, nothing to say.
+  virtual std::string device_guard_note(const BusConfig& bus) const {
     (void)bus;
-    return "no device-side guard: the devices keep their last command if animrt dies";
+    return {};
   }
 
   // Opens the bus (transport included). Throws DeviceError.

@@ -15,6 +15,9 @@ namespace animrt {
 
 struct MitBusOptions {
   canid_t master_id = 0;  // CAN id the motors answer to
+  // Each motor's CAN timeout as set in its setup menu (device_watchdog_ms;
+  // not settable over CAN): limp after this long without a frame. 0: none.
+  int device_watchdog_ms = 0;
 };
 
 struct MitMotorOptions {
@@ -51,9 +54,10 @@ struct Cia402BusOptions {
   //   heartbeat_ms (1017h); one silent for heartbeat_timeout_ms is timed out.
   int heartbeat_ms = 50;
   int heartbeat_timeout_ms = 150;
-  // - the drives watch the host (BusConfig::device_watchdog_ms, 1016h): the
+  // - the drives watch the host (device_watchdog_ms, 1016h; 0: off): the
   //   host produces heartbeats as node host_node_id, and a drive that misses
   //   them for device_watchdog_ms does abort_connection (6007h).
+  int device_watchdog_ms = 0;
   int host_node_id = 127;
   AbortConnection abort_connection = AbortConnection::quick_stop;
   int sync_timeout_ms = 0;  // 0: BusConfig::timeout_s
