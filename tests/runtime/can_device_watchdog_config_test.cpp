@@ -141,6 +141,15 @@ TEST_F(CanWatchdogConfig, OutOfRangeIsAnErrorAtTheKey) {
                 "host_node_id, default 127): its heartbeats would be taken for the drive's");
 }
 
+TEST_F(CanWatchdogConfig, TheHostHeartbeatCountsInTheBusLoad) {
+  const RobotConfig on = load("");
+  const RobotConfig off = load("device_watchdog_ms: off");
+  const Protocol* cia402 = find_protocol("cia402");
+  // SYNC 55 + RPDO and TPDO 115 each, worst-case stuffing; heartbeat 65.
+  EXPECT_EQ(cia402->wire_bits_per_cycle(off.buses[0]), 285.0);
+  EXPECT_EQ(cia402->wire_bits_per_cycle(on.buses[0]), 350.0);
+}
+
 TEST_F(CanWatchdogConfig, ValidateSaysWhatEachBusHas) {
   RobotConfig c = load("", "");
   // The drives are set at activate: nothing to say; the motors' timeout is

@@ -107,7 +107,7 @@ class Cia402 final : public Protocol {
     check("max_deg", joint.limits.max_position);
   }
 
-  // One SYNC (no data) and per drive an RPDO and a TPDO of 6 data bytes;
+  // One SYNC (no data), the host heartbeat, and per drive an RPDO and a TPDO of 6 data bytes;
   // a CAN 2.0A frame is 47 + 8 per data byte bits, plus worst-case bit
   // stuffing (one per four bits of the stuffed span).
   double wire_bits_per_cycle(const BusConfig& bus) const override {
@@ -115,7 +115,10 @@ class Cia402 final : public Protocol {
       const double stuffed = 34.0 + 8.0 * data_bytes;
       return 47.0 + 8.0 * data_bytes + std::floor((stuffed - 1.0) / 4.0);
     };
-    return frame(0) + 2.0 * frame(6) * static_cast<double>(bus.actuators.size());
+    // The host's heartbeat (1 byte) comes at most once a cycle.
+    const bool heartbeat = options_of<Cia402BusOptions>(bus.options).device_watchdog_ms > 0;
+    return frame(0) + (heartbeat ? frame(1) : 0.0) +
+           2.0 * frame(6) * static_cast<double>(bus.actuators.size());
   }
 
   // With the guard on the drives are set at activate: nothing to say.
