@@ -88,7 +88,7 @@ else
 fi
 # -- CAN kill -9: the drive's own guard stops it ------------------------------
 # animrt sim serves the devices; animrt run drives them until it is killed
-# with SIGKILL in the middle of the gait (no stop ramp, no deactivate). The
+# with SIGKILL (no stop ramp, no deactivate). The
 # drive's heartbeat consumer (device_watchdog_ms, 400 ms in this copy) must
 # then send EMCY 8130h (heartbeat error) after the host's last heartbeat and
 # answer an SDO upload of its statusword (sent here with cansend) with a
@@ -104,7 +104,13 @@ kdump=$!
 animrt run /configs/robots/quadruped_can_vcan0.yaml --backend hardware --duration 0 --no-realtime \
   > /tmp/can_kill_run.txt 2>&1 &
 krun=$!
-sleep 4  # 2 s start ramp, then gait
+# Killed 1.5 s after the drives were switched on (bring-up is slow under
+# emulation): in the start ramp or the gait, the drive in Operation Enabled.
+n=0
+while ! grep -q 'activate: torque on' /tmp/can_kill_run.txt && [ $n -lt 200 ] && kill -0 $krun 2>/dev/null; do
+  sleep 0.1; n=$((n + 1))
+done
+sleep 1.5
 if kill -0 $krun 2>/dev/null; then
   kill -9 $krun
   wait $krun 2>/dev/null
