@@ -86,6 +86,67 @@ if [ $rc = 3 ] && grep -q 'no answer to exit motor mode from motor id 1 (lf_hip)
 else
   fail can_missing_devices "expected exit 3 naming the motors, got $rc: $(head -c 300 /tmp/can_missing_run.txt)"
 fi
+# -- CAN kill -9: the drive's own guard stops it ------------------------------
+# animrt sim serves the devices; animrt run drives them until it is killed
+# with SIGKILL (no stop ramp, no deactivate). The
+# drive's heartbeat consumer (device_watchdog_ms, 400 ms in this copy) must
+# then send EMCY 8130h (heartbeat error) after the host's last heartbeat and
+# answer an SDO upload of its statusword (sent here with cansend) with a
+# state other than Operation Enabled. The MIT motors' limp state does not
+# show on the wire (any frame to a motor restarts its timeout).
+: > /tmp/can_kill_sim.txt
+animrt sim /configs/robots/quadruped_can_vcan0.yaml > /tmp/can_kill_sim.txt 2>&1 &
+ksim=$!
+n=0
+while [ "$(grep -c '^can ' /tmp/can_kill_sim.txt)" -lt 3 ] && [ $n -lt 100 ]; do sleep 0.1; n=$((n + 1)); done
+candump -L vcan0,0A0:7FF,77F:7FF,5A0:7FF > /tmp/can_kill.log 2>/dev/null &
+kdump=$!
+animrt run /configs/robots/quadruped_can_vcan0.yaml --backend hardware --duration 0 --no-realtime \
+  > /tmp/can_kill_run.txt 2>&1 &
+krun=$!
+# Killed 1.5 s after the drives were switched on (bring-up is slow under
+# emulation): in the start ramp or the gait, the drive in Operation Enabled.
+n=0
+while ! grep -q 'activate: torque on' /tmp/can_kill_run.txt && [ $n -lt 200 ] && kill -0 $krun 2>/dev/null; do
+  sleep 0.1; n=$((n + 1))
+done
+sleep 1.5
+if kill -0 $krun 2>/dev/null; then
+  kill -9 $krun
+  wait $krun 2>/dev/null
+  sleep 1
+  cansend vcan0 620#4041600000000000
+  sleep 0.3
+  kill $kdump 2>/dev/null; wait $kdump 2>/dev/null
+  # candump -L: "(seconds) vcan0 ID#DATA"; the host's last heartbeat, the
+  # first heartbeat-error EMCY after it, the statusword answer.
+  verdict=$(awk '
+    { t = substr($1, 2, length($1) - 2) + 0; split($3, f, "#") }
+    f[1] == "77F" && f[2] == "05" { hb = t; emcy = 0 }
+    f[1] == "0A0" && substr(f[2], 1, 4) == "3081" && hb > 0 && emcy == 0 { emcy = t }
+    f[1] == "5A0" && substr(f[2], 1, 8) == "4B416000" { sw = substr(f[2], 9, 2) }
+    END {
+      if (hb == 0) { print "no heartbeat of the host (77F#05) recorded"; exit }
+      if (emcy == 0) { print "no EMCY 8130h after the host'"'"'s last heartbeat"; exit }
+      if (sw == "") { print "no answer to the statusword upload"; exit }
+      printf "ok %.3f %s\n", emcy - hb, sw
+    }' /tmp/can_kill.log)
+  case "$verdict" in
+    ok*)
+      set -- $verdict
+      if [ $((0x$3 & 0x6F)) -ne $((0x27)) ]; then
+        pass "can_kill9_drive_stopped (EMCY 8130h $2 s after the last host heartbeat, statusword low byte 0x$3)"
+      else
+        fail can_kill9_drive_stopped "still in Operation Enabled after SIGKILL (statusword low byte 0x$3)"
+      fi ;;
+    *) fail can_kill9_drive_stopped "$verdict" ;;
+  esac
+else
+  kill $kdump 2>/dev/null; wait $kdump 2>/dev/null
+  fail can_kill9_drive_stopped "animrt run ended before the kill: $(head -c 300 /tmp/can_kill_run.txt)"
+fi
+kill $ksim 2>/dev/null; wait $ksim 2>/dev/null
+
 sleep 0.2
 kill $dump 2>/dev/null; wait $dump 2>/dev/null
 # The recording holds each protocol's traffic (candump -L: "(time) vcan0 ID#DATA").
@@ -103,7 +164,8 @@ echo DONE >> $R
 stty -F /dev/ttyS3 raw -echo 2>/dev/null
 {
   for f in results.txt vcan0.log serial_summary.json serial_run.txt modbus_summary.json \
-           modbus_run.txt can_summary.json can_run.txt can_sim.txt can_missing_run.txt; do
+           modbus_run.txt can_summary.json can_run.txt can_sim.txt can_missing_run.txt \
+           can_kill.log can_kill_run.txt; do
     [ -f /tmp/$f ] || continue
     echo "=== BEGIN $f ==="
     cat /tmp/$f

@@ -2,6 +2,10 @@
 
 #include <net/if.h>
 
+#include <cmath>
+
+#include "animrt/bridge/device_watchdog.hpp"
+
 namespace animrt::can_config {
 
 void read_common_bus(const YamlNode& node, BusConfig& bus) {
@@ -21,6 +25,20 @@ void read_common_bus(const YamlNode& node, BusConfig& bus) {
     }
     bus.timeout_s = ms / 1000.0;
   }
+}
+
+int read_device_watchdog(const YamlNode& node, const BusConfig& bus, int max_ms,
+                         std::string_view device) {
+  const int ms = static_cast<int>(
+      read_device_watchdog_ms(node, bus.loop_period_s, 1.0, static_cast<double>(max_ms), device));
+  const double three_periods_ms = 3.0 * bus.loop_period_s * 1000.0;
+  if (ms != 0 && ms < three_periods_ms) {
+    const YamlNode n = node.at(kDeviceWatchdogKey);
+    n.fail("expected off or at least three loop periods (" +
+           format_number(std::ceil(three_periods_ms)) + " ms at loop.rate_hz " +
+           format_number(1.0 / bus.loop_period_s) + "), found " + n.describe());
+  }
+  return ms;
 }
 
 int read_direction(const YamlNode& node) {

@@ -14,6 +14,8 @@ using canopen::NmtState;
 using cia402::State;
 
 constexpr canid_t kExact = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
+// CiA 301 EMCY "life guard error or heartbeat error".
+constexpr std::uint16_t kHeartbeatErrorEmcy = 0x8130;
 
 std::string hex(std::uint32_t v, int digits) {
   char buf[16];
@@ -27,13 +29,27 @@ std::string object_name(std::uint16_t index, std::uint8_t sub) {
 
 }  // namespace
 
+const char* to_string(AbortConnection action) {
+  switch (action) {
+    case AbortConnection::fault:
+      return "a fault";
+    case AbortConnection::disable_voltage:
+      return "disable voltage";
+    case AbortConnection::quick_stop:
+      return "a quick stop";
+  }
+  return "unknown";
+}
+
 Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transport)
     : config_(std::move(config)),
       options_(options_of<Cia402BusOptions>(config_.options)),
       transport_(std::move(transport)),
       timeout_(std::chrono::ceil<std::chrono::microseconds>(std::chrono::duration<double>(
           options_.sync_timeout_ms > 0 ? options_.sync_timeout_ms / 1000.0 : config_.timeout_s))),
-      heartbeat_timeout_ns_(static_cast<Nanos>(options_.heartbeat_timeout_ms) * 1'000'000) {
+      heartbeat_timeout_ns_(static_cast<Nanos>(options_.heartbeat_timeout_ms) * 1'000'000),
+      host_heartbeat_ns_(static_cast<Nanos>(host_heartbeat_ms(options_.device_watchdog_ms)) *
+                         1'000'000) {
   const std::string bus = "bus " + config_.name + ": ";
   if (!transport_) throw DeviceError(bus + "no transport");
   const std::size_t n = config_.actuators.size();
@@ -91,6 +107,11 @@ std::string Cia402Bus::fault_text(std::size_t device) const {
   if (d.state == State::fault)
     out += (out.empty() ? "" : "; ") + std::string("statusword in fault");
   if (d.heartbeat_lost) out += (out.empty() ? "" : "; ") + std::string("heartbeat lost");
+  if (d.last_emcy.code == kHeartbeatErrorEmcy) {
+    out += "; the drive missed the host's heartbeat for more than " +
+           std::to_string(options_.device_watchdog_ms) + " ms (device_watchdog_ms) and did " +
+           to_string(options_.abort_connection);
+  }
   return out;
 }
 
@@ -189,7 +210,18 @@ void Cia402Bus::supervise() {
   }
 }
 
+void Cia402Bus::produce_heartbeat() {
+  if (!producing_) return;
+  const Nanos now = transport_->now();
+  if (now < next_host_heartbeat_) return;
+  transport_->send(
+      canopen::heartbeat(static_cast<std::uint8_t>(options_.host_node_id), NmtState::operational));
+  next_host_heartbeat_ += host_heartbeat_ns_;
+  if (next_host_heartbeat_ <= now) next_host_heartbeat_ = now + host_heartbeat_ns_;
+}
+
 void Cia402Bus::sync_cycle() {
+  produce_heartbeat();
   std::size_t waiting = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     expect_[i] = status_[i].faulted ? 0 : 1;
@@ -390,6 +422,26 @@ void Cia402Bus::activate() {
     target_counts_[i] = actual_counts_[i];
     hw_fault_[i] = 0;
   }
+  if (options_.device_watchdog_ms > 0) {
+    // Armed before the drives are enabled; a drive starts watching at the
+    // first heartbeat after the consumer is set, sent at once.
+    try {
+      for (std::size_t i = 0; i < status_.size(); ++i) {
+        sdo_write(i, cia402::obj::abort_connection_option, 0,
+                  static_cast<std::uint16_t>(options_.abort_connection), 2);
+        sdo_write(i, cia402::obj::heartbeat_consumer, 1,
+                  consumer_entry(options_.host_node_id, options_.device_watchdog_ms), 4);
+      }
+    } catch (const DeviceError& e) {
+      deactivate();
+      throw DeviceError(std::string(e.what()) +
+                        " (the drive's guard against a dead host; device_watchdog_ms: off "
+                        "runs without it)");
+    }
+    producing_ = true;
+    next_host_heartbeat_ = transport_->now();
+    produce_heartbeat();
+  }
   const std::string failed = walk_to(State::operation_enabled);
   if (!failed.empty()) {
     deactivate();
@@ -406,6 +458,7 @@ void Cia402Bus::deactivate() {
   running_ = false;
   try {
     walk_to(State::switch_on_disabled);
+    clear_device_guard();
     for (std::size_t i = 0; i < status_.size(); ++i) {
       nmt(canopen::NmtCommand::enter_pre_operational, i);
     }
@@ -415,6 +468,20 @@ void Cia402Bus::deactivate() {
   } catch (...) {
     // deactivate never throws
   }
+  producing_ = false;
+}
+
+void Cia402Bus::clear_device_guard() {
+  if (options_.device_watchdog_ms <= 0) return;
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    try {
+      sdo_write(i, cia402::obj::heartbeat_consumer, 1, 0, 4);
+    } catch (const DeviceError&) {
+      // A drive that does not answer now has its guard still armed; it will
+      // stop by itself, which is what the guard is for.
+    }
+  }
+  producing_ = false;
 }
 
 // ---- cycle -------------------------------------------------------------------

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/can_protocols.hpp"
@@ -13,8 +14,12 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kCia402BusKeys[] = {"interface", "bitrate", "timeout_ms", "heartbeat_ms",
-                                               "heartbeat_timeout_ms"};
+constexpr std::string_view kCia402BusKeys[] = {
+    "interface",          "bitrate",          "timeout_ms",  "heartbeat_ms", "heartbeat_timeout_ms",
+    "device_watchdog_ms", "abort_connection", "host_node_id"};
+
+// The consumer time of 1016h is 16 bits of milliseconds.
+constexpr int kMaxConsumerMs = 65535;
 constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
                                                     "direction"};
 
@@ -38,6 +43,26 @@ class Cia402 final : public Protocol {
                 "), found " + n->describe());
       }
     }
+    options.device_watchdog_ms =
+        can_config::read_device_watchdog(node, bus, kMaxConsumerMs, "CiA 402 consumer time");
+    if (auto n = node.find("abort_connection")) {
+      const std::string s = n->is_scalar() ? n->raw().Scalar() : "";
+      if (s == "quick_stop") {
+        options.abort_connection = AbortConnection::quick_stop;
+      } else if (s == "disable_voltage") {
+        options.abort_connection = AbortConnection::disable_voltage;
+      } else if (s == "fault") {
+        options.abort_connection = AbortConnection::fault;
+      } else {
+        n->fail(
+            "expected quick_stop, disable_voltage or fault (the drive's reaction to a "
+            "missed host heartbeat, object 6007h), found " +
+            n->describe());
+      }
+    }
+    if (auto n = node.find("host_node_id")) {
+      options.host_node_id = static_cast<int>(n->as_int_in(1, canopen::kMaxNodeId));
+    }
     bus.options = options;
   }
 
@@ -53,6 +78,11 @@ class Cia402 final : public Protocol {
         id_node.fail("node id " + std::to_string(id) + " is already used by joint " + other.joint +
                      " on bus " + bus.name);
       }
+    }
+    const int host = options_of<Cia402BusOptions>(bus.options).host_node_id;
+    if (id == host) {
+      id_node.fail("node id " + std::to_string(id) + " is the host's (bus " + bus.name +
+                   " host_node_id, default 127): its heartbeats would be taken for the drive's");
     }
     out.device_id = static_cast<int>(id);
     double counts_per_rev = 4096.0;
@@ -77,7 +107,7 @@ class Cia402 final : public Protocol {
     check("max_deg", joint.limits.max_position);
   }
 
-  // One SYNC (no data) and per drive an RPDO and a TPDO of 6 data bytes;
+  // One SYNC (no data), the host heartbeat, and per drive an RPDO and a TPDO of 6 data bytes;
   // a CAN 2.0A frame is 47 + 8 per data byte bits, plus worst-case bit
   // stuffing (one per four bits of the stuffed span).
   double wire_bits_per_cycle(const BusConfig& bus) const override {
@@ -85,7 +115,17 @@ class Cia402 final : public Protocol {
       const double stuffed = 34.0 + 8.0 * data_bytes;
       return 47.0 + 8.0 * data_bytes + std::floor((stuffed - 1.0) / 4.0);
     };
-    return frame(0) + 2.0 * frame(6) * static_cast<double>(bus.actuators.size());
+    // The host's heartbeat (1 byte) comes at most once a cycle.
+    const bool heartbeat = options_of<Cia402BusOptions>(bus.options).device_watchdog_ms > 0;
+    return frame(0) + (heartbeat ? frame(1) : 0.0) +
+           2.0 * frame(6) * static_cast<double>(bus.actuators.size());
+  }
+
+  // With the guard on the drives are set at activate: nothing to say.
+  std::string device_guard_note(const BusConfig& bus) const override {
+    if (options_of<Cia402BusOptions>(bus.options).device_watchdog_ms != 0) return {};
+    return "no device-side guard (device_watchdog_ms: off): if the host dies, the drives stay "
+           "in Operation Enabled at their last target";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

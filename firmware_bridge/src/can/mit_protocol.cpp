@@ -10,7 +10,12 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kMitBusKeys[] = {"interface", "bitrate", "timeout_ms", "master_id"};
+constexpr std::string_view kMitBusKeys[] = {"interface", "bitrate", "timeout_ms", "master_id",
+                                            "device_watchdog_ms"};
+
+// The firmware counts its CAN timeout in current-loop cycles (40 kHz) in a
+// 32-bit setting; a minute is far past any use.
+constexpr int kMaxTimeoutMs = 60'000;
 constexpr std::string_view kMitActuatorKeys[] = {"id",
                                                  "model",
                                                  "kp",
@@ -33,6 +38,10 @@ class Mit final : public Protocol {
     MitBusOptions options;
     if (auto n = node.find("master_id"))
       options.master_id = static_cast<canid_t>(n->as_int_in(0, MitBus::kMaxId));
+    // Not settable over CAN: it states what each motor's setup menu holds,
+    // and the simulated motors use it as theirs.
+    options.device_watchdog_ms =
+        can_config::read_device_watchdog(node, bus, kMaxTimeoutMs, "the motors' CAN timeout");
     bus.options = options;
   }
 
@@ -107,6 +116,21 @@ class Mit final : public Protocol {
   double wire_bits_per_cycle(const BusConfig& bus) const override {
     const double frame = 47.0 + 64.0 + std::floor((34.0 + 64.0 - 1.0) / 4.0);
     return 2.0 * frame * static_cast<double>(bus.actuators.size());
+  }
+
+  // The guard lives in each motor's setup menu: always worth a line.
+  std::string device_guard_note(const BusConfig& bus) const override {
+    const int ms = options_of<MitBusOptions>(bus.options).device_watchdog_ms;
+    if (ms == 0) {
+      return "no device-side guard (device_watchdog_ms: off): if the host dies, the motors keep "
+             "their last command (position, gains, torque)";
+    }
+    return "the motors go limp " + std::to_string(ms) +
+           " ms after the last command only if each motor's CAN timeout is set to that in its "
+           "serial setup menu (" +
+           std::to_string(ms * (mit::kCurrentLoopHz / 1000)) + " cycles at " +
+           std::to_string(mit::kCurrentLoopHz / 1000) +
+           " kHz): animrt cannot set or read it over CAN";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

@@ -1,5 +1,6 @@
 #include "animrt/sim/can/can_sim_bus.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "animrt/bridge/can/can_options.hpp"
@@ -24,8 +25,10 @@ CanSimBus::CanSimBus(const BusConfig& config, const Clock& clock, CanSimAttach a
   const Nanos now = clock.now();
   for (const ActuatorBinding& b : config_.actuators) {
     if (config_.protocol == "mit") {
-      nodes_.push_back(std::make_unique<MitMotorNode>(
-          b, options_of<MitBusOptions>(config_.options).master_id, config_.sim, now));
+      // The motors' CAN timeout is what the bus says their setup menu holds.
+      const MitBusOptions options = options_of<MitBusOptions>(config_.options);
+      nodes_.push_back(std::make_unique<MitMotorNode>(b, options.master_id, config_.sim, now,
+                                                      options.device_watchdog_ms));
     } else if (config_.protocol == "cia402") {
       nodes_.push_back(std::make_unique<Cia402DriveNode>(b, config_.sim, now));
     } else {
@@ -94,9 +97,10 @@ void CanSimBus::serve() {
     if (got) {
       ++frames_handled_;
       for (CanNode* n : listeners_[frame.can_id & CAN_SFF_MASK]) n->handle(frame, now, out_);
-    } else {
-      for (const auto& n : nodes_) n->poll(now, out_);
     }
+    // Time-driven behaviour (heartbeats, the guards against a dead host)
+    // must not wait for a quiet bus.
+    for (const auto& n : nodes_) n->poll(now, out_);
     flush(out_);
   }
 }
@@ -126,6 +130,11 @@ void CanSimBus::reboot_device(int device_id) {
   FrameList out;
   node(device_id).reboot(clock_.now(), out);
   flush(out);
+}
+
+bool CanSimBus::device_guard_fired(int device_id) const {
+  std::lock_guard lock(mutex_);
+  return node(device_id).guard_fired();
 }
 
 double CanSimBus::device_position(int device_id) const {

@@ -15,6 +15,8 @@ namespace obj = cia402::obj;
 
 constexpr std::int32_t kTargetWindow = 20;  // counts: "target reached"
 constexpr std::uint16_t kEmcyRpdoLength = 0x8210;
+constexpr std::uint16_t kEmcyHeartbeat = 0x8130;    // life guard or heartbeat error
+constexpr std::uint8_t kCommunicationError = 0x10;  // error register bit 4
 
 // Error register (1001h) bits for an EMCY code's class.
 std::uint8_t error_register_for(std::uint16_t code) {
@@ -62,20 +64,29 @@ Cia402DriveNode::Cia402DriveNode(const ActuatorBinding& binding, const SimBusSet
 }
 
 std::vector<canid_t> Cia402DriveNode::listens_to() const {
-  return {canopen::kNmtId, canopen::kSyncId, canopen::kRpdo1Base + node_,
-          canopen::kRsdoBase + node_};
+  std::vector<canid_t> ids{canopen::kNmtId, canopen::kSyncId, canopen::kRpdo1Base + node_,
+                           canopen::kRsdoBase + node_};
+  // Heartbeats of every other node: the consumer's producer is set at run time.
+  for (canid_t n = 1; n <= static_cast<canid_t>(canopen::kMaxNodeId); ++n) {
+    if (n != node_) ids.push_back(canopen::kHeartbeatBase + n);
+  }
+  return ids;
 }
 
 void Cia402DriveNode::reset_application(Nanos now) {
   od_ = {
       {obj::device_type, 0, 4, Access::ro, false, false, kDriveDeviceType},
       {obj::error_register, 0, 1, Access::ro, false, true, 0},
+      {obj::heartbeat_consumer, 0, 1, Access::ro, false, false, 1},
+      {obj::heartbeat_consumer, 1, 4, Access::rw, false, false, 0},
       {obj::heartbeat_time, 0, 2, Access::rw, false, false, 0},
       {obj::identity, 0, 1, Access::ro, false, false, 4},
       {obj::identity, 1, 4, Access::ro, false, false, kDriveVendorId},
       {obj::identity, 2, 4, Access::ro, false, false, kDriveProductCode},
       {obj::identity, 3, 4, Access::ro, false, false, 0x00010000},
       {obj::identity, 4, 4, Access::ro, false, false, 1000u + node_},
+      {obj::abort_connection_option, 0, 2, Access::rw, false, false,
+       static_cast<std::uint16_t>(AbortConnection::fault)},
       {obj::error_code, 0, 2, Access::ro, false, true, 0},
       {obj::controlword, 0, 2, Access::rw, true, false, 0},
       {obj::statusword, 0, 2, Access::ro, false, true, 0},
@@ -118,6 +129,8 @@ void Cia402DriveNode::reset_communication() {
                    s == 1 ? canopen::mapping(obj::statusword, 0, 16) : 0});
   }
   if (Entry* e = find(obj::heartbeat_time, 0)) e->value = 0;
+  if (Entry* e = find(obj::heartbeat_consumer, 1)) e->value = 0;
+  consumer_armed_ = false;
   rpdo_pending_ = false;
   sync_count_ = 0;
   boot_pending_ = true;
@@ -241,6 +254,15 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
     case obj::heartbeat_time:
       next_heartbeat_ = now;  // restart the producer with the new period
       break;
+    case obj::heartbeat_consumer:
+      if ((value & 0xFF000000u) != 0) return ac::value_range;  // reserved bits
+      consumer_armed_ = false;  // watches from the next heartbeat of that node
+      break;
+    case obj::abort_connection_option: {
+      const auto code = static_cast<std::int16_t>(value);
+      if (code > 3) return ac::value_range;  // < 0: manufacturer-specific, taken as a fault
+      break;
+    }
     default:
       break;
   }
@@ -269,6 +291,7 @@ void Cia402DriveNode::controlword(std::uint16_t value, Nanos now, FrameList& out
     if (condition_ != 0) return;  // the cause is still there: stays in fault
     find(obj::error_register, 0)->value = 0;
     find(obj::error_code, 0)->value = 0;
+    heartbeat_error_ = false;
     emit_emcy(0x0000, out);  // error reset
   }
   const State next = cia402::next_state(state_, command);
@@ -297,6 +320,63 @@ void Cia402DriveNode::reboot(Nanos now, FrameList& out) {
   condition_ = 0;
   reset_application(now);
   boot(out);
+}
+
+// ---- heartbeat consumer -----------------------------------------------------
+
+void Cia402DriveNode::consume_heartbeat(const can_frame& f, Nanos now, FrameList& out) {
+  const std::uint32_t entry = find(obj::heartbeat_consumer, 1)->value;
+  const canid_t producer = (entry >> 16) & 0x7F;
+  if ((entry & 0xFFFF) == 0 || f.len != 1 || (f.can_id & CAN_SFF_MASK) != 0x700 + producer) return;
+  // A boot-up message is no sign of life yet; any other state is.
+  if (f.data[0] == static_cast<std::uint8_t>(NmtState::boot_up)) return;
+  consumer_armed_ = true;
+  last_consumed_ = now;
+  if (heartbeat_error_) {
+    // The producer is back: the communication error is gone (a fault it
+    // caused stays until a fault reset).
+    heartbeat_error_ = false;
+    Entry* reg = find(obj::error_register, 0);
+    reg->value &= ~static_cast<std::uint32_t>(kCommunicationError);
+    if (state_ != State::fault) {
+      if ((reg->value & ~0x01u) == 0) reg->value = 0;
+      find(obj::error_code, 0)->value = 0;
+      emit_emcy(0x0000, out);
+    }
+  }
+}
+
+void Cia402DriveNode::check_consumer(Nanos now, FrameList& out) {
+  if (!consumer_armed_) return;
+  const std::uint32_t ms = find(obj::heartbeat_consumer, 1)->value & 0xFFFF;
+  if (ms == 0) {
+    consumer_armed_ = false;
+    return;
+  }
+  if (now - last_consumed_ <= static_cast<Nanos>(ms) * 1'000'000) return;
+  // Heartbeat event: report it, then the abort connection reaction.
+  consumer_armed_ = false;
+  heartbeat_error_ = true;
+  ++heartbeat_events_;
+  find(obj::error_register, 0)->value |= 0x01u | kCommunicationError;
+  find(obj::error_code, 0)->value = kEmcyHeartbeat;
+  emit_emcy(kEmcyHeartbeat, out);
+  const auto option = static_cast<std::int16_t>(find(obj::abort_connection_option, 0)->value);
+  const bool powered = state_ == State::operation_enabled || state_ == State::switched_on ||
+                       state_ == State::ready_to_switch_on || state_ == State::quick_stop_active;
+  if (option == 0 || !powered) return;
+  if (option == static_cast<std::int16_t>(AbortConnection::quick_stop)) {
+    if (state_ == State::operation_enabled) enter_state(State::quick_stop_active, now);
+    // 605Ah 0-4 end the quick stop in Switch On Disabled, 5-8 stay in it.
+    const auto qs = static_cast<std::int16_t>(find(obj::quick_stop_option, 0)->value);
+    if (qs >= 0 && qs <= 4) enter_state(State::switch_on_disabled, now);
+  } else if (option == static_cast<std::int16_t>(AbortConnection::disable_voltage)) {
+    enter_state(State::switch_on_disabled, now);
+  } else {
+    // 1 (fault signal) and the manufacturer-specific codes.
+    enter_state(State::fault_reaction_active, now);
+    enter_state(State::fault, now);  // the reaction (stop) is immediate here
+  }
 }
 
 // ---- frames ----------------------------------------------------------------
@@ -441,6 +521,8 @@ void Cia402DriveNode::handle(const can_frame& f, Nanos now, FrameList& out) {
     on_sync(now, out);
   } else if (id == canopen::kRsdoBase + node_) {
     handle_sdo(f, now, out);
+  } else if ((id & 0x780) == canopen::kHeartbeatBase) {
+    consume_heartbeat(f, now, out);
   } else if ((cob_id(kRpdo) & cia402::kPdoInvalid) == 0 && id == (cob_id(kRpdo) & CAN_SFF_MASK)) {
     handle_rpdo(f, now, out);
   }
@@ -452,6 +534,7 @@ void Cia402DriveNode::poll(Nanos now, FrameList& out) {
     boot(out);
     next_heartbeat_ = now;
   }
+  check_consumer(now, out);
   const std::uint32_t period_ms = find(obj::heartbeat_time, 0)->value;
   if (period_ms == 0) return;
   const Nanos period = static_cast<Nanos>(period_ms) * 1'000'000;

@@ -10,11 +10,13 @@ constexpr std::uint8_t kTemperatureC = 40;
 }
 
 MitMotorNode::MitMotorNode(const ActuatorBinding& binding, canid_t master_id,
-                           const SimBusSettings& settings, Nanos now)
+                           const SimBusSettings& settings, Nanos now, int can_timeout_ms)
     : binding_(binding),
       options_(options_of<MitMotorOptions>(binding.options)),
       master_id_(master_id),
-      motor_(0.0, settings.time_constant_s, settings.max_speed_rad_s, now) {
+      motor_(0.0, settings.time_constant_s, settings.max_speed_rad_s, now),
+      can_timeout_(static_cast<Nanos>(std::max(0, can_timeout_ms)) * 1'000'000),
+      last_frame_(now) {
   // Start a little away from the home pose, so the start ramp has work to do.
   const double start = options_.to_motor(initial_offset_rad(binding.device_id), binding.direction);
   motor_ = LagMotor(start, settings.time_constant_s, settings.max_speed_rad_s, now);
@@ -44,15 +46,29 @@ can_frame MitMotorNode::reply(Nanos now) const {
   return mit::pack_reply(master_id_, r, options_.ranges);
 }
 
+void MitMotorNode::poll(Nanos now, FrameList&) {
+  if (!motor_mode_ || can_timeout_ == 0 || timed_out_) return;
+  if (now - last_frame_ <= can_timeout_) return;
+  timed_out_ = true;
+  ++timeouts_;
+  command_ = mit::Command{};  // kp = kd = torque = 0
+  motor_.hold(now);
+}
+
 void MitMotorNode::handle(const can_frame& frame, Nanos now, FrameList& out) {
   if (!responding()) return;
   if ((frame.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG)) != 0) return;
   if ((frame.can_id & CAN_SFF_MASK) != static_cast<canid_t>(binding_.device_id)) return;
+  poll(now, out);  // the loop ran out the timeout before this frame came
+  // Any frame addressed to the motor restarts the count; the zeroed command
+  // stays until a command frame sets a new one.
+  last_frame_ = now;
   if (frame.len != 8) return;  // the firmware ignores anything but 8 bytes
   switch (mit::special_of(frame)) {
     case mit::Special::enter_motor_mode:
       if (error_ == 0) {
         motor_mode_ = true;
+        timed_out_ = false;
         command_ = mit::Command{};  // limp until the first command
         motor_.hold(now);
       }
@@ -70,6 +86,7 @@ void MitMotorNode::handle(const can_frame& frame, Nanos now, FrameList& out) {
       if (!mit::unpack_command(frame, options_.ranges, c)) return;
       if (motor_mode_) {
         command_ = c;
+        timed_out_ = false;
         if (c.kp > 0.0) {
           motor_.set_goal(c.position + zero_, now);
         } else {

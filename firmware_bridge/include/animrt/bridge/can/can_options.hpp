@@ -15,6 +15,9 @@ namespace animrt {
 
 struct MitBusOptions {
   canid_t master_id = 0;  // CAN id the motors answer to
+  // Each motor's CAN timeout as set in its setup menu (device_watchdog_ms;
+  // not settable over CAN): limp after this long without a frame. 0: none.
+  int device_watchdog_ms = 0;
 };
 
 struct MitMotorOptions {
@@ -36,10 +39,28 @@ struct MitMotorOptions {
   }
 };
 
+// What a CiA 402 drive does when its heartbeat consumer misses the host
+// (object 6007h, abort connection option code).
+enum class AbortConnection : std::int16_t {
+  fault = 1,            // fault signal: the drive goes to Fault
+  disable_voltage = 2,  // disable voltage command: Switch On Disabled
+  quick_stop = 3,       // quick stop command: stops on the quick stop ramp
+};
+const char* to_string(AbortConnection action);
+
 struct Cia402BusOptions {
-  int heartbeat_ms = 50;           // producer time written to each drive (1017h)
-  int heartbeat_timeout_ms = 150;  // consumer: a drive silent this long is timed out
-  int sync_timeout_ms = 0;         // 0: BusConfig::timeout_s
+  // Two directions of watching, one key each:
+  // - the host watches the drives: each drive produces heartbeats every
+  //   heartbeat_ms (1017h); one silent for heartbeat_timeout_ms is timed out.
+  int heartbeat_ms = 50;
+  int heartbeat_timeout_ms = 150;
+  // - the drives watch the host (device_watchdog_ms, 1016h; 0: off): the
+  //   host produces heartbeats as node host_node_id, and a drive that misses
+  //   them for device_watchdog_ms does abort_connection (6007h).
+  int device_watchdog_ms = 0;
+  int host_node_id = 127;
+  AbortConnection abort_connection = AbortConnection::quick_stop;
+  int sync_timeout_ms = 0;  // 0: BusConfig::timeout_s
 };
 
 // Options of a bus / binding of the given type; a default when absent.

@@ -9,14 +9,16 @@
 namespace animrt::cia402 {
 
 namespace obj {
-inline constexpr std::uint16_t device_type = 0x1000;     // u32, 0x0192 in the low word
-inline constexpr std::uint16_t error_register = 0x1001;  // u8
-inline constexpr std::uint16_t heartbeat_time = 0x1017;  // u16, ms
-inline constexpr std::uint16_t identity = 0x1018;        // record
-inline constexpr std::uint16_t rpdo1_comm = 0x1400;      // :1 COB-ID, :2 transmission type
+inline constexpr std::uint16_t device_type = 0x1000;         // u32, 0x0192 in the low word
+inline constexpr std::uint16_t error_register = 0x1001;      // u8
+inline constexpr std::uint16_t heartbeat_consumer = 0x1016;  // :01 u32, node << 16 | ms
+inline constexpr std::uint16_t heartbeat_time = 0x1017;      // u16, ms
+inline constexpr std::uint16_t identity = 0x1018;            // record
+inline constexpr std::uint16_t rpdo1_comm = 0x1400;          // :1 COB-ID, :2 transmission type
 inline constexpr std::uint16_t rpdo1_map = 0x1600;
 inline constexpr std::uint16_t tpdo1_comm = 0x1800;
 inline constexpr std::uint16_t tpdo1_map = 0x1A00;
+inline constexpr std::uint16_t abort_connection_option = 0x6007;     // i16
 inline constexpr std::uint16_t error_code = 0x603F;                  // u16, last EMCY code
 inline constexpr std::uint16_t controlword = 0x6040;                 // u16
 inline constexpr std::uint16_t statusword = 0x6041;                  // u16

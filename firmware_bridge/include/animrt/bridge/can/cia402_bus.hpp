@@ -11,6 +11,16 @@
 // write() sends each RPDO, applied by the drives at the next SYNC.
 // deactivate(): back down to Switch On Disabled, NMT pre-operational.
 //
+// Guard against a dead host (device_watchdog_ms, off when 0): activate()
+// writes each drive's abort connection option code (6007h) and its
+// heartbeat consumer (1016h:01, the host's node id and the consumer time),
+// and from then on read() produces the host's heartbeat (0x700 + host node
+// id, operational) every host_heartbeat_ms on the bus's I/O thread.
+// Heartbeats go out only while the loop cycles: a loop that hangs is as
+// absent to a drive as a dead process, and both stop it. deactivate()
+// clears the consumer (time 0) once the drive is down, so a clean end
+// leaves no guard armed.
+//
 // Supervision: the heartbeat consumer marks a drive timed out when no
 // heartbeat came for heartbeat_timeout_ms (bus time). A boot-up message in
 // the middle of a run (the drive rebooted), an EMCY with a non-zero code, a
@@ -18,6 +28,7 @@
 // the device a hardware error, which the runtime's safety filter answers by
 // ramping every other joint home.
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <span>
@@ -38,6 +49,16 @@ class Cia402Bus final : public ActuatorBus {
   static constexpr int kStateMachineSteps = 8;  // SYNC cycles to reach a state
 
   Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transport);
+
+  // The host's heartbeat period for a consumer time: a quarter of it, so
+  // that a late cycle or two still leaves a heartbeat inside the window.
+  static int host_heartbeat_ms(int device_watchdog_ms) {
+    return std::max(1, device_watchdog_ms / 4);
+  }
+  // 1016h sub-index 1: bits 23-16 the producer's node id, 15-0 the time in ms.
+  static std::uint32_t consumer_entry(int node_id, int ms) {
+    return (static_cast<std::uint32_t>(node_id) << 16) | static_cast<std::uint32_t>(ms);
+  }
 
   const BusConfig& config() const override { return config_; }
   void configure() override;
@@ -81,6 +102,10 @@ class Cia402Bus final : public ActuatorBus {
   void handle(const can_frame& frame);
   void supervise();
   void send_rpdo(std::size_t device, std::uint16_t controlword, std::int32_t target);
+  // The host's heartbeat, when one is due (guard armed).
+  void produce_heartbeat();
+  // Writes 1016h:01 = 0 on every drive (errors ignored) and stops producing.
+  void clear_device_guard();
   // Runs SYNC cycles until every non-faulted drive is in `goal` (or steps
   // run out); returns the drives that did not get there.
   std::string walk_to(cia402::State goal);
@@ -106,6 +131,9 @@ class Cia402Bus final : public ActuatorBus {
   std::vector<double> min_rad_, max_rad_;  // goals that stay inside int32 counts
   bool running_ = false;                   // between activate() and deactivate(): OE expected
   bool fresh_ = false;
+  bool producing_ = false;  // host heartbeats between activate() and deactivate()
+  Nanos host_heartbeat_ns_ = 0;
+  Nanos next_host_heartbeat_ = 0;
 
   // SDO exchange in flight (configuration only).
   int sdo_slot_ = -1;

@@ -19,7 +19,7 @@ namespace animrt {
 
 class MitBus final : public ActuatorBus {
  public:
-  static constexpr int kTries = 3;  // per motor, lifecycle frames only
+  static constexpr int kTries = 3;      // per motor, lifecycle frames only
   static constexpr int kMaxId = 0x7FF;  // 11-bit CAN identifiers
 
   // Throws DeviceError for ids outside 1..2047, duplicates, or an id equal

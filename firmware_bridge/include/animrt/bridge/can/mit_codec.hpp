@@ -22,6 +22,12 @@
 
 namespace animrt::mit {
 
+// The firmware's current loop rate. Its CAN timeout (setup menu, 0: none)
+// counts these cycles in motor mode since the last frame addressed to the
+// motor; past it the commands are zeroed (kp, kd, torque): the motor goes
+// limp and stays in motor mode until the next command.
+inline constexpr int kCurrentLoopHz = 40'000;
+
 struct Ranges {
   double p_min = -12.5, p_max = 12.5;   // rad
   double v_min = -50.0, v_max = 50.0;   // rad/s

@@ -35,6 +35,9 @@ class CanNode {
   virtual void set_fault(std::uint8_t bits, Nanos now, FrameList& out) = 0;
   // Power cycle: the device restarts with its defaults and says so.
   virtual void reboot(Nanos now, FrameList& out) = 0;
+  // Whether the device's own guard against a dead host (heartbeat consumer,
+  // CAN timeout) has fired and not yet been cleared.
+  virtual bool guard_fired() const { return false; }
 
  private:
   bool responding_ = true;

@@ -51,6 +51,8 @@ class CanSimBus final : public SimulatedBus {
   // CAN-specific fault injection: power-cycle one device (it restarts with
   // its defaults and announces itself with a boot-up message, CiA 402).
   void reboot_device(int device_id);
+  // Whether a device's guard against a dead host has fired (CanNode::guard_fired).
+  bool device_guard_fired(int device_id) const;
   // The in-process virtual bus (nullptr on SocketCAN), e.g. for bus-off.
   const std::shared_ptr<VirtualCanBus>& virtual_bus() const { return virtual_bus_; }
   std::uint64_t frames_handled() const { return frames_handled_.load(); }

@@ -25,6 +25,14 @@
 //   and "error reset" (code 0) when a fault reset clears it; EMCY 8210h when
 //   an RPDO is shorter than its mapping.
 // - Heartbeat producer at the 1017h period.
+// - Heartbeat consumer (1016h:01, one entry: producer node id and time in
+//   ms): it watches from the first heartbeat of that node after the entry
+//   is written; when the time passes without one it sends EMCY 8130h
+//   (heartbeat error), sets the communication bit of the error register and
+//   603Fh, and reacts as 6007h (abort connection option code) says: 1 fault
+//   (the default), 2 disable voltage, 3 quick stop (then 605Ah), 0 none. A
+//   heartbeat that comes back clears the communication error (EMCY 0000h
+//   unless in Fault, which needs a fault reset).
 // - Motor: in Operation Enabled the position follows the target (LagMotor,
 //   in counts); otherwise it holds.
 
@@ -33,6 +41,7 @@
 #include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/canopen.hpp"
 #include "animrt/bridge/can/cia402.hpp"
 #include "animrt/sim/can/can_node.hpp"
@@ -59,6 +68,9 @@ class Cia402DriveNode final : public CanNode {
   cia402::State state() const { return state_; }
   canopen::NmtState nmt_state() const { return nmt_; }
   std::uint16_t statusword(Nanos now) const;
+  // Times the heartbeat consumer fired since power-on.
+  std::uint64_t heartbeat_events() const { return heartbeat_events_; }
+  bool guard_fired() const override { return heartbeat_error_; }
   // The EMCY error code an injected fault condition produces.
   static std::uint16_t emcy_code_for(std::uint8_t bits);
 
@@ -99,6 +111,8 @@ class Cia402DriveNode final : public CanNode {
   void controlword(std::uint16_t value, Nanos now, FrameList& out);
   void enter_state(cia402::State state, Nanos now);
   void emit_emcy(std::uint16_t code, FrameList& out);
+  void consume_heartbeat(const can_frame& frame, Nanos now, FrameList& out);
+  void check_consumer(Nanos now, FrameList& out);
   std::uint32_t cob_id(const Pdo& pdo) const;
   std::uint8_t transmission_type(const Pdo& pdo) const;
 
@@ -113,6 +127,11 @@ class Cia402DriveNode final : public CanNode {
   std::uint8_t condition_ = 0;  // injected fault condition (0: none)
   bool boot_pending_ = true;
   Nanos next_heartbeat_ = 0;
+  // Heartbeat consumer: watching since the first heartbeat, and its time.
+  bool consumer_armed_ = false;
+  Nanos last_consumed_ = 0;
+  bool heartbeat_error_ = false;
+  std::uint64_t heartbeat_events_ = 0;
   // RPDO received, waiting for SYNC.
   std::array<std::uint8_t, 8> rpdo_data_{};
   bool rpdo_pending_ = false;

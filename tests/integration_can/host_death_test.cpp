@@ -1,0 +1,251 @@
+// The host dies mid-motion and the CAN devices of
+// configs/robots/quadruped_can.yaml stop by themselves: the CiA 402 drive
+// leaves Operation Enabled (heartbeat consumer, 6007h) and every MIT motor
+// goes limp (CAN timeout) within device_watchdog_ms of the last frame the
+// host sent.
+//
+// A kill -9 cannot be staged across processes here: the in-process virtual
+// CAN bus is the only CAN this kernel has (`animrt sim` serves SocketCAN
+// interfaces, which it cannot open). So the host side is the runtime's own
+// buses, driven cycle by cycle on a lockstep clock as the loop drives them,
+// and its death is what a kill leaves: mid-cycle, no deactivate, no further
+// frame, while the clock goes on. The drive is then read from the wire by a
+// client written here (SDO upload of the statusword, EMCY), the motors from
+// the simulation's side.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/can/can_options.hpp"
+#include "animrt/bridge/can/virtual_can_bus.hpp"
+#include "animrt/core/clock.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/sim/can/can_sim_bus.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+
+namespace animrt::host_death_test {
+namespace {
+
+const std::string kRobot = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped_can.yaml";
+constexpr Nanos kMs = 1'000'000;
+constexpr canid_t kDrive = 32;
+constexpr int kLeft[] = {1, 2, 3, 4, 5, 6};
+constexpr int kRight[] = {7, 8, 9, 11, 12};
+
+// A CANopen client of its own: SDO upload of one object, EMCY and the
+// host's heartbeat seen on the way.
+class Client {
+ public:
+  explicit Client(const std::string& interface)
+      : transport_(VirtualCanBus::named(interface)->attach()) {
+    const can_filter filters[] = {
+        {0x580 + kDrive, CAN_SFF_MASK}, {0x080 + kDrive, CAN_SFF_MASK}, {0x77F, CAN_SFF_MASK}};
+    transport_->set_filters(filters);
+  }
+  // Frames already on the bus, without waiting.
+  void take_pending() {
+    can_frame f;
+    while (transport_->receive(f, std::chrono::microseconds(0))) note(f);
+  }
+  // Expedited SDO upload (command 0x40) of index:sub from the drive.
+  std::uint32_t upload(std::uint16_t index, std::uint8_t sub) {
+    take_pending();  // the runtime's own SDO answers, from its bring-up
+    can_frame request{};
+    request.can_id = 0x600 + kDrive;
+    request.len = 8;
+    request.data[0] = 0x40;
+    request.data[1] = static_cast<std::uint8_t>(index);
+    request.data[2] = static_cast<std::uint8_t>(index >> 8);
+    request.data[3] = sub;
+    transport_->send(request);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    can_frame f;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (!transport_->receive(f, std::chrono::milliseconds(100))) continue;
+      note(f);
+      if (f.can_id == 0x580 + kDrive && (f.data[0] & 0xE0) == 0x40 &&
+          f.data[1] == request.data[1] && f.data[2] == request.data[2] && f.data[3] == sub) {
+        return static_cast<std::uint32_t>(f.data[4] | (f.data[5] << 8) | (f.data[6] << 16) |
+                                          (f.data[7] << 24));
+      }
+    }
+    ADD_FAILURE() << "no SDO answer from node " << kDrive;
+    return 0;
+  }
+  // Statusword bits 0-3, 5, 6 of Operation Enabled: 0x27 under mask 0x6F.
+  bool operation_enabled() { return (upload(0x6041, 0) & 0x6F) == 0x27; }
+
+  std::vector<std::uint16_t> emcy_codes;
+  bool heartbeat_seen = false;
+
+ private:
+  void note(const can_frame& f) {
+    if (f.can_id == 0x080 + kDrive && f.len == 8) {
+      emcy_codes.push_back(static_cast<std::uint16_t>(f.data[0] | (f.data[1] << 8)));
+    }
+    if (f.can_id == 0x77F && f.len == 1 && f.data[0] == 0x05) heartbeat_seen = true;
+  }
+  std::unique_ptr<CanFrameTransport> transport_;
+};
+
+// The quadruped's three CAN buses and their simulated devices on one
+// lockstep clock; the host side is a set of buses that a test drives.
+struct Figure {
+  ManualClock clock;
+  LoadedRobot robot;
+  std::vector<std::unique_ptr<SimulatedBus>> sims;
+
+  explicit Figure(int watchdog_override_ms = -1) : robot(load_robot(kRobot)) {
+    widen_timeouts_for_lockstep(robot.config.buses);  // as `animrt run --lockstep`
+    if (watchdog_override_ms >= 0) {
+      auto mit = std::any_cast<MitBusOptions>(robot.config.buses[0].options);
+      mit.device_watchdog_ms = watchdog_override_ms;
+      robot.config.buses[0].options = mit;
+      robot.config.buses[1].options = mit;
+      auto drive = std::any_cast<Cia402BusOptions>(robot.config.buses[2].options);
+      drive.device_watchdog_ms = watchdog_override_ms;
+      robot.config.buses[2].options = drive;
+    }
+    clock.set(1000 * kMs);
+    sims = start_simulated_devices(robot.config.buses, clock);
+  }
+  sim::CanSimBus& can(std::size_t i) { return dynamic_cast<sim::CanSimBus&>(*sims[i]); }
+  int watchdog_ms() const {
+    return std::any_cast<Cia402BusOptions>(robot.config.buses[2].options).device_watchdog_ms;
+  }
+  bool any_motor_limp() {
+    for (int id : kLeft)
+      if (can(0).device_guard_fired(id)) return true;
+    for (int id : kRight)
+      if (can(1).device_guard_fired(id)) return true;
+    return false;
+  }
+  bool every_motor_limp() {
+    for (int id : kLeft)
+      if (!can(0).device_guard_fired(id)) return false;
+    for (int id : kRight)
+      if (!can(1).device_guard_fired(id)) return false;
+    return true;
+  }
+};
+
+// The runtime's side: the buses the loop would drive, brought up and
+// cycled as the loop does (read every bus, then write every bus).
+struct Host {
+  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  std::vector<std::vector<double>> start, q;
+
+  explicit Host(Figure& figure) {
+    for (const BusConfig& config : figure.robot.config.buses) buses.push_back(make_bus(config));
+    for (auto& bus : buses) {
+      bus->configure();
+      start.emplace_back(bus->config().actuators.size(), 0.0);
+      bus->read(start.back());
+    }
+    q = start;
+    for (auto& bus : buses) bus->activate();
+  }
+  // One cycle at `t`: a slow sway around the measured pose (0.2 rad, 1 Hz).
+  void cycle(Figure& figure, Nanos t) {
+    figure.clock.set(t);
+    for (std::size_t b = 0; b < buses.size(); ++b) buses[b]->read(q[b]);
+    const double s = 0.2 * std::sin(2.0 * 3.141592653589793 * static_cast<double>(t) * 1e-9);
+    for (std::size_t b = 0; b < buses.size(); ++b) {
+      for (std::size_t d = 0; d < q[b].size(); ++d) q[b][d] = start[b][d] + s;
+      buses[b]->write(q[b]);
+    }
+  }
+};
+
+// Long enough for the simulations' threads (which poll every 2 ms) to act
+// on a new clock value.
+void let_the_devices_poll() { std::this_thread::sleep_for(std::chrono::milliseconds(30)); }
+
+TEST(HostDeath, EveryDeviceStopsWithinTheWatchdogTime) {
+  Figure figure;
+  const Nanos watchdog = static_cast<Nanos>(figure.watchdog_ms()) * kMs;
+  ASSERT_EQ(figure.watchdog_ms(), 50);  // the default at 200 Hz
+  Client client("can1");
+  auto host = std::make_unique<Host>(figure);
+
+  // A second of motion; the last host heartbeat and the last cycle noted.
+  Nanos t = 1000 * kMs, last_heartbeat = -1;
+  for (int k = 1; k <= 200; ++k) {
+    t += 5 * kMs;
+    host->cycle(figure, t);
+    client.heartbeat_seen = false;
+    client.take_pending();
+    if (client.heartbeat_seen) last_heartbeat = t;
+  }
+  const Nanos death = t;
+  ASSERT_GE(last_heartbeat, death - 15 * kMs);
+  ASSERT_TRUE(client.operation_enabled());
+  ASSERT_FALSE(figure.any_motor_limp());
+  // Death: the host objects stay, silent; nothing is sent from here on.
+
+  // Time goes on, a millisecond at a time. The drive: in Operation Enabled
+  // up to the consumer time after the last heartbeat, out of it one
+  // millisecond later, so within the watchdog time of the host's death. The
+  // motors: driven at `death` for the last time, not limp at the timeout.
+  Nanos left_at = -1;
+  for (Nanos now = death + kMs; now <= death + watchdog; now += kMs) {
+    figure.clock.set(now);
+    if (left_at < 0 && !client.operation_enabled()) left_at = now;
+  }
+  let_the_devices_poll();
+  EXPECT_FALSE(figure.any_motor_limp());
+  figure.clock.set(death + watchdog + kMs);
+  if (left_at < 0 && !client.operation_enabled()) left_at = death + watchdog + kMs;
+  ASSERT_GT(left_at, 0) << "the drive stayed in Operation Enabled";
+  EXPECT_EQ(left_at, last_heartbeat + watchdog + kMs);
+  EXPECT_LE(left_at - death, watchdog + kMs);
+  ASSERT_FALSE(client.emcy_codes.empty());
+  EXPECT_EQ(client.emcy_codes.back(), 0x8130);  // heartbeat error
+  EXPECT_EQ(client.upload(0x1001, 0), 0x11u);   // generic + communication
+  // Quick stop (6007h = 3), and the drive's 605Ah keeps it there.
+  EXPECT_EQ(client.upload(0x6041, 0) & 0x6F, 0x07u);
+  // ... and every motor limp a millisecond after its timeout.
+  for (int i = 0; i < 100 && !figure.every_motor_limp(); ++i) let_the_devices_poll();
+  EXPECT_TRUE(figure.every_motor_limp());
+  // Limp: nothing drives them toward their last goals any more.
+  const double held = figure.sims[0]->device_position(1);
+  figure.clock.set(death + 2000 * kMs);
+  EXPECT_NEAR(figure.sims[0]->device_position(1), held, 1e-9);
+
+  // A new host brings the figure up again: the drive is taken out of its
+  // quick stop, the motors into motor mode; a clean end clears the guard.
+  host.reset();
+  Host again(figure);
+  again.cycle(figure, death + 2005 * kMs);
+  EXPECT_TRUE(client.operation_enabled());
+  EXPECT_EQ(client.upload(0x1001, 0), 0u);
+  EXPECT_FALSE(figure.any_motor_limp());
+  EXPECT_EQ(client.upload(0x1016, 1), 0x007F0032u);
+  for (auto& bus : again.buses) bus->deactivate();
+  EXPECT_EQ(client.upload(0x1016, 1), 0u);
+  EXPECT_FALSE(client.operation_enabled());
+}
+
+TEST(HostDeath, WithTheGuardOffTheDevicesKeepGoing) {
+  Figure figure(0);
+  Client client("can1");
+  auto host = std::make_unique<Host>(figure);
+  Nanos t = 1000 * kMs;
+  for (int k = 1; k <= 100; ++k) host->cycle(figure, t += 5 * kMs);
+  figure.clock.set(t + 1000 * kMs);
+  let_the_devices_poll();
+  EXPECT_TRUE(client.operation_enabled());
+  EXPECT_FALSE(figure.any_motor_limp());
+  EXPECT_EQ(client.upload(0x1016, 1), 0u);
+  for (auto& bus : host->buses) bus->deactivate();
+}
+
+}  // namespace
+}  // namespace animrt::host_death_test
