@@ -87,6 +87,10 @@ int cmd_validate(const std::string& path) {
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
+  // What stops the figure if animrt itself dies, where the user must know.
+  for (const std::string& note : animrt::device_guard_notes(robot.config)) {
+    std::cout << note << "\n";
+  }
   return kExitOk;
 }
 

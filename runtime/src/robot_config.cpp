@@ -127,9 +127,11 @@ SimBusSettings parse_sim(const YamlNode& node) {
   return sim;
 }
 
-BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses) {
+BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNode& buses,
+                    double rate_hz) {
   BusConfig bus;
   bus.name = name;
+  bus.loop_period_s = 1.0 / rate_hz;
   bus.where = key_location(buses, name);
 
   const YamlNode protocol_node = node.at("protocol");
@@ -149,12 +151,12 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   return bus;
 }
 
-std::vector<BusConfig> parse_buses(const YamlNode& node) {
+std::vector<BusConfig> parse_buses(const YamlNode& node, double rate_hz) {
   const auto entries = node.entries();
   if (entries.empty()) node.fail("expected at least one bus, found an empty map");
   std::vector<BusConfig> buses;
   for (const auto& [name, value] : entries) {
-    BusConfig bus = parse_bus(name, value, node);
+    BusConfig bus = parse_bus(name, value, node, rate_hz);
     // Two buses on one port would fight over the line.
     for (const auto& other : buses) {
       if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
@@ -440,7 +442,7 @@ RobotConfig load_robot_config(const std::string& path) {
   if (safety) config.safety = parse_safety(*safety, config.rate_hz);
 
   const YamlNode buses = root.at("buses");
-  config.buses = parse_buses(buses);
+  config.buses = parse_buses(buses, config.rate_hz);
   check_bus_timeouts(buses, config, safety);
   parse_joints(root.at("joints"), config);
   check_bus_load(loop.at("rate_hz"), config);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "animrt/bridge/protocol.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/runtime/motion_check.hpp"
@@ -107,6 +108,16 @@ LoadedRobot load_robot(const std::string& path) {
     robot.steering = load_gait_file(robot.config.motion.file).steering;
   }
   return robot;
+}
+
+std::vector<std::string> device_guard_notes(const RobotConfig& config) {
+  std::vector<std::string> notes;
+  for (const BusConfig& bus : config.buses) {
+    const Protocol* protocol = find_protocol(bus.protocol);
+    const std::string note = protocol != nullptr ? protocol->device_guard_note(bus) : "";
+    if (!note.empty()) notes.push_back("bus " + bus.name + " (" + bus.protocol + "): " + note);
+  }
+  return notes;
 }
 
 }  // namespace animrt

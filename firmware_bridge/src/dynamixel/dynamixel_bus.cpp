@@ -109,6 +109,11 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   model_.resize(n);
   firmware_.resize(n);
   fast_mode_ = dxl::bus_options(config_).fast_read;
+  watchdog_units_ = dxl::bus_options(config_).bus_watchdog;
+  if (watchdog_units_ > kMaxWatchdogUnits) {
+    throw DeviceError(bus + "Bus Watchdog " + std::to_string(watchdog_units_) +
+                      " is outside 0..127");
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
@@ -507,6 +512,7 @@ void DynamixelBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
+  clear_bus_watchdogs();
   outside_warning_.clear();
   for (std::size_t i = 0; i < n; ++i) {
     // Goals may lead from where the joint rests to its limits, never farther.
@@ -524,6 +530,30 @@ void DynamixelBus::configure() {
   choose_fast_read();
   read_pending_hardware_status();
   fresh_ = true;
+}
+
+void DynamixelBus::clear_bus_watchdogs() {
+  // A run that died with the Bus Watchdog set leaves it counting, or fired
+  // (goals refused until it reads 0): either way it starts from 0 here.
+  watchdog_warning_.clear();
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    Answer r = unicast(i, dxl::encode_read(id, dxl::xreg::bus_watchdog, 1, tx_), 1);
+    if (r != Answer::ok || value_[0] == 0) continue;  // older firmware: no such item
+    const bool fired = value_[0] == dxl::kBusWatchdogFired;
+    r = write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
+    if (r != Answer::ok) {
+      throw DeviceError(prefix() + "cannot clear the Bus Watchdog of " + describe(i) + ": " +
+                        failure(i, r));
+    }
+    if (fired) watchdog_warning_ += (watchdog_warning_.empty() ? "" : ", ") + describe(i);
+  }
+  if (!watchdog_warning_.empty()) {
+    watchdog_warning_ = "Bus Watchdog had fired on " + watchdog_warning_ +
+                        " (the host that drove them stopped talking without switching them "
+                        "off); cleared";
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), watchdog_warning_.c_str());
+  }
 }
 
 void DynamixelBus::choose_fast_read() {
@@ -611,12 +641,20 @@ void DynamixelBus::activate() {
           "write goal position");
     goal_ticks_[i] = ticks;
     check(write_register(i, dxl::xreg::torque_enable, 1, 1, kTries), "enable torque");
+    // After torque on: the servo watches the line only while torque is on.
+    if (watchdog_units_ > 0) {
+      check(write_register(i, dxl::xreg::bus_watchdog, watchdog_units_, 1, kTries),
+            "set the Bus Watchdog (firmware 38 or later; or device_watchdog_ms: off)");
+    }
   }
 }
 
 void DynamixelBus::deactivate() {
   try {
     for (std::size_t i = 0; i < status_.size(); ++i) {
+      // Before torque off, so a clean stop leaves no guard armed (and clears
+      // one that fired).
+      if (watchdog_units_ > 0) write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
       write_register(i, dxl::xreg::torque_enable, 0, 1, kTries);
     }
   } catch (...) {

@@ -57,6 +57,9 @@ struct BusConfig {
   std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
   std::any options;                        // protocol-specific, see ActuatorBinding::options
   Location where;                          // where the bus is declared
+  // The loop period (s) the bus will run at, known before its keys are read
+  // (defaults such as device_watchdog_ms depend on it); 0 when not known.
+  double loop_period_s = 0.0;
 };
 
 }  // namespace animrt

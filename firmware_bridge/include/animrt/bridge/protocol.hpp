@@ -55,6 +55,15 @@ class Protocol {
     return 0.0;
   }
 
+  // What stops this bus's actuators when the host dies (kill -9, a crash, a
+  // power cut), for `animrt validate`, when the user should hear of it: no
+  // device-side guard, or one that must be set outside animrt. Empty: the
+  // bus sets its guard itself, nothing to say.
+  virtual std::string device_guard_note(const BusConfig& bus) const {
+    (void)bus;
+    return {};
+  }
+
   // Opens the bus (transport included). Throws DeviceError.
   virtual std::unique_ptr<ActuatorBus> make_bus(const BusConfig& bus) const = 0;
 };

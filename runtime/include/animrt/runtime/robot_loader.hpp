@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/controllers/motion_source.hpp"
@@ -22,5 +23,10 @@ struct LoadedRobot {
 // Loads the robot file and its motion source. Throws InputError on the first
 // problem in any of the files.
 LoadedRobot load_robot(const std::string& path);
+
+// One line per bus whose actuators nothing stops if animrt dies (kill -9, a
+// crash, a power cut), or whose guard must be set outside animrt:
+// "bus NAME (PROTOCOL): what to know".
+std::vector<std::string> device_guard_notes(const RobotConfig& config);
 
 }  // namespace animrt

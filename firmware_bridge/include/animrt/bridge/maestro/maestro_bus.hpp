@@ -33,6 +33,10 @@ struct MaestroBusOptions {
   int channels = 12;                     // per board: 6, 12, 18 or 24
   bool multiple_targets = true;          // Set Multiple Targets (Mini Maestro only)
   int device = maestro::kDefaultDevice;  // default device number of the channels (Pololu form)
+  // The serial timeout the board should have (ms, 0: none). The Maestro takes
+  // it only from its settings (Maestro Control Center, Serial Settings:
+  // Timeout), never over the serial line, so animrt can only say so.
+  double serial_timeout_ms = 0.0;
 };
 
 // ActuatorBinding::options of a Maestro channel. The binding's ticks are
