@@ -653,8 +653,12 @@ void DynamixelBus::deactivate() {
   try {
     for (std::size_t i = 0; i < status_.size(); ++i) {
       // Before torque off, so a clean stop leaves no guard armed (and clears
-      // one that fired).
-      if (watchdog_units_ > 0) write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
+      // one that fired). Not for a device the cycle left out: it heard
+      // nothing since, so its guard fired anyway, and a silent one would
+      // only delay its torque-off; the next configure clears it.
+      if (watchdog_units_ > 0 && !status_[i].faulted) {
+        write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
+      }
       write_register(i, dxl::xreg::torque_enable, 0, 1, kTries);
     }
   } catch (...) {

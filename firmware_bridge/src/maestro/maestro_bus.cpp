@@ -222,8 +222,8 @@ void MaestroBus::configure() {
     throw DeviceError(prefix() + "no answer to Get Position/Get Errors from " + silent);
   if (!timeout_warning_.empty()) {
     timeout_warning_ = "serial timeout had fired on " + timeout_warning_ +
-                       " (the host that drove it stopped talking without switching it off); "
-                       "cleared";
+                       " (no host talked to it for longer than its timeout: since power-up, or "
+                       "a host that died without switching it off); cleared";
     std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), timeout_warning_.c_str());
   }
   for (std::size_t i = 0; i < present_.size(); ++i) {

@@ -69,8 +69,8 @@ class DynamixelBus final : public ActuatorBus {
   // stops by itself when no instruction reaches it for that long. On failure
   // turns torque off again and throws DeviceError naming the device.
   void activate() override;
-  // Bus Watchdog 0 (if set), then torque off, on every device, best effort;
-  // never throws.
+  // Bus Watchdog 0 (if set; not on faulted devices), then torque off, on
+  // every device, best effort; never throws.
   void deactivate() override;
 
   // One Sync Read / Sync Write. Counters: `transactions` counts instruction
