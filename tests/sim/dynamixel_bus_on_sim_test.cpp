@@ -261,5 +261,34 @@ TEST(DynamixelBusOnSim, FiredBusWatchdogHoldsTheServoUntilTheNextConfigure) {
   bus.deactivate();
 }
 
+TEST(DynamixelBusOnSim, AHostThatStallsRearmsTheBusWatchdogAndMovesOn) {
+  // Real time on both sides: the host's bus thread stalls for longer than
+  // the guard (the servos stop, as they must), then speaks again.
+  const BusConfig config = guarded(3);  // 60 ms
+  const MonotonicClock clock;
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  bus.configure();
+  bus.activate();
+  std::vector<double> q(2, 0.0);
+  bus.read(q);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  {
+    test::PtyClient other(sim.endpoint());
+    EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  }
+  const double stopped = sim.device_position(3);
+  bus.read(q);
+  bus.write(std::vector<double>{stopped + 0.3, 0.0});
+  bus.read(q);
+  EXPECT_EQ(bus.watchdog_rearms(), 1u);
+  EXPECT_TRUE(sim.device_goal_log(3).back().accepted);
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  bus.read(q);
+  EXPECT_GT(sim.device_position(3), stopped + 0.01);
+  bus.deactivate();
+}
+
 }  // namespace
 }  // namespace animrt

@@ -110,6 +110,7 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   firmware_.resize(n);
   fast_mode_ = dxl::bus_options(config_).fast_read;
   watchdog_units_ = dxl::bus_options(config_).bus_watchdog;
+  watchdog_time_ = std::chrono::milliseconds(20) * watchdog_units_;
   if (watchdog_units_ > kMaxWatchdogUnits) {
     throw DeviceError(bus + "Bus Watchdog " + std::to_string(watchdog_units_) +
                       " is outside 0..127");
@@ -216,6 +217,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
   decoder_.reset();
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
+  last_sent_ = steady_clock::now();
 
   const steady_clock::time_point start = steady_clock::now();
   const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
@@ -303,6 +305,7 @@ void DynamixelBus::transact_fast(std::size_t length, std::size_t count, std::siz
   decoder_.reset();
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
+  last_sent_ = steady_clock::now();
 
   // Collect bytes until the packet the header announces is complete. The
   // packet is not byte-stuffed, so it is read raw, not through the Decoder.
@@ -647,15 +650,16 @@ void DynamixelBus::activate() {
             "set the Bus Watchdog (firmware 38 or later; or device_watchdog_ms: off)");
     }
   }
+  armed_ = watchdog_units_ > 0;
 }
 
 void DynamixelBus::deactivate() {
+  armed_ = false;
   try {
     for (std::size_t i = 0; i < status_.size(); ++i) {
       // Before torque off, so a clean stop leaves no guard armed (and clears
-      // one that fired). Not for a device the cycle left out: it heard
-      // nothing since, so its guard fired anyway, and a silent one would
-      // only delay its torque-off; the next configure clears it.
+      // one that fired). Not for a device the cycle left out: a silent one
+      // would only delay its torque-off; the next configure clears it.
       if (watchdog_units_ > 0 && !status_[i].faulted) {
         write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
       }
@@ -677,6 +681,7 @@ void DynamixelBus::read(std::span<double> positions) {
     }
     fresh_ = false;
   }
+  rearm_after_silence();
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
@@ -713,6 +718,7 @@ std::int32_t DynamixelBus::goal_ticks(std::size_t device, double rad) const {
 }
 
 void DynamixelBus::write(std::span<const double> positions) {
+  rearm_after_silence();
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
@@ -727,7 +733,28 @@ void DynamixelBus::write(std::span<const double> positions) {
   if (count == 0) return;
   const std::size_t length = dxl::encode_sync_write(
       dxl::xreg::goal_position, 4, {ids_.data(), count}, {sync_data_.data(), 4 * count}, tx_);
-  if (length > 0) transport_->write({tx_.data(), length});
+  if (length > 0) {
+    transport_->write({tx_.data(), length});
+    last_sent_ = steady_clock::now();
+  }
+}
+
+void DynamixelBus::rearm_after_silence() {
+  if (!armed_) return;
+  const auto now = steady_clock::now();
+  // Half the guard's time: the servos' clocks and ours need not agree on
+  // when it ran out.
+  if (now - last_sent_ <= watchdog_time_ / 2) return;
+  // The host was silent (a stall, not a death: it speaks again), so the
+  // guard may have fired: the servos stopped and refuse goals. 0 clears it,
+  // the value arms it again; broadcast, so no answers to wait for.
+  for (const std::uint8_t value : {std::uint8_t{0}, watchdog_units_}) {
+    const std::size_t length =
+        dxl::encode_write(dxl::kBroadcastId, dxl::xreg::bus_watchdog, {&value, 1}, tx_);
+    if (length > 0) transport_->write({tx_.data(), length});
+  }
+  last_sent_ = now;
+  ++watchdog_rearms_;
 }
 
 }  // namespace animrt

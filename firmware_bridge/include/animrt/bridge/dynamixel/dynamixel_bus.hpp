@@ -80,8 +80,13 @@ class DynamixelBus final : public ActuatorBus {
   // A joint that started outside its limits may also take goals between its
   // measured start and the limit, never farther out than a goal already
   // sent: the start ramp walks it in, and once inside it stays inside.
+  // With a Bus Watchdog armed, a cycle that finds the line silent for more
+  // than half its time (the host stalled: the servos may have stopped and
+  // locked their goals) first clears and re-arms it with two broadcast
+  // Writes, so the figure goes on from where it stopped (watchdog_rearms()).
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
+  std::uint64_t watchdog_rearms() const { return watchdog_rearms_; }
 
   std::span<DeviceStatus> devices() override { return status_; }
 
@@ -138,6 +143,7 @@ class DynamixelBus final : public ActuatorBus {
   static bool stale(const dxl::Packet& packet, std::size_t data_length);
   void write_position_limits(std::size_t device);
   void clear_bus_watchdogs();
+  void rearm_after_silence();
   // Pulls bytes until the decoder has something other than need_more.
   dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
   // Reads the hardware error register of devices whose alert just appeared.
@@ -174,7 +180,11 @@ class DynamixelBus final : public ActuatorBus {
   std::string latency_warning_;
   std::string outside_warning_;
   std::string watchdog_warning_;
-  std::uint8_t watchdog_units_ = 0;   // Bus Watchdog set at activate; 0: none
+  std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set at activate; 0: none
+  std::chrono::nanoseconds watchdog_time_{0};
+  bool armed_ = false;  // between activate() and deactivate()
+  std::chrono::steady_clock::time_point last_sent_{};
+  std::uint64_t watchdog_rearms_ = 0;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
