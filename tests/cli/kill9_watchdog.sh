@@ -26,8 +26,11 @@ read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
 [[ $kind == serial && $bus == legs && $pty == /dev/pts/* ]] || fail "sim line: $(cat "$tmp/sim.txt")"
 
 # The shipped robot, its port pointed at the simulator's pty (files it names
-# resolved against the shipped folder).
-sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" \
+# resolved against the shipped folder), with answer timeouts of 40 ms: the
+# simulator shares this machine with whatever else runs, and a configure
+# that gives up on a late answer would end the test before it began.
+patient='s#timeout_ms: [0-9]*#timeout_ms: 40#'
+sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" -e "$patient" \
   "$root/configs/robots/quadruped.yaml" > "$tmp/robot.yaml"
 
 start_run() {
@@ -42,6 +45,7 @@ start_run() {
 
 start_run
 sleep 1.0  # mid start ramp: every joint on its way
+kill -0 $run_pid 2> /dev/null || fail "the run ended before the kill: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 kill -KILL $run_pid
 wait $run_pid 2> /dev/null
 run_pid=""
@@ -93,10 +97,11 @@ face=$(awk '$1 == "serial" && $2 == "face" {print $3}' "$tmp/sim.txt")
 torso=$(awk '$1 == "modbus-tcp" && $2 == "torso" {print $3}' "$tmp/sim.txt")
 [[ $neck == /dev/pts/* && $face == /dev/pts/* && -n $torso ]] || fail "sim lines: $(cat "$tmp/sim.txt")"
 sed -e "s#port: /dev/ttyUSB0#port: $neck#" -e "s#port: /dev/ttyACM0#port: $face#" \
-  -e "s#port: 192.168.1.50:502#port: $torso#" -e "s#\.\./#$root/configs/#g" \
+  -e "s#port: 192.168.1.50:502#port: $torso#" -e "s#\.\./#$root/configs/#g" -e "$patient" \
   "$root/configs/robots/animatronic.yaml" > "$tmp/robot.yaml"
 start_run
 sleep 1.0
+kill -0 $run_pid 2> /dev/null || fail "the run ended before the kill: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 kill -KILL $run_pid
 wait $run_pid 2> /dev/null
 run_pid=""
