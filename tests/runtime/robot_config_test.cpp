@@ -1025,6 +1025,18 @@ motion: {type: gait, file: ../gaits/gait.yaml}
 )");
   EXPECT_NE(error.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << error;
   EXPECT_NE(error.find("no device-side watchdog"), std::string::npos) << error;
+  const std::string modbus = error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: modbus-tcp, port: 127.0.0.1:502, device_watchdog_ms: 100}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, slave: 1, map: ../modbus/none.yaml}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)");
+  EXPECT_NE(modbus.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << modbus;
+  EXPECT_NE(modbus.find("names no watchdog or timeout register"), std::string::npos) << modbus;
 }
 
 }  // namespace
