@@ -253,6 +253,12 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
           [&](DynamixelServo& s) { reply(s, s.status_return_level(), StatusError::instruction); });
       break;
   }
+  // Every instruction packet a servo takes in (its id or broadcast) feeds
+  // its Bus Watchdog.
+  if (packet.instruction == inst::status) return;
+  for (DynamixelServo& s : servos_) {
+    if (s.responding() && (broadcast || s.id() == packet.id)) s.feed_watchdog(now);
+  }
 }
 
 }  // namespace animrt::sim

@@ -258,6 +258,17 @@ void DynamixelServo::latch_shutdown() {
 }
 
 DynamixelServo::Motor DynamixelServo::motor_at(Nanos now) const {
+  // Where advance() will find it: held from the moment the watchdog fires.
+  if (const Nanos due = watchdog_fire_time(); physics_ == nullptr && due >= 0 && now > due) {
+    Motor m = motor_until(std::max(due, motor_time_));
+    m.position = std::round(m.position);  // held at the goal it takes: a whole tick
+    m.velocity = 0;
+    return m;
+  }
+  return motor_until(now);
+}
+
+DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
   Motor m = motor_;
   if (physics_ != nullptr) {
     const double scale = binding_.direction * binding_.ticks_per_rad;
@@ -302,8 +313,34 @@ DynamixelServo::Motor DynamixelServo::motor_at(Nanos now) const {
   return m;
 }
 
+Nanos DynamixelServo::watchdog_fire_time() const {
+  const std::uint8_t units = table_[xreg_sim::bus_watchdog];
+  if (units == 0 || units == dxl::kBusWatchdogFired || !torque_on()) return -1;
+  return watchdog_fed_ + static_cast<Nanos>(units) * kBusWatchdogUnitNs;
+}
+
+void DynamixelServo::feed_watchdog(Nanos now) { watchdog_fed_ = std::max(watchdog_fed_, now); }
+
 void DynamixelServo::advance(Nanos now) {
   if (now < motor_time_) return;
+  // The watchdog fires at its own time, however late the next packet comes:
+  // the motor runs to that moment and stops there.
+  if (const Nanos due = watchdog_fire_time(); due >= 0 && now > due) {
+    const Nanos fire = std::max(due, motor_time_);
+    if (physics_ != nullptr) physics_->advance(fire);
+    motor_ = motor_at(fire);
+    motor_time_ = fire;
+    // It stops where it is (Profile Velocity/Acceleration taken as 0) and
+    // keeps torque on; the goal values are locked until 98 is written 0.
+    if (physics_ == nullptr) motor_.position = std::round(motor_.position);
+    dxl::put_u32(
+        &table_[xreg::goal_position],
+        static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+    motor_.velocity = 0;
+    table_[xreg_sim::bus_watchdog] = dxl::kBusWatchdogFired;
+    publish(fire);
+    command_physics();
+  }
   if (physics_ != nullptr) physics_->advance(now);
   motor_ = motor_at(now);
   motor_time_ = now;
@@ -388,6 +425,19 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     a += item.size;
   }
   if (address < xreg_sim::eeprom_end && torque_on()) return StatusError::access;  // ROM lock
+  if (table_[xreg_sim::bus_watchdog] == dxl::kBusWatchdogFired) {
+    // A fired Bus Watchdog locks the goal values; only 0 at 98 clears it.
+    for (std::size_t a = address; a < end;) {
+      Item item{};
+      find_item(a, item);
+      if (item.address == xreg_sim::goal_pwm || item.address == xreg_sim::goal_current ||
+          item.address == xreg_sim::goal_velocity || item.address == xreg::goal_position ||
+          (item.address == xreg_sim::bus_watchdog && data[a - address] != 0)) {
+        return StatusError::data_range;
+      }
+      a += item.size;
+    }
+  }
 
   std::array<std::uint8_t, dxl::xreg::table_size> after = table_;
   std::memcpy(&after[address], data.data(), data.size());

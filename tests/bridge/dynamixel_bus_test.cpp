@@ -317,18 +317,22 @@ class DynamixelBusTest : public ::testing::Test {
 TEST_F(DynamixelBusTest, ConfigurePingsAndReadsEveryDevice) {
   bus_.configure();
   const auto log = fake_.log();
-  ASSERT_EQ(log.size(), 6u);
+  ASSERT_EQ(log.size(), 9u);
   for (std::uint8_t id = 1; id <= 3; ++id) {
     EXPECT_EQ(log[id - 1].instruction, dxl::inst::ping);
     EXPECT_EQ(log[id - 1].id, id);
     EXPECT_EQ(log[id + 2].instruction, dxl::inst::read);
     EXPECT_EQ(log[id + 2].id, id);
     EXPECT_EQ(log[id + 2].params, (std::vector<std::uint8_t>{132, 0, 4, 0}));
+    // Bus Watchdog: read, and (reading 0 here) left alone.
+    EXPECT_EQ(log[id + 5].instruction, dxl::inst::read);
+    EXPECT_EQ(log[id + 5].id, id);
+    EXPECT_EQ(log[id + 5].params, (std::vector<std::uint8_t>{98, 0, 1, 0}));
   }
   for (std::size_t i = 0; i < 3; ++i) {
     expect_ok(i);
     EXPECT_EQ(status(i).device_id, static_cast<int>(i) + 1);
-    EXPECT_EQ(status(i).transactions, 2u);  // the lifecycle's transactions count too
+    EXPECT_EQ(status(i).transactions, 3u);  // the lifecycle's transactions count too
   }
 }
 

@@ -22,6 +22,23 @@ line=$(grep -n '^  rate_hz:' "$tmp/bad.yaml" | cut -d: -f1)
 
 out=$("$animrt" validate "$tmp/missing.yaml" 2>&1)
 [[ $? -eq 2 && $out == *"missing.yaml"*"cannot open"* ]] || fail "missing file: $out"
+# One line per bus that has no device-side guard (or one set outside animrt).
+out=$("$animrt" validate "$root/configs/robots/arm_sts.yaml" 2>&1) || fail "arm_sts rejected: $out"
+[[ $(echo "$out" | grep -c "^bus arm (feetech_sts): no device-side guard") -eq 1 ]] ||
+  fail "no guard line for the Feetech bus: $out"
+out=$("$animrt" validate "$root/configs/robots/animatronic.yaml" 2>&1) || fail "animatronic rejected: $out"
+[[ $(echo "$out" | grep -c "^bus torso (modbus-tcp): no device-side guard") -eq 1 &&
+  $(echo "$out" | grep -c "^bus face (maestro): .*Timeout to 0.05 s in the Maestro Control Center") -eq 1 &&
+  $(echo "$out" | grep -c "^bus neck") -eq 0 ]] || fail "guard lines of the animatronic figure: $out"
+out=$("$animrt" validate "$root/configs/robots/quadruped.yaml" 2>&1)
+[[ $(echo "$out" | wc -l) -eq 1 ]] || fail "the quadruped's Bus Watchdog is set by animrt: $out"
+sed -e 's#^    timeout_ms: 4 .*#    timeout_ms: 4\n    device_watchdog_ms: "off"#' \
+  -e "s#file: \.\./gaits/walk.yaml#file: $root/configs/gaits/walk.yaml#" \
+  -e "s#model: \.\./#model: $root/configs/#" "$root/configs/robots/quadruped.yaml" > "$tmp/off.yaml"
+out=$("$animrt" validate "$tmp/off.yaml" 2>&1) || fail "device_watchdog_ms: off rejected: $out"
+[[ $out == *$'\n'"bus legs (dynamixel2): no device-side guard (device_watchdog_ms: off)"* ]] ||
+  fail "device_watchdog_ms: off: $out"
+
 # Every shipped robot validates (its motion sampled over its whole length).
 for robot in "$root"/configs/robots/*.yaml; do
   out=$("$animrt" validate "$robot" 2>&1) || fail "shipped $robot rejected: $out"

@@ -95,5 +95,37 @@ TEST(MaestroBoard, BadCommandsSetTheProtocolBitAndSendServosHome) {
   EXPECT_EQ(r.board.errors(), 0);  // Get Errors clears
 }
 
+TEST(MaestroBoard, SerialTimeoutSendsServosHomeWhenTheHostGoesSilent) {
+  Rig r;
+  r.board.set_serial_timeout(50 * kMs);
+  r.send(maestro::cmd::set_target, 0, 6000, 0);
+  r.send(maestro::cmd::set_target, 1, 7000, 40 * kMs);  // the latest command: at 40 ms
+  r.board.advance(89 * kMs);
+  EXPECT_EQ(r.board.errors(), 0);
+  EXPECT_EQ(r.board.position(0), 6000);
+  r.board.advance(95 * kMs);
+  EXPECT_EQ(r.board.errors(), maestro::error_bit::serial_timeout);
+  EXPECT_EQ(r.board.position(0), 0);  // home = off: the servo goes limp
+  EXPECT_EQ(r.board.position(1), 0);
+  r.send(maestro::cmd::get_errors, 0, 0, 100 * kMs);
+  ASSERT_EQ(r.out.size(), 2u);
+  EXPECT_EQ(maestro::decode_answer(r.out.data()), maestro::error_bit::serial_timeout);
+  // Fed by that Get Errors: a target now holds until 50 ms of silence again.
+  r.send(maestro::cmd::set_target, 0, 6400, 120 * kMs);
+  r.board.advance(169 * kMs);
+  EXPECT_EQ(r.board.position(0), 6400);
+  EXPECT_EQ(r.board.errors(), 0);
+  r.board.advance(171 * kMs);
+  EXPECT_EQ(r.board.position(0), 0);
+}
+
+TEST(MaestroBoard, NoSerialTimeoutByDefault) {
+  Rig r;
+  r.send(maestro::cmd::set_target, 0, 6000, 0);
+  r.board.advance(60'000 * kMs);
+  EXPECT_EQ(r.board.errors(), 0);
+  EXPECT_EQ(r.board.position(0), 6000);
+}
+
 }  // namespace
 }  // namespace animrt::sim

@@ -235,5 +235,29 @@ TEST(MaestroBus, PololuFormAddressesDaisyChainedBoards) {
   EXPECT_EQ(bus->devices()[2].health, DeviceHealth::timeout);
 }
 
+TEST(MaestroBus, SerialTimeoutOfADeadHostIsClearedWithAWarningAndActivationOutlastsIt) {
+  Rig r("    device_watchdog_ms: 50\n");
+  ASSERT_EQ(std::any_cast<const MaestroBusOptions&>(r.config.buses[0].options).serial_timeout_ms,
+            50.0);
+  r.bus->configure();
+  EXPECT_TRUE(dynamic_cast<MaestroBus&>(*r.bus).timeout_warning().empty());
+  // A pause longer than the timeout between configure and activate (other
+  // buses coming up) must not keep the board from switching on.
+  r.clock.advance(200'000'000);
+  ASSERT_NO_THROW(r.bus->activate());
+  EXPECT_EQ(r.sim->pulse(0), 6000);
+  std::vector<double> pos(3, 0.0);
+  r.bus->read(pos);
+  // The host dies: 50 ms of silence and the servos go limp.
+  r.clock.advance(200'000'000);
+  auto next = make_bus(r.config.buses[0]);
+  next->configure();
+  EXPECT_EQ(r.sim->pulse(0), 0);
+  EXPECT_NE(dynamic_cast<MaestroBus&>(*next).timeout_warning().find(
+                "serial timeout had fired on Maestro 12"),
+            std::string::npos)
+      << dynamic_cast<MaestroBus&>(*next).timeout_warning();
+}
+
 }  // namespace
 }  // namespace animrt

@@ -259,7 +259,7 @@ buses:
     parity: none
 )"),
             at("7:5: buses.b.parity: unknown key (expected one of: protocol, port, baud, "
-               "timeout_ms, fast_read, model, sim)"));
+               "timeout_ms, fast_read, model, device_watchdog_ms, sim)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -989,6 +989,68 @@ TEST_F(RobotConfigTest, MotionLayersAreAtMostSixteen) {
   EXPECT_EQ(error_of(layers(16)), "no error");
   EXPECT_EQ(error_of(layers(17)),
             at("12:5: motion.layers: expected at most 16 motion sources, found 17"));
+}
+
+// ------------------------------------------------------- device watchdog
+
+TEST_F(RobotConfigTest, DynamixelBusWatchdogDefaultsToAFewLoopPeriods) {
+  // 100 Hz: 5 periods are 50 ms, rounded up to the unit of 20 ms: 3 units.
+  EXPECT_EQ(dxl::bus_options(load(kMinimal).buses[0]).bus_watchdog, 3);
+  // 10 Hz: 5 periods are 500 ms: 25 units.
+  std::string slow = kMinimal;
+  slow.replace(slow.find("rate_hz: 100"), 12, "rate_hz: 10");
+  EXPECT_EQ(dxl::bus_options(load(slow).buses[0]).bus_watchdog, 25);
+  // 1 kHz: 5 periods are 5 ms, so 50 ms: 3 units.
+  std::string fast = kMinimal;
+  fast.replace(fast.find("rate_hz: 100"), 12, "rate_hz: 1000");
+  EXPECT_EQ(dxl::bus_options(load(fast).buses[0]).bus_watchdog, 3);
+}
+
+TEST_F(RobotConfigTest, DynamixelBusWatchdogKey) {
+  const auto with = [&](const std::string& value) {
+    std::string text = kMinimal;
+    text.replace(text.find("port: /dev/ttyUSB0}"), 19,
+                 "port: /dev/ttyUSB0, device_watchdog_ms: " + value + "}");
+    return text;
+  };
+  EXPECT_EQ(dxl::bus_options(load(with("off")).buses[0]).bus_watchdog, 0);
+  EXPECT_EQ(dxl::bus_options(load(with("0")).buses[0]).bus_watchdog, 0);
+  EXPECT_EQ(dxl::bus_options(load(with("41")).buses[0]).bus_watchdog, 3);  // rounded up
+  EXPECT_EQ(dxl::bus_options(load(with("2540")).buses[0]).bus_watchdog, 127);
+  const std::string expected =
+      "buses.b.device_watchdog_ms: expected off, 0, or milliseconds from 20 to 2540 (Bus "
+      "Watchdog, units of 20 ms), found ";
+  EXPECT_EQ(error_of(with("2541")), at("4:69: " + expected + "\"2541\""));
+  EXPECT_EQ(error_of(with("10")), at("4:69: " + expected + "\"10\""));
+  EXPECT_EQ(error_of(with("-20")), at("4:69: " + expected + "\"-20\""));
+  EXPECT_EQ(error_of(with("on")), at("4:69: " + expected + "\"on\""));
+}
+
+TEST_F(RobotConfigTest, DeviceWatchdogOnABusWithoutOneIsNamed) {
+  const std::string error = error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: feetech_sts, port: /dev/ttyUSB0, device_watchdog_ms: 100}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, id: 1}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)");
+  EXPECT_NE(error.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << error;
+  EXPECT_NE(error.find("no device-side watchdog"), std::string::npos) << error;
+  const std::string modbus = error_of(R"(name: t
+loop: {rate_hz: 100}
+buses:
+  b: {protocol: modbus-tcp, port: 127.0.0.1:502, device_watchdog_ms: 100}
+joints:
+  j1:
+    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
+    actuator: {bus: b, slave: 1, map: ../modbus/none.yaml}
+motion: {type: gait, file: ../gaits/gait.yaml}
+)");
+  EXPECT_NE(modbus.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << modbus;
+  EXPECT_NE(modbus.find("names no watchdog or timeout register"), std::string::npos) << modbus;
 }
 
 }  // namespace

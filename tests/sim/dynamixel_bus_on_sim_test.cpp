@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "animrt/bridge/byte_transport.hpp"
@@ -149,6 +150,144 @@ TEST(DynamixelBusOnSim, JointRestingOutsideItsLimitsStartsAndIsLedInside) {
   test::PtyClient other(sim.endpoint());
   EXPECT_EQ(as_u32(other.transact(test::read(4, xreg::min_position_limit, 4)).data),
             static_cast<std::uint32_t>(jaw.to_ticks(0.0)));
+}
+
+// ---------------------------------------------------------- Bus Watchdog
+
+BusConfig guarded(std::uint8_t units) {
+  BusConfig config = two_servos(0.1);
+  dxl::BusOptions options;
+  options.bus_watchdog = units;
+  config.options = options;
+  return config;
+}
+
+std::uint32_t reg8(test::PtyClient& client, std::uint8_t id, std::uint16_t address) {
+  const test::Status st = client.transact(test::read(id, address, 1));
+  return st.data.size() == 1 ? st.data[0] : 0xFFFFFFFFu;
+}
+
+TEST(DynamixelBusOnSim, BusWatchdogIsSetAtActivateAndClearedAtDeactivate) {
+  const BusConfig config = guarded(3);
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  bus.configure();
+  test::PtyClient other(sim.endpoint());
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 0u);
+  bus.activate();
+  for (int id : {3, 4}) {
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::torque_enable), 1u);
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 3u);
+  }
+  bus.deactivate();
+  for (int id : {3, 4}) {
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 0u);
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::torque_enable), 0u);
+  }
+}
+
+TEST(DynamixelBusOnSim, BusWatchdogIsJudgedOnTheClockOfTheRun) {
+  // Lockstep: the simulated clock stands still while the machine is slow, so
+  // real time that passes must not fire the watchdog; simulated time must.
+  const BusConfig config = guarded(1);  // 20 ms
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  bus.configure();
+  bus.activate();
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  test::PtyClient other(sim.endpoint());
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 1u);
+  clock.set(10'000'000);
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 1u);  // fed 10 ms ago by that read
+  clock.set(40'000'000);
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  // Servo 4 heard nothing since activate (and the reads of 3 are not for it).
+  EXPECT_EQ(reg8(other, 4, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+}
+
+TEST(DynamixelBusOnSim, FiredBusWatchdogHoldsTheServoUntilTheNextConfigure) {
+  const BusConfig config = guarded(3);
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  double stopped = 0.0;
+  {
+    // A run that dies mid-motion: goals sent, then silence (no deactivate).
+    DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+    bus.configure();
+    bus.activate();
+    std::vector<double> q(2, 0.0);
+    bus.read(q);
+    bus.write(std::vector<double>{1.0, -1.0});
+    clock.set(30'000'000);
+    bus.read(q);
+    clock.set(200'000'000);
+    stopped = sim.device_position(3);
+    clock.set(400'000'000);
+    EXPECT_NEAR(sim.device_position(3), stopped, 1e-6);
+    EXPECT_LT(stopped, 0.9);  // stopped short of its goal
+    // The dead host's goals no longer move it: refused, not taken.
+    bus.read(q);
+    bus.write(std::vector<double>{0.5, 0.5});
+    bus.read(q);  // after the write, so it has been handled
+    const auto log = sim.device_goal_log(3);
+    ASSERT_FALSE(log.empty());
+    EXPECT_FALSE(log.back().accepted);
+    EXPECT_NEAR(sim.device_position(3), stopped, 1e-6);
+  }
+  test::PtyClient other(sim.endpoint());
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  EXPECT_EQ(reg8(other, 3, xreg::moving), 0u);
+  // The next run recovers it at configure, says so, and can move it again.
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  ASSERT_NO_THROW(bus.configure());
+  EXPECT_NE(bus.watchdog_warning().find("Bus Watchdog had fired on id 3 (joint3), id 4 (joint4)"),
+            std::string::npos)
+      << bus.watchdog_warning();
+  EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 0u);
+  ASSERT_NO_THROW(bus.activate());
+  std::vector<double> q(2, 0.0);
+  bus.read(q);
+  bus.write(std::vector<double>{0.2, 0.0});
+  bus.read(q);
+  EXPECT_TRUE(sim.device_goal_log(3).back().accepted);
+  clock.set(420'000'000);
+  bus.read(q);
+  EXPECT_GT(std::abs(sim.device_position(3) - stopped), 0.01);
+  bus.deactivate();
+}
+
+TEST(DynamixelBusOnSim, AHostThatStallsRearmsTheBusWatchdogAndMovesOn) {
+  // Real time on both sides: the host's bus thread stalls for longer than
+  // the guard (the servos stop, as they must), then speaks again.
+  const BusConfig config = guarded(3);  // 60 ms
+  const MonotonicClock clock;
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  bus.configure();
+  bus.activate();
+  std::vector<double> q(2, 0.0);
+  bus.read(q);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  {
+    test::PtyClient other(sim.endpoint());
+    EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  }
+  const double stopped = sim.device_position(3);
+  bus.read(q);
+  bus.write(std::vector<double>{stopped + 0.3, 0.0});
+  bus.read(q);
+  EXPECT_EQ(bus.watchdog_rearms(), 1u);
+  EXPECT_TRUE(sim.device_goal_log(3).back().accepted);
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  bus.read(q);
+  EXPECT_GT(sim.device_position(3), stopped + 0.01);
+  bus.deactivate();
 }
 
 }  // namespace

@@ -118,5 +118,73 @@ TEST(DynamixelSimServo, StartsInsideTheJointLimitsOfItsBinding) {
   EXPECT_DOUBLE_EQ(initial_position_rad(jaw), initial_offset_rad(4));
 }
 
+// ---------------------------------------------------------- Bus Watchdog
+
+std::uint8_t reg8(const DynamixelServo& s, std::uint16_t address) {
+  std::uint8_t v = 0;
+  EXPECT_EQ(s.read(address, 1, {&v, 1}), StatusError::none);
+  return v;
+}
+
+TEST(DynamixelSimServo, BusWatchdogStopsTheServoWhenTheHostGoesSilent) {
+  SimBusSettings settings;  // 6 rad/s: 4095 ticks take about a second
+  DynamixelServo s(binding(1), settings, 1'000'000, 0);
+  const std::uint8_t on = 1, units = 3;  // 60 ms
+  ASSERT_EQ(s.write(xreg::torque_enable, {&on, 1}), StatusError::none);
+  ASSERT_EQ(s.write(xreg::bus_watchdog, {&units, 1}), StatusError::none);
+  s.feed_watchdog(0);
+  set_goal(s, 4000);
+  // Fed at 50 ms: still moving at 100 ms.
+  s.advance(50'000'000);
+  s.feed_watchdog(50'000'000);
+  s.advance(100'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), units);
+  EXPECT_EQ(reg8(s, xreg::moving), 1);
+  // Silent from 50 ms: it stops at 110 ms where it was then, torque on.
+  const double at_fire = s.position_rad(110'000'000);
+  s.advance(300'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  EXPECT_EQ(reg8(s, xreg::moving), 0);
+  EXPECT_EQ(reg8(s, xreg::torque_enable), 1);
+  EXPECT_NEAR(s.position_rad(300'000'000), at_fire, 1e-3);
+  EXPECT_LT(present(s), 3000);  // nowhere near the goal
+  std::uint8_t velocity[4];
+  ASSERT_EQ(s.read(xreg::present_velocity, 4, velocity), StatusError::none);
+  EXPECT_EQ(dxl::get_u32(velocity), 0u);
+  const std::int32_t held = present(s);
+  s.advance(900'000'000);
+  EXPECT_EQ(present(s), held);
+
+  // Goals are refused until 0 is written to 98; another value does not clear it.
+  std::uint8_t goal[4];
+  dxl::put_u32(goal, 4000);
+  EXPECT_EQ(s.write(xreg::goal_position, goal), StatusError::data_range);
+  EXPECT_EQ(s.write(xreg::bus_watchdog, {&units, 1}), StatusError::data_range);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+  const std::uint8_t zero = 0;
+  ASSERT_EQ(s.write(xreg::bus_watchdog, {&zero, 1}), StatusError::none);
+  EXPECT_EQ(s.write(xreg::goal_position, goal), StatusError::none);
+  s.advance(1'000'000'000);
+  EXPECT_GT(present(s), held);  // moves again, and no watchdog is armed
+  s.advance(3'000'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), 0);
+}
+
+TEST(DynamixelSimServo, BusWatchdogWatchesOnlyWhileTorqueIsOn) {
+  SimBusSettings settings;
+  DynamixelServo s(binding(1), settings, 1'000'000, 0);
+  const std::uint8_t units = 1, on = 1;
+  ASSERT_EQ(s.write(xreg::bus_watchdog, {&units, 1}), StatusError::none);
+  s.feed_watchdog(0);
+  s.advance(500'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), units);  // torque off: nothing to stop
+  ASSERT_EQ(s.write(xreg::torque_enable, {&on, 1}), StatusError::none);
+  s.feed_watchdog(500'000'000);
+  s.advance(519'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), units);
+  s.advance(521'000'000);
+  EXPECT_EQ(reg8(s, xreg::bus_watchdog), dxl::kBusWatchdogFired);
+}
+
 }  // namespace
 }  // namespace animrt::sim

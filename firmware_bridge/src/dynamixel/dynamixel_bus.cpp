@@ -109,6 +109,12 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   model_.resize(n);
   firmware_.resize(n);
   fast_mode_ = dxl::bus_options(config_).fast_read;
+  watchdog_units_ = dxl::bus_options(config_).bus_watchdog;
+  watchdog_time_ = std::chrono::milliseconds(20) * watchdog_units_;
+  if (watchdog_units_ > kMaxWatchdogUnits) {
+    throw DeviceError(bus + "Bus Watchdog " + std::to_string(watchdog_units_) +
+                      " is outside 0..127");
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     status_[i].device_id = b.device_id;
@@ -211,6 +217,7 @@ void DynamixelBus::transact(std::size_t length, std::size_t count, std::size_t d
   decoder_.reset();
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
+  last_sent_ = steady_clock::now();
 
   const steady_clock::time_point start = steady_clock::now();
   const Deadline cap = start + timeout_ * static_cast<std::int64_t>(count);
@@ -298,6 +305,7 @@ void DynamixelBus::transact_fast(std::size_t length, std::size_t count, std::siz
   decoder_.reset();
   rx_begin_ = rx_end_ = 0;
   transport_->write({tx_.data(), length});
+  last_sent_ = steady_clock::now();
 
   // Collect bytes until the packet the header announces is complete. The
   // packet is not byte-stuffed, so it is read raw, not through the Decoder.
@@ -507,6 +515,7 @@ void DynamixelBus::configure() {
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
+  clear_bus_watchdogs();
   outside_warning_.clear();
   for (std::size_t i = 0; i < n; ++i) {
     // Goals may lead from where the joint rests to its limits, never farther.
@@ -524,6 +533,30 @@ void DynamixelBus::configure() {
   choose_fast_read();
   read_pending_hardware_status();
   fresh_ = true;
+}
+
+void DynamixelBus::clear_bus_watchdogs() {
+  // A run that died with the Bus Watchdog set leaves it counting, or fired
+  // (goals refused until it reads 0): either way it starts from 0 here.
+  watchdog_warning_.clear();
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    Answer r = unicast(i, dxl::encode_read(id, dxl::xreg::bus_watchdog, 1, tx_), 1);
+    if (r != Answer::ok || value_[0] == 0) continue;  // older firmware: no such item
+    const bool fired = value_[0] == dxl::kBusWatchdogFired;
+    r = write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
+    if (r != Answer::ok) {
+      throw DeviceError(prefix() + "cannot clear the Bus Watchdog of " + describe(i) + ": " +
+                        failure(i, r));
+    }
+    if (fired) watchdog_warning_ += (watchdog_warning_.empty() ? "" : ", ") + describe(i);
+  }
+  if (!watchdog_warning_.empty()) {
+    watchdog_warning_ = "Bus Watchdog had fired on " + watchdog_warning_ +
+                        " (the host that drove them stopped talking without switching them "
+                        "off); cleared";
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), watchdog_warning_.c_str());
+  }
 }
 
 void DynamixelBus::choose_fast_read() {
@@ -611,12 +644,25 @@ void DynamixelBus::activate() {
           "write goal position");
     goal_ticks_[i] = ticks;
     check(write_register(i, dxl::xreg::torque_enable, 1, 1, kTries), "enable torque");
+    // After torque on: the servo watches the line only while torque is on.
+    if (watchdog_units_ > 0) {
+      check(write_register(i, dxl::xreg::bus_watchdog, watchdog_units_, 1, kTries),
+            "set the Bus Watchdog (firmware 38 or later; or device_watchdog_ms: off)");
+    }
   }
+  armed_ = watchdog_units_ > 0;
 }
 
 void DynamixelBus::deactivate() {
+  armed_ = false;
   try {
     for (std::size_t i = 0; i < status_.size(); ++i) {
+      // Before torque off, so a clean stop leaves no guard armed (and clears
+      // one that fired). Not for a device the cycle left out: a silent one
+      // would only delay its torque-off; the next configure clears it.
+      if (watchdog_units_ > 0 && !status_[i].faulted) {
+        write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
+      }
       write_register(i, dxl::xreg::torque_enable, 0, 1, kTries);
     }
   } catch (...) {
@@ -635,6 +681,7 @@ void DynamixelBus::read(std::span<double> positions) {
     }
     fresh_ = false;
   }
+  rearm_after_silence();
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
@@ -671,6 +718,7 @@ std::int32_t DynamixelBus::goal_ticks(std::size_t device, double rad) const {
 }
 
 void DynamixelBus::write(std::span<const double> positions) {
+  rearm_after_silence();
   std::size_t count = 0;
   for (std::size_t i = 0; i < status_.size(); ++i) {
     if (status_[i].faulted) continue;
@@ -685,7 +733,28 @@ void DynamixelBus::write(std::span<const double> positions) {
   if (count == 0) return;
   const std::size_t length = dxl::encode_sync_write(
       dxl::xreg::goal_position, 4, {ids_.data(), count}, {sync_data_.data(), 4 * count}, tx_);
-  if (length > 0) transport_->write({tx_.data(), length});
+  if (length > 0) {
+    transport_->write({tx_.data(), length});
+    last_sent_ = steady_clock::now();
+  }
+}
+
+void DynamixelBus::rearm_after_silence() {
+  if (!armed_) return;
+  const auto now = steady_clock::now();
+  // Half the guard's time: the servos' clocks and ours need not agree on
+  // when it ran out.
+  if (now - last_sent_ <= watchdog_time_ / 2) return;
+  // The host was silent (a stall, not a death: it speaks again), so the
+  // guard may have fired: the servos stopped and refuse goals. 0 clears it,
+  // the value arms it again; broadcast, so no answers to wait for.
+  for (const std::uint8_t value : {std::uint8_t{0}, watchdog_units_}) {
+    const std::size_t length =
+        dxl::encode_write(dxl::kBroadcastId, dxl::xreg::bus_watchdog, {&value, 1}, tx_);
+    if (length > 0) transport_->write({tx_.data(), length});
+  }
+  last_sent_ = now;
+  ++watchdog_rearms_;
 }
 
 }  // namespace animrt

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/device_watchdog.hpp"
 #include "animrt/bridge/dynamixel/dynamixel_bus.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
 
@@ -20,7 +21,12 @@ constexpr std::int64_t kMaxTicks = 4095;
 constexpr double kMinTicksPerRev = 16.0;
 constexpr double kMaxTicksPerRev = 1e8;
 
-constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms", "fast_read", "model"};
+// Bus Watchdog (address 98): 1..127 units of 20 ms.
+constexpr double kWatchdogUnitMs = 20.0;
+constexpr double kWatchdogMaxMs = 127 * kWatchdogUnitMs;
+
+constexpr std::string_view kBusKeys[] = {"port",      "baud",  "timeout_ms",
+                                         "fast_read", "model", "device_watchdog_ms"};
 constexpr std::string_view kActuatorKeys[] = {"id",         "ticks_per_rev", "ticks_per_rad",
                                               "zero_ticks", "direction",     "model"};
 
@@ -91,6 +97,9 @@ class Dynamixel2 final : public Protocol {
     dxl::BusOptions options;
     if (auto n = node.find("fast_read")) options.fast_read = parse_fast_read(*n);
     if (auto n = node.find("model")) options.model_number = parse_model(*n);
+    const double watchdog_ms = read_device_watchdog_ms(
+        node, bus.loop_period_s, kWatchdogUnitMs, kWatchdogMaxMs, "Bus Watchdog, units of 20 ms");
+    options.bus_watchdog = static_cast<std::uint8_t>(std::lround(watchdog_ms / kWatchdogUnitMs));
     bus.options = options;
   }
 
@@ -147,6 +156,12 @@ class Dynamixel2 final : public Protocol {
   double wire_bits_per_cycle(const BusConfig& bus) const override {
     const bool fast = dxl::bus_options(bus).fast_read == dxl::FastRead::on;
     return 10.0 * static_cast<double>(dynamixel_wire_bytes(bus.actuators.size(), fast));
+  }
+
+  std::string device_guard_note(const BusConfig& bus) const override {
+    if (dxl::bus_options(bus).bus_watchdog != 0) return {};
+    return "no device-side guard (device_watchdog_ms: off): if the host dies, the servos hold "
+           "their last goal with torque on";
   }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {

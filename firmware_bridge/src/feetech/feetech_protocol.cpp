@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/device_watchdog.hpp"
 #include "animrt/bridge/feetech/feetech_bus.hpp"
 
 namespace animrt {
@@ -16,7 +17,7 @@ constexpr int kBauds[] = {1'000'000, 500'000, 250'000, 128'000, 115'200, 76'800,
 constexpr double kMinTicksPerRev = 16.0;
 constexpr double kMaxTicksPerRev = 1e6;
 
-constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms"};
+constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms", "device_watchdog_ms"};
 constexpr std::string_view kActuatorKeys[] = {"id", "ticks_per_rev", "ticks_per_rad", "zero_ticks",
                                               "direction"};
 
@@ -34,10 +35,15 @@ class Feetech final : public Protocol {
   Feetech(std::string_view name, ft::Series series) : name_(name), series_(series) {}
 
   std::string_view name() const override { return name_; }
+  std::string device_guard_note(const BusConfig&) const override {
+    return "no device-side guard (Feetech STS/SCS servos have no bus watchdog): if the host "
+           "dies, the servos hold their last goal with torque on";
+  }
   std::span<const std::string_view> bus_keys() const override { return kBusKeys; }
   std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
 
   void read_bus(const YamlNode& node, BusConfig& bus) const override {
+    refuse_device_watchdog(node, "Feetech STS/SCS servos have no device-side watchdog");
     const YamlNode port = node.at("port");
     bus.port = port.as_string();
     if (bus.port.empty()) port.fail("expected a device path such as /dev/ttyUSB0, found \"\"");

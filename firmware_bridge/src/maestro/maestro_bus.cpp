@@ -192,11 +192,17 @@ void MaestroBus::configure() {
     present_[i] = 0;
   }
   std::string silent;
+  timeout_warning_.clear();
   for (Board& board : boards_) {
     bool complete = false;
     // The first Get Errors also clears what the board latched before we came
-    // (e.g. noise while the line was plugged in).
+    // (e.g. noise while the line was plugged in, or a serial timeout after
+    // the host before us died).
     for (int t = 0; t < kTries && !complete; ++t) complete = poll_board(board, false);
+    if (complete && (board.last_errors & maestro::error_bit::serial_timeout) != 0) {
+      timeout_warning_ += (timeout_warning_.empty() ? "" : ", ") + std::string("Maestro ") +
+                          std::to_string(board.address.device);
+    }
     if (complete) complete = poll_board(board, false);
     if (!complete) {
       silent +=
@@ -214,6 +220,12 @@ void MaestroBus::configure() {
   if (transport_->failure() != nullptr) throw DeviceError(prefix() + describe_failure(*transport_));
   if (!silent.empty())
     throw DeviceError(prefix() + "no answer to Get Position/Get Errors from " + silent);
+  if (!timeout_warning_.empty()) {
+    timeout_warning_ = "serial timeout had fired on " + timeout_warning_ +
+                       " (no host talked to it for longer than its timeout: since power-up, or "
+                       "a host that died without switching it off); cleared";
+    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), timeout_warning_.c_str());
+  }
   for (std::size_t i = 0; i < present_.size(); ++i) {
     // A channel that is off has no position: start from the neutral pulse.
     if (present_[i] == 0) {
@@ -228,6 +240,21 @@ void MaestroBus::configure() {
 }
 
 void MaestroBus::activate() {
+  // A serial timeout shorter than the pause since configure() latched its
+  // error and sent the channels home; the targets below switch them on
+  // again. Positions read here are of channels about to be set: kept out.
+  const std::vector<std::uint16_t> present = present_;
+  for (Board& board : boards_) {
+    bool complete = false;
+    for (int t = 0; t < kTries && !complete; ++t) complete = poll_board(board, false);
+    if (complete && (board.last_errors & ~maestro::error_bit::serial_timeout) != 0) {
+      const std::string why = "errors " + error_names(board.last_errors);
+      present_ = present;
+      throw DeviceError(prefix() + "cannot switch on Maestro " +
+                        std::to_string(board.address.device) + ": " + why);
+    }
+  }
+  present_ = present;
   for (Board& board : boards_) {
     std::size_t length = 0;
     for (std::size_t d : board.devices) {

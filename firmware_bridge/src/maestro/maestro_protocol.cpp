@@ -1,16 +1,22 @@
 #include "animrt/bridge/maestro/maestro_protocol.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/device_watchdog.hpp"
 #include "animrt/bridge/maestro/maestro_bus.hpp"
 
 namespace animrt {
 namespace {
 
-constexpr std::string_view kBusKeys[] = {"port",          "baud", "timeout_ms", "serial_protocol",
-                                         "device_number", "board"};
+constexpr std::string_view kBusKeys[] = {
+    "port",          "baud",  "timeout_ms",        "serial_protocol",
+    "device_number", "board", "device_watchdog_ms"};
+// Serial timeout: 0.01 s resolution, at most 655.35 s.
+constexpr double kTimeoutUnitMs = 10.0;
+constexpr double kTimeoutMaxMs = 655350.0;
 constexpr std::string_view kActuatorKeys[] = {"channel",    "device_number", "min_us",
                                               "max_us",     "neutral_us",    "rad_per_us",
                                               "deg_per_us", "speed",         "acceleration"};
@@ -90,7 +96,26 @@ class Maestro final : public Protocol {
       if (!found) n->fail("expected micro6, mini12, mini18 or mini24, found " + n->describe());
     }
     options.device = device;
+    options.serial_timeout_ms = read_device_watchdog_ms(
+        node, bus.loop_period_s, kTimeoutUnitMs, kTimeoutMaxMs, "serial timeout, units of 10 ms");
     bus.options = options;
+  }
+
+  std::string device_guard_note(const BusConfig& bus) const override {
+    const double ms = std::any_cast<const MaestroBusOptions&>(bus.options).serial_timeout_ms;
+    if (ms == 0.0) {
+      return "no device-side guard (device_watchdog_ms: off): if the host dies, the servos hold "
+             "their last target";
+    }
+    // Settings the serial protocol can neither write nor read.
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.2f", ms / 1000.0);
+    return std::string(
+               "the Maestro takes its serial timeout only from its settings: set Serial "
+               "Settings > Timeout to ") +
+           seconds +
+           " s in the Maestro Control Center, and each channel's On startup or error to Off "
+           "or Go to (what the servo does when the host dies)";
   }
 
   void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,

@@ -5,13 +5,16 @@
 #include <filesystem>
 #include <string>
 
+#include "animrt/bridge/device_watchdog.hpp"
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 
 namespace animrt {
 namespace {
 
-constexpr std::string_view kTcpKeys[] = {"port", "timeout_ms", "reconnect_ms"};
-constexpr std::string_view kRtuKeys[] = {"port", "baud", "parity", "stop_bits", "timeout_ms"};
+constexpr std::string_view kTcpKeys[] = {"port", "timeout_ms", "reconnect_ms",
+                                         "device_watchdog_ms"};
+constexpr std::string_view kRtuKeys[] = {"port",      "baud",       "parity",
+                                         "stop_bits", "timeout_ms", "device_watchdog_ms"};
 constexpr std::string_view kActuatorKeys[] = {"slave", "map", "m_per_rad", "zero_m"};
 
 void read_timeout(const YamlNode& node, BusConfig& bus) {
@@ -35,8 +38,16 @@ class ModbusProtocol final : public Protocol {
                 : std::span<const std::string_view>(kRtuKeys);
   }
   std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
+  std::string device_guard_note(const BusConfig&) const override {
+    return "no device-side guard (a register map names no watchdog register; set the drive's "
+           "own communication timeout with its vendor tool): if the host dies, the drives hold "
+           "their last target";
+  }
 
   void read_bus(const YamlNode& node, BusConfig& bus) const override {
+    refuse_device_watchdog(node,
+                           "a Modbus register map names no watchdog or timeout register, so "
+                           "animrt cannot set a device-side watchdog on this bus");
     const YamlNode port = node.at("port");
     bus.port = port.as_string();
     ModbusBusOptions options;

@@ -8,7 +8,10 @@ namespace animrt::sim {
 
 MaestroBoard::MaestroBoard(int device_number, int channels,
                            std::span<const MaestroChannelSetup> setup, Nanos now)
-    : device_(device_number), channels_(static_cast<std::size_t>(channels)), tick_time_(now) {
+    : device_(device_number),
+      channels_(static_cast<std::size_t>(channels)),
+      tick_time_(now),
+      last_command_(now) {
   for (const MaestroChannelSetup& s : setup) {
     if (s.channel < 0 || s.channel >= channels) throw std::out_of_range("Maestro channel");
     Channel& c = channels_[static_cast<std::size_t>(s.channel)];
@@ -52,11 +55,21 @@ void MaestroBoard::tick(Channel& c) const {
   c.step = step;
 }
 
-void MaestroBoard::advance(Nanos now) {
+void MaestroBoard::advance_ticks(Nanos now) {
   while (now - tick_time_ >= kTick) {
     tick_time_ += kTick;
     for (Channel& c : channels_) tick(c);
   }
+}
+
+void MaestroBoard::advance(Nanos now) {
+  while (serial_timeout_ > 0 && now - last_command_ > serial_timeout_) {
+    const Nanos fire = last_command_ + serial_timeout_;
+    advance_ticks(fire);
+    fail(maestro::error_bit::serial_timeout);
+    last_command_ = fire;
+  }
+  advance_ticks(now);
 }
 
 void MaestroBoard::fail(std::uint16_t bits) {
@@ -78,6 +91,28 @@ void MaestroBoard::handle(const maestro::Command& command, Nanos now,
                           std::vector<std::uint8_t>& out) {
   advance(now);
   const auto channel_ok = [&](int ch) { return ch >= 0 && ch < channels(); };
+  // Every valid command restarts the serial timeout (an invalid one fails
+  // below, before this counts).
+  bool valid = false;
+  switch (command.command) {
+    case maestro::cmd::go_home:
+    case maestro::cmd::get_errors:
+    case maestro::cmd::get_moving_state:
+      valid = true;
+      break;
+    case maestro::cmd::set_target:
+    case maestro::cmd::set_speed:
+    case maestro::cmd::set_acceleration:
+    case maestro::cmd::get_position:
+      valid = channel_ok(command.channel);
+      break;
+    case maestro::cmd::set_multiple_targets:
+      valid = channel_ok(command.channel) && channel_ok(command.channel + command.count - 1);
+      break;
+    default:
+      break;
+  }
+  if (valid) last_command_ = std::max(last_command_, now);
   std::uint8_t answer[2];
   switch (command.command) {
     case maestro::cmd::set_target:

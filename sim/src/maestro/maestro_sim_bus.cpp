@@ -30,6 +30,8 @@ MaestroSimBus::MaestroSimBus(const BusConfig& config, const Clock& clock)
   boards_.reserve(per_board.size());
   for (const auto& [device, setup] : per_board) {
     boards_.emplace_back(device, options.channels, setup, clock.now());
+    // The robot file says what the board's settings hold.
+    boards_.back().set_serial_timeout(static_cast<Nanos>(options.serial_timeout_ms * 1e6));
   }
   answers_.reserve(4096);
 }

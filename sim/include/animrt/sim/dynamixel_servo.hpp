@@ -24,6 +24,14 @@
 // Limit, the gains, Profile Acceleration/Velocity, Velocity Limit (the rate
 // limit is SimBusSettings::max_speed_rad_s).
 //
+// Bus Watchdog (98, units of 20 ms), while torque is on: when no instruction
+// packet reached the servo (its id or broadcast: feed_watchdog) for longer
+// than the set time, the servo stops where it is at that moment, keeps torque
+// on, and 98 reads 0xFF (-1); Goal PWM/Current/Velocity/Position then answer
+// Data Range Error until 0 is written to 98. Judged on the time the firmware
+// is given (a lockstep run's clock), at that instant however late the next
+// packet arrives.
+//
 // Motor: with torque on, Present Position follows Goal Position as a first
 // order lag (time constant tau) whose speed is limited to vmax: speed =
 // clamp((goal - position) / tau, -vmax, vmax). The model is integrated in
@@ -93,6 +101,7 @@ inline constexpr std::uint8_t kXFirmwareVersion = 38;
 inline constexpr double kXTicksPerRev = 4096.0;
 inline constexpr double kXVelocityUnitRpm = 0.229;
 inline constexpr std::uint8_t kXTemperatureC = 36;
+inline constexpr Nanos kBusWatchdogUnitNs = 20'000'000;
 inline constexpr std::uint16_t kXInputVoltage = 120;  // 12.0 V
 
 // Baud Rate register value for a baud (9600 -> 0, 57600 -> 1, 115200 -> 2,
@@ -141,8 +150,13 @@ class DynamixelServo {
   std::uint16_t resolve(std::size_t address) const;
   bool torque_on() const { return table_[dxl::xreg::torque_enable] != 0; }
 
-  // Brings the motor and the present-value registers to `now` (never back).
+  // Brings the motor and the present-value registers to `now` (never back),
+  // firing the Bus Watchdog on the way if its time came.
   void advance(Nanos now);
+  // An instruction packet for this servo arrived at `now` (after advance).
+  void feed_watchdog(Nanos now);
+  // Whether the Bus Watchdog fired (98 reads 0xFF).
+  bool watchdog_fired() const { return table_[xreg_sim::bus_watchdog] == dxl::kBusWatchdogFired; }
 
   // Instruction handlers. Each returns the error number for the status
   // packet; a failed write changes nothing. `out` must hold `length` bytes.
@@ -188,6 +202,8 @@ class DynamixelServo {
     double velocity = 0;  // ticks/s
   };
   Motor motor_at(Nanos now) const;
+  Motor motor_until(Nanos now) const;  // the motor model alone, no watchdog
+  Nanos watchdog_fire_time() const;    // when the armed watchdog fires; -1: not armed
   dxl::StatusError check_write(std::uint16_t address, std::span<const std::uint8_t> data) const;
   dxl::StatusError check_direct(std::uint16_t address, std::span<const std::uint8_t> data) const;
   void reset_ram();
@@ -204,6 +220,7 @@ class DynamixelServo {
   Nanos motor_time_;
   JointPhysics* physics_ = nullptr;
   int physics_joint_ = -1;
+  Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;

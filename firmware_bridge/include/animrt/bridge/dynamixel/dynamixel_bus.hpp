@@ -38,6 +38,8 @@ class DynamixelBus final : public ActuatorBus {
   static constexpr int kTries = 3;
   // Largest position an X-series servo takes in position mode.
   static constexpr std::int32_t kXMaxTicks = 4095;
+  // Largest Bus Watchdog (units of 20 ms).
+  static constexpr std::uint8_t kMaxWatchdogUnits = 127;
 
   // Takes an open transport (tests inject one). Allocates every buffer the
   // cycle needs. Throws DeviceError for ids outside 0..252, duplicate ids, a
@@ -59,11 +61,16 @@ class DynamixelBus final : public ActuatorBus {
   // its limits (a jaw hanging open past closed) gets limits widened to its
   // measured position, with a warning (outside_warning()): torque on then
   // holds it where it is, and the goals lead it back inside (below).
+  // A Bus Watchdog left set or fired (it reads 0xFF) by a run that died is
+  // cleared (0), with a warning when it had fired (watchdog_warning()).
   void configure() override;
-  // Per device: goal position = present position, then torque on. On failure
+  // Per device: goal position = present position, then torque on, then the
+  // Bus Watchdog (BusOptions::bus_watchdog, if not 0): from then on the servo
+  // stops by itself when no instruction reaches it for that long. On failure
   // turns torque off again and throws DeviceError naming the device.
   void activate() override;
-  // Torque off on every device, best effort; never throws.
+  // Bus Watchdog 0 (if set; not on faulted devices), then torque off, on
+  // every device, best effort; never throws.
   void deactivate() override;
 
   // One Sync Read / Sync Write. Counters: `transactions` counts instruction
@@ -73,8 +80,13 @@ class DynamixelBus final : public ActuatorBus {
   // A joint that started outside its limits may also take goals between its
   // measured start and the limit, never farther out than a goal already
   // sent: the start ramp walks it in, and once inside it stays inside.
+  // With a Bus Watchdog armed, a cycle that finds the line silent for more
+  // than half its time (the host stalled: the servos may have stopped and
+  // locked their goals) first clears and re-arms it with two broadcast
+  // Writes, so the figure goes on from where it stopped (watchdog_rearms()).
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
+  std::uint64_t watchdog_rearms() const { return watchdog_rearms_; }
 
   std::span<DeviceStatus> devices() override { return status_; }
 
@@ -87,6 +99,9 @@ class DynamixelBus final : public ActuatorBus {
   // The warning configure() printed about joints resting outside their
   // limits (each with its angle and limits); empty when there was none.
   const std::string& outside_warning() const { return outside_warning_; }
+  // The warning configure() printed about Bus Watchdogs that had fired;
+  // empty when none had.
+  const std::string& watchdog_warning() const { return watchdog_warning_; }
 
   // Whether the cycle's read is a Fast Sync Read (decided by configure()).
   bool fast_read_active() const { return fast_; }
@@ -127,6 +142,8 @@ class DynamixelBus final : public ActuatorBus {
   // A status packet from the right id that cannot answer this instruction.
   static bool stale(const dxl::Packet& packet, std::size_t data_length);
   void write_position_limits(std::size_t device);
+  void clear_bus_watchdogs();
+  void rearm_after_silence();
   // Pulls bytes until the decoder has something other than need_more.
   dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
   // Reads the hardware error register of devices whose alert just appeared.
@@ -162,6 +179,12 @@ class DynamixelBus final : public ActuatorBus {
   std::string sysfs_root_ = "/sys";
   std::string latency_warning_;
   std::string outside_warning_;
+  std::string watchdog_warning_;
+  std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set at activate; 0: none
+  std::chrono::nanoseconds watchdog_time_{0};
+  bool armed_ = false;  // between activate() and deactivate()
+  std::chrono::steady_clock::time_point last_sent_{};
+  std::uint64_t watchdog_rearms_ = 0;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};

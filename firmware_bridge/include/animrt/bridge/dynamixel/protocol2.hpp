@@ -63,11 +63,15 @@ inline constexpr std::uint16_t torque_enable = 64;          // 1
 inline constexpr std::uint16_t led = 65;                    // 1
 inline constexpr std::uint16_t status_return_level = 68;    // 1
 inline constexpr std::uint16_t hardware_error_status = 70;  // 1
-inline constexpr std::uint16_t goal_position = 116;         // 4
-inline constexpr std::uint16_t moving = 122;                // 1
-inline constexpr std::uint16_t present_velocity = 128;      // 4
-inline constexpr std::uint16_t present_position = 132;      // 4
-inline constexpr std::uint16_t present_temperature = 146;   // 1
+// 1, units of 20 ms (1..127, 0 off); reads 0xFF (-1) once it fired, and then
+// Goal PWM/Current/Velocity/Position refuse writes (Data Range Error) until
+// 0 is written.
+inline constexpr std::uint16_t bus_watchdog = 98;
+inline constexpr std::uint16_t goal_position = 116;        // 4
+inline constexpr std::uint16_t moving = 122;               // 1
+inline constexpr std::uint16_t present_velocity = 128;     // 4
+inline constexpr std::uint16_t present_position = 132;     // 4
+inline constexpr std::uint16_t present_temperature = 146;  // 1
 // Indirect Address n (2 bytes each) names the register Indirect Data n (1
 // byte) stands for: n = 1..28 at 168 / 224, n = 29..56 at 578 / 634.
 inline constexpr std::uint16_t indirect_address_1 = 168;
@@ -77,6 +81,9 @@ inline constexpr std::uint16_t indirect_data_29 = 634;
 inline constexpr std::uint16_t indirect_count = 28;  // per block
 inline constexpr std::uint16_t table_size = 662;     // through Indirect Data 56 (661)
 }  // namespace xreg
+
+// What Bus Watchdog (xreg::bus_watchdog) reads once it fired (-1).
+inline constexpr std::uint8_t kBusWatchdogFired = 0xFF;
 
 std::uint16_t crc16(std::span<const std::uint8_t> bytes, std::uint16_t accum = 0);
 

@@ -42,6 +42,8 @@ enum class FastRead : std::uint8_t {
 struct BusOptions {
   FastRead fast_read = FastRead::automatic;
   std::uint16_t model_number = 0;  // the bus's `model`, for devices without one; 0: none
+  // Bus Watchdog (address 98) set at activate, in its units of 20 ms; 0: none.
+  std::uint8_t bus_watchdog = 0;
 };
 struct DeviceOptions {
   std::uint16_t model_number = 0;  // 0: no `model` given

@@ -33,6 +33,10 @@ struct MaestroBusOptions {
   int channels = 12;                     // per board: 6, 12, 18 or 24
   bool multiple_targets = true;          // Set Multiple Targets (Mini Maestro only)
   int device = maestro::kDefaultDevice;  // default device number of the channels (Pololu form)
+  // The serial timeout the board should have (ms, 0: none). The Maestro takes
+  // it only from its settings (Maestro Control Center, Serial Settings:
+  // Timeout), never over the serial line, so animrt can only say so.
+  double serial_timeout_ms = 0.0;
 };
 
 // ActuatorBinding::options of a Maestro channel. The binding's ticks are
@@ -58,11 +62,18 @@ class MaestroBus final : public ActuatorBus {
   const BusConfig& config() const override { return config_; }
   // Reads every position and clears each board's error register; throws
   // DeviceError listing every board that did not answer. A channel whose
-  // output is off (position 0) is reported at its neutral pulse.
+  // output is off (position 0) is reported at its neutral pulse. A serial
+  // timeout the board latched (the host before us went silent) is cleared
+  // with a warning (timeout_warning()).
   void configure() override;
-  // Speed and acceleration limits, then target = present output (which
-  // switches the pulses on without a jump); throws DeviceError on an error bit.
+  // Clears a serial timeout latched since configure() (the board's setting
+  // may be shorter than the pause before activation), then speed and
+  // acceleration limits, then target = present output (which switches the
+  // pulses on without a jump); throws DeviceError on any other error bit.
   void activate() override;
+  // The warning configure() printed about serial timeouts that had fired;
+  // empty when none had.
+  const std::string& timeout_warning() const { return timeout_warning_; }
   // Target 0 (pulses off: the servos go limp), best effort.
   void deactivate() override;
   void read(std::span<double> positions) override;
@@ -101,6 +112,7 @@ class MaestroBus final : public ActuatorBus {
   std::vector<std::uint8_t> answered_;  // scratch, per device
   std::vector<std::uint16_t> block_;    // scratch for Set Multiple Targets
   bool fresh_ = false;
+  std::string timeout_warning_;
   std::array<std::uint8_t, 512> tx_{};
   std::array<std::uint8_t, 512> rx_{};
 };

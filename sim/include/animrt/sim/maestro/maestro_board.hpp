@@ -17,6 +17,11 @@
 // channel set the serial protocol error bit; on any error the board sends
 // every channel home (here: off), as the factory settings do. Get Errors
 // answers and clears the register.
+// Serial timeout (a setting, made in the Maestro Control Center, not over
+// the line): when no valid command reached the board for longer than it, the
+// serial timeout error bit is set and every channel goes home (off), at that
+// instant of the board's clock however late the next command comes; it
+// fires again after each further timeout of silence.
 
 #include <cstdint>
 #include <span>
@@ -41,6 +46,8 @@ class MaestroBoard {
                Nanos now);
 
   int device_number() const { return device_; }
+  // The board's serial timeout setting; 0 (the factory setting): none.
+  void set_serial_timeout(Nanos timeout) { serial_timeout_ = timeout; }
   int channels() const { return static_cast<int>(channels_.size()); }
 
   // Handles one command addressed to this board (compact, or Pololu form with
@@ -68,6 +75,7 @@ class MaestroBoard {
     double step = 0.0;  // quarter-us moved in the last tick (for acceleration)
   };
   void tick(Channel& c) const;
+  void advance_ticks(Nanos now);
   void set_target(Channel& c, std::uint16_t target) const;
   void fail(std::uint16_t bits);
 
@@ -75,6 +83,8 @@ class MaestroBoard {
   std::vector<Channel> channels_;
   std::uint16_t errors_ = 0;
   Nanos tick_time_;  // time of the last tick
+  Nanos serial_timeout_ = 0;
+  Nanos last_command_;  // the latest valid command (or serial timeout)
   bool responding_ = true;
 };
 
