@@ -118,12 +118,13 @@ class Slow(threading.Thread):
             time.sleep(self.gap)
 
 
-def stop(port, token):
-    """POST /api/stop with the token and no body (no Content-Length)."""
+def stop(port, token, json_body=False):
+    """POST /api/stop with the token and no body (no Content-Length), or {}."""
+    headers = {"Host": "127.0.0.1:%d" % port, "Authorization": "Bearer " + token}
+    if json_body:
+        headers.update({"Content-Type": "application/json", "Content-Length": "2"})
     t0 = time.monotonic()
-    status, body = request(
-        port, "POST", "/api/stop", {"Host": "127.0.0.1:%d" % port, "Authorization": "Bearer " + token}
-    )
+    status, body = request(port, "POST", "/api/stop", headers, b"{}" if json_body else None)
     return status, body, time.monotonic() - t0
 
 
@@ -134,6 +135,7 @@ def main():
     ap.add_argument("--streams", type=int, default=50)
     ap.add_argument("--slow", type=int, default=50)
     ap.add_argument("--bench", action="store_true", help="only measure the stop's latency")
+    ap.add_argument("--json-body", action="store_true", help="stop with {} as its body")
     a = ap.parse_args()
     port, token = a.port, a.token
     host = "127.0.0.1:%d" % port
@@ -165,7 +167,7 @@ def main():
         slow.start()
         time.sleep(0.5)  # every slow connection has sent part of its headers
 
-    status, body, latency = stop(port, token)
+    status, body, latency = stop(port, token, a.json_body)
     print("stop with %d streams and %d slow-header connections: HTTP %d in %.1f ms"
           % (a.streams, a.slow, status, latency * 1000.0))
     assert status == 200, (status, body)

@@ -225,8 +225,14 @@ export class FigureView {
     this.requestRender();
   }
 
+  // Draws only a pose that differs from the one on screen, so the view is
+  // drawn at most once per streamed state and not at all while the figure
+  // stands still (with software GL each drawing costs the run's machine CPU).
   update(bodies) {
     if (!this.ok || !this.measured || !bodies) return;
+    const pose = JSON.stringify([bodies.measured, bodies.commanded]);
+    if (pose === this.shownPose) return;
+    this.shownPose = pose;
     applyPoses(this.measured, bodies.measured);
     applyPoses(this.commanded, bodies.commanded);
     // A digest of the measured pose, for tests: it changes as the figure moves.
