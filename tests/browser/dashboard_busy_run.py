@@ -82,8 +82,9 @@ def run_test(args, pages, tmp):
         page.wait("a live stream", lambda: page.js("return document.body.dataset.stream === 'live';"), 15)
         check(page.js("return document.getElementById('view3d').dataset.webgl === '1';"),
               "the 3-D view is not drawn (no WebGL): the test would not load the machine")
+        gl = page.js("return document.getElementById('view3d').dataset.gl;")
         page.wait("the motion phase", lambda: page.text("#phase") == "motion", 15)
-        step("page live, run in motion")
+        step(f"page live ({gl} GL), run in motion")
         try:
             code = run.proc.wait(timeout=RUN_S + 30)
         except subprocess.TimeoutExpired:
