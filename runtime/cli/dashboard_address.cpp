@@ -21,8 +21,8 @@ DashboardAddress check_dashboard_address(const std::string& text, bool remote) {
   }
   if (!remote && !is_loopback_host(out.at->first)) {
     std::cerr << "--dashboard: " << out.at->first
-              << " is not a loopback address; the dashboard takes controls, so serving other "
-                 "machines needs --dashboard-remote\n";
+              << " is not a loopback address (127.0.0.1, [::1] or localhost); the dashboard "
+                 "takes controls, so serving other machines needs --dashboard-remote\n";
     out.ok = false;
   }
   return out;

@@ -236,6 +236,9 @@ int cmd_run(const RunArgs& args) {
   options.controls = &g_controls;
   options.backend_name = args.backend;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  options.raise_device_threads = [&simulated](int priority) {
+    return animrt::raise_simulated_devices(simulated, priority);
+  };
 
   // A show's sound track plays on its own thread, started with the motion.
   std::vector<std::unique_ptr<animrt::ShowAudioPlayer>> audio;

@@ -2,9 +2,16 @@
 
 #include "dashboard_core.hpp"
 
+#include <arpa/inet.h>
 #include <fmt/format.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <chrono>
 #include <fstream>
 #include <iterator>
@@ -34,8 +41,81 @@ bool same_dashboard_token(const std::string& given, const std::string& token) {
   return diff == 0;
 }
 
+namespace {
+
+bool loopback_address(const sockaddr* addr) {
+  if (addr->sa_family == AF_INET) {
+    const auto* v4 = reinterpret_cast<const sockaddr_in*>(addr);
+    return (ntohl(v4->sin_addr.s_addr) >> 24) == 127;
+  }
+  if (addr->sa_family == AF_INET6) {
+    const in6_addr& a = reinterpret_cast<const sockaddr_in6*>(addr)->sin6_addr;
+    if (IN6_IS_ADDR_LOOPBACK(&a)) return true;
+    return IN6_IS_ADDR_V4MAPPED(&a) && a.s6_addr[12] == 127;
+  }
+  return false;
+}
+
+bool ip_literal(const std::string& host) {
+  in6_addr a{};
+  return ::inet_pton(AF_INET, host.c_str(), &a) == 1 ||
+         ::inet_pton(AF_INET6, host.c_str(), &a) == 1;
+}
+
+std::string lowercase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!text.empty() && text.back() == '.') text.pop_back();  // "localhost." is localhost
+  return text;
+}
+
+}  // namespace
+
+// An IP literal is parsed, never looked up; "localhost" is resolved (from
+// /etc/hosts) and every address it gives must be loopback. Any other name is
+// refused even when it resolves to loopback today (127.0.0.1.nip.io does):
+// its addresses come from DNS, whose owner can change them, and the
+// dashboard accepts requests for the name it serves, so a page from that
+// name could reach it after a rebinding.
 bool is_loopback_host(const std::string& host) {
-  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
+  const std::string name = lowercase(host);
+  if (name != "localhost" && !ip_literal(name)) return false;
+  addrinfo hints{};
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = name == "localhost" ? 0 : AI_NUMERICHOST;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(name.c_str(), nullptr, &hints, &found) != 0 || found == nullptr) return false;
+  bool all = true;
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next)
+    all = all && loopback_address(a->ai_addr);
+  ::freeaddrinfo(found);
+  return all;
+}
+
+bool dashboard_host_allowed(const std::string& host_header, const std::string& served_host,
+                            int served_port, bool remote) {
+  std::string name = host_header;
+  std::string port;
+  if (!name.empty() && name.front() == '[') {  // [v6]:port
+    const auto close = name.find(']');
+    if (close == std::string::npos) return false;
+    port = name.substr(close + 1);
+    name = name.substr(1, close - 1);
+    if (!port.empty() && port.front() != ':') return false;
+    if (!port.empty()) port.erase(0, 1);
+  } else if (const auto colon = name.rfind(':'); colon != std::string::npos) {
+    port = name.substr(colon + 1);
+    name = name.substr(0, colon);
+  }
+  // Without a port the client means 80.
+  if (port != (port.empty() && served_port == 80 ? "" : std::to_string(served_port))) return false;
+  name = lowercase(name);
+  if (name.empty()) return false;
+  if (ip_literal(name) || name == "localhost" || name == lowercase(served_host)) return true;
+  if (!remote) return false;
+  std::array<char, 256> self{};
+  if (::gethostname(self.data(), self.size() - 1) != 0) return false;
+  const std::string machine = lowercase(self.data());
+  return name == machine || name == machine + ".local";
 }
 
 std::pair<std::string, int> parse_host_port(const std::string& text) {
@@ -62,8 +142,8 @@ DashboardCore::DashboardCore(DashboardListen listen)
     : listen_(std::move(listen)), token_(new_dashboard_token()) {
   if (!listen_.remote && !is_loopback_host(listen_.host)) {
     throw std::invalid_argument("--dashboard " + listen_.host +
-                                " is not a loopback address; add --dashboard-remote to serve "
-                                "other machines");
+                                " is not a loopback address (127.0.0.1, [::1] or localhost); add "
+                                "--dashboard-remote to serve other machines");
   }
   // A stream to a client that never reads gives up after this.
   server_.set_write_timeout(2, 0);
@@ -78,7 +158,8 @@ DashboardCore::~DashboardCore() { stop(); }
 bool DashboardCore::authorized(const httplib::Request& req) const {
   const std::string header = req.get_header_value("Authorization");
   const std::string bearer = "Bearer ";
-  if (header.rfind(bearer, 0) == 0) return same_dashboard_token(header.substr(bearer.size()), token_);
+  if (header.rfind(bearer, 0) == 0)
+    return same_dashboard_token(header.substr(bearer.size()), token_);
   return req.has_param("token") && same_dashboard_token(req.get_param_value("token"), token_);
 }
 
@@ -116,15 +197,24 @@ void DashboardCore::control(const std::string& path,
 }
 
 void DashboardCore::refuse(const std::string& path, const std::string& why) {
-  server_.Post(path, [why](const httplib::Request&, httplib::Response& res) {
-    error(res, 409, why);
-  });
+  server_.Post(path,
+               [why](const httplib::Request&, httplib::Response& res) { error(res, 409, why); });
 }
 
 void DashboardCore::routes() {
   // No compression: on loopback it only costs CPU (brotli at its slowest
   // setting takes seconds for three.js), and the machine runs the loop.
-  server_.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
+  server_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    // A page whose name was rebound to this machine's address reaches the
+    // server with its own name as Host: refused before anything is served.
+    const std::string host = req.get_header_value("Host");
+    if (!dashboard_host_allowed(host, listen_.host, port_, listen_.remote)) {
+      error(res, 403,
+            fmt::format("Host \"{:.80}\" is not this dashboard's address (an IP address, "
+                        "localhost{} with port {})",
+                        host, listen_.remote ? ", this machine's name" : "", port_));
+      return httplib::Server::HandlerResponse::Handled;
+    }
     // The request object itself is not const; httplib passes it so.
     const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
     return httplib::Server::HandlerResponse::Unhandled;
@@ -138,6 +228,11 @@ void DashboardCore::routes() {
     auto seen = std::make_shared<std::uint64_t>(0);
     {
       std::lock_guard lock(mutex_);
+      if (streams_ >= kMaxStreams) {
+        return error(
+            res, 503,
+            fmt::format("too many open streams ({}); close one or read /api/state", kMaxStreams));
+      }
       ++streams_;
     }
     res.set_chunked_content_provider(

@@ -23,6 +23,8 @@
 #include <string>
 #include <thread>
 
+#include "dashboard_http_server.hpp"
+
 namespace animrt {
 
 // A number for the page; NaN and infinity (no value) become null.
@@ -40,6 +42,10 @@ struct DashboardListen {
 
 class DashboardCore {
  public:
+  // Open /api/stream clients beyond this are refused with 503 (a browser tab
+  // holds one; /api/state answers everyone).
+  static constexpr int kMaxStreams = 50;
+
   // Throws std::invalid_argument for a host that is not loopback without
   // `remote` (the message names --dashboard-remote).
   explicit DashboardCore(DashboardListen listen);
@@ -95,7 +101,7 @@ class DashboardCore {
   DashboardListen listen_;
   std::string token_;
   int port_ = 0;
-  httplib::Server server_;
+  DashboardHttpServer server_;
   std::thread listener_;
   std::function<std::string(const std::string&)> state_from_;
 

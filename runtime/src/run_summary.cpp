@@ -49,6 +49,7 @@ std::string format_summary(const RunSummary& s) {
                       : "scheduling: " + s.sched_note);
     line(s.memory_locked ? "memory: locked" : "memory: " + s.mlock_note);
     for (const auto& note : s.io_thread_notes) line("I/O thread: " + note);
+    for (const auto& note : s.device_thread_notes) line("simulated devices: " + note);
   }
   for (const auto& bus : s.buses) {
     line(fmt::format("bus {}: cycle time (read + write) p50 {}, p99 {}, max {}; late cycles {}",
@@ -126,7 +127,8 @@ nlohmann::json to_json(const RunSummary& s) {
                    {"sched_note", s.sched_note},
                    {"memory_locked", s.memory_locked},
                    {"mlock_note", s.mlock_note},
-                   {"io_thread_notes", s.io_thread_notes}};
+                   {"io_thread_notes", s.io_thread_notes},
+                   {"device_thread_notes", s.device_thread_notes}};
   j["buses"] = nlohmann::json::array();
   for (const auto& bus : s.buses)
     j["buses"].push_back(

@@ -165,6 +165,32 @@ RunSummary Runner::run(const RunOptions& options) {
   summary.lockstep = options.lockstep_clock != nullptr;
   summary.rate_hz = m.config.rate_hz;
 
+  // Real time from configure on: under load its transactions miss their
+  // timeouts as the cycle's would. The simulated devices' threads just below
+  // the bus I/O threads, since every transaction waits on their answers.
+  const bool realtime = options.request_realtime && options.lockstep_clock == nullptr;
+  if (realtime) {
+    RealtimeStatus rt = request_realtime(options.realtime_priority);
+    summary.sched_fifo = rt.sched_fifo;
+    summary.sched_priority = rt.priority;
+    summary.sched_note = rt.sched_note;
+    summary.memory_locked = rt.memory_locked;
+    summary.mlock_note = rt.mlock_note;
+  } else {
+    summary.sched_note = options.lockstep_clock ? "lockstep: not requested" : "not requested";
+    summary.mlock_note = summary.sched_note;
+  }
+  struct RealtimeRelease {
+    bool on;
+    ~RealtimeRelease() {
+      if (on) release_realtime();
+    }
+  } realtime_release{realtime};
+  if (realtime && options.raise_device_threads) {
+    summary.device_thread_notes =
+        options.raise_device_threads(std::max(1, options.realtime_priority - 2));
+  }
+
   // --- configure -----------------------------------------------------------
   std::vector<std::vector<double>> bus_positions;
   for (auto& bus : m.buses) {
@@ -214,25 +240,6 @@ RunSummary Runner::run(const RunOptions& options) {
   for (std::size_t b = 0; b < bus_count; ++b) {
     health[b].assign(m.buses[b]->devices().size(), DeviceHealth::ok);
   }
-
-  const bool realtime = options.request_realtime && options.lockstep_clock == nullptr;
-  if (realtime) {
-    RealtimeStatus rt = request_realtime(options.realtime_priority);
-    summary.sched_fifo = rt.sched_fifo;
-    summary.sched_priority = rt.priority;
-    summary.sched_note = rt.sched_note;
-    summary.memory_locked = rt.memory_locked;
-    summary.mlock_note = rt.mlock_note;
-  } else {
-    summary.sched_note = options.lockstep_clock ? "lockstep: not requested" : "not requested";
-    summary.mlock_note = summary.sched_note;
-  }
-  struct RealtimeRelease {
-    bool on;
-    ~RealtimeRelease() {
-      if (on) release_realtime();
-    }
-  } realtime_release{realtime};
 
   // Declared before the I/O threads, so that on any exit the threads stop
   // first and the buses are switched off after them.

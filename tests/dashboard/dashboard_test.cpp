@@ -399,7 +399,9 @@ TEST(Dashboard, AStreamClientThatNeverReadsDoesNotHoldUpTheLoop) {
   addr.sin_port = htons(static_cast<std::uint16_t>(run.server_->port()));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  const std::string request = "GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  const std::string request =
+      "GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(run.server_->port()) +
+      "\r\n\r\n";
   ASSERT_EQ(::send(fd, request.data(), request.size(), 0), static_cast<ssize_t>(request.size()));
   // Others are served meanwhile, with fresh states.
   const double t0 = run.get("/api/state")["t_s"].get<double>();
@@ -467,6 +469,11 @@ TEST(Dashboard, OnlyLoopbackUnlessRemoteIsAllowed) {
   EXPECT_TRUE(is_loopback_host("::1"));
   EXPECT_FALSE(is_loopback_host("0.0.0.0"));
   EXPECT_FALSE(is_loopback_host("192.168.1.5"));
+  EXPECT_TRUE(is_loopback_host("127.0.0.5"));
+  // A DNS name is not loopback, whatever it resolves to today.
+  EXPECT_FALSE(is_loopback_host("127.0.0.1.nip.io"));
+  EXPECT_FALSE(is_loopback_host("127.evil.example"));
+  EXPECT_FALSE(is_loopback_host("::ffff:10.0.0.1"));
   test::SimRig rig(kQuadruped);
   RunMonitor monitor(rig.runner().model());
   RunControls controls;
@@ -478,6 +485,44 @@ TEST(Dashboard, OnlyLoopbackUnlessRemoteIsAllowed) {
   EXPECT_THROW(parse_host_port("127.0.0.1"), std::invalid_argument);
   EXPECT_THROW(parse_host_port("127.0.0.1:70000"), std::invalid_argument);
   EXPECT_THROW(parse_host_port("127.0.0.1:x"), std::invalid_argument);
+}
+
+// A page whose DNS name was rebound to 127.0.0.1 sends its own name as Host.
+TEST(Dashboard, AnotherHostNameIsRefusedAsARebinding) {
+  DashboardRun run(0.0);
+  const std::string port = std::to_string(run.server_->port());
+  auto c = run.client();
+  for (const std::string& host :
+       std::vector<std::string>{"127.0.0.1:" + port, "localhost:" + port, "[::1]:" + port}) {
+    auto res = c.Get("/api/state", {{"Host", host}});
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 200) << host;
+  }
+  for (const std::string& host :
+       std::vector<std::string>{"attacker.example:" + port, "127.0.0.1.nip.io:" + port,
+                                "127.0.0.1:1" + port, "127.0.0.1"}) {
+    for (const char* path : {"/api/state", "/api/info", "/"}) {
+      auto res = c.Get(path, {{"Host", host}});
+      ASSERT_TRUE(res);
+      EXPECT_EQ(res->status, 403) << host << path;
+    }
+    auto res =
+        c.Post("/api/stop", {{"Host", host}, {"Authorization", "Bearer " + run.server_->token()}},
+               "{}", "application/json");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 403) << host;
+  }
+  EXPECT_FALSE(run.controls_.stop.load());
+}
+
+TEST(Dashboard, HostRuleWithRemote) {
+  EXPECT_TRUE(dashboard_host_allowed("192.168.1.5:8080", "0.0.0.0", 8080, true));
+  EXPECT_TRUE(dashboard_host_allowed("[fe80::1]:8080", "0.0.0.0", 8080, true));
+  EXPECT_TRUE(dashboard_host_allowed("Robot.Example:8080", "robot.example", 8080, true));
+  EXPECT_FALSE(dashboard_host_allowed("attacker.example:8080", "0.0.0.0", 8080, true));
+  EXPECT_FALSE(dashboard_host_allowed("192.168.1.5:8081", "0.0.0.0", 8080, true));
+  EXPECT_TRUE(dashboard_host_allowed("192.168.1.5", "0.0.0.0", 80, true));
+  EXPECT_FALSE(dashboard_host_allowed("", "127.0.0.1", 8080, false));
 }
 
 }  // namespace

@@ -6,8 +6,26 @@ import * as THREE from '/lib/three.module.js';
 
 const GHOST = { color: 0x7fc8ff, opacity: 0.28 };
 
-function webglContext(canvas) {
-  const opts = { antialias: true, alpha: false };
+// Software GL (SwiftShader, llvmpipe) draws on the CPUs that run the loop
+// and the simulated devices; multisampling there costs several times the
+// frame itself (with it, a page open on a 2-core machine made the simulated
+// servos miss their watchdog), so it is off.
+function softwareGL() {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl');
+    if (!gl) return false;
+    const debug = gl.getExtension('WEBGL_debug_renderer_info');
+    const name = String(gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    const lose = gl.getExtension('WEBGL_lose_context');
+    if (lose) lose.loseContext();
+    return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+  } catch {
+    return false;
+  }
+}
+
+function webglContext(canvas, antialias) {
+  const opts = { antialias, alpha: false };
   try {
     return canvas.getContext('webgl', opts) || canvas.getContext('experimental-webgl', opts);
   } catch {
@@ -175,15 +193,17 @@ export class FigureView {
     this.note = note;
     this.ok = false;
     const canvas = document.createElement('canvas');
-    const gl = webglContext(canvas);
+    const software = softwareGL();
+    const gl = webglContext(canvas, !software);
     if (!gl) {
       container.dataset.webgl = '0';
       this.showNote('3-D view unavailable: this browser gives no WebGL context.');
       return;
     }
     container.prepend(canvas);
-    this.renderer = new THREE.WebGLRenderer({ canvas, context: gl, antialias: true });
-    this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+    this.renderer = new THREE.WebGLRenderer({ canvas, context: gl, antialias: !software });
+    this.renderer.setPixelRatio(software ? 1 : window.devicePixelRatio || 1);
+    container.dataset.gl = software ? 'software' : 'hardware';
     this.renderer.setClearColor(0x0d1014);
 
     this.scene = new THREE.Scene();
@@ -225,8 +245,14 @@ export class FigureView {
     this.requestRender();
   }
 
+  // Draws only a pose that differs from the one on screen, so the view is
+  // drawn at most once per streamed state and not at all while the figure
+  // stands still (with software GL each drawing costs the run's machine CPU).
   update(bodies) {
     if (!this.ok || !this.measured || !bodies) return;
+    const pose = JSON.stringify([bodies.measured, bodies.commanded]);
+    if (pose === this.shownPose) return;
+    this.shownPose = pose;
     applyPoses(this.measured, bodies.measured);
     applyPoses(this.commanded, bodies.commanded);
     // A digest of the measured pose, for tests: it changes as the figure moves.

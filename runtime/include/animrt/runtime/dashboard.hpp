@@ -49,8 +49,17 @@ struct DashboardSetup {
 std::string new_dashboard_token();
 bool same_dashboard_token(const std::string& given, const std::string& token);
 
-// Whether `host` names the loopback interface (127.0.0.0/8, ::1, localhost).
+// Whether `host` names the loopback interface: an IP address in 127.0.0.0/8
+// or ::1, or localhost when every address it resolves to is one. A DNS name
+// is not, whatever it resolves to today (127.0.0.1.nip.io is not).
 bool is_loopback_host(const std::string& host);
+
+// Whether a request's Host header names the dashboard served at
+// served_host:served_port: an IP address, localhost or the served name, with
+// the served port; with `remote`, also this machine's name (and NAME.local).
+// Any other name is a page whose DNS name was rebound to this machine.
+bool dashboard_host_allowed(const std::string& host_header, const std::string& served_host,
+                            int served_port, bool remote);
 
 // Splits "HOST:PORT" ("[::1]:8080" for IPv6). Throws std::invalid_argument
 // with a message saying what was expected.

@@ -82,6 +82,8 @@ struct RunSummary {
   bool memory_locked = false;
   std::string mlock_note;
   std::vector<std::string> io_thread_notes;  // per bus I/O thread not at SCHED_FIFO: why
+  // Per simulated devices' thread not at SCHED_FIFO (below the I/O threads): why.
+  std::vector<std::string> device_thread_notes;
   std::string telemetry_file;
   std::uint64_t telemetry_records = 0;
   std::uint64_t telemetry_dropped = 0;

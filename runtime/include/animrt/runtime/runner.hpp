@@ -50,6 +50,11 @@ struct RunOptions {
   // Readers of the run (a dashboard): the cycle publishes its state, timing
   // and events here, lock-free. Built on this runner's model().
   RunMonitor* monitor = nullptr;
+  // Threads outside the runner that its buses wait on (simulated devices'):
+  // in a real-time run, called before configure with the priority just below
+  // the bus I/O threads'; returns why, for each thread that could not have it
+  // (the summary's notes).
+  std::function<std::vector<std::string>(int priority)> raise_device_threads;
 };
 
 class Runner {

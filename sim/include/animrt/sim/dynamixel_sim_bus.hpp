@@ -40,6 +40,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/dynamixel_firmware.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
@@ -69,6 +70,7 @@ class DynamixelSimBus final : public SimulatedBus {
   std::string describe() const override;
   void start() override;
   void stop() override;
+  std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   // These take the id from the BusConfig; they throw std::out_of_range for
   // an id that is not on this bus.
   void set_device_responding(int device_id, bool responding) override;

@@ -4,6 +4,7 @@
 // through exactly the code that drives hardware.
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
@@ -16,6 +17,13 @@ namespace animrt {
 // their motor state from it (see make_simulated_bus).
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(
     std::vector<BusConfig>& buses, const Clock& clock, sim::JointPhysics* physics = nullptr);
+
+// Puts every simulated bus's thread at SCHED_FIFO `priority` (a real-time
+// run gives them the one just below its bus I/O threads: a busy host must
+// not make a simulated servo miss its watchdog). One line per bus that could
+// not have it, saying why.
+std::vector<std::string> raise_simulated_devices(
+    const std::vector<std::unique_ptr<SimulatedBus>>& simulated, int priority);
 
 // Simulated devices answer in no simulated time, so in a lockstep run a bus
 // timeout measures only how busy the host is: every bus's timeout is raised

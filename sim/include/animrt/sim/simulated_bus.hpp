@@ -23,6 +23,10 @@ class SimulatedBus {
   // Serve on a background thread until stop() or destruction.
   virtual void start() = 0;
   virtual void stop() = 0;
+  // Puts the serving thread (after start()) at SCHED_FIFO `priority`, so
+  // that a busy host does not make the devices miss their own deadlines;
+  // "" when done, otherwise why not.
+  virtual std::string raise_priority(int priority) = 0;
   // Fault injection: a device that is not responding ignores every packet.
   virtual void set_device_responding(int device_id, bool responding) = 0;
   // Fault injection: a device with hardware error bits set reports them in its

@@ -21,6 +21,7 @@
 #include "animrt/bridge/can/can_transport.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/can/can_node.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
@@ -44,6 +45,7 @@ class CanSimBus final : public SimulatedBus {
   std::string describe() const override;
   void start() override;
   void stop() override;
+  std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   void set_device_responding(int device_id, bool responding) override;
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   double device_position(int device_id) const override;

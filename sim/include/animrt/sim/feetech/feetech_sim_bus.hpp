@@ -24,6 +24,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/feetech/feetech_board.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
 #include "animrt/sim/simulated_bus.hpp"
@@ -50,6 +51,7 @@ class FeetechSimBus final : public SimulatedBus {
   std::string describe() const override;
   void start() override;
   void stop() override;
+  std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   // By the id of the BusConfig; std::out_of_range for an id not on the bus.
   void set_device_responding(int device_id, bool responding) override;
   // Sets the servo's fault bits (ft::error_bit): they appear in the error

@@ -19,6 +19,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/maestro/maestro_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/maestro/maestro_board.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
 #include "animrt/sim/simulated_bus.hpp"
@@ -39,6 +40,7 @@ class MaestroSimBus final : public SimulatedBus {
   std::string describe() const override;
   void start() override;
   void stop() override;
+  std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   // By the device ids of the BusConfig (channel, or 100 * device + channel);
   // these act on the whole board of that channel.
   void set_device_responding(int device_id, bool responding) override;

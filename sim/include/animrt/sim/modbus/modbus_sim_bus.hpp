@@ -29,6 +29,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 struct _modbus;
@@ -58,6 +59,7 @@ class ModbusSimBus final : public SimulatedBus {
   std::string describe() const override;
   void start() override;
   void stop() override;
+  std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   // device_id = slave id. A drive that is not responding ignores requests.
   void set_device_responding(int device_id, bool responding) override;
   // Sets bits in the drive's status register (and disables its motors).
