@@ -37,6 +37,28 @@ else
   fail serial_quadruped "no 8250 driver behind /dev/ttyS1"
 fi
 
+# -- serial: kill -9 of a run; the host-side servos' Bus Watchdog stops them ---
+# The guest only kills the run here; the host reads the servos after the guest
+# has powered off (tests/hil/run, serial_kill9_servos_stopped).
+if [ -e /sys/class/tty/ttyS1/device/driver ]; then
+  animrt run /configs/robots/quadruped_ttyS1.yaml --backend hardware --no-realtime \
+    > /tmp/serial_kill_run.txt 2>&1 &
+  krun=$!
+  i=0
+  while [ $i -lt 200 ] && ! grep -q 'activate: torque on' /tmp/serial_kill_run.txt; do
+    sleep 0.1; i=$((i + 1))
+  done
+  if grep -q 'activate: torque on' /tmp/serial_kill_run.txt && kill -0 $krun 2>/dev/null; then
+    sleep 1.5
+    kill -9 $krun
+    wait $krun 2>/dev/null
+    pass serial_kill9_sent
+  else
+    kill -9 $krun 2>/dev/null; wait $krun 2>/dev/null
+    fail serial_kill9_sent "animrt run did not reach its motion: $(head -c 300 /tmp/serial_kill_run.txt)"
+  fi
+fi
+
 # -- Modbus RTU: libmodbus on the second 8250 UART, host-side simulated drive ---
 # (tests/hil/run checks in the summary that the drive tracked.)
 if [ -e /sys/class/tty/ttyS2/device/driver ]; then
