@@ -28,7 +28,8 @@ start_sim() {
   # The robot file on the pty, its files absolute, short ramps (a quick
   # test) and slack for a busy machine (only what the test does may stop
   # the figure, never a late answer).
-  local here="$root/configs/robots"
+  local here
+  here=$(cd "$root/configs/robots" && pwd)
   robot="$tmp/quadruped_on_pty.yaml"
   sed -E -e "s|^(\s*port:\s*)\S+|\1$pty|" \
     -e "s#^(\s*(file|model):\s*)\.\./#\1$here/../#" \
