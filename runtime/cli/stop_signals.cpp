@@ -18,6 +18,7 @@ constexpr StopSignal kStopSignals[] = {
 };
 
 RunControls* g_controls = nullptr;
+SecondSignal g_second = SecondSignal::cut_torque;
 // Counted on their own: a stop that came another way (the dashboard, the end
 // of --duration) is not the first signal, so one signal during its ramp does
 // not drop the figure.
@@ -45,7 +46,18 @@ void on_stop_signal(int sig) {
     errno = saved;
     return;
   }
-  if (counts(sig) && g_counted.fetch_add(1) > 0) g_controls->abort.store(true);
+  if (counts(sig) && g_counted.fetch_add(1) > 0) {
+    if (g_second == SecondSignal::end_process) {
+      // The default action, delivered when this handler returns (the signal
+      // is held while it runs).
+      struct sigaction dfl {};
+      dfl.sa_handler = SIG_DFL;
+      sigemptyset(&dfl.sa_mask);
+      sigaction(sig, &dfl, nullptr);
+      raise(sig);
+    }
+    g_controls->abort.store(true);
+  }
   g_controls->stop.store(true);
   errno = saved;
 }
@@ -54,8 +66,9 @@ void on_stop_signal(int sig) {
 
 std::span<const StopSignal> stop_signals() { return kStopSignals; }
 
-void install_stop_signals(RunControls& controls) {
+void install_stop_signals(RunControls& controls, SecondSignal second) {
   g_controls = &controls;
+  g_second = second;
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);

@@ -22,9 +22,15 @@ struct StopSignal {
 
 std::span<const StopSignal> stop_signals();
 
+// What a second counted signal does: cut torque (a run: controls.abort), or
+// end the process at once by that signal's default action (a command that
+// holds no torque and ends its work at a stop: a herd or a search with a
+// dashboard, which write their files first).
+enum class SecondSignal { cut_torque, end_process };
+
 // Installs the handlers; they write to `controls` (which must outlive the
 // process's use of them). Lock-free atomics only.
-void install_stop_signals(RunControls& controls);
+void install_stop_signals(RunControls& controls, SecondSignal second = SecondSignal::cut_torque);
 
 // For commands that take the signals with sigwait (the view): every stop
 // signal that counts, in one set.

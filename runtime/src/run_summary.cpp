@@ -98,10 +98,10 @@ std::string format_summary(const RunSummary& s) {
     }
   }
   if (!s.telemetry_file.empty() && (s.telemetry_lost > 0 || !s.telemetry_error.empty())) {
-    line(fmt::format("RECORD LOST telemetry: {} of {} records could not be written to {}: {} "
-                     "({} written, {} dropped)",
+    line(fmt::format("RECORD LOST telemetry: {} of {} records could not be written to {}: {}",
                      s.telemetry_lost, s.telemetry_records + s.telemetry_lost, s.telemetry_file,
-                     s.telemetry_error, s.telemetry_records, s.telemetry_dropped));
+                     s.telemetry_error) +
+         fmt::format(" ({} written, {} dropped)", s.telemetry_records, s.telemetry_dropped));
   } else if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
                      s.telemetry_file, s.telemetry_dropped));

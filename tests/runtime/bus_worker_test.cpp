@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <sched.h>
-
 #include <unistd.h>
 
 #include <atomic>
