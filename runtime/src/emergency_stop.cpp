@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <iterator>
 
 #include "emergency_slots.hpp"
 #include "futex.hpp"
@@ -88,17 +89,20 @@ const char* signal_name(int sig) {
 }
 
 constexpr int kFatalSignals[] = {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL};
+// What each fatal signal did before (the default action, or a sanitizer's
+// report), put back once the buses are off.
+struct sigaction g_previous[std::size(kFatalSignals)];
 
 void on_fatal_signal(int sig) {
   const int saved = errno;
   torque_off_and_report(signal_name(sig));
-  // The default action again, then the signal once more: the process ends
-  // with the status and core dump it would have had. (A fault returns to
-  // the faulting instruction and raises it again; raise() covers the rest.)
-  struct sigaction dfl {};
-  dfl.sa_handler = SIG_DFL;
-  sigemptyset(&dfl.sa_mask);
-  sigaction(sig, &dfl, nullptr);
+  // The previous action again, then the signal once more: the process ends
+  // with the status, core dump or report it would have had. (A fault
+  // returns to the faulting instruction and raises it again; raise()
+  // covers a signal that was sent.)
+  for (std::size_t i = 0; i < std::size(kFatalSignals); ++i) {
+    if (kFatalSignals[i] == sig) sigaction(sig, &g_previous[i], nullptr);
+  }
   errno = saved;
   raise(sig);
 }
@@ -180,7 +184,9 @@ void install_fatal_error_handlers() {
   action.sa_handler = on_fatal_signal;
   action.sa_flags = SA_ONSTACK;
   sigemptyset(&action.sa_mask);
-  for (const int sig : kFatalSignals) sigaction(sig, &action, nullptr);
+  for (std::size_t i = 0; i < std::size(kFatalSignals); ++i) {
+    sigaction(kFatalSignals[i], &action, &g_previous[i]);
+  }
   g_previous_terminate = std::set_terminate(on_terminate);
 }
 
