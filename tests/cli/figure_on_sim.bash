@@ -45,7 +45,7 @@ start_sim() {
 start_figure() {
   "$animrt" run "$robot" --backend hardware --no-realtime "$@" > "$tmp/out.txt" 2> "$tmp/err.txt" &
   pid=$!
-  for _ in $(seq 100); do
+  for _ in $(seq 200); do
     grep -q "activate: torque on" "$tmp/err.txt" && return 0
     kill -0 $pid 2> /dev/null || break
     sleep 0.05

@@ -40,7 +40,7 @@ cat "$tmp/err.fifo" > "$tmp/err.txt" &
 cat_pid=$!
 "$animrt" run "$robot" --backend hardware --no-realtime > "$tmp/out.txt" 2> "$tmp/err.fifo" &
 pid=$!
-for _ in $(seq 100); do
+for _ in $(seq 200); do
   grep -q "activate: torque on" "$tmp/err.txt" && break
   sleep 0.05
 done
