@@ -21,6 +21,7 @@
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "dashboard_address.hpp"
 #include "evolve_pareto.hpp"
+#include "stop_signals.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -47,6 +48,8 @@ struct EvolveArgs {
 std::string with_extension(const std::string& path, const std::string& ext) {
   return std::filesystem::path(path).replace_extension(ext).string();
 }
+
+RunControls evolve_signal_controls;  // a search takes only its stop
 
 int run_evolve(const EvolveArgs& a) {
   if (a.pareto && !a.dashboard.empty()) {
@@ -143,19 +146,24 @@ int run_evolve(const EvolveArgs& a) {
       std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
     if (dashboard) dashboard->publish(s, best);
   };
-  // A stop from the dashboard ends the search after the generation it
-  // arrived in; under MPI rank 0's answer is every rank's.
+  // A stop from the dashboard (or a stop signal, while it serves: a second
+  // one ends the process at once) ends the search after the generation it
+  // arrived in, files written; under MPI rank 0's answer is every rank's.
   if (dashboard_at) {
+    install_stop_signals(evolve_signal_controls, SecondSignal::end_process);
     hooks.stop = [&] {
-      const bool stop = dashboard && dashboard->stop_requested();
+      const bool stop =
+          (dashboard && dashboard->stop_requested()) || evolve_signal_controls.stop.load();
       return session ? session->broadcast(stop) : stop;
     };
   }
   const evolve::SearchResult result = search.run(hooks);
   if (!lead) return 0;
   if (result.stopped) {
-    std::cout << "stopped from the dashboard after generation " << result.history.back().generation
-              << " of " << generations << '\n';
+    std::cout << (evolve_signal_controls.stop.load() ? "stopped by a signal"
+                                                     : "stopped from the dashboard")
+              << " after generation " << result.history.back().generation << " of " << generations
+              << '\n';
   }
 
   const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;

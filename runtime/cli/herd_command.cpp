@@ -18,6 +18,7 @@
 #include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
+#include "stop_signals.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -76,6 +77,8 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
   return j;
 }
 
+RunControls herd_signal_controls;  // a herd takes only its stop
+
 int run_herd(const HerdArgs& a) {
   herd::HerdScene scene = herd::load_herd_scene(a.scene);
   if (a.duration) scene.duration_s = *a.duration;
@@ -96,6 +99,9 @@ int run_herd(const HerdArgs& a) {
     setup.speed = a.dashboard_speed;
     dashboard = std::make_unique<HerdDashboardServer>(herd, setup);
     std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+    // Served, it may be left running: a stop signal ends it as the page's
+    // Stop does, files written (a second one ends it at once).
+    install_stop_signals(herd_signal_controls, SecondSignal::end_process);
   }
   if (!a.quiet) {
     std::cout << "herd " << (s.name.empty() ? s.file : s.name) << ": " << herd.agents().size()
@@ -124,7 +130,7 @@ int run_herd(const HerdArgs& a) {
   auto last_publish = start;
   for (long k = 1; k <= steps; ++k) {
     if (dashboard) {
-      if (dashboard->stop_requested()) break;
+      if (dashboard->stop_requested() || herd_signal_controls.stop.load()) break;
       const auto due =
           start +
           std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -154,11 +160,15 @@ int run_herd(const HerdArgs& a) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const herd::HerdMetrics metrics = herd.metrics();
   std::cout << herd::format_metrics(metrics);
-  // A stop from the dashboard ends the herd early.
+  // A stop from the dashboard (or a stop signal) ends the herd early.
   const bool stopped = dashboard && dashboard->stop_requested();
-  const double ran_s = stopped ? herd.time() : s.duration_s;
+  const bool signalled = dashboard && herd_signal_controls.stop.load();
+  const double ran_s = stopped || signalled ? herd.time() : s.duration_s;
   std::cout << "ran " << ran_s << " s in " << wall_s << " s (" << ran_s / wall_s << " x real time)"
-            << (stopped ? ", stopped from the dashboard" : "") << '\n';
+            << (stopped     ? ", stopped from the dashboard"
+                : signalled ? ", stopped by a signal"
+                            : "")
+            << '\n';
   if (csv.is_open()) {
     csv.close();
     if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");

@@ -1,6 +1,7 @@
 // animrt: validate a robot, run it on hardware or on simulated devices, or
 // serve simulated devices for another program.
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -9,11 +10,12 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -21,6 +23,7 @@
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/emergency_stop.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/runner.hpp"
@@ -30,12 +33,14 @@
 #include "animrt/sim/simulated_backend.hpp"
 #include "dashboard_address.hpp"
 #include "evolve_command.hpp"
+#include "fault_injection.hpp"
 #include "gait_command.hpp"
 #include "head_command.hpp"
 #include "herd_command.hpp"
 #include "herd_driver.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "view_command.hpp"
 
@@ -47,27 +52,6 @@ using animrt::cli::kExitOk;
 using animrt::cli::kExitUsage;
 
 animrt::RunControls g_controls;
-
-// The first SIGINT or SIGTERM ramps home; a second one switches torque off at
-// once. The signals are counted on their own: a stop that came another way
-// (the dashboard, the herd thread) is not the first Ctrl-C, so one Ctrl-C
-// during its ramp does not drop the figure. Lock-free atomics only, safe in
-// a signal handler.
-std::atomic<int> g_stop_signals{0};
-static_assert(std::atomic<int>::is_always_lock_free);
-
-void on_signal(int) {
-  if (g_stop_signals.fetch_add(1) > 0) g_controls.abort.store(true);
-  g_controls.stop.store(true);
-}
-
-void install_signal_handlers() {
-  struct sigaction action {};
-  action.sa_handler = on_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-}
 
 // The robot file's figure model, loaded (so a model that does not load is an
 // error of the robot file), or null when it names none.
@@ -114,6 +98,41 @@ CLI::Validator duration_validator() {
       },
       "SECONDS");
 }
+
+// --summary-json's file: opened before anything moves (a summary that
+// cannot be written is found then), written once at the end, every failure
+// (a full disk, /dev/full, a close that fails) kept with its errno.
+struct SummaryFile {
+  int fd = -1;
+  int error = 0;
+  ~SummaryFile() {
+    if (fd >= 0) ::close(fd);
+  }
+  bool is_open() const { return fd >= 0; }
+  bool open(const std::string& path) {
+    fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) error = errno;
+    return fd >= 0;
+  }
+  bool write(const std::string& text) {
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+      if (n > 0) {
+        done += static_cast<std::size_t>(n);
+      } else if (n < 0 && errno == EINTR) {
+        continue;
+      } else {
+        error = n < 0 ? errno : EIO;
+        return false;
+      }
+    }
+    const int closed = ::close(fd);
+    fd = -1;
+    if (closed != 0) error = errno;
+    return closed == 0;
+  }
+};
 
 struct RunArgs {
   std::string config;
@@ -179,13 +198,11 @@ int cmd_run(const RunArgs& args) {
   }
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
-  std::ofstream summary_out;
-  if (!args.summary_json.empty()) {
-    summary_out.open(args.summary_json);
-    if (!summary_out) {
-      spdlog::error("--summary-json: cannot write {}", args.summary_json);
-      return kExitUsage;
-    }
+  SummaryFile summary_out;
+  if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
+    spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
+                  std::strerror(summary_out.error));
+    return kExitUsage;
   }
   if (args.lockstep && args.backend != "sim") {
     spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
@@ -275,6 +292,7 @@ int cmd_run(const RunArgs& args) {
     options.monitor = monitor.get();
     std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
   }
+  animrt::cli::start_fault_injection();
   animrt::RunSummary summary = runner.run(options);
   if (dashboard) dashboard->stop();
   if (herd) herd->stop();
@@ -294,10 +312,18 @@ int cmd_run(const RunArgs& args) {
     report.lockstep_waits_timed_out = m.lockstep_waits_timed_out;
     summary.physics = report;
   }
-  std::cout << animrt::format_summary(summary) << std::flush;
-  if (herd) std::cout << herd->report() << '\n' << std::flush;
-  if (summary_out.is_open()) summary_out << animrt::to_json(summary).dump(2) << '\n' << std::flush;
-  return summary.exit_code();
+  const bool summary_written =
+      !summary_out.is_open() || summary_out.write(animrt::to_json(summary).dump(2) + '\n');
+  std::cout << animrt::format_summary(summary);
+  if (herd) std::cout << herd->report() << '\n';
+  int code = summary.exit_code();
+  if (!summary_written) {
+    std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "
+              << std::strerror(summary_out.error) << '\n';
+    if (code == kExitOk) code = animrt::cli::kExitRecordLost;
+  }
+  std::cout << std::flush;
+  return code;
 }
 
 int cmd_sim(const std::string& path) {
@@ -318,6 +344,13 @@ int main(int argc, char** argv) {
   auto logger = spdlog::stderr_color_mt("animrt");
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("%^[%l]%$ %v");
+
+  // Before any command runs: a fatal error switches torque off first
+  // (emergency_stop.hpp), and a write to a pipe or socket whose reader left
+  // fails with EPIPE instead of killing the process (a dashboard whose
+  // browser closed; run and sim take SIGPIPE as a stop below).
+  animrt::install_fatal_error_handlers();
+  signal(SIGPIPE, SIG_IGN);
 
   CLI::App app{"animrt: real-time motion for animatronic figures"};
   app.require_subcommand(1);
@@ -385,7 +418,7 @@ int main(int argc, char** argv) {
     // error (CLI11's own exit codes, 100 and up, are not ours).
     return app.exit(e) == static_cast<int>(CLI::ExitCodes::Success) ? kExitOk : kExitUsage;
   }
-  install_signal_handlers();
+  animrt::cli::install_stop_signals(g_controls);
   try {
     if (*validate) return cmd_validate(validate_path);
     if (*run) return cmd_run(run_args);

@@ -14,6 +14,10 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitUsage = 1;
 inline constexpr int kExitInvalidInput = 2;
 inline constexpr int kExitDeviceError = 3;
+// 4 (a fault ended the run) and 5 (torque cut) come from RunSummary::exit_code().
+// The figure's run was clean, but its record is not: telemetry records or
+// the summary JSON could not be written (RunSummary::exit_code() too).
+inline constexpr int kExitRecordLost = 6;
 
 void set_subcommand_body(CLI::App* cmd, std::function<int()> body);
 

@@ -10,6 +10,7 @@
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/telemetry_replay.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
+#include "stop_signals.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -43,12 +44,12 @@ int run_view(const ViewArgs& args) {
   }
   const RobotModel model = replay_model(recording, robot.get());
 
-  // Ctrl-C ends the viewer: the signals are taken by sigwait below, so every
-  // thread started from here on leaves them blocked.
+  // Ctrl-C (or any other stop signal: stop_signals.hpp) ends the viewer:
+  // the signals are taken by sigwait below, so every thread started from
+  // here on leaves them blocked.
   sigset_t signals;
   sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
+  add_counting_stop_signals(signals);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   RunMonitor monitor(model);

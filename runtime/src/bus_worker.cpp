@@ -37,6 +37,8 @@ bool BusWorker::start(int realtime_priority) {
   if (running_) return realtime_ || realtime_priority <= 0;
   stop_ = false;
   realtime_ = false;
+  emergency_ = claim_emergency_slot();
+  wake_ = emergency_ != nullptr ? &emergency_->wake : &own_wake_;
   priority_note_.clear();
   int rc = -1;
   if (realtime_priority > 0) {
@@ -60,7 +62,12 @@ bool BusWorker::start(int realtime_priority) {
   }
   if (rc != 0) {
     rc = pthread_create(&thread_, nullptr, thread_main, this);
-    if (rc != 0) throw std::system_error(rc, std::generic_category(), "bus I/O thread");
+    if (rc != 0) {
+      release_emergency_slot(emergency_);
+      emergency_ = nullptr;
+      wake_ = &own_wake_;
+      throw std::system_error(rc, std::generic_category(), "bus I/O thread");
+    }
     if (priority_note_.empty()) priority_note_ = "default scheduling";
   }
   running_ = true;
@@ -70,22 +77,25 @@ bool BusWorker::start(int realtime_priority) {
 void BusWorker::stop() {
   if (!running_) return;
   stop_.store(true, std::memory_order_release);
-  wake_.fetch_add(1, std::memory_order_release);
-  futex_wake_all(wake_);
+  wake_->fetch_add(1, std::memory_order_release);
+  futex_wake_all(*wake_);
   pthread_join(thread_, nullptr);
+  release_emergency_slot(emergency_);
+  emergency_ = nullptr;
+  wake_ = &own_wake_;
   running_ = false;
 }
 
 void BusWorker::post_read() {
   read_req_.fetch_add(1, std::memory_order_release);
-  wake_.fetch_add(1, std::memory_order_release);
-  futex_wake_all(wake_);
+  wake_->fetch_add(1, std::memory_order_release);
+  futex_wake_all(*wake_);
 }
 
 void BusWorker::post_write() {
   write_req_.fetch_add(1, std::memory_order_release);
-  wake_.fetch_add(1, std::memory_order_release);
-  futex_wake_all(wake_);
+  wake_->fetch_add(1, std::memory_order_release);
+  futex_wake_all(*wake_);
 }
 
 void BusWorker::signal_done() {
@@ -109,10 +119,24 @@ void BusWorker::guarded(F&& io) {
   }
 }
 
+bool BusWorker::honour_emergency() {
+  if (emergency_ == nullptr || emergency_->request.load(std::memory_order_acquire) == 0) {
+    return false;
+  }
+  try {
+    bus_.deactivate();  // never throws; the guard is for a bus that breaks that
+  } catch (...) {
+  }
+  report_emergency_done(*emergency_);
+  return true;
+}
+
 void BusWorker::run() {
+  set_thread_emergency_slot(emergency_);
   const MonotonicClock wall;
   for (;;) {
-    const std::uint32_t seen = wake_.load(std::memory_order_acquire);
+    const std::uint32_t seen = wake_->load(std::memory_order_acquire);
+    if (honour_emergency()) return;
     if (stop_.load(std::memory_order_acquire)) return;
     bool worked = false;
     const std::uint32_t rr = read_req_.load(std::memory_order_acquire);
@@ -124,6 +148,7 @@ void BusWorker::run() {
       signal_done();
       worked = true;
     }
+    if (honour_emergency()) return;  // no goal after a read the request interrupted
     const std::uint32_t wr = write_req_.load(std::memory_order_acquire);
     if (wr != write_done_.load(std::memory_order_relaxed)) {
       const Nanos t0 = wall.now();
@@ -134,7 +159,7 @@ void BusWorker::run() {
       signal_done();
       worked = true;
     }
-    if (!worked) futex_wait_until(wake_, seen, -1);
+    if (!worked) futex_wait_until(*wake_, seen, -1);
   }
 }
 

@@ -19,6 +19,7 @@
 
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "emergency_slots.hpp"
 
 namespace animrt {
 
@@ -77,6 +78,9 @@ class BusWorker {
  private:
   void run();
   void signal_done();
+  // A fatal-error handler asked for torque off: switch the bus off and
+  // touch it no more. Returns whether it did.
+  bool honour_emergency();
   template <typename F>
   void guarded(F&& io);
 
@@ -84,7 +88,11 @@ class BusWorker {
   std::atomic<std::uint32_t>& done_;
   std::vector<double> positions_;
   std::vector<double> commands_;
-  std::atomic<std::uint32_t> wake_{0};
+  // The thread's wake word: in its emergency slot when it has one (so a
+  // fatal-error handler can wake it: emergency_stop.hpp), else own_wake_.
+  EmergencySlot* emergency_ = nullptr;
+  std::atomic<std::uint32_t> own_wake_{0};
+  std::atomic<std::uint32_t>* wake_ = &own_wake_;
   std::atomic<std::uint32_t> read_req_{0}, read_done_{0}, write_req_{0}, write_done_{0};
   std::atomic<bool> stop_{false};
   std::atomic<Nanos> io_ns_{0};

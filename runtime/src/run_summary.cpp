@@ -98,7 +98,12 @@ std::string format_summary(const RunSummary& s) {
                        p.lockstep_waits_timed_out));
     }
   }
-  if (!s.telemetry_file.empty()) {
+  if (!s.telemetry_file.empty() && (s.telemetry_lost > 0 || !s.telemetry_error.empty())) {
+    line(fmt::format("RECORD LOST telemetry: {} of {} records could not be written to {}: {}",
+                     s.telemetry_lost, s.telemetry_records + s.telemetry_lost, s.telemetry_file,
+                     s.telemetry_error) +
+         fmt::format(" ({} written, {} dropped)", s.telemetry_records, s.telemetry_dropped));
+  } else if (!s.telemetry_file.empty()) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
                      s.telemetry_file, s.telemetry_dropped));
   }
@@ -158,7 +163,9 @@ nlohmann::json to_json(const RunSummary& s) {
   }
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},
-                    {"dropped", s.telemetry_dropped}};
+                    {"dropped", s.telemetry_dropped},
+                    {"lost", s.telemetry_lost},
+                    {"error", s.telemetry_error}};
   if (s.physics) {
     const PhysicsReport& p = *s.physics;
     j["physics"] = {{"model", p.model},

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include "animrt/core/error.hpp"
@@ -474,6 +475,8 @@ RunSummary Runner::run(const RunOptions& options) {
     summary.telemetry_file = options.telemetry_path;
     summary.telemetry_records = writer->written();
     summary.telemetry_dropped = ring.dropped();
+    summary.telemetry_lost = writer->lost();
+    if (writer->error() != 0) summary.telemetry_error = std::strerror(writer->error());
   }
   return summary;
 }

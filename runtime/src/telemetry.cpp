@@ -1,10 +1,22 @@
 #include "animrt/runtime/telemetry.hpp"
 
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <iterator>
 #include <stdexcept>
 
 namespace animrt {
+namespace {
+
+// Text gathered before one write(2): a few hundred records.
+constexpr std::size_t kFlushBytes = 1 << 16;
+
+}  // namespace
 
 TelemetryRing::TelemetryRing(std::size_t width, std::size_t capacity)
     : width_(width), capacity_(capacity), slots_(width * capacity, 0.0) {}
@@ -32,13 +44,17 @@ bool TelemetryRing::pop(std::span<double> out) {
 
 TelemetryWriter::TelemetryWriter(const std::string& path, std::span<const std::string> joint_names,
                                  TelemetryRing& ring)
-    : out_(path), ring_(ring), record_(ring.width(), 0.0) {
-  if (!out_) throw std::runtime_error("cannot write telemetry file " + path);
-  out_ << "time_s";
-  for (const auto& name : joint_names) out_ << ',' << name << "_cmd_rad";
-  for (const auto& name : joint_names) out_ << ',' << name << "_meas_rad";
-  out_ << '\n';
-  out_.precision(9);
+    : ring_(ring), record_(ring.width(), 0.0) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0) {
+    throw std::runtime_error("cannot write telemetry file " + path + ": " + std::strerror(errno));
+  }
+  // The header goes out with the first records: a file that takes nothing
+  // is found by the same path as a disk that fills during the run.
+  pending_ = "time_s";
+  for (const auto& name : joint_names) pending_ += ',' + name + "_cmd_rad";
+  for (const auto& name : joint_names) pending_ += ',' + name + "_meas_rad";
+  pending_ += '\n';
   thread_ = std::thread([this] {
     while (!stop_.load(std::memory_order_acquire)) {
       drain();
@@ -48,25 +64,55 @@ TelemetryWriter::TelemetryWriter(const std::string& path, std::span<const std::s
   });
 }
 
-TelemetryWriter::~TelemetryWriter() { finish(); }
+TelemetryWriter::~TelemetryWriter() {
+  finish();
+  if (fd_ >= 0) ::close(fd_);
+}
 
 void TelemetryWriter::finish() {
   if (thread_.joinable()) {
     stop_.store(true, std::memory_order_release);
     thread_.join();
-    out_.flush();
   }
 }
 
 void TelemetryWriter::drain() {
   while (ring_.pop(record_)) {
     for (std::size_t i = 0; i < record_.size(); ++i) {
-      if (i) out_ << ',';
-      out_ << record_[i];
+      if (i) pending_ += ',';
+      fmt::format_to(std::back_inserter(pending_), "{:.9g}", record_[i]);
     }
-    out_ << '\n';
-    written_.fetch_add(1, std::memory_order_relaxed);
+    pending_ += '\n';
+    line_ends_.push_back(pending_.size());
+    if (pending_.size() >= kFlushBytes) flush_pending();
   }
+  flush_pending();
+}
+
+bool TelemetryWriter::flush_pending() {
+  std::size_t done = 0;
+  int failed = 0;
+  while (done < pending_.size()) {
+    const ssize_t n = ::write(fd_, pending_.data() + done, pending_.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    failed = n < 0 ? errno : EIO;
+    break;
+  }
+  std::uint64_t whole = 0;
+  while (whole < line_ends_.size() && line_ends_[whole] <= done) ++whole;
+  written_.fetch_add(whole, std::memory_order_relaxed);
+  lost_.fetch_add(line_ends_.size() - whole, std::memory_order_relaxed);
+  if (failed != 0) {
+    int none = 0;
+    error_.compare_exchange_strong(none, failed);
+  }
+  pending_.clear();
+  line_ends_.clear();
+  return failed == 0;
 }
 
 }  // namespace animrt

@@ -1,16 +1,19 @@
 // BusWorker: the I/O thread gets its scheduling at creation, and a refusal
-// is reported, never fatal.
+// is reported, never fatal. A fatal-error handler's request reaches every
+// running I/O thread, which switches its bus off and touches it no more.
 
 #include "../../runtime/src/bus_worker.hpp"
 
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <vector>
 
 #include "../../runtime/src/futex.hpp"
+#include "animrt/runtime/emergency_stop.hpp"
 
 namespace animrt {
 namespace {
@@ -69,6 +72,57 @@ TEST(BusWorker, NoPriorityAskedIsANormalThread) {
   one_read(worker, done);
   EXPECT_EQ(bus.policy_.load(), SCHED_OTHER);
   worker.stop();
+}
+
+// Counts what the I/O thread does with it.
+class CountingBus final : public ActuatorBus {
+ public:
+  const BusConfig& config() const override { return config_; }
+  void configure() override {}
+  void activate() override {}
+  void deactivate() override { ++deactivations; }
+  void read(std::span<double>) override { ++reads; }
+  void write(std::span<const double>) override {}
+  std::span<DeviceStatus> devices() override { return status_; }
+  std::atomic<int> deactivations{0};
+  std::atomic<int> reads{0};
+
+ private:
+  BusConfig config_;
+  std::vector<DeviceStatus> status_;
+};
+
+TEST(EmergencyTorqueOff, EveryRunningBusThreadSwitchesItsBusOffAndStops) {
+  CountingBus first, second;
+  std::atomic<std::uint32_t> done{0};
+  std::vector<double> initial(1, 0.0);
+  BusWorker a(first, initial, done), b(second, initial, done);
+  a.start(0);
+  b.start(0);
+  one_read(a, done);
+  const EmergencyResult r = emergency_torque_off(5'000'000'000);
+  EXPECT_EQ(r.buses, 2);
+  EXPECT_EQ(r.switched_off, 2);
+  EXPECT_EQ(first.deactivations.load(), 1);
+  EXPECT_EQ(second.deactivations.load(), 1);
+  // Asked again (a terminate handler's abort() comes back as SIGABRT): the
+  // buses are not switched off twice, and the threads touch them no more.
+  const EmergencyResult again = emergency_torque_off(5'000'000'000);
+  EXPECT_EQ(again.switched_off, 2);
+  a.post_read();
+  usleep(20'000);
+  EXPECT_EQ(first.reads.load(), 1);
+  EXPECT_EQ(first.deactivations.load(), 1);
+  a.stop();
+  b.stop();
+  // Stopped threads leave nothing to switch off, and free their slots clean.
+  EXPECT_EQ(emergency_torque_off(0).buses, 0);
+  CountingBus third;
+  BusWorker c(third, initial, done);
+  c.start(0);
+  one_read(c, done);
+  EXPECT_EQ(third.deactivations.load(), 0);
+  c.stop();
 }
 
 }  // namespace

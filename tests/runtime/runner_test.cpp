@@ -255,5 +255,24 @@ TEST(Runner, OnTheWallClockALateBusNeverReceivesAJump) {
   }
 }
 
+// A record that could not be written is exit 6 and its own summary line;
+// what happened to the figure (a fault, a torque cut) comes first.
+TEST(RunSummary, ALostRecordIsExitSixUnlessTheFigureFaredWorse) {
+  RunSummary s;
+  s.telemetry_file = "/dev/full";
+  s.telemetry_records = 0;
+  s.telemetry_lost = 42;
+  s.telemetry_error = "No space left on device";
+  EXPECT_EQ(s.exit_code(), 6);
+  EXPECT_NE(format_summary(s).find("RECORD LOST telemetry: 42 of 42 records could not be written "
+                                   "to /dev/full: No space left on device"),
+            std::string::npos)
+      << format_summary(s);
+  s.torque_cut = "second stop request";
+  EXPECT_EQ(s.exit_code(), 5);
+  s.end_reason = EndReason::fault;
+  EXPECT_EQ(s.exit_code(), 4);
+}
+
 }  // namespace
 }  // namespace animrt

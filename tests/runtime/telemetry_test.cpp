@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -71,6 +72,18 @@ TEST(TelemetryWriter, WritesAHeaderAndOneRowPerRecord) {
   EXPECT_EQ(row1, "0,1,2,3,4");
   EXPECT_EQ(row2, "0.005,1.5,2.5,3.5,4.5");
   std::remove(path.c_str());
+}
+
+TEST(TelemetryWriter, CountsRecordsThatCannotBeWrittenAndSaysWhy) {
+  TelemetryRing ring(3, 16);
+  std::vector<std::string> names{"a"};
+  TelemetryWriter writer("/dev/full", names, ring);
+  ring.push(std::vector<double>{0.0, 1.0, 2.0});
+  ring.push(std::vector<double>{0.005, 1.5, 2.5});
+  writer.finish();
+  EXPECT_EQ(writer.written(), 0u);
+  EXPECT_EQ(writer.lost(), 2u);
+  EXPECT_EQ(writer.error(), ENOSPC);
 }
 
 TEST(MicrosHistogram, Quantiles) {

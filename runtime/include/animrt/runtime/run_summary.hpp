@@ -87,13 +87,20 @@ struct RunSummary {
   std::string telemetry_file;
   std::uint64_t telemetry_records = 0;
   std::uint64_t telemetry_dropped = 0;
+  // Records that could not be written, and why (strerror of the first
+  // failed write; empty when none was lost).
+  std::uint64_t telemetry_lost = 0;
+  std::string telemetry_error;
   std::optional<PhysicsReport> physics;  // set by whoever ran the physics
 
   // 0 for a clean run, 4 when a fault ended it, 5 when torque had to be cut
-  // without the stop ramp (stop deadline, second stop request).
+  // without the stop ramp (stop deadline, second stop request), 6 when the
+  // figure's run was clean but its record is not (telemetry lost). What
+  // happened to the figure comes first.
   int exit_code() const {
     if (end_reason == EndReason::fault) return 4;
-    return torque_cut.empty() ? 0 : 5;
+    if (!torque_cut.empty()) return 5;
+    return telemetry_lost > 0 || !telemetry_error.empty() ? 6 : 0;
   }
 };
 

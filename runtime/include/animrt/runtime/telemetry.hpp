@@ -6,7 +6,6 @@
 
 #include <atomic>
 #include <cstdint>
-#include <fstream>
 #include <span>
 #include <string>
 #include <thread>
@@ -35,6 +34,9 @@ class TelemetryRing {
 };
 
 // Drains a ring into a CSV file: `time_s,<joint>_cmd_rad,<joint>_meas_rad,...`.
+// A record that cannot be written (a full disk, /dev/full, a pipe whose
+// reader left) is counted as lost with the first error, never silently: a
+// record that is not on disk is a fault of the record, and the run says so.
 class TelemetryWriter {
  public:
   // Opens the file (throws std::runtime_error naming it if it cannot).
@@ -44,14 +46,27 @@ class TelemetryWriter {
   // Drains what is left and closes the file.
   void finish();
   std::uint64_t written() const { return written_.load(); }
+  // Records taken from the ring that did not reach the file (a record cut
+  // short by a failed write counts as lost).
+  std::uint64_t lost() const { return lost_.load(); }
+  // errno of the first failed write (0: none failed, the header included).
+  int error() const { return error_.load(); }
 
  private:
   void drain();
-  std::ofstream out_;
+  // Writes the pending text; records whose line did not reach the file whole
+  // are counted lost. Returns whether everything was written.
+  bool flush_pending();
+
+  int fd_ = -1;
   TelemetryRing& ring_;
   std::vector<double> record_;
+  std::string pending_;                 // formatted text not yet written
+  std::vector<std::size_t> line_ends_;  // end offset in pending_ of each record's line
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> written_{0};
+  std::atomic<std::uint64_t> lost_{0};
+  std::atomic<int> error_{0};
   std::thread thread_;
 };
 
