@@ -332,6 +332,12 @@ int cmd_sim(const std::string& path) {
   // Served for other programs: CAN devices go on the real interfaces.
   animrt::sim::set_can_sim_attach(animrt::sim::CanSimAttach::socketcan);
   auto simulated = animrt::start_simulated_devices(robot.config.buses, clock);
+  // Just below the bus threads of an `animrt run` on this machine (loop 80,
+  // buses 79), so a busy host does not make the devices miss their answers.
+  for (const std::string& note :
+       animrt::raise_simulated_devices(simulated, animrt::RunOptions{}.realtime_priority - 2)) {
+    spdlog::warn("simulated devices: {}", note);
+  }
   for (const auto& sim : simulated) std::cout << sim->describe() << '\n';
   std::cout << std::flush;
   while (!g_controls.stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));

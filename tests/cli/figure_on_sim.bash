@@ -53,8 +53,14 @@ start_figure() {
   fail "run did not start: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 }
 
+# "ID=TORQUE_ENABLE ..." of servos 1-12, read by the independent client.
 torque_enable() {
-  /usr/bin/python3 "$root/tests/cli/dxl_torque.py" "$pty" 1000000 $(seq 1 12)
+  local probe
+  probe=$(/usr/bin/python3 "$root/tests/cli/dxl_probe.py" "$pty" 1 12 0 2>&1) || {
+    echo "$probe"
+    return 1
+  }
+  awk '{printf "%s%s=%s", (NR > 1 ? " " : ""), $1, $3} END {print ""}' <<< "$probe"
 }
 
 expect_torque_off() {
