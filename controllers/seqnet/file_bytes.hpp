@@ -9,14 +9,20 @@
 #include <vector>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::seqnet::detail {
 
-// The file's bytes (inflated when it is gzip-compressed). Throws InputError
-// when it cannot be opened, is a broken gzip stream or is larger than
-// max_bytes after inflating.
+// Feature and model files hold every frame or weight uncompressed; meshes
+// (OBJ, MD2, MD3) stay within kMaxInputFileBytes, inflated or not.
+inline constexpr std::uintmax_t kMaxFeatureFileBytes = std::uintmax_t{1} << 30;  // 1 GiB
+inline constexpr std::uintmax_t kMaxModelFileBytes = std::uintmax_t{2} << 30;    // 2 GiB
+
+// The file's bytes through the input checks (read_input_bytes): a regular
+// file of at most max_bytes, inflated when it is gzip-compressed, up to
+// kMaxInflatedBytes. Throws InputError naming the file.
 std::vector<std::uint8_t> read_file_bytes(const std::string& path,
-                                          std::size_t max_bytes = std::size_t{1} << 30);
+                                          std::uintmax_t max_bytes = kMaxInputFileBytes);
 
 // The file name without a trailing ".gz", lower-cased extension included.
 std::string extension_without_gz(const std::string& path);

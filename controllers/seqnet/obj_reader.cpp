@@ -66,7 +66,7 @@ MeshSequence parse_obj(const std::string& file) {
       for (int k = 0; k < 3; ++k) {
         if (!parse_double(tokens[k + 1].first, p[k]) || !std::isfinite(p[k])) {
           obj_fail(file, line_no, tokens[k + 1].second, "v",
-                   "expected a number, found \"" + std::string(tokens[k + 1].first) + "\"");
+                   "expected a number, found " + quote(tokens[k + 1].first));
         }
       }
       vertices.push_back(p);
@@ -81,7 +81,7 @@ MeshSequence parse_obj(const std::string& file) {
         const long long count = static_cast<long long>(vertices.size());
         if (ec != std::errc() || stop != first.data() + first.size() || index == 0) {
           obj_fail(file, line_no, tokens[k].second, "f",
-                   "expected a vertex index, found \"" + std::string(token) + "\"");
+                   "expected a vertex index, found " + quote(token));
         }
         const long long resolved = index > 0 ? index - 1 : count + index;
         if (resolved < 0 || resolved >= count) {
@@ -117,10 +117,13 @@ MeshSequence read_obj_sequence(const std::string& folder) {
   if (!std::filesystem::is_directory(folder, ec)) detail::fail(folder, "", "is not a folder");
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-    if (!entry.is_regular_file()) continue;
-    if (detail::extension_without_gz(entry.path().string()) == ".obj") {
-      files.push_back(entry.path().string());
-    }
+    const std::string path = entry.path().string();
+    if (detail::extension_without_gz(path) != ".obj") continue;
+    // A frame that is a FIFO, a device or a link to one is refused by name:
+    // skipping it would drop a frame from the sequence without a word.
+    if (const std::string problem = input_file_problem(path); !problem.empty())
+      detail::fail(path, "", problem == kFileMissing ? "is a broken link" : problem);
+    files.push_back(path);
   }
   if (ec) detail::fail(folder, "", "cannot list the folder (" + ec.message() + ")");
   if (files.empty()) detail::fail(folder, "", "holds no .obj files");
@@ -164,8 +167,8 @@ MeshSequence read_mesh_sequence(const std::string& path) {
   if (ext == ".md2") return read_md2(path);
   if (ext == ".md3") return read_md3(path);
   detail::fail(path, "",
-               "unknown mesh format \"" + ext +
-                   "\" (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
+               "unknown mesh format " + quote(ext) +
+                   " (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
 }
 
 }  // namespace animrt::seqnet

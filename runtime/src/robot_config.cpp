@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "animrt/bridge/protocol.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
@@ -159,7 +160,7 @@ std::vector<BusConfig> parse_buses(const YamlNode& node) {
     for (const auto& other : buses) {
       if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
                                       find_protocol(bus.protocol)->shares_port())) {
-        value.at("port").fail("port \"" + bus.port + "\" is already used by bus " + other.name);
+        value.at("port").fail("port " + quote(bus.port) + " is already used by bus " + other.name);
       }
     }
     buses.push_back(std::move(bus));
@@ -356,8 +357,8 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
   const std::string problem = input_file_problem(resolved, kMaxMediaFileBytes);
   const std::string where =
       given == resolved
-          ? "\"" + given + "\""
-          : "\"" + given + "\" (resolved against the robot file's folder to \"" + resolved + "\")";
+          ? quote(given)
+          : quote(given) + " (resolved against the robot file's folder to " + quote(resolved) + ")";
   if (problem == kFileMissing) node.fail("file not found: " + where);
   if (!problem.empty()) node.fail(where + " " + problem);
   return resolved;
@@ -410,10 +411,10 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
   motion.file = resolved.string();
 
   const std::string problem = input_file_problem(motion.file);
-  const std::string where =
-      given == motion.file ? "\"" + given + "\""
-                           : "\"" + given + "\" (resolved against the robot file's folder to \"" +
-                                 motion.file + "\")";
+  const std::string where = given == motion.file
+                                ? quote(given)
+                                : quote(given) + " (resolved against the robot file's folder to " +
+                                      quote(motion.file) + ")";
   if (problem == kFileMissing) file.fail("file not found: " + where);
   if (!problem.empty()) file.fail(where + " " + problem);
   return motion;
