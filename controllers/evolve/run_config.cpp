@@ -133,7 +133,7 @@ RunConfig load_run_config(const std::string& path) {
   for (const auto& [key, file] : files) {
     if (const std::string problem = input_file_problem(*file, kMaxMediaFileBytes);
         !problem.empty()) {
-      root.at(key).fail(quote(*file) + " " + problem);
+      root.at(key).fail(quote_path(*file) + " " + problem);
     }
   }
   return c;

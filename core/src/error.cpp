@@ -35,6 +35,10 @@ std::string elide(std::string_view value, std::size_t max_chars) {
 
 std::string quote(std::string_view value) { return '"' + elide(value) + '"'; }
 
+std::string quote_path(std::string_view path) {
+  return '"' + elide(path, kMaxQuotedPathChars) + '"';
+}
+
 InputError::InputError(Location where, std::string key, std::string message)
     : std::runtime_error(format(where, key, message)),
       where_(std::move(where)),

@@ -160,7 +160,8 @@ std::vector<BusConfig> parse_buses(const YamlNode& node) {
     for (const auto& other : buses) {
       if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
                                       find_protocol(bus.protocol)->shares_port())) {
-        value.at("port").fail("port " + quote(bus.port) + " is already used by bus " + other.name);
+        value.at("port").fail("port " + quote_path(bus.port) + " is already used by bus " +
+                              other.name);
       }
     }
     buses.push_back(std::move(bus));
@@ -356,9 +357,9 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
       (fs::path(given).is_absolute() ? fs::path(given) : folder / given).string();
   const std::string problem = input_file_problem(resolved, kMaxMediaFileBytes);
   const std::string where =
-      given == resolved
-          ? quote(given)
-          : quote(given) + " (resolved against the robot file's folder to " + quote(resolved) + ")";
+      given == resolved ? quote_path(given)
+                        : quote_path(given) + " (resolved against the robot file's folder to " +
+                              quote_path(resolved) + ")";
   if (problem == kFileMissing) node.fail("file not found: " + where);
   if (!problem.empty()) node.fail(where + " " + problem);
   return resolved;
@@ -411,10 +412,10 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
   motion.file = resolved.string();
 
   const std::string problem = input_file_problem(motion.file);
-  const std::string where = given == motion.file
-                                ? quote(given)
-                                : quote(given) + " (resolved against the robot file's folder to " +
-                                      quote(motion.file) + ")";
+  const std::string where =
+      given == motion.file ? quote_path(given)
+                           : quote_path(given) + " (resolved against the robot file's folder to " +
+                                 quote_path(motion.file) + ")";
   if (problem == kFileMissing) file.fail("file not found: " + where);
   if (!problem.empty()) file.fail(where + " " + problem);
   return motion;

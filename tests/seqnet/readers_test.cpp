@@ -368,6 +368,21 @@ TEST(ObjReader, FolderRefusesAFrameThatIsAFifoOrADeviceByName) {
   EXPECT_EQ(error_of(dir, read_obj_sequence), dir + "/d.obj: is a broken link");
 }
 
+TEST(ObjReader, MoreVerticesOrTrianglesThanAFrameMayHaveAreRefused) {
+  const std::string path = seqtest::temp_path("many.obj");
+  std::string text;
+  for (int i = 0; i < 1000001; ++i) text += "v 0 0 0\n";
+  seqtest::write_text(path, text);
+  EXPECT_EQ(error_of(path, read_obj),
+            path + ": v: 1000001 vertices, more than the 1000000 a frame may have");
+  // One polygon of 2000003 corners fans into 2000001 triangles.
+  text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 2000003; ++i) text += " " + std::to_string(1 + i % 3);
+  seqtest::write_text(path, text + "\n");
+  EXPECT_EQ(error_of(path, read_obj),
+            path + ":4:1: f: more than the 2000000 triangles a frame may have");
+}
+
 TEST(ObjReader, ALongTokenIsQuotedShort) {
   const std::string path = seqtest::temp_path("long_token.obj");
   seqtest::write_text(path, "v 0 0 " + std::string(60u << 20, '7') + "x\n");

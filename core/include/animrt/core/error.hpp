@@ -18,8 +18,14 @@ inline constexpr std::size_t kMaxQuotedChars = 80;
 //   "abcdefgh[... 59999920 characters ...]stuvwxyz"
 std::string elide(std::string_view value, std::size_t max_chars = kMaxQuotedChars);
 
+// File names are quoted whole up to this length (a resolved path easily
+// passes 80 characters), and elided beyond it like any value.
+inline constexpr std::size_t kMaxQuotedPathChars = 256;
+
 // elide(value) in double quotes: how a message quotes a user's value.
 std::string quote(std::string_view value);
+// The same for a file name, with kMaxQuotedPathChars.
+std::string quote_path(std::string_view path);
 
 // 1-based line and column; 0 means unknown.
 struct Location {
