@@ -36,6 +36,10 @@ rm -f pipe.obj pipe.model pipe.csv && mkfifo pipe.obj pipe.model pipe.csv
 [ -e vertices.obj ] || python3 -c "
 import sys
 sys.stdout.buffer.write(b'v 0 0 0\n' * (60 * 1024 * 1024 // 8))" >vertices.obj
+# One number of 60 MB in an OBJ: the error line must not repeat it.
+[ -e long_number.obj ] || python3 -c "
+import sys
+sys.stdout.write('v 0 0 ' + '7' * (60 * 1000 * 1000) + 'x\n')" >long_number.obj
 # An MD2 header claiming 512 frames of 2048 vertices in 68 bytes.
 python3 -c "
 import struct, sys
@@ -59,7 +63,7 @@ measure() {  # LABEL INPUT COMMAND...
   local label=$1 input=$2
   shift 2
   local size
-  size=$(stat -Lc %s "$input" 2>/dev/null || echo "-")
+  size=$(stat -Lc %s "$input" 2>/dev/null || echo "none")
   [ -p "$input" ] && size=FIFO
   [ -c "$input" ] && size=device
   timeout 60 /usr/bin/time -v -o time.txt "$@" >out.txt 2>err.txt
@@ -76,12 +80,14 @@ measure() {  # LABEL INPUT COMMAND...
 
 echo "| input | size (bytes) | exit | max RSS | error output |"
 echo "| --- | --- | --- | --- | --- |"
+measure "baseline: a missing file" missing.obj "$animrt" seq features missing.obj --out f.feat
 measure "OBJ: FIFO" pipe.obj "$animrt" seq features pipe.obj --out f.feat
 measure "OBJ: /dev/zero" zero.obj "$animrt" seq features zero.obj --out f.feat
 measure "OBJ .gz: 2 GiB of zeros" bomb.obj.gz "$animrt" seq features bomb.obj.gz --out f.feat
 measure "MD3 .gz: 2 GiB of zeros" bomb.md3.gz "$animrt" seq features bomb.md3.gz --out f.feat
 measure "MD2: header claims 512 x 2048 vertices" lying.md2 "$animrt" seq features lying.md2 --out f.feat
 measure "OBJ: 60 MiB of vertex lines" vertices.obj "$animrt" seq features vertices.obj --out f.feat
+measure "OBJ: one 60 MB number" long_number.obj "$animrt" seq features long_number.obj --out f.feat
 measure "feature file: gzip bomb" bomb.feat "$animrt" seq reconstruct bomb.feat --out frames
 measure "model: FIFO" pipe.model "$animrt" seq generate pipe.model --init x.obj --frames 2 --out g
 measure "model: /dev/zero" zero.model "$animrt" seq generate zero.model --init x.obj --frames 2 --out g
