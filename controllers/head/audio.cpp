@@ -62,7 +62,7 @@ void check_riff_length(const std::string& path) {
 
 // Frames read and mixed at a time.
 constexpr sf_count_t kChunkFrames = 16384;
-// A compressed file (FLAC, Ogg) may declare at most this many samples per
+// A compressed file (FLAC, Ogg, MPEG) may declare at most this many samples per
 // byte it has, and at least kMinCompressedSamples in any case. Speech and
 // music compress to about a byte a sample; long silence far further, which
 // the floor covers for short files.
@@ -102,22 +102,23 @@ int bytes_per_sample(int format) {
 }
 
 // Why the header's frame count cannot be true of a file of `file_size`
-// bytes, or "".
+// bytes, or "". Divides rather than multiplies: the count is the header's
+// word and may be anything up to 2^63.
 std::string frame_count_problem(const SF_INFO& info, std::uintmax_t file_size) {
-  const auto samples =
-      static_cast<std::uintmax_t>(info.frames) * static_cast<std::uintmax_t>(info.channels);
-  const std::string claim = "the header declares " + std::to_string(info.frames) + " frames of " +
+  const auto frames = static_cast<std::uintmax_t>(info.frames);
+  const auto channels = static_cast<std::uintmax_t>(info.channels);
+  const std::string claim = "the header declares " + std::to_string(info.frames) + " frames x " +
                             std::to_string(info.channels) + " channels";
   if (const int width = bytes_per_sample(info.format); width > 0) {
-    if (samples > file_size / static_cast<std::uintmax_t>(width)) {
-      return claim + " (" + std::to_string(samples * static_cast<std::uintmax_t>(width)) +
-             " bytes), more than the file's " + std::to_string(file_size) + " bytes";
+    if (frames > file_size / static_cast<std::uintmax_t>(width) / channels) {
+      return claim + " of " + std::to_string(width) + " bytes, more than the file's " +
+             std::to_string(file_size) + " bytes";
     }
     return "";
   }
   const std::uintmax_t cap =
       std::max(kMinCompressedSamples, file_size * kMaxSamplesPerCompressedByte);
-  if (samples > cap) {
+  if (frames > cap / channels) {
     return claim + ", more than " + std::to_string(kMaxSamplesPerCompressedByte) +
            " samples per byte of its " + std::to_string(file_size) + " compressed bytes";
   }

@@ -45,11 +45,7 @@ class ByteView {
   void need(std::uint64_t offset, std::uint64_t count, std::uint64_t item, const std::string& key,
             const std::string& what) const {
     const std::uint64_t n = bytes_.size();
-    if (item != 0 && count > n / item) {
-      fail(file_, key,
-           what + " (" + std::to_string(count) + " x " + std::to_string(item) +
-               " bytes) is larger than the file (" + std::to_string(n) + " bytes)");
-    }
+    check_header_count(file_, key, what, count, item, n);
     if (offset > n || count * item > n - offset) {
       fail(file_, key,
            "file is truncated: " + what + " at byte " + std::to_string(offset) + " needs " +

@@ -177,8 +177,7 @@ void check_header_count(const std::string& path, const std::string& key, const s
   if (item_bytes == 0 || count <= available / item_bytes) return;
   throw InputError(Location{path, 0, 0}, key,
                    what + " (" + std::to_string(count) + " x " + std::to_string(item_bytes) +
-                       " bytes) needs more than the " + std::to_string(available) +
-                       " bytes the file has");
+                       " bytes) is larger than the file (" + std::to_string(available) + " bytes)");
 }
 
 }  // namespace animrt

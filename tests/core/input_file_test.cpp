@@ -132,8 +132,8 @@ TEST(HeaderCount, CountsMustFitTheFileBeforeAnythingIsSized) {
     ADD_FAILURE() << "a count past the file's size passed";
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(),
-                 "m.bin: header: the frames (1099511627776 x 8 bytes) needs more than the 80 "
-                 "bytes the file has");
+                 "m.bin: header: the frames (1099511627776 x 8 bytes) is larger than the file "
+                 "(80 bytes)");
   }
 }
 

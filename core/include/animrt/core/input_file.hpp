@@ -47,8 +47,8 @@ std::vector<std::uint8_t> read_input_bytes(const std::string& path,
                                            std::uintmax_t max_inflated = kMaxInflatedBytes);
 
 // Counts read from a binary header, checked before anything is sized from
-// them: throws InputError "PATH: KEY: WHAT (COUNT x ITEM bytes) needs more
-// than the AVAILABLE bytes the file has" unless count * item fits.
+// them: throws InputError "PATH: KEY: WHAT (COUNT x ITEM bytes) is larger
+// than the file (AVAILABLE bytes)" unless count * item fits.
 void check_header_count(const std::string& path, const std::string& key, const std::string& what,
                         std::uint64_t count, std::uint64_t item_bytes, std::uint64_t available);
 
