@@ -7,7 +7,6 @@
 #include <optional>
 
 #include "animrt/controllers/seqnet/model_file.hpp"
-#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
