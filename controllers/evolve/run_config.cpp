@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <utility>
 
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
@@ -132,7 +133,7 @@ RunConfig load_run_config(const std::string& path) {
   for (const auto& [key, file] : files) {
     if (const std::string problem = input_file_problem(*file, kMaxMediaFileBytes);
         !problem.empty()) {
-      root.at(key).fail("\"" + *file + "\" " + problem);
+      root.at(key).fail(quote_path(*file) + " " + problem);
     }
   }
   return c;

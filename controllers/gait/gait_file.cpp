@@ -14,6 +14,7 @@
 
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/controllers/gait/froude.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/joint.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -169,7 +170,7 @@ double positive_in(const YamlNode& node, double lo, double hi) {
 
 int read_sign(const YamlNode& node) {
   const double v = node.as_double();
-  if (v != 1.0 && v != -1.0) node.fail("expected 1 or -1, found \"" + node.as_string() + "\"");
+  if (v != 1.0 && v != -1.0) node.fail("expected 1 or -1, found " + quote(node.as_string()));
   return v > 0 ? 1 : -1;
 }
 

@@ -60,6 +60,71 @@ void check_riff_length(const std::string& path) {
   }
 }
 
+// Frames read and mixed at a time.
+constexpr sf_count_t kChunkFrames = 16384;
+// A compressed file (FLAC, Ogg, MPEG) may declare at most this many samples per
+// byte it has, and at least kMinCompressedSamples in any case. Speech and
+// music compress to about a byte a sample; long silence far further, which
+// the floor covers for short files.
+constexpr std::uintmax_t kMaxSamplesPerCompressedByte = 64;
+constexpr std::uintmax_t kMinCompressedSamples = std::uintmax_t{1} << 20;
+
+// Bytes a sample takes in an uncompressed encoding, 0 for a compressed one.
+// FLAC, Ogg and MPEG name the decoded bit depth in the subformat: compressed
+// whatever it says.
+int bytes_per_sample(int format) {
+  switch (format & SF_FORMAT_TYPEMASK) {
+    case SF_FORMAT_FLAC:
+    case SF_FORMAT_OGG:
+    case SF_FORMAT_MPEG:
+      return 0;
+    default:
+      break;
+  }
+  switch (format & SF_FORMAT_SUBMASK) {
+    case SF_FORMAT_PCM_S8:
+    case SF_FORMAT_PCM_U8:
+    case SF_FORMAT_ULAW:
+    case SF_FORMAT_ALAW:
+      return 1;
+    case SF_FORMAT_PCM_16:
+      return 2;
+    case SF_FORMAT_PCM_24:
+      return 3;
+    case SF_FORMAT_PCM_32:
+    case SF_FORMAT_FLOAT:
+      return 4;
+    case SF_FORMAT_DOUBLE:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+// Why the header's frame count cannot be true of a file of `file_size`
+// bytes, or "". Divides rather than multiplies: the count is the header's
+// word and may be anything up to 2^63.
+std::string frame_count_problem(const SF_INFO& info, std::uintmax_t file_size) {
+  const auto frames = static_cast<std::uintmax_t>(info.frames);
+  const auto channels = static_cast<std::uintmax_t>(info.channels);
+  const std::string claim = "the header declares " + std::to_string(info.frames) + " frames x " +
+                            std::to_string(info.channels) + " channels";
+  if (const int width = bytes_per_sample(info.format); width > 0) {
+    if (frames > file_size / static_cast<std::uintmax_t>(width) / channels) {
+      return claim + " of " + std::to_string(width) + " bytes, more than the file's " +
+             std::to_string(file_size) + " bytes";
+    }
+    return "";
+  }
+  const std::uintmax_t cap =
+      std::max(kMinCompressedSamples, file_size * kMaxSamplesPerCompressedByte);
+  if (frames > cap / channels) {
+    return claim + ", more than " + std::to_string(kMaxSamplesPerCompressedByte) +
+           " samples per byte of its " + std::to_string(file_size) + " compressed bytes";
+  }
+  return "";
+}
+
 }  // namespace
 
 Audio load_audio(const std::string& path, int target_rate) {
@@ -67,7 +132,8 @@ Audio load_audio(const std::string& path, int target_rate) {
   if (const std::string problem = input_file_problem(path, kMaxMediaFileBytes); !problem.empty())
     fail(path, problem == kFileMissing ? "audio file not found" : problem);
   std::error_code ec;
-  if (fs::file_size(path, ec) == 0) fail(path, "empty file (0 bytes), expected audio");
+  const std::uintmax_t file_size = fs::file_size(path, ec);
+  if (file_size == 0) fail(path, "empty file (0 bytes), expected audio");
 
   check_riff_length(path);  // before sf_open: a throw here leaves nothing open
   SF_INFO info{};
@@ -91,27 +157,44 @@ Audio load_audio(const std::string& path, int target_rate) {
     fail(path, std::to_string(info.channels) + " channels in the header, expected 1.." +
                    std::to_string(kMaxAudioChannels));
   }
-  std::vector<float> interleaved(static_cast<std::size_t>(info.frames) *
-                                 static_cast<std::size_t>(info.channels));
-  const sf_count_t got = sf_readf_float(file, interleaved.data(), info.frames);
+  // The frame count is the header's word: checked against the file's size
+  // before anything is sized from it, and the samples are read in chunks
+  // (mixed to mono as they come), so a header that lies costs nothing.
+  if (const std::string problem = frame_count_problem(info, file_size); !problem.empty()) {
+    sf_close(file);
+    fail(path, problem);
+  }
+  Audio audio;
+  audio.sample_rate = info.samplerate;
+  audio.samples.reserve(static_cast<std::size_t>(
+      std::min<sf_count_t>(info.frames, static_cast<sf_count_t>(file_size))));
+  const auto channels = static_cast<std::size_t>(info.channels);
+  std::vector<float> chunk(kChunkFrames * channels);
+  sf_count_t got = 0;
+  while (got < info.frames) {
+    const sf_count_t want = std::min<sf_count_t>(kChunkFrames, info.frames - got);
+    const sf_count_t n = sf_readf_float(file, chunk.data(), want);
+    if (n <= 0) break;
+    for (sf_count_t f = 0; f < n; ++f) {
+      float sum = 0.0f;
+      for (std::size_t c = 0; c < channels; ++c)
+        sum += chunk[static_cast<std::size_t>(f) * channels + c];
+      const float mono = sum / static_cast<float>(channels);
+      if (!std::isfinite(mono)) {
+        sf_close(file);
+        const auto i = static_cast<double>(got + f);
+        fail(path, "sample " + std::to_string(got + f) + " (at " +
+                       format_number(i / info.samplerate) +
+                       " s) is not a finite number (NaN or infinity)");
+      }
+      audio.samples.push_back(mono);
+    }
+    got += n;
+  }
   sf_close(file);
   if (got != info.frames) {
     fail(path, "truncated audio file: expected " + std::to_string(info.frames) + " frames, read " +
                    std::to_string(got));
-  }
-  Audio audio;
-  audio.sample_rate = info.samplerate;
-  audio.samples.resize(static_cast<std::size_t>(got));
-  const auto channels = static_cast<std::size_t>(info.channels);
-  for (std::size_t i = 0; i < audio.samples.size(); ++i) {
-    float sum = 0.0f;
-    for (std::size_t c = 0; c < channels; ++c) sum += interleaved[i * channels + c];
-    audio.samples[i] = sum / static_cast<float>(channels);
-    if (!std::isfinite(audio.samples[i])) {
-      fail(path, "sample " + std::to_string(i) + " (at " +
-                     format_number(static_cast<double>(i) / info.samplerate) +
-                     " s) is not a finite number (NaN or infinity)");
-    }
   }
   if (target_rate > 0) {
     try {

@@ -6,8 +6,19 @@
 #include <random>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::head {
+namespace {
+
+void refuse_unreadable(const std::string& path) {
+  const std::string problem = input_file_problem(path, kMaxMediaFileBytes);
+  if (!problem.empty())
+    throw InputError(Location{path, 0, 0}, "",
+                     problem == kFileMissing ? "is a broken link" : problem);
+}
+
+}  // namespace
 
 std::vector<Utterance> list_corpus(const std::string& dir) {
   namespace fs = std::filesystem;
@@ -16,7 +27,11 @@ std::vector<Utterance> list_corpus(const std::string& dir) {
     throw InputError(Location{dir, 0, 0}, "", "corpus folder not found");
   std::vector<fs::path> wavs;
   for (const auto& entry : fs::directory_iterator(dir)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".wav") wavs.push_back(entry.path());
+    if (entry.path().extension() != ".wav") continue;
+    // A recording that is a FIFO, a device or a link to one is refused by
+    // name: skipping it would shrink the corpus without a word.
+    refuse_unreadable(entry.path().string());
+    wavs.push_back(entry.path());
   }
   std::sort(wavs.begin(), wavs.end());
   if (wavs.empty()) throw InputError(Location{dir, 0, 0}, "", "no .wav files in the corpus folder");
@@ -27,10 +42,10 @@ std::vector<Utterance> list_corpus(const std::string& dir) {
     u.audio_path = w.string();
     for (const char* ext : {".csv", ".bvh", ".markers.csv"}) {
       const fs::path p = w.parent_path() / (u.name + ext);
-      if (fs::is_regular_file(p)) {
-        u.pose_path = p.string();
-        break;
-      }
+      if (input_file_problem(p.string(), kMaxMediaFileBytes) == kFileMissing) continue;
+      refuse_unreadable(p.string());
+      u.pose_path = p.string();
+      break;
     }
     if (u.pose_path.empty()) {
       throw InputError(Location{u.audio_path, 0, 0}, "",

@@ -41,7 +41,7 @@ int CsvTable::require(const std::string& name) const {
     std::string have;
     for (const auto& h : header) have += (have.empty() ? "" : ", ") + h;
     throw InputError(Location{file, 1, 1}, name,
-                     "missing column \"" + name + "\" in the header (found: " + have + ")");
+                     "missing column " + quote(name) + " in the header (found: " + have + ")");
   }
   return c;
 }
@@ -73,7 +73,7 @@ CsvTable read_csv_table(const std::string& path) {
       row[i] = std::strtod(cells[i].c_str(), &end);
       if (cells[i].empty() || *end != '\0' || errno != 0 || !std::isfinite(row[i])) {
         throw InputError(Location{path, line_no, col}, table.header[i],
-                         "expected a number, found \"" + cells[i] + "\"");
+                         "expected a number, found " + quote(cells[i]));
       }
       col += static_cast<int>(cells[i].size()) + 1;
     }

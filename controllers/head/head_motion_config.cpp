@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "animrt/controllers/head/head_source.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 
 namespace animrt::head {
@@ -16,8 +17,9 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
       fs::path(given).is_absolute() ? fs::path(given) : fs::path(robot_path).parent_path() / given;
   const std::string problem = input_file_problem(p.string(), kMaxMediaFileBytes);
   if (problem == kFileMissing)
-    node.fail("file not found: \"" + given + "\" (resolved to \"" + p.string() + "\")");
-  if (!problem.empty()) node.fail("\"" + p.string() + "\" " + problem);
+    node.fail("file not found: " + quote_path(given) + " (resolved to " + quote_path(p.string()) +
+              ")");
+  if (!problem.empty()) node.fail(quote_path(p.string()) + " " + problem);
   return p.string();
 }
 

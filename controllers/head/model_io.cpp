@@ -79,7 +79,7 @@ class Reader {
     while (true) {
       if (!std::getline(in_, text)) {
         throw InputError(Location{path_, line_no_ + 1, 0}, keyword,
-                         "unexpected end of file (truncated model?), expected \"" + keyword + "\"");
+                         "unexpected end of file (truncated model?), expected " + quote(keyword));
       }
       ++line_no_;
       // strtod and the word splitter would stop at a NUL and quietly accept
@@ -97,8 +97,8 @@ class Reader {
     while (ws >> w) tokens_.push_back(w);
     key_ = keyword;
     if (tokens_.empty() || tokens_[0] != keyword) {
-      fail("expected a line starting with \"" + keyword + "\", found \"" +
-           (tokens_.empty() ? "" : tokens_[0]) + "\"");
+      fail("expected a line starting with " + quote(keyword) + ", found " +
+           quote(tokens_.empty() ? std::string() : tokens_[0]));
     }
     pos_ = 1;
   }
@@ -109,7 +109,7 @@ class Reader {
   // A named value: "name value".
   std::string named(const std::string& name) {
     const std::string w = word();
-    if (w != name) fail("expected \"" + name + "\", found \"" + w + "\"");
+    if (w != name) fail("expected " + quote(name) + ", found " + quote(w));
     return word();
   }
   double num() {
@@ -119,12 +119,12 @@ class Reader {
     errno = 0;
     const double v = std::strtod(w.c_str(), &end);
     if (*end != '\0' || errno == ERANGE || !std::isfinite(v))
-      fail("expected a number, found \"" + w + "\"");
+      fail("expected a number, found " + quote(w));
     return v;
   }
   double named_num(const std::string& name) {
     const std::string w = word();
-    if (w != name) fail("expected \"" + name + "\", found \"" + w + "\"");
+    if (w != name) fail("expected " + quote(name) + ", found " + quote(w));
     return num();
   }
   int named_int(const std::string& name, int lo, int hi) {
@@ -141,7 +141,7 @@ class Reader {
     return v;
   }
   void done() {
-    if (pos_ != tokens_.size()) fail("unexpected extra value \"" + tokens_[pos_] + "\"");
+    if (pos_ != tokens_.size()) fail("unexpected extra value " + quote(tokens_[pos_]));
   }
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(Location{path_, line_no_, 0}, key_, message);
@@ -337,7 +337,7 @@ HeadModel load_model(const std::string& path) {
   m.states = r.named_int("S", 1, 64);
   m.mixtures = r.named_int("M", 1, 64);
   const std::string topo = r.named("topology");
-  r.check(topo == "LR" || topo == "EG", "topology must be LR or EG, found \"" + topo + "\"");
+  r.check(topo == "LR" || topo == "EG", "topology must be LR or EG, found " + quote(topo));
   m.topology = topo == "LR" ? Topology::kLeftToRight : Topology::kErgodic;
   r.done();
   r.line("utterances");

@@ -113,7 +113,7 @@ class BvhLexer {
     const std::string t = expect_word(what);
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
-    if (*end != '\0' || !std::isfinite(v)) fail(what, "expected a number, found \"" + t + "\"");
+    if (*end != '\0' || !std::isfinite(v)) fail(what, "expected a number, found " + quote(t));
     return v;
   }
   [[noreturn]] void fail(const std::string& key, const std::string& message) const {
@@ -146,7 +146,7 @@ PoseTrack load_bvh(const std::string& path, const BvhOptions& options) {
   int channel_count = 0;
   std::string tok = lex.expect_word("HIERARCHY");
   if (tok != "HIERARCHY")
-    lex.fail("HIERARCHY", "not a BVH file: expected HIERARCHY, found \"" + tok + "\"");
+    lex.fail("HIERARCHY", "not a BVH file: expected HIERARCHY, found " + quote(tok));
   int pending = -1;  // joint awaiting its "{"
   bool in_end_site = false;
   while (true) {
@@ -187,13 +187,13 @@ PoseTrack load_bvh(const std::string& path, const BvhOptions& options) {
         static const char* kKnown[] = {"Xposition", "Yposition", "Zposition",
                                        "Xrotation", "Yrotation", "Zrotation"};
         if (std::find(std::begin(kKnown), std::end(kKnown), c) == std::end(kKnown)) {
-          lex.fail("CHANNELS", "unknown channel \"" + c + "\"");
+          lex.fail("CHANNELS", "unknown channel " + quote(c));
         }
         j.channels.push_back(c);
       }
       channel_count += static_cast<int>(n);
     } else {
-      lex.fail("HIERARCHY", "unexpected \"" + tok + "\"");
+      lex.fail("HIERARCHY", "unexpected " + quote(tok));
     }
   }
   if (!stack.empty()) lex.fail("MOTION", "unbalanced braces before MOTION");
@@ -206,7 +206,7 @@ PoseTrack load_bvh(const std::string& path, const BvhOptions& options) {
     std::string have;
     for (const auto& j : joints) have += (have.empty() ? "" : ", ") + j.name;
     throw InputError(Location{path, 0, 0}, key,
-                     "no joint named \"" + name + "\" (joints: " + have + ")");
+                     "no joint named " + quote(name) + " (joints: " + have + ")");
   };
   const int head = find_joint(options.head_joint, "head_joint");
   const int torso =
@@ -215,8 +215,8 @@ PoseTrack load_bvh(const std::string& path, const BvhOptions& options) {
   for (int j = head; j != torso; j = joints[static_cast<std::size_t>(j)].parent) {
     if (j < 0) {
       throw InputError(Location{path, 0, 0}, "torso_joint",
-                       "joint \"" + options.head_joint + "\" is not below \"" +
-                           joints[static_cast<std::size_t>(torso)].name + "\"");
+                       "joint " + quote(options.head_joint) + " is not below " +
+                           quote(joints[static_cast<std::size_t>(torso)].name));
     }
     chain.push_back(j);
   }

@@ -83,7 +83,8 @@ void write_feature_file(const std::string& file, const SequenceFeatures& f) {
 }
 
 SequenceFeatures read_feature_file(const std::string& file) {
-  const std::vector<std::uint8_t> bytes = detail::read_file_bytes(file);
+  const std::vector<std::uint8_t> bytes =
+      detail::read_file_bytes(file, detail::kMaxFeatureFileBytes);
   const detail::ByteView in(bytes, file);
   in.need(0, 1, 32, "header", "the header");
   if (std::memcmp(bytes.data(), kFeatureFileMagic, 8) != 0) {

@@ -9,14 +9,20 @@
 #include <vector>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::seqnet::detail {
 
-// The file's bytes (inflated when it is gzip-compressed). Throws InputError
-// when it cannot be opened, is a broken gzip stream or is larger than
-// max_bytes after inflating.
+// Feature and model files hold every frame or weight uncompressed; meshes
+// (OBJ, MD2, MD3) stay within kMaxInputFileBytes, inflated or not.
+inline constexpr std::uintmax_t kMaxFeatureFileBytes = std::uintmax_t{1} << 30;  // 1 GiB
+inline constexpr std::uintmax_t kMaxModelFileBytes = std::uintmax_t{2} << 30;    // 2 GiB
+
+// The file's bytes through the input checks (read_input_bytes): a regular
+// file of at most max_bytes, inflated when it is gzip-compressed, up to
+// kMaxInflatedBytes. Throws InputError naming the file.
 std::vector<std::uint8_t> read_file_bytes(const std::string& path,
-                                          std::size_t max_bytes = std::size_t{1} << 30);
+                                          std::uintmax_t max_bytes = kMaxInputFileBytes);
 
 // The file name without a trailing ".gz", lower-cased extension included.
 std::string extension_without_gz(const std::string& path);
@@ -39,11 +45,7 @@ class ByteView {
   void need(std::uint64_t offset, std::uint64_t count, std::uint64_t item, const std::string& key,
             const std::string& what) const {
     const std::uint64_t n = bytes_.size();
-    if (item != 0 && count > n / item) {
-      fail(file_, key,
-           what + " (" + std::to_string(count) + " x " + std::to_string(item) +
-               " bytes) is larger than the file (" + std::to_string(n) + " bytes)");
-    }
+    check_header_count(file_, key, what, count, item, n);
     if (offset > n || count * item > n - offset) {
       fail(file_, key,
            "file is truncated: " + what + " at byte " + std::to_string(offset) + " needs " +

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::seqnet {
 namespace {
@@ -22,14 +23,17 @@ bool is_joint_column(const std::string& name) {
 }
 
 JointCsv read_joint_csv(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) fail(file, 0, 0, "", "cannot open");
+  const std::string text = read_input_file(file);
   JointCsv t;
   std::vector<std::string> names;
   std::vector<std::size_t> use;
   std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  for (std::size_t at = 0; at < text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    line.assign(text, at, end - at);
+    at = end + 1;
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty() || line[0] == '#') continue;
@@ -69,7 +73,7 @@ JointCsv read_joint_csv(const std::string& file) {
         used = 0;
       }
       if (used == 0 || used != cells[c].size() || !std::isfinite(v)) {
-        fail(file, number, columns[c], names[c], "\"" + cells[c] + "\" is not a finite number");
+        fail(file, number, columns[c], names[c], quote(cells[c]) + " is not a finite number");
       }
       row.push_back(v);
     }

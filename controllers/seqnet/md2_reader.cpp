@@ -9,6 +9,13 @@
 #include "mesh_checks.hpp"
 
 namespace animrt::seqnet {
+namespace {
+
+constexpr std::int32_t kMd2MaxVerts = 2048;
+constexpr std::int32_t kMd2MaxTriangles = 4096;
+constexpr std::int32_t kMd2MaxFrames = 512;
+
+}  // namespace
 
 MeshSequence read_md2(const std::string& file) {
   const std::vector<std::uint8_t> bytes = detail::read_file_bytes(file);
@@ -27,15 +34,19 @@ MeshSequence read_md2(const std::string& file) {
   const std::int32_t num_frames = in.i32(40);
   const std::int32_t ofs_tris = in.i32(52);
   const std::int32_t ofs_frames = in.i32(56);
-  auto positive = [&](std::int32_t value, const char* what) {
-    if (value <= 0) {
+  // Each frame's vertices grow sixfold in memory (4 bytes to 3 doubles), so
+  // the counts are held to the Quake II engine's limits (qfiles.h) as well
+  // as to the file's size.
+  auto in_range = [&](std::int32_t value, std::int32_t high, const char* what) {
+    if (value <= 0 || value > high) {
       detail::fail(file, "header",
-                   std::string(what) + " is " + std::to_string(value) + ", expected > 0");
+                   std::string(what) + " is " + std::to_string(value) + ", expected 1.." +
+                       std::to_string(high));
     }
   };
-  positive(num_xyz, "vertex count");
-  positive(num_tris, "triangle count");
-  positive(num_frames, "frame count");
+  in_range(num_xyz, kMd2MaxVerts, "vertex count");
+  in_range(num_tris, kMd2MaxTriangles, "triangle count");
+  in_range(num_frames, kMd2MaxFrames, "frame count");
   if (num_st < 0) detail::fail(file, "header", "texture coordinate count is negative");
   if (ofs_tris < 68 || ofs_frames < 68)
     detail::fail(file, "header", "an offset points into the header");

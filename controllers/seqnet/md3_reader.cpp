@@ -5,10 +5,10 @@
 // each); clips come from an animation.cfg in the same folder when present.
 
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/core/input_file.hpp"
 #include "file_bytes.hpp"
 #include "mesh_checks.hpp"
 
@@ -22,6 +22,8 @@ constexpr std::int32_t kMaxTags = 16;
 constexpr std::int32_t kMaxVerts = 4096;
 constexpr std::int32_t kMaxTriangles = 8192;
 constexpr double kXyzScale = 1.0 / 64.0;
+// An animation.cfg is a few kilobytes: 31 lines of four numbers and a header.
+constexpr std::uintmax_t kMaxAnimationCfgBytes = std::uintmax_t{1} << 20;
 
 // animation.cfg lines in the order the engine reads them (the last six are
 // Team Arena additions some configs carry).
@@ -51,12 +53,14 @@ struct CfgEntry {
 // no torso frames, so its LEGS_ first frames are shifted down by the
 // distance from TORSO_GESTURE to LEGS_WALKCR, as the engine does.
 std::vector<Clip> clips_from_cfg(const std::string& cfg, const std::string& model, int frames) {
-  std::ifstream in(cfg);
-  if (!in) return {};
   std::string stem = std::filesystem::path(model).filename().string();
   const bool lower = stem.rfind("lower", 0) == 0;
   const bool upper = stem.rfind("upper", 0) == 0;
   if (!lower && !upper) return {};
+  // No animation.cfg beside the model: no clips. One that is there but is
+  // not a readable regular file (a FIFO, a device) is refused by name.
+  if (input_file_problem(cfg) == kFileMissing) return {};
+  std::istringstream in(read_input_file(cfg, kMaxAnimationCfgBytes));
   std::vector<CfgEntry> entries;
   std::string line;
   int line_no = 0;

@@ -313,7 +313,7 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
 }
 
 ModelFile read_model_file(const std::string& file) {
-  return parse_model_file(detail::read_file_bytes(file, std::size_t{1} << 31), file);
+  return parse_model_file(detail::read_file_bytes(file, detail::kMaxModelFileBytes), file);
 }
 
 void check_model_mesh(const ModelFile& model, const std::string& file, int vertex_count,

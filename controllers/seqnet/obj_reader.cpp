@@ -42,11 +42,44 @@ std::vector<std::pair<std::string_view, int>> tokens_of(std::string_view line) {
   return out;
 }
 
+// Limits of one OBJ frame: the sequence model's own bound on vertices, and
+// two triangles a vertex. A vertex line of 8 bytes becomes 24 in memory and
+// a face line 12 plus its edges in the checks, so a file within the size
+// limit could otherwise ask for several times its size.
+constexpr std::size_t kMaxObjVertices = 1000000;
+constexpr std::size_t kMaxObjTriangles = 2000000;
+
+// How many lines of `text` are vertex lines ("v" then a blank), counted
+// before any is parsed so that the positions are sized once.
+std::size_t count_vertex_lines(std::string_view text) {
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::size_t count = 0;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    while (at < text.size() && blank(text[at])) ++at;
+    if (at < text.size() && text[at] == 'v' &&
+        (at + 1 == text.size() || blank(text[at + 1]) || text[at + 1] == '#' ||
+         text[at + 1] == '\n'))
+      ++count;
+    const std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) break;
+    at = end + 1;
+  }
+  return count;
+}
+
 // The vertices and triangles of one file, unchecked beyond syntax.
 MeshSequence parse_obj(const std::string& file) {
   const std::vector<std::uint8_t> bytes = detail::read_file_bytes(file);
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  std::vector<Eigen::Vector3d> vertices;
+  const std::size_t vertex_lines = count_vertex_lines(text);
+  if (vertex_lines > kMaxObjVertices) {
+    detail::fail(file, "v",
+                 std::to_string(vertex_lines) + " vertices, more than the " +
+                     std::to_string(kMaxObjVertices) + " a frame may have");
+  }
+  Positions frame(3, static_cast<Eigen::Index>(vertex_lines));
+  std::size_t vertices = 0;
   MeshSequence out;
   out.source = file;
   std::size_t at = 0;
@@ -62,14 +95,17 @@ MeshSequence parse_obj(const std::string& file) {
     const std::string_view kind = tokens[0].first;
     if (kind == "v") {
       if (tokens.size() < 4) obj_fail(file, line_no, 1, "v", "needs x y z");
-      Eigen::Vector3d p;
+      // The count above sees every line tokens_of reads as "v"; a mismatch
+      // would be a bug here, never a reason to write past the positions.
+      if (vertices >= vertex_lines) obj_fail(file, line_no, 1, "v", "vertex lines miscounted");
       for (int k = 0; k < 3; ++k) {
-        if (!parse_double(tokens[k + 1].first, p[k]) || !std::isfinite(p[k])) {
+        double& p = frame(k, static_cast<Eigen::Index>(vertices));
+        if (!parse_double(tokens[k + 1].first, p) || !std::isfinite(p)) {
           obj_fail(file, line_no, tokens[k + 1].second, "v",
-                   "expected a number, found \"" + std::string(tokens[k + 1].first) + "\"");
+                   "expected a number, found " + quote(tokens[k + 1].first));
         }
       }
-      vertices.push_back(p);
+      ++vertices;
     } else if (kind == "f") {
       if (tokens.size() < 4) obj_fail(file, line_no, 1, "f", "needs at least three vertices");
       std::vector<int> corners;
@@ -78,10 +114,10 @@ MeshSequence parse_obj(const std::string& file) {
         const std::string_view first = token.substr(0, token.find('/'));
         long long index = 0;
         const auto [stop, ec] = std::from_chars(first.data(), first.data() + first.size(), index);
-        const long long count = static_cast<long long>(vertices.size());
+        const long long count = static_cast<long long>(vertices);
         if (ec != std::errc() || stop != first.data() + first.size() || index == 0) {
           obj_fail(file, line_no, tokens[k].second, "f",
-                   "expected a vertex index, found \"" + std::string(token) + "\"");
+                   "expected a vertex index, found " + quote(token));
         }
         const long long resolved = index > 0 ? index - 1 : count + index;
         if (resolved < 0 || resolved >= count) {
@@ -91,15 +127,17 @@ MeshSequence parse_obj(const std::string& file) {
         }
         corners.push_back(static_cast<int>(resolved));
       }
+      if (out.triangles.size() + corners.size() - 2 > kMaxObjTriangles) {
+        obj_fail(
+            file, line_no, 1, "f",
+            "more than the " + std::to_string(kMaxObjTriangles) + " triangles a frame may have");
+      }
       for (std::size_t k = 1; k + 1 < corners.size(); ++k) {
         out.triangles.push_back({corners[0], corners[k], corners[k + 1]});
       }
     }
     // vt, vn, g, o, s, usemtl, mtllib and the rest carry nothing we use.
   }
-  Positions frame(3, static_cast<Eigen::Index>(vertices.size()));
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-    frame.col(static_cast<Eigen::Index>(i)) = vertices[i];
   out.frames.push_back(std::move(frame));
   return out;
 }
@@ -117,10 +155,13 @@ MeshSequence read_obj_sequence(const std::string& folder) {
   if (!std::filesystem::is_directory(folder, ec)) detail::fail(folder, "", "is not a folder");
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-    if (!entry.is_regular_file()) continue;
-    if (detail::extension_without_gz(entry.path().string()) == ".obj") {
-      files.push_back(entry.path().string());
-    }
+    const std::string path = entry.path().string();
+    if (detail::extension_without_gz(path) != ".obj") continue;
+    // A frame that is a FIFO, a device or a link to one is refused by name:
+    // skipping it would drop a frame from the sequence without a word.
+    if (const std::string problem = input_file_problem(path); !problem.empty())
+      detail::fail(path, "", problem == kFileMissing ? "is a broken link" : problem);
+    files.push_back(path);
   }
   if (ec) detail::fail(folder, "", "cannot list the folder (" + ec.message() + ")");
   if (files.empty()) detail::fail(folder, "", "holds no .obj files");
@@ -164,8 +205,8 @@ MeshSequence read_mesh_sequence(const std::string& path) {
   if (ext == ".md2") return read_md2(path);
   if (ext == ".md3") return read_md3(path);
   detail::fail(path, "",
-               "unknown mesh format \"" + ext +
-                   "\" (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
+               "unknown mesh format " + quote(ext) +
+                   " (expected .obj, .md2, .md3, optionally .gz, or a folder of .obj)");
 }
 
 }  // namespace animrt::seqnet

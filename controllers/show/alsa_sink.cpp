@@ -26,7 +26,7 @@ class AlsaSink final : public AudioSink {
     }
     snd_lib_error_set_handler(nullptr);
     if (err < 0) {
-      throw DeviceError("ALSA playback device \"" + device + "\": " + snd_strerror(err));
+      throw DeviceError("ALSA playback device " + quote(device) + ": " + snd_strerror(err));
     }
   }
   ~AlsaSink() override {

@@ -74,12 +74,12 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
   try {
     model = seqnet::read_model_file(show.learned.model_file);
   } catch (const InputError& e) {
-    model_node.fail("model \"" + show.learned.model_file + "\": " + e.what());
+    model_node.fail("model " + quote_path(show.learned.model_file) + ": " + e.what());
   } catch (const std::exception& e) {
-    model_node.fail("cannot read model \"" + show.learned.model_file + "\": " + e.what());
+    model_node.fail("cannot read model " + quote_path(show.learned.model_file) + ": " + e.what());
   }
   if (model.shape.kind != seqnet::ModelKind::joints) {
-    model_node.fail("model \"" + show.learned.model_file + "\" is a " +
+    model_node.fail("model " + quote_path(show.learned.model_file) + " is a " +
                     seqnet::kind_name(model.shape.kind) +
                     " model; a show needs a joint-space model (animrt seq train on joint CSVs)");
   }
@@ -257,24 +257,26 @@ ShowFile load_show_file(const std::string& path) {
     if (auto o = a->find("offset_s")) show.audio.offset_s = o->as_double_in(-1e6, 1e6);
     std::error_code ec;
     if (!fs::exists(resolved, ec)) {
-      file.fail("audio file not found: \"" + given +
-                "\" (resolved against the show file's folder to \"" + show.audio.file + "\")");
+      file.fail("audio file not found: " + quote_path(given) +
+                " (resolved against the show file's folder to " + quote_path(show.audio.file) +
+                ")");
     }
     if (const std::string problem = input_file_problem(show.audio.file, kMaxMediaFileBytes);
         !problem.empty()) {
-      file.fail("audio file \"" + show.audio.file + "\" " + problem);
+      file.fail("audio file " + quote_path(show.audio.file) + " " + problem);
     }
     SF_INFO info{};
     SNDFILE* sf = sf_open(show.audio.file.c_str(), SFM_READ, &info);
     if (sf == nullptr) {
-      file.fail("cannot open audio file \"" + show.audio.file + "\": " + sf_strerror(nullptr));
+      file.fail("cannot open audio file " + quote_path(show.audio.file) + ": " +
+                sf_strerror(nullptr));
     }
     sf_close(sf);
     if (info.frames <= 0 || info.samplerate <= 0) {
-      file.fail("audio file \"" + show.audio.file + "\" holds no sound");
+      file.fail("audio file " + quote_path(show.audio.file) + " holds no sound");
     }
     if (info.samplerate < kMinShowAudioRate || info.samplerate > kMaxShowAudioRate) {
-      file.fail("audio file \"" + show.audio.file + "\" declares a sample rate of " +
+      file.fail("audio file " + quote_path(show.audio.file) + " declares a sample rate of " +
                 std::to_string(info.samplerate) + " Hz, expected " +
                 std::to_string(kMinShowAudioRate) + ".." + std::to_string(kMaxShowAudioRate) +
                 " Hz");

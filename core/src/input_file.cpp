@@ -3,7 +3,9 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -60,7 +62,12 @@ void check_input_file(const std::string& path, std::uintmax_t max_bytes) {
     fail(path, problem == kMissing ? errno_problem(ENOENT) : problem);
 }
 
-std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+namespace {
+
+// Reads the whole of `path` into `out` (std::string or a byte vector) after
+// the checks of check_input_file.
+template <class Buffer>
+void read_whole(const std::string& path, std::uintmax_t max_bytes, Buffer& out) {
   check_input_file(path, max_bytes);
   // O_NONBLOCK: should the path have become a FIFO since the check, open and
   // read return at once instead of waiting for a writer.
@@ -68,9 +75,8 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
   if (fd < 0) fail(path, errno_problem(errno));
   struct stat st {};
   std::string problem = ::fstat(fd, &st) != 0 ? errno_problem(errno) : problem_of(st, max_bytes);
-  std::string text;
   if (problem.empty()) {
-    text.reserve(static_cast<std::size_t>(st.st_size));
+    out.reserve(static_cast<std::size_t>(st.st_size));
     char chunk[65536];
     while (true) {
       const ssize_t n = ::read(fd, chunk, sizeof chunk);
@@ -81,16 +87,97 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
       }
       if (n == 0) break;
       // A file that grows while it is read is still held to the limit.
-      if (text.size() + static_cast<std::size_t>(n) > max_bytes) {
+      if (out.size() + static_cast<std::size_t>(n) > max_bytes) {
         problem = "grew past the " + size_text(max_bytes) + " limit while being read";
         break;
       }
-      text.append(chunk, static_cast<std::size_t>(n));
+      out.insert(out.end(), chunk, chunk + n);
     }
   }
   ::close(fd);
   if (!problem.empty()) fail(path, problem);
+}
+
+bool is_gzip(const std::vector<std::uint8_t>& bytes) {
+  return bytes.size() >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b;
+}
+
+// Inflates gzip members one after the other (as gzip -d does) into a buffer
+// whose capacity never exceeds the limit: growth doubles up to it, never
+// past it, so refusing a bomb costs at most the limit.
+std::vector<std::uint8_t> inflate_gzip(const std::string& path,
+                                       const std::vector<std::uint8_t>& packed,
+                                       std::uintmax_t max_inflated) {
+  z_stream z{};
+  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) fail(path, "cannot start gzip inflation");
+  std::vector<std::uint8_t> out;
+  std::string problem;
+  z.next_in = const_cast<Bytef*>(packed.data());
+  std::size_t left = packed.size();
+  std::uint8_t chunk[65536];
+  for (;;) {
+    const auto feed = static_cast<uInt>(std::min<std::size_t>(left, 1u << 30));
+    z.avail_in = feed;
+    z.next_out = chunk;
+    z.avail_out = sizeof chunk;
+    const int rc = inflate(&z, Z_NO_FLUSH);
+    left -= feed - z.avail_in;
+    const std::size_t produced = sizeof chunk - z.avail_out;
+    if (out.size() + produced > max_inflated) {
+      problem = "gzip data inflates to more than the " + size_text(max_inflated) + " limit";
+      break;
+    }
+    if (out.size() + produced > out.capacity()) {
+      out.reserve(static_cast<std::size_t>(std::min<std::uintmax_t>(
+          std::max<std::uintmax_t>(2 * out.capacity(), out.size() + produced), max_inflated)));
+    }
+    out.insert(out.end(), chunk, chunk + produced);
+    if (rc == Z_STREAM_END) {
+      // Another member may follow; trailing zero padding ends the stream too.
+      if (left == 0 || std::all_of(z.next_in, z.next_in + left, [](Bytef b) { return b == 0; }))
+        break;
+      if (inflateReset(&z) != Z_OK) {
+        problem = "broken gzip data";
+        break;
+      }
+      continue;
+    }
+    if (rc == Z_BUF_ERROR && left == 0 && produced == 0) {
+      problem = "gzip data is truncated";
+      break;
+    }
+    if (rc != Z_OK && rc != Z_BUF_ERROR) {
+      problem = std::string("broken gzip data (") + (z.msg != nullptr ? z.msg : "zlib error") + ")";
+      break;
+    }
+  }
+  inflateEnd(&z);
+  if (!problem.empty()) fail(path, problem);
+  return out;
+}
+
+}  // namespace
+
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+  std::string text;
+  read_whole(path, max_bytes, text);
   return text;
+}
+
+std::vector<std::uint8_t> read_input_bytes(const std::string& path, std::uintmax_t max_bytes,
+                                           std::uintmax_t max_inflated) {
+  std::vector<std::uint8_t> bytes;
+  read_whole(path, max_bytes, bytes);
+  if (!is_gzip(bytes)) return bytes;
+  return inflate_gzip(path, bytes, max_inflated);
+}
+
+void check_header_count(const std::string& path, const std::string& key, const std::string& what,
+                        std::uint64_t count, std::uint64_t item_bytes, std::uint64_t available) {
+  if (item_bytes == 0 || count <= available / item_bytes) return;
+  throw InputError(Location{path, 0, 0}, key,
+                   what + " (" + std::to_string(count) + " x " + std::to_string(item_bytes) +
+                       " bytes) is larger than the file (" + std::to_string(available) + " bytes)");
 }
 
 }  // namespace animrt

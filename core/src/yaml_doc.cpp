@@ -65,7 +65,7 @@ std::string YamlNode::describe() const {
   if (!node_ || node_.IsNull()) return "nothing";
   if (node_.IsMap()) return "a map";
   if (node_.IsSequence()) return "a list";
-  return "\"" + node_.Scalar() + "\"";
+  return quote(node_.Scalar());
 }
 
 bool YamlNode::has(std::string_view key) const {

@@ -56,8 +56,8 @@ seqnet::MeshSequence read_inputs(const std::vector<std::string>& inputs) {
     if (s.vertex_count() != all.vertex_count() || s.triangles != all.triangles) {
       throw InputError(Location{inputs[k], 0, 0}, "connectivity",
                        "differs from " + inputs.front() + " (" + std::to_string(s.vertex_count()) +
-                           " vertices, " + std::to_string(s.triangles.size()) + " triangles against " +
-                           std::to_string(all.vertex_count()) + " and " +
+                           " vertices, " + std::to_string(s.triangles.size()) +
+                           " triangles against " + std::to_string(all.vertex_count()) + " and " +
                            std::to_string(all.triangles.size()) + ")");
     }
     add_clips(s, inputs[k], all.frame_count());
@@ -80,7 +80,7 @@ int run_features(const SeqArgs& a) {
       for (const auto& c : sequence.clips) names += (names.empty() ? "" : ", ") + c.name;
       throw InputError(
           Location{a.inputs.front(), 0, 0}, "--clip",
-          "no clip \"" + a.clip + "\" (clips: " + (names.empty() ? "none" : names) + ")");
+          "no clip " + quote(a.clip) + " (clips: " + (names.empty() ? "none" : names) + ")");
     }
     first = found->first;
     count = found->count;
@@ -90,9 +90,9 @@ int run_features(const SeqArgs& a) {
   seqnet::write_feature_file(a.out, features);
   std::cout << (a.inputs.size() == 1 ? a.inputs.front()
                                      : std::to_string(a.inputs.size()) + " inputs")
-            << ": " << sequence.vertex_count() << " vertices, "
-            << sequence.triangles.size() << " triangles, frames " << first << ".."
-            << first + count - 1 << " -> " << a.out << '\n';
+            << ": " << sequence.vertex_count() << " vertices, " << sequence.triangles.size()
+            << " triangles, frames " << first << ".." << first + count - 1 << " -> " << a.out
+            << '\n';
   // Round trip per clip (or the whole range when it has none).
   const seqnet::Reconstructor solver(features.rest, features.triangles);
   std::vector<seqnet::Clip> clips = features.clips;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "animrt/bridge/protocol.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
@@ -165,7 +166,8 @@ std::vector<BusConfig> parse_buses(const YamlNode& node, double rate_hz) {
     for (const auto& other : buses) {
       if (other.port == bus.port && !(find_protocol(other.protocol)->shares_port() &&
                                       find_protocol(bus.protocol)->shares_port())) {
-        value.at("port").fail("port \"" + bus.port + "\" is already used by bus " + other.name);
+        value.at("port").fail("port " + quote_path(bus.port) + " is already used by bus " +
+                              other.name);
       }
     }
     buses.push_back(std::move(bus));
@@ -361,9 +363,9 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
       (fs::path(given).is_absolute() ? fs::path(given) : folder / given).string();
   const std::string problem = input_file_problem(resolved, kMaxMediaFileBytes);
   const std::string where =
-      given == resolved
-          ? "\"" + given + "\""
-          : "\"" + given + "\" (resolved against the robot file's folder to \"" + resolved + "\")";
+      given == resolved ? quote_path(given)
+                        : quote_path(given) + " (resolved against the robot file's folder to " +
+                              quote_path(resolved) + ")";
   if (problem == kFileMissing) node.fail("file not found: " + where);
   if (!problem.empty()) node.fail(where + " " + problem);
   return resolved;
@@ -421,9 +423,9 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
 
   const std::string problem = input_file_problem(motion.file);
   const std::string where =
-      given == motion.file ? "\"" + given + "\""
-                           : "\"" + given + "\" (resolved against the robot file's folder to \"" +
-                                 motion.file + "\")";
+      given == motion.file ? quote_path(given)
+                           : quote_path(given) + " (resolved against the robot file's folder to " +
+                                 quote_path(motion.file) + ")";
   if (problem == kFileMissing) file.fail("file not found: " + where);
   if (!problem.empty()) file.fail(where + " " + problem);
   return motion;

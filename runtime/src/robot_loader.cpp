@@ -6,6 +6,7 @@
 #include "animrt/bridge/protocol.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/runtime/motion_check.hpp"
 
 namespace animrt {
@@ -93,8 +94,7 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     }
     return source;
   } else {
-    throw InputError(motion.where, "motion.type",
-                     "unsupported motion type \"" + motion.type + "\"");
+    throw InputError(motion.where, "motion.type", "unsupported motion type " + quote(motion.type));
   }
 }
 

@@ -47,19 +47,18 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   if (header.empty() || header[0] != "time_s" || n == 0 || header.size() != 1 + 2 * n) {
     fail(1,
          "expected the header time_s,<joint>_cmd_rad,...,<joint>_meas_rad,... of animrt run "
-         "--telemetry, found \"" +
-             line.substr(0, 80) + "\"");
+         "--telemetry, found " +
+             quote(line));
   }
   int column = static_cast<int>(header[0].size()) + 2;
   for (std::size_t j = 0; j < n; ++j) {
     const std::string& cmd = header[1 + j];
     const std::string& meas = header[1 + n + j];
-    if (!ends_with(cmd, "_cmd_rad"))
-      fail(column, "expected <joint>_cmd_rad, found \"" + cmd + "\"");
+    if (!ends_with(cmd, "_cmd_rad")) fail(column, "expected <joint>_cmd_rad, found " + quote(cmd));
     const std::string name = cmd.substr(0, cmd.size() - 8);
     if (meas != name + "_meas_rad") {
-      fail(0, "expected " + name + "_meas_rad as column " + std::to_string(2 + n + j) +
-                  ", found \"" + meas + "\"");
+      fail(0, "expected " + name + "_meas_rad as column " + std::to_string(2 + n + j) + ", found " +
+                  quote(meas));
     }
     rec.joints.push_back(name);
     column += static_cast<int>(cmd.size()) + 1;
@@ -78,7 +77,7 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
       const std::string& f = fields[i];
       const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), values[i]);
       if (ec != std::errc() || end != f.data() + f.size()) {
-        fail(col, "expected a number, found \"" + f + "\"");
+        fail(col, "expected a number, found " + quote(f));
       }
       col += static_cast<int>(f.size()) + 1;
     }

@@ -17,6 +17,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "animrt/controllers/head/audio.hpp"
+
 extern char** environ;
 
 namespace animrt::sim::head_corpus {
@@ -81,18 +83,12 @@ std::string make_ssml(const std::string& sentence, std::mt19937_64& rng, std::st
   return out;
 }
 
+// Through the one audio loader: its frame count is checked against the
+// file before anything is sized from it.
 std::vector<float> read_wav(const std::string& path, int& rate) {
-  SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (f == nullptr) throw std::runtime_error("cannot read " + path + ": " + sf_strerror(nullptr));
-  std::vector<float> inter(static_cast<std::size_t>(info.frames * info.channels));
-  sf_readf_float(f, inter.data(), info.frames);
-  sf_close(f);
-  std::vector<float> mono(static_cast<std::size_t>(info.frames));
-  for (std::size_t i = 0; i < mono.size(); ++i)
-    mono[i] = inter[i * static_cast<std::size_t>(info.channels)];
-  rate = info.samplerate;
-  return mono;
+  head::Audio audio = head::load_audio(path, 0);
+  rate = audio.sample_rate;
+  return std::move(audio.samples);
 }
 
 // One-pole low-pass with time constant tau (seconds) at `rate`.

@@ -12,6 +12,45 @@ TEST(InputError, FormatsFileLineColumnKey) {
   EXPECT_STREQ(e.what(), "robot.yaml:12:7: joints[3].home_deg: expected a number");
 }
 
+TEST(InputError, LongValuesAreElidedInTheMiddle) {
+  EXPECT_EQ(elide("short"), "short");
+  const std::string value = std::string(50, 'a') + std::string(1000, 'm') + std::string(50, 'z');
+  const std::string out = elide(value);
+  EXPECT_EQ(out, std::string(40, 'a') + "[... 1020 characters ...]" + std::string(40, 'z'));
+  EXPECT_EQ(quote(value), '"' + out + '"');
+  EXPECT_EQ(quote(std::string(80, 'x')), '"' + std::string(80, 'x') + '"');
+}
+
+TEST(InputError, SixtyMegabyteValueGivesAShortLine) {
+  const std::string huge(60u << 20, 'x');
+  // A message, a key and a file name built from it: every part of the line
+  // is bounded, the parts themselves stay whole.
+  const InputError built(Location{huge, 1, 1}, huge, "found " + quote(huge) + " and " + huge);
+  EXPECT_LT(std::string(built.what()).size(), 2500u);
+  EXPECT_EQ(built.key().size(), huge.size());
+}
+
+TEST(InputError, LongYamlValueAndKeyAreQuotedShort) {
+  // yaml-cpp parses a 60 MB scalar in half a minute: 1 MB shows the same.
+  const std::string big(1u << 20, 'x');
+  const YamlNode doc = YamlNode::load_string("rate: " + big + "\n? " + big + "\n: 1\n", "t.yaml");
+  try {
+    (void)doc.at("rate").as_double();
+    ADD_FAILURE() << "a string read as a number";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_LT(what.size(), 200u) << what.substr(0, 300);
+    EXPECT_EQ(what.rfind("t.yaml:1:7: rate: expected a number, found \"xxx", 0), 0u)
+        << what.substr(0, 300);
+  }
+  try {
+    doc.allow_only({"rate"});
+    ADD_FAILURE() << "an unknown key passed";
+  } catch (const InputError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 200u) << std::string(e.what()).substr(0, 300);
+  }
+}
+
 TEST(InputError, OmitsUnknownParts) {
   InputError e(Location{"robot.yaml", 0, 0}, "", "file is empty");
   EXPECT_STREQ(e.what(), "robot.yaml: file is empty");

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "animrt/core/yaml_doc.hpp"
+#include "support/hostile_files.hpp"
 
 namespace animrt {
 namespace {
@@ -74,6 +75,65 @@ TEST_F(InputFileTest, YamlLoaderUsesTheChecks) {
   } catch (const InputError& e) {
     // Not "file is empty", which is what reading a directory used to say.
     EXPECT_EQ(std::string(e.what()), dir_.string() + ": is a directory");
+  }
+}
+
+std::string bytes_error_of(const std::string& file, std::uintmax_t max_bytes,
+                           std::uintmax_t max_inflated) {
+  try {
+    (void)read_input_bytes(file, max_bytes, max_inflated);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST_F(InputFileTest, BytesArePlainOrInflatedMemberAfterMember) {
+  std::ofstream(path("plain.bin"), std::ios::binary) << "abc";
+  const std::vector<std::uint8_t> plain = read_input_bytes(path("plain.bin"));
+  EXPECT_EQ(std::string(plain.begin(), plain.end()), "abc");
+  // Two gzip members in a row read as one stream, as gzip -d reads them.
+  test::write_gzip_bomb(path("one.gz"), 0, "first ");
+  test::write_gzip_bomb(path("two.gz"), 3, "second");
+  {
+    std::ofstream both(path("both.gz"), std::ios::binary);
+    both << std::ifstream(path("one.gz"), std::ios::binary).rdbuf()
+         << std::ifstream(path("two.gz"), std::ios::binary).rdbuf();
+  }
+  const std::vector<std::uint8_t> both = read_input_bytes(path("both.gz"));
+  EXPECT_EQ(std::string(both.begin(), both.end()), std::string("first second\0\0\0", 15));
+}
+
+TEST_F(InputFileTest, BytesRefuseFifoDeviceAndGzipBombNamingTheFile) {
+  const test::UnblockedFifo fifo(path("pipe.gz"));
+  EXPECT_EQ(bytes_error_of(fifo.path(), kMaxInputFileBytes, kMaxInflatedBytes),
+            fifo.path() + ": is not a regular file (FIFO)");
+  EXPECT_EQ(bytes_error_of("/dev/zero", kMaxInputFileBytes, kMaxInflatedBytes),
+            "/dev/zero: is not a regular file (character device)");
+  // 80 MiB of zeros in some 80 KB: refused at the 64 MiB limit while
+  // inflating, and a lower limit stops it sooner.
+  test::write_gzip_bomb(path("bomb.gz"), std::uint64_t{80} << 20);
+  EXPECT_LT(fs::file_size(path("bomb.gz")), 200000u);
+  EXPECT_EQ(bytes_error_of(path("bomb.gz"), kMaxInputFileBytes, kMaxInflatedBytes),
+            path("bomb.gz") + ": gzip data inflates to more than the 64 MiB limit");
+  EXPECT_EQ(bytes_error_of(path("bomb.gz"), kMaxInputFileBytes, std::uintmax_t{1} << 20),
+            path("bomb.gz") + ": gzip data inflates to more than the 1 MiB limit");
+  // A cut stream is named too.
+  fs::copy_file(path("bomb.gz"), path("cut.gz"));
+  fs::resize_file(path("cut.gz"), fs::file_size(path("bomb.gz")) / 2);
+  EXPECT_EQ(bytes_error_of(path("cut.gz"), kMaxInputFileBytes, std::uintmax_t{128} << 20),
+            path("cut.gz") + ": gzip data is truncated");
+}
+
+TEST(HeaderCount, CountsMustFitTheFileBeforeAnythingIsSized) {
+  EXPECT_NO_THROW(check_header_count("m.bin", "header", "the frames", 10, 8, 80));
+  try {
+    check_header_count("m.bin", "header", "the frames", std::uint64_t{1} << 40, 8, 80);
+    ADD_FAILURE() << "a count past the file's size passed";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "m.bin: header: the frames (1099511627776 x 8 bytes) is larger than the file "
+                 "(80 bytes)");
   }
 }
 

@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "animrt/controllers/head/audio.hpp"
+#include "animrt/controllers/head/corpus.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/core/error.hpp"
 #include "head_test_util.hpp"
+#include "support/hostile_files.hpp"
 
 namespace animrt::head {
 namespace {
@@ -104,6 +106,60 @@ TEST_F(WavHardening, TruncatedDirectoryAndFifoHaveClearMessages) {
   ASSERT_EQ(::mkfifo((dir_ + "/pipe.wav").c_str(), 0600), 0);
   EXPECT_EQ(error_of([&] { load_audio(dir_ + "/pipe.wav"); }),
             dir_ + "/pipe.wav: is not a regular file (FIFO)");
+}
+
+// A FLAC file whose STREAMINFO claims 2^28 frames: nothing may be sized from
+// that claim (a buffer of 1 GiB for 32 KB of sound).
+TEST_F(WavHardening, FlacHeaderClaimingFarMoreFramesThanItCanHoldIsRefused) {
+  const std::string path = dir_ + "/lying.flac";
+  {
+    SF_INFO info{};
+    info.samplerate = 16000;
+    info.channels = 1;
+    info.format = SF_FORMAT_FLAC | SF_FORMAT_PCM_16;
+    SNDFILE* sf = sf_open(path.c_str(), SFM_WRITE, &info);
+    ASSERT_NE(sf, nullptr);
+    const Audio a = test::tone(150, 1.0);
+    sf_writef_float(sf, a.samples.data(), static_cast<sf_count_t>(a.samples.size()));
+    sf_close(sf);
+  }
+  // "fLaC", a 4-byte block header, then STREAMINFO: its 36-bit total sample
+  // count is the low nibble of file byte 21 and bytes 22..25, big-endian.
+  std::string bytes = read_all(path);
+  ASSERT_EQ(bytes.substr(0, 4), "fLaC");
+  bytes[21] = static_cast<char>(bytes[21] & 0xf0);
+  const unsigned char total[4] = {0x10, 0, 0, 0};  // 2^28
+  std::memcpy(bytes.data() + 22, total, 4);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  const std::string e = error_of([&] { load_audio(path); });
+  EXPECT_EQ(e.rfind(path + ": the header declares 268435456 frames x 1 channels, more than 64 "
+                           "samples per byte of its ",
+                    0),
+            0u)
+      << e;
+
+  // A claim within that bound but beyond what the file holds is read in
+  // chunks and refused as truncated.
+  bytes[22] = 0;
+  const unsigned char smaller[4] = {0, 0x01, 0, 0};  // 65536 frames, 16000 present
+  std::memcpy(bytes.data() + 22, smaller, 4);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_EQ(error_of([&] { load_audio(path); }),
+            path + ": truncated audio file: expected 65536 frames, read 16000");
+}
+
+TEST_F(WavHardening, CorpusFolderRefusesARecordingOrPoseFileThatIsAFifo) {
+  write_wav(dir_ + "/a.wav", test::tone(150, 0.2));
+  std::ofstream(dir_ + "/a.csv") << "time_s,yaw_deg,pitch_deg,roll_deg\n0,0,0,0\n";
+  {
+    const animrt::test::UnblockedFifo fifo(dir_ + "/b.wav");
+    EXPECT_EQ(error_of([&] { (void)list_corpus(dir_); }),
+              fifo.path() + ": is not a regular file (FIFO)");
+  }
+  write_wav(dir_ + "/b.wav", test::tone(150, 0.2));
+  const animrt::test::UnblockedFifo pose(dir_ + "/b.csv");
+  EXPECT_EQ(error_of([&] { (void)list_corpus(dir_); }),
+            pose.path() + ": is not a regular file (FIFO)");
 }
 
 }  // namespace

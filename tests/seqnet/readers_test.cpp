@@ -7,6 +7,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/core/error.hpp"
 #include "seq_test_util.hpp"
+#include "support/hostile_files.hpp"
 
 namespace animrt::seqnet {
 namespace {
@@ -136,7 +137,7 @@ TEST(Md2Reader, BadFilesNameFileAndPart) {
   huge.put_i32(40, 1 << 30);  // frame count far beyond the file
   huge.save(path);
   e = error_of(path, read_md2);
-  EXPECT_NE(e.find("frames"), std::string::npos) << e;
+  EXPECT_NE(e.find("frame count is 1073741824"), std::string::npos) << e;
 
   Bytes index = b;
   index.data[68] = 9;  // first triangle's first vertex index: 9 of 5
@@ -283,6 +284,111 @@ TEST(ObjReader, FolderInNameOrderWithOneConnectivity) {
   EXPECT_NE(e.find("c.obj"), std::string::npos) << e;
   EXPECT_NE(e.find("frame 2"), std::string::npos) << e;
   EXPECT_NE(e.find("connectivity differs"), std::string::npos) << e;
+}
+
+// Hostile inputs: every mesh reader refuses a FIFO (without blocking), a
+// device and a gzip bomb, and names the file.
+TEST(MeshReaders, FifoDeviceAndGzipBombAreRefusedByName) {
+  namespace fs = std::filesystem;
+  const std::string dir = seqtest::temp_path("hostile_meshes");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // 80 MiB of zeros, past the 64 MiB inflated limit, in some 80 KB.
+  animrt::test::write_gzip_bomb(dir + "/bomb.gz", std::uint64_t{80} << 20);
+  for (const std::string ext : {".obj", ".md2", ".md3"}) {
+    const animrt::test::UnblockedFifo fifo(dir + "/pipe" + ext);
+    EXPECT_EQ(error_of(fifo.path(), read_mesh_sequence),
+              fifo.path() + ": is not a regular file (FIFO)");
+    EXPECT_EQ(fifo.times_opened(), 0) << ext;
+    const std::string zero = dir + "/zero" + ext;
+    fs::create_symlink("/dev/zero", zero);
+    EXPECT_EQ(error_of(zero, read_mesh_sequence),
+              zero + ": is not a regular file (character device)");
+    const std::string bomb = dir + "/bomb" + ext + ".gz";
+    fs::copy_file(dir + "/bomb.gz", bomb);
+    EXPECT_EQ(error_of(bomb, read_mesh_sequence),
+              bomb + ": gzip data inflates to more than the 64 MiB limit");
+  }
+}
+
+TEST(Md2Reader, CountsBeyondTheEngineLimitsOrTheFileAreRefused) {
+  const std::string path = seqtest::temp_path("counts.md2");
+  // 600 frames, every byte present: more than the 512 Quake II allows.
+  std::vector<Md2Frame> many(600, Md2Frame{{1, 1, 1}, {0, 0, 0}, "idle"});
+  make_md2(many).save(path);
+  EXPECT_EQ(error_of(path, read_md2), path + ": header: frame count is 600, expected 1..512");
+  // A header that claims more frames than the file holds.
+  Bytes lying = make_md2(three_frames());
+  lying.put_i32(40, 500);
+  lying.save(path);
+  std::string e = error_of(path, read_md2);
+  EXPECT_EQ(e.rfind(path + ": header: ", 0), 0u) << e;
+  EXPECT_NE(e.find("the frames"), std::string::npos) << e;
+  // 100000 vertices with the matching frame size, in a file of 300 bytes.
+  lying = make_md2(three_frames());
+  lying.put_i32(24, 100000);
+  lying.put_i32(16, 40 + 4 * 100000);
+  lying.save(path);
+  EXPECT_EQ(error_of(path, read_md2), path + ": header: vertex count is 100000, expected 1..2048");
+}
+
+TEST(Md3Reader, AnimationCfgThatIsAFifoOrDeviceIsRefusedByName) {
+  namespace fs = std::filesystem;
+  const std::string dir = seqtest::temp_path("md3_cfg");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  make_md3(2, 2).save(dir + "/lower.md3");
+  {
+    const animrt::test::UnblockedFifo fifo(dir + "/animation.cfg");
+    EXPECT_EQ(error_of(dir + "/lower.md3", read_md3),
+              fifo.path() + ": is not a regular file (FIFO)");
+    EXPECT_EQ(fifo.times_opened(), 0);
+  }
+  fs::create_symlink("/dev/zero", dir + "/animation.cfg");
+  EXPECT_EQ(error_of(dir + "/lower.md3", read_md3),
+            dir + "/animation.cfg: is not a regular file (character device)");
+}
+
+TEST(ObjReader, FolderRefusesAFrameThatIsAFifoOrADeviceByName) {
+  namespace fs = std::filesystem;
+  const std::string dir = seqtest::temp_path("objs_hostile");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  seqtest::write_text(dir + "/a.obj", "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 2 3\nf 1 3 4\n");
+  {
+    const animrt::test::UnblockedFifo fifo(dir + "/b.obj");
+    EXPECT_EQ(error_of(dir, read_obj_sequence), fifo.path() + ": is not a regular file (FIFO)");
+    EXPECT_EQ(fifo.times_opened(), 0);
+  }
+  fs::create_symlink("/dev/zero", dir + "/c.obj.gz");
+  EXPECT_EQ(error_of(dir, read_obj_sequence),
+            dir + "/c.obj.gz: is not a regular file (character device)");
+  fs::remove(dir + "/c.obj.gz");
+  fs::create_symlink(dir + "/gone.obj", dir + "/d.obj");
+  EXPECT_EQ(error_of(dir, read_obj_sequence), dir + "/d.obj: is a broken link");
+}
+
+TEST(ObjReader, MoreVerticesOrTrianglesThanAFrameMayHaveAreRefused) {
+  const std::string path = seqtest::temp_path("many.obj");
+  std::string text;
+  for (int i = 0; i < 1000001; ++i) text += "v 0 0 0\n";
+  seqtest::write_text(path, text);
+  EXPECT_EQ(error_of(path, read_obj),
+            path + ": v: 1000001 vertices, more than the 1000000 a frame may have");
+  // One polygon of 2000003 corners fans into 2000001 triangles.
+  text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 2000003; ++i) text += " " + std::to_string(1 + i % 3);
+  seqtest::write_text(path, text + "\n");
+  EXPECT_EQ(error_of(path, read_obj),
+            path + ":4:1: f: more than the 2000000 triangles a frame may have");
+}
+
+TEST(ObjReader, ALongTokenIsQuotedShort) {
+  const std::string path = seqtest::temp_path("long_token.obj");
+  seqtest::write_text(path, "v 0 0 " + std::string(60u << 20, '7') + "x\n");
+  const std::string e = error_of(path, read_obj);
+  EXPECT_LT(e.size(), path.size() + 200) << e.substr(0, 300);
+  EXPECT_NE(e.find("characters ...]"), std::string::npos) << e.substr(0, 300);
 }
 
 }  // namespace

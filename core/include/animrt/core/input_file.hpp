@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "animrt/core/error.hpp"
 
@@ -20,6 +21,10 @@ inline constexpr std::uintmax_t kMaxInputFileBytes = std::uintmax_t{64} << 20;  
 // decoded whole into floats, up to 4x its size in memory.
 inline constexpr std::uintmax_t kMaxMediaFileBytes = std::uintmax_t{256} << 20;  // 256 MiB
 
+// What a gzip-compressed input may inflate to. Checked while inflating, so a
+// small file that would inflate to gigabytes stops at this limit.
+inline constexpr std::uintmax_t kMaxInflatedBytes = std::uintmax_t{64} << 20;  // 64 MiB
+
 // What is wrong with `path` as an input file, or "" when it is a readable
 // regular file of at most `max_bytes`: "does not exist", "is a directory",
 // "is not a regular file (FIFO)", "is 80 MiB, more than the 64 MiB limit", ...
@@ -33,5 +38,18 @@ void check_input_file(const std::string& path, std::uintmax_t max_bytes = kMaxIn
 // The whole file, after the checks above (made again on the open descriptor,
 // so a file swapped between check and open is caught too). Throws InputError.
 std::string read_input_file(const std::string& path, std::uintmax_t max_bytes = kMaxInputFileBytes);
+
+// The whole file as bytes, read as read_input_file does; a file that starts
+// with the gzip magic is inflated (several members in a row as one stream),
+// and refused as soon as its inflated bytes pass `max_inflated`.
+std::vector<std::uint8_t> read_input_bytes(const std::string& path,
+                                           std::uintmax_t max_bytes = kMaxInputFileBytes,
+                                           std::uintmax_t max_inflated = kMaxInflatedBytes);
+
+// Counts read from a binary header, checked before anything is sized from
+// them: throws InputError "PATH: KEY: WHAT (COUNT x ITEM bytes) is larger
+// than the file (AVAILABLE bytes)" unless count * item fits.
+void check_header_count(const std::string& path, const std::string& key, const std::string& what,
+                        std::uint64_t count, std::uint64_t item_bytes, std::uint64_t available);
 
 }  // namespace animrt
