@@ -78,6 +78,7 @@ Trial run_trial() {
   }
   q = start;
   for (auto& bus : buses) bus->activate();
+  for (auto& bus : buses) bus->arm_device_guard();
   const auto period = std::chrono::nanoseconds(static_cast<long>(1e9 / robot.config.rate_hz));
   auto deadline = std::chrono::steady_clock::now();
   const int cycles = static_cast<int>(robot.config.rate_hz);

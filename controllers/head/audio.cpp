@@ -64,9 +64,11 @@ void check_riff_length(const std::string& path) {
 constexpr sf_count_t kChunkFrames = 16384;
 // A compressed file (FLAC, Ogg, MPEG) may declare at most this many samples per
 // byte it has, and at least kMinCompressedSamples in any case. Speech and
-// music compress to about a byte a sample; long silence far further, which
-// the floor covers for short files.
-constexpr std::uintmax_t kMaxSamplesPerCompressedByte = 64;
+// music compress to about a byte a sample; digital silence in FLAC (constant
+// subframes, about 15 bytes a 4096-sample block) to some 300-500, and a show
+// track may be mostly silence. Nothing is sized from the claim (samples are
+// read in chunks), so this only refuses a header that cannot be true.
+constexpr std::uintmax_t kMaxSamplesPerCompressedByte = 4096;
 constexpr std::uintmax_t kMinCompressedSamples = std::uintmax_t{1} << 20;
 
 // Bytes a sample takes in an uncompressed encoding, 0 for a compressed one.

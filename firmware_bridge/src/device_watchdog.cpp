@@ -7,7 +7,7 @@
 namespace animrt {
 namespace {
 
-constexpr double kMinDefaultMs = 50.0;
+constexpr double kMinDefaultMs = 100.0;
 constexpr double kDefaultPeriods = 5.0;
 
 double round_up(double ms, double unit_ms) { return std::ceil(ms / unit_ms - 1e-9) * unit_ms; }

@@ -11,10 +11,10 @@ namespace animrt::cli {
 namespace {
 
 constexpr StopSignal kStopSignals[] = {
-    {SIGINT, "SIGINT", true},   {SIGTERM, "SIGTERM", true},     {SIGHUP, "SIGHUP", true},
-    {SIGQUIT, "SIGQUIT", true}, {SIGUSR1, "SIGUSR1", true},     {SIGUSR2, "SIGUSR2", true},
-    {SIGALRM, "SIGALRM", true}, {SIGVTALRM, "SIGVTALRM", true}, {SIGPROF, "SIGPROF", true},
-    {SIGXCPU, "SIGXCPU", true}, {SIGPIPE, "SIGPIPE", false},    {SIGXFSZ, "SIGXFSZ", false},
+    {SIGINT, "SIGINT", true},    {SIGTERM, "SIGTERM", true},     {SIGHUP, "SIGHUP", true},
+    {SIGQUIT, "SIGQUIT", true},  {SIGUSR1, "SIGUSR1", true},     {SIGUSR2, "SIGUSR2", true},
+    {SIGALRM, "SIGALRM", true},  {SIGVTALRM, "SIGVTALRM", true}, {SIGPROF, "SIGPROF", true},
+    {SIGXCPU, "SIGXCPU", false}, {SIGPIPE, "SIGPIPE", false},    {SIGXFSZ, "SIGXFSZ", false},
 };
 
 RunControls* g_controls = nullptr;

@@ -1,9 +1,10 @@
 #pragma once
 // Every catchable signal that would end the process is a stop request: the
 // figure ramps home and the run ends as after Ctrl-C. A second one of those
-// sent from outside (all but SIGPIPE and SIGXFSZ) switches torque off at
-// once, as a second Ctrl-C does. SIGPIPE and SIGXFSZ come from the process's
-// own writes and repeat with every write, so each stops at most once and
+// sent from outside (all but SIGPIPE, SIGXFSZ and SIGXCPU) switches torque
+// off at once, as a second Ctrl-C does. SIGPIPE and SIGXFSZ come from the
+// process's own writes and repeat with every write, SIGXCPU from a CPU-time
+// limit and repeats every second past it, so each stops at most once and
 // never cuts torque; a SIGPIPE stops only when it is stdout or stderr whose
 // reader left (`animrt run ... | head -1`), not a socket or a telemetry pipe
 // (those writes fail with EPIPE and are counted where they happen).

@@ -314,7 +314,7 @@ void DashboardCore::stop() {
     // client that does not read is not waited for long.
     changed_.wait_for(lock, std::chrono::seconds(1), [this] { return streams_ == 0; });
   }
-  server_.stop();
+  server_.close_listener();
   if (listener_.joinable()) listener_.join();
 }
 

@@ -201,6 +201,13 @@ void DashboardHttpServer::untrack(socket_t sock) {
   open_.erase(sock);
 }
 
+void DashboardHttpServer::close_listener() {
+  const socket_t sock = svr_sock_.exchange(INVALID_SOCKET);
+  if (sock == INVALID_SOCKET) return;
+  ::shutdown(sock, SHUT_RDWR);
+  ::close(sock);
+}
+
 void DashboardHttpServer::wake_all() {
   std::lock_guard lock(mutex_);
   waking_ = true;

@@ -39,6 +39,11 @@ class DashboardHttpServer : public httplib::Server {
   // Connections being served now.
   int connections() const;
 
+  // Ends the listening thread whenever it is called. httplib's stop() does
+  // nothing until that thread has set its running flag, so a stop that comes
+  // first (a run that ends at once) would leave it accepting for ever.
+  void close_listener();
+
  private:
   class ConnectionThreads;
   class ConnectionStream;

@@ -50,6 +50,7 @@ class ActivationGuard {
 
   void activate_all() {
     while (activated_ < buses_.size()) buses_[activated_++]->activate();
+    for (auto& bus : buses_) bus->arm_device_guard();
   }
   void release() {
     for (std::size_t b = 0; b < activated_; ++b) buses_[b]->deactivate();

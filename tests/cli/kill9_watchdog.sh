@@ -49,8 +49,8 @@ kill -0 $run_pid 2> /dev/null || fail "the run ended before the kill: $(cat "$tm
 kill -KILL $run_pid
 wait $run_pid 2> /dev/null
 run_pid=""
-# The default watchdog here is 60 ms (5 periods of 200 Hz are 25 ms; at
-# least 50 ms; units of 20 ms). 0.3 s is plenty, and short of any servo
+# The default watchdog here is 100 ms (5 periods of 200 Hz are 25 ms; at
+# least 100 ms; units of 20 ms). 0.3 s is plenty, and short of any servo
 # reaching its goal by itself.
 sleep 0.3
 /usr/bin/python3 "$root/tests/cli/dxl_probe.py" "$pty" 1 12 0.2 > "$tmp/probe.txt" ||
@@ -105,7 +105,7 @@ kill -0 $run_pid 2> /dev/null || fail "the run ended before the kill: $(cat "$tm
 kill -KILL $run_pid
 wait $run_pid 2> /dev/null
 run_pid=""
-sleep 0.3  # watchdogs: 60 ms (neck), 50 ms (face)
+sleep 0.3  # watchdogs: 100 ms (neck and face)
 /usr/bin/python3 "$root/tests/cli/dxl_probe.py" "$neck" 1 2 0.2 > "$tmp/probe.txt" ||
   fail "probe: $(cat "$tmp/probe.txt")"
 while read -r id watchdog torque moving p1 p2; do

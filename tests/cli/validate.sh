@@ -28,7 +28,7 @@ out=$("$animrt" validate "$root/configs/robots/arm_sts.yaml" 2>&1) || fail "arm_
   fail "no guard line for the Feetech bus: $out"
 out=$("$animrt" validate "$root/configs/robots/animatronic.yaml" 2>&1) || fail "animatronic rejected: $out"
 [[ $(echo "$out" | grep -c "^bus torso (modbus-tcp): no device-side guard") -eq 1 &&
-  $(echo "$out" | grep -c "^bus face (maestro): .*Timeout to 0.05 s in the Maestro Control Center") -eq 1 &&
+  $(echo "$out" | grep -c "^bus face (maestro): .*Timeout to 0.10 s in the Maestro Control Center") -eq 1 &&
   $(echo "$out" | grep -c "^bus neck") -eq 0 ]] || fail "guard lines of the animatronic figure: $out"
 out=$("$animrt" validate "$root/configs/robots/quadruped.yaml" 2>&1)
 [[ $(echo "$out" | wc -l) -eq 1 ]] || fail "the quadruped's Bus Watchdog is set by animrt: $out"

@@ -24,6 +24,7 @@ class SwappedAnswers final : public ActuatorBus {
   const BusConfig& config() const override { return inner_->config(); }
   void configure() override { inner_->configure(); }
   void activate() override { inner_->activate(); }
+  void arm_device_guard() override { inner_->arm_device_guard(); }
   void deactivate() override { inner_->deactivate(); }
   void read(std::span<double> positions) override {
     inner_->read(positions);

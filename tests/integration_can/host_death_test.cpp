@@ -151,6 +151,7 @@ struct Host {
     }
     q = start;
     for (auto& bus : buses) bus->activate();
+    for (auto& bus : buses) bus->arm_device_guard();
   }
   // One cycle at `t`: a slow sway around the measured pose (0.2 rad, 1 Hz).
   void cycle(Figure& figure, Nanos t) {

@@ -44,7 +44,7 @@ TEST(MixedCli, ValidateNamesEveryLayerFile) {
   EXPECT_EQ(out, kFigure + ": ok (6 joints, 3 buses, 6 devices, layers [gait " + robots +
                      "../shows/neck_idle_gait.yaml, show " + robots +
                      "../shows/hello.yaml])\nbus face (maestro): the Maestro takes its serial "
-                     "timeout only from its settings: set Serial Settings > Timeout to 0.05 s in "
+                     "timeout only from its settings: set Serial Settings > Timeout to 0.10 s in "
                      "the Maestro Control Center, and each channel's On startup or error to Off "
                      "or Go to (what the servo does when the host dies)\nbus torso (modbus-tcp): "
                      "no device-side guard (a register map names no watchdog register; set the "

@@ -259,5 +259,27 @@ TEST(MaestroBus, SerialTimeoutOfADeadHostIsClearedWithAWarningAndActivationOutla
       << dynamic_cast<MaestroBus&>(*next).timeout_warning();
 }
 
+TEST(MaestroBus, ASerialTimeoutWhileTheOtherBusesCameUpRefusesTheRun) {
+  // The board's timeout is always on: if it ran out between activate() and
+  // the first cycle, the channels went home and the first target would jump
+  // them back, so the run is refused, saying what to change.
+  Rig r("    device_watchdog_ms: 50\n");
+  r.bus->configure();
+  r.bus->activate();
+  r.clock.advance(20'000'000);
+  ASSERT_NO_THROW(r.bus->arm_device_guard());  // within the timeout: nothing to say
+  r.clock.advance(200'000'000);
+  try {
+    r.bus->arm_device_guard();
+    FAIL() << "a serial timeout that fired before the first cycle was taken";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("serial timeout of Maestro 12 ran out while the other "
+                                         "buses came up"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(r.sim->pulse(0), 0);  // switched off, not left to the board
+}
+
 }  // namespace
 }  // namespace animrt

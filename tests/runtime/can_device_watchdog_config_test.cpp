@@ -77,13 +77,13 @@ class CanWatchdogConfig : public ::testing::Test {
   fs::path dir_;
 };
 
-TEST_F(CanWatchdogConfig, DefaultIsTheLargerOf50MsAndFiveLoopPeriods) {
+TEST_F(CanWatchdogConfig, DefaultIsTheLargerOf100MsAndFiveLoopPeriods) {
   RobotConfig c = load("");
-  EXPECT_EQ(drive_ms(c), 50);
-  EXPECT_EQ(motor_ms(c), 50);
-  c = load("", "", 50);  // 20 ms periods
   EXPECT_EQ(drive_ms(c), 100);
   EXPECT_EQ(motor_ms(c), 100);
+  c = load("", "", 40);  // 25 ms periods
+  EXPECT_EQ(drive_ms(c), 125);
+  EXPECT_EQ(motor_ms(c), 125);
   c = load("", "", 30);  // 33.3 ms periods
   EXPECT_EQ(drive_ms(c), 167);
   const auto o = std::any_cast<Cia402BusOptions>(c.buses[0].options);
@@ -157,8 +157,8 @@ TEST_F(CanWatchdogConfig, ValidateSaysWhatEachBusHas) {
   std::vector<std::string> notes = device_guard_notes(c);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_EQ(notes[0],
-            "bus motors (mit): the motors go limp 50 ms after the last command only if each "
-            "motor's CAN timeout is set to that in its serial setup menu (2000 cycles at 40 "
+            "bus motors (mit): the motors go limp 100 ms after the last command only if each "
+            "motor's CAN timeout is set to that in its serial setup menu (4000 cycles at 40 "
             "kHz): animrt cannot set or read it over CAN");
   c = load("device_watchdog_ms: off", "device_watchdog_ms: off");
   notes = device_guard_notes(c);

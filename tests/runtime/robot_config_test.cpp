@@ -994,16 +994,20 @@ TEST_F(RobotConfigTest, MotionLayersAreAtMostSixteen) {
 // ------------------------------------------------------- device watchdog
 
 TEST_F(RobotConfigTest, DynamixelBusWatchdogDefaultsToAFewLoopPeriods) {
-  // 100 Hz: 5 periods are 50 ms, rounded up to the unit of 20 ms: 3 units.
-  EXPECT_EQ(dxl::bus_options(load(kMinimal).buses[0]).bus_watchdog, 3);
+  // 100 Hz: 5 periods are 50 ms, so the floor of 100 ms: 5 units of 20 ms.
+  EXPECT_EQ(dxl::bus_options(load(kMinimal).buses[0]).bus_watchdog, 5);
   // 10 Hz: 5 periods are 500 ms: 25 units.
   std::string slow = kMinimal;
   slow.replace(slow.find("rate_hz: 100"), 12, "rate_hz: 10");
   EXPECT_EQ(dxl::bus_options(load(slow).buses[0]).bus_watchdog, 25);
-  // 1 kHz: 5 periods are 5 ms, so 50 ms: 3 units.
+  // 30 Hz: 5 periods are 166.7 ms, rounded up to 180 ms: 9 units.
+  std::string mid = kMinimal;
+  mid.replace(mid.find("rate_hz: 100"), 12, "rate_hz: 30");
+  EXPECT_EQ(dxl::bus_options(load(mid).buses[0]).bus_watchdog, 9);
+  // 1 kHz: 5 periods are 5 ms, so 100 ms: 5 units.
   std::string fast = kMinimal;
   fast.replace(fast.find("rate_hz: 100"), 12, "rate_hz: 1000");
-  EXPECT_EQ(dxl::bus_options(load(fast).buses[0]).bus_watchdog, 3);
+  EXPECT_EQ(dxl::bus_options(load(fast).buses[0]).bus_watchdog, 5);
 }
 
 TEST_F(RobotConfigTest, DynamixelBusWatchdogKey) {

@@ -70,6 +70,7 @@ TEST(DynamixelBusOnSim, ServoRefusesGoalsOutsideTheJointLimitsTheBusWrote) {
   DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
   bus.configure();
   bus.activate();
+  bus.arm_device_guard();
   std::vector<double> q(2, 0.0);
   bus.read(q);
   bus.write(std::vector<double>{2.0, 0.0});  // clamped by the bus to 0.4
@@ -117,6 +118,7 @@ TEST(DynamixelBusOnSim, JointRestingOutsideItsLimitsStartsAndIsLedInside) {
   EXPECT_NE(bus.outside_warning().find("id 4 (joint4) is at -3.0 deg"), std::string::npos)
       << bus.outside_warning();
   ASSERT_NO_THROW(bus.activate());
+  ASSERT_NO_THROW(bus.arm_device_guard());
   std::vector<double> q(2, 0.0);
   bus.read(q);
   EXPECT_NEAR(q[1], rest, 1e-3);
@@ -177,6 +179,7 @@ TEST(DynamixelBusOnSim, BusWatchdogIsSetAtActivateAndClearedAtDeactivate) {
   test::PtyClient other(sim.endpoint());
   EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 0u);
   bus.activate();
+  bus.arm_device_guard();
   for (int id : {3, 4}) {
     EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::torque_enable), 1u);
     EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 3u);
@@ -186,6 +189,33 @@ TEST(DynamixelBusOnSim, BusWatchdogIsSetAtActivateAndClearedAtDeactivate) {
     EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 0u);
     EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::torque_enable), 0u);
   }
+}
+
+TEST(DynamixelBusOnSim, BusWatchdogStartsOnlyWhenEveryBusIsUp) {
+  // Other buses may take longer to come up than the guard's time: the servos
+  // must not count that (they would stop and refuse goals from the first
+  // cycle on), and arming reaches every servo at once.
+  const BusConfig config = guarded(1);  // 20 ms
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(config, clock);
+  sim.start();
+  DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
+  bus.configure();
+  bus.activate();
+  clock.set(500'000'000);  // the other buses took half a second
+  test::PtyClient other(sim.endpoint());
+  for (int id : {3, 4})
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 0u);
+  bus.arm_device_guard();
+  for (int id : {3, 4})
+    EXPECT_EQ(reg8(other, static_cast<std::uint8_t>(id), xreg::bus_watchdog), 1u);
+  std::vector<double> q(2, 0.0);
+  bus.read(q);
+  for (double& v : q) v += 0.05;
+  bus.write(q);
+  for (const DeviceStatus& d : bus.devices()) EXPECT_EQ(d.health, DeviceHealth::ok);
+  clock.set(530'000'000);  // 30 ms without a word: now it fires
+  EXPECT_EQ(reg8(other, 4, xreg::bus_watchdog), dxl::kBusWatchdogFired);
 }
 
 TEST(DynamixelBusOnSim, BusWatchdogIsJudgedOnTheClockOfTheRun) {
@@ -198,6 +228,7 @@ TEST(DynamixelBusOnSim, BusWatchdogIsJudgedOnTheClockOfTheRun) {
   DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
   bus.configure();
   bus.activate();
+  bus.arm_device_guard();
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   test::PtyClient other(sim.endpoint());
   EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 1u);
@@ -220,6 +251,7 @@ TEST(DynamixelBusOnSim, FiredBusWatchdogHoldsTheServoUntilTheNextConfigure) {
     DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
     bus.configure();
     bus.activate();
+    bus.arm_device_guard();
     std::vector<double> q(2, 0.0);
     bus.read(q);
     bus.write(std::vector<double>{1.0, -1.0});
@@ -250,6 +282,7 @@ TEST(DynamixelBusOnSim, FiredBusWatchdogHoldsTheServoUntilTheNextConfigure) {
       << bus.watchdog_warning();
   EXPECT_EQ(reg8(other, 3, xreg::bus_watchdog), 0u);
   ASSERT_NO_THROW(bus.activate());
+  ASSERT_NO_THROW(bus.arm_device_guard());
   std::vector<double> q(2, 0.0);
   bus.read(q);
   bus.write(std::vector<double>{0.2, 0.0});
@@ -271,6 +304,7 @@ TEST(DynamixelBusOnSim, AHostThatStallsRearmsTheBusWatchdogAndMovesOn) {
   DynamixelBus bus(config, open_serial(sim.endpoint(), 1'000'000));
   bus.configure();
   bus.activate();
+  bus.arm_device_guard();
   std::vector<double> q(2, 0.0);
   bus.read(q);
   std::this_thread::sleep_for(std::chrono::milliseconds(200));

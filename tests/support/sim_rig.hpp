@@ -64,6 +64,7 @@ class WatchedBus final : public ActuatorBus {
     notify(BusCall::activate);
     inner_->activate();
   }
+  void arm_device_guard() override { inner_->arm_device_guard(); }
   void deactivate() override {
     notify(BusCall::deactivate);
     inner_->deactivate();

@@ -422,26 +422,6 @@ void Cia402Bus::activate() {
     target_counts_[i] = actual_counts_[i];
     hw_fault_[i] = 0;
   }
-  if (options_.device_watchdog_ms > 0) {
-    // Armed before the drives are enabled; a drive starts watching at the
-    // first heartbeat after the consumer is set, sent at once.
-    try {
-      for (std::size_t i = 0; i < status_.size(); ++i) {
-        sdo_write(i, cia402::obj::abort_connection_option, 0,
-                  static_cast<std::uint16_t>(options_.abort_connection), 2);
-        sdo_write(i, cia402::obj::heartbeat_consumer, 1,
-                  consumer_entry(options_.host_node_id, options_.device_watchdog_ms), 4);
-      }
-    } catch (const DeviceError& e) {
-      deactivate();
-      throw DeviceError(std::string(e.what()) +
-                        " (the drive's guard against a dead host; device_watchdog_ms: off "
-                        "runs without it)");
-    }
-    producing_ = true;
-    next_host_heartbeat_ = transport_->now();
-    produce_heartbeat();
-  }
   const std::string failed = walk_to(State::operation_enabled);
   if (!failed.empty()) {
     deactivate();
@@ -452,6 +432,29 @@ void Cia402Bus::activate() {
     hw_fault_[i] = 0;
   }
   running_ = true;
+}
+
+void Cia402Bus::arm_device_guard() {
+  if (options_.device_watchdog_ms <= 0) return;
+  // A drive starts watching at the first heartbeat after the consumer is
+  // set, sent at once; from then on every read produces them.
+  try {
+    for (std::size_t i = 0; i < status_.size(); ++i) {
+      if (status_[i].faulted) continue;
+      sdo_write(i, cia402::obj::abort_connection_option, 0,
+                static_cast<std::uint16_t>(options_.abort_connection), 2);
+      sdo_write(i, cia402::obj::heartbeat_consumer, 1,
+                consumer_entry(options_.host_node_id, options_.device_watchdog_ms), 4);
+    }
+  } catch (const DeviceError& e) {
+    deactivate();
+    throw DeviceError(std::string(e.what()) +
+                      " (the drive's guard against a dead host; device_watchdog_ms: off "
+                      "runs without it)");
+  }
+  producing_ = true;
+  next_host_heartbeat_ = transport_->now();
+  produce_heartbeat();
 }
 
 void Cia402Bus::deactivate() {

@@ -160,6 +160,7 @@ void MitBus::activate() {
     }
     for (int t = 0; t < kTries && exchange() > 0; ++t) {
     }
+    held_at_ = transport_->now();
     std::string failed = missing_list();
     for (std::size_t i = 0; i < status_.size(); ++i) {
       if (!pending_[i] && !status_[i].faulted &&
@@ -173,6 +174,22 @@ void MitBus::activate() {
       throw DeviceError(prefix() + "cannot " + (step == 0 ? "enter motor mode" : "hold position") +
                         " on " + failed);
     }
+  }
+}
+
+void MitBus::arm_device_guard() {
+  const int timeout_ms = bus_options_.device_watchdog_ms;
+  if (timeout_ms <= 0) return;
+  const Nanos since_hold = transport_->now() - held_at_;
+  if (since_hold >= Nanos{timeout_ms} * 1'000'000) {
+    deactivate();
+    throw DeviceError(prefix() + "the motors' CAN timeout (" + std::to_string(timeout_ms) +
+                      " ms) ran out while the other buses came up (" +
+                      std::to_string(since_hold / 1'000'000) +
+                      " ms): set a longer one on the motors and in device_watchdog_ms");
+  }
+  for (std::size_t i = 0; i < status_.size(); ++i) pending_[i] = status_[i].faulted ? 0 : 1;
+  for (int t = 0; t < kTries && exchange() > 0; ++t) {
   }
 }
 

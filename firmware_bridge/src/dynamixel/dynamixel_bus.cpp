@@ -644,13 +644,43 @@ void DynamixelBus::activate() {
           "write goal position");
     goal_ticks_[i] = ticks;
     check(write_register(i, dxl::xreg::torque_enable, 1, 1, kTries), "enable torque");
-    // After torque on: the servo watches the line only while torque is on.
-    if (watchdog_units_ > 0) {
-      check(write_register(i, dxl::xreg::bus_watchdog, watchdog_units_, 1, kTries),
-            "set the Bus Watchdog (firmware 38 or later; or device_watchdog_ms: off)");
+  }
+}
+
+void DynamixelBus::arm_device_guard() {
+  if (watchdog_units_ == 0) return;
+  // After torque on: a servo watches the line only while torque is on.
+  broadcast_bus_watchdog();
+  std::string unset;
+  for (std::size_t i = 0; i < status_.size(); ++i) {
+    if (status_[i].faulted) continue;
+    const auto id = static_cast<std::uint8_t>(status_[i].device_id);
+    const Answer r = unicast(i, dxl::encode_read(id, dxl::xreg::bus_watchdog, 1, tx_), 1);
+    if (r != Answer::ok || value_[0] != watchdog_units_) {
+      unset += (unset.empty() ? "" : ", ") + describe(i) + ": " +
+               (r == Answer::ok ? "reads " + std::to_string(value_[0]) : failure(i, r));
     }
   }
-  armed_ = watchdog_units_ > 0;
+  if (!unset.empty()) {
+    deactivate();
+    throw DeviceError(prefix() + "cannot set the Bus Watchdog (firmware 38 or later; or " +
+                      "device_watchdog_ms: off) of " + unset);
+  }
+  // The reads above fed only the servo each was for: start every servo's
+  // time again together.
+  broadcast_bus_watchdog();
+  last_answered_ = last_sent_;
+  armed_ = true;
+}
+
+void DynamixelBus::broadcast_bus_watchdog() {
+  // 0 first: a guard that fired (255) takes a new time only from 0.
+  for (const std::uint8_t value : {std::uint8_t{0}, watchdog_units_}) {
+    const std::size_t length =
+        dxl::encode_write(dxl::kBroadcastId, dxl::xreg::bus_watchdog, {&value, 1}, tx_);
+    if (length > 0) transport_->write({tx_.data(), length});
+  }
+  last_sent_ = steady_clock::now();
 }
 
 void DynamixelBus::deactivate() {
@@ -702,6 +732,7 @@ void DynamixelBus::read(std::span<double> positions) {
       }
       for (std::size_t s = 0; s < count; ++s) {
         if (answer_[s] != Answer::ok) continue;
+        last_answered_ = steady_clock::now();
         const std::size_t i = asked_[s];
         present_ticks_[i] = static_cast<std::int32_t>(value_[s]);
         if (i < n) positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
@@ -743,17 +774,14 @@ void DynamixelBus::rearm_after_silence() {
   if (!armed_) return;
   const auto now = steady_clock::now();
   // Half the guard's time: the servos' clocks and ours need not agree on
-  // when it ran out.
-  if (now - last_sent_ <= watchdog_time_ / 2) return;
-  // The host was silent (a stall, not a death: it speaks again), so the
-  // guard may have fired: the servos stopped and refuse goals. 0 clears it,
-  // the value arms it again; broadcast, so no answers to wait for.
-  for (const std::uint8_t value : {std::uint8_t{0}, watchdog_units_}) {
-    const std::size_t length =
-        dxl::encode_write(dxl::kBroadcastId, dxl::xreg::bus_watchdog, {&value, 1}, tx_);
-    if (length > 0) transport_->write({tx_.data(), length});
-  }
-  last_sent_ = now;
+  // when it ran out. Silent either way: nothing sent (the host stalled), or
+  // nothing heard (what was sent sat in a kernel or adapter buffer, and the
+  // servos heard nothing either).
+  const auto half = watchdog_time_ / 2;
+  if (now - last_sent_ <= half && now - last_answered_ <= half) return;
+  // So the guard may have fired: the servos stopped and refuse goals.
+  // Broadcast, so no answers to wait for.
+  broadcast_bus_watchdog();
   ++watchdog_rearms_;
 }
 

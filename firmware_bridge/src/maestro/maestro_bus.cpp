@@ -282,6 +282,23 @@ void MaestroBus::activate() {
   }
 }
 
+void MaestroBus::arm_device_guard() {
+  const std::vector<std::uint16_t> present = present_;
+  for (Board& board : boards_) {
+    bool complete = false;
+    for (int t = 0; t < kTries && !complete; ++t) complete = poll_board(board, false);
+    if (complete && (board.last_errors & maestro::error_bit::serial_timeout) != 0) {
+      present_ = present;
+      deactivate();
+      throw DeviceError(prefix() + "the serial timeout of Maestro " +
+                        std::to_string(board.address.device) +
+                        " ran out while the other buses came up: set a longer one in the "
+                        "Maestro Control Center and in device_watchdog_ms");
+    }
+  }
+  present_ = present;
+}
+
 void MaestroBus::deactivate() {
   try {
     for (Board& board : boards_) {

@@ -48,6 +48,11 @@ class ActuatorBus {
   virtual void configure() = 0;
   virtual void activate() = 0;
   virtual void deactivate() = 0;
+  // The devices' own guard against a dead host (device_watchdog_ms) starts
+  // here: called once every bus of the run is active, just before the first
+  // cycle, so the time the other buses take to come up is not counted
+  // against this bus's devices. Throws DeviceError naming the device.
+  virtual void arm_device_guard() {}
 
   // One cycle. Indexed like config().actuators. read() updates the entries of
   // devices that answered and leaves the others unchanged; write() sends the

@@ -12,10 +12,13 @@ namespace animrt {
 
 inline constexpr std::string_view kDeviceWatchdogKey = "device_watchdog_ms";
 
-// The default: the larger of 50 ms and 5 loop periods. Not shorter: a host
-// that is not real-time (no SCHED_FIFO, a busy desktop) misses a few periods
-// now and then, and every such hiccup would stop the figure. 0 (unknown
-// period) counts as no period.
+// The default: the larger of 100 ms and 5 loop periods. Not shorter: a host
+// that is not real-time (no SCHED_FIFO, a busy desktop, a USB adapter's or a
+// pty's bytes held up in the kernel) misses a few periods now and then, and
+// every such hiccup would stop the figure; 100 ms is also how long the
+// runtime itself lets a device go unanswered before it faults it
+// (safety.watchdog_timeout_s), so the devices give up on the host no sooner
+// than the host gives up on them. 0 (unknown period) counts as no period.
 double default_device_watchdog_ms(double loop_period_s);
 
 // Reads `device_watchdog_ms` of a bus node: absent -> the default, `off` or 0

@@ -63,6 +63,9 @@ class Cia402Bus final : public ActuatorBus {
   const BusConfig& config() const override { return config_; }
   void configure() override;
   void activate() override;
+  // 6007h and the heartbeat consumer (1016h:01) on every drive, then the
+  // host's heartbeats from every read on (device_watchdog_ms; none if off).
+  void arm_device_guard() override;
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;

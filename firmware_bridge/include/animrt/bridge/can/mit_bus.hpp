@@ -29,6 +29,12 @@ class MitBus final : public ActuatorBus {
   const BusConfig& config() const override { return config_; }
   void configure() override;
   void activate() override;
+  // The motors' CAN timeout (device_watchdog_ms, set in their setup menu) ran
+  // from activate()'s hold command: held again at the same positions, so the
+  // time the other buses took to come up does not make them go limp; if it
+  // already ran out they went limp and may have moved, and holding them at
+  // the old positions would jump: refused (DeviceError) instead.
+  void arm_device_guard() override;
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
@@ -51,6 +57,7 @@ class MitBus final : public ActuatorBus {
   BusConfig config_;
   MitBusOptions bus_options_;
   std::vector<MitMotorOptions> motor_;
+  Nanos held_at_ = 0;  // when activate() sent its hold command
   std::unique_ptr<CanFrameTransport> transport_;
   std::chrono::microseconds timeout_;
 

@@ -64,11 +64,15 @@ class DynamixelBus final : public ActuatorBus {
   // A Bus Watchdog left set or fired (it reads 0xFF) by a run that died is
   // cleared (0), with a warning when it had fired (watchdog_warning()).
   void configure() override;
-  // Per device: goal position = present position, then torque on, then the
-  // Bus Watchdog (BusOptions::bus_watchdog, if not 0): from then on the servo
-  // stops by itself when no instruction reaches it for that long. On failure
+  // Per device: goal position = present position, then torque on. On failure
   // turns torque off again and throws DeviceError naming the device.
   void activate() override;
+  // The Bus Watchdog (BusOptions::bus_watchdog, if not 0) on every servo at
+  // once, by broadcast, then read back from each: from then on a servo stops
+  // by itself when no instruction reaches it for that long. Armed one servo
+  // at a time, the first would time out while the others are asked (12
+  // servos at 57600 baud take longer than 60 ms).
+  void arm_device_guard() override;
   // Bus Watchdog 0 (if set; not on faulted devices), then torque off, on
   // every device, best effort; never throws.
   void deactivate() override;
@@ -81,9 +85,10 @@ class DynamixelBus final : public ActuatorBus {
   // measured start and the limit, never farther out than a goal already
   // sent: the start ramp walks it in, and once inside it stays inside.
   // With a Bus Watchdog armed, a cycle that finds the line silent for more
-  // than half its time (the host stalled: the servos may have stopped and
-  // locked their goals) first clears and re-arms it with two broadcast
-  // Writes, so the figure goes on from where it stopped (watchdog_rearms()).
+  // than half its time (nothing sent, or no valid answer heard: the servos
+  // may have stopped and locked their goals) first clears and re-arms it
+  // with two broadcast Writes, so the figure goes on from where it stopped
+  // (watchdog_rearms()).
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
   std::uint64_t watchdog_rearms() const { return watchdog_rearms_; }
@@ -144,6 +149,8 @@ class DynamixelBus final : public ActuatorBus {
   void write_position_limits(std::size_t device);
   void clear_bus_watchdogs();
   void rearm_after_silence();
+  // Bus Watchdog 0, then its time, to every servo in two broadcast writes.
+  void broadcast_bus_watchdog();
   // Pulls bytes until the decoder has something other than need_more.
   dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
   // Reads the hardware error register of devices whose alert just appeared.
@@ -180,10 +187,11 @@ class DynamixelBus final : public ActuatorBus {
   std::string latency_warning_;
   std::string outside_warning_;
   std::string watchdog_warning_;
-  std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set at activate; 0: none
+  std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set before the first cycle; 0: none
   std::chrono::nanoseconds watchdog_time_{0};
-  bool armed_ = false;  // between activate() and deactivate()
+  bool armed_ = false;  // between arm_device_guard() and deactivate()
   std::chrono::steady_clock::time_point last_sent_{};
+  std::chrono::steady_clock::time_point last_answered_{};  // a valid answer to a cycle's read
   std::uint64_t watchdog_rearms_ = 0;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;

@@ -71,6 +71,11 @@ class MaestroBus final : public ActuatorBus {
   // acceleration limits, then target = present output (which switches the
   // pulses on without a jump); throws DeviceError on any other error bit.
   void activate() override;
+  // The board's serial timeout is its own setting, always on, so it may have
+  // fired while the other buses came up: the channels it sent home would
+  // jump back at the first target. Get Errors tells (and clears it); then
+  // the run is refused (DeviceError) rather than started.
+  void arm_device_guard() override;
   // The warning configure() printed about serial timeouts that had fired;
   // empty when none had.
   const std::string& timeout_warning() const { return timeout_warning_; }
