@@ -93,18 +93,29 @@ constexpr int kFatalSignals[] = {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL};
 // report), put back once the buses are off.
 struct sigaction g_previous[std::size(kFatalSignals)];
 
-void on_fatal_signal(int sig) {
+void on_fatal_signal(int sig, siginfo_t* info, void*) {
   const int saved = errno;
   torque_off_and_report(signal_name(sig));
-  // The previous action again, then the signal once more: the process ends
-  // with the status, core dump or report it would have had. (A fault
-  // returns to the faulting instruction and raises it again; raise()
-  // covers a signal that was sent.)
+  // A fault (si_code > 0): the previous action again, and returning runs the
+  // faulting instruction again, which meets it with its own siginfo (the
+  // default's core dump, or a sanitizer's report of the real address). A
+  // signal that was sent (kill, raise, abort: si_code <= 0) ends the process
+  // by its default action, so its status names the signal; a sanitizer's
+  // handler would report a memory error that never happened.
+  const bool sent = info == nullptr || info->si_code <= 0;
   for (std::size_t i = 0; i < std::size(kFatalSignals); ++i) {
-    if (kFatalSignals[i] == sig) sigaction(sig, &g_previous[i], nullptr);
+    if (kFatalSignals[i] != sig) continue;
+    if (sent) {
+      struct sigaction fallback {};
+      fallback.sa_handler = SIG_DFL;
+      sigemptyset(&fallback.sa_mask);
+      sigaction(sig, &fallback, nullptr);
+    } else {
+      sigaction(sig, &g_previous[i], nullptr);
+    }
   }
   errno = saved;
-  raise(sig);
+  if (sent) raise(sig);
 }
 
 std::terminate_handler g_previous_terminate = nullptr;
@@ -181,8 +192,8 @@ void install_fatal_error_handlers() {
   ss.ss_size = sizeof alternate_stack;
   sigaltstack(&ss, nullptr);
   struct sigaction action {};
-  action.sa_handler = on_fatal_signal;
-  action.sa_flags = SA_ONSTACK;
+  action.sa_sigaction = on_fatal_signal;
+  action.sa_flags = SA_ONSTACK | SA_SIGINFO;
   sigemptyset(&action.sa_mask);
   for (std::size_t i = 0; i < std::size(kFatalSignals); ++i) {
     sigaction(kFatalSignals[i], &action, &g_previous[i]);
