@@ -111,19 +111,19 @@ echo "commit $(git -C "$root" rev-parse --short HEAD), $trials trials per delay"
 start_sim quadruped
 robot quadruped
 pty=$(awk '$2 == "legs" {print $3}' "$tmp/sim.txt")
-for delay in 0.045 0.050 0.055 0.060 0.065 0.070; do
+for delay in 0.085 0.090 0.095 0.100 0.105 0.110; do
   n=0 ended=0
   for _ in $(seq "$trials"); do tally "$(trial $delay 0.5 dxl "$pty" 12)"; done
-  echo "dynamixel2 (quadruped, 12 servos, Bus Watchdog 60 ms): ${delay} s after kill -9: all stopped in $n of $trials$lost"
+  echo "dynamixel2 (quadruped, 12 servos, Bus Watchdog 100 ms): ${delay} s after kill -9: all stopped in $n of $trials$lost"
 done
 stop_sim
 
 start_sim animatronic
 robot animatronic
 pty=$(awk '$2 == "face" {print $3}' "$tmp/sim.txt")
-for delay in 0.035 0.040 0.045 0.050 0.055 0.060; do
+for delay in 0.085 0.090 0.095 0.100 0.105 0.110; do
   n=0 ended=0
   for _ in $(seq "$trials"); do tally "$(trial $delay 0.5 maestro "$pty")"; done
-  echo "maestro (animatronic face, serial timeout 50 ms): ${delay} s after kill -9: timed out in $n of $trials$lost"
+  echo "maestro (animatronic face, serial timeout 100 ms): ${delay} s after kill -9: timed out in $n of $trials$lost"
 done
 stop_sim
