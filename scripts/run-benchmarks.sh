@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Runs every benchmark and keeps the output in BUILD/bench/ (the README's
-# figures come from these files). cyclictest (rt-tests) first, as the
+# Runs every benchmark and keeps the output in BUILD/bench/ (the figures in
+# docs/results/ come from these files). cyclictest (rt-tests) first, as the
 # machine's own wake-up latency baseline: the loop cannot do better.
 set -euo pipefail
 build=${1:-build}

@@ -23,8 +23,6 @@
 
 namespace animrt {
 
-// Futex wait/wake on a 32-bit atomic. timeout_ns < 0 waits without limit.
-
 // The start routine of every BusWorker thread (tests tell run threads apart
 // by it).
 using ThreadRoutine = void* (*)(void*);

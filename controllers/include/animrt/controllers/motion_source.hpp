@@ -42,8 +42,9 @@ class MotionSource {
   // Robot joint indices this source drives, fixed after construction.
   virtual std::span<const int> driven_joints() const = 0;
 
-  // Writes targets (rad) for the driven joints into `targets`, which is
-  // indexed by robot joint index and has one entry per robot joint. Entries
+  // Writes targets (rad, or m for a prismatic joint) for the driven joints
+  // into `targets`, which is indexed by robot joint index and has one entry
+  // per robot joint. Entries
   // of joints it does not drive are left untouched. `t` is seconds since the
   // motion started (t = 0 is the pose the start ramp goes to).
   virtual void sample(double t, std::span<double> targets) const = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // Strict reading of YAML input files on top of yaml-cpp. Every accessor that
 // finds something wrong throws InputError naming the file, line, column and
-// the dotted key path (for example "joints[3].limits.velocity_max_dps").
+// the dotted key path (for example "joints.lf_hip.limits.velocity_dps").
 
 #include <yaml-cpp/yaml.h>
 

@@ -56,8 +56,9 @@ class ActuatorBus {
 
   // One cycle. Indexed like config().actuators. read() updates the entries of
   // devices that answered and leaves the others unchanged; write() sends the
-  // goal positions (rad). Neither allocates, and neither blocks longer than
-  // the bus timeout. Devices marked `faulted` are skipped.
+  // goal positions (rad, or m for a prismatic joint). Neither allocates, and
+  // neither blocks longer than the bus timeout. Devices marked `faulted` are
+  // skipped.
   virtual void read(std::span<double> positions) = 0;
   virtual void write(std::span<const double> positions) = 0;
 

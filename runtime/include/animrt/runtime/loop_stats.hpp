@@ -1,7 +1,8 @@
 #pragma once
-// Loop timing statistics, gathered without allocation: microsecond
-// histograms of the period between cycle starts and of wake-up latency
-// (how late a cycle started against its deadline).
+// Loop timing statistics, gathered without allocation: a microsecond
+// histogram, one each for the period between cycle starts, the wake-up
+// latency (how late a cycle started against its deadline), the work per
+// cycle and every bus's I/O time.
 
 #include <cstdint>
 #include <vector>

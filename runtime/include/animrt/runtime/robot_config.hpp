@@ -31,7 +31,7 @@ struct SafetyConfig {
 };
 
 struct MotionConfig {
-  std::string type;  // "gait"
+  std::string type;  // "gait", "show", "head" or "layers"
   std::string file;  // resolved against the robot file's folder
   Location where;
   std::string key;  // dotted key of `where`, e.g. "motion.file" or "motion.layers[1].file"

@@ -28,9 +28,9 @@ struct ManualTarget {
 };
 
 struct RunControls {
-  // Ramp home and end the run (SIGINT, SIGTERM, a dashboard's stop).
+  // Ramp home and end the run (a stop signal, a dashboard's stop).
   std::atomic<bool> stop{false};
-  // Switch torque off at once, without a ramp (a second SIGINT).
+  // Switch torque off at once, without a ramp (a second stop signal).
   std::atomic<bool> abort{false};
   // Speed and turn of a steered motion source.
   Mailbox<MotionCommand> steer;

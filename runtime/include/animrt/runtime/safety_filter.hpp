@@ -24,7 +24,7 @@ class SafetyFilter {
   // snapped.
   void reset(std::span<const double> measured);
 
-  // One cycle: moves the command toward `targets` (rad) within the limits and
+  // One cycle: moves the command toward `targets` (rad or m) within the limits and
   // writes it to `commands`. A joint whose entry in `active` is 0 (its bus is
   // late and takes no write this cycle) holds its last command and comes to
   // rest there: the device, which keeps its last goal, has stopped too, so

@@ -1,7 +1,8 @@
 #pragma once
-// Offline synthesis: features -> most likely cluster sequence -> cluster
-// means as poses -> quaternions -> key poses every 1/key_rate s -> SQUAD to
-// the output rate -> Euler angles + seeded uniform noise.
+// Offline synthesis: features -> most likely cluster sequence -> each
+// cluster's pose (its mean moved toward the mean pose: cluster_pose()) ->
+// quaternions -> key poses every 1/key_rate s -> SQUAD to the output rate ->
+// Euler angles + seeded uniform noise.
 
 #include <vector>
 

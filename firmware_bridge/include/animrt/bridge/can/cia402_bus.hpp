@@ -11,11 +11,12 @@
 // write() sends each RPDO, applied by the drives at the next SYNC.
 // deactivate(): back down to Switch On Disabled, NMT pre-operational.
 //
-// Guard against a dead host (device_watchdog_ms, off when 0): activate()
-// writes each drive's abort connection option code (6007h) and its
-// heartbeat consumer (1016h:01, the host's node id and the consumer time),
-// and from then on read() produces the host's heartbeat (0x700 + host node
-// id, operational) every host_heartbeat_ms on the bus's I/O thread.
+// Guard against a dead host (device_watchdog_ms, off when 0):
+// arm_device_guard(), called once every bus of the run is active, writes
+// each drive's abort connection option code (6007h) and its heartbeat
+// consumer (1016h:01, the host's node id and the consumer time), and from
+// then on read() produces the host's heartbeat (0x700 + host node id,
+// operational) every host_heartbeat_ms on the bus's I/O thread.
 // Heartbeats go out only while the loop cycles: a loop that hangs is as
 // absent to a drive as a dead process, and both stop it. deactivate()
 // clears the consumer (time 0) once the drive is down, so a clean end
@@ -25,8 +26,8 @@
 // heartbeat came for heartbeat_timeout_ms (bus time). A boot-up message in
 // the middle of a run (the drive rebooted), an EMCY with a non-zero code, a
 // statusword in Fault, or a drive that left Operation Enabled by itself make
-// the device a hardware error, which the runtime's safety filter answers by
-// ramping every other joint home.
+// the device a hardware error, which the runtime's watchdog faults, ramping
+// every other joint home.
 
 #include <algorithm>
 #include <chrono>
@@ -134,7 +135,7 @@ class Cia402Bus final : public ActuatorBus {
   std::vector<double> min_rad_, max_rad_;  // goals that stay inside int32 counts
   bool running_ = false;                   // between activate() and deactivate(): OE expected
   bool fresh_ = false;
-  bool producing_ = false;  // host heartbeats between activate() and deactivate()
+  bool producing_ = false;  // host heartbeats between arm_device_guard() and deactivate()
   Nanos host_heartbeat_ns_ = 0;
   Nanos next_host_heartbeat_ = 0;
 

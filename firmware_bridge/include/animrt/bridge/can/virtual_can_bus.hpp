@@ -40,9 +40,9 @@ class VirtualCanBus : public std::enable_shared_from_this<VirtualCanBus> {
   // The clock must outlive the endpoints' use of it.
   void set_clock(const Clock* clock);
 
-  // Fault injection. An error frame goes to every endpoint. Bus-off: an error
-  // frame with CAN_ERR_BUSOFF, then nothing is delivered and sends fail until
-  // recover(), which sends CAN_ERR_RESTARTED.
+  // Fault injection. An error frame goes to every endpoint. set_bus_off(true):
+  // an error frame with CAN_ERR_BUSOFF, then nothing is delivered and sends
+  // fail until set_bus_off(false), which sends CAN_ERR_RESTARTED.
   void inject_error(const can_frame& error_frame);
   void set_bus_off(bool bus_off);
 

@@ -46,11 +46,14 @@ struct ModbusBusOptions {
 };
 
 // ActuatorBinding::options of a Modbus joint:
-//   map value (SI, map->unit) = zero + per_rad * joint angle (rad).
+//   map value (SI, map->unit) = zero + per_rad * joint position
+// (the joint in rad, or in m for a prismatic joint; keys m_per_rad, zero_m).
 struct ModbusJointOptions {
   int slave = 1;
   std::shared_ptr<const modbus::RegisterMap> map;
-  double per_rad = 1.0;  // 1 for maps in rad; metres per radian for a linear actuator on a lever
+  // 1 for maps in rad and for a prismatic joint (the stroke is the joint);
+  // metres per radian for a linear actuator on a lever.
+  double per_rad = 1.0;
   double zero = 0.0;
 };
 
