@@ -17,9 +17,9 @@
 
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/inference.hpp"
-#include "animrt/controllers/seqnet/network.hpp"
+#include "animrt/learn/seqnet/network.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 
 using namespace animrt::seqnet;
 

@@ -10,9 +10,9 @@
 #include <optional>
 #include <thread>
 
-#include "animrt/controllers/evolve/mpi_evaluator.hpp"
-#include "animrt/controllers/evolve/report.hpp"
-#include "animrt/controllers/evolve/search.hpp"
+#include "animrt/learn/evolve/mpi_evaluator.hpp"
+#include "animrt/learn/evolve/report.hpp"
+#include "animrt/learn/evolve/search.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/evolve/fitness.hpp"
+#include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "gait_command.hpp"

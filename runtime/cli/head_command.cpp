@@ -11,13 +11,13 @@
 #include <memory>
 #include <set>
 
-#include "animrt/controllers/head/corpus.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/controllers/head/trainer.hpp"
+#include "animrt/learn/head/trainer.hpp"
 #include "animrt/core/error.hpp"
-#include "animrt/sim/head_corpus/generator.hpp"
+#include "animrt/learn/head_corpus/generator.hpp"
 
 namespace animrt::cli {
 namespace {

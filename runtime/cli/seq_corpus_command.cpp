@@ -9,7 +9,7 @@
 
 #include "animrt/core/error.hpp"
 #include "subcommand.hpp"
-#include "animrt/sim/seq_corpus/generator.hpp"
+#include "animrt/learn/seq_corpus/generator.hpp"
 
 namespace animrt::cli {
 namespace {

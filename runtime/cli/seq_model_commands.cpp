@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/seqnet/evaluation.hpp"
+#include "animrt/learn/seqnet/evaluation.hpp"
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/generation.hpp"
 #include "animrt/controllers/seqnet/inference.hpp"

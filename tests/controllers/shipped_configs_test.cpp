@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/evolve/run_config.hpp"
+#include "animrt/learn/evolve/run_config.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/controllers/gait/walk_response.hpp"
 #include "animrt/controllers/herd/scene.hpp"

@@ -23,7 +23,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"

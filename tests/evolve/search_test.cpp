@@ -2,7 +2,7 @@
 // invalid individuals score worst and are counted, a falling phenotype gets
 // the worst score, the run file is checked.
 
-#include "animrt/controllers/evolve/search.hpp"
+#include "animrt/learn/evolve/search.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <functional>
 #include <set>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
-#include "animrt/controllers/evolve/phenotype.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
+#include "animrt/learn/evolve/phenotype.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 

@@ -13,10 +13,10 @@
 #include <filesystem>
 #include <map>
 
-#include "animrt/controllers/head/corpus.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/controllers/head/trainer.hpp"
+#include "animrt/learn/head/trainer.hpp"
 #include "head_test_util.hpp"
 
 namespace animrt::head {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "animrt/controllers/head/audio.hpp"
-#include "animrt/sim/head_corpus/generator.hpp"
+#include "animrt/learn/head_corpus/generator.hpp"
 
 namespace animrt::head::test {
 

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "animrt/controllers/head/bigram.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
+#include "animrt/learn/head/evaluation.hpp"
 #include "animrt/controllers/head/rotation.hpp"
 #include "animrt/controllers/head/spline.hpp"
 #include "animrt/controllers/head/squad.hpp"

@@ -14,8 +14,8 @@
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
-#include "animrt/sim/seq_corpus/body_field.hpp"
-#include "animrt/sim/seq_corpus/generator.hpp"
+#include "animrt/learn/seq_corpus/body_field.hpp"
+#include "animrt/learn/seq_corpus/generator.hpp"
 #include "support/files.hpp"
 
 namespace {

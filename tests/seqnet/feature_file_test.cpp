@@ -6,7 +6,7 @@
 
 #include <numbers>
 
-#include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 #include "animrt/core/error.hpp"
 #include "seq_test_util.hpp"
 

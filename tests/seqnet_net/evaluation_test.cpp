@@ -5,14 +5,14 @@
 // and vertex-space is not; the change per frame is the step's, and 0 for a
 // model that never moves; a model of another template is refused.
 
-#include "animrt/controllers/seqnet/evaluation.hpp"
+#include "animrt/learn/seqnet/evaluation.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
-#include "animrt/controllers/seqnet/network.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
+#include "animrt/learn/seqnet/network.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
 #include "net_test_util.hpp"
 

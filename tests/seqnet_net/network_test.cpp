@@ -1,7 +1,7 @@
 // The network's pieces: Eq. 2 on a hand-computed mesh, the shared parameter
 // set of the two chains, and each loss term on hand-made tensors.
 
-#include "animrt/controllers/seqnet/network.hpp"
+#include "animrt/learn/seqnet/network.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "../subcommand.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt::cli {
