@@ -2,7 +2,6 @@
 // evaluation and the paper's Table 1.
 
 #include "head_command.hpp"
-#include "subcommand.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -11,13 +10,14 @@
 #include <memory>
 #include <set>
 
-#include "animrt/learn/head/corpus.hpp"
-#include "animrt/learn/head/evaluation.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/learn/head/trainer.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
+#include "animrt/learn/head/trainer.hpp"
 #include "animrt/learn/head_corpus/generator.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -33,7 +33,6 @@ struct HeadArgs {
   double shrink = -1;
   bool quiet = false;
 };
-
 
 TrainOptions train_options(const HeadArgs& a) {
   TrainOptions o;

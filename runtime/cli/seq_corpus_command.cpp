@@ -8,8 +8,8 @@
 #include <memory>
 
 #include "animrt/core/error.hpp"
-#include "subcommand.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {

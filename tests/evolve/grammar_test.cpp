@@ -8,10 +8,10 @@
 #include <cmath>
 #include <sstream>
 
-#include "animrt/learn/evolve/mapper.hpp"
-#include "animrt/learn/evolve/random.hpp"
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/evolve/mapper.hpp"
+#include "animrt/learn/evolve/random.hpp"
 #include "support/files.hpp"
 
 namespace animrt::evolve {

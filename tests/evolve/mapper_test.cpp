@@ -9,8 +9,8 @@
 #include <set>
 #include <string>
 
-#include "animrt/learn/evolve/operators.hpp"
 #include "animrt/controllers/gait/expression.hpp"
+#include "animrt/learn/evolve/operators.hpp"
 
 namespace animrt::evolve {
 namespace {

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <limits>
 
-#include "animrt/learn/evolve/pareto_search.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/learn/evolve/pareto_search.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 

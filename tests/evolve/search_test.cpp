@@ -347,8 +347,7 @@ TEST(RunConfig, ShippedRunFilesLoad) {
        {"horse_numerical", "horse_concatenating", "horse_hybrid", "horse_sinusoidal", "horse_free",
         "horse_concatenating_varying_weights", "horse_concatenating_varying_freedom",
         "horse_hybrid_structured", "horse_numerical_balance", "horse_hybrid_balance",
-        "horse_hybrid_structured_balance",
-        "quadruped_concatenating"}) {
+        "horse_hybrid_structured_balance", "quadruped_concatenating"}) {
     const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;

@@ -13,9 +13,9 @@
 #include <filesystem>
 #include <map>
 
+#include "animrt/controllers/head/synthesis.hpp"
 #include "animrt/learn/head/corpus.hpp"
 #include "animrt/learn/head/evaluation.hpp"
-#include "animrt/controllers/head/synthesis.hpp"
 #include "animrt/learn/head/trainer.hpp"
 #include "head_test_util.hpp"
 

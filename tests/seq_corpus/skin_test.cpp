@@ -13,9 +13,9 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
-#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/learn/seq_corpus/body_field.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 
 namespace {

@@ -8,8 +8,8 @@
 #include <Eigen/Dense>
 #include <numbers>
 
-#include "animrt/learn/seqnet/interpolation.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
+#include "animrt/learn/seqnet/interpolation.hpp"
 #include "animrt/learn/seqnet/shapes.hpp"
 
 namespace animrt::seqnet {

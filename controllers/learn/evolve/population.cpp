@@ -6,9 +6,9 @@
 #include <chrono>
 #include <string_view>
 
+#include "animrt/core/error.hpp"
 #include "animrt/learn/evolve/operators.hpp"
 #include "animrt/learn/evolve/phenotype.hpp"
-#include "animrt/core/error.hpp"
 
 namespace animrt::evolve {
 

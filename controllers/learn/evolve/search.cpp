@@ -34,9 +34,8 @@ void Search::evaluate(std::vector<Individual>& pop, int generation, GenerationSt
 
 SearchResult Search::run(const std::function<void(const GenerationStats&)>& progress) {
   SearchHooks hooks;
-  if (progress) hooks.generation = [&progress](const GenerationStats& st, const Individual&) {
-    progress(st);
-  };
+  if (progress)
+    hooks.generation = [&progress](const GenerationStats& st, const Individual&) { progress(st); };
   return run(hooks);
 }
 

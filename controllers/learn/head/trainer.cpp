@@ -4,6 +4,9 @@
 #include <stdexcept>
 
 #include "animrt/controllers/head/synthesis.hpp"
+#include "animrt/learn/head/bigram_training.hpp"
+#include "animrt/learn/head/hmm_training.hpp"
+#include "animrt/learn/head/lbg.hpp"
 
 namespace animrt::head {
 namespace {

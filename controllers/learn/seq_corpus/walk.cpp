@@ -9,8 +9,8 @@
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
-#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
+#include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
 namespace animrt::sim::seq_corpus {

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <map>
 
-#include "animrt/learn/seqnet/held_out.hpp"
-#include "animrt/learn/seqnet/interpolation.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/held_out.hpp"
+#include "animrt/learn/seqnet/interpolation.hpp"
 
 namespace animrt::seqnet {
 namespace {
@@ -31,7 +31,8 @@ double vertex_error(const Positions& truth, const Positions& got, const Neighbou
 Evaluation evaluate(const ModelFile& model, const std::string& model_path,
                     const SequenceFeatures& data, const EvaluationOptions& o) {
   if (model.shape.kind != ModelKind::mesh) {
-    throw InputError(Location{model_path, 0, 0}, "model", "a joint model: evaluation takes a mesh model");
+    throw InputError(Location{model_path, 0, 0}, "model",
+                     "a joint model: evaluation takes a mesh model");
   }
   check_model_mesh(model, model_path, data.vertex_count(), data.triangles);
   if (model.rest.cols() != data.rest.cols() || !model.rest.isApprox(data.rest, 1e-9)) {
@@ -61,7 +62,8 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
   bool measured = false;
 
   // Table 1: generation from u initial frames against extrapolation.
-  const int longest = o.horizons.empty() ? 0 : *std::max_element(o.horizons.begin(), o.horizons.end());
+  const int longest =
+      o.horizons.empty() ? 0 : *std::max_element(o.horizons.begin(), o.horizons.end());
   for (int u : o.initial_frames) {
     std::vector<GenerationRow> rows;
     for (int h : o.horizons) rows.push_back(GenerationRow{u, h, 0, 0.0, 0.0});
@@ -75,8 +77,7 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
         for (GenerationRow& r : rows) {
           const int target = s + u - 1 + r.horizon;
           const Positions learned = solver.solve(frame_of(all.col(u - 1 + r.horizon)));
-          const Positions extrapolated =
-              solver.solve(lerp_features(before, last, 1.0 + r.horizon));
+          const Positions extrapolated = solver.solve(lerp_features(before, last, 1.0 + r.horizon));
           r.learned += vertex_error(truth.at(target), learned, ring);
           r.extrapolated += vertex_error(truth.at(target), extrapolated, ring);
           ++r.frames;
@@ -99,9 +100,8 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
     if (keys < 2) continue;
     FrameMatrix key_frames(net.dims(), keys);
     for (int k = 0; k < keys; ++k) key_frames.col(k) = column(data.raw(p.first + k * (o.gap + 1)));
-    const Completion done =
-        net.complete(key_frames, std::vector<int>(static_cast<std::size_t>(keys - 1), o.gap),
-                     o.completion);
+    const Completion done = net.complete(
+        key_frames, std::vector<int>(static_cast<std::size_t>(keys - 1), o.gap), o.completion);
     for (int g = 0; g + 1 < keys; ++g) {
       const int k0 = p.first + g * (o.gap + 1), k1 = k0 + o.gap + 1;
       ++c.gaps;
@@ -109,8 +109,8 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
       for (int t = 1; t <= o.gap; ++t) {
         const Positions& want = truth.at(k0 + t);
         const double s = static_cast<double>(t) / (o.gap + 1);
-        c.learned += vertex_error(
-            want, solver.solve(frame_of(done.frames.col(g * (o.gap + 1) + t))), ring);
+        c.learned +=
+            vertex_error(want, solver.solve(frame_of(done.frames.col(g * (o.gap + 1) + t))), ring);
         c.feature_linear +=
             vertex_error(want, solver.solve(lerp_features(data.raw(k0), data.raw(k1), s)), ring);
         c.vertex_linear += vertex_error(want, lerp_positions(truth.at(k0), truth.at(k1), s), ring);

@@ -13,10 +13,10 @@
 #include <sstream>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
-#include "animrt/learn/seqnet/held_out.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
-#include "animrt/learn/seqnet/network.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/held_out.hpp"
+#include "animrt/learn/seqnet/network.hpp"
 
 namespace animrt::seqnet {
 namespace {

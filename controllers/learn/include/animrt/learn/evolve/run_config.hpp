@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/controllers/gait/gait_simulator.hpp"
+#include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/learn/evolve/operators.hpp"
 
 namespace animrt::evolve {

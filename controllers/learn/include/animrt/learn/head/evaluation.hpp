@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "animrt/learn/head/corpus.hpp"
 #include "animrt/controllers/head/model.hpp"
+#include "animrt/learn/head/corpus.hpp"
 #include "animrt/learn/head/trainer.hpp"
 
 namespace animrt::head {

@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "animrt/learn/head/corpus.hpp"
 #include "animrt/controllers/head/model.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/lbg.hpp"
 
 namespace animrt::head {
 

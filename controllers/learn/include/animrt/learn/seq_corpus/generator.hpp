@@ -26,8 +26,8 @@
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
 #include "animrt/core/joint.hpp"
-#include "animrt/sim/mujoco/mujoco_model.hpp"
 #include "animrt/learn/seq_corpus/skin.hpp"
+#include "animrt/sim/mujoco/mujoco_model.hpp"
 
 namespace animrt::sim::seq_corpus {
 

@@ -16,12 +16,12 @@
 namespace animrt::seqnet {
 
 struct EvaluationOptions {
-  double held_out = 0.2;                // the trainer's fraction (its seed is the model's)
+  double held_out = 0.2;  // the trainer's fraction (its seed is the model's)
   std::vector<int> initial_frames{1, 3};
   std::vector<int> horizons{5, 10, 15};  // generated frames measured
   int gap = 9;                           // completion: frames between keys
   CompletionOptions completion;
-  int change_frames = 32;                // frames generated for the change per frame
+  int change_frames = 32;  // frames generated for the change per frame
 };
 
 // Mean per-vertex distance to the true frame after removing the mean offset
@@ -32,7 +32,8 @@ struct GenerationRow {
   int horizon = 0;  // n-th generated frame
   int frames = 0;   // starts measured
   double learned = 0;
-  double extrapolated = 0;  // linear in feature space from the last two given frames (u = 1: repeated)
+  double extrapolated =
+      0;  // linear in feature space from the last two given frames (u = 1: repeated)
 };
 
 struct CompletionRow {

@@ -1,4 +1,4 @@
-#include "animrt/controllers/head/bigram.hpp"
+#include "animrt/learn/head/bigram_training.hpp"
 
 #include <cmath>
 #include <stdexcept>
