@@ -57,12 +57,12 @@ int run_features(const HeadArgs& a) {
 }
 
 int run_corpus(const HeadArgs& a) {
-  sim::head_corpus::CorpusOptions o;
+  learn::head_corpus::CorpusOptions o;
   o.utterances = a.utterances;
   o.speakers = a.speakers;
   o.seed = a.seed;
   if (!a.quiet) o.log = [](const std::string& s) { std::cerr << s << '\n'; };
-  sim::head_corpus::generate_corpus(a.out, o);
+  learn::head_corpus::generate_corpus(a.out, o);
   std::cout << "wrote " << a.utterances << " utterances to " << a.out << '\n';
   return 0;
 }

@@ -30,11 +30,11 @@ struct FourSpeakers {
 
 FourSpeakers make_four_speakers(std::uint64_t corpus_seed) {
   const std::string dir = test::temp_dir("corpus4");
-  sim::head_corpus::CorpusOptions co;
+  learn::head_corpus::CorpusOptions co;
   co.utterances = 40;
   co.speakers = 4;
   co.seed = corpus_seed;
-  sim::head_corpus::generate_corpus(dir, co);
+  learn::head_corpus::generate_corpus(dir, co);
   FourSpeakers out;
   out.corpus_seed = corpus_seed;
   const auto split = split_corpus(list_corpus(dir), 0.8, 1);

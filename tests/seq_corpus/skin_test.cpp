@@ -23,7 +23,7 @@ namespace {
 using animrt::kSourceRoot;
 
 using namespace animrt::sim;
-using namespace animrt::sim::seq_corpus;
+using namespace animrt::learn::seq_corpus;
 
 TEST(MarchingTetrahedra, SphereIsClosedOrientedAndHasItsVolume) {
   const double r = 0.5, step = 0.05;

@@ -21,7 +21,7 @@
 
 extern char** environ;
 
-namespace animrt::sim::head_corpus {
+namespace animrt::learn::head_corpus {
 namespace {
 
 const char* const kSentences[] = {
@@ -308,4 +308,4 @@ void generate_corpus(const std::string& dir, const CorpusOptions& options) {
   }
 }
 
-}  // namespace animrt::sim::head_corpus
+}  // namespace animrt::learn::head_corpus

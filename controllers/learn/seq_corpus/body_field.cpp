@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 // Polynomial smooth minimum: equal to min(a, b) once they differ by more
@@ -139,4 +139,4 @@ Eigen::AlignedBox3d BodyField::bounds() const {
   return box;
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

@@ -8,7 +8,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 namespace fs = std::filesystem;
@@ -170,4 +170,4 @@ CorpusSummary generate_corpus(const std::string& dir, const CorpusOptions& o) {
   return summary;
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

@@ -8,7 +8,7 @@
 
 #include "animrt/learn/seq_corpus/triangle_mesh.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 // A collapse may not leave a triangle worse than this (4 sqrt 3 area over
@@ -227,4 +227,4 @@ TriangleMesh decimate(const TriangleMesh& mesh, int target_vertices) {
   return d.result();
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

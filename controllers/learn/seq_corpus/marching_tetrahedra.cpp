@@ -9,7 +9,7 @@
 
 #include "animrt/learn/seq_corpus/triangle_mesh.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 // Crossings are kept this share of an edge away from its ends.
@@ -125,4 +125,4 @@ TriangleMesh marching_tetrahedra(const std::function<double(const Eigen::Vector3
   return out;
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

@@ -8,7 +8,7 @@
 
 #include "animrt/learn/seq_corpus/triangle_mesh.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 struct UnionFind {
@@ -170,4 +170,4 @@ double enclosed_volume(const TriangleMesh& mesh) {
   return six_v / 6.0;
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

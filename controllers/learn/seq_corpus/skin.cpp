@@ -10,7 +10,7 @@
 
 #include "animrt/learn/seq_corpus/body_field.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 namespace {
 
 // Tries of the grid step, each corrected by how far the vertex count missed.
@@ -142,4 +142,4 @@ int dominant_body(const Skin& skin, int v) {
   return skin.bodies[static_cast<std::size_t>(v)][i];
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

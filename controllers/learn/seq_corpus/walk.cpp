@@ -13,7 +13,11 @@
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
+
+using sim::has_fallen;
+using sim::model_joint_specs;
+using sim::place_standing;
 namespace {
 
 // Noise of a seed (relative Froude number, settling range in seconds).
@@ -176,4 +180,4 @@ WalkRecord walk_sequence(const MujocoModel& mm, const Skin& skin, const WalkConf
   return out;
 }
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

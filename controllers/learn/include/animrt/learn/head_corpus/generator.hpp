@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace animrt::sim::head_corpus {
+namespace animrt::learn::head_corpus {
 
 // Per-speaker motion style (degrees).
 struct SpeakerStyle {
@@ -67,4 +67,4 @@ void generate_corpus(const std::string& dir, const CorpusOptions& options);
 void speak_to_wav(const std::string& espeak, const std::string& voice, int pitch, int rate_wpm,
                   const std::string& ssml, const std::string& wav_path);
 
-}  // namespace animrt::sim::head_corpus
+}  // namespace animrt::learn::head_corpus

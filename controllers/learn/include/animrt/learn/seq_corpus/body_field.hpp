@@ -15,7 +15,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 
 struct GeomShape {
   int body = -1;
@@ -52,4 +52,4 @@ class BodyField {
 // Signed distance to one geom (without its inflation).
 double geom_distance(const GeomShape& g, const Eigen::Vector3d& p);
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

@@ -29,7 +29,13 @@
 #include "animrt/learn/seq_corpus/skin.hpp"
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
+
+// The figures walk on the simulator's MuJoCo models.
+using sim::load_mujoco_model;
+using sim::make_mujoco_data;
+using sim::MujocoData;
+using sim::MujocoModel;
 
 // One sequence of the schedule.
 struct WalkConfig {
@@ -126,4 +132,4 @@ CorpusSummary generate_corpus(const std::string& dir, const CorpusOptions& optio
 
 void write_joints_csv(const std::string& path, const MujocoModel& model, const WalkRecord& walk);
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

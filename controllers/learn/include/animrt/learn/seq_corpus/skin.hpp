@@ -14,7 +14,7 @@
 #include "animrt/controllers/seqnet/mesh_sequence.hpp"
 #include "animrt/learn/seq_corpus/triangle_mesh.hpp"
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 
 // Bodies that move a vertex, at most.
 constexpr int kInfluences = 3;
@@ -46,4 +46,4 @@ void pose_skin(const Skin& skin, const mjData* d, seqnet::Positions& out);
 // The body that moves vertex `v` most.
 int dominant_body(const Skin& skin, int v);
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus

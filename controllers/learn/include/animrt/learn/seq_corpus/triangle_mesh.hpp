@@ -9,7 +9,7 @@
 #include <functional>
 #include <vector>
 
-namespace animrt::sim::seq_corpus {
+namespace animrt::learn::seq_corpus {
 
 struct TriangleMesh {
   Eigen::Matrix3Xd vertices;                  // one column per vertex
@@ -65,4 +65,4 @@ MeshReport check_mesh(const TriangleMesh& mesh, double min_area);
 // Enclosed volume (positive when triangles face outward).
 double enclosed_volume(const TriangleMesh& mesh);
 
-}  // namespace animrt::sim::seq_corpus
+}  // namespace animrt::learn::seq_corpus
