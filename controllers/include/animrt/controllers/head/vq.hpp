@@ -1,6 +1,7 @@
 #pragma once
-// Linde-Buzo-Gray vector quantisation: K code vectors (Voronoi regions), each
-// with the mean and covariance of the vectors it holds.
+// A vector-quantisation codebook: K code vectors (Voronoi regions), each
+// with the mean and covariance of the vectors it holds. Trained by
+// Linde-Buzo-Gray splitting (controllers/learn/head/lbg.cpp).
 
 #include <Eigen/Core>
 #include <cstdint>
