@@ -10,9 +10,9 @@
 #include <cstdlib>
 #include <vector>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 
 namespace {

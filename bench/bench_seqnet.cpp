@@ -17,9 +17,9 @@
 
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/inference.hpp"
-#include "animrt/controllers/seqnet/network.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/network.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 
 using namespace animrt::seqnet;
 
@@ -162,7 +162,8 @@ void plain_frames(benchmark::State& state, const NetShape& shape, const MeshSequ
     model.triangles = mesh->triangles;
     graph = mesh_graph(mesh->vertex_count(), mesh->triangles);
   } else {
-    for (int j = 0; j < shape.joint_count; ++j) model.joint_names.push_back("j" + std::to_string(j));
+    for (int j = 0; j < shape.joint_count; ++j)
+      model.joint_names.push_back("j" + std::to_string(j));
   }
   model.low.assign(static_cast<std::size_t>(shape.input_dims()), -1.0);
   model.high.assign(static_cast<std::size_t>(shape.input_dims()), 1.0);

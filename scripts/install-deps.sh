@@ -17,7 +17,7 @@ packages=(
   clang libclang-rt-14-dev  # fuzz harnesses (tests/fuzz, make fuzz)
   zlib1g-dev  # gzip-compressed mesh sequences (controllers/seqnet)
   libirrlicht-doc openarena-data unzip  # real MD2/MD3 clips for tests/seqnet
-  # The sequence network (controllers/seqnet/torch); Debian's libtorch falls
+  # The sequence network (controllers/learn/seqnet/torch); Debian's libtorch falls
   # back to the slow reference BLAS without OpenBLAS.
   libtorch-dev libopenblas0-openmp
   # The dashboard: its HTTP server (and the tests' client), the page's 3-D

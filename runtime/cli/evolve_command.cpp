@@ -10,11 +10,11 @@
 #include <optional>
 #include <thread>
 
-#include "animrt/controllers/evolve/mpi_evaluator.hpp"
-#include "animrt/controllers/evolve/report.hpp"
-#include "animrt/controllers/evolve/search.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/evolve/mpi_evaluator.hpp"
+#include "animrt/learn/evolve/report.hpp"
+#include "animrt/learn/evolve/search.hpp"
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/evolve_dashboard.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include "animrt/controllers/evolve/pareto_report.hpp"
-#include "animrt/controllers/evolve/pareto_search.hpp"
+#include "animrt/learn/evolve/pareto_report.hpp"
+#include "animrt/learn/evolve/pareto_search.hpp"
 
 namespace animrt::cli {
 

@@ -3,9 +3,9 @@
 
 #include <string>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
-#include "animrt/controllers/evolve/grammar.hpp"
-#include "animrt/controllers/evolve/run_config.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
+#include "animrt/learn/evolve/grammar.hpp"
+#include "animrt/learn/evolve/run_config.hpp"
 
 namespace animrt::cli {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/evolve/fitness.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "gait_command.hpp"
 #include "subcommand.hpp"

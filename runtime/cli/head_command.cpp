@@ -2,7 +2,6 @@
 // evaluation and the paper's Table 1.
 
 #include "head_command.hpp"
-#include "subcommand.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -11,13 +10,14 @@
 #include <memory>
 #include <set>
 
-#include "animrt/controllers/head/corpus.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/controllers/head/trainer.hpp"
 #include "animrt/core/error.hpp"
-#include "animrt/sim/head_corpus/generator.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
+#include "animrt/learn/head/trainer.hpp"
+#include "animrt/learn/head_corpus/generator.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -33,7 +33,6 @@ struct HeadArgs {
   double shrink = -1;
   bool quiet = false;
 };
-
 
 TrainOptions train_options(const HeadArgs& a) {
   TrainOptions o;
@@ -58,12 +57,12 @@ int run_features(const HeadArgs& a) {
 }
 
 int run_corpus(const HeadArgs& a) {
-  sim::head_corpus::CorpusOptions o;
+  learn::head_corpus::CorpusOptions o;
   o.utterances = a.utterances;
   o.speakers = a.speakers;
   o.seed = a.seed;
   if (!a.quiet) o.log = [](const std::string& s) { std::cerr << s << '\n'; };
-  sim::head_corpus::generate_corpus(a.out, o);
+  learn::head_corpus::generate_corpus(a.out, o);
   std::cout << "wrote " << a.utterances << " utterances to " << a.out << '\n';
   return 0;
 }

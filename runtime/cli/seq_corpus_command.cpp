@@ -8,8 +8,8 @@
 #include <memory>
 
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seq_corpus/generator.hpp"
 #include "subcommand.hpp"
-#include "animrt/sim/seq_corpus/generator.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -32,9 +32,9 @@ struct SeqCorpusArgs {
 bool is_preset(const std::string& model) { return model == "horse" || model == "quadruped"; }
 
 int run_seq_corpus(const SeqCorpusArgs& a) {
-  sim::seq_corpus::CorpusOptions o;
+  learn::seq_corpus::CorpusOptions o;
   if (is_preset(a.model)) {
-    o = sim::seq_corpus::model_preset(a.model, a.configs);
+    o = learn::seq_corpus::model_preset(a.model, a.configs);
   } else {
     o.model_file = a.model;
     if (a.model.size() < 4 || a.model.compare(a.model.size() - 4, 4, ".xml") != 0) {
@@ -57,7 +57,7 @@ int run_seq_corpus(const SeqCorpusArgs& a) {
   o.walk.fps = a.fps;
   if (!a.quiet) o.log = [](const std::string& s) { std::cerr << s << '\n'; };
   const auto t0 = std::chrono::steady_clock::now();
-  const auto s = sim::seq_corpus::generate_corpus(a.out, o);
+  const auto s = learn::seq_corpus::generate_corpus(a.out, o);
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf(
       "wrote %d sequences (%ld frames, %d vertices, %d triangles, %d fell) to %s in %.1f s\n",

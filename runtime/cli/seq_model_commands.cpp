@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/seqnet/evaluation.hpp"
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/generation.hpp"
 #include "animrt/controllers/seqnet/inference.hpp"
@@ -19,6 +18,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/evaluation.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {

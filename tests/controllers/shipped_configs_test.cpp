@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/evolve/run_config.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/controllers/gait/walk_response.hpp"
 #include "animrt/controllers/herd/scene.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/yaml_doc.hpp"
+#include "animrt/learn/evolve/run_config.hpp"
 #include "support/files.hpp"
 
 namespace animrt {

@@ -23,9 +23,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
@@ -340,8 +340,9 @@ TEST(EvolveDashboard, AStreamClientThatNeverReadsHoldsUpNeitherPublishingNorOthe
   addr.sin_port = htons(static_cast<std::uint16_t>(rig.server->port()));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  const std::string request = "GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:" +
-                              std::to_string(rig.server->port()) + "\r\n\r\n";
+  const std::string request =
+      "GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(rig.server->port()) +
+      "\r\n\r\n";
   ASSERT_EQ(::send(fd, request.data(), request.size(), 0), static_cast<ssize_t>(request.size()));
   const evolve::SearchResult result = rig.search();  // frames pile up unread meanwhile
   // Publishing never waits for a client: a thousand generations' worth.

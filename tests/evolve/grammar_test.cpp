@@ -1,17 +1,17 @@
 // BNF grammar parsing: the paper's grammars load; every kind of bad grammar
 // gets one error naming file, line, column and rule.
 
-#include "animrt/controllers/evolve/grammar.hpp"
+#include "animrt/learn/evolve/grammar.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <sstream>
 
-#include "animrt/controllers/evolve/mapper.hpp"
-#include "animrt/controllers/evolve/random.hpp"
 #include "animrt/controllers/gait/expression.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/evolve/mapper.hpp"
+#include "animrt/learn/evolve/random.hpp"
 #include "support/files.hpp"
 
 namespace animrt::evolve {

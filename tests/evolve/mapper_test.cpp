@@ -1,7 +1,7 @@
 // The GE mapping (worked by hand), wrapping, invalid individuals, and the
 // genetic operators.
 
-#include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/learn/evolve/mapper.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <set>
 #include <string>
 
-#include "animrt/controllers/evolve/operators.hpp"
 #include "animrt/controllers/gait/expression.hpp"
+#include "animrt/learn/evolve/operators.hpp"
 
 namespace animrt::evolve {
 namespace {

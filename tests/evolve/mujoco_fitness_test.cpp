@@ -9,11 +9,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "animrt/controllers/evolve/fitness.hpp"
-#include "animrt/controllers/evolve/phenotype.hpp"
-#include "animrt/controllers/evolve/random.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/evolve/fitness.hpp"
+#include "animrt/learn/evolve/phenotype.hpp"
+#include "animrt/learn/evolve/random.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 

@@ -2,15 +2,15 @@
 // quadruped: its front is non-dominated, repeatable, and the same however the
 // walks are spread.
 
-#include "animrt/controllers/evolve/pareto.hpp"
+#include "animrt/learn/evolve/pareto.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "animrt/controllers/evolve/pareto_search.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/learn/evolve/pareto_search.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 

@@ -2,7 +2,7 @@
 // invalid individuals score worst and are counted, a falling phenotype gets
 // the worst score, the run file is checked.
 
-#include "animrt/controllers/evolve/search.hpp"
+#include "animrt/learn/evolve/search.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <functional>
 #include <set>
 
-#include "animrt/controllers/evolve/evaluator.hpp"
-#include "animrt/controllers/evolve/phenotype.hpp"
+#include "animrt/learn/evolve/evaluator.hpp"
+#include "animrt/learn/evolve/phenotype.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "support/files.hpp"
 
@@ -347,8 +347,7 @@ TEST(RunConfig, ShippedRunFilesLoad) {
        {"horse_numerical", "horse_concatenating", "horse_hybrid", "horse_sinusoidal", "horse_free",
         "horse_concatenating_varying_weights", "horse_concatenating_varying_freedom",
         "horse_hybrid_structured", "horse_numerical_balance", "horse_hybrid_balance",
-        "horse_hybrid_structured_balance",
-        "quadruped_concatenating"}) {
+        "horse_hybrid_structured_balance", "quadruped_concatenating"}) {
     const RunConfig c = load_run_config(kSourceRoot + "/configs/evolve/" + f + ".yaml");
     EXPECT_NO_THROW(Grammar::load_file(c.grammar)) << f;
     EXPECT_NO_THROW(load_gait_file(c.seed_gait)) << f;

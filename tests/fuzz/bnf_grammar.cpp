@@ -6,8 +6,8 @@
 #include <cstring>
 #include <vector>
 
-#include "animrt/controllers/evolve/grammar.hpp"
-#include "animrt/controllers/evolve/mapper.hpp"
+#include "animrt/learn/evolve/grammar.hpp"
+#include "animrt/learn/evolve/mapper.hpp"
 #include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "animrt/controllers/evolve/run_config.hpp"
+#include "animrt/learn/evolve/run_config.hpp"
 #include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -13,10 +13,10 @@
 #include <filesystem>
 #include <map>
 
-#include "animrt/controllers/head/corpus.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/controllers/head/trainer.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
+#include "animrt/learn/head/trainer.hpp"
 #include "head_test_util.hpp"
 
 namespace animrt::head {
@@ -30,11 +30,11 @@ struct FourSpeakers {
 
 FourSpeakers make_four_speakers(std::uint64_t corpus_seed) {
   const std::string dir = test::temp_dir("corpus4");
-  sim::head_corpus::CorpusOptions co;
+  learn::head_corpus::CorpusOptions co;
   co.utterances = 40;
   co.speakers = 4;
   co.seed = corpus_seed;
-  sim::head_corpus::generate_corpus(dir, co);
+  learn::head_corpus::generate_corpus(dir, co);
   FourSpeakers out;
   out.corpus_seed = corpus_seed;
   const auto split = split_corpus(list_corpus(dir), 0.8, 1);

@@ -7,13 +7,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "animrt/controllers/head/corpus.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/controllers/head/streaming.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
-#include "animrt/controllers/head/trainer.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/head/corpus.hpp"
+#include "animrt/learn/head/evaluation.hpp"
+#include "animrt/learn/head/trainer.hpp"
 #include "head_test_util.hpp"
 
 namespace animrt::head {

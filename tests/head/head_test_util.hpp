@@ -10,7 +10,7 @@
 #include <string>
 
 #include "animrt/controllers/head/audio.hpp"
-#include "animrt/sim/head_corpus/generator.hpp"
+#include "animrt/learn/head_corpus/generator.hpp"
 
 namespace animrt::head::test {
 
@@ -53,11 +53,11 @@ inline Audio concat(const Audio& a, const Audio& b) {
 inline const std::string& tiny_corpus() {
   static const std::string dir = [] {
     const std::string d = temp_dir("corpus");
-    sim::head_corpus::CorpusOptions o;
+    learn::head_corpus::CorpusOptions o;
     o.utterances = 10;
     o.speakers = 1;
     o.seed = 7;
-    sim::head_corpus::generate_corpus(d, o);
+    learn::head_corpus::generate_corpus(d, o);
     return d;
   }();
   return dir;

@@ -7,6 +7,8 @@
 #include <random>
 
 #include "animrt/controllers/head/decoder.hpp"
+#include "animrt/learn/head/bigram_training.hpp"
+#include "animrt/learn/head/hmm_training.hpp"
 
 namespace animrt::head {
 namespace {

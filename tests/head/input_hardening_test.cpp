@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "animrt/controllers/head/audio.hpp"
-#include "animrt/controllers/head/corpus.hpp"
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/head/corpus.hpp"
 #include "head_test_util.hpp"
 #include "support/hostile_files.hpp"
 

@@ -5,11 +5,13 @@
 #include <random>
 
 #include "animrt/controllers/head/bigram.hpp"
-#include "animrt/controllers/head/evaluation.hpp"
 #include "animrt/controllers/head/rotation.hpp"
 #include "animrt/controllers/head/spline.hpp"
 #include "animrt/controllers/head/squad.hpp"
 #include "animrt/controllers/head/vq.hpp"
+#include "animrt/learn/head/bigram_training.hpp"
+#include "animrt/learn/head/evaluation.hpp"
+#include "animrt/learn/head/lbg.hpp"
 
 namespace animrt::head {
 namespace {

@@ -13,9 +13,9 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
+#include "animrt/learn/seq_corpus/body_field.hpp"
+#include "animrt/learn/seq_corpus/generator.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
-#include "animrt/sim/seq_corpus/body_field.hpp"
-#include "animrt/sim/seq_corpus/generator.hpp"
 #include "support/files.hpp"
 
 namespace {
@@ -23,7 +23,7 @@ namespace {
 using animrt::kSourceRoot;
 
 using namespace animrt::sim;
-using namespace animrt::sim::seq_corpus;
+using namespace animrt::learn::seq_corpus;
 
 TEST(MarchingTetrahedra, SphereIsClosedOrientedAndHasItsVolume) {
   const double r = 0.5, step = 0.05;

@@ -6,8 +6,8 @@
 
 #include <numbers>
 
-#include "animrt/controllers/seqnet/shapes.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 #include "seq_test_util.hpp"
 
 namespace animrt::seqnet {

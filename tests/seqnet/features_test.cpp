@@ -8,9 +8,9 @@
 #include <Eigen/Dense>
 #include <numbers>
 
-#include "animrt/controllers/seqnet/interpolation.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/interpolation.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 
 namespace animrt::seqnet {
 namespace {

@@ -8,7 +8,7 @@
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 #include "seq_test_util.hpp"
 
 namespace animrt::seqnet {

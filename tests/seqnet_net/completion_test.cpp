@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "animrt/controllers/seqnet/inference.hpp"
-#include "animrt/controllers/seqnet/network.hpp"
+#include "animrt/learn/seqnet/network.hpp"
 
 namespace animrt::seqnet {
 namespace {

@@ -5,23 +5,23 @@
 // and vertex-space is not; the change per frame is the step's, and 0 for a
 // model that never moves; a model of another template is refused.
 
-#include "animrt/controllers/seqnet/evaluation.hpp"
+#include "animrt/learn/seqnet/evaluation.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
-#include "animrt/controllers/seqnet/network.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/network.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "net_test_util.hpp"
 
 namespace animrt::seqnet {
 namespace {
 
 constexpr int kFrames = 60;
-constexpr float kStep[kFeatureDims] = {0.1F, -0.06F, 0.08F, 0.03F, -0.05F, 0.04F,
-                                       0.06F, -0.02F, 0.05F};
+constexpr float kStep[kFeatureDims] = {0.1F,  -0.06F, 0.08F,  0.03F, -0.05F,
+                                       0.04F, 0.06F,  -0.02F, 0.05F};
 
 // The bending bar's template and scale, its frames replaced by frame 0 plus
 // t steps (normalised units, the same step at every vertex), two clips.
@@ -57,7 +57,8 @@ ModelFile step_model(const SequenceFeatures& f, float scale) {
   for (NamedArray& a : m.parameters) {
     std::fill(a.values.begin(), a.values.end(), 0.0F);
     if (a.name == "decoder.4.self.bias") {
-      for (int c = 0; c < kFeatureDims; ++c) a.values[static_cast<std::size_t>(c)] = scale * kStep[c];
+      for (int c = 0; c < kFeatureDims; ++c)
+        a.values[static_cast<std::size_t>(c)] = scale * kStep[c];
     }
   }
   return m;
@@ -135,7 +136,8 @@ TEST(SeqEvaluation, ChangePerFrameIsTheStepsAndZeroWhenFrozen) {
     for (const Clip& p : e.pieces) {
       for (int s = p.first; s < p.first + p.count; ++s, ++starts) {
         FeatureFrame x = f.frames[static_cast<std::size_t>(s)];
-        for (int c = 0; c < kFeatureDims; ++c) x.row(c).array() += static_cast<double>(kStep[c]) * t;
+        for (int c = 0; c < kFeatureDims; ++c)
+          x.row(c).array() += static_cast<double>(kStep[c]) * t;
         expected += step_norm / x.norm();
       }
     }

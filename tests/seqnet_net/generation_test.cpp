@@ -9,9 +9,9 @@
 
 #include <sstream>
 
-#include "animrt/controllers/seqnet/shapes.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "net_test_util.hpp"
 
 namespace animrt::seqnet {

@@ -11,10 +11,10 @@
 
 #include <sstream>
 
-#include "animrt/controllers/seqnet/network.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/network.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "net_test_util.hpp"
 
 namespace animrt::seqnet {
@@ -144,7 +144,8 @@ TEST(SeqInference, MeshModelWithNineChannelsEqualsTheTorchNetwork) {
 TEST(SeqInference, JointModelEqualsTheTorchNetwork) { expect_same_chains(random_joint_model()); }
 
 TEST(SeqInference, TrainedJointModelEqualsTheTorchNetwork) {
-  expect_same_chains(trained({nettest::write_joint_csv("infer_walk.csv", 60)}, "infer_joint.model"));
+  expect_same_chains(
+      trained({nettest::write_joint_csv("infer_walk.csv", 60)}, "infer_joint.model"));
 }
 
 TEST(SeqInference, TrainedMeshModelEqualsTheTorchNetwork) {

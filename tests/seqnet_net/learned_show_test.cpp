@@ -12,10 +12,10 @@
 
 #include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/seqnet/model_file.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 #include "net_test_util.hpp"
 
 namespace animrt {

@@ -10,9 +10,9 @@
 #include <fstream>
 #include <iterator>
 
-#include "animrt/controllers/seqnet/network.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/network.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
 #include "net_test_util.hpp"
 
 namespace animrt::seqnet {

@@ -12,8 +12,8 @@
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
-#include "animrt/controllers/seqnet/shapes.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
+#include "animrt/learn/seqnet/shapes.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 
 namespace nettest {
 

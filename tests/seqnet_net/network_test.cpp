@@ -1,7 +1,7 @@
 // The network's pieces: Eq. 2 on a hand-computed mesh, the shared parameter
 // set of the two chains, and each loss term on hand-made tensors.
 
-#include "animrt/controllers/seqnet/network.hpp"
+#include "animrt/learn/seqnet/network.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
@@ -186,10 +186,10 @@ TEST_F(SeqNetTest, BatchLossWeighsTheTermsAsThePaper) {
   // Without L2 (the third ablation) the weights are no longer in the total.
   const LossTerms no_l2 = batch_loss(net, truth, false, 1.0, true, 0.0);
   EXPECT_GT(no_l2.l2.item<double>(), 0.0);
-  EXPECT_NEAR(no_l2.total.item<double>(),
-              no_l2.recon.item<double>() + 0.5 * no_l2.bidir.item<double>() +
-                  0.1 * no_l2.kl.item<double>(),
-              1e-5);
+  EXPECT_NEAR(
+      no_l2.total.item<double>(),
+      no_l2.recon.item<double>() + 0.5 * no_l2.bidir.item<double>() + 0.1 * no_l2.kl.item<double>(),
+      1e-5);
 }
 
 TEST_F(SeqNetTest, AdamFollowsItsUpdateRule) {

@@ -2,7 +2,7 @@
 // seed, a resumed run equals an uninterrupted one, the held-out split, and
 // data or checkpoints that do not fit are refused.
 
-#include "animrt/controllers/seqnet/training.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>

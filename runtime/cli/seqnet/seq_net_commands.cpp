@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "../subcommand.hpp"
-#include "animrt/controllers/seqnet/training.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/training.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -73,7 +73,6 @@ void add_seq_net_commands(CLI::App& app) {
   train->add_flag("!--unidirectional", train_args->bidirectional,
                   "forward chain only, no L_bidir (ablation)");
   set_subcommand_body(train, [train_args] { return run_train(*train_args); });
-
 }
 
 }  // namespace animrt::cli

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "animrt/controllers/evolve/search.hpp"
+#include "animrt/learn/evolve/search.hpp"
 #include "animrt/runtime/figure_kinematics.hpp"
 
 namespace animrt {

@@ -17,6 +17,8 @@ constexpr double kLogZero = -std::numeric_limits<double>::infinity();
 
 // log(exp(a) + exp(b)) without overflow; handles -inf.
 double log_add(double a, double b);
+// log(sum exp(v)) without overflow; kLogZero when every entry is.
+double log_sum(const Eigen::Ref<const Eigen::VectorXd>& v);
 
 enum class Topology { kLeftToRight, kErgodic };
 const char* topology_name(Topology t);  // "LR" or "EG"
@@ -52,28 +54,5 @@ double backward(const Hmm& hmm, const Eigen::MatrixXd& log_b, Eigen::MatrixXd& l
 // Most likely state path; returns its log probability (exit included), or
 // kLogZero (empty path) when no path exists.
 double viterbi(const Hmm& hmm, const Eigen::MatrixXd& log_b, std::vector<int>& path);
-
-struct HmmTrainOptions {
-  int states = 3;
-  int mixtures = 2;
-  Topology topology = Topology::kLeftToRight;
-  int max_iterations = 20;
-  double tolerance = 1e-4;         // stop when the mean per-frame log likelihood gains less
-  Eigen::VectorXd variance_floor;  // D, absolute
-  std::uint64_t seed = 1;
-};
-
-// Initialises an HMM from sequences known to belong to it: each sequence is
-// cut into `states` equal parts (the known segmentation), each state's
-// mixture starts from k-means of its frames, transitions from the counts.
-// Sequences shorter than the number of states are ignored by left-to-right
-// models. Needs at least one usable frame.
-Hmm init_hmm(const std::vector<Eigen::MatrixXd>& sequences, const HmmTrainOptions& options);
-
-// Baum-Welch re-estimation over all sequences. Returns the total log
-// likelihood of the usable sequences before each iteration and after the last
-// (non-decreasing up to rounding).
-std::vector<double> baum_welch(Hmm& hmm, const std::vector<Eigen::MatrixXd>& sequences,
-                               const HmmTrainOptions& options);
 
 }  // namespace animrt::head

@@ -14,7 +14,7 @@
 
 #include <memory>
 
-#include "animrt/controllers/evolve/gait_simulator.hpp"
+#include "animrt/controllers/gait/gait_simulator.hpp"
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
 namespace animrt::sim {

@@ -1,0 +1,320 @@
+#include "animrt/learn/seqnet/network.hpp"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "animrt/core/error.hpp"
+
+namespace animrt::seqnet {
+
+MeshGraph mesh_graph(int vertex_count, const std::vector<std::array<int, 3>>& triangles) {
+  std::vector<std::set<int>> ring(static_cast<std::size_t>(vertex_count));
+  for (const auto& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<std::size_t>(k)];
+      const int b = t[static_cast<std::size_t>((k + 1) % 3)];
+      ring[static_cast<std::size_t>(a)].insert(b);
+      ring[static_cast<std::size_t>(b)].insert(a);
+    }
+  }
+  std::vector<std::int64_t> rows, cols;
+  std::vector<float> weights;
+  for (int i = 0; i < vertex_count; ++i) {
+    const auto& r = ring[static_cast<std::size_t>(i)];
+    for (int j : r) {
+      rows.push_back(i);
+      cols.push_back(j);
+      weights.push_back(1.0F / static_cast<float>(r.size()));
+    }
+  }
+  const auto n = static_cast<std::int64_t>(rows.size());
+  MeshGraph g;
+  g.vertex_count = vertex_count;
+  g.rows = torch::from_blob(rows.data(), {n}, torch::kInt64).clone();
+  g.cols = torch::from_blob(cols.data(), {n}, torch::kInt64).clone();
+  g.weights = torch::from_blob(weights.data(), {n}, torch::kFloat32).clone();
+  return g;
+}
+
+MeshConvImpl::MeshConvImpl(int in, int out, MeshGraph graph, bool transpose)
+    : graph_(std::move(graph)), transpose_(transpose) {
+  self = register_module("self", torch::nn::Linear(torch::nn::LinearOptions(in, out)));
+  neighbours = register_module("neighbours",
+                               torch::nn::Linear(torch::nn::LinearOptions(in, out).bias(false)));
+}
+
+torch::Tensor MeshConvImpl::ring(const torch::Tensor& x) const {
+  // A sparse V x V matrix times the vertices-first [V, B C] view: the
+  // neighbour mean (row i: 1/d_i at its neighbours), or with the indices
+  // swapped its adjoint. A gather and index_add over dimension 1 of
+  // [B, V, C] gives the same numbers but is several times slower, forward
+  // and backward. mesh_graph lists the pairs sorted by row and then column,
+  // so the matrix is already coalesced; the adjoint's pairs are sorted here.
+  const std::int64_t v = graph_.vertex_count;
+  torch::Tensor matrix;
+  if (transpose_) {
+    matrix =
+        torch::sparse_coo_tensor(torch::stack({graph_.cols, graph_.rows}), graph_.weights, {v, v})
+            .coalesce();
+  } else {
+    matrix = torch::_sparse_coo_tensor_unsafe(torch::stack({graph_.rows, graph_.cols}),
+                                              graph_.weights, {v, v})
+                 ._coalesced_(true);
+  }
+  const std::int64_t batch = x.size(0), channels = x.size(2);
+  const torch::Tensor columns = x.transpose(0, 1).reshape({v, batch * channels});
+  return torch::mm(matrix, columns).view({v, batch, channels}).transpose(0, 1);
+}
+
+torch::Tensor MeshConvImpl::forward(const torch::Tensor& x) {
+  return self->forward(x) + neighbours->forward(ring(x));
+}
+
+SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
+  const bool mesh = shape.kind == ModelKind::mesh;
+  const int width = mesh ? shape.channels : shape.dense_width;
+  encoder = torch::nn::Sequential();
+  decoder = torch::nn::Sequential();
+  for (int k = 0; k < shape.conv_layers; ++k) {
+    if (mesh) {
+      encoder->push_back(MeshConv(k == 0 ? 9 : width, width, graph, false));
+    } else {
+      encoder->push_back(torch::nn::Linear(k == 0 ? shape.joint_count : width, width));
+    }
+    encoder->push_back(torch::nn::Tanh());
+  }
+  const std::int64_t flat = mesh ? std::int64_t{shape.vertex_count} * width : width;
+  encoder = register_module("encoder", encoder);
+  to_mu = register_module("to_mu", torch::nn::Linear(flat, shape.latent));
+  to_logvar = register_module("to_logvar", torch::nn::Linear(flat, shape.latent));
+  lstm = register_module(
+      "lstm",
+      torch::nn::LSTM(
+          torch::nn::LSTMOptions(shape.latent, shape.hidden).num_layers(shape.lstm_layers)));
+  from_hidden = register_module("from_hidden", torch::nn::Linear(shape.hidden, flat));
+  for (int k = 0; k < shape.conv_layers; ++k) {
+    const bool last = k + 1 == shape.conv_layers;
+    const int out = last ? (mesh ? 9 : shape.joint_count) : width;
+    if (mesh) {
+      decoder->push_back(MeshConv(width, out, graph, true));
+    } else {
+      decoder->push_back(torch::nn::Linear(width, out));
+    }
+    if (!last) decoder->push_back(torch::nn::Tanh());
+  }
+  decoder = register_module("decoder", decoder);
+}
+
+std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& x) {
+  const std::int64_t batch = x.size(0);
+  torch::Tensor h = shape_.kind == ModelKind::mesh ? x.view({batch, shape_.vertex_count, 9}) : x;
+  h = encoder->forward(h).reshape({batch, -1});
+  return {to_mu->forward(h), to_logvar->forward(h)};
+}
+
+torch::Tensor SeqNetImpl::decode(const torch::Tensor& hidden) {
+  const std::int64_t batch = hidden.size(0);
+  torch::Tensor h = torch::tanh(from_hidden->forward(hidden));
+  if (shape_.kind == ModelKind::mesh) h = h.view({batch, shape_.vertex_count, shape_.channels});
+  return decoder->forward(h).reshape({batch, -1});
+}
+
+LstmState SeqNetImpl::initial_state(int batch, double sign) const {
+  const auto value = sign * shape_.s0;
+  return {torch::full({shape_.lstm_layers, batch, shape_.hidden}, value),
+          torch::full({shape_.lstm_layers, batch, shape_.hidden}, value)};
+}
+
+Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool sample) {
+  const std::int64_t u = given.size(0);
+  std::vector<torch::Tensor> frames{given[0]}, mus, logvars;
+  torch::Tensor x = given[0];
+  for (int t = 1; t < n; ++t) {
+    auto [mu, logvar] = encode(x);
+    torch::Tensor z = mu;
+    if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
+    auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
+    state = next_state;
+    const torch::Tensor generated = x + decode(out.squeeze(0));
+    x = t < u ? given[t] : generated;
+    frames.push_back(x);
+    mus.push_back(mu);
+    logvars.push_back(logvar);
+  }
+  return {torch::stack(frames), torch::stack(mus), torch::stack(logvars)};
+}
+
+torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& backward,
+                         const torch::Tensor& truth) {
+  const torch::Tensor f = (forward - truth).pow(2).flatten(1).mean(1);
+  const torch::Tensor b = (backward - truth.flip(0)).pow(2).flatten(1).mean(1);
+  return (f + b).sum();
+}
+
+torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward) {
+  return (forward - backward.flip(0)).pow(2).flatten(1).mean(1).sum();
+}
+
+torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar) {
+  return (-0.5 * (1.0 + logvar - mu.pow(2) - logvar.exp())).mean();
+}
+
+torch::Tensor l2_loss(const torch::nn::Module& net) {
+  torch::Tensor sum = torch::zeros({});
+  std::int64_t count = 0;
+  for (const auto& p : net.parameters()) {
+    if (p.dim() < 2) continue;
+    sum = sum + p.pow(2).sum();
+    count += p.numel();
+  }
+  return count == 0 ? sum : sum / static_cast<double>(count);
+}
+
+LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
+                     bool bidirectional, double l2_weight) {
+  const auto n = static_cast<int>(truth.size(0));
+  const auto batch = static_cast<int>(truth.size(1));
+  LossTerms l;
+  const Chain f = net->run(truth.slice(0, 0, 1), n, net->initial_state(batch, 1.0), sample);
+  torch::Tensor kl = kl_loss(f.mu, f.logvar);
+  if (bidirectional) {
+    const Chain b = net->run(truth.slice(0, n - 1, n), n, net->initial_state(batch, -1.0), sample);
+    l.recon = recon_loss(f.frames, b.frames, truth);
+    l.bidir = bidir_loss(f.frames, b.frames);
+    kl = 0.5 * (kl + kl_loss(b.mu, b.logvar));
+  } else {
+    // One direction: its reconstruction counted twice, to keep the scale.
+    l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
+    l.bidir = torch::zeros({});
+  }
+  l.kl = kl;
+  l.l2 = l2_loss(*net);
+  l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l2_weight * l.l2);
+  return l;
+}
+
+Adam::Adam(std::vector<torch::Tensor> parameters, double learning_rate)
+    : params_(std::move(parameters)), lr_(learning_rate) {
+  for (const auto& p : params_) {
+    m_.push_back(torch::zeros_like(p));
+    v_.push_back(torch::zeros_like(p));
+  }
+}
+
+void Adam::step() {
+  torch::NoGradGuard no_grad;
+  ++steps_;
+  const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
+  const double c1 = 1.0 - std::pow(b1, static_cast<double>(steps_));
+  const double c2 = 1.0 - std::pow(b2, static_cast<double>(steps_));
+  for (std::size_t k = 0; k < params_.size(); ++k) {
+    torch::Tensor& p = params_[k];
+    if (!p.grad().defined()) continue;
+    const torch::Tensor g = p.grad();
+    m_[k].mul_(b1).add_(g, 1.0 - b1);
+    v_[k].mul_(b2).addcmul_(g, g, 1.0 - b2);
+    p.addcdiv_(m_[k] / c1, (v_[k] / c2).sqrt_().add_(eps), -lr_);
+    p.mutable_grad().zero_();
+  }
+}
+
+namespace {
+
+NamedArray to_array(const std::string& name, const torch::Tensor& t) {
+  NamedArray a;
+  a.name = name;
+  const torch::Tensor c = t.detach().contiguous().to(torch::kFloat32);
+  a.shape.assign(c.sizes().begin(), c.sizes().end());
+  a.values.assign(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+  return a;
+}
+
+void copy_into(torch::Tensor& target, const NamedArray& a, const std::string& file,
+               const std::string& what) {
+  const std::vector<std::int64_t> want(target.sizes().begin(), target.sizes().end());
+  if (a.shape != want) {
+    auto str = [](const std::vector<std::int64_t>& s) {
+      std::string out;
+      for (auto d : s) out += (out.empty() ? "" : "x") + std::to_string(d);
+      return out.empty() ? std::string("scalar") : out;
+    };
+    throw InputError(Location{file, 0, 0}, what + " " + a.name,
+                     "shape " + str(a.shape) + ", the network needs " + str(want));
+  }
+  torch::NoGradGuard no_grad;
+  target.copy_(torch::from_blob(const_cast<float*>(a.values.data()),
+                                {static_cast<std::int64_t>(a.values.size())}, torch::kFloat32)
+                   .view(target.sizes()));
+}
+
+const NamedArray& find_array(const std::vector<NamedArray>& arrays, const std::string& name,
+                             const std::string& file, const std::string& what) {
+  for (const NamedArray& a : arrays) {
+    if (a.name == name) return a;
+  }
+  throw InputError(Location{file, 0, 0}, what + " " + name, "missing from the file");
+}
+
+}  // namespace
+
+std::vector<NamedArray> Adam::state(const std::vector<std::string>& names) const {
+  std::vector<NamedArray> out;
+  for (std::size_t k = 0; k < params_.size(); ++k) {
+    out.push_back(to_array("m." + names[k], m_[k]));
+    out.push_back(to_array("v." + names[k], v_[k]));
+  }
+  NamedArray steps;
+  steps.name = "steps";
+  steps.shape = {1};
+  // Exact as a float up to 2^24 steps.
+  steps.values = {static_cast<float>(steps_)};
+  out.push_back(steps);
+  return out;
+}
+
+void Adam::restore(const std::vector<NamedArray>& state, const std::vector<std::string>& names,
+                   const std::string& file) {
+  for (std::size_t k = 0; k < params_.size(); ++k) {
+    copy_into(m_[k], find_array(state, "m." + names[k], file, "optimiser"), file, "optimiser");
+    copy_into(v_[k], find_array(state, "v." + names[k], file, "optimiser"), file, "optimiser");
+  }
+  const NamedArray& steps = find_array(state, "steps", file, "optimiser");
+  if (steps.values.size() != 1 || steps.values[0] < 0.0F) {
+    throw InputError(Location{file, 0, 0}, "optimiser steps", "not one count");
+  }
+  steps_ = static_cast<std::int64_t>(steps.values[0]);
+}
+
+std::vector<NamedArray> save_parameters(const SeqNetImpl& net) {
+  std::vector<NamedArray> out;
+  for (const auto& item : net.named_parameters()) out.push_back(to_array(item.key(), item.value()));
+  return out;
+}
+
+void load_parameters(SeqNetImpl& net, const std::vector<NamedArray>& arrays,
+                     const std::string& file) {
+  auto params = net.named_parameters();
+  if (arrays.size() != params.size()) {
+    throw InputError(Location{file, 0, 0}, "parameters",
+                     std::to_string(arrays.size()) + " arrays, the network has " +
+                         std::to_string(params.size()));
+  }
+  for (auto& item : params) {
+    copy_into(item.value(), find_array(arrays, item.key(), file, "parameter"), file, "parameter");
+  }
+}
+
+SeqNet network_for(const ModelFile& model, const std::string& file) {
+  MeshGraph graph;
+  if (model.shape.kind == ModelKind::mesh) {
+    graph = mesh_graph(model.shape.vertex_count, model.triangles);
+  }
+  SeqNet net(model.shape, graph);
+  load_parameters(*net, model.parameters, file);
+  return net;
+}
+
+}  // namespace animrt::seqnet

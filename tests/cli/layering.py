@@ -1,0 +1,136 @@
+"""The layers' dependency rules (docs/architecture.md), checked on the tree.
+
+Usage: layering.py SOURCE_DIR BUILD_DIR
+
+Every #include of one of our headers (animrt/<layer>/...) must point the
+way the layers do: core includes nothing of ours; firmware_bridge only core;
+the motion that plays (controllers/, outside learn/) no bridge, sim, runtime
+or learner; the learners (controllers/learn/) no bridge or runtime, and sim
+only from the corpus generator that walks figures on MuJoCo; sim no learner;
+the runtime library no sim, no learner and no herd (Recast). Then what the
+runtime library links, as CMake wrote it at configure time: no learner, no
+libtorch, no MPI, no simulator, no Recast, no MuJoCo. Prints one line per
+violation and exits 1 if there is any.
+"""
+
+import pathlib
+import re
+import sys
+
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](animrt/([a-z_]+)/[^">]*)[">]')
+
+# Files the runtime's folder holds that do not build into animrt_runtime:
+# the dashboards of a herd and of an evolve run are targets of their own
+# (animrt_herd_dashboard, animrt_evolve_dashboard) that the CLI links.
+RUNTIME_FRONT_ENDS = {
+    "runtime/src/herd_dashboard.cpp",
+    "runtime/include/animrt/runtime/herd_dashboard.hpp",
+    "runtime/src/evolve_dashboard.cpp",
+    "runtime/include/animrt/runtime/evolve_dashboard.hpp",
+}
+
+
+def layer_of(rel):
+    """The rule set a file falls under, or None for folders without rules."""
+    if rel.startswith("core/"):
+        return "core"
+    if rel.startswith("firmware_bridge/"):
+        return "bridge"
+    if rel.startswith("controllers/learn/seq_corpus/") or rel.startswith(
+            "controllers/learn/include/animrt/learn/seq_corpus/"):
+        return "learn_physics"
+    if rel.startswith("controllers/learn/"):
+        return "learn"
+    if rel.startswith("controllers/"):
+        return "play"
+    if rel.startswith("sim/"):
+        return "sim"
+    if rel.startswith("runtime/cli/"):
+        return None  # the executables link whatever they run
+    if rel.startswith("runtime/"):
+        return "runtime_front_end" if rel in RUNTIME_FRONT_ENDS else "runtime"
+    return None
+
+
+# Per rule set: the header folders (animrt/<folder>/) it may include, and the
+# header paths allowed beyond them.
+ALLOWED = {
+    "core": ({"core"}, set()),
+    "bridge": ({"core", "bridge"}, set()),
+    "play": ({"core", "controllers"}, set()),
+    "learn": ({"core", "controllers", "learn"}, set()),
+    "learn_physics": ({"core", "controllers", "learn", "sim"}, set()),
+    # sim/mujoco poses a figure for the runtime behind an interface the
+    # runtime declares (a header only; sim does not link the runtime).
+    "sim": ({"core", "bridge", "sim", "controllers"}, {"animrt/runtime/figure_kinematics.hpp"}),
+    "runtime": ({"core", "bridge", "controllers", "runtime"}, set()),
+    "runtime_front_end": ({"core", "bridge", "controllers", "runtime", "learn"}, set()),
+}
+
+# Header paths a rule set may not include even inside an allowed folder.
+FORBIDDEN_PREFIXES = {
+    "runtime": ("animrt/controllers/herd/",),  # Recast: animrt_herd, not the loop's
+}
+
+
+def include_violations(root):
+    out = []
+    for path in sorted(root.rglob("*")):
+        if path.suffix not in (".cpp", ".hpp", ".h") or not path.is_file():
+            continue
+        rel = path.relative_to(root).as_posix()
+        if rel.startswith(("build", "tests/", "bench/")):
+            continue
+        layer = layer_of(rel)
+        if layer is None:
+            continue
+        folders, extra = ALLOWED[layer]
+        banned = FORBIDDEN_PREFIXES.get(layer, ())
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            match = INCLUDE.match(line)
+            if not match:
+                continue
+            header, folder = match.group(1), match.group(2)
+            if (folder in folders or header in extra) and not header.startswith(banned):
+                continue
+            out.append(f"{rel}:{number}: a {layer} file includes {header}")
+    return out
+
+
+# Anything in the runtime library's link closure whose name matches is a
+# learner or a dependency the loop must not carry.
+FORBIDDEN_LINKS = re.compile(
+    r"animrt_(learn|seq_corpus|evolve_mpi|seqnet_torch|sim|herd|evolve_dashboard|"
+    r"herd_dashboard)\b|torch|c10|MPI|mpi|Recast|Detour|mujoco", re.IGNORECASE)
+
+
+def link_violations(build):
+    closure = build / "link_closure" / "animrt_runtime.txt"
+    if not closure.is_file():
+        return [f"{closure}: missing (CMake writes it at configure time)"]
+    out = []
+    for line in closure.read_text().splitlines():
+        kind, _, rest = line.partition(" ")
+        if kind == "source":
+            target, _, source = rest.partition(" ")
+            if source.startswith("controllers/learn/") or source.startswith("sim/"):
+                out.append(f"animrt_runtime links {target}, which compiles {source}")
+        elif FORBIDDEN_LINKS.search(rest):
+            out.append(f"animrt_runtime links {rest}")
+    return out
+
+
+def main():
+    root, build = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+    problems = include_violations(root) + link_violations(build)
+    for p in problems:
+        print(p)
+    if problems:
+        print(f"{len(problems)} layering violation(s)")
+        return 1
+    print("layering: every include and the runtime's link closure follow the rules")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
