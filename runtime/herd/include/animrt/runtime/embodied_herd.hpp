@@ -1,11 +1,13 @@
 #pragma once
-// `animrt run ROBOT --herd SCENE --agent NAME`: the robot is one agent of a
-// herd. The herd steps on its own thread on the run's clock and posts the
-// agent's speed and turn to the robot's gait through the run's steering
-// mailbox; with physics, the MuJoCo torso's measured pose replaces the
-// agent's own, so the herd sees the real walk.
+// A running figure as one agent of a herd (`animrt run ROBOT --herd SCENE
+// --agent NAME`): a supervisor outside the cycle. The herd steps on its own
+// thread on the run's clock and posts the agent's speed and turn to the
+// robot's gait through the run's steering mailbox; given the figure's
+// measured track (physics), that replaces the agent's own pose, so the herd
+// sees the real walk.
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -13,15 +15,29 @@
 #include "animrt/controllers/herd/herd.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/run_controls.hpp"
-#include "animrt/sim/mujoco/mujoco_physics.hpp"
 
-namespace animrt::cli {
+namespace animrt {
+
+// The gait a herd figure walks: the motion file of the robot file
+// `robot_file`. Throws InputError when that robot's motion is not a gait.
+std::string gait_of_robot(const std::string& robot_file);
 
 class EmbodiedHerd {
  public:
+  // Where the figure's trunk has gone since its start pose: forward,
+  // leftward (m) and turned (rad, counter-clockwise).
+  struct Track {
+    double x_m = 0.0;
+    double y_m = 0.0;
+    double yaw_rad = 0.0;
+  };
+  // Reads the track from the herd's thread; empty when nothing measures it
+  // (the agent then walks as its gait achieves).
+  using MeasuredTrack = std::function<Track()>;
+
   // Throws InputError for a bad scene or an agent the scene does not have.
   EmbodiedHerd(const std::string& scene_file, const std::string& agent, const Clock& clock,
-               RunControls& controls, const sim::MujocoJointPhysics* physics);
+               RunControls& controls, MeasuredTrack measured = {});
   ~EmbodiedHerd();
 
   // The motion started at t0 on the run's clock: the herd starts stepping.
@@ -39,7 +55,7 @@ class EmbodiedHerd {
   int agent_ = -1;
   const Clock& clock_;
   RunControls& controls_;
-  const sim::MujocoJointPhysics* physics_;
+  MeasuredTrack measured_;
   herd::Vec2 spawn_;
   double spawn_heading_ = 0.0;
   std::atomic<Nanos> t0_{-1};
@@ -48,4 +64,4 @@ class EmbodiedHerd {
   std::thread thread_;
 };
 
-}  // namespace animrt::cli
+}  // namespace animrt
