@@ -152,12 +152,6 @@ struct RunArgs {
   std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
-// The show files a motion plays (a show, or show layers).
-void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>& out) {
-  if (motion.type == "show") out.push_back(motion.file);
-  for (const auto& layer : motion.layers) collect_shows(layer, out);
-}
-
 int cmd_run(const RunArgs& args) {
   // The dashboard's address is a usage error before any file is read.
   const animrt::cli::DashboardAddress address =
@@ -203,8 +197,10 @@ int cmd_run(const RunArgs& args) {
   figure_options.lockstep = args.lockstep;
   figure_options.log = [](const std::string& line) { spdlog::info("{}", line); };
   // A show's sound track plays on its own thread, started with the motion.
-  std::vector<std::string> shows;
-  if (!args.no_audio) collect_shows(robot.config.motion, shows);
+  if (!args.no_audio) {
+    figure_options.audio_sink = [](int rate) { return animrt::open_alsa_sink("default", rate); };
+  }
+  figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
   animrt::Figure figure(std::move(robot), backend, figure_options);
 
   std::unique_ptr<animrt::EmbodiedHerd> herd;
@@ -228,23 +224,7 @@ int cmd_run(const RunArgs& args) {
   options.telemetry_path = args.telemetry;
   options.controls = &g_controls;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
-  animrt::MonotonicClock wall_clock;
-  std::vector<std::unique_ptr<animrt::ShowAudioPlayer>> audio = animrt::open_show_audio(
-      shows, args.lockstep, [](int rate) { return animrt::open_alsa_sink("default", rate); },
-      wall_clock, [](const std::string& message) { spdlog::warn("{}", message); });
-  options.on_motion_start = [&audio, &herd](animrt::Nanos t0) {
-    for (auto& player : audio) player->start(t0);
-    if (herd) herd->start(t0);
-  };
-  options.on_motion_end = [&audio] {
-    for (auto& player : audio) player->stop();
-  };
-  // The sound track follows the show's pause, seek and play.
-  if (!audio.empty()) {
-    options.on_show_command = [&audio](const animrt::ShowCommand& command, double t) {
-      for (auto& player : audio) player->control(command, t);
-    };
-  }
+  if (herd) options.on_motion_start = [&herd](animrt::Nanos t0) { herd->start(t0); };
 
   // The dashboard serves before the start ramp, so its line comes first.
   if (!args.dashboard.empty()) {

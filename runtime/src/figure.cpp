@@ -3,16 +3,27 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "animrt/controllers/show/show_audio.hpp"
+
 namespace animrt {
+
+namespace {
+
+// The show files a motion plays (a show, or show layers).
+void collect_shows(const MotionConfig& motion, std::vector<std::string>& out) {
+  if (motion.type == "show") out.push_back(motion.file);
+  for (const auto& layer : motion.layers) collect_shows(layer, out);
+}
+
+}  // namespace
 
 Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& options)
     : steering_(std::move(robot.steering)), backend_(backend), lockstep_(options.lockstep) {
   // Every refusal comes before the first device starts.
   if (lockstep_ && !backend_.keeps_run_clock()) {
     throw std::invalid_argument(
-        "a lockstep run needs a backend whose devices keep the run's "
-        "clock; " +
-        backend_.name() + " devices keep the wall's");
+        "a lockstep run needs a backend whose devices keep the run's clock; " + backend_.name() +
+        " devices keep the wall's");
   }
   if (!robot.motion) throw std::invalid_argument("figure " + robot.config.name + ": no motion");
   backend_.check(robot.config, lockstep_);
@@ -32,10 +43,19 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
   }
   runner_ =
       std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
+  if (options.audio_sink) {
+    std::vector<std::string> shows;
+    collect_shows(config_.motion, shows);
+    const auto warn = [&options](const std::string& line) {
+      if (options.warn) options.warn(line);
+    };
+    audio_ = open_show_audio(shows, lockstep_, options.audio_sink, wall_clock_, warn);
+  }
 }
 
 Figure::~Figure() {
   dashboard_.reset();
+  audio_.clear();
   runner_.reset();  // the buses close before their devices stop
   backend_.stop();
 }
@@ -71,13 +91,23 @@ DashboardServer& Figure::serve_dashboard(DashboardSetup setup, RunControls& cont
 RunSummary Figure::run(const RunOptions& options) {
   RunOptions run = options;
   run.on_motion_start = [this, start = options.on_motion_start](Nanos t0) {
+    for (auto& player : audio_) player->start(t0);
     if (start) start(t0);
     backend_.motion_started(t0);
   };
   run.on_motion_end = [this, end = options.on_motion_end] {
+    for (auto& player : audio_) player->stop();
     if (end) end();
     backend_.motion_ended();
   };
+  // The sound track follows the show's pause, seek and play.
+  if (!audio_.empty()) {
+    run.on_show_command = [this, command = options.on_show_command](const ShowCommand& c,
+                                                                    double t) {
+      for (auto& player : audio_) player->control(c, t);
+      if (command) command(c, t);
+    };
+  }
   if (dashboard_ && run.monitor == nullptr) run.monitor = monitor_.get();
   struct StopServing {
     DashboardServer* server;

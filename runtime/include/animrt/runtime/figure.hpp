@@ -21,6 +21,9 @@
 
 namespace animrt {
 
+class AudioSink;        // controllers/show/show_audio.hpp, kept out of this header:
+class ShowAudioPlayer;  // it brings Eigen, which httplib's <resolv.h> breaks
+
 struct FigureOptions {
   // The run's clock is simulated (advanced one period per cycle): needs a
   // backend whose devices keep the run's clock.
@@ -31,6 +34,11 @@ struct FigureOptions {
   std::function<std::unique_ptr<ActuatorBus>(std::unique_ptr<ActuatorBus>, std::size_t)> wrap_bus;
   // Lines from the backend as it starts (which devices, where).
   std::function<void(const std::string&)> log;
+  // Plays the sound tracks of the shows the motion plays, started with the
+  // motion, through sinks made here (none: silent). A lockstep run plays
+  // nothing. What cannot be played is told to `warn`, and the run goes on.
+  std::function<std::unique_ptr<AudioSink>(int rate)> audio_sink;
+  std::function<void(const std::string&)> warn;
 };
 
 class Figure {
@@ -62,9 +70,10 @@ class Figure {
   // Serves the dashboard for the next run. `setup` gives where and how; the
   // figure fills in what it knows (robot, backend, buses, motion).
   DashboardServer& serve_dashboard(DashboardSetup setup, RunControls& controls);
-  // Runs the whole lifecycle (Runner::run) with the backend's motion hooks
-  // and dashboard added to `options`, the backend's measures added to the
-  // summary. A dashboard stops serving when the run returns.
+  // Runs the whole lifecycle (Runner::run) with the sound tracks, the
+  // backend's motion hooks and the dashboard added to `options`, the
+  // backend's measures added to the summary. A dashboard stops serving when
+  // the run returns.
   RunSummary run(const RunOptions& options);
 
  private:
@@ -77,6 +86,7 @@ class Figure {
   MonotonicClock wall_clock_;
   std::vector<ActuatorBus*> buses_;
   std::unique_ptr<Runner> runner_;
+  std::vector<std::unique_ptr<ShowAudioPlayer>> audio_;
   std::unique_ptr<RunMonitor> monitor_;
   std::unique_ptr<DashboardServer> dashboard_;
 };
