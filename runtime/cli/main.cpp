@@ -152,6 +152,60 @@ struct RunArgs {
   std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
+// Options that need one another or the simulated backend: a usage error
+// (logged) when they do not go together.
+bool run_args_go_together(const RunArgs& args) {
+  if (args.lockstep && args.backend != "sim") {
+    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
+    return false;
+  }
+  if (!args.physics.empty() && args.backend != "sim") {
+    spdlog::error("--physics needs --backend sim (it replaces the simulated servos' motors)");
+    return false;
+  }
+  if (args.herd.empty() != args.agent.empty()) {
+    spdlog::error("--herd and --agent go together: the scene and which of its agents the robot is");
+    return false;
+  }
+  return true;
+}
+
+// --herd: the herd that steers the figure as one of its agents (null without),
+// seeing the walk the physics measures when there is physics.
+std::unique_ptr<animrt::EmbodiedHerd> join_herd(const RunArgs& args, const animrt::Figure& figure,
+                                                const animrt::SimulatedBackend& simulated) {
+  if (args.herd.empty()) return nullptr;
+  const animrt::sim::MujocoJointPhysics* physics = simulated.mujoco_physics();
+  animrt::EmbodiedHerd::MeasuredTrack measured;
+  if (physics) {
+    measured = [physics] {
+      const animrt::sim::TorsoPose p = physics->torso_pose();
+      return animrt::EmbodiedHerd::Track{p.x_m, p.y_m, p.yaw_rad};
+    };
+  }
+  auto herd = std::make_unique<animrt::EmbodiedHerd>(args.herd, args.agent, figure.clock(),
+                                                     g_controls, std::move(measured));
+  spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
+  return herd;
+}
+
+// --dashboard: where and how it serves; the figure adds what it knows.
+animrt::DashboardSetup dashboard_setup(const RunArgs& args, const std::pair<std::string, int>& at,
+                                       const animrt::Figure& figure,
+                                       animrt::FigureKinematics* model) {
+  animrt::DashboardSetup setup;
+  setup.host = at.first;
+  setup.port = at.second;
+  setup.remote = args.dashboard_remote;
+  setup.rate_hz = args.dashboard_rate;
+  setup.www_dir = args.dashboard_www;
+  // A herd steers the gait itself (and the steering mailbox takes one writer).
+  if (args.herd.empty()) setup.steering = figure.steering();
+  setup.duration_s = args.duration;
+  setup.figure = model;
+  return setup;
+}
+
 int cmd_run(const RunArgs& args) {
   // The dashboard's address is a usage error before any file is read.
   const animrt::cli::DashboardAddress address =
@@ -176,18 +230,7 @@ int cmd_run(const RunArgs& args) {
                   std::strerror(summary_out.error));
     return kExitUsage;
   }
-  if (args.lockstep && args.backend != "sim") {
-    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
-    return kExitUsage;
-  }
-  if (!args.physics.empty() && args.backend != "sim") {
-    spdlog::error("--physics needs --backend sim (it replaces the simulated servos' motors)");
-    return kExitUsage;
-  }
-  if (args.herd.empty() != args.agent.empty()) {
-    spdlog::error("--herd and --agent go together: the scene and which of its agents the robot is");
-    return kExitUsage;
-  }
+  if (!run_args_go_together(args)) return kExitUsage;
 
   animrt::HardwareBackend hardware;
   animrt::SimulatedBackend simulated(animrt::SimulatedBackend::Settings{args.physics, nullptr});
@@ -203,20 +246,7 @@ int cmd_run(const RunArgs& args) {
   figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
   animrt::Figure figure(std::move(robot), backend, figure_options);
 
-  std::unique_ptr<animrt::EmbodiedHerd> herd;
-  if (!args.herd.empty()) {
-    const animrt::sim::MujocoJointPhysics* physics = simulated.mujoco_physics();
-    animrt::EmbodiedHerd::MeasuredTrack measured;
-    if (physics) {
-      measured = [physics] {
-        const animrt::sim::TorsoPose p = physics->torso_pose();
-        return animrt::EmbodiedHerd::Track{p.x_m, p.y_m, p.yaw_rad};
-      };
-    }
-    herd = std::make_unique<animrt::EmbodiedHerd>(args.herd, args.agent, figure.clock(), g_controls,
-                                                  std::move(measured));
-    spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
-  }
+  std::unique_ptr<animrt::EmbodiedHerd> herd = join_herd(args, figure, simulated);
 
   animrt::RunOptions options = figure.run_options();
   options.duration_s = args.duration;
@@ -228,16 +258,7 @@ int cmd_run(const RunArgs& args) {
 
   // The dashboard serves before the start ramp, so its line comes first.
   if (!args.dashboard.empty()) {
-    animrt::DashboardSetup setup;
-    setup.host = dashboard_at.first;
-    setup.port = dashboard_at.second;
-    setup.remote = args.dashboard_remote;
-    setup.rate_hz = args.dashboard_rate;
-    setup.www_dir = args.dashboard_www;
-    // A herd steers the gait itself (and the steering mailbox takes one writer).
-    if (args.herd.empty()) setup.steering = figure.steering();
-    setup.duration_s = args.duration;
-    setup.figure = figure_model.get();
+    animrt::DashboardSetup setup = dashboard_setup(args, dashboard_at, figure, figure_model.get());
     std::cout << "dashboard: " << figure.serve_dashboard(std::move(setup), g_controls).url() << '\n'
               << std::flush;
   }
