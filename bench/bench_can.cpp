@@ -19,8 +19,8 @@
 
 #include "animrt/bridge/can/mit_codec.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
 namespace {
@@ -83,19 +83,19 @@ int main() {
   const std::string path = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped_can.yaml";
   LoadedRobot robot = load_robot(path);
   const double rate = robot.config.rate_hz;
-  ManualClock clock;
-  for (auto& bus : robot.config.buses) bus.timeout_s = 0.05;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
+  SimulatedBackend simulated;
+  FigureOptions lockstep;
+  lockstep.lockstep = true;
+  lockstep.edit = [](RobotConfig& config) {
+    for (auto& bus : config.buses) bus.timeout_s = 0.05;
+  };
+  Figure figure(std::move(robot), simulated, lockstep);
   std::map<std::string, std::unique_ptr<CanFrameTransport>> sniffers;
-  for (const auto& bus : robot.config.buses) {
+  for (const auto& bus : figure.config().buses) {
     if (!sniffers.count(bus.port)) sniffers[bus.port] = open_can(bus.port);
   }
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
-  RunOptions options;
+  RunOptions options = figure.run_options();
   options.duration_s = 2.0;
-  options.lockstep_clock = &clock;
   // Every frame of the run, drained as it goes (the queues are bounded).
   std::map<std::string, Tally> tally;
   for (auto& [port, sniffer] : sniffers) tally[port];
@@ -115,7 +115,7 @@ int main() {
       }
     });
   }
-  const RunSummary summary = runner.run(options);
+  const RunSummary summary = figure.run(options);
   stop = true;
   for (auto& d : drains) d.join();
   std::printf(

@@ -21,6 +21,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/simulated_backend.hpp"
@@ -58,30 +59,33 @@ struct Trial {
 };
 
 Trial run_trial() {
-  MonotonicClock clock;
   LoadedRobot robot = load_robot(kRobot);
   for (BusConfig& bus : robot.config.buses) bus.timeout_s = std::max(bus.timeout_s, 0.02);
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  auto& left = dynamic_cast<sim::CanSimBus&>(*sims[0]);
-  auto& right = dynamic_cast<sim::CanSimBus&>(*sims[1]);
+  // The figure's buses are driven here, by hand, so that the host can die
+  // between two cycles; the loop never runs.
+  SimulatedBackend simulated;
+  auto figure = std::make_unique<Figure>(std::move(robot), simulated);
+  const RobotConfig& config = figure->config();
+  auto& left = dynamic_cast<sim::CanSimBus&>(*simulated.devices()[0]);
+  auto& right = dynamic_cast<sim::CanSimBus&>(*simulated.devices()[1]);
   auto client = VirtualCanBus::named("can1")->attach();
   const can_filter filter{0x580 + kDrive, CAN_SFF_MASK};
   client->set_filters(std::span<const can_filter>(&filter, 1));
 
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  std::vector<ActuatorBus*> buses;
   std::vector<std::vector<double>> start, q;
-  for (const BusConfig& config : robot.config.buses) buses.push_back(make_bus(config));
-  for (auto& bus : buses) {
+  for (std::size_t b = 0; b < figure->bus_count(); ++b) buses.push_back(&figure->bus(b));
+  for (auto* bus : buses) {
     bus->configure();
     start.emplace_back(bus->config().actuators.size(), 0.0);
     bus->read(start.back());
   }
   q = start;
-  for (auto& bus : buses) bus->activate();
-  for (auto& bus : buses) bus->arm_device_guard();
-  const auto period = std::chrono::nanoseconds(static_cast<long>(1e9 / robot.config.rate_hz));
+  for (auto* bus : buses) bus->activate();
+  for (auto* bus : buses) bus->arm_device_guard();
+  const auto period = std::chrono::nanoseconds(static_cast<long>(1e9 / config.rate_hz));
   auto deadline = std::chrono::steady_clock::now();
-  const int cycles = static_cast<int>(robot.config.rate_hz);
+  const int cycles = static_cast<int>(config.rate_hz);
   for (int k = 0; k < cycles; ++k) {
     deadline += period;
     std::this_thread::sleep_until(deadline);
@@ -111,9 +115,9 @@ Trial run_trial() {
     }
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
-  buses.clear();  // dead: never deactivated
+  buses.clear();
+  figure.reset();  // dead: the buses close, never deactivated; then the devices stop
   client.reset();
-  sims.clear();
   return t;
 }
 

@@ -20,8 +20,8 @@
 #include "animrt/core/clock.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
 namespace {
@@ -36,24 +36,17 @@ void run_case(bool dashboard, double seconds) {
   LoadedRobot robot = load_robot(kQuadruped);
   robot.config.safety.start_ramp_s = 0.5;
   robot.config.safety.stop_ramp_s = 0.5;
-  MonotonicClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-  DashboardSetup setup;
-  setup.robot = robot.config.name;
-  setup.steering = robot.steering;
-  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
+  SimulatedBackend simulated;
+  Figure figure(std::move(robot), simulated);
   RunControls controls;
-  RunOptions options;
+  RunOptions options = figure.run_options();
   options.duration_s = seconds;
-  options.backend_name = "sim";
   options.controls = &controls;
+  options.raise_device_threads = nullptr;  // as measured before: devices at normal priority
 
   // Stops the stream and joins its client however the run ends.
   struct Dashboard {
-    std::unique_ptr<RunMonitor> monitor;
-    std::unique_ptr<DashboardServer> server;
+    DashboardServer* server = nullptr;
     std::thread client;
     std::atomic<bool> quit{false};
     std::atomic<int> frames{0};
@@ -64,9 +57,9 @@ void run_case(bool dashboard, double seconds) {
     }
   } d;
   if (dashboard) {
-    d.monitor = std::make_unique<RunMonitor>(runner.model());
-    d.server = std::make_unique<DashboardServer>(*d.monitor, controls, setup);
-    options.monitor = d.monitor.get();
+    DashboardSetup setup;
+    setup.steering = figure.steering();
+    d.server = &figure.serve_dashboard(setup, controls);
     d.client = std::thread([&d] {
       httplib::Client c("127.0.0.1", d.server->port());
       c.Get("/api/stream", [&d](const char* data, std::size_t length) {
@@ -77,7 +70,7 @@ void run_case(bool dashboard, double seconds) {
       });
     });
   }
-  RunSummary s = runner.run(options);
+  RunSummary s = figure.run(options);
   std::printf(
       "%-14s period p50 %6.3f p99 %6.3f max %6.3f ms | jitter p50 %6.3f p99 %6.3f max %6.3f ms | "
       "work p50 %6.3f p99 %6.3f max %6.3f ms | overruns %3llu/%-5llu late %3llu | ended by %s | %s",

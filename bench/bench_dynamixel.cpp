@@ -23,6 +23,7 @@
 #include "animrt/bridge/dynamixel/dynamixel_protocol.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
@@ -50,11 +51,13 @@ Result run(int baud, bool fast, double seconds, bool wire_time = true) {
   dxl::BusOptions options = dxl::bus_options(config);
   options.fast_read = fast ? dxl::FastRead::on : dxl::FastRead::off;
   config.options = options;
+  const std::size_t servos = config.actuators.size();
+  SimulatedBackend simulated;
+  Figure figure(std::move(robot), simulated);  // its bus driven here, not by the loop
   MonotonicClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  auto bus = make_bus(config);
+  ActuatorBus* bus = &figure.bus(0);
   bus->configure();
-  std::vector<double> positions(config.actuators.size(), 0.0);
+  std::vector<double> positions(servos, 0.0);
   bus->read(positions);
   const Nanos start = clock.now();
   std::uint64_t cycles = 0;
@@ -65,10 +68,10 @@ Result run(int baud, bool fast, double seconds, bool wire_time = true) {
   }
   Result r;
   r.achieved = static_cast<double>(cycles) / to_seconds(clock.now() - start);
-  r.bytes = dynamixel_wire_bytes(config.actuators.size(), fast);
+  r.bytes = dynamixel_wire_bytes(servos, fast);
   r.limit = baud / 10.0 / static_cast<double>(r.bytes);
   for (const auto& d : bus->devices()) r.timeouts += d.timeouts;
-  if (auto* dxl_bus = dynamic_cast<DynamixelBus*>(bus.get())) r.fast = dxl_bus->fast_read_active();
+  if (auto* dxl_bus = dynamic_cast<DynamixelBus*>(bus)) r.fast = dxl_bus->fast_read_active();
   return r;
 }
 

@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
+#include "animrt/controllers/herd/pony_params.hpp"
 #include "animrt/controllers/herd/reynolds_flock.hpp"
 #include "animrt/controllers/herd/unity_flock.hpp"
-#include "../tests/herd/pony_params.hpp"
 
 namespace {
 
@@ -63,8 +63,8 @@ void run(benchmark::State& state, const Params& p, NeighbourSearch search) {
 }
 
 // The pony-size parameters the flock tests and the shipped scenes use.
-ReynoldsFlockParams reynolds() { return test::pony_reynolds(); }
-UnityFlockParams unity() { return test::pony_unity(); }
+ReynoldsFlockParams reynolds() { return pony_reynolds(); }
+UnityFlockParams unity() { return pony_unity(); }
 
 void BM_ReynoldsGrid(benchmark::State& s) {
   run<ReynoldsFlock>(s, reynolds(), NeighbourSearch::grid);

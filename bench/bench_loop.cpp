@@ -15,8 +15,8 @@
 
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
 namespace {
@@ -37,15 +37,12 @@ void loop_case(double rate_hz, bool wire_time, int baud, double seconds) {
     bus.sim.wire_time = wire_time;
     bus.baud = baud;
   }
-  MonotonicClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
-  RunOptions options;
+  SimulatedBackend simulated;
+  Figure figure(std::move(robot), simulated);
+  RunOptions options = figure.run_options();
   options.duration_s = seconds;
-  options.backend_name = "sim";
-  RunSummary s = runner.run(options);
+  options.raise_device_threads = nullptr;  // as measured before: devices at normal priority
+  RunSummary s = figure.run(options);
   std::printf(
       "%6.0f Hz  %-22s  period p50 %6.3f p99 %6.3f max %6.3f ms | jitter p50 %5.0f p99 %5.0f max "
       "%6.0f us | overruns %5llu/%-6llu | bus I/O p50 %6.3f p99 %6.3f ms | %s\n",
@@ -71,12 +68,13 @@ std::size_t cycle_bytes(std::size_t servos) {
 
 void throughput_case(int baud, double seconds) {
   LoadedRobot robot = load_robot(kQuadruped);
-  auto& bus_config = robot.config.buses[0];
-  bus_config.sim.wire_time = true;
-  bus_config.baud = baud;
+  robot.config.buses[0].sim.wire_time = true;
+  robot.config.buses[0].baud = baud;
+  SimulatedBackend simulated;
+  Figure figure(std::move(robot), simulated);  // its bus driven here, not by the loop
+  const BusConfig& bus_config = figure.config().buses[0];
   MonotonicClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  auto bus = make_bus(bus_config);
+  ActuatorBus* bus = &figure.bus(0);
   bus->configure();
   std::vector<double> positions(bus_config.actuators.size(), 0.0);
   bus->read(positions);

@@ -18,9 +18,8 @@
 
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
-#include "animrt/sim/modbus/modbus_sim_bus.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
 namespace {
@@ -42,15 +41,12 @@ void loop_case(double rate_hz, int torso_delay_us, double seconds) {
       bus.timeout_s = 0.2;
     }
   }
-  MonotonicClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
-  RunOptions options;
+  SimulatedBackend simulated;
+  Figure figure(std::move(robot), simulated);
+  RunOptions options = figure.run_options();
   options.duration_s = seconds;
-  options.backend_name = "sim";
-  const RunSummary s = runner.run(options);
+  options.raise_device_threads = nullptr;  // as measured before: devices at normal priority
+  const RunSummary s = figure.run(options);
   std::printf(
       "%5.0f Hz, torso answer delay %2d ms: cycles %llu, overruns %llu, period p99 %.3f ms, jitter "
       "p99 %.3f ms%s\n",
@@ -66,16 +62,11 @@ void loop_case(double rate_hz, int torso_delay_us, double seconds) {
 }
 
 void modbus_case(double seconds) {
-  LoadedRobot robot = load_robot(kFigure);
-  BusConfig torso;
-  for (auto& bus : robot.config.buses) {
-    if (bus.name == "torso") torso = bus;
-  }
-  MonotonicClock clock;
-  sim::ModbusSimBus sim(torso, clock);
-  sim.start();
-  torso.port = sim.endpoint();
-  ModbusBus bus(torso);
+  SimulatedBackend simulated;
+  Figure figure(load_robot(kFigure), simulated);  // its torso bus driven here, not by the loop
+  std::size_t torso = 0;
+  while (figure.config().buses[torso].name != "torso") ++torso;
+  ModbusBus& bus = dynamic_cast<ModbusBus&>(figure.bus(torso));
   bus.configure();
   bus.activate();
   std::vector<double> pos(1), goal(1, 0.0);

@@ -15,6 +15,7 @@
 #include "animrt/controllers/herd/herd_output.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/embodied_herd.hpp"
 #include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
@@ -188,15 +189,6 @@ int run_herd(const HerdArgs& a) {
 }
 
 }  // namespace
-
-std::string gait_of_robot(const std::string& robot_file) {
-  const RobotConfig config = load_robot_config(robot_file);
-  if (config.motion.type != "gait") {
-    throw InputError(config.motion.where, config.motion.key.empty() ? "motion" : config.motion.key,
-                     "a herd figure walks a gait; this robot's motion is " + config.motion.type);
-  }
-  return config.motion.file;
-}
 
 void add_herd_command(CLI::App& app) {
   auto args = std::make_shared<HerdArgs>();

@@ -11,7 +11,4 @@ namespace animrt::cli {
 
 void add_herd_command(CLI::App& app);
 
-// The gait a robot file plays (its motion must be a gait).
-std::string gait_of_robot(const std::string& robot_file);
-
 }  // namespace animrt::cli

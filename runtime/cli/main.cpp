@@ -23,10 +23,11 @@
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
+#include "animrt/runtime/embodied_herd.hpp"
 #include "animrt/runtime/emergency_stop.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
@@ -37,7 +38,6 @@
 #include "gait_command.hpp"
 #include "head_command.hpp"
 #include "herd_command.hpp"
-#include "herd_driver.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
 #include "stop_signals.hpp"
@@ -152,10 +152,58 @@ struct RunArgs {
   std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
 };
 
-// The show files a motion plays (a show, or show layers).
-void collect_shows(const animrt::MotionConfig& motion, std::vector<std::string>& out) {
-  if (motion.type == "show") out.push_back(motion.file);
-  for (const auto& layer : motion.layers) collect_shows(layer, out);
+// Options that need one another or the simulated backend: a usage error
+// (logged) when they do not go together.
+bool run_args_go_together(const RunArgs& args) {
+  if (args.lockstep && args.backend != "sim") {
+    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
+    return false;
+  }
+  if (!args.physics.empty() && args.backend != "sim") {
+    spdlog::error("--physics needs --backend sim (it replaces the simulated servos' motors)");
+    return false;
+  }
+  if (args.herd.empty() != args.agent.empty()) {
+    spdlog::error("--herd and --agent go together: the scene and which of its agents the robot is");
+    return false;
+  }
+  return true;
+}
+
+// --herd: the herd that steers the figure as one of its agents (null without),
+// seeing the walk the physics measures when there is physics.
+std::unique_ptr<animrt::EmbodiedHerd> join_herd(const RunArgs& args, const animrt::Figure& figure,
+                                                const animrt::SimulatedBackend& simulated) {
+  if (args.herd.empty()) return nullptr;
+  const animrt::sim::MujocoJointPhysics* physics = simulated.mujoco_physics();
+  animrt::EmbodiedHerd::MeasuredTrack measured;
+  if (physics) {
+    measured = [physics] {
+      const animrt::sim::TorsoPose p = physics->torso_pose();
+      return animrt::EmbodiedHerd::Track{p.x_m, p.y_m, p.yaw_rad};
+    };
+  }
+  auto herd = std::make_unique<animrt::EmbodiedHerd>(args.herd, args.agent, figure.clock(),
+                                                     g_controls, std::move(measured));
+  spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
+  return herd;
+}
+
+// --dashboard: where and how it serves; the figure adds what it knows.
+animrt::DashboardSetup dashboard_setup(const RunArgs& args, const std::pair<std::string, int>& at,
+                                       const animrt::Figure& figure,
+                                       animrt::FigureKinematics* model) {
+  animrt::DashboardSetup setup;
+  setup.host = at.first;
+  setup.port = at.second;
+  setup.remote = args.dashboard_remote;
+  setup.rate_hz = args.dashboard_rate;
+  setup.www_dir = args.dashboard_www;
+  // A herd steers the gait itself (and the steering mailbox takes one writer).
+  if (args.herd.empty()) setup.steering = figure.steering();
+  setup.duration_s = args.duration;
+  setup.figure = model;
+  return setup;
 }
 
 int cmd_run(const RunArgs& args) {
@@ -166,35 +214,13 @@ int cmd_run(const RunArgs& args) {
   const std::pair<std::string, int> dashboard_at =
       address.at.value_or(std::pair<std::string, int>{});
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
-  // The figure: the robot file's model, or else the physics model.
-  std::unique_ptr<animrt::sim::MujocoFigure> figure = load_figure(robot.config);
-  if (!figure && !args.physics.empty() && !args.dashboard.empty()) {
+  // The figure the dashboard draws: the robot file's model, or else the physics model.
+  std::unique_ptr<animrt::sim::MujocoFigure> figure_model = load_figure(robot.config);
+  if (!figure_model && !args.physics.empty() && !args.dashboard.empty()) {
     animrt::RobotConfig with_physics = robot.config;
     with_physics.model = args.physics;
     with_physics.model_where = animrt::Location{args.physics, 0, 0};
-    figure = load_figure(with_physics);
-  }
-  // What the dashboard tells of the run, taken before the runner owns the config.
-  animrt::DashboardSetup dashboard_setup;
-  if (!args.dashboard.empty()) {
-    dashboard_setup.host = dashboard_at.first;
-    dashboard_setup.port = dashboard_at.second;
-    dashboard_setup.remote = args.dashboard_remote;
-    dashboard_setup.rate_hz = args.dashboard_rate;
-    dashboard_setup.www_dir = args.dashboard_www;
-    dashboard_setup.robot = robot.config.name;
-    dashboard_setup.backend = args.backend;
-    for (const auto& bus : robot.config.buses)
-      dashboard_setup.bus_protocols.push_back(bus.protocol);
-    dashboard_setup.motion_kind = robot.config.motion.type;
-    dashboard_setup.motion_name = std::filesystem::path(robot.config.motion.file).stem().string();
-    // A herd steers the gait itself (and the steering mailbox takes one writer).
-    if (args.herd.empty()) dashboard_setup.steering = robot.steering;
-    const animrt::ShowPosition show = robot.motion->show_position(0.0);
-    dashboard_setup.show = show.show;
-    dashboard_setup.show_duration_s = show.duration_s;
-    dashboard_setup.duration_s = args.duration;
-    dashboard_setup.figure = figure.get();
+    figure_model = load_figure(with_physics);
   }
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
@@ -204,114 +230,41 @@ int cmd_run(const RunArgs& args) {
                   std::strerror(summary_out.error));
     return kExitUsage;
   }
-  if (args.lockstep && args.backend != "sim") {
-    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
-    return kExitUsage;
-  }
-  if (!args.physics.empty() && args.backend != "sim") {
-    spdlog::error("--physics needs --backend sim (it replaces the simulated servos' motors)");
-    return kExitUsage;
-  }
-  animrt::ManualClock lockstep_clock;
-  animrt::MonotonicClock wall_clock;
-  std::unique_ptr<animrt::sim::MujocoJointPhysics> physics;  // outlives the devices below
-  std::vector<std::unique_ptr<animrt::SimulatedBus>> simulated;
-  if (args.backend == "sim") {
-    const animrt::Clock& clock = args.lockstep ? static_cast<const animrt::Clock&>(lockstep_clock)
-                                               : static_cast<const animrt::Clock&>(wall_clock);
-    if (!args.physics.empty()) {
-      physics = std::make_unique<animrt::sim::MujocoJointPhysics>(args.physics, robot.config.joints,
-                                                                  robot.config.file, clock.now());
-      spdlog::info("physics: {} drives the simulated servos", args.physics);
-    }
-    simulated = animrt::start_simulated_devices(robot.config.buses, clock, physics.get());
-    for (const auto& sim : simulated) spdlog::info("simulated devices: {}", sim->describe());
-  }
-  if (args.lockstep) animrt::widen_timeouts_for_lockstep(robot.config.buses);
-  std::vector<std::unique_ptr<animrt::ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(animrt::make_bus(bus));
+  if (!run_args_go_together(args)) return kExitUsage;
 
-  if (args.herd.empty() != args.agent.empty()) {
-    spdlog::error("--herd and --agent go together: the scene and which of its agents the robot is");
-    return kExitUsage;
+  animrt::HardwareBackend hardware;
+  animrt::SimulatedBackend simulated(animrt::SimulatedBackend::Settings{args.physics, nullptr});
+  animrt::FigureBackend& backend =
+      args.backend == "sim" ? static_cast<animrt::FigureBackend&>(simulated) : hardware;
+  animrt::FigureOptions figure_options;
+  figure_options.lockstep = args.lockstep;
+  figure_options.log = [](const std::string& line) { spdlog::info("{}", line); };
+  // A show's sound track plays on its own thread, started with the motion.
+  if (!args.no_audio) {
+    figure_options.audio_sink = [](int rate) { return animrt::open_alsa_sink("default", rate); };
   }
-  std::unique_ptr<animrt::cli::EmbodiedHerd> herd;
-  if (!args.herd.empty()) {
-    const animrt::Clock& run_clock = args.lockstep
-                                         ? static_cast<const animrt::Clock&>(lockstep_clock)
-                                         : static_cast<const animrt::Clock&>(wall_clock);
-    herd = std::make_unique<animrt::cli::EmbodiedHerd>(args.herd, args.agent, run_clock, g_controls,
-                                                       physics.get());
-    spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
-  }
+  figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
+  animrt::Figure figure(std::move(robot), backend, figure_options);
 
-  animrt::RunOptions options;
+  std::unique_ptr<animrt::EmbodiedHerd> herd = join_herd(args, figure, simulated);
+
+  animrt::RunOptions options = figure.run_options();
   options.duration_s = args.duration;
-  options.lockstep_clock = args.lockstep ? &lockstep_clock : nullptr;
   options.request_realtime = !args.no_realtime;
   options.telemetry_path = args.telemetry;
   options.controls = &g_controls;
-  options.backend_name = args.backend;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
-  options.raise_device_threads = [&simulated](int priority) {
-    return animrt::raise_simulated_devices(simulated, priority);
-  };
+  if (herd) options.on_motion_start = [&herd](animrt::Nanos t0) { herd->start(t0); };
 
-  // A show's sound track plays on its own thread, started with the motion.
-  std::vector<std::unique_ptr<animrt::ShowAudioPlayer>> audio;
-  if (!args.no_audio) {
-    std::vector<std::string> shows;
-    collect_shows(robot.config.motion, shows);
-    audio = animrt::open_show_audio(
-        shows, args.lockstep, [](int rate) { return animrt::open_alsa_sink("default", rate); },
-        wall_clock, [](const std::string& message) { spdlog::warn("{}", message); });
-  }
-  options.on_motion_start = [&audio, &herd, p = physics.get()](animrt::Nanos t0) {
-    for (auto& player : audio) player->start(t0);
-    if (herd) herd->start(t0);
-    if (p) p->mark_motion_start();
-  };
-  options.on_motion_end = [&audio, p = physics.get()] {
-    for (auto& player : audio) player->stop();
-    if (p) p->mark_motion_end();
-  };
-  // The sound track follows the show's pause, seek and play.
-  if (!audio.empty()) {
-    options.on_show_command = [&audio](const animrt::ShowCommand& command, double t) {
-      for (auto& player : audio) player->control(command, t);
-    };
-  }
-
-  animrt::Runner runner(std::move(robot.config), std::move(buses), std::move(robot.motion));
   // The dashboard serves before the start ramp, so its line comes first.
-  std::unique_ptr<animrt::RunMonitor> monitor;
-  std::unique_ptr<animrt::DashboardServer> dashboard;
   if (!args.dashboard.empty()) {
-    monitor = std::make_unique<animrt::RunMonitor>(runner.model());
-    dashboard = std::make_unique<animrt::DashboardServer>(*monitor, g_controls, dashboard_setup);
-    options.monitor = monitor.get();
-    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+    animrt::DashboardSetup setup = dashboard_setup(args, dashboard_at, figure, figure_model.get());
+    std::cout << "dashboard: " << figure.serve_dashboard(std::move(setup), g_controls).url() << '\n'
+              << std::flush;
   }
   animrt::cli::start_fault_injection();
-  animrt::RunSummary summary = runner.run(options);
-  if (dashboard) dashboard->stop();
+  animrt::RunSummary summary = figure.run(options);
   if (herd) herd->stop();
-  if (physics) {
-    const animrt::sim::PhysicsMeasures m = physics->measures();
-    animrt::PhysicsReport report;
-    report.model = m.model_file;
-    report.timestep_s = m.timestep_s;
-    report.simulated_s = m.simulated_s;
-    report.forward_m = m.forward_m;
-    report.sideways_m = m.sideways_m;
-    report.motion_s = m.motion_s;
-    report.motion_forward_m = m.motion_forward_m;
-    report.average_speed_m_s = m.motion_s > 0 ? m.motion_forward_m / m.motion_s : 0.0;
-    report.falls = m.falls;
-    report.first_fall_s = m.first_fall_s;
-    report.lockstep_waits_timed_out = m.lockstep_waits_timed_out;
-    summary.physics = report;
-  }
   const bool summary_written =
       !summary_out.is_open() || summary_out.write(animrt::to_json(summary).dump(2) + '\n');
   std::cout << animrt::format_summary(summary);

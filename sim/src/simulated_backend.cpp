@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "animrt/core/error.hpp"
+#include "animrt/sim/mujoco/mujoco_physics.hpp"
+
 namespace animrt {
 
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
@@ -31,5 +34,72 @@ std::vector<std::string> raise_simulated_devices(
 void widen_timeouts_for_lockstep(std::vector<BusConfig>& buses) {
   for (BusConfig& bus : buses) bus.timeout_s = std::max(bus.timeout_s, kLockstepMinTimeoutS);
 }
+
+SimulatedBackend::SimulatedBackend() = default;
+SimulatedBackend::SimulatedBackend(Settings settings) : settings_(std::move(settings)) {}
+SimulatedBackend::~SimulatedBackend() { stop(); }
+
+void SimulatedBackend::check(const RobotConfig& config, bool lockstep) const {
+  (void)lockstep;
+  if (settings_.physics_model.empty() && settings_.physics == nullptr) return;
+  for (const BusConfig& bus : config.buses) {
+    if (bus.protocol != "dynamixel2") {
+      throw InputError(
+          bus.where, "protocol",
+          "physics drives only dynamixel2 buses; bus '" + bus.name + "' is " + bus.protocol);
+    }
+  }
+}
+
+void SimulatedBackend::adjust(RobotConfig& config, bool lockstep) const {
+  if (lockstep) widen_timeouts_for_lockstep(config.buses);
+}
+
+std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Clock& clock) {
+  std::vector<std::string> lines;
+  sim::JointPhysics* physics = settings_.physics;
+  if (!settings_.physics_model.empty()) {
+    own_physics_ = std::make_unique<sim::MujocoJointPhysics>(settings_.physics_model, config.joints,
+                                                             config.file, clock.now());
+    physics = own_physics_.get();
+    lines.push_back("physics: " + settings_.physics_model + " drives the simulated servos");
+  }
+  devices_ = start_simulated_devices(config.buses, clock, physics);
+  for (const auto& device : devices_) lines.push_back("simulated devices: " + device->describe());
+  return lines;
+}
+
+std::vector<std::string> SimulatedBackend::raise_threads(int priority) {
+  return raise_simulated_devices(devices_, priority);
+}
+
+void SimulatedBackend::motion_started(Nanos t0) {
+  (void)t0;
+  if (own_physics_) own_physics_->mark_motion_start();
+}
+
+void SimulatedBackend::motion_ended() {
+  if (own_physics_) own_physics_->mark_motion_end();
+}
+
+void SimulatedBackend::report(RunSummary& summary) const {
+  if (!own_physics_) return;
+  const sim::PhysicsMeasures m = own_physics_->measures();
+  PhysicsReport report;
+  report.model = m.model_file;
+  report.timestep_s = m.timestep_s;
+  report.simulated_s = m.simulated_s;
+  report.forward_m = m.forward_m;
+  report.sideways_m = m.sideways_m;
+  report.motion_s = m.motion_s;
+  report.motion_forward_m = m.motion_forward_m;
+  report.average_speed_m_s = m.motion_s > 0 ? m.motion_forward_m / m.motion_s : 0.0;
+  report.falls = m.falls;
+  report.first_fall_s = m.first_fall_s;
+  report.lockstep_waits_timed_out = m.lockstep_waits_timed_out;
+  summary.physics = report;
+}
+
+void SimulatedBackend::stop() { devices_.clear(); }
 
 }  // namespace animrt

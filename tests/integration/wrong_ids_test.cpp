@@ -9,8 +9,8 @@
 #include <memory>
 #include <string>
 
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 
 namespace animrt {
@@ -40,19 +40,23 @@ class SwappedAnswers final : public ActuatorBus {
 };
 
 RunSummary run_quadruped(bool swapped) {
-  LoadedRobot robot = load_robot(std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml");
-  for (auto& bus : robot.config.buses) bus.timeout_s = 0.05;
-  ManualClock clock;
-  auto sims = start_simulated_devices(robot.config.buses, clock);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  auto bus = std::make_unique<SwappedAnswers>(make_bus(robot.config.buses[0]), 0, 1);
-  bus->swap = swapped;
-  buses.push_back(std::move(bus));
-  Runner runner(robot.config, std::move(buses), std::move(robot.motion));
-  RunOptions options;
+  SimulatedBackend simulated;
+  FigureOptions lockstep;
+  lockstep.lockstep = true;
+  lockstep.edit = [](RobotConfig& config) {
+    for (auto& bus : config.buses) bus.timeout_s = 0.05;
+  };
+  lockstep.wrap_bus = [swapped](std::unique_ptr<ActuatorBus> bus, std::size_t) {
+    auto answers = std::make_unique<SwappedAnswers>(std::move(bus), 0, 1);
+    answers->swap = swapped;
+    return std::unique_ptr<ActuatorBus>(std::move(answers));
+  };
+  Figure figure(load_robot(std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped.yaml"),
+                simulated, lockstep);
+  RunOptions options = figure.run_options();
+  options.raise_device_threads = nullptr;
   options.duration_s = 6.0;
-  options.lockstep_clock = &clock;
-  return runner.run(options);
+  return figure.run(options);
 }
 
 TEST(WrongIds, SwappedServosAreAFollowingErrorFault) {

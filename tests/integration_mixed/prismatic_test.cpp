@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
-#include "animrt/runtime/runner.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "support/files.hpp"
 
@@ -91,16 +91,15 @@ TEST(Prismatic, AShowInMetresMovesALinearActuator) {
   EXPECT_DOUBLE_EQ(targets[1], 0.08);
   EXPECT_NEAR(targets[0], deg_to_rad(10.0), 1e-12);
 
-  ManualClock clock;
-  auto sims = start_simulated_devices(loaded.config.buses, clock);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : loaded.config.buses) buses.push_back(make_bus(bus));
-  Runner runner(loaded.config, std::move(buses), std::move(loaded.motion));
-  RunOptions options;
+  SimulatedBackend simulated;
+  FigureOptions lockstep;
+  lockstep.lockstep = true;
+  Figure figure(std::move(loaded), simulated, lockstep);
+  RunOptions options = figure.run_options();
+  options.raise_device_threads = nullptr;
   options.duration_s = 2.0;
-  options.lockstep_clock = &clock;
   options.request_realtime = false;
-  RunSummary s = runner.run(options);
+  RunSummary s = figure.run(options);
   EXPECT_EQ(s.end_reason, EndReason::duration) << format_summary(s);
   EXPECT_TRUE(s.faults.empty());
   ASSERT_EQ(s.joints.size(), 2u);
@@ -110,7 +109,7 @@ TEST(Prismatic, AShowInMetresMovesALinearActuator) {
   EXPECT_LT(s.joints[1].max_tracking_error_rad, 0.003) << format_summary(s);
   EXPECT_GT(s.joints[1].max_tracking_error_rad, 0.0);
   // Back home in metres: the drive's own position (register value in m).
-  EXPECT_NEAR(sims[1]->device_position(1), 0.05, 1e-3);
+  EXPECT_NEAR(simulated.devices()[1]->device_position(1), 0.05, 1e-3);
   const std::string text = format_summary(s);
   EXPECT_NE(text.find("  slide          rms "), std::string::npos) << text;
   EXPECT_NE(text.find(" mm\n"), std::string::npos) << text;

@@ -3,44 +3,42 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "animrt/sim/simulated_backend.hpp"
-
 namespace animrt::test {
 
 SimRig::SimRig(const std::string& robot_file, const RigSettings& settings)
-    : lockstep_(settings.lockstep) {
-  robot = load_robot(robot_file);
-  if (settings.edit_motion) settings.edit_motion(robot);
-  for (auto& bus : robot.config.buses) {
-    bus.timeout_s = std::max(bus.timeout_s, settings.min_bus_timeout_s);
-    bus.sim.wire_time = settings.wire_time;
-  }
-  if (lockstep_) widen_timeouts_for_lockstep(robot.config.buses);  // as `animrt run --lockstep`
-  if (settings.edit) settings.edit(robot.config);
-  sims = start_simulated_devices(robot.config.buses, clock(), settings.physics);
+    : backend_(SimulatedBackend::Settings{"", settings.physics}), sims(backend_.devices()) {
+  LoadedRobot loaded = load_robot(robot_file);
+  if (settings.edit_motion) settings.edit_motion(loaded);
+  auto owner = std::make_unique<ProbeSource>(std::move(loaded.motion));
+  probe = owner.get();
+  loaded.motion = std::move(owner);
   hook_ = [this](std::size_t bus, BusCall call, std::uint64_t index) {
     bus_call(bus, call, index);
   };
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (std::size_t b = 0; b < robot.config.buses.size(); ++b) {
-    auto watched = std::make_unique<WatchedBus>(make_bus(robot.config.buses[b]), b, hook_);
+  FigureOptions options;
+  options.lockstep = settings.lockstep;  // timeouts widen as in `animrt run --lockstep`
+  options.edit = [&settings](RobotConfig& config) {
+    for (auto& bus : config.buses) {
+      bus.timeout_s = std::max(bus.timeout_s, settings.min_bus_timeout_s);
+      bus.sim.wire_time = settings.wire_time;
+    }
+    if (settings.edit) settings.edit(config);
+  };
+  options.wrap_bus = [this](std::unique_ptr<ActuatorBus> bus, std::size_t b) {
+    auto watched = std::make_unique<WatchedBus>(std::move(bus), b, hook_);
     watched_.push_back(watched.get());
-    buses.push_back(std::move(watched));
-  }
-  auto owner = std::make_unique<ProbeSource>(std::move(robot.motion));
-  probe = owner.get();
-  runner_ = std::make_unique<Runner>(robot.config, std::move(buses), std::move(owner));
+    return std::unique_ptr<ActuatorBus>(std::move(watched));
+  };
+  robot.steering = loaded.steering;
+  figure_ = std::make_unique<Figure>(std::move(loaded), backend_, options);
+  robot.config = figure_->config();
 }
 
 SimRig::~SimRig() {
-  runner_.reset();  // buses close before their devices stop
-  sims.clear();
+  figure_.reset();  // buses close before their devices stop
 }
 
-const Clock& SimRig::clock() const {
-  return lockstep_ ? static_cast<const Clock&>(lockstep_clock_)
-                   : static_cast<const Clock&>(wall_clock_);
-}
+const Clock& SimRig::clock() const { return figure_->clock(); }
 
 SimulatedBus& SimRig::sim(const std::string& bus_name) {
   for (std::size_t b = 0; b < robot.config.buses.size(); ++b) {
@@ -50,12 +48,12 @@ SimulatedBus& SimRig::sim(const std::string& bus_name) {
 }
 
 RunOptions SimRig::options(double duration, const std::string& telemetry) {
-  RunOptions options;
+  RunOptions options = figure_->run_options();
   options.duration_s = duration;
-  options.lockstep_clock = lockstep_ ? &lockstep_clock_ : nullptr;
   options.request_realtime = false;
   options.telemetry_path = telemetry;
-  options.backend_name = "sim";
+  // The devices' threads keep their priority, whatever a test asks of the loop.
+  options.raise_device_threads = nullptr;
   return options;
 }
 
@@ -63,7 +61,7 @@ RunSummary SimRig::run(double duration, const std::string& telemetry) {
   return run(options(duration, telemetry));
 }
 
-RunSummary SimRig::run(const RunOptions& options) { return runner_->run(options); }
+RunSummary SimRig::run(const RunOptions& options) { return figure_->run(options); }
 
 void SimRig::bus_call(std::size_t bus, BusCall call, std::uint64_t index) {
   if (watch_ != nullptr) {
@@ -115,7 +113,7 @@ RunSummary SimRig::run_watching(RunAllocationWatch& watch, const RunOptions& opt
       rig.in_window_ = false;
     }
   } reset{*this};
-  return runner_->run(watched);
+  return figure_->run(watched);
 }
 
 std::string lockstep_problems(const RunSummary& s) {

@@ -1,7 +1,7 @@
 #pragma once
 // A robot file run against its simulated devices, the setup the integration
-// tests share: load the robot, start the simulated devices (on a lockstep or
-// the wall clock), build the buses and the runner. Each bus is wrapped in a
+// tests share: the robot loaded and built into a figure (figure.hpp) on the
+// simulated backend, on a lockstep or the wall clock. Each bus is wrapped in a
 // WatchedBus, which forwards every call to the real bus and lets a test act
 // on the calling thread before a read or write (make the bus late, inject a
 // fault at a given cycle) and open an allocation window at the first cycle.
@@ -16,8 +16,10 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
+#include "animrt/sim/simulated_backend.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -118,7 +120,8 @@ class SimRig {
   // The real bus (behind its WatchedBus) and the wrapper.
   ActuatorBus& bus(std::size_t index) { return watched_[index]->inner(); }
   WatchedBus& watched(std::size_t index) { return *watched_[index]; }
-  const Runner& runner() const { return *runner_; }
+  const Runner& runner() const { return figure_->runner(); }
+  Figure& figure() { return *figure_; }
 
   // Options for a run of `duration` s (0: until a stop request), with
   // telemetry to `telemetry` if not empty.
@@ -135,7 +138,12 @@ class SimRig {
   }
 
   LoadedRobot robot;  // the config points at the simulated devices
-  std::vector<std::unique_ptr<SimulatedBus>> sims;
+
+ private:
+  SimulatedBackend backend_;
+
+ public:
+  std::vector<std::unique_ptr<SimulatedBus>>& sims;  // the backend's, per bus
   ProbeSource* probe = nullptr;
   // Called before every forwarded bus call (see WatchedBus); set before run().
   WatchedBus::Hook on_bus_call;
@@ -143,12 +151,9 @@ class SimRig {
  private:
   void bus_call(std::size_t bus, BusCall call, std::uint64_t index);
 
-  bool lockstep_;
-  ManualClock lockstep_clock_;
-  MonotonicClock wall_clock_;
   std::vector<WatchedBus*> watched_;
-  std::unique_ptr<Runner> runner_;
   WatchedBus::Hook hook_;
+  std::unique_ptr<Figure> figure_;
   RunAllocationWatch* watch_ = nullptr;
   std::atomic<int> active_buses_{0};
   std::atomic<int> phase_{0};

@@ -9,6 +9,7 @@
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure_backend.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt {
@@ -31,5 +32,48 @@ std::vector<std::string> raise_simulated_devices(
 // a device look silent (and two lockstep runs differ).
 inline constexpr double kLockstepMinTimeoutS = 0.25;
 void widen_timeouts_for_lockstep(std::vector<BusConfig>& buses);
+
+namespace sim {
+class MujocoJointPhysics;
+}
+
+// The simulated backend a figure is built on (figure.hpp): simulated devices
+// for every bus, on the run's clock, optionally driven by physics.
+class SimulatedBackend final : public FigureBackend {
+ public:
+  struct Settings {
+    // A MuJoCo model (MJCF) behind the simulated servos: loaded when the
+    // devices start, marked at the motion's start and end, and its measures
+    // (distance, speed, falls) added to the run's summary.
+    std::string physics_model;
+    // Or physics of the caller's (outlives the backend), used as it is.
+    sim::JointPhysics* physics = nullptr;
+  };
+  SimulatedBackend();
+  explicit SimulatedBackend(Settings settings);
+  ~SimulatedBackend() override;
+
+  std::string name() const override { return "sim"; }
+  bool keeps_run_clock() const override { return true; }
+  // Physics drives dynamixel2 buses only: any other bus is refused.
+  void check(const RobotConfig& config, bool lockstep) const override;
+  void adjust(RobotConfig& config, bool lockstep) const override;
+  std::vector<std::string> start(RobotConfig& config, const Clock& clock) override;
+  std::vector<std::string> raise_threads(int priority) override;
+  void motion_started(Nanos t0) override;
+  void motion_ended() override;
+  void report(RunSummary& summary) const override;
+  void stop() override;
+
+  // The devices of each bus, in the robot's bus order (after start()).
+  std::vector<std::unique_ptr<SimulatedBus>>& devices() { return devices_; }
+  // The physics loaded from Settings::physics_model (null without).
+  const sim::MujocoJointPhysics* mujoco_physics() const { return own_physics_.get(); }
+
+ private:
+  Settings settings_;
+  std::unique_ptr<sim::MujocoJointPhysics> own_physics_;  // outlives the devices
+  std::vector<std::unique_ptr<SimulatedBus>> devices_;
+};
 
 }  // namespace animrt

@@ -1,4 +1,4 @@
-#include "herd_driver.hpp"
+#include "animrt/runtime/embodied_herd.hpp"
 
 #include <fmt/format.h>
 
@@ -6,14 +6,22 @@
 #include <cmath>
 
 #include "animrt/core/error.hpp"
-#include "herd_command.hpp"
+#include "animrt/runtime/robot_config.hpp"
 
-namespace animrt::cli {
+namespace animrt {
+
+std::string gait_of_robot(const std::string& robot_file) {
+  const RobotConfig config = load_robot_config(robot_file);
+  if (config.motion.type != "gait") {
+    throw InputError(config.motion.where, config.motion.key.empty() ? "motion" : config.motion.key,
+                     "a herd figure walks a gait; this robot's motion is " + config.motion.type);
+  }
+  return config.motion.file;
+}
 
 EmbodiedHerd::EmbodiedHerd(const std::string& scene_file, const std::string& agent,
-                           const Clock& clock, RunControls& controls,
-                           const sim::MujocoJointPhysics* physics)
-    : clock_(clock), controls_(controls), physics_(physics) {
+                           const Clock& clock, RunControls& controls, MeasuredTrack measured)
+    : clock_(clock), controls_(controls), measured_(std::move(measured)) {
   herd::HerdScene scene = herd::load_herd_scene(scene_file);
   herd_ = std::make_unique<herd::Herd>(std::move(scene), gait_of_robot);
   agent_ = herd_->find_agent(agent);
@@ -25,7 +33,7 @@ EmbodiedHerd::EmbodiedHerd(const std::string& scene_file, const std::string& age
     throw InputError(Location{scene_file, 0, 0}, "--agent",
                      "no agent named '" + agent + "' (agents are GROUP.INDEX, e.g. " + names + ")");
   }
-  if (physics_) herd_->embody(agent_);
+  if (measured_) herd_->embody(agent_);
   const herd::Agent& a = herd_->agents()[static_cast<std::size_t>(agent_)];
   spawn_ = a.position;
   spawn_heading_ = a.heading;
@@ -63,9 +71,9 @@ void EmbodiedHerd::step_until_quit() {
     if (t0 >= 0) {
       const double run_t = to_seconds(clock_.now() - t0);
       while (herd_->time() + dt <= run_t && !quit_.load()) {
-        if (physics_) {
-          // The torso's track, turned and moved onto the agent's spawn pose.
-          const sim::TorsoPose p = physics_->torso_pose();
+        if (measured_) {
+          // The trunk's track, turned and moved onto the agent's spawn pose.
+          const Track p = measured_();
           const herd::Vec2 ahead = herd::heading_vector(spawn_heading_);
           const herd::Vec2 left{-ahead.y, ahead.x};
           const herd::Vec2 position = spawn_ + ahead * p.x_m + left * p.y_m;
@@ -98,7 +106,7 @@ std::string EmbodiedHerd::report() const {
       "heading "
       "{:.2f} rad, last command {:.3f} m/s, {:.3f} rad/s",
       herd_->time(), herd_->agent_name(agent_),
-      physics_ ? "measured by physics" : "as its gait achieves", spawn_.x, spawn_.y, a.position.x,
+      measured_ ? "measured by physics" : "as its gait achieves", spawn_.x, spawn_.y, a.position.x,
       a.position.y, a.heading, herd_->commands()[static_cast<std::size_t>(agent_)].speed_m_s,
       herd_->commands()[static_cast<std::size_t>(agent_)].turn_rad_s);
   const auto& group = herd_->scene().groups[static_cast<std::size_t>(a.group)];
@@ -114,4 +122,4 @@ std::string EmbodiedHerd::report() const {
   return s;
 }
 
-}  // namespace animrt::cli
+}  // namespace animrt
