@@ -64,6 +64,8 @@ struct Dynamixel {
         break;
       case dxl::inst::write:
         out.kind = Request::write;
+        out.address = u16(0);
+        out.ids.assign(p.params.begin() + 2, p.params.end());  // the data written
         break;
       case dxl::inst::sync_read:
         out.kind = Request::sync_read;
@@ -153,12 +155,15 @@ class ScheduledServos final : public ByteTransport {
   std::map<std::uint8_t, std::uint8_t> error;  // error byte of their answers
   Bytes garbage;                               // sent before the first answer
   std::map<std::uint8_t, std::int32_t> ticks;
+  std::map<std::uint16_t, std::uint32_t> registers;  // what other addresses read
+  std::vector<Request> requests;                     // every packet the master sent
   microseconds waited_since_last_answer{0};
 
   void set_timeout(microseconds) override {}
   bool write(std::span<const std::uint8_t> bytes) override {
     Request r;
     if (!Family::parse(Bytes(bytes.begin(), bytes.end()), r)) return true;
+    requests.push_back(r);
     std::vector<std::uint8_t> who;
     if (r.kind == Request::sync_read) {
       who = r.ids;
@@ -172,8 +177,8 @@ class ScheduledServos final : public ByteTransport {
       if (silent.count(id) != 0) continue;
       Bytes data;
       if (r.kind == Request::read || r.kind == Request::sync_read) {
-        const std::uint32_t v =
-            r.address == Family::kPresent ? static_cast<std::uint32_t>(ticks[id]) : 0;
+        std::uint32_t v = registers.count(r.address) != 0 ? registers[r.address] : 0;
+        if (r.address == Family::kPresent) v = static_cast<std::uint32_t>(ticks[id]);
         data = Family::value(v, r.length);
       }
       Bytes a = Family::status(id, error.count(id) != 0 ? error[id] : 0, data);
@@ -343,6 +348,67 @@ TYPED_TEST(SerialServoCore, GarbageBeforeAndBetweenAnswersIsSkipped) {
   for (int id = 2; id <= this->kServos; ++id) EXPECT_EQ(this->dev(id).health, DeviceHealth::ok);
   // The impossible header was counted against the servo whose answer was due.
   EXPECT_EQ(this->dev(1).protocol_errors, 1u);
+}
+
+TEST(DynamixelBusWatchdog, IsRearmedWhenNothingValidWasHeardForHalfItsTime) {
+  // The host keeps sending every cycle, but no valid answer comes back (what
+  // it sent sat in a buffer: the servos heard nothing either, and their
+  // guard may have fired). After half the guard's time the bus clears and
+  // re-arms it by broadcast, and stops once answers come again.
+  auto owned = std::make_unique<ScheduledServos<Dynamixel>>();
+  ScheduledServos<Dynamixel>& line = *owned;
+  constexpr std::uint8_t kUnits = 10;  // 200 ms
+  BusConfig config;
+  config.name = "guarded";
+  config.timeout_s = 0.002;
+  dxl::BusOptions options;
+  options.bus_watchdog = kUnits;
+  config.options = options;
+  for (std::uint8_t id : {1, 2}) {
+    ActuatorBinding b;
+    b.joint = "j" + std::to_string(id);
+    b.device_id = id;
+    config.actuators.push_back(b);
+    line.ticks[id] = 2048;
+  }
+  line.registers[dxl::xreg::bus_watchdog] = kUnits;  // reads back as armed
+  DynamixelBus bus(config, std::move(owned));
+  bus.configure();
+  bus.activate();
+  bus.arm_device_guard();
+  const auto rearm_broadcasts = [&] {
+    int n = 0;
+    for (const Request& r : line.requests) {
+      n += r.kind == Request::write && r.id == dxl::kBroadcastId &&
+           r.address == dxl::xreg::bus_watchdog && r.ids == Bytes{kUnits};
+    }
+    return n;
+  };
+  const int armed = rearm_broadcasts();
+  std::vector<double> q(2, 0.0);
+  const auto cycles_for = [&](milliseconds span) {
+    const auto end = Clock::now() + span;
+    while (Clock::now() < end) {
+      bus.read(q);
+      bus.write(q);
+      std::this_thread::sleep_for(milliseconds(5));
+    }
+  };
+  // Answers every cycle for longer than half the guard: nothing to re-arm.
+  cycles_for(milliseconds(150));
+  EXPECT_EQ(bus.watchdog_rearms(), 0u);
+  // Sent every cycle, never answered, for longer than half the guard.
+  line.silent = {1, 2};
+  cycles_for(milliseconds(150));
+  EXPECT_GE(bus.watchdog_rearms(), 1u);
+  EXPECT_EQ(rearm_broadcasts() - armed, static_cast<int>(bus.watchdog_rearms()));
+  // Heard again: no more re-arming.
+  line.silent.clear();
+  bus.read(q);
+  const std::uint64_t rearms = bus.watchdog_rearms();
+  cycles_for(milliseconds(50));
+  EXPECT_EQ(bus.watchdog_rearms(), rearms);
+  bus.deactivate();
 }
 
 TEST(StatusBook, NamesTheBusAndItsDevices) {
