@@ -71,9 +71,6 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
     : config_(std::move(config)), link_(config_, std::move(transport), dxl::LinkCodec{}) {
   servo::check_bindings(config_, 252, kMaxDevices);
   const std::size_t n = config_.actuators.size();
-  present_ticks_.resize(n);
-  goal_ticks_.resize(n);
-  window_.resize(n);
   sync_data_.resize(4 * n);
   model_.resize(n);
   firmware_.resize(n);
@@ -84,13 +81,9 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
     throw DeviceError("bus " + config_.name + ": Bus Watchdog " + std::to_string(watchdog_units_) +
                       " is outside 0..127");
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    const ActuatorBinding& b = config_.actuators[i];
-    present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
-    // One tick inside the int32 range so rounding cannot wrap.
-    window_[i] = GoalWindow::for_joint(b, std::numeric_limits<std::int32_t>::min() + 1,
-                                       std::numeric_limits<std::int32_t>::max() - 1);
-  }
+  // One tick inside the int32 range so rounding cannot wrap.
+  positions_.init(config_, std::numeric_limits<std::int32_t>::min() + 1,
+                  std::numeric_limits<std::int32_t>::max() - 1);
 }
 
 // ---- transactions ---------------------------------------------------------
@@ -200,7 +193,7 @@ void DynamixelBus::configure() {
   }
   const std::size_t n = link_.book().size();
   link_.reset();
-  fresh_ = false;
+  positions_.forget_found();
 
   std::vector<bool> garbled(n, false);
   const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
@@ -234,30 +227,18 @@ void DynamixelBus::configure() {
     const std::size_t length = dxl::encode_read(id, dxl::xreg::present_position, 4, link_.tx());
     const Answer a = unicast(i, length, 4);
     if (a == Answer::ok) {
-      present_ticks_[i] = goal_ticks_[i] = static_cast<std::int32_t>(link_.value(0));
+      positions_.found(i, static_cast<std::int32_t>(link_.value(0)));
     } else {
       unread += (unread.empty() ? "" : "; ") + describe(i) + ": " + failure(i, a);
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
   clear_bus_watchdogs();
-  outside_warning_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    // Goals may lead from where the joint rests to its limits, never farther.
-    const std::string outside = window_[i].start_at(config_.actuators[i], present_ticks_[i]);
-    if (!outside.empty()) {
-      outside_warning_ +=
-          (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + outside;
-    }
-    write_position_limits(i);
-  }
-  if (!outside_warning_.empty()) {
-    outside_warning_ = outside_limits_warning(outside_warning_, "position limits");
-    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
-  }
+  outside_warning_ = positions_.start(link_.book(), "position limits");
+  for (std::size_t i = 0; i < n; ++i) write_position_limits(i);
   choose_fast_read();
   read_pending_hardware_status();
-  fresh_ = true;
+  positions_.ready();
 }
 
 void DynamixelBus::clear_bus_watchdogs() {
@@ -320,7 +301,7 @@ void DynamixelBus::write_position_limits(std::size_t device) {
   // (0..4095).
   const std::int32_t a = b.to_ticks(b.min_position);
   const std::int32_t c = b.to_ticks(b.max_position);
-  const std::int32_t at = present_ticks_[device];
+  const std::int32_t at = positions_.present(device);
   const auto lo = static_cast<std::uint32_t>(std::clamp(std::min({a, c, at}), 0, kXMaxTicks));
   const auto hi = static_cast<std::uint32_t>(std::clamp(std::max({a, c, at}), 0, kXMaxTicks));
   const auto id = link_.bus_id(device);
@@ -353,7 +334,7 @@ void DynamixelBus::activate() {
   for (std::size_t i = 0; i < link_.book().size(); ++i) {
     if (link_.book()[i].faulted) continue;
     // Goal = where the servo is, so torque on cannot jump to a stale goal.
-    const std::int32_t ticks = present_ticks_[i];
+    const std::int32_t ticks = positions_.present(i);
     const auto check = [&](Answer a, const char* action) {
       if (a == Answer::ok && (link_.book()[i].last_error_byte & dxl::kAlertBit) == 0) return;
       // A servo in hardware error shutdown would stay limp: refuse to start.
@@ -365,7 +346,7 @@ void DynamixelBus::activate() {
     };
     check(write_register(i, dxl::xreg::goal_position, static_cast<std::uint32_t>(ticks), 4, kTries),
           "write goal position");
-    goal_ticks_[i] = ticks;
+    positions_.found(i, ticks);
     check(write_register(i, dxl::xreg::torque_enable, 1, 1, kTries), "enable torque");
   }
 }
@@ -425,14 +406,7 @@ void DynamixelBus::deactivate() {
 // ---- cycle ----------------------------------------------------------------
 
 void DynamixelBus::read(std::span<double> positions) {
-  const std::size_t n = std::min(link_.book().size(), positions.size());
-  if (fresh_) {
-    // Hand out what configure() read, so no entry starts undefined.
-    for (std::size_t i = 0; i < n; ++i) {
-      positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
-    }
-    fresh_ = false;
-  }
+  positions_.hand_out_found(positions);
   rearm_after_silence();
   const std::size_t count = link_.ask_all_healthy();
   if (count > 0) {
@@ -450,9 +424,7 @@ void DynamixelBus::read(std::span<double> positions) {
       for (std::size_t s = 0; s < count; ++s) {
         if (link_.answer(s) != Answer::ok) continue;
         last_answered_ = steady_clock::now();
-        const std::size_t i = link_.asked(s);
-        present_ticks_[i] = static_cast<std::int32_t>(link_.value(s));
-        if (i < n) positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
+        positions_.measured(link_.asked(s), static_cast<std::int32_t>(link_.value(s)), positions);
       }
     }
   }
@@ -460,22 +432,15 @@ void DynamixelBus::read(std::span<double> positions) {
   read_pending_hardware_status();
 }
 
-std::int32_t DynamixelBus::goal_ticks(std::size_t device, double rad) const {
-  if (!std::isfinite(rad)) return goal_ticks_[device];  // hold the last goal
-  return config_.actuators[device].to_ticks(window_[device].clamp(rad));
-}
-
 void DynamixelBus::write(std::span<const double> positions) {
   rearm_after_silence();
   std::size_t count = 0;
   for (std::size_t i = 0; i < link_.book().size(); ++i) {
     if (link_.book()[i].faulted) continue;
-    if (i < positions.size()) {
-      goal_ticks_[i] = goal_ticks(i, positions[i]);
-      if (std::isfinite(positions[i])) window_[i].narrow(positions[i]);
-    }
+    const std::int32_t goal =
+        i < positions.size() ? positions_.take_goal(i, positions[i]) : positions_.goal(i);
     link_.ids()[count] = link_.bus_id(i);
-    dxl::put_u32(sync_data_.data() + 4 * count, static_cast<std::uint32_t>(goal_ticks_[i]));
+    dxl::put_u32(sync_data_.data() + 4 * count, static_cast<std::uint32_t>(goal));
     ++count;
   }
   if (count == 0) return;

@@ -52,15 +52,8 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
       max_ticks_(series == ft::Series::sts ? (1 << ft::kStsSignBit) - 1 : ft::kScsMaxPosition) {
   servo::check_bindings(config_, ft::kMaxDeviceId, kMaxDevices);
   const std::size_t n = config_.actuators.size();
-  present_ticks_.resize(n);
-  goal_ticks_.resize(n);
-  window_.resize(n);
   sync_data_.resize(2 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const ActuatorBinding& b = config_.actuators[i];
-    present_ticks_[i] = goal_ticks_[i] = b.zero_ticks;
-    window_[i] = GoalWindow::for_joint(b, min_ticks_, max_ticks_);
-  }
+  positions_.init(config_, min_ticks_, max_ticks_);
 }
 
 std::int32_t FeetechBus::to_position(std::uint16_t raw) const {
@@ -107,7 +100,7 @@ std::string FeetechBus::failure(std::size_t device, Answer answer) const {
 void FeetechBus::configure() {
   const std::size_t n = link_.book().size();
   link_.reset();
-  fresh_ = false;
+  positions_.forget_found();
 
   std::vector<bool> garbled(n, false);
   const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
@@ -121,26 +114,15 @@ void FeetechBus::configure() {
     const auto id = link_.bus_id(i);
     const Answer a = unicast(i, ft::encode_read(id, ft::reg::present_position, 2, link_.tx()), 2);
     if (a == Answer::ok) {
-      present_ticks_[i] = goal_ticks_[i] = to_position(link_.value(0));
+      positions_.found(i, to_position(static_cast<std::uint16_t>(link_.value(0))));
     } else {
       unread += (unread.empty() ? "" : "; ") + describe(i) + ": " + failure(i, a);
     }
   }
   if (!unread.empty()) throw DeviceError(prefix() + "cannot read present position of " + unread);
-  outside_warning_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::string outside = window_[i].start_at(config_.actuators[i], present_ticks_[i]);
-    if (!outside.empty()) {
-      outside_warning_ +=
-          (outside_warning_.empty() ? "" : "; ") + describe(i) + " is at " + outside;
-    }
-    write_angle_limits(i);
-  }
-  if (!outside_warning_.empty()) {
-    outside_warning_ = outside_limits_warning(outside_warning_, "angle limits");
-    std::fprintf(stderr, "warning: bus %s: %s\n", config_.name.c_str(), outside_warning_.c_str());
-  }
-  fresh_ = true;
+  outside_warning_ = positions_.start(link_.book(), "angle limits");
+  for (std::size_t i = 0; i < n; ++i) write_angle_limits(i);
+  positions_.ready();
 }
 
 void FeetechBus::write_angle_limits(std::size_t device) {
@@ -152,7 +134,7 @@ void FeetechBus::write_angle_limits(std::size_t device) {
   const std::int32_t top = series_ == ft::Series::sts ? ft::kStsMaxPosition : ft::kScsMaxPosition;
   const std::int32_t a = b.to_ticks(b.min_position);
   const std::int32_t c = b.to_ticks(b.max_position);
-  const std::int32_t at = present_ticks_[device];
+  const std::int32_t at = positions_.present(device);
   const auto lo = static_cast<std::uint16_t>(std::clamp(std::min({a, c, at}), 0, top));
   const auto hi = static_cast<std::uint16_t>(std::clamp(std::max({a, c, at}), 0, top));
   const auto id = link_.bus_id(device);
@@ -193,8 +175,8 @@ void FeetechBus::activate() {
       throw DeviceError(message);
     };
     // Goal = where the servo is, so torque on cannot jump to a stale goal.
-    check(write_goal(i, present_ticks_[i]), "write goal position");
-    goal_ticks_[i] = present_ticks_[i];
+    check(write_goal(i, positions_.present(i)), "write goal position");
+    positions_.found(i, positions_.present(i));
     check(write_byte(i, ft::reg::torque_enable, 1), "enable torque");
   }
 }
@@ -229,38 +211,25 @@ void FeetechBus::read_positions(std::size_t count) {
 }
 
 void FeetechBus::read(std::span<double> positions) {
-  const std::size_t n = std::min(link_.book().size(), positions.size());
-  if (fresh_) {
-    for (std::size_t i = 0; i < n; ++i)
-      positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
-    fresh_ = false;
-  }
+  positions_.hand_out_found(positions);
   const std::size_t count = link_.ask_all_healthy();
   if (count == 0) return;
   read_positions(count);
   for (std::size_t s = 0; s < count; ++s) {
     if (link_.answer(s) != Answer::ok) continue;
-    const std::size_t i = link_.asked(s);
-    present_ticks_[i] = to_position(link_.value(s));
-    if (i < n) positions[i] = config_.actuators[i].to_rad(present_ticks_[i]);
+    positions_.measured(link_.asked(s), to_position(static_cast<std::uint16_t>(link_.value(s))),
+                        positions);
   }
-}
-
-std::int32_t FeetechBus::goal_ticks(std::size_t device, double rad) const {
-  if (!std::isfinite(rad)) return goal_ticks_[device];
-  return config_.actuators[device].to_ticks(window_[device].clamp(rad));
 }
 
 void FeetechBus::write(std::span<const double> positions) {
   std::size_t count = 0;
   for (std::size_t i = 0; i < link_.book().size(); ++i) {
     if (link_.book()[i].faulted) continue;
-    if (i < positions.size()) {
-      goal_ticks_[i] = goal_ticks(i, positions[i]);
-      if (std::isfinite(positions[i])) window_[i].narrow(positions[i]);
-    }
+    const std::int32_t goal =
+        i < positions.size() ? positions_.take_goal(i, positions[i]) : positions_.goal(i);
     link_.ids()[count] = link_.bus_id(i);
-    ft::put_u16(series_, sync_data_.data() + 2 * count, from_position(goal_ticks_[i]));
+    ft::put_u16(series_, sync_data_.data() + 2 * count, from_position(goal));
     ++count;
   }
   if (count == 0) return;

@@ -25,6 +25,7 @@
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/bridge/goal_window.hpp"
+#include "animrt/bridge/serial_servo/servo_positions.hpp"
 
 namespace animrt {
 
@@ -133,7 +134,6 @@ class DynamixelBus final : public ActuatorBus {
   void read_pending_hardware_status();
   Answer write_register(std::size_t device, std::uint16_t address, std::uint32_t value,
                         std::uint16_t size, int tries);
-  std::int32_t goal_ticks(std::size_t device, double rad) const;
 
   // Why a lifecycle transaction failed; for `ok` the hardware error it carried.
   std::string failure(std::size_t device, Answer answer) const;
@@ -142,10 +142,7 @@ class DynamixelBus final : public ActuatorBus {
 
   BusConfig config_;
   servo::Link<dxl::LinkCodec> link_;
-  std::vector<std::int32_t> present_ticks_;  // latest known, per device
-  std::vector<std::int32_t> goal_ticks_;     // latest sent, per device
-  std::vector<GoalWindow> window_;           // the goals allowed now, per servo
-  bool fresh_ = false;                       // configure() values not yet handed out
+  servo::ServoPositions positions_;
   dxl::FastRead fast_mode_ = dxl::FastRead::automatic;
   bool fast_ = false;  // the cycle's read is a Fast Sync Read
   std::string sysfs_root_ = "/sys";

@@ -26,6 +26,7 @@
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/bridge/feetech/link_codec.hpp"
 #include "animrt/bridge/goal_window.hpp"
+#include "animrt/bridge/serial_servo/servo_positions.hpp"
 
 namespace animrt {
 
@@ -88,7 +89,6 @@ class FeetechBus final : public ActuatorBus {
   void read_positions(std::size_t count);
   std::int32_t to_position(std::uint16_t raw) const;
   std::uint16_t from_position(std::int32_t ticks) const;
-  std::int32_t goal_ticks(std::size_t device, double rad) const;
 
   std::string failure(std::size_t device, Answer answer) const;
   std::string prefix() const { return link_.book().prefix(); }
@@ -99,11 +99,8 @@ class FeetechBus final : public ActuatorBus {
   servo::Link<ft::LinkCodec> link_;
   std::int32_t min_ticks_, max_ticks_;  // position range of the series
 
-  std::vector<std::int32_t> present_ticks_;
-  std::vector<std::int32_t> goal_ticks_;
-  std::vector<GoalWindow> window_;  // the goals allowed now, per servo
+  servo::ServoPositions positions_;
   std::string outside_warning_;
-  bool fresh_ = false;
   std::vector<std::uint8_t> sync_data_;
 };
 
