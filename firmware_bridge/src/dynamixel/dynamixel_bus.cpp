@@ -42,27 +42,15 @@ const char* status_error_name(std::uint8_t number) {
   return "unknown error";
 }
 
-std::string hex_byte(std::uint8_t v) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%02X", v);
-  return buf;
-}
+using servo::hex_byte;
 
 // X-series hardware error status register (address 70) bits.
 std::string hardware_error_text(std::uint8_t bits) {
-  static constexpr std::pair<std::uint8_t, const char*> kBits[] = {
+  static constexpr servo::FaultBit kBits[] = {
       {0x01, "input voltage"},    {0x04, "overheating"}, {0x08, "motor encoder"},
       {0x10, "electrical shock"}, {0x20, "overload"},
   };
-  std::string out = "hardware error status " + hex_byte(bits);
-  std::string names;
-  for (const auto& [bit, name] : kBits) {
-    if ((bits & bit) == 0) continue;
-    if (!names.empty()) names += ", ";
-    names += name;
-  }
-  if (!names.empty()) out += ": " + names;
-  return out;
+  return servo::fault_text("hardware error status", bits, kBits);
 }
 
 }  // namespace

@@ -15,14 +15,8 @@ namespace {
 using servo::Answer;
 constexpr std::size_t kAnyLength = servo::kAnyLength;
 
-std::string hex_byte(std::uint8_t v) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%02X", v);
-  return buf;
-}
-
 std::string error_text(std::uint8_t bits) {
-  static constexpr std::pair<std::uint8_t, const char*> kBits[] = {
+  static constexpr servo::FaultBit kBits[] = {
       {ft::error_bit::voltage, "voltage"},
       {ft::error_bit::sensor, "sensor"},
       {ft::error_bit::temperature, "temperature"},
@@ -30,14 +24,7 @@ std::string error_text(std::uint8_t bits) {
       {ft::error_bit::angle, "angle"},
       {ft::error_bit::overload, "overload"},
   };
-  std::string out = "servo status " + hex_byte(bits);
-  std::string names;
-  for (const auto& [bit, name] : kBits) {
-    if ((bits & bit) == 0) continue;
-    names += (names.empty() ? "" : ", ") + std::string(name);
-  }
-  if (!names.empty()) out += ": " + names;
-  return out;
+  return servo::fault_text("servo status", bits, kBits);
 }
 
 }  // namespace

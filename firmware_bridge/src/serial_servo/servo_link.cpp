@@ -1,6 +1,7 @@
 #include "animrt/bridge/serial_servo/servo_link.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "animrt/core/error.hpp"
 
@@ -28,6 +29,21 @@ void check_bindings(const BusConfig& config, int max_id, std::size_t max_devices
       throw DeviceError(bus + who + ": ticks per radian must be positive");
     }
   }
+}
+
+std::string hex_byte(std::uint8_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", v);
+  return buf;
+}
+
+std::string fault_text(const char* what, std::uint8_t bits, std::span<const FaultBit> names) {
+  std::string out = std::string(what) + " " + hex_byte(bits);
+  std::string set;
+  for (const FaultBit& f : names) {
+    if ((bits & f.bit) != 0) set += (set.empty() ? "" : ", ") + std::string(f.name);
+  }
+  return set.empty() ? out : out + ": " + set;
 }
 
 void throw_unanswered(const StatusBook& book, const ByteTransport& transport,

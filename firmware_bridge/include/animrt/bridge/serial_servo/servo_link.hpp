@@ -82,6 +82,16 @@ enum class Frame : std::uint8_t { packet, need_more, bad_check, malformed };
 // not positive, or more than max_devices devices.
 void check_bindings(const BusConfig& config, int max_id, std::size_t max_devices);
 
+// "0x2C".
+std::string hex_byte(std::uint8_t v);
+// A fault register for messages: "`what` 0x24: overheating, overload",
+// naming each set bit found in `names`.
+struct FaultBit {
+  std::uint8_t bit;
+  const char* name;
+};
+std::string fault_text(const char* what, std::uint8_t bits, std::span<const FaultBit> names);
+
 // After configure()'s ping rounds: throws the DeviceError that names every
 // device that never answered (`answered` false; `garbled` true when what
 // came was garbage), or the line's failure.
