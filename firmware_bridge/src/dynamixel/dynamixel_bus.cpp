@@ -283,15 +283,11 @@ void DynamixelBus::choose_fast_read() {
 void DynamixelBus::write_position_limits(std::size_t device) {
   const ActuatorBinding& b = config_.actuators[device];
   if (!b.has_limits()) return;
-  // The joint's limits in ticks, widened to the measured position of a joint
-  // that rests outside them (else the servo would refuse to hold it there:
-  // Data Limit Error), inside the range X-series position mode accepts
-  // (0..4095).
-  const std::int32_t a = b.to_ticks(b.min_position);
-  const std::int32_t c = b.to_ticks(b.max_position);
-  const std::int32_t at = positions_.present(device);
-  const auto lo = static_cast<std::uint32_t>(std::clamp(std::min({a, c, at}), 0, kXMaxTicks));
-  const auto hi = static_cast<std::uint32_t>(std::clamp(std::max({a, c, at}), 0, kXMaxTicks));
+  // Inside the range X-series position mode accepts (0..4095); a joint
+  // resting outside its limits would otherwise get a Data Limit Error.
+  const auto span = positions_.limit_ticks(device, kXMaxTicks);
+  const auto lo = static_cast<std::uint32_t>(span.lo);
+  const auto hi = static_cast<std::uint32_t>(span.hi);
   const auto id = link_.bus_id(device);
   const auto fail = [&](Answer answer, const std::string& what) {
     throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +

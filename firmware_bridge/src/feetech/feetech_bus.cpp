@@ -115,15 +115,11 @@ void FeetechBus::configure() {
 void FeetechBus::write_angle_limits(std::size_t device) {
   const ActuatorBinding& b = config_.actuators[device];
   if (!b.has_limits()) return;
-  // The joint's limits in steps, widened to where a joint resting outside
-  // them is (else torque on would snap it to a limit), inside the
-  // position-mode range.
+  // Inside the position-mode range of the series.
   const std::int32_t top = series_ == ft::Series::sts ? ft::kStsMaxPosition : ft::kScsMaxPosition;
-  const std::int32_t a = b.to_ticks(b.min_position);
-  const std::int32_t c = b.to_ticks(b.max_position);
-  const std::int32_t at = positions_.present(device);
-  const auto lo = static_cast<std::uint16_t>(std::clamp(std::min({a, c, at}), 0, top));
-  const auto hi = static_cast<std::uint16_t>(std::clamp(std::max({a, c, at}), 0, top));
+  const auto span = positions_.limit_ticks(device, top);
+  const auto lo = static_cast<std::uint16_t>(span.lo);
+  const auto hi = static_cast<std::uint16_t>(span.hi);
   const auto id = link_.bus_id(device);
   const auto fail = [&](Answer answer, const std::string& what) {
     throw DeviceError(prefix() + "cannot " + what + " of " + describe(device) + ": " +

@@ -34,6 +34,14 @@ std::string ServoPositions::start(const StatusBook& book, const char* limits_nam
   return outside;
 }
 
+ServoPositions::Span ServoPositions::limit_ticks(std::size_t device, std::int32_t top) const {
+  const ActuatorBinding& b = bindings_[device];
+  const std::int32_t a = b.to_ticks(b.min_position);
+  const std::int32_t c = b.to_ticks(b.max_position);
+  const std::int32_t at = present_[device];
+  return {std::clamp(std::min({a, c, at}), 0, top), std::clamp(std::max({a, c, at}), 0, top)};
+}
+
 void ServoPositions::hand_out_found(std::span<double> positions) {
   if (!fresh_) return;
   for (std::size_t i = 0; i < std::min(positions.size(), present_.size()); ++i) {

@@ -38,6 +38,15 @@ class ServoPositions {
   // `limits_name`: the servo's name for its limit registers.
   std::string start(const StatusBook& book, const char* limits_name);
 
+  // configure(): what a servo's own position limits should hold for a joint
+  // with limits: the joint's limits in ticks, widened to where the joint
+  // rests if it rests outside them (else the servo would refuse to hold it,
+  // or torque on would snap it to a limit), inside 0..top.
+  struct Span {
+    std::int32_t lo, hi;
+  };
+  Span limit_ticks(std::size_t device, std::int32_t top) const;
+
   // read(): the first call after ready() hands out every found position,
   // so no entry starts undefined; then measured() updates one.
   void hand_out_found(std::span<double> positions);
