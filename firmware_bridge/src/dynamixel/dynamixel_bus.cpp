@@ -183,17 +183,11 @@ void DynamixelBus::configure() {
   link_.reset();
   positions_.forget_found();
 
-  std::vector<bool> garbled(n, false);
-  const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
-    const Answer a = unicast(i, dxl::encode_ping(link_.bus_id(i), link_.tx()), kAnyLength);
-    if (a == Answer::ok) {  // model number (2 bytes), firmware version
-      model_[i] = static_cast<std::uint16_t>(link_.value(0) & 0xFFFF);
-      firmware_[i] = static_cast<std::uint8_t>((link_.value(0) >> 16) & 0xFF);
-    }
-    garbled[i] = a == Answer::garbled;
-    return a == Answer::ok || a == Answer::rejected;  // it answered: it is there
+  link_.ping_all(kTries, dxl::encode_ping, [&](std::size_t i) {
+    // Model number (2 bytes), firmware version.
+    model_[i] = static_cast<std::uint16_t>(link_.value(0) & 0xFFFF);
+    firmware_[i] = static_cast<std::uint8_t>((link_.value(0) >> 16) & 0xFF);
   });
-  servo::throw_unanswered(link_.book(), link_.transport(), answered, garbled);
 
   std::string wrong_model;
   for (std::size_t i = 0; i < n; ++i) {

@@ -89,13 +89,7 @@ void FeetechBus::configure() {
   link_.reset();
   positions_.forget_found();
 
-  std::vector<bool> garbled(n, false);
-  const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
-    const Answer a = unicast(i, ft::encode_ping(link_.bus_id(i), link_.tx()), kAnyLength);
-    garbled[i] = a == Answer::garbled;
-    return a == Answer::ok;
-  });
-  servo::throw_unanswered(link_.book(), link_.transport(), answered, garbled);
+  link_.ping_all(kTries, ft::encode_ping, [](std::size_t) {});
   std::string unread;
   for (std::size_t i = 0; i < n; ++i) {
     const auto id = link_.bus_id(i);

@@ -293,6 +293,25 @@ class Link {
     return a;
   }
 
+  // configure()'s search for the devices: pings each (kTries attempts, then
+  // again for kPingRounds rounds while any is silent: ping_until_answered),
+  // with the ping `encode(id, tx())` builds. A device that answered at all
+  // (ok or rejected) is there; seen(device) is called after each ok answer
+  // (value(0) holds its data). Throws the DeviceError naming every device
+  // that stayed silent or answered garbage.
+  template <class Encode, class Seen>
+  void ping_all(int tries, Encode&& encode, Seen&& seen) {
+    const std::size_t n = book_.size();
+    std::vector<bool> garbled(n, false);
+    const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
+      const Answer a = unicast(i, encode(bus_ids_[i], tx()), kAnyLength, tries);
+      if (a == Answer::ok) seen(i);
+      garbled[i] = a == Answer::garbled;
+      return a == Answer::ok || a == Answer::rejected;
+    });
+    throw_unanswered(book_, *transport_, answered, garbled);
+  }
+
   // For a family's own transaction kinds (a Dynamixel Fast Sync Read):
   // begin() sends and counts, judge() takes one answer's error byte and
   // data, blame()/suspect() count what came instead, settle() turns the
