@@ -30,7 +30,7 @@
 //      using Packet; using Decoder;            // Decoder: feed/next/reset/buffered
 //      static constexpr std::size_t kMaxPacket;
 //      static constexpr bool kFaultInErrorByte; // the error byte IS the fault
-//                                               // register (else read it: fault_appeared())
+//                                               // register (else read it: take_new_fault())
 //      Frame next(Decoder&, Packet&) const;     // the decoder's verdict
 //      bool from_device(const Packet&, std::span<const std::uint8_t> sent) const;
 //                                               // false: our own echo, a broadcast
@@ -42,8 +42,11 @@
 //      std::uint32_t value(std::span<const std::uint8_t> data) const;  // byte order
 // 2. A model table: control-table addresses and ranges per model (present
 //    and goal position, torque enable, position limits, their sizes).
-// 3. A bus class that builds the codec's instructions into tx() and calls
-//    transact() / unicast(); the lifecycle's family-specific steps.
+// 3. A thin bus class: it builds the codec's instructions into tx() and
+//    calls transact() / unicast() / ping_all(), keeps its positions in a
+//    ServoPositions (servo_positions.hpp), and adds the lifecycle steps its
+//    servos need (limits in EEPROM, a bus watchdog). The simulated side
+//    shares the same codec adapter (sim/serial_line.hpp).
 
 #include <algorithm>
 #include <array>
