@@ -38,6 +38,13 @@ struct Request {
   Bytes ids;  // Sync Read: who answers, in order
 };
 
+// `length` bytes of `v`, low byte first (Dynamixel; Feetech STS).
+Bytes low_first(std::uint32_t v, std::size_t length) {
+  Bytes out(length);
+  for (std::size_t i = 0; i < length; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+  return out;
+}
+
 struct Dynamixel {
   static constexpr std::uint8_t kFault = dxl::kAlertBit;
   static constexpr std::uint16_t kPresent = dxl::xreg::present_position;
@@ -82,11 +89,6 @@ struct Dynamixel {
     std::array<std::uint8_t, dxl::kMaxPacket> out{};
     const std::size_t n = dxl::encode_status(id, error, data, out);
     return Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
-  }
-  static Bytes value(std::uint32_t v, std::size_t length) {
-    Bytes out(length);
-    for (std::size_t i = 0; i < length; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
-    return out;
   }
   // A header with an impossible id: not a packet, and behind it the search goes on.
   static Bytes junk_header() { return {0xFF, 0xFF, 0xFD, 0x00, 0xFF, 0x03, 0x00}; }
@@ -134,11 +136,6 @@ struct Feetech {
     const std::size_t n = ft::encode_status(id, error, data, out);
     return Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
   }
-  static Bytes value(std::uint32_t v, std::size_t length) {
-    Bytes out(length);
-    for (std::size_t i = 0; i < length; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
-    return out;
-  }
   // A header whose length is impossible (below 2).
   static Bytes junk_header() { return {0xFF, 0xFF, 0x01, 0x01}; }
 };
@@ -179,7 +176,7 @@ class ScheduledServos final : public ByteTransport {
       if (r.kind == Request::read || r.kind == Request::sync_read) {
         std::uint32_t v = registers.count(r.address) != 0 ? registers[r.address] : 0;
         if (r.address == Family::kPresent) v = static_cast<std::uint32_t>(ticks[id]);
-        data = Family::value(v, r.length);
+        data = low_first(v, r.length);
       }
       Bytes a = Family::status(id, error.count(id) != 0 ? error[id] : 0, data);
       if (damaged.count(id) != 0) a.back() ^= 0x5A;
