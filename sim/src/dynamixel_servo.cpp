@@ -281,36 +281,10 @@ DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
     return m;
   }
   if (now <= motor_time_) return m;
-  double dt = to_seconds(now - motor_time_);
   // Limits may have changed while torque was off; the servo never leaves them.
   const double goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
                                  reg32(xreg::max_position_limit));
-  const double vmax = vmax_ticks_s_;
-  const double error = goal - m.position;
-  const double dir = error >= 0 ? 1.0 : -1.0;
-  if (tau_s_ <= 0) {  // pure rate limiter
-    const double travel = std::min(std::abs(error), vmax * dt);
-    m.position += dir * travel;
-    m.velocity = m.position == goal ? 0.0 : dir * vmax;
-    return m;
-  }
-  // Closed form of speed = clamp(error / tau, +-vmax): a ramp at vmax until
-  // the error is vmax * tau, then an exponential decay.
-  const double band = vmax * tau_s_;
-  if (std::abs(error) > band) {
-    const double ramp_s = (std::abs(error) - band) / vmax;
-    if (dt <= ramp_s) {
-      m.position += dir * vmax * dt;
-      m.velocity = dir * vmax;
-      return m;
-    }
-    m.position = goal - dir * band;
-    dt -= ramp_s;
-  }
-  const double remaining = (goal - m.position) * std::exp(-dt / tau_s_);
-  m.position = goal - remaining;
-  m.velocity = remaining / tau_s_;
-  return m;
+  return m.after(to_seconds(now - motor_time_), goal, vmax_ticks_s_, tau_s_);
 }
 
 Nanos DynamixelServo::watchdog_fire_time() const {

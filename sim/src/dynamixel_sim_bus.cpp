@@ -14,16 +14,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "animrt/bridge/dynamixel/link_codec.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt::sim {
 namespace {
-
-constexpr int kWriteStallMs = 200;  // a client that stops reading loses answers after this
-constexpr int kBitsPerByte = 10;    // start + 8 data + stop
-// Silence after which the firmware drops a packet it has only partly
-// received, as a servo's receive timeout does.
-constexpr int kPacketSilenceMs = 5;
 
 [[noreturn]] void fail(const BusConfig& config, const char* what, int error) {
   throw DeviceError("simulated bus '" + config.name + "': " + what + ": " + std::strerror(error));
@@ -42,14 +37,6 @@ std::size_t wire_size(const dxl::Packet& packet) {
     }
   }
   return 10 + packet.params.size() + stuffed;  // header, id, len, inst, params, crc
-}
-
-void sleep_until_monotonic(Nanos t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 // By the id of the BusConfig; the ids a test or the CLI knows.
@@ -142,61 +129,19 @@ void DynamixelSimBus::serve() {
   // on this thread's sleeps.
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   std::array<std::uint8_t, 4096> buffer{};
-  const MonotonicClock wall;
-  Nanos last_byte = 0;
-  while (!stop_.load()) {
-    pollfd fds[2] = {{master_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    // With a packet half received, wait only for the inter-byte silence.
-    const int wait_ms = decoder_.buffered() > 0 ? kPacketSilenceMs : -1;
-    const int ready = ::poll(fds, 2, wait_ms);
-    if (ready < 0) {
-      if (errno == EINTR) continue;
-      break;
-    }
-    if (ready == 0 ||
-        (decoder_.buffered() > 0 && wall.now() - last_byte > Nanos{kPacketSilenceMs} * 1'000'000)) {
-      drop_partial_packet();
-      if (ready == 0) continue;
-    }
-    if (fds[1].revents != 0) break;
-    if (fds[0].revents & POLLIN) {
-      const ssize_t n = ::read(master_, buffer.data(), buffer.size());
-      if (n > 0) {
-        last_byte = wall.now();
-        process({buffer.data(), static_cast<std::size_t>(n)}, last_byte);
-        continue;
-      }
-      if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
-    }
-    // Hangup or error: not expected while we hold the slave open; do not spin.
-    ::poll(&fds[1], 1, 10);
-  }
-}
-
-void DynamixelSimBus::drop_partial_packet() {
-  if (decoder_.buffered() == 0) return;
-  dropped_partial_ += decoder_.buffered();
-  decoder_.reset();
-}
-
-void DynamixelSimBus::process(std::span<const std::uint8_t> bytes, Nanos arrival) {
-  std::size_t fed = 0;
-  while (fed < bytes.size()) {
-    fed += decoder_.feed(bytes.subspan(fed));
-    dxl::Packet packet;
-    for (;;) {
-      const dxl::DecodeResult result = decoder_.next(packet);
-      if (result == dxl::DecodeResult::need_more) break;
-      if (result == dxl::DecodeResult::bad_crc) {
-        ++crc_errors_;  // a servo ignores a packet it cannot trust
-      } else if (result == dxl::DecodeResult::malformed) {
-        ++malformed_;
-      } else {
-        handle(packet, arrival);
-      }
-    }
-  }
-  stray_bytes_ = decoder_.stray_bytes();
+  line::serve(master_, wake_[0], stop_, buffer,
+              {[this](std::span<const std::uint8_t> bytes, Nanos arrival) {
+                 line::feed(dxl::LinkCodec{}, decoder_, bytes, decode_counts_,
+                            [&](const dxl::Packet& packet) { handle(packet, arrival); });
+                 stray_bytes_ = decoder_.stray_bytes();
+               },
+               [this] { return decoder_.buffered() > 0; },
+               [this] {
+                 // A packet only partly received: dropped, as a servo's
+                 // receive timeout does.
+                 dropped_partial_ += decoder_.buffered();
+                 decoder_.reset();
+               }});
 }
 
 void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
@@ -214,7 +159,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
 
   if (!config_.sim.wire_time) {
     for (const Answers::Answer& a : answers_.list) {
-      if (a.late_ns > 0) sleep_until_monotonic(MonotonicClock().now() + a.late_ns);
+      if (a.late_ns > 0) line::sleep_until_monotonic(MonotonicClock().now() + a.late_ns);
       send(answers_.packet(a));
     }
   } else {
@@ -247,7 +192,7 @@ void DynamixelSimBus::send_paced() {
       ++end;
     }
     if (end == k) {
-      sleep_until_monotonic(due_[k]);
+      line::sleep_until_monotonic(due_[k]);
       continue;
     }
     const std::size_t first = list[k].offset;
@@ -257,29 +202,11 @@ void DynamixelSimBus::send_paced() {
 }
 
 Nanos DynamixelSimBus::wire_ns(std::size_t bytes) const {
-  const int baud = std::max(config_.baud, 1);
-  return static_cast<Nanos>(bytes) * kBitsPerByte * 1'000'000'000 / baud;
+  return line::wire_ns(bytes, config_.baud);
 }
 
 void DynamixelSimBus::send(std::span<const std::uint8_t> bytes) {
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(master_, bytes.data() + done, bytes.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && errno == EAGAIN) {
-      // The client is not reading: wait a little, as a line would not.
-      pollfd fds[2] = {{master_, POLLOUT, 0}, {wake_[0], POLLIN, 0}};
-      if (::poll(fds, 2, kWriteStallMs) > 0 && fds[1].revents == 0 && (fds[0].revents & POLLOUT)) {
-        continue;
-      }
-    }
-    break;
-  }
-  dropped_bytes_ += bytes.size() - done;
+  dropped_bytes_ += bytes.size() - line::write_all(master_, wake_[0], bytes);
 }
 
 void DynamixelSimBus::set_device_responding(int device_id, bool responding) {
@@ -316,8 +243,8 @@ DynamixelSimStats DynamixelSimBus::stats() const {
   DynamixelSimStats s;
   s.packets = packets_;
   s.answers = answers_sent_;
-  s.crc_errors = crc_errors_;
-  s.malformed = malformed_;
+  s.crc_errors = decode_counts_.bad_checks;
+  s.malformed = decode_counts_.malformed;
   s.stray_bytes = stray_bytes_;
   s.dropped_bytes = dropped_bytes_;
   s.partial_packet_bytes = dropped_partial_;

@@ -66,7 +66,7 @@ Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transp
     }
     slot_of_node_[b.device_id] = static_cast<int>(i);
   }
-  status_.resize(n);
+  book_ = StatusBook(config_, transport_->interface(), "node");
   drive_.resize(n);
   actual_counts_.resize(n);
   target_counts_.resize(n);
@@ -78,21 +78,11 @@ Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transp
   max_rad_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
-    status_[i].device_id = b.device_id;
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
     const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
     min_rad_[i] = std::min(a, c);
     max_rad_[i] = std::max(a, c);
   }
-}
-
-std::string Cia402Bus::prefix() const {
-  return "bus " + config_.name + " (" + transport_->interface() + "): ";
-}
-
-std::string Cia402Bus::describe(std::size_t device) const {
-  const ActuatorBinding& b = config_.actuators[device];
-  return "node " + std::to_string(b.device_id) + " (" + b.joint + ")";
 }
 
 std::string Cia402Bus::fault_text(std::size_t device) const {
@@ -131,10 +121,9 @@ void Cia402Bus::handle(const can_frame& f) {
     case canopen::kTpdo1Base: {
       slot = slot_of(cob, canopen::kTpdo1Base);
       if (slot < 0) return;
-      DeviceStatus& st = status_[slot];
+      const auto device = static_cast<std::size_t>(slot);
       if (f.len != 6) {
-        ++st.protocol_errors;
-        st.health = DeviceHealth::protocol_error;
+        book_.garbled(device);
         return;
       }
       DriveReport& d = drive_[slot];
@@ -143,7 +132,7 @@ void Cia402Bus::handle(const can_frame& f) {
       actual_counts_[slot] = static_cast<std::int32_t>(canopen::get_le(f.data + 2, 4));
       if (expect_[slot]) {
         expect_[slot] = 0;
-        st.health = DeviceHealth::ok;
+        book_.answered(device);
       }
       if (d.state == State::fault || d.state == State::fault_reaction_active ||
           (running_ && d.state != State::operation_enabled)) {
@@ -182,31 +171,31 @@ void Cia402Bus::handle(const can_frame& f) {
     canopen::Emcy e;
     if (slot < 0 || !canopen::parse_emcy(f, e)) return;
     DriveReport& d = drive_[slot];
-    DeviceStatus& st = status_[slot];
+    DeviceStatus& st = book_[static_cast<std::size_t>(slot)];
     st.hardware_error_status = e.error_register;
     if (e.code == 0) return;  // error reset: the statusword says whether the fault is gone
     d.last_emcy = e;
     ++d.emcy_count;
-    ++st.hardware_errors;
+    book_.fault_reported(static_cast<std::size_t>(slot));
     hw_fault_[slot] = 1;
   }
 }
 
 void Cia402Bus::supervise() {
   const Nanos now = transport_->now();
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    DeviceStatus& st = status_[i];
-    if (st.faulted) continue;
-    if (expect_[i]) {
-      ++st.timeouts;
-      st.health = DeviceHealth::timeout;
-    }
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    if (book_.faulted(i)) continue;
+    if (expect_[i]) book_.timed_out(i);
     if (options_.heartbeat_ms > 0 && now - last_heartbeat_[i] > heartbeat_timeout_ns_) {
-      if (!drive_[i].heartbeat_lost) ++st.timeouts;
+      // One timeout counted per heartbeat lost, the health says so while it is.
+      if (!drive_[i].heartbeat_lost) {
+        book_.timed_out(i);
+      } else {
+        book_[i].health = DeviceHealth::timeout;
+      }
       drive_[i].heartbeat_lost = true;
-      st.health = DeviceHealth::timeout;
     }
-    if (hw_fault_[i]) st.health = DeviceHealth::hardware_error;
+    if (hw_fault_[i]) book_[i].health = DeviceHealth::hardware_error;
   }
 }
 
@@ -223,10 +212,10 @@ void Cia402Bus::produce_heartbeat() {
 void Cia402Bus::sync_cycle() {
   produce_heartbeat();
   std::size_t waiting = 0;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    expect_[i] = status_[i].faulted ? 0 : 1;
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    expect_[i] = book_[i].faulted ? 0 : 1;
     if (expect_[i]) {
-      ++status_[i].transactions;
+      book_.asked(i);
       ++waiting;
     }
   }
@@ -308,12 +297,12 @@ std::uint32_t Cia402Bus::sdo_exchange(std::size_t device, const can_frame& reque
     // Uploads are expedited only: a segmented answer is not understood.
     const bool expedited_if_upload = expected != canopen::SdoKind::upload_response || a.expedited;
     if (a.kind != expected || !expedited_if_upload || a.index != index || a.subindex != sub) {
-      ++status_[device].protocol_errors;
+      book_.stray(device);
       throw DeviceError(prefix() + describe(device) + ": " + what + ": unexpected answer");
     }
     return a.value;
   }
-  ++status_[device].timeouts;
+  ++book_[device].timeouts;
   throw DeviceError(prefix() + describe(device) + ": no answer to " + what);
 }
 
@@ -331,16 +320,15 @@ void Cia402Bus::configure() {
   transport_->set_filters(filters);
   running_ = false;
   const Nanos now = transport_->now();
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    status_[i] = DeviceStatus{};
-    status_[i].device_id = config_.actuators[i].device_id;
+  book_.reset();
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     drive_[i] = DriveReport{};
     hw_fault_[i] = 0;
     last_heartbeat_[i] = now;
   }
 
   std::string missing;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     try {
       const std::uint32_t type = sdo_read(i, cia402::obj::device_type, 0);
       if ((type & 0xFFFF) != cia402::kDeviceProfile) {
@@ -360,7 +348,7 @@ void Cia402Bus::configure() {
   }
 
   using namespace cia402::obj;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     const auto node = static_cast<std::uint32_t>(config_.actuators[i].device_id);
     nmt(canopen::NmtCommand::enter_pre_operational, i);
     sdo_write(i, heartbeat_time, 0, static_cast<std::uint32_t>(options_.heartbeat_ms), 2);
@@ -389,15 +377,15 @@ void Cia402Bus::configure() {
     controlword_[i] = static_cast<std::uint16_t>(sdo_read(i, controlword, 0));
     nmt(canopen::NmtCommand::start, i);
   }
-  for (std::size_t i = 0; i < status_.size(); ++i) last_heartbeat_[i] = transport_->now();
+  for (std::size_t i = 0; i < book_.size(); ++i) last_heartbeat_[i] = transport_->now();
   fresh_ = true;
 }
 
 std::string Cia402Bus::walk_to(State goal) {
   for (int step = 0; step < kStateMachineSteps; ++step) {
     bool all_there = true;
-    for (std::size_t i = 0; i < status_.size(); ++i) {
-      if (status_[i].faulted) continue;
+    for (std::size_t i = 0; i < book_.size(); ++i) {
+      if (book_[i].faulted) continue;
       if (drive_[i].state == goal) continue;
       all_there = false;
       send_rpdo(i, cia402::controlword_toward(drive_[i].state, goal, controlword_[i]),
@@ -407,8 +395,8 @@ std::string Cia402Bus::walk_to(State goal) {
     sync_cycle();
   }
   std::string failed;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    if (status_[i].faulted || drive_[i].state == goal) continue;
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    if (book_[i].faulted || drive_[i].state == goal) continue;
     std::string why = fault_text(i);
     failed += (failed.empty() ? "" : ", ") + describe(i) + " stays in " +
               cia402::to_string(drive_[i].state) + (why.empty() ? "" : " (" + why + ")");
@@ -418,7 +406,7 @@ std::string Cia402Bus::walk_to(State goal) {
 
 void Cia402Bus::activate() {
   // Targets = where each drive is, so enabling cannot jump to a stale goal.
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     target_counts_[i] = actual_counts_[i];
     hw_fault_[i] = 0;
   }
@@ -427,7 +415,7 @@ void Cia402Bus::activate() {
     deactivate();
     throw DeviceError(prefix() + "cannot enable operation: " + failed);
   }
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     target_counts_[i] = actual_counts_[i];
     hw_fault_[i] = 0;
   }
@@ -439,8 +427,8 @@ void Cia402Bus::arm_device_guard() {
   // A drive starts watching at the first heartbeat after the consumer is
   // set, sent at once; from then on every read produces them.
   try {
-    for (std::size_t i = 0; i < status_.size(); ++i) {
-      if (status_[i].faulted) continue;
+    for (std::size_t i = 0; i < book_.size(); ++i) {
+      if (book_[i].faulted) continue;
       sdo_write(i, cia402::obj::abort_connection_option, 0,
                 static_cast<std::uint16_t>(options_.abort_connection), 2);
       sdo_write(i, cia402::obj::heartbeat_consumer, 1,
@@ -462,7 +450,7 @@ void Cia402Bus::deactivate() {
   try {
     walk_to(State::switch_on_disabled);
     clear_device_guard();
-    for (std::size_t i = 0; i < status_.size(); ++i) {
+    for (std::size_t i = 0; i < book_.size(); ++i) {
       nmt(canopen::NmtCommand::enter_pre_operational, i);
     }
     const std::string errors = describe_errors(transport_->errors());
@@ -476,7 +464,7 @@ void Cia402Bus::deactivate() {
 
 void Cia402Bus::clear_device_guard() {
   if (options_.device_watchdog_ms <= 0) return;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     try {
       sdo_write(i, cia402::obj::heartbeat_consumer, 1, 0, 4);
     } catch (const DeviceError&) {
@@ -490,7 +478,7 @@ void Cia402Bus::clear_device_guard() {
 // ---- cycle -------------------------------------------------------------------
 
 void Cia402Bus::read(std::span<double> positions) {
-  const std::size_t n = std::min(positions.size(), status_.size());
+  const std::size_t n = std::min(positions.size(), book_.size());
   if (!fresh_) sync_cycle();
   fresh_ = false;
   for (std::size_t i = 0; i < n; ++i) {
@@ -499,8 +487,8 @@ void Cia402Bus::read(std::span<double> positions) {
 }
 
 void Cia402Bus::write(std::span<const double> positions) {
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    if (status_[i].faulted) continue;
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    if (book_[i].faulted) continue;
     if (i < positions.size() && std::isfinite(positions[i])) {
       const double goal = config_.actuators[i].safe_goal(positions[i], positions[i]);
       target_counts_[i] = config_.actuators[i].to_ticks(std::clamp(goal, min_rad_[i], max_rad_[i]));

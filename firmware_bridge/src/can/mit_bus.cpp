@@ -29,39 +29,25 @@ MitBus::MitBus(BusConfig config, std::unique_ptr<CanFrameTransport> transport)
     slot_of_id_[b.device_id] = static_cast<int>(i);
     motor_.push_back(options_of<MitMotorOptions>(b.options));
   }
-  status_.resize(n);
+  book_ = StatusBook(config_, transport_->interface(), "motor id");
   reply_.resize(n);
   goal_motor_rad_.resize(n);
   frames_.resize(n);
   pending_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    status_[i].device_id = config_.actuators[i].device_id;
     goal_motor_rad_[i] = motor_[i].zero_rad;
   }
 }
 
-std::string MitBus::prefix() const {
-  return "bus " + config_.name + " (" + transport_->interface() + "): ";
-}
-
-std::string MitBus::describe(std::size_t device) const {
-  const ActuatorBinding& b = config_.actuators[device];
-  return "motor id " + std::to_string(b.device_id) + " (" + b.joint + ")";
-}
-
 std::string MitBus::missing_list() const {
-  std::string out;
-  for (std::size_t i = 0; i < pending_.size(); ++i) {
-    if (pending_[i]) out += (out.empty() ? "" : ", ") + describe(i);
-  }
-  return out;
+  return book_.list([&](std::size_t i) { return pending_[i] != 0; });
 }
 
 std::size_t MitBus::exchange() {
   std::size_t waiting = 0;
   for (std::size_t i = 0; i < pending_.size(); ++i) {
     if (!pending_[i]) continue;
-    ++status_[i].transactions;
+    book_.asked(i);
     transport_->send(frames_[i]);
     ++waiting;
   }
@@ -81,20 +67,17 @@ std::size_t MitBus::exchange() {
       ++foreign_frames_;  // another motor on a shared interface, or an NMT frame
       continue;
     }
-    DeviceStatus& st = status_[slot];
-    if (!mit::unpack_reply(frame, motor_[slot].ranges, reply)) {
-      ++st.protocol_errors;
-      st.health = DeviceHealth::protocol_error;
+    const auto device = static_cast<std::size_t>(slot);
+    if (!mit::unpack_reply(frame, motor_[device].ranges, reply)) {
+      book_.garbled(device);
       continue;
     }
-    reply_[slot] = reply;
+    reply_[device] = reply;
     if (reply.error != 0) {
-      ++st.hardware_errors;
-      st.hardware_error_status = reply.error;
-      st.last_error_byte = reply.error;
-      st.health = DeviceHealth::hardware_error;
+      book_.hardware_fault(device, reply.error);
+      book_[device].last_error_byte = reply.error;
     } else {
-      st.health = DeviceHealth::ok;
+      book_.answered(device);
     }
     if (pending_[slot]) {
       pending_[slot] = 0;
@@ -103,8 +86,7 @@ std::size_t MitBus::exchange() {
   }
   for (std::size_t i = 0; i < pending_.size(); ++i) {
     if (!pending_[i]) continue;
-    ++status_[i].timeouts;
-    status_[i].health = DeviceHealth::timeout;
+    book_.timed_out(i);
   }
   return waiting;
 }
@@ -113,10 +95,7 @@ void MitBus::configure() {
   const canid_t flags = CAN_EFF_FLAG | CAN_RTR_FLAG;
   const can_filter filters[] = {{bus_options_.master_id, CAN_SFF_MASK | flags}};
   transport_->set_filters(filters);
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    status_[i] = DeviceStatus{};
-    status_[i].device_id = config_.actuators[i].device_id;
-  }
+  book_.reset();
   // Exit motor mode: de-energised, and every motor answers with its state.
   std::fill(pending_.begin(), pending_.end(), 1);
   for (int t = 0; t < kTries; ++t) {
@@ -132,7 +111,7 @@ void MitBus::configure() {
     throw DeviceError(message);
   }
   std::string faulty;
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     goal_motor_rad_[i] = reply_[i].position;
     if (reply_[i].error != 0) {
       faulty += (faulty.empty() ? "" : ", ") + describe(i) + " reports error code " +
@@ -146,8 +125,8 @@ void MitBus::configure() {
 void MitBus::activate() {
   // Enter motor mode, then hold where each motor is.
   for (int step = 0; step < 2; ++step) {
-    for (std::size_t i = 0; i < status_.size(); ++i) {
-      pending_[i] = status_[i].faulted ? 0 : 1;
+    for (std::size_t i = 0; i < book_.size(); ++i) {
+      pending_[i] = book_[i].faulted ? 0 : 1;
       const auto id = static_cast<canid_t>(config_.actuators[i].device_id);
       if (step == 0) {
         frames_[i] = mit::special_frame(id, mit::Special::enter_motor_mode);
@@ -162,11 +141,10 @@ void MitBus::activate() {
     }
     held_at_ = transport_->now();
     std::string failed = missing_list();
-    for (std::size_t i = 0; i < status_.size(); ++i) {
-      if (!pending_[i] && !status_[i].faulted &&
-          status_[i].health == DeviceHealth::hardware_error) {
+    for (std::size_t i = 0; i < book_.size(); ++i) {
+      if (!pending_[i] && !book_[i].faulted && book_[i].health == DeviceHealth::hardware_error) {
         failed += (failed.empty() ? "" : ", ") + describe(i) + " (error code " +
-                  std::to_string(status_[i].hardware_error_status) + ")";
+                  std::to_string(book_[i].hardware_error_status) + ")";
       }
     }
     if (!failed.empty()) {
@@ -188,14 +166,14 @@ void MitBus::arm_device_guard() {
                       std::to_string(since_hold / 1'000'000) +
                       " ms): set a longer one on the motors and in device_watchdog_ms");
   }
-  for (std::size_t i = 0; i < status_.size(); ++i) pending_[i] = status_[i].faulted ? 0 : 1;
+  for (std::size_t i = 0; i < book_.size(); ++i) pending_[i] = book_[i].faulted ? 0 : 1;
   for (int t = 0; t < kTries && exchange() > 0; ++t) {
   }
 }
 
 void MitBus::deactivate() {
   try {
-    for (std::size_t i = 0; i < status_.size(); ++i) {
+    for (std::size_t i = 0; i < book_.size(); ++i) {
       pending_[i] = 1;
       frames_[i] = mit::special_frame(static_cast<canid_t>(config_.actuators[i].device_id),
                                       mit::Special::exit_motor_mode);
@@ -210,9 +188,9 @@ void MitBus::deactivate() {
 }
 
 void MitBus::read(std::span<double> positions) {
-  const std::size_t n = std::min(positions.size(), status_.size());
+  const std::size_t n = std::min(positions.size(), book_.size());
   for (std::size_t i = 0; i < n; ++i) {
-    if (fresh_ || status_[i].health != DeviceHealth::timeout) {
+    if (fresh_ || book_[i].health != DeviceHealth::timeout) {
       positions[i] = motor_[i].to_joint(reply_[i].position, config_.actuators[i].direction);
     }
   }
@@ -220,9 +198,9 @@ void MitBus::read(std::span<double> positions) {
 }
 
 void MitBus::write(std::span<const double> positions) {
-  for (std::size_t i = 0; i < status_.size(); ++i) {
+  for (std::size_t i = 0; i < book_.size(); ++i) {
     pending_[i] = 0;
-    if (status_[i].faulted) continue;
+    if (book_[i].faulted) continue;
     const MitMotorOptions& m = motor_[i];
     if (i < positions.size() && std::isfinite(positions[i])) {
       const double goal = config_.actuators[i].safe_goal(positions[i], positions[i]);

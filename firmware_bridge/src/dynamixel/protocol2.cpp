@@ -281,58 +281,37 @@ std::size_t encode_status(std::uint8_t id, std::uint8_t error, std::span<const s
   return w.finish();
 }
 
-void Decoder::reset() { size_ = 0; }
-
-std::size_t Decoder::feed(std::span<const std::uint8_t> bytes) {
-  const std::size_t n = std::min(bytes.size(), sizeof(buffer_) - size_);
-  if (n > 0) std::memcpy(buffer_ + size_, bytes.data(), n);
-  size_ += n;
-  return n;
-}
-
-void Decoder::drop_front(std::size_t n) {
-  if (n >= size_) {
-    size_ = 0;
-    return;
-  }
-  std::memmove(buffer_, buffer_ + n, size_ - n);
-  size_ -= n;
-}
-
 DecodeResult Decoder::next(Packet& out) {
   // Skip to the first header; keep a partial header at the end of the buffer.
   std::size_t start = 0;
   std::size_t matched = 0;
-  while (start + matched < size_ && matched < kHeaderSize) {
-    if (buffer_[start + matched] == kHeader[matched]) {
+  while (start + matched < rx_.size() && matched < kHeaderSize) {
+    if (rx_[start + matched] == kHeader[matched]) {
       ++matched;
     } else {
       ++start;
       matched = 0;
     }
   }
-  if (start > 0) {
-    stray_bytes_ += start;
-    drop_front(start);
-  }
-  if (size_ < kPrefixSize) return DecodeResult::need_more;
+  rx_.skip(start);
+  if (rx_.size() < kPrefixSize) return DecodeResult::need_more;
 
-  const std::uint8_t id = buffer_[4];
-  const std::size_t length = get_u16(buffer_ + 5);
+  const std::uint8_t id = rx_[4];
+  const std::size_t length = get_u16(rx_.data() + 5);
   if (!valid_id(id) || length < kMinLength || length > kMaxLength) {
     // Not a packet start after all: drop the header and search again, so a
     // real header right behind it is still found.
-    drop_front(kHeaderSize);
+    rx_.drop_front(kHeaderSize);
     return DecodeResult::malformed;
   }
   const std::size_t total = kPrefixSize + length;
-  if (size_ < total) return DecodeResult::need_more;  // truncated so far
+  if (rx_.size() < total) return DecodeResult::need_more;  // truncated so far
 
   const std::size_t crc_at = total - kCrcSize;
-  if (crc16({buffer_, crc_at}) != get_u16(buffer_ + crc_at)) {
+  if (crc16({rx_.data(), crc_at}) != get_u16(rx_.data() + crc_at)) {
     // Drop only the header: if LEN was corrupted, the packets it swallowed
     // are found on the next search.
-    drop_front(kHeaderSize);
+    rx_.drop_front(kHeaderSize);
     return DecodeResult::bad_crc;
   }
 
@@ -342,10 +321,10 @@ DecodeResult Decoder::next(Packet& out) {
   int ff_run = 0;
   bool bad_stuffing = false;
   for (std::size_t i = kPrefixSize; i < crc_at; ++i) {
-    const std::uint8_t b = buffer_[i];
+    const std::uint8_t b = rx_[i];
     unstuffed_[n++] = b;
     if (b == 0xFD && ff_run >= 2) {
-      if (i + 1 >= crc_at || buffer_[i + 1] != 0xFD) {
+      if (i + 1 >= crc_at || rx_[i + 1] != 0xFD) {
         bad_stuffing = true;
         break;
       }
@@ -357,10 +336,10 @@ DecodeResult Decoder::next(Packet& out) {
   }
   const std::uint8_t instruction = unstuffed_[0];
   if (bad_stuffing || (instruction == inst::status && n < 2)) {
-    drop_front(total);
+    rx_.drop_front(total);
     return DecodeResult::malformed;
   }
-  drop_front(total);
+  rx_.drop_front(total);
   out.id = id;
   out.instruction = instruction;
   out.params = std::span<const std::uint8_t>(unstuffed_ + 1, n - 1);

@@ -142,63 +142,44 @@ std::size_t encode_status(std::uint8_t id, std::uint8_t error, std::span<const s
   return encode_packet(id, error, data, out);
 }
 
-std::size_t Decoder::feed(std::span<const std::uint8_t> bytes) {
-  const std::size_t n = std::min(bytes.size(), sizeof(buffer_) - size_);
-  if (n > 0) std::memcpy(buffer_ + size_, bytes.data(), n);
-  size_ += n;
-  return n;
-}
-
-void Decoder::drop_front(std::size_t n) {
-  if (n >= size_) {
-    size_ = 0;
-    return;
-  }
-  std::memmove(buffer_, buffer_ + n, size_ - n);
-  size_ -= n;
-}
-
 DecodeResult Decoder::next(Packet& out) {
   // Skip to the first FF FF that is not followed by another FF (a run of FF
   // is idle line or junk; the last two of the run are the header).
   std::size_t start = 0;
-  while (start < size_) {
-    if (buffer_[start] != 0xFF) {
+  while (start < rx_.size()) {
+    if (rx_[start] != 0xFF) {
       ++start;
       continue;
     }
-    if (start + 1 >= size_) break;  // a lone FF at the end: maybe half a header
-    if (buffer_[start + 1] != 0xFF) {
+    if (start + 1 >= rx_.size()) break;  // a lone FF at the end: maybe half a header
+    if (rx_[start + 1] != 0xFF) {
       start += 2;
       continue;
     }
-    if (start + 2 < size_ && buffer_[start + 2] == 0xFF) {
+    if (start + 2 < rx_.size() && rx_[start + 2] == 0xFF) {
       ++start;
       continue;
     }
     break;
   }
-  if (start > 0) {
-    stray_bytes_ += start;
-    drop_front(start);
-  }
-  if (size_ < kPrefixSize) return DecodeResult::need_more;
+  rx_.skip(start);
+  if (rx_.size() < kPrefixSize) return DecodeResult::need_more;
 
-  const std::size_t length = buffer_[3];
+  const std::size_t length = rx_[3];
   if (length < kMinLength) {
-    drop_front(2);  // not a packet start after all; search on behind it
+    rx_.drop_front(2);  // not a packet start after all; search on behind it
     return DecodeResult::malformed;
   }
   const std::size_t total = kPrefixSize + length;
-  if (size_ < total) return DecodeResult::need_more;
-  if (checksum({buffer_ + 2, total - 3}) != buffer_[total - 1]) {
+  if (rx_.size() < total) return DecodeResult::need_more;
+  if (checksum({rx_.data() + 2, total - 3}) != rx_[total - 1]) {
     // Drop only the header: if LEN was damaged, the packets it swallowed are
     // found on the next search.
-    drop_front(2);
+    rx_.drop_front(2);
     return DecodeResult::bad_checksum;
   }
-  std::memcpy(packet_, buffer_, total);
-  drop_front(total);
+  std::memcpy(packet_, rx_.data(), total);
+  rx_.drop_front(total);
   out.id = packet_[2];
   out.code = packet_[4];
   out.params = std::span<const std::uint8_t>(packet_ + 5, total - 6);

@@ -53,7 +53,7 @@ MaestroBus::MaestroBus(BusConfig config, std::unique_ptr<ByteTransport> transpor
   if (const auto* o = std::any_cast<MaestroBusOptions>(&config_.options)) options_ = *o;
   const std::size_t n = config_.actuators.size();
   channels_.resize(n);
-  status_.resize(n);
+  book_ = StatusBook(config_, transport_->port());
   present_.assign(n, 0);
   goal_.assign(n, 0);
   answered_.assign(n, 0);
@@ -92,10 +92,6 @@ MaestroBus::MaestroBus(BusConfig config, std::unique_ptr<ByteTransport> transpor
   }
 }
 
-std::string MaestroBus::prefix() const {
-  return "bus " + config_.name + " (" + transport_->port() + "): ";
-}
-
 void MaestroBus::send(std::size_t length) {
   if (length > 0) transport_->write({tx_.data(), length});
 }
@@ -120,7 +116,7 @@ bool MaestroBus::poll_board(Board& board, bool count) {
   std::size_t asked = 0;
   for (std::size_t d : board.devices) {
     answered_[d] = 0;
-    if (status_[d].faulted) continue;
+    if (book_[d].faulted) continue;
     length +=
         maestro::encode_get_position(board.address, static_cast<std::uint8_t>(channels_[d].channel),
                                      {tx_.data() + length, tx_.size() - length});
@@ -135,21 +131,18 @@ bool MaestroBus::poll_board(Board& board, bool count) {
 
   std::size_t slot = 0;
   for (std::size_t d : board.devices) {
-    if (status_[d].faulted) continue;
-    DeviceStatus& st = status_[d];
-    if (count) ++st.transactions;
+    if (book_[d].faulted) continue;
+    if (count) book_.asked(d);
     if (got >= 2 * (slot + 1)) {
       const std::uint16_t position = maestro::decode_answer(&rx_[2 * slot]);
       // 0: the channel is off (no pulses); keep the last known output.
       if (position != 0) present_[d] = position;
       answered_[d] = 1;
-      st.health = DeviceHealth::ok;
+      book_.answered(d);
     } else if (count && got > 2 * slot) {
-      ++st.protocol_errors;  // an answer cut short
-      st.health = DeviceHealth::protocol_error;
+      book_.garbled(d);  // an answer cut short
     } else if (count) {
-      ++st.timeouts;
-      st.health = DeviceHealth::timeout;
+      book_.timed_out(d);
     }
     ++slot;
   }
@@ -158,12 +151,9 @@ bool MaestroBus::poll_board(Board& board, bool count) {
   board.last_errors = errors;
   if (errors != 0 && count) {
     for (std::size_t d : board.devices) {
-      if (status_[d].faulted) continue;
-      DeviceStatus& st = status_[d];
-      ++st.hardware_errors;
-      st.hardware_error_status = static_cast<std::uint8_t>(errors & 0xFF);
-      st.last_error_byte = static_cast<std::uint8_t>(errors >> 8);
-      st.health = DeviceHealth::hardware_error;
+      if (book_[d].faulted) continue;
+      book_.hardware_fault(d, static_cast<std::uint8_t>(errors & 0xFF));
+      book_[d].last_error_byte = static_cast<std::uint8_t>(errors >> 8);
     }
   }
   return true;
@@ -183,12 +173,12 @@ std::uint16_t MaestroBus::target_of(std::size_t device, double rad) const {
 // ---- lifecycle --------------------------------------------------------------
 
 void MaestroBus::configure() {
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    status_[i] = DeviceStatus{};
-    status_[i].device_id = options_.form == maestro::Form::compact
-                               ? channels_[i].channel
-                               : 100 * channels_[i].device + channels_[i].channel;
-    status_[i].open_loop = true;
+  book_.reset();
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    book_[i].device_id = options_.form == maestro::Form::compact
+                             ? channels_[i].channel
+                             : 100 * channels_[i].device + channels_[i].channel;
+    book_[i].open_loop = true;
     present_[i] = 0;
   }
   std::string silent;
@@ -315,7 +305,7 @@ void MaestroBus::deactivate() {
 // ---- cycle ----------------------------------------------------------------
 
 void MaestroBus::read(std::span<double> positions) {
-  const std::size_t n = std::min(positions.size(), status_.size());
+  const std::size_t n = std::min(positions.size(), book_.size());
   if (fresh_) {
     for (std::size_t i = 0; i < n; ++i) positions[i] = config_.actuators[i].to_rad(present_[i]);
     fresh_ = false;
@@ -333,7 +323,7 @@ void MaestroBus::write(std::span<const double> positions) {
     const std::size_t count = board.devices.size();
     while (k < count) {
       const std::size_t d = board.devices[k];
-      if (status_[d].faulted) {
+      if (book_[d].faulted) {
         ++k;
         continue;
       }
@@ -341,7 +331,7 @@ void MaestroBus::write(std::span<const double> positions) {
       block_.clear();
       const int first = channels_[d].channel;
       std::size_t e = k;
-      while (e < count && !status_[board.devices[e]].faulted &&
+      while (e < count && !book_[board.devices[e]].faulted &&
              channels_[board.devices[e]].channel == first + static_cast<int>(e - k)) {
         const std::size_t dev = board.devices[e];
         if (dev < positions.size()) goal_[dev] = target_of(dev, positions[dev]);

@@ -46,7 +46,7 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
   if (const auto* o = std::any_cast<ModbusBusOptions>(&config_.options)) options_ = *o;
   const std::size_t n = config_.actuators.size();
   joints_.resize(n);
-  status_.resize(n);
+  book_ = StatusBook(config_, config_.port, "slave");
   present_rad_.assign(n, 0.0);
   goal_rad_.assign(n, 0.0);
   answered_.assign(n, 0);
@@ -145,10 +145,6 @@ ModbusBus::~ModbusBus() {
   }
 }
 
-std::string ModbusBus::prefix() const {
-  return "bus " + config_.name + " (" + config_.port + "): ";
-}
-
 void ModbusBus::disconnect() {
   if (connected_) modbus_close(ctx_);
   connected_ = false;
@@ -202,27 +198,19 @@ ModbusBus::Failure ModbusBus::classify(int error) const {
 ModbusBus::Failure ModbusBus::fail_slave(const Slave& slave, int error) {
   const Failure f = classify(error);
   for (std::size_t d : slave.devices) {
-    DeviceStatus& st = status_[d];
-    if (st.faulted) continue;
+    if (book_.faulted(d)) continue;
     switch (f) {
       case Failure::exception:
-        ++st.exceptions;
-        st.last_error_byte = static_cast<std::uint8_t>(error - MODBUS_ENOBASE);
-        st.health = DeviceHealth::protocol_error;
+        book_.exception(d, static_cast<std::uint8_t>(error - MODBUS_ENOBASE));
         break;
       case Failure::crc:
-        ++st.crc_errors;
-        st.health = DeviceHealth::protocol_error;
-        break;
       case Failure::protocol:
-        ++st.protocol_errors;
-        st.health = DeviceHealth::protocol_error;
+        book_.garbled(d, f == Failure::crc);
         break;
       case Failure::timeout:
       case Failure::connection:
       case Failure::none:
-        ++st.timeouts;
-        st.health = DeviceHealth::timeout;
+        book_.timed_out(d);
         break;
     }
   }
@@ -249,9 +237,9 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
   bool any = false;
   for (std::size_t d : slave.devices) {
     answered_[d] = 0;
-    if (status_[d].faulted) continue;
+    if (book_[d].faulted) continue;
     any = true;
-    if (count) ++status_[d].transactions;
+    if (count) book_.asked(d);
   }
   if (!any) return true;
   for (Read& r : slave.reads) {
@@ -269,7 +257,7 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
         disconnect();
       }
       if (!count)
-        status_[slave.devices[0]].last_error_byte =
+        book_[slave.devices[0]].last_error_byte =
             classify(error) == Failure::exception
                 ? static_cast<std::uint8_t>(error - MODBUS_ENOBASE)
                 : 0;
@@ -277,29 +265,25 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
     }
   }
   for (std::size_t d : slave.devices) {
-    if (status_[d].faulted) continue;
+    if (book_[d].faulted) continue;
     const modbus::RegisterMap& m = *joints_[d].map;
     const ModbusJointOptions& j = joints_[d];
-    DeviceStatus& st = status_[d];
     present_rad_[d] = (m.present.decode(words_of(slave, m.present)) - j.zero) / j.per_rad;
     answered_[d] = 1;
-    st.health = DeviceHealth::ok;
+    std::uint16_t faults = 0;
     if (m.has_status) {
-      const std::uint16_t value = *words_of(slave, m.status);
-      const std::uint16_t faults = value & m.fault_mask;
-      st.hardware_error_status = static_cast<std::uint8_t>(faults & 0xFF);
-      if (faults != 0) {
-        if (count) ++st.hardware_errors;
-        st.health = DeviceHealth::hardware_error;
-      }
+      faults = *words_of(slave, m.status) & m.fault_mask;
+      book_[d].hardware_error_status = static_cast<std::uint8_t>(faults & 0xFF);
+      if (faults != 0 && count) book_.fault_reported(d);
     }
+    book_.answered(d, faults != 0);
   }
   return true;
 }
 
 bool ModbusBus::write_slave(Slave& slave) {
   for (std::size_t d : slave.devices) {
-    if (status_[d].faulted) return true;  // a faulted drive is left alone
+    if (book_[d].faulted) return true;  // a faulted drive is left alone
   }
   for (std::size_t d : slave.devices) {
     const modbus::RegisterMap& m = *joints_[d].map;
@@ -342,10 +326,8 @@ bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
 // ---- lifecycle --------------------------------------------------------------
 
 void ModbusBus::configure() {
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    status_[i] = DeviceStatus{};
-    status_[i].device_id = joints_[i].slave;
-  }
+  book_.reset();
+  for (std::size_t i = 0; i < book_.size(); ++i) book_.set_device_id(i, joints_[i].slave);
   if (!ensure_connected(true)) {
     throw DeviceError(prefix() + "cannot connect: " + modbus_strerror(errno));
   }
@@ -358,7 +340,7 @@ void ModbusBus::configure() {
       ok = read_slave(s, false);
     }
     if (ok) continue;
-    const std::uint8_t code = status_[s.devices[0]].last_error_byte;
+    const std::uint8_t code = book_[s.devices[0]].last_error_byte;
     std::string joints;
     for (std::size_t d : s.devices)
       joints += (joints.empty() ? "" : ", ") + config_.actuators[d].joint;
@@ -370,11 +352,11 @@ void ModbusBus::configure() {
   if (!failed.empty()) throw DeviceError(prefix() + "cannot read " + failed);
   for (Slave& s : slaves_) {
     for (std::size_t d : s.devices) {
-      if (status_[d].health == DeviceHealth::hardware_error) {
+      if (book_[d].health == DeviceHealth::hardware_error) {
         const auto& m = *joints_[d].map;
         throw DeviceError(prefix() + "slave " + std::to_string(s.id) + " (" +
                           config_.actuators[d].joint +
-                          ") reports faults: " + m.fault_text(status_[d].hardware_error_status));
+                          ") reports faults: " + m.fault_text(book_[d].hardware_error_status));
       }
     }
   }
@@ -414,7 +396,7 @@ void ModbusBus::deactivate() {
 // ---- cycle ----------------------------------------------------------------
 
 void ModbusBus::read(std::span<double> positions) {
-  const std::size_t n = std::min(positions.size(), status_.size());
+  const std::size_t n = std::min(positions.size(), book_.size());
   if (fresh_) {
     for (std::size_t i = 0; i < n; ++i) positions[i] = present_rad_[i];
     fresh_ = false;
@@ -422,11 +404,10 @@ void ModbusBus::read(std::span<double> positions) {
   if (!ensure_connected(false)) {
     // Down and waiting for the next attempt: no answer this cycle.
     for (Slave& s : slaves_) s.silent = true;
-    for (DeviceStatus& st : status_) {
-      if (st.faulted) continue;
-      ++st.transactions;
-      ++st.timeouts;
-      st.health = DeviceHealth::timeout;
+    for (std::size_t d = 0; d < book_.size(); ++d) {
+      if (book_.faulted(d)) continue;
+      book_.asked(d);
+      book_.timed_out(d);
     }
     return;
   }
@@ -435,10 +416,9 @@ void ModbusBus::read(std::span<double> positions) {
     if (!connected_) {
       s.silent = true;
       for (std::size_t d : s.devices) {
-        if (status_[d].faulted) continue;
-        ++status_[d].transactions;
-        ++status_[d].timeouts;
-        status_[d].health = DeviceHealth::timeout;
+        if (book_.faulted(d)) continue;
+        book_.asked(d);
+        book_.timed_out(d);
       }
       continue;
     }

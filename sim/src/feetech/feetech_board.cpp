@@ -140,34 +140,7 @@ FeetechServo::Motor FeetechServo::motor_at(Nanos now) const {
     return m;
   }
   if (now <= motor_time_) return m;
-  double dt = to_seconds(now - motor_time_);
-  const double goal = goal_position();
-  const double vmax = vmax_steps_s_;
-  const double error = goal - m.position;
-  const double dir = error >= 0 ? 1.0 : -1.0;
-  if (tau_s_ <= 0) {
-    const double travel = std::min(std::abs(error), vmax * dt);
-    m.position += dir * travel;
-    m.velocity = m.position == goal ? 0.0 : dir * vmax;
-    return m;
-  }
-  // speed = clamp(error / tau, +-vmax): a ramp at vmax until the error is
-  // vmax * tau, then an exponential decay.
-  const double band = vmax * tau_s_;
-  if (std::abs(error) > band) {
-    const double ramp_s = (std::abs(error) - band) / vmax;
-    if (dt <= ramp_s) {
-      m.position += dir * vmax * dt;
-      m.velocity = dir * vmax;
-      return m;
-    }
-    m.position = goal - dir * band;
-    dt -= ramp_s;
-  }
-  const double remaining = (goal - m.position) * std::exp(-dt / tau_s_);
-  m.position = goal - remaining;
-  m.velocity = remaining / tau_s_;
-  return m;
+  return m.after(to_seconds(now - motor_time_), goal_position(), vmax_steps_s_, tau_s_);
 }
 
 void FeetechServo::advance(Nanos now) {

@@ -1,30 +1,13 @@
 #include "animrt/sim/feetech/feetech_sim_bus.hpp"
 
-#include <poll.h>
-#include <time.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cerrno>
 #include <stdexcept>
 
+#include "animrt/bridge/feetech/link_codec.hpp"
+
 namespace animrt::sim {
-namespace {
-
-constexpr int kWriteStallMs = 200;  // a client that stops reading loses answers after this
-constexpr int kBitsPerByte = 10;    // start + 8 data + stop
-constexpr int kPacketSilenceMs = 5;
-
-void sleep_until_monotonic(Nanos t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
-
-}  // namespace
 
 FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock)
     : config_(config),
@@ -57,53 +40,16 @@ void FeetechSimBus::stop() {
 
 void FeetechSimBus::serve() {
   std::array<std::uint8_t, 1024> buffer{};
-  const MonotonicClock wall;
-  Nanos last_byte = 0;
-  while (!stop_.load()) {
-    pollfd fds[2] = {{pty_.master(), POLLIN, 0}, {wake_.read_fd(), POLLIN, 0}};
-    const int wait_ms = decoder_.buffered() > 0 ? kPacketSilenceMs : -1;
-    const int ready = ::poll(fds, 2, wait_ms);
-    if (ready < 0) {
-      if (errno == EINTR) continue;
-      break;
-    }
-    if (decoder_.buffered() > 0 &&
-        (ready == 0 || wall.now() - last_byte > Nanos{kPacketSilenceMs} * 1'000'000)) {
-      dropped_partial_ += decoder_.buffered();  // a servo's receive timeout
-      decoder_.reset();
-    }
-    if (ready == 0) continue;
-    if (fds[1].revents != 0) break;
-    if (fds[0].revents & POLLIN) {
-      const ssize_t n = ::read(pty_.master(), buffer.data(), buffer.size());
-      if (n > 0) {
-        last_byte = wall.now();
-        process({buffer.data(), static_cast<std::size_t>(n)}, last_byte);
-        continue;
-      }
-      if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
-    }
-    ::poll(&fds[1], 1, 10);  // hangup or error: do not spin
-  }
-}
-
-void FeetechSimBus::process(std::span<const std::uint8_t> bytes, Nanos arrival) {
-  std::size_t fed = 0;
-  while (fed < bytes.size()) {
-    fed += decoder_.feed(bytes.subspan(fed));
-    ft::Packet packet;
-    for (;;) {
-      const ft::DecodeResult r = decoder_.next(packet);
-      if (r == ft::DecodeResult::need_more) break;
-      if (r == ft::DecodeResult::bad_checksum) {
-        ++bad_checksums_;  // a servo ignores a packet it cannot trust
-      } else if (r == ft::DecodeResult::malformed) {
-        ++malformed_;
-      } else {
-        handle(packet, arrival);
-      }
-    }
-  }
+  line::serve(pty_.master(), wake_.read_fd(), stop_, buffer,
+              {[this](std::span<const std::uint8_t> bytes, Nanos arrival) {
+                 line::feed(ft::LinkCodec{}, decoder_, bytes, decode_counts_,
+                            [&](const ft::Packet& packet) { handle(packet, arrival); });
+               },
+               [this] { return decoder_.buffered() > 0; },
+               [this] {
+                 dropped_partial_ += decoder_.buffered();  // a servo's receive timeout
+                 decoder_.reset();
+               }});
 }
 
 void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
@@ -122,7 +68,7 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
     Nanos t = std::max(arrival, bus_free_) + wire_ns(packet.raw.size());
     for (const FeetechAnswers::Answer& a : answers_.list) {
       t += static_cast<Nanos>(a.return_delay_us) * 1000 + wire_ns(a.size);
-      sleep_until_monotonic(t);
+      line::sleep_until_monotonic(t);
       send(answers_.packet(a));
     }
     bus_free_ = t;
@@ -130,28 +76,10 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
   answers_sent_ += answers_.list.size();
 }
 
-Nanos FeetechSimBus::wire_ns(std::size_t bytes) const {
-  const int baud = std::max(config_.baud, 1);
-  return static_cast<Nanos>(bytes) * kBitsPerByte * 1'000'000'000 / baud;
-}
+Nanos FeetechSimBus::wire_ns(std::size_t bytes) const { return line::wire_ns(bytes, config_.baud); }
 
 void FeetechSimBus::send(std::span<const std::uint8_t> bytes) {
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(pty_.master(), bytes.data() + done, bytes.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && errno == EAGAIN) {
-      pollfd fds[2] = {{pty_.master(), POLLOUT, 0}, {wake_.read_fd(), POLLIN, 0}};
-      if (::poll(fds, 2, kWriteStallMs) > 0 && fds[1].revents == 0 && (fds[0].revents & POLLOUT)) {
-        continue;
-      }
-    }
-    break;
-  }
+  line::write_all(pty_.master(), wake_.read_fd(), bytes);
 }
 
 FeetechServo& FeetechSimBus::servo(int device_id) {
@@ -196,8 +124,8 @@ FeetechSimStats FeetechSimBus::stats() const {
   FeetechSimStats s;
   s.packets = packets_;
   s.answers = answers_sent_;
-  s.bad_checksums = bad_checksums_;
-  s.malformed = malformed_;
+  s.bad_checksums = decode_counts_.bad_checks;
+  s.malformed = decode_counts_.malformed;
   s.partial_packet_bytes = dropped_partial_;
   return s;
 }

@@ -52,7 +52,11 @@ struct BusConfig {
   std::string protocol;  // a registered Protocol's name, e.g. "dynamixel2"
   std::string port;      // where the bus is: /dev/ttyUSB0, host:port, can0, ...
   int baud = 1'000'000;
-  double timeout_s = 0.004;  // answer timeout for one transaction
+  // The wait for ONE answer: from a request to its first answer, and from
+  // each answer to the next when several devices answer one request (a
+  // Sync Read). A request that N devices answer thus takes at most N times
+  // this; a silent device costs it once.
+  double timeout_s = 0.004;
   SimBusSettings sim;
   std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
   std::any options;                        // protocol-specific, see ActuatorBinding::options

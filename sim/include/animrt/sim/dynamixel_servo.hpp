@@ -53,6 +53,7 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
+#include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
 
@@ -197,10 +198,7 @@ class DynamixelServo {
   double position_rad(Nanos now) const;
 
  private:
-  struct Motor {
-    double position = 0;  // ticks
-    double velocity = 0;  // ticks/s
-  };
+  using Motor = ServoMotor;  // ticks, ticks/s
   Motor motor_at(Nanos now) const;
   Motor motor_until(Nanos now) const;  // the motor model alone, no watchdog
   Nanos watchdog_fire_time() const;    // when the armed watchdog fires; -1: not armed

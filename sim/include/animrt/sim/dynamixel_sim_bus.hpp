@@ -42,6 +42,7 @@
 #include "animrt/core/clock.hpp"
 #include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/dynamixel_firmware.hpp"
+#include "animrt/sim/serial_line.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -85,13 +86,11 @@ class DynamixelSimBus final : public SimulatedBus {
 
  private:
   void serve();
-  void process(std::span<const std::uint8_t> bytes, Nanos arrival);
   void handle(const dxl::Packet& packet, Nanos arrival);
   void send(std::span<const std::uint8_t> bytes);
   void send_paced();  // answers_ at the times in due_
   Nanos wire_ns(std::size_t bytes) const;
   void close_fds();
-  void drop_partial_packet();
 
   BusConfig config_;
   const Clock& clock_;
@@ -118,8 +117,7 @@ class DynamixelSimBus final : public SimulatedBus {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> packets_{0};
   std::atomic<std::uint64_t> answers_sent_{0};
-  std::atomic<std::uint64_t> crc_errors_{0};
-  std::atomic<std::uint64_t> malformed_{0};
+  line::DecodeCounts decode_counts_;
   std::atomic<std::uint64_t> stray_bytes_{0};
   std::atomic<std::uint64_t> dropped_bytes_{0};
   std::atomic<std::uint64_t> dropped_partial_{0};

@@ -41,6 +41,7 @@
 #include "animrt/bridge/can/can_transport.hpp"
 #include "animrt/bridge/can/canopen.hpp"
 #include "animrt/bridge/can/cia402.hpp"
+#include "animrt/bridge/status_book.hpp"
 
 namespace animrt {
 
@@ -70,7 +71,7 @@ class Cia402Bus final : public ActuatorBus {
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return book_.devices(); }
 
   // What the runtime knows about each drive.
   struct DriveReport {
@@ -97,7 +98,7 @@ class Cia402Bus final : public ActuatorBus {
 
  private:
   // Frames taken past a deadline before giving up (a flooding node).
-  std::size_t frame_budget() const { return 64 + 8 * status_.size(); }
+  std::size_t frame_budget() const { return 64 + 8 * book_.size(); }
   // Sends `request` (retried on silence) and returns the answer's value.
   std::uint32_t sdo_exchange(std::size_t device, const can_frame& request, std::uint16_t index,
                              std::uint8_t sub, const std::string& what, canopen::SdoKind expected);
@@ -114,8 +115,8 @@ class Cia402Bus final : public ActuatorBus {
   // run out); returns the drives that did not get there.
   std::string walk_to(cia402::State goal);
   int slot_of(canid_t cob, canid_t base) const;
-  std::string prefix() const;
-  std::string describe(std::size_t device) const;
+  std::string prefix() const { return book_.prefix(); }
+  std::string describe(std::size_t device) const { return book_.describe(device); }
 
   BusConfig config_;
   Cia402BusOptions options_;
@@ -123,7 +124,7 @@ class Cia402Bus final : public ActuatorBus {
   std::chrono::microseconds timeout_;
   Nanos heartbeat_timeout_ns_;
 
-  std::vector<DeviceStatus> status_;
+  StatusBook book_;
   std::vector<DriveReport> drive_;
   std::vector<std::int32_t> actual_counts_;
   std::vector<std::int32_t> target_counts_;

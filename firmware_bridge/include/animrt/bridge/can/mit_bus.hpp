@@ -14,6 +14,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/can_transport.hpp"
+#include "animrt/bridge/status_book.hpp"
 
 namespace animrt {
 
@@ -38,7 +39,7 @@ class MitBus final : public ActuatorBus {
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return book_.devices(); }
 
   const CanFrameTransport& transport() const { return *transport_; }
   std::uint64_t foreign_frames() const { return foreign_frames_; }  // replies from ids not ours
@@ -50,8 +51,8 @@ class MitBus final : public ActuatorBus {
   // replies until each answered or the deadline passed; returns how many
   // motors did not answer.
   std::size_t exchange();
-  std::string prefix() const;
-  std::string describe(std::size_t device) const;
+  std::string prefix() const { return book_.prefix(); }
+  std::string describe(std::size_t device) const { return book_.describe(device); }
   std::string missing_list() const;
 
   BusConfig config_;
@@ -61,7 +62,7 @@ class MitBus final : public ActuatorBus {
   std::unique_ptr<CanFrameTransport> transport_;
   std::chrono::microseconds timeout_;
 
-  std::vector<DeviceStatus> status_;
+  StatusBook book_;
   std::vector<mit::Reply> reply_;
   std::vector<double> goal_motor_rad_;
   std::vector<can_frame> frames_;

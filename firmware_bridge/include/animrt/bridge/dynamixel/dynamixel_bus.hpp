@@ -4,13 +4,11 @@
 // read of the present positions (Fast Sync Read when the servos support it,
 // else Sync Read) and one Sync Write of the goals.
 //
-// Timeout: BusConfig::timeout_s is the wait allowed for ONE answer: from
-// sending the instruction to the first answer, and from each answer to the
-// next (a status packet of a Sync Read, a servo's slice of a Fast Sync Read
-// status packet). A transaction expecting N answers thus ends at the latest
-// N x timeout_s after its instruction, and twelve healthy servos cannot time
-// out a read because twelve answers take longer than one. A silent servo
-// costs one timeout_s (the wait after the last answer that came).
+// The transactions, the status book, the timeout (one timeout_s per answer:
+// a Sync Read of N servos may take N of them, a silent servo costs one) and
+// the ping rounds are the serial-servo core's (serial_servo/servo_link.hpp);
+// this class adds what X-series servos need beyond it: the model check,
+// Fast Sync Read, position limits in EEPROM and the Bus Watchdog.
 
 #include <array>
 #include <chrono>
@@ -23,9 +21,11 @@
 
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/byte_transport.hpp"
+#include "animrt/bridge/dynamixel/link_codec.hpp"
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/bridge/goal_window.hpp"
+#include "animrt/bridge/serial_servo/servo_positions.hpp"
 
 namespace animrt {
 
@@ -93,7 +93,7 @@ class DynamixelBus final : public ActuatorBus {
   void write(std::span<const double> positions) override;
   std::uint64_t watchdog_rearms() const { return watchdog_rearms_; }
 
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return link_.book().devices(); }
 
   // Where configure() looks for the USB adapter's latency timer (tests point
   // it at a fake tree); "/sys" by default.
@@ -115,72 +115,34 @@ class DynamixelBus final : public ActuatorBus {
   std::uint8_t firmware_version(std::size_t device) const { return firmware_[device]; }
 
  private:
-  using Deadline = std::chrono::steady_clock::time_point;
+  using Answer = servo::Answer;
 
-  // What became of one device's answer in a transaction.
-  enum class Answer : std::uint8_t {
-    pending,
-    ok,        // status packet with usable data (value_ holds it)
-    rejected,  // status packet with an error number or the wrong data length
-    timeout,   // nothing arrived
-    garbled,   // bad CRC, or junk / truncated / wrong-id packet and nothing better
-  };
-
-  // Sends tx_[0, length) and collects status packets for the devices in
-  // asked_[0, count) (ids in ids_) until each answered or the wait for the
-  // next answer (see Timeout at the top) ran out. Updates every counter; results land in answer_
-  // and value_.
-  void transact(std::size_t length, std::size_t count, std::size_t data_length, bool diagnostic);
-  // One device, one instruction; kTries attempts while nothing usable came.
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
-                 int tries = kTries, bool diagnostic = false);
-  // The same for one Fast Sync Read of asked_[0, count): one status packet
+                 int tries = kTries, bool diagnostic = false) {
+    return link_.unicast(device, length, data_length, tries, diagnostic);
+  }
+  // One Fast Sync Read of the link's slots [0, count): one status packet
   // with a slice per device, judged slice by slice.
   void transact_fast(std::size_t length, std::size_t count, std::size_t data_length);
   void choose_fast_read();
-  // Judges one status packet for slot `slot`.
-  void accept(std::size_t slot, const dxl::Packet& packet, std::size_t data_length,
-              bool diagnostic);
-  void accept(std::size_t slot, std::uint8_t error, std::span<const std::uint8_t> data,
-              std::size_t data_length, bool diagnostic);
-  void blame(std::size_t slot, bool crc);
-  // A status packet from the right id that cannot answer this instruction.
-  static bool stale(const dxl::Packet& packet, std::size_t data_length);
   void write_position_limits(std::size_t device);
   void clear_bus_watchdogs();
   void rearm_after_silence();
   // Bus Watchdog 0, then its time, to every servo in two broadcast writes.
   void broadcast_bus_watchdog();
-  // Pulls bytes until the decoder has something other than need_more.
-  dxl::DecodeResult next_event(dxl::Packet& packet, Deadline deadline);
   // Reads the hardware error register of devices whose alert just appeared.
   void read_pending_hardware_status();
   Answer write_register(std::size_t device, std::uint16_t address, std::uint32_t value,
                         std::uint16_t size, int tries);
-  std::int32_t goal_ticks(std::size_t device, double rad) const;
 
   // Why a lifecycle transaction failed; for `ok` the hardware error it carried.
   std::string failure(std::size_t device, Answer answer) const;
-  std::string prefix() const;                      // "bus legs (/dev/pts/4): "
-  std::string describe(std::size_t device) const;  // "id 5 (lf_ankle)"
+  std::string prefix() const { return link_.book().prefix(); }
+  std::string describe(std::size_t device) const { return link_.book().describe(device); }
 
   BusConfig config_;
-  std::unique_ptr<ByteTransport> transport_;
-  std::chrono::microseconds timeout_;
-
-  std::vector<DeviceStatus> status_;
-  std::array<std::int16_t, 256> device_of_id_ = filled_minus_one();  // bus id -> device
-  static std::array<std::int16_t, 256> filled_minus_one() {
-    std::array<std::int16_t, 256> a{};
-    a.fill(-1);
-    return a;
-  }
-  std::vector<std::int32_t> present_ticks_;   // latest known, per device
-  std::vector<std::int32_t> goal_ticks_;      // latest sent, per device
-  std::vector<GoalWindow> window_;            // the goals allowed now, per servo
-  std::vector<std::uint8_t> alert_seen_;      // alert bit in the latest status
-  std::vector<std::uint8_t> status_pending_;  // hardware error register to read
-  bool fresh_ = false;                        // configure() values not yet handed out
+  servo::Link<dxl::LinkCodec> link_;
+  servo::ServoPositions positions_;
   dxl::FastRead fast_mode_ = dxl::FastRead::automatic;
   bool fast_ = false;  // the cycle's read is a Fast Sync Read
   std::string sysfs_root_ = "/sys";
@@ -190,25 +152,13 @@ class DynamixelBus final : public ActuatorBus {
   std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set before the first cycle; 0: none
   std::chrono::nanoseconds watchdog_time_{0};
   bool armed_ = false;  // between arm_device_guard() and deactivate()
-  std::chrono::steady_clock::time_point last_sent_{};
   std::chrono::steady_clock::time_point last_answered_{};  // a valid answer to a cycle's read
   std::uint64_t watchdog_rearms_ = 0;
   std::vector<std::uint16_t> model_;  // from each device's Ping answer
   std::vector<std::uint8_t> firmware_;
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
 
-  // Per slot of the current transaction.
-  std::vector<std::uint8_t> ids_;
-  std::vector<std::size_t> asked_;
-  std::vector<Answer> answer_;
-  std::vector<std::uint8_t> suspect_;  // blamed for junk or a wrong id, still waited for
-  std::vector<std::uint32_t> value_;
   std::vector<std::uint8_t> sync_data_;
-
-  std::array<std::uint8_t, dxl::kMaxPacket> tx_{};
-  std::array<std::uint8_t, 256> rx_{};
-  std::size_t rx_begin_ = 0, rx_end_ = 0;
-  dxl::Decoder decoder_;
 };
 
 }  // namespace animrt

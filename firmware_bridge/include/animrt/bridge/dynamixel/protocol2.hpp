@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <span>
 
+#include "animrt/bridge/serial_servo/rx_buffer.hpp"
+
 namespace animrt::dxl {
 
 inline constexpr std::uint8_t kBroadcastId = 0xFE;
@@ -229,19 +231,16 @@ enum class DecodeResult : std::uint8_t {
 class Decoder {
  public:
   Decoder() = default;
-  void reset();
+  void reset() { rx_.reset(); }
   // Appends bytes; returns how many fitted (the rest must be fed again later).
-  std::size_t feed(std::span<const std::uint8_t> bytes);
+  std::size_t feed(std::span<const std::uint8_t> bytes) { return rx_.feed(bytes); }
   DecodeResult next(Packet& out);
-  std::uint64_t stray_bytes() const { return stray_bytes_; }
-  std::size_t buffered() const { return size_; }
+  std::uint64_t stray_bytes() const { return rx_.stray(); }
+  std::size_t buffered() const { return rx_.size(); }
 
  private:
-  void drop_front(std::size_t n);
-  std::uint8_t buffer_[2 * kMaxPacket]{};
+  servo::RxBuffer<2 * kMaxPacket> rx_;
   std::uint8_t unstuffed_[kMaxPacket]{};
-  std::size_t size_ = 0;
-  std::uint64_t stray_bytes_ = 0;
 };
 
 }  // namespace animrt::dxl

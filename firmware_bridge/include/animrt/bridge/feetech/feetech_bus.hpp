@@ -8,6 +8,9 @@
 // sensor, temperature, current, angle, overload); a non-zero byte counts as
 // a hardware error and shows as DeviceHealth::hardware_error, which the
 // runtime's watchdog faults. Its last value is kept in hardware_error_status.
+//
+// The transactions, the status book, the timeout (one timeout_s per answer)
+// and the ping rounds are the serial-servo core's (serial_servo/servo_link.hpp).
 
 #include <array>
 #include <chrono>
@@ -21,7 +24,9 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
+#include "animrt/bridge/feetech/link_codec.hpp"
 #include "animrt/bridge/goal_window.hpp"
+#include "animrt/bridge/serial_servo/servo_positions.hpp"
 
 namespace animrt {
 
@@ -59,69 +64,44 @@ class FeetechBus final : public ActuatorBus {
   // Torque off on every servo, best effort; never throws.
   void deactivate() override;
 
-  // One cycle; neither throws nor allocates. read() takes at most one
-  // timeout (STS) or one timeout per servo (SCS). Goals are clamped into the
+  // One cycle; neither throws nor allocates. read() waits at most one
+  // timeout per servo (one for each answer of the Sync Read, STS; one for
+  // each Read, SCS). Goals are clamped into the
   // joint limits and the servo's position range; NaN holds the last goal.
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
 
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return link_.book().devices(); }
   // The last configure()'s warning about joints resting outside their
   // limits, empty when none did.
   const std::string& outside_warning() const { return outside_warning_; }
 
  private:
-  using Deadline = std::chrono::steady_clock::time_point;
-  enum class Answer : std::uint8_t { pending, ok, timeout, garbled };
+  using Answer = servo::Answer;
 
-  // Sends tx_[0, length) and collects status packets for the servos in
-  // asked_[0, count) until each answered or the deadline passed.
-  void transact(std::size_t length, std::size_t count, std::size_t data_length);
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length,
-                 int tries = kTries);
+                 int tries = kTries) {
+    return link_.unicast(device, length, data_length, tries);
+  }
   Answer write_byte(std::size_t device, std::uint8_t address, std::uint8_t value);
   Answer write_goal(std::size_t device, std::int32_t ticks);
   void write_angle_limits(std::size_t device);
-  ft::DecodeResult next_event(ft::Packet& packet, Deadline deadline);
-  void accept(std::size_t slot, const ft::Packet& packet);
-  void blame(std::size_t slot, bool checksum);
   void read_positions(std::size_t count);
   std::int32_t to_position(std::uint16_t raw) const;
   std::uint16_t from_position(std::int32_t ticks) const;
-  std::int32_t goal_ticks(std::size_t device, double rad) const;
 
   std::string failure(std::size_t device, Answer answer) const;
-  std::string prefix() const;
-  std::string describe(std::size_t device) const;
+  std::string prefix() const { return link_.book().prefix(); }
+  std::string describe(std::size_t device) const { return link_.book().describe(device); }
 
   BusConfig config_;
   ft::Series series_;
-  std::unique_ptr<ByteTransport> transport_;
-  std::chrono::microseconds timeout_;
+  servo::Link<ft::LinkCodec> link_;
   std::int32_t min_ticks_, max_ticks_;  // position range of the series
 
-  std::vector<DeviceStatus> status_;
-  std::array<std::int16_t, 256> device_of_id_{};
-  std::vector<std::int32_t> present_ticks_;
-  std::vector<std::int32_t> goal_ticks_;
-  std::vector<GoalWindow> window_;  // the goals allowed now, per servo
+  servo::ServoPositions positions_;
   std::string outside_warning_;
-  bool fresh_ = false;
-
-  // Per slot of the current transaction.
-  std::vector<std::uint8_t> ids_;
-  std::vector<std::size_t> asked_;
-  std::vector<Answer> answer_;
-  std::vector<std::uint8_t> suspect_;
-  std::vector<std::uint16_t> value_;
   std::vector<std::uint8_t> sync_data_;
-
-  std::array<std::uint8_t, ft::kMaxPacket> tx_{};
-  std::size_t tx_length_ = 0;
-  std::array<std::uint8_t, 256> rx_{};
-  std::size_t rx_begin_ = 0, rx_end_ = 0;
-  bool late_read_done_ = false;  // the one read allowed past a transaction's deadline
-  ft::Decoder decoder_;
 };
 
 }  // namespace animrt

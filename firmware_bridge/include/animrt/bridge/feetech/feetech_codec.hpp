@@ -21,6 +21,8 @@
 #include <cstdint>
 #include <span>
 
+#include "animrt/bridge/serial_servo/rx_buffer.hpp"
+
 namespace animrt::ft {
 
 enum class Series : std::uint8_t { sts, scs };
@@ -150,19 +152,16 @@ enum class DecodeResult : std::uint8_t {
 // No allocation.
 class Decoder {
  public:
-  void reset() { size_ = 0; }
+  void reset() { rx_.reset(); }
   // Appends bytes; returns how many fitted.
-  std::size_t feed(std::span<const std::uint8_t> bytes);
+  std::size_t feed(std::span<const std::uint8_t> bytes) { return rx_.feed(bytes); }
   DecodeResult next(Packet& out);
-  std::uint64_t stray_bytes() const { return stray_bytes_; }
-  std::size_t buffered() const { return size_; }
+  std::uint64_t stray_bytes() const { return rx_.stray(); }
+  std::size_t buffered() const { return rx_.size(); }
 
  private:
-  void drop_front(std::size_t n);
-  std::uint8_t buffer_[2 * kMaxPacket]{};
+  servo::RxBuffer<2 * kMaxPacket> rx_;
   std::uint8_t packet_[kMaxPacket]{};
-  std::size_t size_ = 0;
-  std::uint64_t stray_bytes_ = 0;
 };
 
 }  // namespace animrt::ft

@@ -24,6 +24,7 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/byte_transport.hpp"
 #include "animrt/bridge/maestro/maestro_codec.hpp"
+#include "animrt/bridge/status_book.hpp"
 
 namespace animrt {
 
@@ -83,7 +84,7 @@ class MaestroBus final : public ActuatorBus {
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return book_.devices(); }
 
   // The last error register read from each board, by board index.
   std::uint16_t board_errors(std::size_t board) const { return boards_[board].last_errors; }
@@ -103,7 +104,7 @@ class MaestroBus final : public ActuatorBus {
   std::size_t receive(std::size_t want, std::chrono::microseconds timeout);
   void send(std::size_t length);
   std::uint16_t target_of(std::size_t device, double rad) const;
-  std::string prefix() const;
+  std::string prefix() const { return book_.prefix(); }
 
   BusConfig config_;
   MaestroBusOptions options_;
@@ -111,7 +112,7 @@ class MaestroBus final : public ActuatorBus {
   std::chrono::microseconds timeout_;
   std::vector<MaestroChannelOptions> channels_;  // per device
   std::vector<Board> boards_;
-  std::vector<DeviceStatus> status_;
+  StatusBook book_;
   std::vector<std::uint16_t> present_;  // quarter-us, latest known
   std::vector<std::uint16_t> goal_;     // quarter-us, latest sent
   std::vector<std::uint8_t> answered_;  // scratch, per device

@@ -31,6 +31,7 @@
 
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/bridge/modbus/register_map.hpp"
+#include "animrt/bridge/status_book.hpp"
 
 struct _modbus;
 
@@ -76,7 +77,7 @@ class ModbusBus final : public ActuatorBus {
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
-  std::span<DeviceStatus> devices() override { return status_; }
+  std::span<DeviceStatus> devices() override { return book_.devices(); }
 
   std::uint64_t reconnects() const { return reconnects_; }
   bool connected() const { return connected_; }
@@ -114,13 +115,13 @@ class ModbusBus final : public ActuatorBus {
   const std::uint16_t* words_of(const Slave& slave, const modbus::Register& r) const;
   bool write_slave(Slave& slave);
   bool set_enable(Slave& slave, bool on, int* error);
-  std::string prefix() const;
+  std::string prefix() const { return book_.prefix(); }
 
   BusConfig config_;
   ModbusBusOptions options_;
   std::vector<ModbusJointOptions> joints_;
   std::vector<Slave> slaves_;
-  std::vector<DeviceStatus> status_;
+  StatusBook book_;
   std::vector<double> present_rad_;
   std::vector<double> goal_rad_;
   std::vector<std::uint8_t> answered_;

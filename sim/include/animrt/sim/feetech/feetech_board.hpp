@@ -31,6 +31,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
 
@@ -81,10 +82,7 @@ class FeetechServo {
   double position_rad(Nanos now) const;
 
  private:
-  struct Motor {
-    double position = 0;  // steps
-    double velocity = 0;  // steps/s
-  };
+  using Motor = ServoMotor;  // steps, steps/s
   Motor motor_at(Nanos now) const;
   void publish();
   std::int32_t position_value(std::uint8_t address) const;

@@ -27,6 +27,7 @@
 #include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/feetech/feetech_board.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
+#include "animrt/sim/serial_line.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -65,7 +66,6 @@ class FeetechSimBus final : public SimulatedBus {
 
  private:
   void serve();
-  void process(std::span<const std::uint8_t> bytes, Nanos arrival);
   void handle(const ft::Packet& packet, Nanos arrival);
   void send(std::span<const std::uint8_t> bytes);
   Nanos wire_ns(std::size_t bytes) const;
@@ -90,8 +90,7 @@ class FeetechSimBus final : public SimulatedBus {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> packets_{0};
   std::atomic<std::uint64_t> answers_sent_{0};
-  std::atomic<std::uint64_t> bad_checksums_{0};
-  std::atomic<std::uint64_t> malformed_{0};
+  line::DecodeCounts decode_counts_;
   std::atomic<std::uint64_t> dropped_partial_{0};
 };
 
