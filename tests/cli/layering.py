@@ -47,6 +47,8 @@ def layer_of(rel):
         return "sim"
     if rel.startswith("runtime/cli/"):
         return None  # the executables link whatever they run
+    if rel.startswith("runtime/herd/"):
+        return "runtime_herd"  # animrt_runtime_herd: a figure steered by a herd
     if rel.startswith("runtime/"):
         return "runtime_front_end" if rel in RUNTIME_FRONT_ENDS else "runtime"
     return None
@@ -60,11 +62,14 @@ ALLOWED = {
     "play": ({"core", "controllers"}, set()),
     "learn": ({"core", "controllers", "learn"}, set()),
     "learn_physics": ({"core", "controllers", "learn", "sim"}, set()),
-    # sim/mujoco poses a figure for the runtime behind an interface the
-    # runtime declares (a header only; sim does not link the runtime).
-    "sim": ({"core", "bridge", "sim", "controllers"}, {"animrt/runtime/figure_kinematics.hpp"}),
+    # sim implements two interfaces the runtime declares: posing a figure
+    # (sim/mujoco) and standing behind a figure as its backend (the builder
+    # runs a figure on it). Headers only; the runtime never includes sim.
+    "sim": ({"core", "bridge", "sim", "controllers"},
+            {"animrt/runtime/figure_kinematics.hpp", "animrt/runtime/figure_backend.hpp"}),
     "runtime": ({"core", "bridge", "controllers", "runtime"}, set()),
     "runtime_front_end": ({"core", "bridge", "controllers", "runtime", "learn"}, set()),
+    "runtime_herd": ({"core", "bridge", "controllers", "runtime"}, set()),
 }
 
 # Header paths a rule set may not include even inside an allowed folder.
