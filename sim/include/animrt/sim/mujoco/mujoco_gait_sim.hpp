@@ -4,7 +4,7 @@
 // (feet on the floor), settles, then plays the gait through the position
 // actuators: warm-up cycles, then measured cycles. A gait with `balance:`
 // walks with its balance reflex added to the curves (legs on the ground
-// stretched against the trunk's roll and pitch; gait_file.hpp).
+// stretched against the trunk's roll and pitch; balance_reflex.hpp).
 //
 // Measures: forward (+x) speed of the torso, stride length from successive
 // landings of each foot (first to last, per stride period), duty factor from foot contacts, energy
