@@ -1,14 +1,15 @@
 // The head MotionSource: a worker thread streams audio through the
-// synthesizer at real time and publishes poses into a preallocated ring;
-// sample() only reads the ring (no allocation, no lock, no I/O).
+// synthesizer as it "arrives" on the run's clock and publishes poses into a
+// preallocated ring; sample() only reads the ring (no allocation, no lock,
+// no I/O; in lockstep it waits for the blocks due by the run's clock).
 
 #include "animrt/controllers/head/head_source.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -18,11 +19,7 @@
 namespace animrt::head {
 namespace {
 
-std::int64_t now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
-}
+constexpr Nanos kNever = std::numeric_limits<Nanos>::max();
 
 struct Drive {
   int joint = -1;
@@ -75,17 +72,25 @@ class HeadSource final : public MotionSource {
     }
   }
 
-  ~HeadSource() override {
+  ~HeadSource() override { stop(); }
+
+  std::span<const int> driven_joints() const override { return driven_; }
+
+  void start(const MotionClock& clock) override {
+    if (clock.clock == nullptr || started_.load(std::memory_order_relaxed)) return;
+    clock_ = clock;
+    // Live capture follows the microphone, whatever the run's clock.
+    waits_ = clock.lockstep && worker_.joinable() && config_.capture.empty();
+    started_.store(true, std::memory_order_release);
+  }
+
+  void stop() override {
     stop_.store(true);
     if (worker_.joinable()) worker_.join();
   }
 
-  std::span<const int> driven_joints() const override { return driven_; }
-
   void sample(double t, std::span<double> targets) const override {
-    if (t > 0 && start_ns_.load(std::memory_order_relaxed) == 0) {
-      start_ns_.store(now_ns() - static_cast<std::int64_t>(t * 1e9), std::memory_order_release);
-    }
+    if (waits_) await_stream();
     double pose[4] = {0, 0, 0, 0};  // yaw, pitch, roll, energy
     const double audio_t = t - latency_s_;
     const std::uint64_t written = written_.load(std::memory_order_acquire);
@@ -120,6 +125,37 @@ class HeadSource final : public MotionSource {
     std::atomic<double> v[4];
   };
 
+  // Lockstep: every block due by the run's clock is in the ring before a
+  // pose is read, so the pose depends on the simulated time alone. The
+  // worker ends with seen_ = kNever, so this never outwaits it.
+  void await_stream() const {
+    const Nanos now = clock_.clock->now();
+    for (int spins = 0; seen_.load(std::memory_order_acquire) < now; ++spins) {
+      if (spins < 64) {
+        std::this_thread::yield();
+      } else {
+        std::this_thread::sleep_for(std::chrono::microseconds(20));
+      }
+    }
+  }
+
+  // Until the run's clock reaches `due`; false when stopping. A lockstep
+  // clock moves only when the run steps it: while it stands, every block
+  // due by it has been fed, which seen_ tells sample().
+  bool wait_until(Nanos due) {
+    for (;;) {
+      if (stop_.load()) return false;
+      const Nanos now = clock_.clock->now();
+      if (now >= due) return true;
+      if (clock_.lockstep) {
+        seen_.store(now, std::memory_order_release);
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+      } else {
+        std::this_thread::sleep_for(std::chrono::nanoseconds(due - now));
+      }
+    }
+  }
+
   void store(std::size_t i, const StreamPose& p) {
     Slot& s = ring_[i % ring_.size()];
     s.v[0].store(p.pose.yaw, std::memory_order_relaxed);
@@ -129,9 +165,14 @@ class HeadSource final : public MotionSource {
   }
 
   // Worker: waits for the motion to start, then feeds one block per block
-  // period (audio "arrives" in real time), playing it to ALSA when asked.
+  // period of the run's clock (audio "arrives" as the motion's time passes),
+  // playing it to ALSA when asked.
   void run() {
-    while (!stop_.load() && start_ns_.load(std::memory_order_acquire) == 0) {
+    struct Done {
+      std::atomic<Nanos>& seen;
+      ~Done() { seen.store(kNever, std::memory_order_release); }
+    } done{seen_};
+    while (!stop_.load() && !started_.load(std::memory_order_acquire)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     if (stop_.load()) return;
@@ -155,7 +196,7 @@ class HeadSource final : public MotionSource {
     StreamingSynthesizer stream(model_, stream_options_);
     std::vector<StreamPose> out;
     std::vector<float> block(block_);
-    const std::int64_t start = start_ns_.load();
+    const Nanos start = clock_.start;
     std::uint64_t fed = 0, next = 0;
     std::size_t pos = 0;
     while (!stop_.load()) {
@@ -171,11 +212,9 @@ class HeadSource final : public MotionSource {
         std::fill(block.begin() + static_cast<std::ptrdiff_t>(n), block.end(), 0.0f);
         pos += n;
         // This block has "arrived" once its last sample has been spoken.
-        const std::int64_t due =
-            start +
-            static_cast<std::int64_t>(static_cast<double>(fed + block_) * 1e9 / audio_.sample_rate);
-        timespec ts{static_cast<time_t>(due / 1000000000LL), static_cast<long>(due % 1000000000LL)};
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+        const Nanos due = start + static_cast<Nanos>(static_cast<double>(fed + block_) * 1e9 /
+                                                     audio_.sample_rate);
+        if (!wait_until(due)) break;
         if (playback) playback->write(block);
       }
       fed += block_;
@@ -205,7 +244,12 @@ class HeadSource final : public MotionSource {
   double latency_s_ = 0, rate_ = 120;
   std::vector<Slot> ring_;
   std::atomic<std::uint64_t> written_{0};
-  mutable std::atomic<std::int64_t> start_ns_{0};
+  // The run's clock from start() on (written before started_, read by the
+  // worker after it); waits_: sample() waits for the stream (lockstep).
+  MotionClock clock_;
+  bool waits_ = false;
+  std::atomic<bool> started_{false};
+  std::atomic<Nanos> seen_{0};  // lockstep: the clock time every due block is fed by
   std::atomic<bool> stop_{false};
   std::thread worker_;
 };

@@ -215,6 +215,12 @@ class LayeredSource final : public MotionSource {
   void control(const ShowCommand& command, double t) override {
     for (const auto& l : layers_) l->control(command, t);
   }
+  void start(const MotionClock& clock) override {
+    for (const auto& l : layers_) l->start(clock);
+  }
+  void stop() override {
+    for (const auto& l : layers_) l->stop();
+  }
   // The first show layer's playhead (every show layer gets the same commands).
   ShowPosition show_position(double t) const override {
     for (const auto& l : layers_) {

@@ -160,6 +160,12 @@ RunSummary Runner::run(const RunOptions& options) {
   const Clock& clock = options.lockstep_clock ? static_cast<const Clock&>(*options.lockstep_clock)
                                               : static_cast<const Clock&>(wall);
   const Nanos period = model.period;
+  // The motion reads the run's clock from its start on; whatever ends the
+  // run, it lets go of it here, before the clock can go.
+  struct MotionClockRelease {
+    MotionSource& motion;
+    ~MotionClockRelease() { motion.stop(); }
+  } motion_clock_release{*m.motion};
 
   RunSummary summary;
   summary.robot = m.config.name;
@@ -378,8 +384,9 @@ RunSummary Runner::run(const RunOptions& options) {
       options.on_show_command(show, in.t - state.motion_start());
     }
     for (const CycleEvent& e : out.events) {
-      if (e.kind == EventKind::motion_started && options.on_motion_start) {
-        options.on_motion_start(deadline);
+      if (e.kind == EventKind::motion_started) {
+        m.motion->start(MotionClock{&clock, deadline, options.lockstep_clock != nullptr});
+        if (options.on_motion_start) options.on_motion_start(deadline);
       }
       if (e.kind == EventKind::motion_ended && options.on_motion_end) options.on_motion_end();
     }

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "animrt/controllers/gait/balance_reflex.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
@@ -27,15 +28,14 @@ int root_qpos(const mjModel* m, int torso) {
   return (j >= 0 && m->jnt_type[j] == mjJNT_FREE) ? m->jnt_qposadr[j] : -1;
 }
 
-// The gait file's balance reflex (GaitBalance): each leg on the ground is
-// lengthened along the trunk's vertical by tilt_m * d + tilt_rate_m_s * d',
-// d being how far its side (roll) or end (pitch) of the trunk is down. A
-// leg's stretch goes to its joints through the foot's Jacobian (least-norm
-// joint change), so it needs no knowledge of how the leg is built.
+// The gait's balance reflex (balance_reflex.hpp) on the physics: measures
+// the trunk's tilt and which feet touch something, and turns each leg's
+// stretch into actuator targets through the foot's Jacobian along the
+// trunk's vertical.
 class LegBalance {
  public:
   LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains)
-      : mm_(mm), gains_(gains), jacp_(3 * static_cast<std::size_t>(mm.model->nv)) {
+      : mm_(mm), reflex_(gains), jacp_(3 * static_cast<std::size_t>(mm.model->nv)) {
     const mjModel* m = mm.model.get();
     const double* r = d->xmat + 9 * mm.torso_body;  // row-major: world = r * body
     const double* c = d->xpos + 3 * mm.torso_body;
@@ -44,8 +44,8 @@ class LegBalance {
       leg.geom = g;
       const double w[3] = {d->geom_xpos[3 * g] - c[0], d->geom_xpos[3 * g + 1] - c[1],
                            d->geom_xpos[3 * g + 2] - c[2]};
-      leg.front = (r[0] * w[0] + r[3] * w[1] + r[6] * w[2]) > 0 ? 1.0 : -1.0;
-      leg.left = (r[1] * w[0] + r[4] * w[1] + r[7] * w[2]) > 0 ? 1.0 : -1.0;
+      leg.where.front = (r[0] * w[0] + r[3] * w[1] + r[6] * w[2]) > 0 ? 1.0 : -1.0;
+      leg.where.left = (r[1] * w[0] + r[4] * w[1] + r[7] * w[2]) > 0 ? 1.0 : -1.0;
       for (int b = m->geom_bodyid[g]; b > 0 && b != mm.torso_body; b = m->body_parentid[b]) {
         for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j) {
           const char* name = mj_id2name(m, mjOBJ_JOINT, j);
@@ -62,42 +62,28 @@ class LegBalance {
     const mjModel* m = mm_.model.get();
     const int nv = m->nv;
     const double* r = d->xmat + 9 * mm_.torso_body;
-    // World z of the trunk's forward and left axes: the sines of the nose
-    // and the left side being up.
-    const double nose_up = r[6], left_up = r[7];
-    const double nose_rate = started_ ? (nose_up - last_nose_) / dt : 0.0;
-    const double left_rate = started_ ? (left_up - last_left_) / dt : 0.0;
-    started_ = true;
-    last_nose_ = nose_up;
-    last_left_ = left_up;
+    // World z of the trunk's forward and left axes.
+    reflex_.update(TrunkTilt{r[6], r[7]}, dt);
     for (const Leg& leg : legs_) {
-      // Only a leg on the ground holds the trunk up; a swing leg stretched
-      // would stub its foot (measured: the seed walk then falls 2 to 8 of 10).
-      if (!on_ground(d, leg.geom)) continue;
-      // This leg's end of the trunk is down by -(sine of it being up).
-      const double down = -(leg.front * nose_up + leg.left * left_up);
-      const double down_rate = -(leg.front * nose_rate + leg.left * left_rate);
-      const double stretch = std::clamp(gains_.tilt_m * down + gains_.tilt_rate_m_s * down_rate,
-                                        -kMaxBalanceStretchM, kMaxBalanceStretchM);
+      const bool on_ground = touches(d, leg.geom);
+      if (!on_ground) continue;
+      const double stretch = reflex_.stretch(leg.where, on_ground);
       mj_jac(m, d, jacp_.data(), nullptr, d->geom_xpos + 3 * leg.geom, m->geom_bodyid[leg.geom]);
       // How far the foot moves down the trunk's vertical per radian of each joint.
-      double norm = 0.0;
       down_per_rad_.assign(leg.actuators.size(), 0.0);
       for (std::size_t i = 0; i < leg.actuators.size(); ++i) {
         const int dof = mm_.actuator_dof[static_cast<std::size_t>(leg.actuators[i])];
         down_per_rad_[i] =
             -(r[2] * jacp_[dof] + r[5] * jacp_[nv + dof] + r[8] * jacp_[2 * nv + dof]);
-        norm += down_per_rad_[i] * down_per_rad_[i];
       }
-      if (norm < 1e-12) continue;
-      for (std::size_t i = 0; i < leg.actuators.size(); ++i) {
-        d->ctrl[leg.actuators[i]] += down_per_rad_[i] * stretch / norm;
-      }
+      delta_.assign(leg.actuators.size(), 0.0);
+      if (!leg_stretch_to_joints(stretch, down_per_rad_, delta_)) continue;
+      for (std::size_t i = 0; i < leg.actuators.size(); ++i) d->ctrl[leg.actuators[i]] += delta_[i];
     }
   }
 
  private:
-  static bool on_ground(const mjData* d, int geom) {
+  static bool touches(const mjData* d, int geom) {
     for (int c = 0; c < d->ncon; ++c) {
       if (d->contact[c].geom1 == geom || d->contact[c].geom2 == geom) return true;
     }
@@ -105,16 +91,15 @@ class LegBalance {
   }
   struct Leg {
     int geom = -1;
-    double front = 1.0, left = 1.0;  // +1 front / left of the trunk's centre, -1 behind / right
-    std::vector<int> actuators;      // of the joints between the trunk and the foot
+    BalanceLeg where;
+    std::vector<int> actuators;  // of the joints between the trunk and the foot
   };
   const MujocoModel& mm_;
-  GaitBalance gains_;
+  BalanceReflex reflex_;
   std::vector<Leg> legs_;
   std::vector<double> jacp_;
   std::vector<double> down_per_rad_;
-  bool started_ = false;
-  double last_nose_ = 0.0, last_left_ = 0.0;
+  std::vector<double> delta_;
 };
 
 }  // namespace

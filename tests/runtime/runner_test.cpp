@@ -257,6 +257,64 @@ TEST(Runner, OnTheWallClockALateBusNeverReceivesAJump) {
 
 // A record that could not be written is exit 6 and its own summary line;
 // what happened to the figure (a fault, a torque cut) comes first.
+// Records the clock the run hands over and what it read on it.
+class ClockedSource final : public SineSource {
+ public:
+  explicit ClockedSource(std::size_t n) : SineSource(n) {}
+  void start(const MotionClock& clock) override {
+    ++starts;
+    given = clock;
+  }
+  void stop() override { ++stops; }
+  void sample(double t, std::span<double> targets) const override {
+    if (starts > 0 && stops == 0 && first_t < 0 && t > 0) {
+      first_t = t;
+      clock_then = given.clock->now();
+    }
+    SineSource::sample(t, targets);
+  }
+  int starts = 0, stops = 0;
+  MotionClock given;
+  mutable double first_t = -1.0;
+  mutable Nanos clock_then = -1;
+};
+
+TEST(Runner, TheMotionReadsTheRunsClockFromItsStartAndLetsGoOfItOnEveryWayOut) {
+  for (const bool throws : {false, true}) {
+    auto source = std::make_unique<ClockedSource>(4);
+    ClockedSource* clocked = source.get();
+    std::vector<std::unique_ptr<ActuatorBus>> buses;
+    buses.push_back(std::make_unique<FakeBus>("a", std::vector<int>{0, 1, 2, 3}));
+    RobotConfig config = two_bus_config();
+    Runner runner(config, std::move(buses), std::move(source));
+    ManualClock clock(5'000'000'000);
+    RunOptions o;
+    o.duration_s = 0.5;
+    o.lockstep_clock = &clock;
+    Nanos t0 = -1;
+    o.on_motion_start = [&](Nanos t) {
+      t0 = t;
+      if (throws) throw std::runtime_error("sound card gone");
+    };
+    if (throws) {
+      EXPECT_THROW(runner.run(o), std::runtime_error);
+    } else {
+      runner.run(o);
+    }
+    EXPECT_EQ(clocked->starts, 1) << throws;
+    EXPECT_EQ(clocked->given.clock, &clock);
+    EXPECT_TRUE(clocked->given.lockstep);
+    EXPECT_EQ(clocked->given.start, t0);  // the motion's t = 0 on the run's clock
+    EXPECT_GT(t0, Nanos{5'000'000'000});  // after the start ramp
+    EXPECT_EQ(clocked->stops, 1) << throws;
+    if (!throws) {
+      // The clock read in a sample is the motion's start plus the sample's t.
+      ASSERT_GT(clocked->first_t, 0.0);
+      EXPECT_EQ(clocked->clock_then, t0 + from_seconds(clocked->first_t));
+    }
+  }
+}
+
 TEST(RunSummary, ALostRecordIsExitSixUnlessTheFigureFaredWorse) {
   RunSummary s;
   s.telemetry_file = "/dev/full";

@@ -165,6 +165,40 @@ TEST(Show, LayersPassTheTransportToTheirShows) {
   EXPECT_EQ(now, at_half);
 }
 
+// A layer that counts the clock handovers it gets.
+class ClockCounter final : public MotionSource {
+ public:
+  std::span<const int> driven_joints() const override { return {}; }
+  void sample(double, std::span<double>) const override {}
+  void start(const MotionClock& clock) override {
+    ++starts;
+    start_ns = clock.start;
+  }
+  void stop() override { ++stops; }
+  int starts = 0, stops = 0;
+  Nanos start_ns = -1;
+};
+
+TEST(Show, LayersPassTheRunsClockToEveryLayer) {
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  auto a = std::make_unique<ClockCounter>();
+  auto b = std::make_unique<ClockCounter>();
+  ClockCounter* pa = a.get();
+  ClockCounter* pb = b.get();
+  layers.push_back(std::move(a));
+  layers.push_back(load_show_source(write("d.yaml", kShow), joints()));
+  layers.push_back(std::move(b));
+  auto s = make_layered_source(std::move(layers));
+  const ManualClock clock(7);
+  s->start(MotionClock{&clock, 42, true});
+  s->stop();
+  for (const ClockCounter* c : {pa, pb}) {
+    EXPECT_EQ(c->starts, 1);
+    EXPECT_EQ(c->start_ns, 42);
+    EXPECT_EQ(c->stops, 1);
+  }
+}
+
 TEST(Show, SampleDoesNotAllocate) {
   auto s = load_show_source(write("show.yaml", kShow), joints());
   std::vector<double> targets(3);

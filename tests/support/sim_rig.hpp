@@ -41,6 +41,8 @@ class ProbeSource final : public MotionSource {
   }
   void control(const ShowCommand& command, double t) override { inner_->control(command, t); }
   ShowPosition show_position(double t) const override { return inner_->show_position(t); }
+  void start(const MotionClock& clock) override { inner_->start(clock); }
+  void stop() override { inner_->stop(); }
   std::function<void(double)> on_sample;
 
  private:

@@ -1,11 +1,15 @@
 #pragma once
 // A motion source turns time into joint targets. sample() runs inside the
-// real-time cycle: it must not allocate, lock, log or do I/O.
+// real-time cycle: it must not allocate, lock, log or do I/O. It reads only
+// the time it is given, never a clock of its own, so a lockstep run plays
+// the same motion however fast the machine is.
 
 #include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
+
+#include "animrt/core/clock.hpp"
 
 namespace animrt {
 
@@ -35,6 +39,14 @@ struct ShowPosition {
   double duration_s = 0.0;
 };
 
+// The run's clock, handed to a source when its motion starts: CLOCK_MONOTONIC
+// in a real-time run, the simulated clock in a lockstep run.
+struct MotionClock {
+  const Clock* clock = nullptr;
+  Nanos start = 0;        // the motion's t = 0 on that clock
+  bool lockstep = false;  // the clock moves only when the run steps it
+};
+
 class MotionSource {
  public:
   virtual ~MotionSource() = default;
@@ -44,9 +56,9 @@ class MotionSource {
 
   // Writes targets (rad, or m for a prismatic joint) for the driven joints
   // into `targets`, which is indexed by robot joint index and has one entry
-  // per robot joint. Entries
-  // of joints it does not drive are left untouched. `t` is seconds since the
-  // motion started (t = 0 is the pose the start ramp goes to).
+  // per robot joint. Entries of joints it does not drive are left untouched.
+  // `t` is seconds since the motion started (t = 0 is the pose the start
+  // ramp goes to).
   virtual void sample(double t, std::span<double> targets) const = 0;
 
   // The newest steering command, handed over by the cycle before sample()
@@ -62,6 +74,19 @@ class MotionSource {
   // rules as sample().
   virtual void control(const ShowCommand& /*command*/, double /*t*/) {}
   virtual ShowPosition show_position(double /*t*/) const { return {}; }
+
+  // The motion starts (called by the cycle's shell right after the cycle
+  // that sampled t = 0; same rules as sample()). A source whose work runs
+  // outside the cycle (a head's speech stream on a worker thread) paces that
+  // work on this clock and on no other, so that in a lockstep run it follows
+  // the simulated time; there sample(t) may wait until the work due by the
+  // clock's time is done, as the run waits for a lockstep bus. A source
+  // plays in one run.
+  virtual void start(const MotionClock& /*clock*/) {}
+
+  // The run is over (called outside the cycle, on every way out of the run):
+  // the clock handed to start() is read no more, it may be gone.
+  virtual void stop() {}
 };
 
 }  // namespace animrt

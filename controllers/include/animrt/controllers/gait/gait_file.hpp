@@ -57,9 +57,10 @@ constexpr double kMaxBalanceStretchM = 0.1;
 //   tilt_m * d + tilt_rate_m_s * d'
 // where d is how far its side or end of the trunk is down (the sine of the
 // roll for left and right, of the pitch for front and back) and d' its rate,
-// so the low side is pushed back up and a swaying trunk is damped. It needs
-// the trunk's attitude, which the fitness walk and `gait measure` read from
-// the physics; the runtime has no attitude input yet and refuses such a gait.
+// so the low side is pushed back up and a swaying trunk is damped. The law
+// is BalanceReflex (balance_reflex.hpp). It needs the trunk's attitude, which
+// the fitness walk and `gait measure` read from the physics; the runtime has
+// no attitude input yet and refuses such a gait.
 struct GaitBalance {
   double tilt_m = 0.0;         // m of leg length per unit of tilt sine
   double tilt_rate_m_s = 0.0;  // m of leg length per unit of tilt sine per second

@@ -1,6 +1,6 @@
 #pragma once
-// The head as a MotionSource: speech (a bundled WAV played at real time, or
-// live ALSA capture) goes through the streaming synthesizer in blocks; the
+// The head as a MotionSource: speech (a bundled WAV played as the run's
+// clock passes, or live ALSA capture) goes through the streaming synthesizer in blocks; the
 // Euler angles drive the neck joints (axis mapping, signs, scale, offsets,
 // clamped to the joint limits) and the speech energy opens the jaw.
 //
@@ -8,7 +8,10 @@
 // latency_s is the synthesizer's worst-case latency plus one block. When a
 // file is played, its sound is delayed by the same amount, so what is heard
 // and what moves stay in step; with live capture the head trails the voice
-// by latency_s.
+// by latency_s. A file's blocks "arrive" on the run's clock
+// (MotionSource::start): in a lockstep run on the simulated time, and
+// sample(t) waits for the blocks due by then, so the head moves the same
+// however fast the machine runs.
 //
 // Robot file (motion section), see docs/head.md:
 //   motion:

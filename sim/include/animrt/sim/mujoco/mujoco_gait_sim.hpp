@@ -1,16 +1,17 @@
 #pragma once
 // The evolver's GaitSimulator on MuJoCo: one mjData per simulator over a
-// shared read-only model. A walk starts standing in the gait's first pose
-// (feet on the floor), settles, then plays the gait through the position
-// actuators: warm-up cycles, then measured cycles. A gait with `balance:`
+// shared read-only model. A walk starts standing in the gait's mean pose
+// over a stride (feet on the floor), settles, then plays the gait through
+// the position actuators, blended in over the first cycle: warm-up cycles,
+// then measured cycles. A gait with `balance:`
 // walks with its balance reflex added to the curves (legs on the ground
-// stretched against the trunk's roll and pitch; gait_file.hpp).
+// stretched against the trunk's roll and pitch; balance_reflex.hpp).
 //
 // Measures: forward (+x) speed of the torso, stride length from successive
 // landings of each foot (first to last, per stride period), duty factor from foot contacts, energy
 // as sum |actuator force x velocity| dt per cycle. The walk counts as a fall (and stops) when the
-// torso drops below half its standing height, tilts more than 60 degrees, or the physics goes
-// unstable.
+// torso drops below half its standing height, tilts more than 60 degrees, touches the
+// floor, or the physics goes unstable (has_fallen).
 
 #include <memory>
 
