@@ -119,7 +119,7 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
 }
 
 GaitCalibration load_gait_calibration(const std::string& path) {
-  return parse_gait_calibration(read_input_file(path), path);
+  return parse_gait_calibration(read_input_file(path, kMaxYamlFileBytes), path);
 }
 
 void check_calibration_references(const GaitCalibration& cal, const std::string& calibration_path,

@@ -572,7 +572,7 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
 }
 
 GaitFile load_gait_file(const std::string& path) {
-  return parse_gait_file(read_input_file(path), path);
+  return parse_gait_file(read_input_file(path, kMaxYamlFileBytes), path);
 }
 
 void validate_gait(const GaitFile& gait) {
