@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <stdexcept>
 
+#include "animrt/core/error.hpp"
+
 namespace animrt::sim {
 namespace {
 
@@ -29,7 +31,7 @@ void sleep_until_monotonic(Nanos t) {
 FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock)
     : config_(config),
       clock_(clock),
-      pty_("simulated bus '" + config.name + "'"),
+      pty_("simulated bus '" + elide(config.name) + "'"),
       board_(config, series, clock.now()),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
@@ -158,7 +160,7 @@ FeetechServo& FeetechSimBus::servo(int device_id) {
   FeetechServo* s = board_.find_configured(device_id);
   if (s == nullptr) {
     throw std::out_of_range("no device " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   }
   return *s;
 }

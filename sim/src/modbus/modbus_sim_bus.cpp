@@ -102,7 +102,7 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
         static_cast<unsigned>(n(hold_lo, hold_hi)),
         static_cast<unsigned>(n(in_lo, in_hi) ? in_lo : 0), static_cast<unsigned>(n(in_lo, in_hi)));
     if (d.mapping == nullptr)
-      throw DeviceError("simulated bus '" + config_.name + "': modbus mapping");
+      throw DeviceError("simulated bus '" + elide(config_.name) + "': modbus mapping");
     for (Joint& j : d.joints) {
       const modbus::RegisterMap& m = *j.options.map;
       j.options.map->goal.encode(
@@ -137,17 +137,18 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
       const int error = errno;
       if (listen_fd_ >= 0) ::close(listen_fd_);
       if (ctx_) modbus_free(ctx_);
-      throw DeviceError("simulated bus '" + config_.name +
+      throw DeviceError("simulated bus '" + elide(config_.name) +
                         "': cannot listen on 127.0.0.1: " + std::strerror(error));
     }
     endpoint_ = "127.0.0.1:" + std::to_string(ntohs(addr.sin_port));
   } else {
-    pty_ = std::make_unique<PtyPair>("simulated bus '" + config_.name + "'");
+    pty_ = std::make_unique<PtyPair>("simulated bus '" + elide(config_.name) + "'");
     endpoint_ = pty_->path();
     ctx_ = modbus_new_rtu("/dev/null", std::max(config_.baud, 300), 'N', 8, 1);
     if (ctx_) modbus_set_socket(ctx_, pty_->master());
   }
-  if (ctx_ == nullptr) throw DeviceError("simulated bus '" + config_.name + "': libmodbus context");
+  if (ctx_ == nullptr)
+    throw DeviceError("simulated bus '" + elide(config_.name) + "': libmodbus context");
 }
 
 ModbusSimBus::~ModbusSimBus() {
@@ -432,7 +433,7 @@ void ModbusSimBus::set_device_responding(int device_id, bool responding) {
   Drive* d = drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   d->responding = responding;
 }
 
@@ -441,7 +442,7 @@ void ModbusSimBus::set_device_hardware_error(int device_id, std::uint8_t error_b
   Drive* d = drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   advance(*d, clock_.now());
   d->faults = static_cast<std::uint16_t>(d->faults | error_bits);
   publish(*d);
@@ -453,7 +454,7 @@ double ModbusSimBus::device_position(int device_id) const {
   Drive* d = self->drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   self->advance(*d, clock_.now());
   return d->joints.front().position;
 }
