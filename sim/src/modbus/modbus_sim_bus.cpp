@@ -50,6 +50,11 @@ struct ModbusSimBus::Drive {
   std::uint16_t faults = 0;
   bool enabled = false;
   Nanos time = 0;
+  // The communication timeout: the register (if a map names one), the time
+  // it allows (0: off) and when the drive last heard a request.
+  const modbus::Watchdog* watchdog = nullptr;
+  Nanos guard = 0;
+  Nanos last_request = 0;
   ~Drive() {
     if (mapping) modbus_mapping_free(mapping);
   }
@@ -69,6 +74,7 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
       d->slave = o.slave;
       d->time = now;
     }
+    if (o.map->watchdog.configured && d->watchdog == nullptr) d->watchdog = &o.map->watchdog;
     Joint j;
     j.binding = &b;
     j.options = o;
@@ -191,14 +197,32 @@ ModbusSimBus::Drive* ModbusSimBus::drive(int slave) {
 void ModbusSimBus::advance(Drive& d, Nanos now) {
   const double tau = config_.sim.time_constant_s;
   const double vmax = config_.sim.max_speed_rad_s;
-  for (; d.time + kStep <= now; d.time += kStep) {
-    if (!d.enabled || d.faults) continue;
-    const double dt = to_seconds(kStep);
-    for (Joint& j : d.joints) {
-      const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
-      j.position += v * dt;
+  const auto integrate = [&](Nanos until) {
+    for (; d.time + kStep <= until; d.time += kStep) {
+      if (!d.enabled || d.faults) continue;
+      const double dt = to_seconds(kStep);
+      for (Joint& j : d.joints) {
+        const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
+        j.position += v * dt;
+      }
+    }
+  };
+  // The communication timeout ran out: the drive disables its output from
+  // that moment (the enable reads off until the host switches it on again).
+  if (d.guard > 0 && d.enabled && now - d.last_request > d.guard) {
+    integrate(d.last_request + d.guard);
+    d.enabled = false;
+    for (const Joint& j : d.joints) {
+      const modbus::Enable& e = j.options.map->enable;
+      if (!e.configured) continue;
+      if (e.coil) {
+        d.mapping->tab_bits[e.address - d.mapping->start_bits] = static_cast<std::uint8_t>(e.off);
+      } else {
+        d.mapping->tab_registers[e.address - d.mapping->start_registers] = e.off;
+      }
     }
   }
+  integrate(now);
 }
 
 void ModbusSimBus::publish(Drive& d) {
@@ -229,6 +253,7 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
   const Nanos now = clock_.now();
   advance(*d, now);
   publish(*d);
+  d->last_request = now;
 
   // The drive's own checks of written values, before libmodbus stores them.
   // A write that declares more values than it carries is left to libmodbus,
@@ -289,6 +314,11 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
     }
   }
   d->enabled = !any_enable || enabled;
+  if (d->watchdog != nullptr) {
+    const std::uint16_t counts =
+        d->mapping->tab_registers[d->watchdog->address - d->mapping->start_registers];
+    d->guard = static_cast<Nanos>(std::llround(counts * d->watchdog->unit_ms * 1e6));
+  }
 }
 
 void ModbusSimBus::close_client(std::size_t i) {
