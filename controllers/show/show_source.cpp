@@ -183,7 +183,7 @@ void complete_learned(const ShowFile& show, std::span<const JointSpec> joints,
       // both the model's fault, refused with the track's line.
       if (const double v = done.frames(static_cast<Eigen::Index>(j), f); !std::isfinite(v)) {
         throw InputError(where, "joints." + joints[static_cast<std::size_t>(track.joint)].name,
-                         "the learned model \"" + learned.model_file + "\" completed " +
+                         "the learned model " + quote_path(learned.model_file) + " completed " +
                              (std::isnan(v) ? std::string("nan")
                               : v > 0       ? "inf"
                                             : "-inf") +

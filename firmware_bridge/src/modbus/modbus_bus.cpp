@@ -118,12 +118,12 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
   if (options_.tcp) {
     const auto colon = config_.port.rfind(':');
     if (colon == std::string::npos)
-      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+      throw DeviceError(bus + "expected HOST:PORT, found " + quote(config_.port));
     host_ = config_.port.substr(0, colon);
     try {
       tcp_port_ = std::stoi(config_.port.substr(colon + 1));
     } catch (...) {
-      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+      throw DeviceError(bus + "expected HOST:PORT, found " + quote(config_.port));
     }
     ctx_ = modbus_new_tcp(host_.c_str(), tcp_port_);
   } else {

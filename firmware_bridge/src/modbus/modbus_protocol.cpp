@@ -129,8 +129,8 @@ class ModbusProtocol final : public Protocol {
     const fs::path folder = fs::path(node.file()).parent_path();
     const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
     if (!fs::is_regular_file(resolved)) {
-      map_node.fail("register map not found: \"" + given + "\" (resolved to \"" +
-                    resolved.string() + "\")");
+      map_node.fail("register map not found: " + quote_path(given) + " (resolved to " +
+                    quote_path(resolved.string()) + ")");
     }
     j.map = modbus::load_register_map(resolved.string());
     const modbus::RegisterMap& m = *j.map;

@@ -125,7 +125,7 @@ std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
           bit = -1;
         }
         if (bit < 0 || bit > 15)
-          value.fail("expected a bit number 0..15 as the key, found \"" + key + "\"");
+          value.fail("expected a bit number 0..15 as the key, found " + quote(key));
         map->faults.push_back(FaultBit{bit, value.as_string()});
         map->fault_mask = static_cast<std::uint16_t>(map->fault_mask | (1u << bit));
       }
