@@ -58,6 +58,19 @@ fi
 [ -e long_value.yaml ] || python3 -c "
 import sys
 sys.stdout.write('name: ' + 'x' * (60 * 1000 * 1000) + '\n')" >long_value.yaml
+# The largest value a YAML file may hold: one line of just under 4 MiB.
+[ -e long_value_4mib.yaml ] || python3 -c "
+import sys
+sys.stdout.write('name: ' + 'x' * (4 * 1024 * 1024 - 7) + '\n')" >long_value_4mib.yaml
+# The densest YAML: a flow list of as many nodes as a file may have (100000,
+# the root map and its key included), and 4 MiB of block list items, refused
+# at the node limit.
+[ -e nodes_at_limit.yaml ] || python3 -c "
+import sys
+sys.stdout.write('name: [' + '0,' * (100000 - 4) + '0]\n')" >nodes_at_limit.yaml
+[ -e tiny_items.yaml ] || python3 -c "
+import sys
+sys.stdout.write('name:\n' + '- 0\n' * (1024 * 1024 - 2))" >tiny_items.yaml
 
 measure() {  # LABEL INPUT COMMAND...
   local label=$1 input=$2
@@ -94,3 +107,6 @@ measure "model: /dev/zero" zero.model "$animrt" seq generate zero.model --init x
 measure "model: gzip bomb" bomb.model "$animrt" seq generate bomb.model --init x.obj --frames 2 --out g
 measure "FLAC: header claims 2^28 frames" lying.flac "$animrt" head features lying.flac --out f.csv
 measure "YAML: 60 MB value" long_value.yaml "$animrt" validate long_value.yaml
+measure "YAML: one 4 MiB value" long_value_4mib.yaml "$animrt" validate long_value_4mib.yaml
+measure "YAML: 100000 nodes in a flow list" nodes_at_limit.yaml "$animrt" validate nodes_at_limit.yaml
+measure "YAML: 4 MiB of list items" tiny_items.yaml "$animrt" validate tiny_items.yaml

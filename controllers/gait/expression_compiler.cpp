@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "animrt/controllers/gait/expression.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
 #include "expression_program.hpp"
 
@@ -147,7 +148,7 @@ class ExpressionCompiler {
     if (ec == std::errc::result_out_of_range)
       throw ExpressionError(column_of(i), "number out of range");
     if (ec != std::errc() || ptr != e) {
-      throw ExpressionError(column_of(i), "malformed number '" + std::string(b, e) + "'");
+      throw ExpressionError(column_of(i), "malformed number '" + elide(std::string(b, e)) + "'");
     }
     tok_ = Token{Kind::kNumber, i, j, value};
   }
@@ -246,7 +247,7 @@ class ExpressionCompiler {
       const std::string fn(name);
       advance();
       if (tok_.kind != Kind::kLParen) {
-        throw ExpressionError(tok_column(), "expected '(' after '" + fn + "'");
+        throw ExpressionError(tok_column(), "expected '(' after '" + elide(fn) + "'");
       }
       const int open = tok_column();
       Nest nest(*this);
@@ -255,8 +256,8 @@ class ExpressionCompiler {
       expect_close(open);
       emit_unary(op, col);
     } else {
-      throw ExpressionError(col,
-                            "unknown name '" + std::string(name) + "' (expected t, PI, sin, cos)");
+      throw ExpressionError(
+          col, "unknown name '" + elide(std::string(name)) + "' (expected t, PI, sin, cos)");
     }
   }
 

@@ -119,7 +119,7 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
 }
 
 GaitCalibration load_gait_calibration(const std::string& path) {
-  return parse_gait_calibration(read_input_file(path), path);
+  return parse_gait_calibration(read_input_file(path, kMaxYamlFileBytes), path);
 }
 
 void check_calibration_references(const GaitCalibration& cal, const std::string& calibration_path,
@@ -131,23 +131,23 @@ void check_calibration_references(const GaitCalibration& cal, const std::string&
   };
   const auto where = [](const Location& at) { return at.line > 0 ? at : Location{at.file, 0, 0}; };
   const std::string gait = resolve(cal.gait_file);
-  const std::string against = " (resolved against the table's folder to \"" + gait + "\")";
+  const std::string against = " (resolved against the table's folder to " + quote_path(gait) + ")";
   if (const std::string problem = input_file_problem(gait); !problem.empty()) {
     throw InputError(where(cal.gait_where), "gait",
-                     "gait file \"" + cal.gait_file + "\"" + against + " " + problem);
+                     "gait file " + quote_path(cal.gait_file) + against + " " + problem);
   }
   std::error_code ec;
   if (!fs::equivalent(gait, gait_path, ec)) {
     throw InputError(where(cal.gait_where), "gait",
-                     "this table was measured for \"" + cal.gait_file + "\"" + against +
-                         ", not for the gait beside it (\"" + gait_path +
-                         "\"); measure it again with animrt gait calibrate");
+                     "this table was measured for " + quote_path(cal.gait_file) + against +
+                         ", not for the gait beside it (" + quote_path(gait_path) +
+                         "); measure it again with animrt gait calibrate");
   }
   const std::string model = resolve(cal.model_file);
   if (const std::string problem = input_file_problem(model, kMaxMediaFileBytes); !problem.empty()) {
     throw InputError(where(cal.model_where), "model",
-                     "model file \"" + cal.model_file +
-                         "\" (resolved against the table's folder to \"" + model + "\") " +
+                     "model file " + quote_path(cal.model_file) +
+                         " (resolved against the table's folder to " + quote_path(model) + ") " +
                          problem);
   }
 }

@@ -286,14 +286,14 @@ void read_joints(const YamlNode& root, GaitFile& gait) {
     const YamlNode curve = node.at("curve");
     joint.curve = curve.as_string();
     if (!gait.find_curve(joint.curve)) {
-      curve.fail("undefined curve '" + joint.curve + "' (curves: " + join_names(curve_names(gait)) +
-                 ")");
+      curve.fail("undefined curve '" + elide(joint.curve) +
+                 "' (curves: " + join_names(curve_names(gait)) + ")");
     }
     const YamlNode limb = node.at("limb");
     joint.limb = limb.as_string();
     if (!gait.find_limb(joint.limb)) {
-      limb.fail("undefined limb '" + joint.limb + "' (limbs: " + join_names(limb_names(gait)) +
-                ")");
+      limb.fail("undefined limb '" + elide(joint.limb) +
+                "' (limbs: " + join_names(limb_names(gait)) + ")");
     }
     if (auto sign = node.find("sign")) joint.sign = read_sign(*sign);
     // A curve is in degrees already: a scale beyond 100 or an offset beyond
@@ -312,7 +312,7 @@ std::vector<std::string> read_names(const YamlNode& list) {
   for (const YamlNode& item : list.items()) {
     std::string name = item.as_string();
     for (const auto& seen : out) {
-      if (seen == name) item.fail("'" + name + "' is listed twice");
+      if (seen == name) item.fail("'" + elide(name) + "' is listed twice");
     }
     out.push_back(std::move(name));
   }
@@ -355,11 +355,11 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
     const auto items = list.items();
     for (std::size_t i = 0; i < names.size(); ++i) {
       if (!gait.find_limb(names[i])) {
-        items[i].fail("undefined limb '" + names[i] + "' (limbs: " + join_names(limb_names(gait)) +
-                      ")");
+        items[i].fail("undefined limb '" + elide(names[i]) +
+                      "' (limbs: " + join_names(limb_names(gait)) + ")");
       }
       for (const auto& l : s.left) {
-        if (l == names[i]) items[i].fail("limb '" + names[i] + "' is on both sides");
+        if (l == names[i]) items[i].fail("limb '" + elide(names[i]) + "' is on both sides");
       }
     }
     (side[0] == 'l' ? s.left : s.right) = std::move(names);
@@ -371,7 +371,7 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
       bool mapped = false;
       for (const auto& j : gait.joints) mapped = mapped || j.name == s.yaw_joints[i];
       if (!mapped) {
-        items[i].fail("yaw joint '" + s.yaw_joints[i] +
+        items[i].fail("yaw joint '" + elide(s.yaw_joints[i]) +
                       "' is not one of the gait's joints (map it under joints)");
       }
     }
@@ -384,7 +384,7 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
     for (std::size_t i = 0; i < s.lift_curves.size(); ++i) {
       bool defined = false;
       for (const auto& c : gait.curves) defined = defined || c.name == s.lift_curves[i];
-      if (!defined) items[i].fail("undefined curve '" + s.lift_curves[i] + "'");
+      if (!defined) items[i].fail("undefined curve '" + elide(s.lift_curves[i]) + "'");
     }
   }
   gait.steering = std::move(s);
@@ -458,27 +458,27 @@ void validate_steering(const GaitFile& gait) {
   for (const auto* side : {&s.left, &s.right}) {
     for (std::size_t i = 0; i < side->size(); ++i) {
       const std::string& limb = (*side)[i];
-      if (!gait.find_limb(limb)) fail("sides", "undefined limb '" + limb + "'");
+      if (!gait.find_limb(limb)) fail("sides", "undefined limb '" + elide(limb) + "'");
       for (std::size_t k = 0; k < i; ++k) {
-        if ((*side)[k] == limb) fail("sides", "limb '" + limb + "' is listed twice");
+        if ((*side)[k] == limb) fail("sides", "limb '" + elide(limb) + "' is listed twice");
       }
     }
   }
   for (const auto& l : s.left) {
     for (const auto& r : s.right) {
-      if (l == r) fail("sides", "limb '" + l + "' is on both sides");
+      if (l == r) fail("sides", "limb '" + elide(l) + "' is on both sides");
     }
   }
   for (const auto& y : s.yaw_joints) {
     bool mapped = false;
     for (const auto& j : gait.joints) mapped = mapped || j.name == y;
-    if (!mapped) fail("yaw_joints", "yaw joint '" + y + "' is not one of the gait's joints");
+    if (!mapped) fail("yaw_joints", "yaw joint '" + elide(y) + "' is not one of the gait's joints");
   }
   if (!in(s.swing_offset, -5.0, 0.9)) fail("swing_offset", "expected a number from -5 to 0.9");
   for (const auto& c : s.lift_curves) {
     bool defined = false;
     for (const auto& gc : gait.curves) defined = defined || gc.name == c;
-    if (!defined) fail("lift_curves", "undefined curve '" + c + "'");
+    if (!defined) fail("lift_curves", "undefined curve '" + elide(c) + "'");
   }
 }
 
@@ -572,7 +572,7 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
 }
 
 GaitFile load_gait_file(const std::string& path) {
-  return parse_gait_file(read_input_file(path), path);
+  return parse_gait_file(read_input_file(path, kMaxYamlFileBytes), path);
 }
 
 void validate_gait(const GaitFile& gait) {
@@ -644,14 +644,14 @@ void validate_gait(const GaitFile& gait) {
       if (gait.joints[k].name == j.name) throw InputError(j.where, key, "duplicate joint");
     }
     if (!gait.find_curve(j.curve)) {
-      throw InputError(
-          j.where, key + ".curve",
-          "undefined curve '" + j.curve + "' (curves: " + join_names(curve_names(gait)) + ")");
+      throw InputError(j.where, key + ".curve",
+                       "undefined curve '" + elide(j.curve) +
+                           "' (curves: " + join_names(curve_names(gait)) + ")");
     }
     if (!gait.find_limb(j.limb)) {
       throw InputError(
           j.where, key + ".limb",
-          "undefined limb '" + j.limb + "' (limbs: " + join_names(limb_names(gait)) + ")");
+          "undefined limb '" + elide(j.limb) + "' (limbs: " + join_names(limb_names(gait)) + ")");
     }
     if (j.sign != 1 && j.sign != -1) {
       throw InputError(j.where, key + ".sign", "expected 1 or -1, found " + std::to_string(j.sign));

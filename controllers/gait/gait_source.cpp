@@ -69,7 +69,7 @@ std::unique_ptr<MotionSource> source_for(const GaitFile& gait, std::span<const J
     }
     if (d.joint < 0) {
       throw InputError(gj.where, "joints." + gj.name,
-                       "no joint named '" + gj.name +
+                       "no joint named '" + elide(gj.name) +
                            "' in the robot (its joints: " + joint_names(joints) + ")");
     }
     for (std::size_t i = 0; i < gait.curves.size(); ++i) {

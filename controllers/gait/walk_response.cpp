@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt {
 namespace {
@@ -230,8 +231,9 @@ MotionCommand WalkResponse::command_for(const MotionCommand& wanted) const {
 WalkResponse load_walk_response(const std::string& gait_path) {
   const GaitFile gait = load_gait_file(gait_path);
   if (!gait.steering) {
-    throw InputError(Location{gait_path, 0, 0}, "steering",
-                     "gait '" + gait.name + "' has no steering section, so it cannot be steered");
+    throw InputError(
+        Location{gait_path, 0, 0}, "steering",
+        "gait '" + elide(gait.name) + "' has no steering section, so it cannot be steered");
   }
   const std::string cal_path = calibration_path_for(gait_path);
   std::error_code ec;

@@ -23,15 +23,15 @@ snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream
   const char* what = stream == SND_PCM_STREAM_PLAYBACK ? "playback" : "capture";
   int err = open_quietly(&pcm, device, stream, 0);
   if (err < 0) {
-    throw DeviceError("ALSA " + std::string(what) + " device \"" + device +
-                      "\": " + snd_strerror(err));
+    throw DeviceError("ALSA " + std::string(what) + " device " + quote(device) + ": " +
+                      snd_strerror(err));
   }
   err = snd_pcm_set_params(pcm, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
                            static_cast<unsigned>(rate), 1, 50000);
   if (err < 0) {
     snd_pcm_close(pcm);
-    throw DeviceError("ALSA " + std::string(what) + " device \"" + device +
-                      "\": " + snd_strerror(err));
+    throw DeviceError("ALSA " + std::string(what) + " device " + quote(device) + ": " +
+                      snd_strerror(err));
   }
   return pcm;
 }

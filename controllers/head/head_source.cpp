@@ -15,6 +15,7 @@
 
 #include "animrt/controllers/head/alsa_audio.hpp"
 #include "animrt/controllers/head/streaming.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt::head {
 namespace {
@@ -268,8 +269,8 @@ Drive bind_joint(const std::string& name, const Location& where, const std::stri
   if (d.joint < 0) {
     std::string have;
     for (const auto& j : joints) have += (have.empty() ? "" : ", ") + j.name;
-    throw InputError(where, key,
-                     "no joint named '" + name + "' in the robot (its joints: " + have + ")");
+    throw InputError(
+        where, key, "no joint named '" + elide(name) + "' in the robot (its joints: " + have + ")");
   }
   return d;
 }

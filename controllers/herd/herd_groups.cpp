@@ -13,6 +13,7 @@
 #include "animrt/controllers/herd/reynolds_flock.hpp"
 #include "animrt/controllers/herd/unity_flock.hpp"
 #include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt::herd {
 namespace {
@@ -200,7 +201,7 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
           figure_of[static_cast<std::size_t>(members[g].front())])];
       if (p.speed_max_mps > f.walk.max_speed() * (1 + 1e-9)) {
         throw InputError(spec.where, "groups[" + std::to_string(g) + "].speed_mps",
-                         "figure '" + f.name + "' walks at most " +
+                         "figure '" + elide(f.name) + "' walks at most " +
                              format_number(f.walk.max_speed()) +
                              " m/s (its gait's steering range)");
       }

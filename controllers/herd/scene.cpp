@@ -6,6 +6,8 @@
 #include <numbers>
 #include <set>
 
+#include "animrt/core/error.hpp"
+
 namespace animrt::herd {
 namespace {
 
@@ -130,11 +132,12 @@ GroupSpec group(const YamlNode& node, const HerdScene& scene, std::set<std::stri
   const YamlNode name = node.at("name");
   g.name = name.as_string();
   if (g.name.empty()) name.fail("expected a non-empty name");
-  if (!names.insert(g.name).second) name.fail("a group named '" + g.name + "' is already defined");
+  if (!names.insert(g.name).second)
+    name.fail("a group named '" + elide(g.name) + "' is already defined");
   const YamlNode figure = node.at("figure");
   g.figure = figure.as_string();
   if (scene.find_figure(g.figure) == nullptr) {
-    figure.fail("no figure named '" + g.figure + "' in figures");
+    figure.fail("no figure named '" + elide(g.figure) + "' in figures");
   }
   g.count = static_cast<int>(node.at("count").as_int_in(1, 100000));
   const YamlNode spawn = node.at("spawn_m");

@@ -183,7 +183,7 @@ void complete_learned(const ShowFile& show, std::span<const JointSpec> joints,
       // both the model's fault, refused with the track's line.
       if (const double v = done.frames(static_cast<Eigen::Index>(j), f); !std::isfinite(v)) {
         throw InputError(where, "joints." + joints[static_cast<std::size_t>(track.joint)].name,
-                         "the learned model \"" + learned.model_file + "\" completed " +
+                         "the learned model " + quote_path(learned.model_file) + " completed " +
                              (std::isnan(v) ? std::string("nan")
                               : v > 0       ? "inf"
                                             : "-inf") +
@@ -251,15 +251,15 @@ std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
     if (t.joint < 0) {
       throw InputError(
           st.where, "joints." + st.joint,
-          "no joint named '" + st.joint + "' in the robot (its joints: " + names + ")");
+          "no joint named '" + elide(st.joint) + "' in the robot (its joints: " + names + ")");
     }
     const JointSpec& joint = joints[static_cast<std::size_t>(t.joint)];
     const bool prismatic = joint.type == JointType::prismatic;
     if (st.unit == (prismatic ? ShowUnit::deg : ShowUnit::m)) {
       throw InputError(st.unit_where, "joints." + st.joint + ".unit",
-                       prismatic ? "unit deg, but joint '" + st.joint +
+                       prismatic ? "unit deg, but joint '" + elide(st.joint) +
                                        "' is prismatic (its limits are in metres); use unit: m"
-                                 : "unit m, but joint '" + st.joint +
+                                 : "unit m, but joint '" + elide(st.joint) +
                                        "' is revolute (its limits are in degrees); use unit: deg");
     }
     const char* unit = prismatic ? " m" : " deg";

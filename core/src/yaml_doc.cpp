@@ -1,5 +1,8 @@
 #include "animrt/core/yaml_doc.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -8,6 +11,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <streambuf>
 
 #include "animrt/core/input_file.hpp"
 
@@ -24,6 +28,52 @@ Location location_of(const std::string& file, const YAML::Mark& mark) {
   return Location{file, mark.line + 1, mark.column + 1};
 }
 
+// Counts the nodes of the first document as the parser meets them and stops
+// at the first one past the limit, before any tree exists.
+class NodeCounter : public YAML::EventHandler {
+ public:
+  explicit NodeCounter(const std::string& file) : file_(file) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    count(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    count(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    count(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void count(const YAML::Mark& mark) {
+    if (++nodes_ <= kMaxYamlNodes) return;
+    throw InputError(location_of(file_, mark), "",
+                     "more than " + std::to_string(kMaxYamlNodes) +
+                         " YAML nodes (values, lists and maps); a configuration needs far fewer");
+  }
+
+  const std::string& file_;
+  std::size_t nodes_ = 0;
+};
+
+// Reads a string in place, without the copy an istringstream makes.
+class TextBuffer : public std::streambuf {
+ public:
+  explicit TextBuffer(const std::string& text) {
+    char* begin = const_cast<char*>(text.data());
+    setg(begin, begin, begin + text.size());
+  }
+};
+
 }  // namespace
 
 YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std::string path,
@@ -31,13 +81,23 @@ YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std
     : file_(std::move(file)), node_(std::move(node)), path_(std::move(path)), mark_(mark) {}
 
 YamlNode YamlNode::load_file(const std::string& path) {
-  return load_string(read_input_file(path), path);
+  return load_string(read_input_file(path, kMaxYamlFileBytes), path);
 }
 
 YamlNode YamlNode::load_string(const std::string& text, const std::string& file_name) {
   auto file = std::make_shared<const std::string>(file_name);
+  if (text.size() > kMaxYamlFileBytes) {
+    throw InputError(Location{file_name, 0, 0}, "",
+                     "is " + std::to_string(text.size()) + " bytes, more than the " +
+                         std::to_string(kMaxYamlFileBytes >> 20) + " MiB limit");
+  }
   YAML::Node root;
   try {
+    TextBuffer buffer(text);
+    std::istream in(&buffer);
+    YAML::Parser parser(in);
+    NodeCounter counter(file_name);
+    parser.HandleNextDocument(counter);
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(location_of(file_name, e.mark), "", "YAML syntax error: " + e.msg);

@@ -39,7 +39,7 @@ std::string supported_protocols() {
 
 std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) {
   if (const Protocol* protocol = find_protocol(config.protocol)) return protocol->make_bus(config);
-  throw DeviceError("bus " + config.name + ": unknown protocol '" + config.protocol +
+  throw DeviceError("bus " + config.name + ": unknown protocol '" + elide(config.protocol) +
                     "' (supported: " + supported_protocols() + ")");
 }
 

@@ -8,16 +8,34 @@
 #include <thread>
 
 namespace animrt::cli {
+namespace {
+
+// SECONDS from the environment variable, or a negative number when absent.
+double seconds_of(const char* name) {
+  const char* text = std::getenv(name);
+  if (text == nullptr) return -1.0;
+  const double seconds = std::strtod(text, nullptr);
+  return std::isfinite(seconds) && seconds >= 0.0 ? seconds : -1.0;
+}
+
+}  // namespace
 
 void start_fault_injection() {
-  const char* after = std::getenv("ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S");
-  if (after == nullptr) return;
-  const double seconds = std::strtod(after, nullptr);
-  if (!std::isfinite(seconds) || seconds < 0.0) return;
-  std::thread([seconds] {
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-    throw std::runtime_error("injected by ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S");
-  }).detach();
+  if (const double seconds = seconds_of("ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S"); seconds >= 0.0) {
+    std::thread([seconds] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+      throw std::runtime_error("injected by ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S");
+    }).detach();
+  }
+  if (const double seconds = seconds_of("ANIMRT_TEST_NULL_WRITE_AFTER_S"); seconds >= 0.0) {
+    std::thread([seconds] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+      // Through a volatile pointer, so the compiler emits the store itself
+      // (not a trap instruction): the kernel raises SIGSEGV for it.
+      volatile int* volatile target = nullptr;
+      *target = 1;
+    }).detach();
+  }
 }
 
 }  // namespace animrt::cli

@@ -1,9 +1,11 @@
 #pragma once
-// A test hook for the fatal-error path (emergency_stop.hpp): with
-// ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S=SECONDS in the environment, a
-// thread of `animrt run` throws an exception nobody catches that many
-// seconds after the run starts, as a bug in a helper thread would. Read once,
-// at the start; absent (always, outside tests), nothing happens.
+// Test hooks for the fatal-error path (emergency_stop.hpp), read once at the
+// start of `animrt run`; absent (always, outside tests), nothing happens.
+//   ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S=SECONDS: a thread throws an
+//     exception nobody catches that many seconds after the run starts, as a
+//     bug in a helper thread would.
+//   ANIMRT_TEST_NULL_WRITE_AFTER_S=SECONDS: a thread writes through a null
+//     pointer then: a real SIGSEGV, raised by the fault, not sent.
 
 namespace animrt::cli {
 

@@ -91,7 +91,7 @@ CLI::Validator duration_validator() {
         const auto [stop, ec] = std::from_chars(text.data(), end, value);
         const std::string expected = "expected seconds from 0 (until Ctrl-C) to " +
                                      std::to_string(static_cast<long long>(kMaxDurationS)) +
-                                     ", found \"" + text + "\"";
+                                     ", found " + animrt::quote(text);
         if (ec != std::errc() || stop != end || text.empty()) return expected;
         if (!std::isfinite(value) || value < 0.0 || value > kMaxDurationS) return expected;
         return "";

@@ -30,8 +30,9 @@ EmbodiedHerd::EmbodiedHerd(const std::string& scene_file, const std::string& age
     for (std::size_t g = 0; g < herd_->scene().groups.size(); ++g) {
       names += (g ? ", " : "") + herd_->scene().groups[g].name + ".0";
     }
-    throw InputError(Location{scene_file, 0, 0}, "--agent",
-                     "no agent named '" + agent + "' (agents are GROUP.INDEX, e.g. " + names + ")");
+    throw InputError(
+        Location{scene_file, 0, 0}, "--agent",
+        "no agent named '" + elide(agent) + "' (agents are GROUP.INDEX, e.g. " + names + ")");
   }
   if (measured_) herd_->embody(agent_);
   const herd::Agent& a = herd_->agents()[static_cast<std::size_t>(agent_)];

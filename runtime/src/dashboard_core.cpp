@@ -18,6 +18,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
 
 namespace animrt {
@@ -121,7 +122,7 @@ bool dashboard_host_allowed(const std::string& host_header, const std::string& s
 std::pair<std::string, int> parse_host_port(const std::string& text) {
   const auto colon = text.rfind(':');
   const std::string expected =
-      "expected HOST:PORT (e.g. 127.0.0.1:8080, port 0 for a free one), found \"" + text + "\"";
+      "expected HOST:PORT (e.g. 127.0.0.1:8080, port 0 for a free one), found " + quote(text);
   if (colon == std::string::npos || colon == 0) throw std::invalid_argument(expected);
   std::string host = text.substr(0, colon);
   if (host.size() > 2 && host.front() == '[' && host.back() == ']') {

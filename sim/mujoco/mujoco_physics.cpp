@@ -35,7 +35,7 @@ MujocoJointPhysics::MujocoJointPhysics(const std::string& model_path,
     const int a = meta_.actuator_of(joint.name);
     if (a < 0) {
       throw InputError({model_path, 0, 0}, "actuator",
-                       "joint '" + joint.name + "' of " + robot_file +
+                       "joint '" + elide(joint.name) + "' of " + robot_file +
                            " has no position actuator on a hinge joint of that name in this "
                            "model (it has: " +
                            listed(meta_.actuated_joints) + ")");

@@ -36,12 +36,12 @@ DynamixelFirmware::DynamixelFirmware(const BusConfig& config, Nanos now, JointPh
     if (binding.device_id < 0 || binding.device_id > kMaxDeviceId) {
       throw InputError(config.where, "device_id",
                        "Dynamixel id " + std::to_string(binding.device_id) + " of joint '" +
-                           binding.joint + "' is outside 0..252");
+                           elide(binding.joint) + "' is outside 0..252");
     }
     if (find_configured(binding.device_id) != nullptr) {
       throw InputError(config.where, "device_id",
                        "Dynamixel id " + std::to_string(binding.device_id) +
-                           " is used twice on bus '" + config.name + "'");
+                           " is used twice on bus '" + elide(config.name) + "'");
     }
     servos_.emplace_back(binding, config.sim, config.baud, now, physics);
   }

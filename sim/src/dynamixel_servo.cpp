@@ -183,7 +183,7 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
     physics_joint_ = physics_->joint_index(binding.joint);
     if (physics_joint_ < 0) {
       throw InputError({}, "actuator",
-                       "joint '" + binding.joint + "' is not driven by the physics model");
+                       "joint '" + elide(binding.joint) + "' is not driven by the physics model");
     }
   }
   // EEPROM at its defaults, shaped by the bus config.

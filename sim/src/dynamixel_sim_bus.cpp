@@ -21,7 +21,8 @@ namespace animrt::sim {
 namespace {
 
 [[noreturn]] void fail(const BusConfig& config, const char* what, int error) {
-  throw DeviceError("simulated bus '" + config.name + "': " + what + ": " + std::strerror(error));
+  throw DeviceError("simulated bus '" + elide(config.name) + "': " + what + ": " +
+                    std::strerror(error));
 }
 
 // Bytes the packet took on the wire, stuffing included.
@@ -45,7 +46,7 @@ auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id)
   auto* servo = firmware.find_configured(device_id);
   if (servo == nullptr) {
     throw std::out_of_range("no device " + std::to_string(device_id) + " on simulated bus '" +
-                            config.name + "'");
+                            elide(config.name) + "'");
   }
   return *servo;
 }

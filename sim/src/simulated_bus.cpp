@@ -20,9 +20,9 @@ std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const 
     return std::make_unique<sim::DynamixelSimBus>(config, clock, physics);
   }
   if (physics != nullptr) {
-    throw InputError(
-        config.where, "protocol",
-        "physics drives only dynamixel2 buses; bus '" + config.name + "' is " + config.protocol);
+    throw InputError(config.where, "protocol",
+                     "physics drives only dynamixel2 buses; bus '" + elide(config.name) + "' is " +
+                         config.protocol);
   }
   if (ft::Series series; feetech_series(config.protocol, series)) {
     return std::make_unique<sim::FeetechSimBus>(config, series, clock);
@@ -34,8 +34,8 @@ std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const 
     return std::make_unique<sim::ModbusSimBus>(config, clock);
   }
   throw InputError(config.where, "protocol",
-                   "no simulated devices for protocol '" + config.protocol + "' on bus '" +
-                       config.name +
+                   "no simulated devices for protocol '" + elide(config.protocol) + "' on bus '" +
+                       elide(config.name) +
                        "' (expected dynamixel2, feetech_sts, feetech_scs, mit, cia402, maestro, "
                        "modbus-tcp or modbus-rtu)");
 }

@@ -4,7 +4,8 @@
 # same signal in its status). Run on --backend hardware against
 # `animrt sim`; an independent Protocol 2.0 client then reads Torque
 # Enable = 0 on all 12 servos. Cases: an exception nobody catches in a
-# helper thread (std::terminate), an assertion's SIGABRT, a SIGSEGV.
+# helper thread (std::terminate), an assertion's SIGABRT, a SIGSEGV sent,
+# and a real SIGSEGV: a helper thread's write through a null pointer.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -46,4 +47,11 @@ start_figure --duration 3
 sleep 0.8
 kill -SEGV $pid
 expect_death "SIGSEGV" 139
+
+# Under AddressSanitizer the real fault goes on to the sanitizer's own
+# handler after torque is off, which reports it and exits 1.
+real_segv=139
+ldd "$animrt" 2>/dev/null | grep -q libasan && real_segv=1
+ANIMRT_TEST_NULL_WRITE_AFTER_S=1.2 start_figure --duration 3
+expect_death "a write through a null pointer" $real_segv
 echo "fatal_error_torque_off: ok"

@@ -78,6 +78,42 @@ TEST_F(InputFileTest, YamlLoaderUsesTheChecks) {
   }
 }
 
+std::string yaml_error_of(const std::string& text) {
+  try {
+    (void)YamlNode::load_string(text, "t.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST_F(InputFileTest, YamlFileOverItsOwnLimitIsRefusedBeforeReading) {
+  // A single 5 MB value: yaml-cpp would hold it several times over.
+  const std::string text = "name: " + std::string(5000000, 'x') + "\n";
+  std::ofstream(path("long.yaml"), std::ios::binary) << text;
+  try {
+    (void)YamlNode::load_file(path("long.yaml"));
+    ADD_FAILURE() << "a 5 MB YAML file loaded";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path("long.yaml") + ": is 5000007 bytes, more than the 4 MiB limit");
+  }
+  EXPECT_EQ(yaml_error_of(text), "t.yaml: is 5000007 bytes, more than the 4 MiB limit");
+}
+
+TEST_F(InputFileTest, YamlNodesPastTheLimitAreRefusedWhereTheyPassIt) {
+  // Two bytes a node: 200 KB that yaml-cpp would turn into some 50 MiB per
+  // 100000 nodes. The root map, its key and the list come first.
+  std::string items;
+  for (std::size_t i = 0; i < kMaxYamlNodes; ++i) items += "- 0\n";
+  EXPECT_EQ(yaml_error_of("a:\n" + items),
+            "t.yaml:99999:3: more than 100000 YAML nodes (values, lists and maps); a "
+            "configuration needs far fewer");
+  // One node fewer loads.
+  items.resize(items.size() - 4 * 3);
+  EXPECT_EQ(yaml_error_of("a:\n" + items), "no error");
+}
+
 std::string bytes_error_of(const std::string& file, std::uintmax_t max_bytes,
                            std::uintmax_t max_inflated) {
   try {

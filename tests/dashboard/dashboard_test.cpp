@@ -11,8 +11,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -461,6 +464,37 @@ TEST(Dashboard, TheCycleStillDoesNotAllocate) {
   ASSERT_TRUE(watch.was_opened());
   EXPECT_GT(rig.cycles_in(test::RunPhase::motion), 100u);
   EXPECT_EQ(watch.counted(), 0u) << watch.where();
+}
+
+// A server stopped as soon as it was made: its listening thread may not have
+// begun to accept yet, and must still end (httplib's own stop() is ignored
+// until that thread has started, so the stop waited for ever).
+TEST(Dashboard, AServerStoppedBeforeItsListenerStartedEnds) {
+  test::SimRig rig(kQuadruped);
+  RunMonitor monitor(rig.runner().model());
+  RunControls controls;
+  std::atomic<int> stopped{0};
+  std::thread worker([&] {
+    for (int i = 0; i < 200; ++i) {
+      DashboardServer server(monitor, controls, DashboardSetup{});
+      server.stop();
+      ++stopped;
+    }
+  });
+  for (int waited = 0; stopped.load() < 200 && waited < 600; ++waited)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  if (stopped.load() < 200) {
+    ADD_FAILURE() << "a stop hung after " << stopped.load() << " servers";
+    std::fflush(nullptr);
+    std::_Exit(1);  // the hung listener cannot be joined
+  }
+  worker.join();
+  // And the server still serves after all that.
+  DashboardServer server(monitor, controls, DashboardSetup{});
+  httplib::Client client("127.0.0.1", server.port());
+  const auto info = client.Get("/api/info");
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->status, 200);
 }
 
 TEST(Dashboard, OnlyLoopbackUnlessRemoteIsAllowed) {

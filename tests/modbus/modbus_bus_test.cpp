@@ -11,13 +11,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <any>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "animrt/bridge/protocol.hpp"
 #include "animrt/core/joint.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"
@@ -287,6 +290,102 @@ TEST(ModbusBus, ADroppedConnectionIsReopenedWithBackoff) {
   EXPECT_TRUE(back);
   EXPECT_EQ(r.bus->reconnects(), 2u);
   EXPECT_GE(r.sim->stats().connections, 2u);
+}
+
+// The drive's communication timeout: a register map that names it, the bus
+// key that sets it, written when the bus arms its device guards.
+struct GuardedRig {
+  ManualClock clock;
+  RobotConfig config;
+  std::unique_ptr<sim::ModbusSimBus> sim;
+  std::unique_ptr<ModbusBus> bus;
+  explicit GuardedRig(const std::string& device_watchdog_ms) {
+    std::ifstream in(kMaps + "position_drive.yaml");
+    std::stringstream map;
+    map << in.rdbuf() << "watchdog: {register: 40, unit_ms: 10}\n";
+    const std::string map_path = ::testing::TempDir() + "/guarded_drive_" +
+                                 ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                                 ".yaml";
+    std::ofstream(map_path) << map.str();
+    config = load(
+        "name: guarded\nloop: {rate_hz: 100}\nsafety: {watchdog_timeout_s: 0.5}\nbuses:\n"
+        "  drives: {protocol: modbus-tcp, port: 127.0.0.1:1502, timeout_ms: 200, "
+        "device_watchdog_ms: " +
+        device_watchdog_ms +
+        "}\njoints:\n  pan:\n"
+        "    limits: {min_deg: -90, max_deg: 90, velocity_dps: 100, acceleration_dps2: 500}\n"
+        "    actuator: {bus: drives, slave: 1, map: " +
+        map_path + "}\nmotion: {type: gait, file: " + std::string(ANIMRT_SOURCE_DIR) +
+        "/configs/gaits/walk.yaml}\n");
+    BusConfig& b = config.buses[0];
+    sim = std::make_unique<sim::ModbusSimBus>(b, clock);
+    sim->start();
+    b.port = sim->endpoint();
+    bus = std::make_unique<ModbusBus>(b);
+  }
+  void cycles(double goal, int n) {
+    std::vector<double> pos(1, 0.0);
+    for (int k = 0; k < n; ++k) {
+      bus->write(std::vector<double>{goal});
+      clock.advance(10'000'000);
+      bus->read(pos);
+    }
+  }
+};
+
+TEST(ModbusBus, ADriveWhoseHostFallsSilentDisablesWithinItsCommunicationTimeout) {
+  GuardedRig r("50");
+  EXPECT_EQ(std::any_cast<const ModbusJointOptions&>(r.config.buses[0].actuators[0].options)
+                .watchdog_counts,
+            5);
+  r.bus->configure();
+  r.bus->activate();
+  r.bus->arm_device_guard();
+  const double start = r.sim->device_position(1);
+  r.cycles(start, 10);
+  // The host's last goal, 60 degrees away, then nothing (killed): the drive
+  // runs towards it at its rate limit for the 50 ms timeout, then stops.
+  const double goal = start + deg_to_rad(60);
+  r.bus->write(std::vector<double>{goal});
+  r.clock.advance(40'000'000);
+  const double moving = r.sim->device_position(1);
+  EXPECT_GT(moving - start, deg_to_rad(5));
+  r.clock.advance(60'000'000);
+  const double stopped = r.sim->device_position(1);
+  r.clock.advance(2'000'000'000);
+  EXPECT_DOUBLE_EQ(r.sim->device_position(1), stopped);
+  EXPECT_GT(goal - stopped, deg_to_rad(30));
+  // Requests again: the output stays off until the host enables it.
+  r.cycles(goal, 20);
+  EXPECT_DOUBLE_EQ(r.sim->device_position(1), stopped);
+  r.bus->deactivate();
+
+  // The same drive with the guard off follows the last goal to the end.
+  GuardedRig off("off");
+  off.bus->configure();
+  off.bus->activate();
+  off.bus->arm_device_guard();
+  const double from = off.sim->device_position(1);
+  off.cycles(from, 10);
+  off.bus->write(std::vector<double>{from + deg_to_rad(60)});
+  off.clock.advance(2'000'000'000);
+  EXPECT_NEAR(off.sim->device_position(1), from + deg_to_rad(60), 1e-3);
+  off.bus->deactivate();
+}
+
+TEST(ModbusConfig, AWatchdogRegisterTakesTheBusKeyAndValidateSaysWhoHasNone) {
+  GuardedRig r("50");
+  const Protocol* protocol = find_protocol("modbus-tcp");
+  ASSERT_NE(protocol, nullptr);
+  EXPECT_EQ(protocol->device_guard_note(r.config.buses[0]), "");
+  EXPECT_EQ(protocol->device_guard_note(load(robot_text("modbus-tcp")).buses[0]),
+            "no device-side guard (a register map names no watchdog register; set the drive's "
+            "own communication timeout with its vendor tool): if the host dies, the drives hold "
+            "their last target");
+  GuardedRig off("off");
+  EXPECT_EQ(protocol->device_guard_note(off.config.buses[0]),
+            "no device-side guard (device_watchdog_ms: off): if the host dies, the drives hold "
+            "their last target");
 }
 
 TEST(ModbusConfig, ErrorsNameFileLineAndKey) {

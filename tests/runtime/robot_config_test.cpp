@@ -1043,6 +1043,7 @@ motion: {type: gait, file: ../gaits/gait.yaml}
 )");
   EXPECT_NE(error.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << error;
   EXPECT_NE(error.find("no device-side watchdog"), std::string::npos) << error;
+  // A register map that names no watchdog register.
   const std::string modbus = error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -1050,7 +1051,9 @@ buses:
 joints:
   j1:
     limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
-    actuator: {bus: b, slave: 1, map: ../modbus/none.yaml}
+    actuator: {bus: b, slave: 1, map: )" +
+                                      std::string(ANIMRT_SOURCE_DIR) +
+                                      R"(/configs/modbus/position_drive.yaml}
 motion: {type: gait, file: ../gaits/gait.yaml}
 )");
   EXPECT_NE(modbus.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << modbus;

@@ -75,7 +75,7 @@ PopulationWalker::PopulationWalker(const RunConfig& config, const Grammar& gramm
                                    [&](const GaitCurve& c) { return c.name == name; });
       if (it == seed_.curves.end()) {
         throw InputError(stage.where, "fitness.freedom.free",
-                         "no curve '" + name + "' in the seed gait " + seed_.file);
+                         "no curve '" + elide(name) + "' in the seed gait " + seed_.file);
       }
       held[static_cast<std::size_t>(it - seed_.curves.begin())].clear();
     }

@@ -58,7 +58,7 @@ RunConfig from_root(const YamlNode& root) {
       if (m == "structured") {
         ss.mapping = Mapping::structured;
       } else if (m != "standard") {
-        v->fail("expected standard or structured, got '" + m + "'");
+        v->fail("expected standard or structured, got '" + elide(m) + "'");
       }
       ss.mapping_where = v->location();
     }

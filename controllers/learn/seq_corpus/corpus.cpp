@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
 
 namespace animrt::learn::seq_corpus {
@@ -77,7 +78,7 @@ CorpusOptions model_preset(const std::string& name, const std::string& configs_d
                (root / "gaits/quadruped_evolved.yaml").string()};
     o.froude = {0.04, 0.06, 0.08};  // walk.yaml's 1 Hz is Fr 0.054, the evolved gait's 0.06
   } else {
-    throw std::invalid_argument("no preset for model '" + name + "' (horse, quadruped)");
+    throw std::invalid_argument("no preset for model '" + elide(name) + "' (horse, quadruped)");
   }
   return o;
 }

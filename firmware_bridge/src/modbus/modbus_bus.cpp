@@ -118,12 +118,12 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
   if (options_.tcp) {
     const auto colon = config_.port.rfind(':');
     if (colon == std::string::npos)
-      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+      throw DeviceError(bus + "expected HOST:PORT, found " + quote(config_.port));
     host_ = config_.port.substr(0, colon);
     try {
       tcp_port_ = std::stoi(config_.port.substr(colon + 1));
     } catch (...) {
-      throw DeviceError(bus + "expected HOST:PORT, found \"" + config_.port + "\"");
+      throw DeviceError(bus + "expected HOST:PORT, found " + quote(config_.port));
     }
     ctx_ = modbus_new_tcp(host_.c_str(), tcp_port_);
   } else {
@@ -323,6 +323,19 @@ bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
   return true;
 }
 
+bool ModbusBus::set_watchdog(Slave& slave, bool on, int* error) {
+  for (std::size_t d : slave.devices) {
+    const modbus::Watchdog& w = joints_[d].map->watchdog;
+    if (!w.configured || joints_[d].watchdog_counts == 0) continue;
+    modbus_set_slave(ctx_, slave.id);
+    if (modbus_write_register(ctx_, w.address, on ? joints_[d].watchdog_counts : 0) != 1) {
+      *error = errno;
+      return false;
+    }
+  }
+  return true;
+}
+
 // ---- lifecycle --------------------------------------------------------------
 
 void ModbusBus::configure() {
@@ -385,11 +398,34 @@ void ModbusBus::activate() {
   }
 }
 
+void ModbusBus::arm_device_guard() {
+  for (Slave& s : slaves_) {
+    bool ok = false;
+    int error = 0;
+    for (int t = 0; t < kTries && !ok; ++t) {
+      if (!connected_) ensure_connected(true);
+      ok = set_watchdog(s, true, &error);
+      if (!ok && error == 0) error = errno;
+    }
+    if (!ok) {
+      const std::string why = classify(error) == Failure::exception
+                                  ? exception_name(error - MODBUS_ENOBASE)
+                                  : std::string(modbus_strerror(error));
+      throw DeviceError(prefix() + "cannot set the communication timeout of slave " +
+                        std::to_string(s.id) + " (device_watchdog_ms): " + why);
+    }
+  }
+}
+
 void ModbusBus::deactivate() {
   if (!connected_ && !ensure_connected(true)) return;
   for (Slave& s : slaves_) {
     int error = 0;
     if (!set_enable(s, false, &error) && classify(error) == Failure::connection) return;
+  }
+  for (Slave& s : slaves_) {
+    int error = 0;
+    if (!set_watchdog(s, false, &error) && classify(error) == Failure::connection) return;
   }
 }
 

@@ -17,6 +17,10 @@ constexpr std::string_view kRtuKeys[] = {"port",      "baud",       "parity",
                                          "stop_bits", "timeout_ms", "device_watchdog_ms"};
 constexpr std::string_view kActuatorKeys[] = {"slave", "map", "m_per_rad", "zero_m"};
 
+// The longest communication timeout set from the robot file: a guard of a
+// minute protects nothing a figure needs.
+constexpr double kMaxGuardMs = 60000.0;
+
 void read_timeout(const YamlNode& node, BusConfig& bus) {
   bus.timeout_s = 0.02;
   if (auto n = node.find("timeout_ms")) {
@@ -38,19 +42,42 @@ class ModbusProtocol final : public Protocol {
                 : std::span<const std::string_view>(kRtuKeys);
   }
   std::span<const std::string_view> actuator_keys() const override { return kActuatorKeys; }
-  std::string device_guard_note(const BusConfig&) const override {
-    return "no device-side guard (a register map names no watchdog register; set the drive's "
-           "own communication timeout with its vendor tool): if the host dies, the drives hold "
-           "their last target";
+  std::string device_guard_note(const BusConfig& bus) const override {
+    const auto* options = std::any_cast<ModbusBusOptions>(&bus.options);
+    if (options != nullptr && options->device_watchdog_ms == 0.0) {
+      return "no device-side guard (device_watchdog_ms: off): if the host dies, the drives hold "
+             "their last target";
+    }
+    std::string unguarded;
+    std::size_t count = 0;
+    for (const ActuatorBinding& b : bus.actuators) {
+      const auto* j = std::any_cast<ModbusJointOptions>(&b.options);
+      if (j != nullptr && j->map && j->map->watchdog.configured) continue;
+      unguarded += (unguarded.empty() ? "" : ", ") + b.joint;
+      ++count;
+    }
+    if (count == 0) return {};
+    if (count == bus.actuators.size()) {
+      return "no device-side guard (a register map names no watchdog register; set the drive's "
+             "own communication timeout with its vendor tool): if the host dies, the drives hold "
+             "their last target";
+    }
+    return "no device-side guard for " + unguarded +
+           " (their register maps name no watchdog register; set the drive's own communication "
+           "timeout with its vendor tool): if the host dies, those drives hold their last target";
   }
 
   void read_bus(const YamlNode& node, BusConfig& bus) const override {
-    refuse_device_watchdog(node,
-                           "a Modbus register map names no watchdog or timeout register, so "
-                           "animrt cannot set a device-side watchdog on this bus");
     const YamlNode port = node.at("port");
     bus.port = port.as_string();
     ModbusBusOptions options;
+    options.device_watchdog_ms = read_device_watchdog_ms(node, bus.loop_period_s, 1.0, kMaxGuardMs,
+                                                         "the drives' communication timeout");
+    if (const auto given = node.find(kDeviceWatchdogKey)) {
+      options.device_watchdog_given = true;
+      options.device_watchdog_where = given->location();
+      options.device_watchdog_path = given->path();
+    }
     options.tcp = tcp_;
     if (tcp_) {
       const auto colon = bus.port.rfind(':');
@@ -102,11 +129,28 @@ class ModbusProtocol final : public Protocol {
     const fs::path folder = fs::path(node.file()).parent_path();
     const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
     if (!fs::is_regular_file(resolved)) {
-      map_node.fail("register map not found: \"" + given + "\" (resolved to \"" +
-                    resolved.string() + "\")");
+      map_node.fail("register map not found: " + quote_path(given) + " (resolved to " +
+                    quote_path(resolved.string()) + ")");
     }
     j.map = modbus::load_register_map(resolved.string());
     const modbus::RegisterMap& m = *j.map;
+    const auto& bus_options = std::any_cast<const ModbusBusOptions&>(bus.options);
+    if (bus_options.device_watchdog_ms > 0.0 && m.watchdog.configured) {
+      const double counts = std::ceil(bus_options.device_watchdog_ms / m.watchdog.unit_ms - 1e-9);
+      if (counts > 65535.0) {
+        map_node.fail("device_watchdog_ms " + format_number(bus_options.device_watchdog_ms) +
+                      " is more than the watchdog register of " + quote_path(given) +
+                      " holds (65535 counts of " + format_number(m.watchdog.unit_ms) + " ms)");
+      }
+      j.watchdog_counts = static_cast<std::uint16_t>(std::max(1.0, counts));
+    } else if (bus_options.device_watchdog_given && bus_options.device_watchdog_ms > 0.0) {
+      throw InputError(bus_options.device_watchdog_where, bus_options.device_watchdog_path,
+                       "the register map " + quote_path(given) + " of joint " + joint.name +
+                           " names no watchdog or timeout register, so animrt cannot set a "
+                           "device-side watchdog on this bus: remove " +
+                           std::string(kDeviceWatchdogKey) +
+                           " or name the drive's timeout register (watchdog) in the map");
+    }
     const auto per = node.find("m_per_rad");
     const auto zero = node.find("zero_m");
     const bool prismatic = joint.type == JointType::prismatic;

@@ -79,7 +79,7 @@ std::string span_text(Table t, int begin, int end) {
 }
 
 std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
-  root.allow_only({"name", "unit", "goal", "present", "status", "enable", "range"});
+  root.allow_only({"name", "unit", "goal", "present", "status", "enable", "watchdog", "range"});
   auto map = std::make_shared<RegisterMap>();
   map->file = root.file();
   map->name = root.get_string("name", "");
@@ -125,7 +125,7 @@ std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
           bit = -1;
         }
         if (bit < 0 || bit > 15)
-          value.fail("expected a bit number 0..15 as the key, found \"" + key + "\"");
+          value.fail("expected a bit number 0..15 as the key, found " + quote(key));
         map->faults.push_back(FaultBit{bit, value.as_string()});
         map->fault_mask = static_cast<std::uint16_t>(map->fault_mask | (1u << bit));
       }
@@ -151,6 +151,16 @@ std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
     if (e.on == e.off)
       enable->at("on").fail("on and off must differ, both are " + std::to_string(e.on));
     if (!e.coil) used.push_back({"enable", Table::holding, e.address, e.address + 1, e.where});
+  }
+  if (auto watchdog = root.find("watchdog")) {
+    if (!watchdog->is_map()) watchdog->fail("expected a map, found " + watchdog->describe());
+    watchdog->allow_only({"register", "unit_ms"});
+    Watchdog& w = map->watchdog;
+    w.configured = true;
+    w.where = watchdog->location();
+    w.address = static_cast<int>(watchdog->at("register").as_int_in(0, kMaxAddress));
+    if (auto n = watchdog->find("unit_ms")) w.unit_ms = n->as_double_in(0.001, 60000.0);
+    used.push_back({"watchdog", Table::holding, w.address, w.address + 1, w.where});
   }
   if (auto range = root.find("range")) {
     range->allow_only({"min", "max"});
@@ -264,6 +274,8 @@ std::vector<std::pair<Table, std::pair<int, int>>> RegisterMap::spans() const {
   if (has_status) out.push_back({status.table, {status.address, status.end()}});
   if (enable.configured && !enable.coil)
     out.push_back({Table::holding, {enable.address, enable.address + 1}});
+  if (watchdog.configured)
+    out.push_back({Table::holding, {watchdog.address, watchdog.address + 1}});
   return out;
 }
 

@@ -33,7 +33,7 @@ CanSimBus::CanSimBus(const BusConfig& config, const Clock& clock, CanSimAttach a
       nodes_.push_back(std::make_unique<Cia402DriveNode>(b, config_.sim, now));
     } else {
       throw InputError(config_.where, "protocol",
-                       "no simulated CAN devices for protocol '" + config_.protocol + "'");
+                       "no simulated CAN devices for protocol '" + elide(config_.protocol) + "'");
     }
   }
   listeners_.resize(CAN_SFF_MASK + 1);

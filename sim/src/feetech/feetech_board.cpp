@@ -229,13 +229,13 @@ FeetechBoard::FeetechBoard(const BusConfig& config, ft::Series series, Nanos now
   for (const ActuatorBinding& b : config.actuators) {
     if (b.device_id < 0 || b.device_id > ft::kMaxDeviceId) {
       throw InputError(config.where, "id",
-                       "Feetech id " + std::to_string(b.device_id) + " of joint '" + b.joint +
-                           "' is outside 0.." + std::to_string(ft::kMaxDeviceId));
+                       "Feetech id " + std::to_string(b.device_id) + " of joint '" +
+                           elide(b.joint) + "' is outside 0.." + std::to_string(ft::kMaxDeviceId));
     }
     if (find_configured(b.device_id) != nullptr) {
       throw InputError(config.where, "id",
                        "Feetech id " + std::to_string(b.device_id) + " is used twice on bus '" +
-                           config.name + "'");
+                           elide(config.name) + "'");
     }
     servos_.emplace_back(b, series, config.sim, config.baud, now);
   }

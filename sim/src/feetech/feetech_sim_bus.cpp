@@ -6,13 +6,14 @@
 #include <stdexcept>
 
 #include "animrt/bridge/feetech/link_codec.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt::sim {
 
 FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock)
     : config_(config),
       clock_(clock),
-      pty_("simulated bus '" + config.name + "'"),
+      pty_("simulated bus '" + elide(config.name) + "'"),
       board_(config, series, clock.now()),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
@@ -86,7 +87,7 @@ FeetechServo& FeetechSimBus::servo(int device_id) {
   FeetechServo* s = board_.find_configured(device_id);
   if (s == nullptr) {
     throw std::out_of_range("no device " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   }
   return *s;
 }

@@ -9,13 +9,14 @@
 #include <stdexcept>
 
 #include "animrt/bridge/maestro/maestro_bus.hpp"
+#include "animrt/core/error.hpp"
 
 namespace animrt::sim {
 
 MaestroSimBus::MaestroSimBus(const BusConfig& config, const Clock& clock)
     : config_(config),
       clock_(clock),
-      pty_("simulated bus '" + config.name + "'"),
+      pty_("simulated bus '" + elide(config.name) + "'"),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
   MaestroBusOptions options;
@@ -133,7 +134,7 @@ MaestroSimBus::Where MaestroSimBus::find(int device_id) const {
     }
   }
   throw std::out_of_range("no device " + std::to_string(device_id) + " on simulated bus '" +
-                          config_.name + "'");
+                          elide(config_.name) + "'");
 }
 
 void MaestroSimBus::set_device_responding(int device_id, bool responding) {

@@ -50,6 +50,11 @@ struct ModbusSimBus::Drive {
   std::uint16_t faults = 0;
   bool enabled = false;
   Nanos time = 0;
+  // The communication timeout: the register (if a map names one), the time
+  // it allows (0: off) and when the drive last heard a request.
+  const modbus::Watchdog* watchdog = nullptr;
+  Nanos guard = 0;
+  Nanos last_request = 0;
   ~Drive() {
     if (mapping) modbus_mapping_free(mapping);
   }
@@ -69,6 +74,7 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
       d->slave = o.slave;
       d->time = now;
     }
+    if (o.map->watchdog.configured && d->watchdog == nullptr) d->watchdog = &o.map->watchdog;
     Joint j;
     j.binding = &b;
     j.options = o;
@@ -102,7 +108,7 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
         static_cast<unsigned>(n(hold_lo, hold_hi)),
         static_cast<unsigned>(n(in_lo, in_hi) ? in_lo : 0), static_cast<unsigned>(n(in_lo, in_hi)));
     if (d.mapping == nullptr)
-      throw DeviceError("simulated bus '" + config_.name + "': modbus mapping");
+      throw DeviceError("simulated bus '" + elide(config_.name) + "': modbus mapping");
     for (Joint& j : d.joints) {
       const modbus::RegisterMap& m = *j.options.map;
       j.options.map->goal.encode(
@@ -137,17 +143,18 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
       const int error = errno;
       if (listen_fd_ >= 0) ::close(listen_fd_);
       if (ctx_) modbus_free(ctx_);
-      throw DeviceError("simulated bus '" + config_.name +
+      throw DeviceError("simulated bus '" + elide(config_.name) +
                         "': cannot listen on 127.0.0.1: " + std::strerror(error));
     }
     endpoint_ = "127.0.0.1:" + std::to_string(ntohs(addr.sin_port));
   } else {
-    pty_ = std::make_unique<PtyPair>("simulated bus '" + config_.name + "'");
+    pty_ = std::make_unique<PtyPair>("simulated bus '" + elide(config_.name) + "'");
     endpoint_ = pty_->path();
     ctx_ = modbus_new_rtu("/dev/null", std::max(config_.baud, 300), 'N', 8, 1);
     if (ctx_) modbus_set_socket(ctx_, pty_->master());
   }
-  if (ctx_ == nullptr) throw DeviceError("simulated bus '" + config_.name + "': libmodbus context");
+  if (ctx_ == nullptr)
+    throw DeviceError("simulated bus '" + elide(config_.name) + "': libmodbus context");
 }
 
 ModbusSimBus::~ModbusSimBus() {
@@ -190,14 +197,32 @@ ModbusSimBus::Drive* ModbusSimBus::drive(int slave) {
 void ModbusSimBus::advance(Drive& d, Nanos now) {
   const double tau = config_.sim.time_constant_s;
   const double vmax = config_.sim.max_speed_rad_s;
-  for (; d.time + kStep <= now; d.time += kStep) {
-    if (!d.enabled || d.faults) continue;
-    const double dt = to_seconds(kStep);
-    for (Joint& j : d.joints) {
-      const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
-      j.position += v * dt;
+  const auto integrate = [&](Nanos until) {
+    for (; d.time + kStep <= until; d.time += kStep) {
+      if (!d.enabled || d.faults) continue;
+      const double dt = to_seconds(kStep);
+      for (Joint& j : d.joints) {
+        const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
+        j.position += v * dt;
+      }
+    }
+  };
+  // The communication timeout ran out: the drive disables its output from
+  // that moment (the enable reads off until the host switches it on again).
+  if (d.guard > 0 && d.enabled && now - d.last_request > d.guard) {
+    integrate(d.last_request + d.guard);
+    d.enabled = false;
+    for (const Joint& j : d.joints) {
+      const modbus::Enable& e = j.options.map->enable;
+      if (!e.configured) continue;
+      if (e.coil) {
+        d.mapping->tab_bits[e.address - d.mapping->start_bits] = static_cast<std::uint8_t>(e.off);
+      } else {
+        d.mapping->tab_registers[e.address - d.mapping->start_registers] = e.off;
+      }
     }
   }
+  integrate(now);
 }
 
 void ModbusSimBus::publish(Drive& d) {
@@ -228,6 +253,7 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
   const Nanos now = clock_.now();
   advance(*d, now);
   publish(*d);
+  d->last_request = now;
 
   // The drive's own checks of written values, before libmodbus stores them.
   // A write that declares more values than it carries is left to libmodbus,
@@ -288,6 +314,11 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
     }
   }
   d->enabled = !any_enable || enabled;
+  if (d->watchdog != nullptr) {
+    const std::uint16_t counts =
+        d->mapping->tab_registers[d->watchdog->address - d->mapping->start_registers];
+    d->guard = static_cast<Nanos>(std::llround(counts * d->watchdog->unit_ms * 1e6));
+  }
 }
 
 void ModbusSimBus::close_client(std::size_t i) {
@@ -432,7 +463,7 @@ void ModbusSimBus::set_device_responding(int device_id, bool responding) {
   Drive* d = drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   d->responding = responding;
 }
 
@@ -441,7 +472,7 @@ void ModbusSimBus::set_device_hardware_error(int device_id, std::uint8_t error_b
   Drive* d = drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   advance(*d, clock_.now());
   d->faults = static_cast<std::uint16_t>(d->faults | error_bits);
   publish(*d);
@@ -453,7 +484,7 @@ double ModbusSimBus::device_position(int device_id) const {
   Drive* d = self->drive(device_id);
   if (!d)
     throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
-                            config_.name + "'");
+                            elide(config_.name) + "'");
   self->advance(*d, clock_.now());
   return d->joints.front().position;
 }

@@ -15,7 +15,8 @@ namespace animrt {
 // What input_file_problem says of a path where nothing is.
 inline constexpr const char* kFileMissing = "does not exist";
 
-// Text inputs: YAML, BNF, model files.
+// Text inputs: BNF, model, CSV files (YAML files have a smaller limit,
+// kMaxYamlFileBytes in yaml_doc.hpp).
 inline constexpr std::uintmax_t kMaxInputFileBytes = std::uintmax_t{64} << 20;  // 64 MiB
 // Inputs that may be larger (WAV sound tracks, MJCF models). A sound file is
 // decoded whole into floats, up to 4x its size in memory.

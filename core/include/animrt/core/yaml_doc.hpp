@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
@@ -19,11 +20,21 @@
 
 namespace animrt {
 
+// What a YAML input may hold before yaml-cpp builds its tree. yaml-cpp keeps
+// some 500 bytes per node (a value, a list or a map, keys included) and a long
+// value several times over, so these bound what one file can make it allocate
+// to about 50 MiB. The largest shipped configuration has some 600 nodes in
+// 7.5 KB: the limits leave a hand-written show or table a hundredfold room.
+inline constexpr std::uintmax_t kMaxYamlFileBytes = std::uintmax_t{4} << 20;  // 4 MiB
+inline constexpr std::size_t kMaxYamlNodes = 100000;
+
 class YamlNode {
  public:
-  // Parses a file; a missing file or a YAML syntax error is an InputError.
+  // Parses a file; a missing file, a YAML syntax error or a file past the
+  // limits above is an InputError.
   static YamlNode load_file(const std::string& path);
-  // Parses text as if it came from `file_name` (for tests and embedded text).
+  // Parses text as if it came from `file_name` (for tests, embedded text and
+  // files read first), with the same limits.
   static YamlNode load_string(const std::string& text, const std::string& file_name);
 
   const std::string& file() const { return *file_; }

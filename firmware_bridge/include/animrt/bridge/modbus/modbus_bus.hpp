@@ -44,6 +44,12 @@ struct ModbusBusOptions {
   int stop_bits = 1;  // RTU
   double reconnect_min_s = 0.1;
   double reconnect_max_s = 2.0;
+  // device_watchdog_ms (0: off), written to each drive whose register map
+  // names a watchdog register; where the key was given, if it was.
+  double device_watchdog_ms = 0.0;
+  bool device_watchdog_given = false;
+  Location device_watchdog_where;
+  std::string device_watchdog_path;
 };
 
 // ActuatorBinding::options of a Modbus joint:
@@ -56,6 +62,9 @@ struct ModbusJointOptions {
   // metres per radian for a linear actuator on a lever.
   double per_rad = 1.0;
   double zero = 0.0;
+  // The drive's communication timeout in counts of the map's watchdog unit
+  // (0: the map names no watchdog register, or the guard is off).
+  std::uint16_t watchdog_counts = 0;
 };
 
 class ModbusBus final : public ActuatorBus {
@@ -73,7 +82,9 @@ class ModbusBus final : public ActuatorBus {
   void configure() override;
   // Goal = present, then the enable coil/register on; throws on failure.
   void activate() override;
-  // Enable off, best effort.
+  // Writes each drive's communication timeout (the map's watchdog register).
+  void arm_device_guard() override;
+  // Enable off, then the communication timeout cleared, best effort.
   void deactivate() override;
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
@@ -115,6 +126,7 @@ class ModbusBus final : public ActuatorBus {
   const std::uint16_t* words_of(const Slave& slave, const modbus::Register& r) const;
   bool write_slave(Slave& slave);
   bool set_enable(Slave& slave, bool on, int* error);
+  bool set_watchdog(Slave& slave, bool on, int* error);
   std::string prefix() const { return book_.prefix(); }
 
   BusConfig config_;

@@ -52,6 +52,18 @@ struct Enable {
   Location where;
 };
 
+// The drive's communication timeout (a watchdog against a dead host): a
+// holding register, uint16, in counts of unit_ms, 0 = off. When no request
+// reaches the drive for that long, the drive takes its own action (stop or
+// disable, set with the vendor's tool). The bus writes it when it arms the
+// device guards and clears it at a clean deactivate.
+struct Watchdog {
+  bool configured = false;
+  int address = 0;
+  double unit_ms = 1.0;
+  Location where;
+};
+
 struct FaultBit {
   int bit = 0;
   std::string name;
@@ -68,6 +80,7 @@ struct RegisterMap {
   std::uint16_t fault_mask = 0;
   std::vector<FaultBit> faults;
   Enable enable;
+  Watchdog watchdog;
   bool has_range = false;
   double range_min = 0.0, range_max = 0.0;  // goal values the drive accepts (SI)
 
