@@ -60,6 +60,37 @@ void add_telemetry(std::string& out, const RunSummary& s) {
   }
 }
 
+nlohmann::json device_json(const DeviceReport& d) {
+  const DeviceStatus& st = d.status;
+  return nlohmann::json{{"bus", d.bus},
+                        {"id", st.device_id},
+                        {"joint", d.joint},
+                        {"health", to_string(st.health)},
+                        {"faulted", st.faulted},
+                        {"transactions", st.transactions},
+                        {"timeouts", st.timeouts},
+                        {"crc_errors", st.crc_errors},
+                        {"protocol_errors", st.protocol_errors},
+                        {"hardware_errors", st.hardware_errors},
+                        {"hardware_error_status", st.hardware_error_status},
+                        {"exceptions", st.exceptions},
+                        {"open_loop", st.open_loop}};
+}
+
+nlohmann::json physics_json(const PhysicsReport& p) {
+  return nlohmann::json{{"model", p.model},
+                        {"timestep_s", p.timestep_s},
+                        {"simulated_s", p.simulated_s},
+                        {"forward_m", p.forward_m},
+                        {"sideways_m", p.sideways_m},
+                        {"motion_s", p.motion_s},
+                        {"motion_forward_m", p.motion_forward_m},
+                        {"average_speed_m_s", p.average_speed_m_s},
+                        {"falls", p.falls},
+                        {"first_fall_s", p.first_fall_s},
+                        {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
+}
+
 }  // namespace
 
 const char* to_string(EndReason reason) {
@@ -155,41 +186,13 @@ nlohmann::json to_json(const RunSummary& s) {
                            {"max_tracking_error_rad", joint.max_tracking_error_rad}});
   }
   j["devices"] = nlohmann::json::array();
-  for (const auto& d : s.devices) {
-    const DeviceStatus& st = d.status;
-    j["devices"].push_back({{"bus", d.bus},
-                            {"id", st.device_id},
-                            {"joint", d.joint},
-                            {"health", to_string(st.health)},
-                            {"faulted", st.faulted},
-                            {"transactions", st.transactions},
-                            {"timeouts", st.timeouts},
-                            {"crc_errors", st.crc_errors},
-                            {"protocol_errors", st.protocol_errors},
-                            {"hardware_errors", st.hardware_errors},
-                            {"hardware_error_status", st.hardware_error_status},
-                            {"exceptions", st.exceptions},
-                            {"open_loop", st.open_loop}});
-  }
+  for (const auto& d : s.devices) j["devices"].push_back(device_json(d));
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},
                     {"dropped", s.telemetry_dropped},
                     {"lost", s.telemetry_lost},
                     {"error", s.telemetry_error}};
-  if (s.physics) {
-    const PhysicsReport& p = *s.physics;
-    j["physics"] = {{"model", p.model},
-                    {"timestep_s", p.timestep_s},
-                    {"simulated_s", p.simulated_s},
-                    {"forward_m", p.forward_m},
-                    {"sideways_m", p.sideways_m},
-                    {"motion_s", p.motion_s},
-                    {"motion_forward_m", p.motion_forward_m},
-                    {"average_speed_m_s", p.average_speed_m_s},
-                    {"falls", p.falls},
-                    {"first_fall_s", p.first_fall_s},
-                    {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
-  }
+  if (s.physics) j["physics"] = physics_json(*s.physics);
   return j;
 }
 
