@@ -16,7 +16,9 @@ BusWorker::BusWorker(ActuatorBus& bus, std::span<const double> initial_positions
     : bus_(bus),
       done_(done),
       positions_(initial_positions.begin(), initial_positions.end()),
-      commands_(initial_positions.begin(), initial_positions.end()) {}
+      commands_(initial_positions.begin(), initial_positions.end()),
+      failures_(bus.devices().size(), 0),
+      failing_(bus.devices().size(), 0) {}
 
 BusWorker::~BusWorker() { stop(); }
 
@@ -104,17 +106,25 @@ void BusWorker::signal_done() {
 }
 
 template <typename F>
-void BusWorker::guarded(F&& io) {
+void BusWorker::guarded(bool reading, F&& io) {
+  const auto devices = bus_.devices();
   try {
     io();
+    // The read gave every device it asked (every one not faulted) a health
+    // of its own.
+    if (!reading) return;
+    for (std::size_t d = 0; d < devices.size(); ++d) {
+      if (!devices[d].faulted) failing_[d] = 0;
+    }
   } catch (...) {
     // Last line of defence only: the buses report a gone line as timeouts
     // and never throw in read()/write(). Should one still throw, its devices
-    // count a timeout and the loop's watchdog turns that into a fault.
-    for (DeviceStatus& st : bus_.devices()) {
-      if (st.faulted) continue;
-      ++st.timeouts;
-      st.health = DeviceHealth::timeout;
+    // count a timeout (in the worker's records: the bus's statuses are the
+    // bus's) and the loop's watchdog turns that into a fault.
+    for (std::size_t d = 0; d < devices.size(); ++d) {
+      if (devices[d].faulted) continue;
+      ++failures_[d];
+      failing_[d] = 1;
     }
   }
 }
@@ -142,7 +152,7 @@ void BusWorker::run() {
     const std::uint32_t rr = read_req_.load(std::memory_order_acquire);
     if (rr != read_done_.load(std::memory_order_relaxed)) {
       const Nanos t0 = wall.now();
-      guarded([this] { bus_.read(positions_); });
+      guarded(true, [this] { bus_.read(positions_); });
       read_ns_ = wall.now() - t0;
       read_done_.store(rr, std::memory_order_release);
       signal_done();
@@ -152,7 +162,7 @@ void BusWorker::run() {
     const std::uint32_t wr = write_req_.load(std::memory_order_acquire);
     if (wr != write_done_.load(std::memory_order_relaxed)) {
       const Nanos t0 = wall.now();
-      guarded([this] { bus_.write(commands_); });
+      guarded(false, [this] { bus_.write(commands_); });
       io_ns_.store(read_ns_ + (wall.now() - t0), std::memory_order_relaxed);
       io_cycles_.fetch_add(1, std::memory_order_release);
       write_done_.store(wr, std::memory_order_release);

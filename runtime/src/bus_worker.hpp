@@ -6,8 +6,10 @@
 // with release/acquire ordering, and futex waits on them (no mutex, no
 // allocation after start()).
 //
-// Ownership: positions() and commands() belong to the worker thread while a
-// request is pending, and to the loop thread while idle().
+// Ownership: positions(), commands(), failures() and failing() belong to
+// the worker thread while a request is pending, and to the loop thread while
+// idle(). The worker never writes the bus's DeviceStatus: a request the bus
+// threw on is counted here, and the loop combines the two.
 
 #include <pthread.h>
 
@@ -66,6 +68,12 @@ class BusWorker {
 
   std::span<double> positions() { return positions_; }
   std::span<double> commands() { return commands_; }
+  // Per device: requests the bus threw on while the device was not marked
+  // faulted (each a timeout of that device, for the run's view), and
+  // whether one threw since the device's latest answered read (its health
+  // is a timeout, whatever its bus's status says).
+  std::span<const std::uint64_t> failures() const { return failures_; }
+  std::span<const std::uint8_t> failing() const { return failing_; }
   // Read + write time of the last completed cycle, and how many have completed.
   Nanos last_io_ns() const { return io_ns_.load(std::memory_order_acquire); }
   std::uint64_t io_cycles() const { return io_cycles_.load(std::memory_order_acquire); }
@@ -80,12 +88,14 @@ class BusWorker {
   // touch it no more. Returns whether it did.
   bool honour_emergency();
   template <typename F>
-  void guarded(F&& io);
+  void guarded(bool reading, F&& io);
 
   ActuatorBus& bus_;
   std::atomic<std::uint32_t>& done_;
   std::vector<double> positions_;
   std::vector<double> commands_;
+  std::vector<std::uint64_t> failures_;
+  std::vector<std::uint8_t> failing_;
   // The thread's wake word: in its emergency slot when it has one (so a
   // fatal-error handler can wake it: emergency_stop.hpp), else own_wake_.
   EmergencySlot* emergency_ = nullptr;

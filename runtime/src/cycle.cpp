@@ -100,96 +100,113 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
   stop_start_ = t;
 }
 
-const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleState& s,
-                         const CycleInputs& in) {
-  const std::size_t n = model.joint_count();
-  const double t = in.t;
-  CycleOutputs& out = s.out_;
-  out.events.clear();
-  out.show_controlled = false;
-  std::fill(out.write.begin(), out.write.end(), 0);
-  if (s.phase_ == Phase::done) return out;
-
+// The stages of step(), in the order it runs them. Each reads and writes the
+// cycle state only; none allocates.
+struct CycleStages {
   // Controls from outside, read once at the start of the cycle.
-  if (in.steer) motion.steer(*in.steer);
-  if (in.jog && in.jog->joint >= 0 && static_cast<std::size_t>(in.jog->joint) < n &&
-      std::isfinite(in.jog->offset)) {
-    s.jog_[static_cast<std::size_t>(in.jog->joint)] = in.jog->offset;
+  static void take_controls(const RobotModel& model, MotionSource& motion, CycleState& s,
+                            const CycleInputs& in) {
+    if (in.steer) motion.steer(*in.steer);
+    const JogCommand* jog = in.jog;
+    if (jog && jog->joint >= 0 && static_cast<std::size_t>(jog->joint) < model.joint_count() &&
+        std::isfinite(jog->offset)) {
+      s.jog_[static_cast<std::size_t>(jog->joint)] = jog->offset;
+    }
   }
 
   // Measurements: a late bus keeps its last ones.
-  for (std::size_t b = 0; b < in.buses.size(); ++b) {
-    if (!in.buses[b].fresh) ++s.late_cycles_[b];
-  }
-  for (std::size_t j = 0; j < n; ++j) {
-    const JointSlot slot = s.slots_[j];
-    const BusIo& io = in.buses[slot.bus];
-    s.active_[j] = io.fresh ? 1 : 0;
-    if (io.fresh && std::isfinite(io.positions[slot.device])) {
-      s.measured_[j] = io.positions[slot.device];
+  static void take_measurements(CycleState& s, const CycleInputs& in) {
+    for (std::size_t b = 0; b < in.buses.size(); ++b) {
+      if (!in.buses[b].fresh) ++s.late_cycles_[b];
+    }
+    for (std::size_t j = 0; j < s.slots_.size(); ++j) {
+      const JointSlot slot = s.slots_[j];
+      const BusIo& io = in.buses[slot.bus];
+      s.active_[j] = io.fresh ? 1 : 0;
+      if (io.fresh && std::isfinite(io.positions[slot.device])) {
+        s.measured_[j] = io.positions[slot.device];
+      }
     }
   }
 
   // Watchdog: a device silent (or answering garbage) for longer than the
-  // watchdog, or one reporting a hardware error, is faulted.
-  if (s.cycles_ == 0) {
-    for (auto& bus : s.last_ok_) std::fill(bus.begin(), bus.end(), t);
-  }
-  const double watchdog = model.safety.watchdog_timeout_s;
-  bool fault = false;
-  for (std::size_t b = 0; b < in.buses.size(); ++b) {
-    const BusIo& io = in.buses[b];
-    for (std::size_t d = 0; d < s.faulted_[b].size(); ++d) {
-      if (s.faulted_[b][d]) continue;
-      double& last_ok = s.last_ok_[b][d];
-      if (!io.fresh && t - last_ok <= late_bus_grace(watchdog) + kTimeEps) continue;
-      const DeviceHealth health = io.fresh ? io.health[d] : DeviceHealth::timeout;
-      if (health == DeviceHealth::ok) {
-        last_ok = t;
-      } else if (health == DeviceHealth::hardware_error || t - last_ok > watchdog + kTimeEps) {
-        s.faulted_[b][d] = 1;
-        fault = true;
-        s.emit(CycleEvent{EventKind::device_fault, t, model.buses[b].joint[d], b, d, health});
+  // watchdog, or one reporting a hardware error, is faulted. Returns whether
+  // a device faulted this cycle.
+  static bool watch_devices(const RobotModel& model, CycleState& s, const CycleInputs& in) {
+    const double t = in.t;
+    if (s.cycles_ == 0) {
+      for (auto& bus : s.last_ok_) std::fill(bus.begin(), bus.end(), t);
+    }
+    const double watchdog = model.safety.watchdog_timeout_s;
+    bool fault = false;
+    for (std::size_t b = 0; b < in.buses.size(); ++b) {
+      const BusIo& io = in.buses[b];
+      for (std::size_t d = 0; d < s.faulted_[b].size(); ++d) {
+        if (s.faulted_[b][d]) continue;
+        double& last_ok = s.last_ok_[b][d];
+        if (!io.fresh && t - last_ok <= late_bus_grace(watchdog) + kTimeEps) continue;
+        const DeviceHealth health = io.fresh ? io.health[d] : DeviceHealth::timeout;
+        if (health == DeviceHealth::ok) {
+          last_ok = t;
+        } else if (health == DeviceHealth::hardware_error || t - last_ok > watchdog + kTimeEps) {
+          s.faulted_[b][d] = 1;
+          fault = true;
+          s.emit(CycleEvent{EventKind::device_fault, t, model.buses[b].joint[d], b, d, health});
+        }
       }
     }
+    return fault;
+  }
+
+  // Adds joint j's squared error to its window; returns the window's RMS
+  // once the window is full, else -1.
+  static double window_rms(CycleState& s, std::size_t j, double sq) {
+    double& slot_sq = s.err_ring_[j * s.window_ + s.err_next_[j]];
+    s.err_sum_[j] += sq - slot_sq;
+    slot_sq = sq;
+    s.err_next_[j] = (s.err_next_[j] + 1) % s.window_;
+    if (s.err_next_[j] == 0) {  // once per window: the running sum starts afresh
+      double sum = 0.0;
+      for (std::size_t k = 0; k < s.window_; ++k) sum += s.err_ring_[j * s.window_ + k];
+      s.err_sum_[j] = sum;
+    }
+    s.err_count_[j] = std::min(s.err_count_[j] + 1, s.window_);
+    if (s.err_count_[j] < s.window_) return -1.0;
+    return std::sqrt(std::max(0.0, s.err_sum_[j]) / static_cast<double>(s.window_));
   }
 
   // Following error: the last command a device was sent against what it
   // measured since. A joint whose RMS error over the last window is above
   // the limit is faulted like a silent device (held; the others ramp home).
-  if (s.cycles_ > 0) {
-    for (std::size_t j = 0; j < n; ++j) {
+  static bool watch_following_error(const RobotModel& model, CycleState& s, double t) {
+    if (s.cycles_ == 0) return false;
+    bool fault = false;
+    for (std::size_t j = 0; j < s.slots_.size(); ++j) {
       const JointSlot slot = s.slots_[j];
       if (!s.active_[j] || s.joint_faulted(j)) continue;
       const double e = std::abs(s.last_sent_[slot.bus][slot.device] - s.measured_[j]);
       s.sq_error_[j] += e * e;
       s.max_error_[j] = std::max(s.max_error_[j], e);
       ++s.error_samples_[j];
-      double& slot_sq = s.err_ring_[j * s.window_ + s.err_next_[j]];
-      s.err_sum_[j] += e * e - slot_sq;
-      slot_sq = e * e;
-      s.err_next_[j] = (s.err_next_[j] + 1) % s.window_;
-      if (s.err_next_[j] == 0) {  // once per window: the running sum starts afresh
-        double sum = 0.0;
-        for (std::size_t k = 0; k < s.window_; ++k) sum += s.err_ring_[j * s.window_ + k];
-        s.err_sum_[j] = sum;
-      }
-      s.err_count_[j] = std::min(s.err_count_[j] + 1, s.window_);
-      const double rms = std::sqrt(std::max(0.0, s.err_sum_[j]) / static_cast<double>(s.window_));
-      if (s.err_count_[j] == s.window_ && rms > model.following_error[j]) {
+      const double rms = window_rms(s, j, e * e);
+      if (rms > model.following_error[j]) {
         s.faulted_[slot.bus][slot.device] = 1;
         fault = true;
         s.emit(CycleEvent{EventKind::following_error, t, static_cast<int>(j), slot.bus, slot.device,
                           DeviceHealth::ok, rms});
       }
     }
+    return fault;
   }
-  if (fault) s.end_.fault = true;
 
   // Torque off at once: a second stop request, or a stop that ran over.
-  const bool overran =
-      s.phase_ == Phase::stop_ramp && t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps;
-  if (in.abort || overran) {
+  // Returns whether the run ended here.
+  static bool cut_torque(const RobotModel& model, CycleState& s, const CycleInputs& in,
+                         CycleOutputs& out) {
+    const double t = in.t;
+    const bool overran = s.phase_ == Phase::stop_ramp &&
+                         t - s.stop_start_ >= model.safety.stop_deadline_s - kTimeEps;
+    if (!in.abort && !overran) return false;
     if (in.abort) {
       s.emit(CycleEvent{EventKind::aborted, t});
     } else {
@@ -204,12 +221,15 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     s.end_.stopped = s.end_.stopped || in.abort;
     s.phase_ = Phase::done;
     out.torque_off_now = true;
-    ++s.cycles_;
-    return out;
+    return true;
   }
 
-  // Phase changes.
-  if (s.phase_ != Phase::stop_ramp) {
+  // Phase changes: a fault or a stop starts the stop ramp, so does the end of
+  // the motion's duration; the end of the start ramp starts the motion.
+  static void change_phase(const RobotModel& model, CycleState& s, const CycleInputs& in,
+                           bool fault) {
+    if (s.phase_ == Phase::stop_ramp) return;
+    const double t = in.t;
     if (fault) {
       s.begin_stop(model, t);
     } else if (in.stop) {
@@ -229,43 +249,45 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   // Manual mode: on, the joints hold where the filter has them and move
   // only by manual targets (clamped to the limits); off, the motion's
   // targets return, and the filter makes the way back smooth.
-  if (s.phase_ == Phase::motion) {
+  static void take_manual(const RobotModel& model, CycleState& s, const CycleInputs& in) {
+    if (s.phase_ != Phase::motion) {
+      s.manual_ = false;
+      return;
+    }
     if (in.manual && !s.manual_) {
       const auto held = s.filter_.position();
       std::copy(held.begin(), held.end(), s.manual_pose_.begin());
     }
     s.manual_ = in.manual;
-    if (s.manual_) {
-      for (const ManualTarget& target : in.manual_targets) {
-        if (target.joint < 0 || static_cast<std::size_t>(target.joint) >= n ||
-            !std::isfinite(target.position)) {
-          continue;
-        }
-        const auto j = static_cast<std::size_t>(target.joint);
-        s.manual_pose_[j] =
-            std::clamp(target.position, model.limits[j].min_position, model.limits[j].max_position);
+    if (!s.manual_) return;
+    for (const ManualTarget& target : in.manual_targets) {
+      if (target.joint < 0 || static_cast<std::size_t>(target.joint) >= model.joint_count() ||
+          !std::isfinite(target.position)) {
+        continue;
       }
+      const auto j = static_cast<std::size_t>(target.joint);
+      s.manual_pose_[j] =
+          std::clamp(target.position, model.limits[j].min_position, model.limits[j].max_position);
     }
-  } else {
-    s.manual_ = false;
   }
 
   // A show's transport acts at the motion's time, before it is sampled.
-  if (s.phase_ == Phase::motion && in.show) {
-    motion.control(*in.show, t - s.motion_start_);
+  static void control_show(MotionSource& motion, CycleState& s, const CycleInputs& in,
+                           CycleOutputs& out) {
+    if (s.phase_ != Phase::motion || !in.show) return;
+    motion.control(*in.show, in.t - s.motion_start_);
     out.show_controlled = true;
   }
 
-  // Sample.
-  if (s.phase_ == Phase::motion && s.manual_) {
-    std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
-  } else if (s.phase_ == Phase::motion) {
+  // The motion's targets plus the jog; a non-finite one is a motion fault:
+  // the joint holds its last command and the run ramps home.
+  static void sample_motion(const RobotModel& model, MotionSource& motion, CycleState& s,
+                            double t) {
     std::copy(model.home.begin(), model.home.end(), s.targets_.begin());
     motion.sample(t - s.motion_start_, s.targets_);
     bool bad = false;
-    for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t j = 0; j < s.targets_.size(); ++j) {
       if (std::isfinite(s.targets_[j])) continue;
-      // A motion fault: the joint holds its last command, the run ramps home.
       s.emit(CycleEvent{EventKind::motion_fault, t, static_cast<int>(j), s.slots_[j].bus,
                         s.slots_[j].device, DeviceHealth::ok, s.targets_[j]});
       bad = true;
@@ -274,35 +296,79 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
       s.end_.fault = true;
       s.begin_stop(model, t);
     } else {
-      for (std::size_t j = 0; j < n; ++j) s.targets_[j] += s.jog_[j];
+      for (std::size_t j = 0; j < s.targets_.size(); ++j) s.targets_[j] += s.jog_[j];
     }
   }
-  if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
-  s.show_ = motion.show_position(s.phase_ == Phase::motion       ? t - s.motion_start_
-                                 : s.phase_ == Phase::start_ramp ? 0.0
-                                                                 : s.motion_time_);
-  const auto position = s.filter_.position();
-  for (std::size_t j = 0; j < n; ++j) {
-    if (s.joint_faulted(j)) s.targets_[j] = position[j];
+
+  // This cycle's targets: the manual pose, the motion, or the ramp; a faulted
+  // joint is held where the filter has it.
+  static void sample_targets(const RobotModel& model, MotionSource& motion, CycleState& s,
+                             double t) {
+    if (s.phase_ == Phase::motion && s.manual_) {
+      std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
+    } else if (s.phase_ == Phase::motion) {
+      sample_motion(model, motion, s, t);
+    }
+    if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
+    s.show_ = motion.show_position(s.phase_ == Phase::motion       ? t - s.motion_start_
+                                   : s.phase_ == Phase::start_ramp ? 0.0
+                                                                   : s.motion_time_);
+    const auto position = s.filter_.position();
+    for (std::size_t j = 0; j < s.targets_.size(); ++j) {
+      if (s.joint_faulted(j)) s.targets_[j] = position[j];
+    }
   }
 
-  // Filter; a late bus's joints hold the last command it was sent.
-  s.filter_.step(s.targets_, out.commands, s.active_);
-  for (std::size_t b = 0; b < in.buses.size(); ++b) out.write[b] = in.buses[b].fresh ? 1 : 0;
-  for (std::size_t j = 0; j < n; ++j) {
-    const JointSlot slot = s.slots_[j];
-    if (!s.active_[j]) continue;
-    out.bus_commands[slot.bus][slot.device] = out.commands[j];
-    s.last_sent_[slot.bus][slot.device] = out.commands[j];
+  // Filter, and route the commands to the buses that take a write; a late
+  // bus's joints hold the last command it was sent.
+  static void filter_and_route(CycleState& s, const CycleInputs& in, CycleOutputs& out) {
+    s.filter_.step(s.targets_, out.commands, s.active_);
+    for (std::size_t b = 0; b < in.buses.size(); ++b) out.write[b] = in.buses[b].fresh ? 1 : 0;
+    for (std::size_t j = 0; j < s.slots_.size(); ++j) {
+      const JointSlot slot = s.slots_[j];
+      if (!s.active_[j]) continue;
+      out.bus_commands[slot.bus][slot.device] = out.commands[j];
+      s.last_sent_[slot.bus][slot.device] = out.commands[j];
+    }
   }
 
-  if (s.phase_ == Phase::stop_ramp && t - s.phase_start_ >= s.ramp_.duration()) {
+  // The run is done once the stop ramp has ended and the joints have
+  // settled (or the settling took too long).
+  static void settle(CycleState& s, double t) {
+    if (s.phase_ != Phase::stop_ramp || t - s.phase_start_ < s.ramp_.duration()) return;
     double fastest = 0.0;
     for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
     if (fastest < kSettledVelocity || t - s.phase_start_ >= s.ramp_.duration() + kMaxSettleTime) {
       s.phase_ = Phase::done;
     }
   }
+};
+
+const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleState& s,
+                         const CycleInputs& in) {
+  using S = CycleStages;
+  CycleOutputs& out = s.out_;
+  out.events.clear();
+  out.show_controlled = false;
+  std::fill(out.write.begin(), out.write.end(), 0);
+  if (s.phase_ == Phase::done) return out;
+
+  S::take_controls(model, motion, s, in);
+  S::take_measurements(s, in);
+  const bool device_fault = S::watch_devices(model, s, in);
+  const bool following_fault = S::watch_following_error(model, s, in.t);
+  const bool fault = device_fault || following_fault;
+  if (fault) s.end_.fault = true;
+  if (S::cut_torque(model, s, in, out)) {
+    ++s.cycles_;
+    return out;
+  }
+  S::change_phase(model, s, in, fault);
+  S::take_manual(model, s, in);
+  S::control_show(motion, s, in, out);
+  S::sample_targets(model, motion, s, in.t);
+  S::filter_and_route(s, in, out);
+  S::settle(s, in.t);
   ++s.cycles_;
   return out;
 }

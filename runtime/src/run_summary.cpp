@@ -13,6 +13,84 @@ nlohmann::json timing_json(const TimingSummary& t) {
   return {{"count", t.count}, {"p50_s", t.p50_s}, {"p99_s", t.p99_s}, {"max_s", t.max_s}};
 }
 
+std::string device_line(const DeviceReport& d) {
+  const DeviceStatus& st = d.status;
+  return fmt::format(
+             "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware "
+             "{}{}",
+             d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
+             st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
+             st.hardware_error_status
+                 ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
+                 : std::string()) +
+         (st.exceptions
+              ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
+              : std::string()) +
+         (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
+                       : std::string());
+}
+
+void add_physics(std::string& out, const PhysicsReport& p) {
+  auto line = [&out](const std::string& text) { out += text + '\n'; };
+  line(fmt::format(
+      "physics: {} ({:g} ms steps), {:.2f} s simulated: forward {:.3f} m, sideways {:.3f} m, "
+      "falls {}{}",
+      p.model, p.timestep_s * 1e3, p.simulated_s, p.forward_m, p.sideways_m, p.falls,
+      p.falls > 0 ? fmt::format(" (first at {:.2f} s)", p.first_fall_s) : std::string()));
+  line(fmt::format("physics, motion only: forward {:.3f} m in {:.2f} s, average speed {:.3f} m/s",
+                   p.motion_forward_m, p.motion_s, p.average_speed_m_s));
+  if (p.lockstep_waits_timed_out > 0) {
+    line(
+        fmt::format("physics: a bus kept the others waiting {} time(s); this lockstep run may "
+                    "not repeat exactly",
+                    p.lockstep_waits_timed_out));
+  }
+}
+
+void add_telemetry(std::string& out, const RunSummary& s) {
+  auto line = [&out](const std::string& text) { out += text + '\n'; };
+  if (!s.telemetry_file.empty() && (s.telemetry_lost > 0 || !s.telemetry_error.empty())) {
+    line(fmt::format("RECORD LOST telemetry: {} of {} records could not be written to {}: {}",
+                     s.telemetry_lost, s.telemetry_records + s.telemetry_lost, s.telemetry_file,
+                     s.telemetry_error) +
+         fmt::format(" ({} written, {} dropped)", s.telemetry_records, s.telemetry_dropped));
+  } else if (!s.telemetry_file.empty()) {
+    line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
+                     s.telemetry_file, s.telemetry_dropped));
+  }
+}
+
+nlohmann::json device_json(const DeviceReport& d) {
+  const DeviceStatus& st = d.status;
+  return nlohmann::json{{"bus", d.bus},
+                        {"id", st.device_id},
+                        {"joint", d.joint},
+                        {"health", to_string(st.health)},
+                        {"faulted", st.faulted},
+                        {"transactions", st.transactions},
+                        {"timeouts", st.timeouts},
+                        {"crc_errors", st.crc_errors},
+                        {"protocol_errors", st.protocol_errors},
+                        {"hardware_errors", st.hardware_errors},
+                        {"hardware_error_status", st.hardware_error_status},
+                        {"exceptions", st.exceptions},
+                        {"open_loop", st.open_loop}};
+}
+
+nlohmann::json physics_json(const PhysicsReport& p) {
+  return nlohmann::json{{"model", p.model},
+                        {"timestep_s", p.timestep_s},
+                        {"simulated_s", p.simulated_s},
+                        {"forward_m", p.forward_m},
+                        {"sideways_m", p.sideways_m},
+                        {"motion_s", p.motion_s},
+                        {"motion_forward_m", p.motion_forward_m},
+                        {"average_speed_m_s", p.average_speed_m_s},
+                        {"falls", p.falls},
+                        {"first_fall_s", p.first_fall_s},
+                        {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
+}
+
 }  // namespace
 
 const char* to_string(EndReason reason) {
@@ -67,46 +145,9 @@ std::string format_summary(const RunSummary& s) {
                      rad_to_deg(j.rms_tracking_error_rad), rad_to_deg(j.max_tracking_error_rad)));
   }
   line("devices:");
-  for (const auto& d : s.devices) {
-    const DeviceStatus& st = d.status;
-    line(fmt::format(
-             "  {} id {:<3} {:<14} {:<15} transactions {} timeouts {} crc {} protocol {} hardware "
-             "{}{}",
-             d.bus, st.device_id, d.joint, st.faulted ? "FAULTED" : to_string(st.health),
-             st.transactions, st.timeouts, st.crc_errors, st.protocol_errors, st.hardware_errors,
-             st.hardware_error_status
-                 ? fmt::format(" (hardware error status 0x{:02x})", st.hardware_error_status)
-                 : std::string()) +
-         (st.exceptions
-              ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
-              : std::string()) +
-         (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
-                       : std::string()));
-  }
-  if (s.physics) {
-    const PhysicsReport& p = *s.physics;
-    line(fmt::format(
-        "physics: {} ({:g} ms steps), {:.2f} s simulated: forward {:.3f} m, sideways {:.3f} m, "
-        "falls {}{}",
-        p.model, p.timestep_s * 1e3, p.simulated_s, p.forward_m, p.sideways_m, p.falls,
-        p.falls > 0 ? fmt::format(" (first at {:.2f} s)", p.first_fall_s) : std::string()));
-    line(fmt::format("physics, motion only: forward {:.3f} m in {:.2f} s, average speed {:.3f} m/s",
-                     p.motion_forward_m, p.motion_s, p.average_speed_m_s));
-    if (p.lockstep_waits_timed_out > 0) {
-      line(fmt::format("physics: a bus kept the others waiting {} time(s); this lockstep run may "
-                       "not repeat exactly",
-                       p.lockstep_waits_timed_out));
-    }
-  }
-  if (!s.telemetry_file.empty() && (s.telemetry_lost > 0 || !s.telemetry_error.empty())) {
-    line(fmt::format("RECORD LOST telemetry: {} of {} records could not be written to {}: {}",
-                     s.telemetry_lost, s.telemetry_records + s.telemetry_lost, s.telemetry_file,
-                     s.telemetry_error) +
-         fmt::format(" ({} written, {} dropped)", s.telemetry_records, s.telemetry_dropped));
-  } else if (!s.telemetry_file.empty()) {
-    line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
-                     s.telemetry_file, s.telemetry_dropped));
-  }
+  for (const auto& d : s.devices) line(device_line(d));
+  if (s.physics) add_physics(out, *s.physics);
+  add_telemetry(out, s);
   return out;
 }
 
@@ -145,41 +186,13 @@ nlohmann::json to_json(const RunSummary& s) {
                            {"max_tracking_error_rad", joint.max_tracking_error_rad}});
   }
   j["devices"] = nlohmann::json::array();
-  for (const auto& d : s.devices) {
-    const DeviceStatus& st = d.status;
-    j["devices"].push_back({{"bus", d.bus},
-                            {"id", st.device_id},
-                            {"joint", d.joint},
-                            {"health", to_string(st.health)},
-                            {"faulted", st.faulted},
-                            {"transactions", st.transactions},
-                            {"timeouts", st.timeouts},
-                            {"crc_errors", st.crc_errors},
-                            {"protocol_errors", st.protocol_errors},
-                            {"hardware_errors", st.hardware_errors},
-                            {"hardware_error_status", st.hardware_error_status},
-                            {"exceptions", st.exceptions},
-                            {"open_loop", st.open_loop}});
-  }
+  for (const auto& d : s.devices) j["devices"].push_back(device_json(d));
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},
                     {"dropped", s.telemetry_dropped},
                     {"lost", s.telemetry_lost},
                     {"error", s.telemetry_error}};
-  if (s.physics) {
-    const PhysicsReport& p = *s.physics;
-    j["physics"] = {{"model", p.model},
-                    {"timestep_s", p.timestep_s},
-                    {"simulated_s", p.simulated_s},
-                    {"forward_m", p.forward_m},
-                    {"sideways_m", p.sideways_m},
-                    {"motion_s", p.motion_s},
-                    {"motion_forward_m", p.motion_forward_m},
-                    {"average_speed_m_s", p.average_speed_m_s},
-                    {"falls", p.falls},
-                    {"first_fall_s", p.first_fall_s},
-                    {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
-  }
+  if (s.physics) j["physics"] = physics_json(*s.physics);
   return j;
 }
 

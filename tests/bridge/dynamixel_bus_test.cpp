@@ -677,7 +677,7 @@ TEST_F(DynamixelBusTest, WriteClampsToInt32AndHoldsOnNaN) {
 
 TEST_F(DynamixelBusTest, FaultedDeviceIsLeftOutOfSyncReadAndSyncWrite) {
   configured();
-  bus_.devices()[1].faulted = true;
+  bus_.mark_faulted(1);
   std::vector<double> q(3, 0.0);
   bus_.read(q);
   bus_.write(q);

@@ -23,10 +23,10 @@ INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](animrt/([a-z_]+)/[^">]*)[">]')
 # the dashboards of a herd and of an evolve run are targets of their own
 # (animrt_herd_dashboard, animrt_evolve_dashboard) that the CLI links.
 RUNTIME_FRONT_ENDS = {
-    "runtime/src/herd_dashboard.cpp",
-    "runtime/include/animrt/runtime/herd_dashboard.hpp",
-    "runtime/src/evolve_dashboard.cpp",
-    "runtime/include/animrt/runtime/evolve_dashboard.hpp",
+    "runtime/dashboard/src/herd_dashboard.cpp",
+    "runtime/dashboard/include/animrt/runtime/herd_dashboard.hpp",
+    "runtime/dashboard/src/evolve_dashboard.cpp",
+    "runtime/dashboard/include/animrt/runtime/evolve_dashboard.hpp",
 }
 
 

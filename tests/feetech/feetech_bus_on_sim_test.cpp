@@ -238,7 +238,7 @@ TEST(FeetechBusOnSim, ASilentServoIsCountedAndTheOthersStillServed) {
   EXPECT_EQ(f.bus.devices()[0].timeouts, 0u);
   EXPECT_NEAR(q[0], 0.1, 2 * kPi / 4096);
   // Once faulted (by the runtime's watchdog) it is no longer asked.
-  f.bus.devices()[1].faulted = true;
+  f.bus.mark_faulted(1);
   f.bus.read(q);
   EXPECT_EQ(f.bus.devices()[1].timeouts, 3u);
   EXPECT_EQ(f.bus.devices()[0].timeouts, 0u);

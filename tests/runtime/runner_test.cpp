@@ -52,25 +52,58 @@ class FakeBus : public ActuatorBus {
     torque_on = true;
   }
   void deactivate() override {
+    check_statuses();
     ++deactivations;
     torque_on = false;
   }
   void read(std::span<double> positions) override {
-    const int late_ms = late_every > 0 && ++reads % late_every == 0 ? late_by_ms : 0;
+    check_statuses();
+    ++reads;
+    const int late_ms = late_every > 0 && reads % late_every == 0 ? late_by_ms : 0;
     if (late_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(late_ms));
+    if (throw_from > 0 && reads >= throw_from) throw std::runtime_error("adapter unplugged");
     for (std::size_t d = 0; d < positions.size(); ++d) {
+      DeviceStatus& st = status_[d];
+      if (st.faulted) continue;
+      ++st.transactions;
+      if (d == 0 && silent_from > 0 && reads >= silent_from) {
+        ++st.timeouts;
+        st.health = DeviceHealth::timeout;
+        continue;
+      }
       positions[d] = positions_[d];
-      ++status_[d].transactions;
-      status_[d].health = DeviceHealth::ok;
+      st.health = DeviceHealth::ok;
     }
+    mine_.assign(status_.begin(), status_.end());
   }
   void write(std::span<const double> positions) override {
+    check_statuses();
     positions_.assign(positions.begin(), positions.end());
     if (goals_.size() < goals_.capacity()) {
       goals_.push_back(Goal{to_seconds(wall_.now()), positions_});
     }
   }
+  void mark_faulted(std::size_t device) override {
+    check_statuses();
+    ActuatorBus::mark_faulted(device);
+    mine_.assign(status_.begin(), status_.end());
+  }
   std::span<DeviceStatus> devices() override { return status_; }
+
+  // Counts statuses that changed since this bus last wrote them: someone
+  // else wrote them.
+  void check_statuses() {
+    if (mine_.size() != status_.size()) mine_.assign(status_.begin(), status_.end());
+    for (std::size_t d = 0; d < status_.size(); ++d) {
+      const DeviceStatus& a = status_[d];
+      const DeviceStatus& b = mine_[d];
+      if (a.health != b.health || a.faulted != b.faulted || a.transactions != b.transactions ||
+          a.timeouts != b.timeouts || a.protocol_errors != b.protocol_errors) {
+        ++foreign_writes;
+      }
+    }
+    mine_.assign(status_.begin(), status_.end());
+  }
 
   const std::vector<Goal>& goals() const { return goals_; }
 
@@ -79,12 +112,16 @@ class FakeBus : public ActuatorBus {
   bool throw_on_activate = false;
   int late_every = 0;  // every n-th read is late
   int late_by_ms = 0;
+  int throw_from = 0;   // from the n-th read on, read() throws
+  int silent_from = 0;  // from the n-th read on, device 0 does not answer
+  std::atomic<int> foreign_writes{0};
 
  private:
   BusConfig config_;
   std::vector<DeviceStatus> status_;
   std::vector<double> positions_;
   std::vector<Goal> goals_;
+  std::vector<DeviceStatus> mine_;  // the statuses as this bus last left them
   int reads = 0;
   MonotonicClock wall_;
 };
@@ -253,6 +290,43 @@ TEST(Runner, OnTheWallClockALateBusNeverReceivesAJump) {
           << "goal " << k << " device " << d;
     }
   }
+}
+
+// A bus's statuses have one writer, the bus. What the runner knows beyond
+// them (a bus whose read throws, its watchdog's faults) still reaches the
+// summary and the watchdog, and a faulted device is asked no more.
+TEST(Runner, ABusAloneWritesItsStatusesAndTheSummaryCombinesWhatTheLoopKnows) {
+  Rig rig;
+  rig.bus_a->silent_from = 40;  // j0 stops answering after 0.2 s
+  rig.bus_b->throw_from = 40;   // bus b's reads throw from then on
+  const RunSummary s = rig.runner->run(lockstep(rig, 3.0));
+  rig.bus_a->check_statuses();
+  rig.bus_b->check_statuses();
+  EXPECT_EQ(rig.bus_a->foreign_writes.load(), 0);
+  EXPECT_EQ(rig.bus_b->foreign_writes.load(), 0);
+  // The faults reached the buses, which skip those devices now.
+  EXPECT_TRUE(rig.bus_a->devices()[0].faulted);
+  EXPECT_FALSE(rig.bus_a->devices()[1].faulted);
+  EXPECT_TRUE(rig.bus_b->devices()[0].faulted);
+  EXPECT_TRUE(rig.bus_b->devices()[1].faulted);
+  EXPECT_EQ(s.end_reason, EndReason::fault) << format_summary(s);
+  EXPECT_EQ(s.faults.size(), 3u) << format_summary(s);
+  ASSERT_EQ(s.devices.size(), 4u);
+  // j0: its own bus counted its timeouts; j1 answered throughout.
+  EXPECT_TRUE(s.devices[0].status.faulted);
+  EXPECT_EQ(s.devices[0].status.health, DeviceHealth::timeout);
+  EXPECT_GT(s.devices[0].status.timeouts, 0u);
+  EXPECT_FALSE(s.devices[1].status.faulted);
+  EXPECT_EQ(s.devices[1].status.health, DeviceHealth::ok);
+  // j2, j3: bus b never counted a timeout (it threw); the loop did.
+  for (std::size_t d = 2; d < 4; ++d) {
+    EXPECT_TRUE(s.devices[d].status.faulted) << d;
+    EXPECT_EQ(s.devices[d].status.health, DeviceHealth::timeout) << d;
+    EXPECT_GT(s.devices[d].status.timeouts, 0u) << d;
+    EXPECT_EQ(rig.bus_b->devices()[d - 2].timeouts, 0u) << d;
+  }
+  EXPECT_NE(format_summary(s).find("j2             FAULTED"), std::string::npos)
+      << format_summary(s);
 }
 
 // A record that could not be written is exit 6 and its own summary line;

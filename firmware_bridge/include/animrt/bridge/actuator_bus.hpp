@@ -18,11 +18,14 @@ enum class DeviceHealth : std::uint8_t { ok, timeout, protocol_error, hardware_e
 
 const char* to_string(DeviceHealth health);
 
-// Per device, counted since configure(). Read by the runtime after each cycle.
+// Per device, counted since configure(). One writer: the bus that owns the
+// device (its transactions, and mark_faulted()). The runtime reads it while
+// the bus is idle and keeps what it knows beyond it (requests that threw,
+// its watchdog's faults) in its own records.
 struct DeviceStatus {
   int device_id = 0;
   DeviceHealth health = DeviceHealth::ok;  // result of the latest transaction
-  bool faulted = false;                    // set by the runtime's watchdog / by hardware error
+  bool faulted = false;                    // mark_faulted(): the bus skips the device
   std::uint64_t transactions = 0;
   std::uint64_t timeouts = 0;
   std::uint64_t crc_errors = 0;
@@ -62,7 +65,13 @@ class ActuatorBus {
   virtual void read(std::span<double> positions) = 0;
   virtual void write(std::span<const double> positions) = 0;
 
-  // Per device status, indexed like config().actuators.
+  // The runtime's watchdog has faulted `device` (indexed like
+  // config().actuators): read() and write() skip it until the next
+  // configure(). Called while no read() or write() runs.
+  virtual void mark_faulted(std::size_t device) { devices()[device].faulted = true; }
+
+  // Per device status, indexed like config().actuators; written by this bus
+  // alone (see DeviceStatus).
   virtual std::span<DeviceStatus> devices() = 0;
 };
 

@@ -2,9 +2,15 @@
 // One cycle of the run as a plain function: step(model, motion, state,
 // inputs) maps the cycle state, this cycle's I/O results and the time to the
 // commands for the buses and the events of the cycle. No threads, no clock,
-// no I/O: the runner is a thin shell around it, and every edge of the safety
-// path (a late bus, a NaN from the motion, a silent device, a joint that does
-// not follow, a stop that runs over) is a deterministic unit test.
+// no I/O: the runner and its run loop are the shell around it, and every
+// edge of the safety path (a late bus, a NaN from the motion, a silent
+// device, a joint that does not follow, a stop that runs over) is a
+// deterministic unit test.
+//
+// step() runs in named stages (cycle.cpp): take the controls, take the
+// measurements, watch the devices, watch the following error, cut torque
+// if asked, change phase, take manual targets, control a show, sample the
+// targets, filter and route them to the buses, settle the stop.
 //
 // Everything step() touches is allocated when the CycleState is built;
 // step() itself never allocates.
@@ -127,6 +133,7 @@ class CycleState {
  private:
   friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
                                   const CycleInputs&);
+  friend struct CycleStages;  // step()'s stages (cycle.cpp)
   void emit(const CycleEvent& event);
   void begin_stop(const RobotModel& model, double t);
 

@@ -1,10 +1,13 @@
 #pragma once
 // The lifecycle of a run: configure (open buses, ping every device, read the
-// pose), activate (torque on, ramp from the measured pose to the motion's
-// first pose), run (read -> sample -> filter -> write on absolute deadlines),
-// deactivate (ramp to home, torque off) on the end of the duration, a stop
-// request or a fault. The runner is the shell around the cycle (cycle.hpp):
-// threads, clock and lifecycle; what happens in a cycle is step()'s.
+// pose), plan (the start ramp; everything the cycle touches is allocated),
+// activate (torque on), run (read -> sample -> filter -> write on absolute
+// deadlines: the start ramp from the measured pose to the motion's first
+// pose, the motion, and on the end of the duration, a stop request or a
+// fault the stop ramp to home), deactivate (torque off). The runner is the
+// shell around the cycle (cycle.hpp): it holds the lifecycle; threads, clock
+// and the buses' I/O are the run loop's (src/run_loop.hpp); what happens in
+// a cycle is step()'s.
 
 #include <atomic>
 #include <functional>

@@ -1,0 +1,293 @@
+#include "run_loop.hpp"
+
+#include <fmt/format.h>
+#include <time.h>
+
+#include <algorithm>
+
+#include "futex.hpp"
+
+namespace animrt {
+namespace {
+
+constexpr std::size_t kTelemetryCapacity = 1 << 14;  // records (~80 s at 200 Hz)
+// Real time: how long after its deadline a cycle waits for the buses' reads,
+// as a fraction of the period. A bus that has not answered by then keeps its
+// last measurement this cycle, and the others go on without it.
+constexpr double kReadBudget = 0.6;
+constexpr std::size_t kManualPerCycle = 64;  // manual targets taken per cycle, at most
+
+void sleep_until_deadline(Nanos deadline) {
+  timespec ts{};
+  ts.tv_sec = deadline / 1'000'000'000;
+  ts.tv_nsec = deadline % 1'000'000'000;
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+const Clock& run_clock(const RunOptions& options, const MonotonicClock& wall) {
+  return options.lockstep_clock ? static_cast<const Clock&>(*options.lockstep_clock)
+                                : static_cast<const Clock&>(wall);
+}
+
+}  // namespace
+
+void ActivationGuard::activate_all() {
+  while (activated_ < buses_.size()) buses_[activated_++]->activate();
+  for (auto& bus : buses_) bus->arm_device_guard();
+}
+
+void ActivationGuard::release() {
+  for (std::size_t b = 0; b < activated_; ++b) buses_[b]->deactivate();
+  activated_ = 0;
+}
+
+RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBus>>& buses,
+                 MotionSource& motion, const RunOptions& options, CycleState& state,
+                 std::span<const std::vector<double>> bus_positions, RunSummary& summary)
+    : model_(model),
+      buses_(buses),
+      motion_(motion),
+      options_(options),
+      state_(state),
+      summary_(summary),
+      clock_(run_clock(options, wall_)),
+      period_(model.period),
+      ring_(1 + 2 * model.joint_count(), kTelemetryCapacity),
+      record_(1 + 2 * model.joint_count()),
+      bus_hist_(buses.size()),
+      io_(buses.size()),
+      health_(buses.size()),
+      view_(buses.size()),
+      pending_(buses.size(), 0),
+      io_seen_(buses.size(), 0),
+      manual_(kManualPerCycle),
+      monitor_devices_(buses.size()),
+      activation_(buses) {
+  if (!options.telemetry_path.empty()) {
+    writer_.emplace(options.telemetry_path, model.joint_names, ring_);
+  }
+  for (std::size_t b = 0; b < buses.size(); ++b) {
+    const auto devices = buses[b]->devices();
+    health_[b].assign(devices.size(), DeviceHealth::ok);
+    view_[b].assign(devices.begin(), devices.end());
+  }
+  in_.buses = io_;
+  in_.motion_duration_s = options.duration_s;
+  for (std::size_t b = 0; b < buses.size(); ++b) {
+    workers_.push_back(std::make_unique<BusWorker>(*buses[b], bus_positions[b], io_done_));
+    const int priority = summary.sched_fifo ? std::max(1, summary.sched_priority - 1) : 0;
+    if (!workers_.back()->start(priority) && priority > 0) {
+      summary.io_thread_notes.push_back(
+          fmt::format("bus {}: {}", buses[b]->config().name, workers_.back()->priority_note()));
+    }
+  }
+}
+
+bool RunLoop::run() {
+  start_ = clock_.now();
+  deadline_ = start_;
+  while (!state_.done()) {
+    const Wake woke = wake();
+    post_reads();
+    // The budget counts from the deadline, not from a late wake-up.
+    wait_for(true,
+             options_.lockstep_clock
+                 ? Nanos{-1}
+                 : deadline_ + static_cast<Nanos>(kReadBudget * static_cast<double>(period_)));
+    take_reads();
+    gather_inputs();
+    const CycleOutputs& out = step(model_, motion_, state_, in_);
+    publish(out);
+    notify(out);
+    if (out.torque_off_now) return true;
+    post_writes(out);
+    record(out);
+    pace(woke);
+  }
+  return false;
+}
+
+void RunLoop::finish() {
+  for (auto& w : workers_) w->stop();
+  if (options_.monitor) options_.monitor->publish_ended();
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    count_io(b);
+    mark_faults(b);
+    update_view(b);
+  }
+  activation_.release();
+  if (writer_) writer_->finish();
+}
+
+RunLoop::Wake RunLoop::wake() {
+  if (options_.lockstep_clock) options_.lockstep_clock->set(deadline_);
+  const Wake woke{clock_.now(), wall_.now()};
+  jitter_hist_.add(to_seconds(woke.run - deadline_));
+  if (previous_wake_ >= 0) {
+    last_period_s_ = to_seconds(woke.run - previous_wake_);
+    period_hist_.add(last_period_s_);
+  }
+  previous_wake_ = woke.run;
+  return woke;
+}
+
+// Every idle bus reads on its own thread; a bus still busy from an earlier
+// cycle is late. A read that came back after an earlier cycle's budget is
+// used now.
+void RunLoop::post_reads() {
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    io_[b].fresh = false;
+    if (pending_[b] || !workers_[b]->idle()) continue;
+    count_io(b);
+    mark_faults(b);
+    workers_[b]->post_read();
+    pending_[b] = 1;
+  }
+}
+
+// Waits until every bus with a posted request of the kind is done, or until
+// `deadline` (CLOCK_MONOTONIC; < 0: no limit, as in lockstep).
+void RunLoop::wait_for(bool reads, Nanos deadline) {
+  for (;;) {
+    const std::uint32_t seen = io_done_.load(std::memory_order_acquire);
+    bool all = true;
+    for (auto& w : workers_) all = all && (reads ? w->read_done() : w->write_done());
+    if (all || (deadline >= 0 && wall_.now() >= deadline)) return;
+    futex_wait_until(io_done_, seen, deadline);
+  }
+}
+
+void RunLoop::take_reads() {
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    if (!pending_[b] || !workers_[b]->read_done()) continue;
+    pending_[b] = 0;
+    io_[b].fresh = true;
+    update_view(b);
+    for (std::size_t d = 0; d < view_[b].size(); ++d) health_[b][d] = view_[b][d].health;
+    io_[b].positions = workers_[b]->positions();
+    io_[b].health = health_[b];
+  }
+}
+
+void RunLoop::gather_inputs() {
+  RunControls* const controls = options_.controls;
+  in_.t = to_seconds(deadline_ - start_);  // nominal time: smooth motion
+  in_.stop = controls && controls->stop.load(std::memory_order_relaxed);
+  in_.abort = controls && controls->abort.load(std::memory_order_relaxed);
+  in_.steer = controls && controls->steer.take(steer_) ? &steer_ : nullptr;
+  in_.jog = controls && controls->jog.take(jog_) ? &jog_ : nullptr;
+  in_.show = controls && controls->show.take(show_) ? &show_ : nullptr;
+  // Targets first, then the mode: a target posted after manual mode was
+  // switched on is never taken for one sent before it.
+  std::size_t count = 0;
+  if (controls) {
+    double target[2];
+    while (count < manual_.size() && controls->manual_targets.pop(target)) {
+      manual_[count++] = ManualTarget{static_cast<int>(target[0]), target[1]};
+    }
+    in_.manual = controls->manual.load(std::memory_order_acquire);
+  }
+  in_.manual_targets = std::span<const ManualTarget>(manual_.data(), count);
+}
+
+void RunLoop::publish(const CycleOutputs& out) {
+  RunMonitor* const monitor = options_.monitor;
+  if (!monitor) return;
+  // Before the writes are posted: a fresh bus's view was taken while its
+  // I/O thread was idle; a late bus keeps its last published statuses.
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    monitor_devices_[b] =
+        io_[b].fresh ? std::span<const DeviceStatus>(view_[b]) : std::span<const DeviceStatus>();
+  }
+  monitor->publish(in_.t, state_, out.commands, monitor_devices_, summary_.overruns,
+                   summary_.skipped_cycles, in_.steer);
+  for (const CycleEvent& e : out.events) monitor->push_event(e);
+}
+
+void RunLoop::notify(const CycleOutputs& out) {
+  if (out.show_controlled && options_.on_show_command) {
+    options_.on_show_command(show_, in_.t - state_.motion_start());
+  }
+  for (const CycleEvent& e : out.events) {
+    if (e.kind == EventKind::motion_started) {
+      motion_.start(MotionClock{&clock_, deadline_, options_.lockstep_clock != nullptr});
+      if (options_.on_motion_start) options_.on_motion_start(deadline_);
+    }
+    if (e.kind == EventKind::motion_ended && options_.on_motion_end) options_.on_motion_end();
+  }
+}
+
+void RunLoop::post_writes(const CycleOutputs& out) {
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    if (!out.write[b]) continue;
+    std::copy(out.bus_commands[b].begin(), out.bus_commands[b].end(),
+              workers_[b]->commands().begin());
+    workers_[b]->post_write();
+  }
+  // Lockstep: the writes land before the clock moves on (deterministic).
+  if (options_.lockstep_clock) wait_for(false, -1);
+}
+
+void RunLoop::record(const CycleOutputs& out) {
+  if (!writer_) return;
+  record_[0] = in_.t;
+  std::copy(out.commands.begin(), out.commands.end(), record_.begin() + 1);
+  const auto seen = state_.measured();
+  std::copy(seen.begin(), seen.end(), record_.begin() + 1 + static_cast<long>(seen.size()));
+  ring_.push(record_);
+}
+
+void RunLoop::pace(const Wake& woke) {
+  const Nanos busy = wall_.now() - woke.wall;
+  busy_hist_.add(to_seconds(busy));
+  if (options_.monitor) {
+    options_.monitor->push_timing(CycleTiming{in_.t, period_hist_.count() ? last_period_s_ : -1.0,
+                                              to_seconds(woke.run - deadline_), to_seconds(busy)});
+  }
+  if (options_.lockstep_clock) {
+    deadline_ += period_;
+    return;
+  }
+  const NextDeadline next = next_deadline(deadline_, clock_.now(), period_);
+  deadline_ = next.deadline;
+  if (next.overrun) ++summary_.overruns;
+  summary_.skipped_cycles += next.skipped;
+  sleep_until_deadline(deadline_);
+}
+
+// The cycle's faults reach the bus while its I/O thread is idle: the bus
+// marks them in its own statuses and skips those devices from then on.
+void RunLoop::mark_faults(std::size_t b) {
+  ActuatorBus& bus = *buses_[b];
+  const auto devices = bus.devices();
+  const auto& faulted = state_.faulted()[b];
+  for (std::size_t d = 0; d < devices.size(); ++d) {
+    if (faulted[d] && !devices[d].faulted) bus.mark_faulted(d);
+  }
+}
+
+// While bus b's I/O thread is idle: its statuses as the run sees them.
+void RunLoop::update_view(std::size_t b) {
+  const auto devices = buses_[b]->devices();
+  const BusWorker& worker = *workers_[b];
+  const auto failures = worker.failures();
+  const auto failing = worker.failing();
+  const auto& faulted = state_.faulted()[b];
+  for (std::size_t d = 0; d < devices.size(); ++d) {
+    DeviceStatus& v = view_[b][d];
+    v = devices[d];
+    v.timeouts += failures[d];
+    if (failing[d]) v.health = DeviceHealth::timeout;
+    v.faulted = faulted[d] != 0;
+  }
+}
+
+// A completed read + write since the last look: its time.
+void RunLoop::count_io(std::size_t b) {
+  if (workers_[b]->io_cycles() == io_seen_[b]) return;
+  io_seen_[b] = workers_[b]->io_cycles();
+  bus_hist_[b].add(to_seconds(workers_[b]->last_io_ns()));
+}
+
+}  // namespace animrt
