@@ -57,6 +57,9 @@ class RunLoop {
   RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBus>>& buses,
           MotionSource& motion, const RunOptions& options, CycleState& state,
           std::span<const std::vector<double>> bus_positions, RunSummary& summary);
+  // The motion lets go of the run's clock (which may be this loop's own)
+  // before anything of the loop goes, whatever ends the run.
+  ~RunLoop() { motion_.stop(); }
   RunLoop(const RunLoop&) = delete;
   RunLoop& operator=(const RunLoop&) = delete;
 

@@ -267,12 +267,6 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
 
 RunSummary Runner::run(const RunOptions& options) {
   Impl& m = *impl_;
-  // The motion reads the run's clock from its start on; whatever ends the
-  // run, it lets go of it here, before the clock can go.
-  struct MotionClockRelease {
-    MotionSource& motion;
-    ~MotionClockRelease() { motion.stop(); }
-  } motion_clock_release{*m.motion};
   RunSummary summary = m.begin_summary(options);
   const RealtimeScope realtime(options, summary);
   const std::vector<std::vector<double>> bus_positions = m.configure(options);
