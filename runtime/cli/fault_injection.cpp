@@ -1,5 +1,7 @@
 #include "fault_injection.hpp"
 
+#include <sys/mman.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -27,12 +29,15 @@ void start_fault_injection() {
       throw std::runtime_error("injected by ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S");
     }).detach();
   }
-  if (const double seconds = seconds_of("ANIMRT_TEST_NULL_WRITE_AFTER_S"); seconds >= 0.0) {
+  if (const double seconds = seconds_of("ANIMRT_TEST_BAD_WRITE_AFTER_S"); seconds >= 0.0) {
     std::thread([seconds] {
       std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-      // Through a volatile pointer, so the compiler emits the store itself
-      // (not a trap instruction): the kernel raises SIGSEGV for it.
-      volatile int* volatile target = nullptr;
+      // A page mapped without access, not a null pointer: the store is
+      // defined to the compiler and to UBSan (which would stop a null store
+      // itself), and only the MMU refuses it, as with a stray pointer.
+      void* page = ::mmap(nullptr, 4096, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (page == MAP_FAILED) return;
+      volatile int* volatile target = static_cast<int*>(page);
       *target = 1;
     }).detach();
   }

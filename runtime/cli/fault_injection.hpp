@@ -4,8 +4,8 @@
 //   ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S=SECONDS: a thread throws an
 //     exception nobody catches that many seconds after the run starts, as a
 //     bug in a helper thread would.
-//   ANIMRT_TEST_NULL_WRITE_AFTER_S=SECONDS: a thread writes through a null
-//     pointer then: a real SIGSEGV, raised by the fault, not sent.
+//   ANIMRT_TEST_BAD_WRITE_AFTER_S=SECONDS: a thread writes to a page it may
+//     not write then: a real SIGSEGV, raised by the fault, not sent.
 
 namespace animrt::cli {
 

@@ -5,7 +5,7 @@
 # `animrt sim`; an independent Protocol 2.0 client then reads Torque
 # Enable = 0 on all 12 servos. Cases: an exception nobody catches in a
 # helper thread (std::terminate), an assertion's SIGABRT, a SIGSEGV sent,
-# and a real SIGSEGV: a helper thread's write through a null pointer.
+# and a real SIGSEGV: a helper thread's write to a page it may not write.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -52,6 +52,6 @@ expect_death "SIGSEGV" 139
 # handler after torque is off, which reports it and exits 1.
 real_segv=139
 ldd "$animrt" 2>/dev/null | grep -q libasan && real_segv=1
-ANIMRT_TEST_NULL_WRITE_AFTER_S=1.2 start_figure --duration 3
-expect_death "a write through a null pointer" $real_segv
+ANIMRT_TEST_BAD_WRITE_AFTER_S=1.2 start_figure --duration 3
+expect_death "a write to a page without access" $real_segv
 echo "fatal_error_torque_off: ok"
