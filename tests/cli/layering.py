@@ -7,10 +7,13 @@ way the layers do: core includes nothing of ours; firmware_bridge only core;
 the motion that plays (controllers/, outside learn/) no bridge, sim, runtime
 or learner; the learners (controllers/learn/) no bridge or runtime, and sim
 only from the corpus generator that walks figures on MuJoCo; sim no learner;
-the runtime library no sim, no learner and no herd (Recast). Then what the
+the runtime library no sim, no learner and no herd (Recast); the loop
+(runtime/src and runtime/config, but the figure builder) neither the
+dashboards nor the builder above it, nor an HTTP server. Then what the
 runtime library links, as CMake wrote it at configure time: no learner, no
-libtorch, no MPI, no simulator, no Recast, no MuJoCo. Prints one line per
-violation and exits 1 if there is any.
+libtorch, no MPI, no simulator, no Recast, no MuJoCo; and what the loop's
+library (animrt_loop) links: none of those, no dashboard, no HTTP server.
+Prints one line per violation and exits 1 if there is any.
 """
 
 import pathlib
@@ -18,6 +21,12 @@ import re
 import sys
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](animrt/([a-z_]+)/[^">]*)[">]')
+HTTP_INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](httplib\.h)[">]')
+
+# The runtime's files above the loop: the figure builder (which serves a
+# dashboard beside a run) and the dashboards' servers.
+RUNTIME_ABOVE_LOOP = ("runtime/src/figure.cpp", "runtime/include/animrt/runtime/figure.hpp",
+                      "runtime/dashboard/")
 
 # Files the runtime's folder holds that do not build into animrt_runtime:
 # the dashboards of a herd and of an evolve run are targets of their own
@@ -49,8 +58,12 @@ def layer_of(rel):
         return None  # the executables link whatever they run
     if rel.startswith("runtime/herd/"):
         return "runtime_herd"  # animrt_runtime_herd: a figure steered by a herd
+    if rel in RUNTIME_FRONT_ENDS:
+        return "runtime_front_end"
+    if rel.startswith(RUNTIME_ABOVE_LOOP):
+        return "runtime"
     if rel.startswith("runtime/"):
-        return "runtime_front_end" if rel in RUNTIME_FRONT_ENDS else "runtime"
+        return "loop"
     return None
 
 
@@ -67,6 +80,7 @@ ALLOWED = {
     # runs a figure on it). Headers only; the runtime never includes sim.
     "sim": ({"core", "bridge", "sim", "controllers"},
             {"animrt/runtime/figure_kinematics.hpp", "animrt/runtime/figure_backend.hpp"}),
+    "loop": ({"core", "bridge", "controllers", "runtime"}, set()),
     "runtime": ({"core", "bridge", "controllers", "runtime"}, set()),
     "runtime_front_end": ({"core", "bridge", "controllers", "runtime", "learn"}, set()),
     "runtime_herd": ({"core", "bridge", "controllers", "runtime"}, set()),
@@ -75,6 +89,10 @@ ALLOWED = {
 # Header paths a rule set may not include even inside an allowed folder.
 FORBIDDEN_PREFIXES = {
     "runtime": ("animrt/controllers/herd/",),  # Recast: animrt_herd, not the loop's
+    # The loop knows no dashboard and no builder: they sit above it.
+    "loop": ("animrt/controllers/herd/", "animrt/runtime/dashboard.hpp",
+             "animrt/runtime/herd_dashboard.hpp", "animrt/runtime/evolve_dashboard.hpp",
+             "animrt/runtime/figure.hpp"),
 }
 
 
@@ -92,6 +110,9 @@ def include_violations(root):
         folders, extra = ALLOWED[layer]
         banned = FORBIDDEN_PREFIXES.get(layer, ())
         for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            if layer == "loop" and HTTP_INCLUDE.match(line):
+                out.append(f"{rel}:{number}: a loop file includes httplib.h")
+                continue
             match = INCLUDE.match(line)
             if not match:
                 continue
@@ -109,31 +130,42 @@ FORBIDDEN_LINKS = re.compile(
     r"herd_dashboard)\b|torch|c10|MPI|mpi|Recast|Detour|mujoco", re.IGNORECASE)
 
 
-def link_violations(build):
-    closure = build / "link_closure" / "animrt_runtime.txt"
+# What the loop's library must not link beyond that: the dashboards, the
+# builder that serves them, an HTTP server.
+LOOP_FORBIDDEN_LINKS = re.compile(
+    r"animrt_(runtime|dashboard)\b|httplib", re.IGNORECASE)
+
+
+def link_violations(build, target, forbidden):
+    closure = build / "link_closure" / f"{target}.txt"
     if not closure.is_file():
         return [f"{closure}: missing (CMake writes it at configure time)"]
     out = []
     for line in closure.read_text().splitlines():
         kind, _, rest = line.partition(" ")
         if kind == "source":
-            target, _, source = rest.partition(" ")
+            owner, _, source = rest.partition(" ")
             if source.startswith("controllers/learn/") or source.startswith("sim/"):
-                out.append(f"animrt_runtime links {target}, which compiles {source}")
-        elif FORBIDDEN_LINKS.search(rest):
-            out.append(f"animrt_runtime links {rest}")
+                out.append(f"{target} links {owner}, which compiles {source}")
+            elif target == "animrt_loop" and source.startswith(RUNTIME_ABOVE_LOOP):
+                out.append(f"{target} links {owner}, which compiles {source}")
+        elif any(f.search(rest) for f in forbidden):
+            out.append(f"{target} links {rest}")
     return out
 
 
 def main():
     root, build = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
-    problems = include_violations(root) + link_violations(build)
+    problems = (include_violations(root) +
+                link_violations(build, "animrt_runtime", [FORBIDDEN_LINKS]) +
+                link_violations(build, "animrt_loop", [FORBIDDEN_LINKS, LOOP_FORBIDDEN_LINKS]))
     for p in problems:
         print(p)
     if problems:
         print(f"{len(problems)} layering violation(s)")
         return 1
-    print("layering: every include and the runtime's link closure follow the rules")
+    print("layering: every include and the runtime's and the loop's link closures "
+          "follow the rules")
     return 0
 
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The layers' dependency rules: includes across a forbidden layer and a
-# learner in the runtime library's link closure fail (tests/cli/layering.py).
+# learner in the runtime library's link closure, or an HTTP server in the
+# loop's, fail (tests/cli/layering.py).
 set -uo pipefail
 animrt=$1
 root=$2
