@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
@@ -42,8 +43,7 @@ void replace_once(std::string& text, const std::string& from, const std::string&
 }
 
 // The demo quadruped playing `gait`, without wire-time emulation (lockstep
-// needs no real-time pacing). Lockstep runs widen the bus timeouts
-// themselves (widen_timeouts_for_lockstep).
+// needs no real-time pacing).
 std::string write_robot(const std::string& name, const std::string& gait) {
   std::string robot = read_file(kSourceRoot + "/configs/robots/quadruped.yaml");
   replace_once(robot, "file: ../gaits/walk.yaml", "file: " + gait);
@@ -123,32 +123,28 @@ std::vector<double> last_measured(const std::string& csv) {
 }
 
 // A lockstep run of `robot_file` for `duration` s of motion with the servos
-// on the physics; `hold_home` replaces the robot's gait.
+// on the physics; `hold_home` replaces the robot's gait. The figure is built
+// as `animrt run --lockstep --physics` builds it: the simulated backend loads
+// the model, widens the bus timeouts (with 50 ms, an answer late under a
+// parallel sanitizer run once made two lockstep runs differ) and marks the
+// motion's start and end.
 Outcome run_on_physics(const std::string& robot_file, double duration, bool hold_home,
                        const std::string& model = kModel) {
-  ManualClock clock;
   LoadedRobot robot = load_robot(robot_file);
-  // As `animrt run --lockstep` does (with 50 ms, an answer late under a
-  // parallel sanitizer run once made two lockstep runs differ).
-  widen_timeouts_for_lockstep(robot.config.buses);
-  sim::MujocoJointPhysics physics(model, robot.config.joints, robot.config.file, clock.now());
-  auto sims = start_simulated_devices(robot.config.buses, clock, &physics);
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
-  for (const auto& bus : robot.config.buses) buses.push_back(make_bus(bus));
-  std::unique_ptr<MotionSource> motion =
-      hold_home ? std::make_unique<HoldHome>(robot.config.joints) : std::move(robot.motion);
-  Runner runner(robot.config, std::move(buses), std::move(motion));
-  RunOptions options;
+  if (hold_home) robot.motion = std::make_unique<HoldHome>(robot.config.joints);
+  SimulatedBackend simulated(SimulatedBackend::Settings{model, nullptr});
+  FigureOptions lockstep;
+  lockstep.lockstep = true;
+  Figure figure(std::move(robot), simulated, lockstep);
+  RunOptions options = figure.run_options();
   options.duration_s = duration;
-  options.lockstep_clock = &clock;
-  options.backend_name = "sim";
+  options.raise_device_threads = nullptr;  // the devices' threads keep their priority
   options.telemetry_path = robot_file + ".csv";
-  options.on_motion_start = [&physics](Nanos) { physics.mark_motion_start(); };
-  options.on_motion_end = [&physics] { physics.mark_motion_end(); };
   Outcome out;
-  out.summary = runner.run(options);
+  out.summary = figure.run(options);
+  const sim::MujocoJointPhysics& physics = *simulated.mujoco_physics();
   out.physics = physics.measures();
-  for (int j = 0; j < static_cast<int>(robot.config.joints.size()); ++j) {
+  for (int j = 0; j < static_cast<int>(figure.config().joints.size()); ++j) {
     out.joints_at_end.push_back(physics.position(j));
   }
   out.measured_at_end = last_measured(options.telemetry_path);

@@ -26,6 +26,8 @@
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/virtual_can_bus.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/runtime/figure.hpp"
+#include "animrt/runtime/figure_backend.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/simulated_backend.hpp"
@@ -95,30 +97,37 @@ class Client {
   std::unique_ptr<CanFrameTransport> transport_;
 };
 
-// The quadruped's three CAN buses and their simulated devices on one
-// lockstep clock; the host side is a set of buses that a test drives.
-struct Figure {
-  ManualClock clock;
-  LoadedRobot robot;
-  std::vector<std::unique_ptr<SimulatedBus>> sims;
+// The quadruped's three CAN buses and their simulated devices, built by the
+// figure builder on its lockstep clock as `animrt run --lockstep` builds
+// them; the host side is the figure's buses, which a test drives itself (the
+// loop never runs).
+struct Rig {
+  SimulatedBackend simulated;
+  std::unique_ptr<Figure> figure;  // closes its buses before the devices stop
+  ManualClock* clock = nullptr;
 
-  explicit Figure(int watchdog_override_ms = -1) : robot(load_robot(kRobot)) {
-    widen_timeouts_for_lockstep(robot.config.buses);  // as `animrt run --lockstep`
-    if (watchdog_override_ms >= 0) {
-      auto mit = std::any_cast<MitBusOptions>(robot.config.buses[0].options);
+  explicit Rig(int watchdog_override_ms = -1) {
+    FigureOptions options;
+    options.lockstep = true;  // timeouts widen as in `animrt run --lockstep`
+    options.edit = [watchdog_override_ms](RobotConfig& config) {
+      if (watchdog_override_ms < 0) return;
+      auto mit = std::any_cast<MitBusOptions>(config.buses[0].options);
       mit.device_watchdog_ms = watchdog_override_ms;
-      robot.config.buses[0].options = mit;
-      robot.config.buses[1].options = mit;
-      auto drive = std::any_cast<Cia402BusOptions>(robot.config.buses[2].options);
+      config.buses[0].options = mit;
+      config.buses[1].options = mit;
+      auto drive = std::any_cast<Cia402BusOptions>(config.buses[2].options);
       drive.device_watchdog_ms = watchdog_override_ms;
-      robot.config.buses[2].options = drive;
-    }
-    clock.set(1000 * kMs);
-    sims = start_simulated_devices(robot.config.buses, clock);
+      config.buses[2].options = drive;
+    };
+    figure = std::make_unique<Figure>(load_robot(kRobot), simulated, options);
+    clock = figure->run_options().lockstep_clock;
+    clock->set(1000 * kMs);
   }
-  sim::CanSimBus& can(std::size_t i) { return dynamic_cast<sim::CanSimBus&>(*sims[i]); }
+  sim::CanSimBus& can(std::size_t i) {
+    return dynamic_cast<sim::CanSimBus&>(*simulated.devices()[i]);
+  }
   int watchdog_ms() const {
-    return std::any_cast<Cia402BusOptions>(robot.config.buses[2].options).device_watchdog_ms;
+    return std::any_cast<Cia402BusOptions>(figure->config().buses[2].options).device_watchdog_ms;
   }
   bool any_motor_limp() {
     for (int id : kLeft)
@@ -136,26 +145,26 @@ struct Figure {
   }
 };
 
-// The runtime's side: the buses the loop would drive, brought up and
-// cycled as the loop does (read every bus, then write every bus).
+// The runtime's side: a figure's buses, brought up and cycled as the loop
+// does (read every bus, then write every bus).
 struct Host {
-  std::vector<std::unique_ptr<ActuatorBus>> buses;
+  std::vector<ActuatorBus*> buses;
   std::vector<std::vector<double>> start, q;
 
   explicit Host(Figure& figure) {
-    for (const BusConfig& config : figure.robot.config.buses) buses.push_back(make_bus(config));
-    for (auto& bus : buses) {
+    for (std::size_t b = 0; b < figure.bus_count(); ++b) buses.push_back(&figure.bus(b));
+    for (auto* bus : buses) {
       bus->configure();
       start.emplace_back(bus->config().actuators.size(), 0.0);
       bus->read(start.back());
     }
     q = start;
-    for (auto& bus : buses) bus->activate();
-    for (auto& bus : buses) bus->arm_device_guard();
+    for (auto* bus : buses) bus->activate();
+    for (auto* bus : buses) bus->arm_device_guard();
   }
   // One cycle at `t`: a slow sway around the measured pose (0.2 rad, 1 Hz).
-  void cycle(Figure& figure, Nanos t) {
-    figure.clock.set(t);
+  void cycle(Rig& rig, Nanos t) {
+    rig.clock->set(t);
     for (std::size_t b = 0; b < buses.size(); ++b) buses[b]->read(q[b]);
     const double s = 0.2 * std::sin(2.0 * 3.141592653589793 * static_cast<double>(t) * 1e-9);
     for (std::size_t b = 0; b < buses.size(); ++b) {
@@ -170,17 +179,17 @@ struct Host {
 void let_the_devices_poll() { std::this_thread::sleep_for(std::chrono::milliseconds(30)); }
 
 TEST(HostDeath, EveryDeviceStopsWithinTheWatchdogTime) {
-  Figure figure;
-  const Nanos watchdog = static_cast<Nanos>(figure.watchdog_ms()) * kMs;
-  ASSERT_EQ(figure.watchdog_ms(), 50);  // the default at 200 Hz
+  Rig rig;
+  const Nanos watchdog = static_cast<Nanos>(rig.watchdog_ms()) * kMs;
+  ASSERT_EQ(rig.watchdog_ms(), 50);  // the default at 200 Hz
   Client client("can1");
-  auto host = std::make_unique<Host>(figure);
+  Host host(*rig.figure);
 
   // A second of motion; the last host heartbeat and the last cycle noted.
   Nanos t = 1000 * kMs, last_heartbeat = -1;
   for (int k = 1; k <= 200; ++k) {
     t += 5 * kMs;
-    host->cycle(figure, t);
+    host.cycle(rig, t);
     client.heartbeat_seen = false;
     client.take_pending();
     if (client.heartbeat_seen) last_heartbeat = t;
@@ -188,8 +197,8 @@ TEST(HostDeath, EveryDeviceStopsWithinTheWatchdogTime) {
   const Nanos death = t;
   ASSERT_GE(last_heartbeat, death - 15 * kMs);
   ASSERT_TRUE(client.operation_enabled());
-  ASSERT_FALSE(figure.any_motor_limp());
-  // Death: the host objects stay, silent; nothing is sent from here on.
+  ASSERT_FALSE(rig.any_motor_limp());
+  // Death: the host's buses stay, silent; nothing is sent from here on.
 
   // Time goes on, a millisecond at a time. The drive: in Operation Enabled
   // up to the consumer time after the last heartbeat, out of it one
@@ -197,12 +206,12 @@ TEST(HostDeath, EveryDeviceStopsWithinTheWatchdogTime) {
   // motors: driven at `death` for the last time, not limp at the timeout.
   Nanos left_at = -1;
   for (Nanos now = death + kMs; now <= death + watchdog; now += kMs) {
-    figure.clock.set(now);
+    rig.clock->set(now);
     if (left_at < 0 && !client.operation_enabled()) left_at = now;
   }
   let_the_devices_poll();
-  EXPECT_FALSE(figure.any_motor_limp());
-  figure.clock.set(death + watchdog + kMs);
+  EXPECT_FALSE(rig.any_motor_limp());
+  rig.clock->set(death + watchdog + kMs);
   if (left_at < 0 && !client.operation_enabled()) left_at = death + watchdog + kMs;
   ASSERT_GT(left_at, 0) << "the drive stayed in Operation Enabled";
   EXPECT_EQ(left_at, last_heartbeat + watchdog + kMs);
@@ -213,39 +222,44 @@ TEST(HostDeath, EveryDeviceStopsWithinTheWatchdogTime) {
   // Quick stop (6007h = 3), and the drive's 605Ah keeps it there.
   EXPECT_EQ(client.upload(0x6041, 0) & 0x6F, 0x07u);
   // ... and every motor limp a millisecond after its timeout.
-  for (int i = 0; i < 100 && !figure.every_motor_limp(); ++i) let_the_devices_poll();
-  EXPECT_TRUE(figure.every_motor_limp());
+  for (int i = 0; i < 100 && !rig.every_motor_limp(); ++i) let_the_devices_poll();
+  EXPECT_TRUE(rig.every_motor_limp());
   // Limp: nothing drives them toward their last goals any more.
-  const double held = figure.sims[0]->device_position(1);
-  figure.clock.set(death + 2000 * kMs);
-  EXPECT_NEAR(figure.sims[0]->device_position(1), held, 1e-9);
+  const double held = rig.simulated.devices()[0]->device_position(1);
+  rig.clock->set(death + 2000 * kMs);
+  EXPECT_NEAR(rig.simulated.devices()[0]->device_position(1), held, 1e-9);
 
   // A new host brings the figure up again: the drive is taken out of its
   // quick stop, the motors into motor mode; a clean end clears the guard.
-  host.reset();
-  Host again(figure);
-  again.cycle(figure, death + 2005 * kMs);
+  // It is a figure of its own, built on the devices as a second process
+  // would find them: as hardware, at the interfaces the first figure opened.
+  LoadedRobot robot = load_robot(kRobot);
+  robot.config = rig.figure->config();
+  HardwareBackend devices;
+  Figure second(std::move(robot), devices);
+  Host again(second);
+  again.cycle(rig, death + 2005 * kMs);
   EXPECT_TRUE(client.operation_enabled());
   EXPECT_EQ(client.upload(0x1001, 0), 0u);
-  EXPECT_FALSE(figure.any_motor_limp());
+  EXPECT_FALSE(rig.any_motor_limp());
   EXPECT_EQ(client.upload(0x1016, 1), 0x007F0032u);
-  for (auto& bus : again.buses) bus->deactivate();
+  for (auto* bus : again.buses) bus->deactivate();
   EXPECT_EQ(client.upload(0x1016, 1), 0u);
   EXPECT_FALSE(client.operation_enabled());
 }
 
 TEST(HostDeath, WithTheGuardOffTheDevicesKeepGoing) {
-  Figure figure(0);
+  Rig rig(0);
   Client client("can1");
-  auto host = std::make_unique<Host>(figure);
+  Host host(*rig.figure);
   Nanos t = 1000 * kMs;
-  for (int k = 1; k <= 100; ++k) host->cycle(figure, t += 5 * kMs);
-  figure.clock.set(t + 1000 * kMs);
+  for (int k = 1; k <= 100; ++k) host.cycle(rig, t += 5 * kMs);
+  rig.clock->set(t + 1000 * kMs);
   let_the_devices_poll();
   EXPECT_TRUE(client.operation_enabled());
-  EXPECT_FALSE(figure.any_motor_limp());
+  EXPECT_FALSE(rig.any_motor_limp());
   EXPECT_EQ(client.upload(0x1016, 1), 0u);
-  for (auto& bus : host->buses) bus->deactivate();
+  for (auto* bus : host.buses) bus->deactivate();
 }
 
 // The buses come up one after another; the devices' guards start only once
@@ -254,17 +268,17 @@ TEST(HostDeath, WithTheGuardOffTheDevicesKeepGoing) {
 // not held again at its old pose (it may have sagged): the run is refused.
 TEST(HostDeath, ASlowBusComingUpDoesNotCountAgainstTheOthers) {
   for (const Nanos bring_up : {40 * kMs, 80 * kMs}) {
-    Figure figure;
-    std::vector<std::unique_ptr<ActuatorBus>> buses;
-    for (const BusConfig& config : figure.robot.config.buses) buses.push_back(make_bus(config));
-    for (auto& bus : buses) bus->configure();
+    Rig rig;
+    std::vector<ActuatorBus*> buses;
+    for (std::size_t b = 0; b < rig.figure->bus_count(); ++b) buses.push_back(&rig.figure->bus(b));
+    for (auto* bus : buses) bus->configure();
     buses[0]->activate();
     buses[1]->activate();
-    figure.clock.set(figure.clock.now() + bring_up);
+    rig.clock->set(rig.clock->now() + bring_up);
     buses[2]->activate();
     std::string refused;
     try {
-      for (auto& bus : buses) bus->arm_device_guard();
+      for (auto* bus : buses) bus->arm_device_guard();
     } catch (const DeviceError& e) {
       refused = e.what();
     }
@@ -273,16 +287,16 @@ TEST(HostDeath, ASlowBusComingUpDoesNotCountAgainstTheOthers) {
       EXPECT_EQ(refused, "");
       // 30 ms after arming, 70 ms after the motors were activated: arming
       // held them again, so they are still driven.
-      figure.clock.set(figure.clock.now() + 30 * kMs);
+      rig.clock->set(rig.clock->now() + 30 * kMs);
       let_the_devices_poll();
-      EXPECT_FALSE(figure.any_motor_limp());
+      EXPECT_FALSE(rig.any_motor_limp());
     } else {
       EXPECT_NE(refused.find("the motors' CAN timeout (50 ms) ran out while the other buses "
                              "came up (80 ms)"),
                 std::string::npos)
           << refused;
     }
-    for (auto& bus : buses) bus->deactivate();
+    for (auto* bus : buses) bus->deactivate();
   }
 }
 
