@@ -78,101 +78,95 @@ std::string span_text(Table t, int begin, int end) {
          (end - begin > 1 ? ".." + std::to_string(end - 1) : "");
 }
 
-std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
-  root.allow_only({"name", "unit", "goal", "present", "status", "enable", "watchdog", "range"});
-  auto map = std::make_shared<RegisterMap>();
-  map->file = root.file();
-  map->name = root.get_string("name", "");
-  const YamlNode unit = root.at("unit");
-  map->unit = unit.as_string();
-  if (map->unit != "rad" && map->unit != "m")
-    unit.fail("expected rad or m, found " + unit.describe());
-  map->goal = parse_register(root.at("goal"), false, true);
-  map->present = parse_register(root.at("present"), true, true);
+// A register the map uses, for the overlap check.
+struct Named {
+  const char* key;
+  Table table;
+  int begin, end;
+  Location where;
+};
 
-  struct Named {
-    const char* key;
-    Table table;
-    int begin, end;
-    Location where;
-  };
-  std::vector<Named> used{
-      {"goal", map->goal.table, map->goal.address, map->goal.end(), map->goal.where},
-      {"present", map->present.table, map->present.address, map->present.end(),
-       map->present.where}};
-
-  if (auto status = root.find("status")) {
-    if (!status->is_map()) status->fail("expected a map, found " + status->describe());
-    status->allow_only({"table", "address", "type", "fault_bits"});
-    // The register part, without the fault bits.
-    map->has_status = true;
-    map->status.where = status->location();
-    map->status.table = parse_table(status->at("table"), true);
-    map->status.type = parse_type(status->at("type"));
-    if (map->status.words() != 1) {
-      status->at("type").fail("a status register is int16 or uint16, found " +
-                              status->at("type").describe());
-    }
-    map->status.address = static_cast<int>(status->at("address").as_int_in(0, kMaxAddress));
-    if (auto bits = status->find("fault_bits")) {
-      for (const auto& [key, value] : bits->entries()) {
-        int bit = -1;
-        try {
-          std::size_t used_chars = 0;
-          bit = std::stoi(key, &used_chars);
-          if (used_chars != key.size()) bit = -1;
-        } catch (...) {
-          bit = -1;
-        }
-        if (bit < 0 || bit > 15)
-          value.fail("expected a bit number 0..15 as the key, found " + quote(key));
-        map->faults.push_back(FaultBit{bit, value.as_string()});
-        map->fault_mask = static_cast<std::uint16_t>(map->fault_mask | (1u << bit));
+// The status register and its fault bits.
+void parse_status(const YamlNode& status, RegisterMap& map, std::vector<Named>& used) {
+  if (!status.is_map()) status.fail("expected a map, found " + status.describe());
+  status.allow_only({"table", "address", "type", "fault_bits"});
+  // The register part, without the fault bits.
+  map.has_status = true;
+  map.status.where = status.location();
+  map.status.table = parse_table(status.at("table"), true);
+  map.status.type = parse_type(status.at("type"));
+  if (map.status.words() != 1) {
+    status.at("type").fail("a status register is int16 or uint16, found " +
+                           status.at("type").describe());
+  }
+  map.status.address = static_cast<int>(status.at("address").as_int_in(0, kMaxAddress));
+  if (auto bits = status.find("fault_bits")) {
+    for (const auto& [key, value] : bits->entries()) {
+      int bit = -1;
+      try {
+        std::size_t used_chars = 0;
+        bit = std::stoi(key, &used_chars);
+        if (used_chars != key.size()) bit = -1;
+      } catch (...) {
+        bit = -1;
       }
-    }
-    used.push_back(
-        {"status", map->status.table, map->status.address, map->status.end(), map->status.where});
-  }
-  if (auto enable = root.find("enable")) {
-    if (!enable->is_map()) enable->fail("expected a map, found " + enable->describe());
-    enable->allow_only({"coil", "register", "on", "off"});
-    Enable& e = map->enable;
-    e.configured = true;
-    e.where = enable->location();
-    const auto coil = enable->find("coil");
-    const auto reg = enable->find("register");
-    if (coil && reg) reg->fail("give either coil or register, not both");
-    if (!coil && !reg) enable->fail("missing key coil or register");
-    e.coil = coil.has_value();
-    e.address = static_cast<int>((coil ? *coil : *reg).as_int_in(0, kMaxAddress));
-    const std::int64_t top = e.coil ? 1 : 65535;
-    if (auto n = enable->find("on")) e.on = static_cast<std::uint16_t>(n->as_int_in(0, top));
-    if (auto n = enable->find("off")) e.off = static_cast<std::uint16_t>(n->as_int_in(0, top));
-    if (e.on == e.off)
-      enable->at("on").fail("on and off must differ, both are " + std::to_string(e.on));
-    if (!e.coil) used.push_back({"enable", Table::holding, e.address, e.address + 1, e.where});
-  }
-  if (auto watchdog = root.find("watchdog")) {
-    if (!watchdog->is_map()) watchdog->fail("expected a map, found " + watchdog->describe());
-    watchdog->allow_only({"register", "unit_ms"});
-    Watchdog& w = map->watchdog;
-    w.configured = true;
-    w.where = watchdog->location();
-    w.address = static_cast<int>(watchdog->at("register").as_int_in(0, kMaxAddress));
-    if (auto n = watchdog->find("unit_ms")) w.unit_ms = n->as_double_in(0.001, 60000.0);
-    used.push_back({"watchdog", Table::holding, w.address, w.address + 1, w.where});
-  }
-  if (auto range = root.find("range")) {
-    range->allow_only({"min", "max"});
-    map->has_range = true;
-    map->range_min = range->at("min").as_double();
-    const YamlNode max = range->at("max");
-    map->range_max = max.as_double();
-    if (!(map->range_max > map->range_min)) {
-      max.fail("expected a value greater than min (" + format_number(map->range_min) + "), found " +
-               max.describe());
+      if (bit < 0 || bit > 15)
+        value.fail("expected a bit number 0..15 as the key, found " + quote(key));
+      map.faults.push_back(FaultBit{bit, value.as_string()});
+      map.fault_mask = static_cast<std::uint16_t>(map.fault_mask | (1u << bit));
     }
   }
+  used.push_back(
+      {"status", map.status.table, map.status.address, map.status.end(), map.status.where});
+}
+
+// The coil or register that switches the drive on and off.
+void parse_enable(const YamlNode& enable, RegisterMap& map, std::vector<Named>& used) {
+  if (!enable.is_map()) enable.fail("expected a map, found " + enable.describe());
+  enable.allow_only({"coil", "register", "on", "off"});
+  Enable& e = map.enable;
+  e.configured = true;
+  e.where = enable.location();
+  const auto coil = enable.find("coil");
+  const auto reg = enable.find("register");
+  if (coil && reg) reg->fail("give either coil or register, not both");
+  if (!coil && !reg) enable.fail("missing key coil or register");
+  e.coil = coil.has_value();
+  e.address = static_cast<int>((coil ? *coil : *reg).as_int_in(0, kMaxAddress));
+  const std::int64_t top = e.coil ? 1 : 65535;
+  if (auto n = enable.find("on")) e.on = static_cast<std::uint16_t>(n->as_int_in(0, top));
+  if (auto n = enable.find("off")) e.off = static_cast<std::uint16_t>(n->as_int_in(0, top));
+  if (e.on == e.off)
+    enable.at("on").fail("on and off must differ, both are " + std::to_string(e.on));
+  if (!e.coil) used.push_back({"enable", Table::holding, e.address, e.address + 1, e.where});
+}
+
+// The drive's own guard against a dead host.
+void parse_watchdog(const YamlNode& watchdog, RegisterMap& map, std::vector<Named>& used) {
+  if (!watchdog.is_map()) watchdog.fail("expected a map, found " + watchdog.describe());
+  watchdog.allow_only({"register", "unit_ms"});
+  Watchdog& w = map.watchdog;
+  w.configured = true;
+  w.where = watchdog.location();
+  w.address = static_cast<int>(watchdog.at("register").as_int_in(0, kMaxAddress));
+  if (auto n = watchdog.find("unit_ms")) w.unit_ms = n->as_double_in(0.001, 60000.0);
+  used.push_back({"watchdog", Table::holding, w.address, w.address + 1, w.where});
+}
+
+void parse_range(const YamlNode& range, RegisterMap& map) {
+  range.allow_only({"min", "max"});
+  map.has_range = true;
+  map.range_min = range.at("min").as_double();
+  const YamlNode max = range.at("max");
+  map.range_max = max.as_double();
+  if (!(map.range_max > map.range_min)) {
+    max.fail("expected a value greater than min (" + format_number(map.range_min) + "), found " +
+             max.describe());
+  }
+}
+
+// Two registers of one table that share an address are refused.
+void check_overlaps(const std::vector<Named>& used) {
   for (std::size_t i = 0; i < used.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
       const Named& a = used[j];
@@ -185,6 +179,29 @@ std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
       }
     }
   }
+}
+
+std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
+  root.allow_only({"name", "unit", "goal", "present", "status", "enable", "watchdog", "range"});
+  auto map = std::make_shared<RegisterMap>();
+  map->file = root.file();
+  map->name = root.get_string("name", "");
+  const YamlNode unit = root.at("unit");
+  map->unit = unit.as_string();
+  if (map->unit != "rad" && map->unit != "m")
+    unit.fail("expected rad or m, found " + unit.describe());
+  map->goal = parse_register(root.at("goal"), false, true);
+  map->present = parse_register(root.at("present"), true, true);
+
+  std::vector<Named> used{
+      {"goal", map->goal.table, map->goal.address, map->goal.end(), map->goal.where},
+      {"present", map->present.table, map->present.address, map->present.end(),
+       map->present.where}};
+  if (auto status = root.find("status")) parse_status(*status, *map, used);
+  if (auto enable = root.find("enable")) parse_enable(*enable, *map, used);
+  if (auto watchdog = root.find("watchdog")) parse_watchdog(*watchdog, *map, used);
+  if (auto range = root.find("range")) parse_range(*range, *map);
+  check_overlaps(used);
   return map;
 }
 
