@@ -32,6 +32,122 @@ void read_timeout(const YamlNode& node, BusConfig& bus) {
   }
 }
 
+// The joint's register map, resolved against the robot file's folder.
+std::shared_ptr<const modbus::RegisterMap> load_joint_map(const YamlNode& node,
+                                                          const YamlNode& map_node,
+                                                          const std::string& given) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(node.file()).parent_path();
+  const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
+  if (!fs::is_regular_file(resolved)) {
+    map_node.fail("register map not found: " + quote_path(given) + " (resolved to " +
+                  quote_path(resolved.string()) + ")");
+  }
+  return modbus::load_register_map(resolved.string());
+}
+
+// The device-side watchdog in the map's counts, or a refusal when the bus
+// asks for one the map cannot set.
+void set_watchdog_counts(const YamlNode& map_node, const std::string& given, const JointSpec& joint,
+                         const BusConfig& bus, ModbusJointOptions& j) {
+  const modbus::RegisterMap& m = *j.map;
+  const auto& bus_options = std::any_cast<const ModbusBusOptions&>(bus.options);
+  if (bus_options.device_watchdog_ms > 0.0 && m.watchdog.configured) {
+    const double counts = std::ceil(bus_options.device_watchdog_ms / m.watchdog.unit_ms - 1e-9);
+    if (counts > 65535.0) {
+      map_node.fail("device_watchdog_ms " + format_number(bus_options.device_watchdog_ms) +
+                    " is more than the watchdog register of " + quote_path(given) +
+                    " holds (65535 counts of " + format_number(m.watchdog.unit_ms) + " ms)");
+    }
+    j.watchdog_counts = static_cast<std::uint16_t>(std::max(1.0, counts));
+  } else if (bus_options.device_watchdog_given && bus_options.device_watchdog_ms > 0.0) {
+    throw InputError(bus_options.device_watchdog_where, bus_options.device_watchdog_path,
+                     "the register map " + quote_path(given) + " of joint " + joint.name +
+                         " names no watchdog or timeout register, so animrt cannot set a "
+                         "device-side watchdog on this bus: remove " +
+                         std::string(kDeviceWatchdogKey) +
+                         " or name the drive's timeout register (watchdog) in the map");
+  }
+}
+
+// How the joint maps to the actuator's stroke (m_per_rad, zero_m).
+void read_stroke(const YamlNode& node, const YamlNode& map_node, const std::string& given,
+                 const JointSpec& joint, ModbusJointOptions& j) {
+  const modbus::RegisterMap& m = *j.map;
+  const auto per = node.find("m_per_rad");
+  const auto zero = node.find("zero_m");
+  const bool prismatic = joint.type == JointType::prismatic;
+  if (prismatic) {
+    // The joint is the actuator's stroke itself: metres in, metres out.
+    if (m.unit != "m") {
+      map_node.fail("joint " + joint.name + " is prismatic (metres) but the map " + given +
+                    " is in radians; use a map in metres");
+    }
+    if (per) {
+      per->fail("joint " + joint.name +
+                " is prismatic: the actuator moves it directly, so there is no stroke per "
+                "radian (zero_m alone sets the actuator position at joint 0 m)");
+    }
+    j.per_rad = 1.0;
+    if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
+  } else if (m.unit == "m") {
+    if (!per) {
+      node.fail("missing key m_per_rad: the map " + given +
+                " is in metres, so the joint needs the stroke per radian (negative to reverse)");
+    }
+    j.per_rad = per->as_double();
+    if (!(std::abs(j.per_rad) >= 1e-6 && std::abs(j.per_rad) <= 10.0))
+      per->fail("expected a magnitude from 1e-06 to 10 m/rad (negative to reverse), found " +
+                per->describe());
+    if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
+  } else if (per || zero) {
+    (per ? *per : *zero)
+        .fail("the map " + given + " is in radians; m_per_rad and zero_m apply to maps in metres");
+  }
+}
+
+// Two joints of one slave must not share a register.
+void check_shared_registers(const YamlNode& slave, const JointSpec& joint, const BusConfig& bus,
+                            const ModbusJointOptions& j) {
+  const modbus::RegisterMap& m = *j.map;
+  for (const auto& other : bus.actuators) {
+    const auto& o = std::any_cast<const ModbusJointOptions&>(other.options);
+    if (o.slave != j.slave) continue;
+    for (const auto& a : m.spans()) {
+      for (const auto& b : o.map->spans()) {
+        if (a.first == b.first && a.second.first < b.second.second &&
+            b.second.first < a.second.second) {
+          slave.fail("registers overlap: joint " + joint.name + " and joint " + other.joint +
+                     " on slave " + std::to_string(j.slave) + " both use " +
+                     modbus::to_string(a.first) + " register " +
+                     std::to_string(std::max(a.second.first, b.second.first)));
+        }
+      }
+    }
+  }
+}
+
+// The joint's limits fit in the range the map gives the actuator.
+void check_range(const YamlNode& limits_node, const std::string& given, const JointSpec& joint,
+                 const ModbusJointOptions& j) {
+  const modbus::RegisterMap& m = *j.map;
+  if (!m.has_range) return;
+  const bool prismatic = joint.type == JointType::prismatic;
+  static constexpr const char* kDegKeys[] = {"min_deg", "max_deg"};
+  static constexpr const char* kMetreKeys[] = {"min_m", "max_m"};
+  for (const char* key : prismatic ? kMetreKeys : kDegKeys) {
+    const double rad = key[1] == 'i' ? joint.limits.min_position : joint.limits.max_position;
+    const double si = j.zero + j.per_rad * rad;
+    if (si < m.range_min - 1e-12 || si > m.range_max + 1e-12) {
+      limits_node.at(key).fail(
+          (prismatic ? format_number(rad) + " m" : format_number(rad_to_deg(rad)) + " deg") +
+          " maps to " + format_number(si) + " " + m.unit + ", outside the range of " + given +
+          " (" + format_number(m.range_min) + ".." + format_number(m.range_max) + " " + m.unit +
+          ")");
+    }
+  }
+}
+
 class ModbusProtocol final : public Protocol {
  public:
   explicit ModbusProtocol(bool tcp) : tcp_(tcp) {}
@@ -125,94 +241,11 @@ class ModbusProtocol final : public Protocol {
     }
     const YamlNode map_node = node.at("map");
     const std::string given = map_node.as_string();
-    namespace fs = std::filesystem;
-    const fs::path folder = fs::path(node.file()).parent_path();
-    const fs::path resolved = fs::path(given).is_absolute() ? fs::path(given) : folder / given;
-    if (!fs::is_regular_file(resolved)) {
-      map_node.fail("register map not found: " + quote_path(given) + " (resolved to " +
-                    quote_path(resolved.string()) + ")");
-    }
-    j.map = modbus::load_register_map(resolved.string());
-    const modbus::RegisterMap& m = *j.map;
-    const auto& bus_options = std::any_cast<const ModbusBusOptions&>(bus.options);
-    if (bus_options.device_watchdog_ms > 0.0 && m.watchdog.configured) {
-      const double counts = std::ceil(bus_options.device_watchdog_ms / m.watchdog.unit_ms - 1e-9);
-      if (counts > 65535.0) {
-        map_node.fail("device_watchdog_ms " + format_number(bus_options.device_watchdog_ms) +
-                      " is more than the watchdog register of " + quote_path(given) +
-                      " holds (65535 counts of " + format_number(m.watchdog.unit_ms) + " ms)");
-      }
-      j.watchdog_counts = static_cast<std::uint16_t>(std::max(1.0, counts));
-    } else if (bus_options.device_watchdog_given && bus_options.device_watchdog_ms > 0.0) {
-      throw InputError(bus_options.device_watchdog_where, bus_options.device_watchdog_path,
-                       "the register map " + quote_path(given) + " of joint " + joint.name +
-                           " names no watchdog or timeout register, so animrt cannot set a "
-                           "device-side watchdog on this bus: remove " +
-                           std::string(kDeviceWatchdogKey) +
-                           " or name the drive's timeout register (watchdog) in the map");
-    }
-    const auto per = node.find("m_per_rad");
-    const auto zero = node.find("zero_m");
-    const bool prismatic = joint.type == JointType::prismatic;
-    if (prismatic) {
-      // The joint is the actuator's stroke itself: metres in, metres out.
-      if (m.unit != "m") {
-        map_node.fail("joint " + joint.name + " is prismatic (metres) but the map " + given +
-                      " is in radians; use a map in metres");
-      }
-      if (per) {
-        per->fail("joint " + joint.name +
-                  " is prismatic: the actuator moves it directly, so there is no stroke per "
-                  "radian (zero_m alone sets the actuator position at joint 0 m)");
-      }
-      j.per_rad = 1.0;
-      if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
-    } else if (m.unit == "m") {
-      if (!per) {
-        node.fail("missing key m_per_rad: the map " + given +
-                  " is in metres, so the joint needs the stroke per radian (negative to reverse)");
-      }
-      j.per_rad = per->as_double();
-      if (!(std::abs(j.per_rad) >= 1e-6 && std::abs(j.per_rad) <= 10.0))
-        per->fail("expected a magnitude from 1e-06 to 10 m/rad (negative to reverse), found " +
-                  per->describe());
-      if (zero) j.zero = zero->as_double_in(-1000.0, 1000.0);
-    } else if (per || zero) {
-      (per ? *per : *zero)
-          .fail("the map " + given +
-                " is in radians; m_per_rad and zero_m apply to maps in metres");
-    }
-    // Two joints of one slave must not share a register.
-    for (const auto& other : bus.actuators) {
-      const auto& o = std::any_cast<const ModbusJointOptions&>(other.options);
-      if (o.slave != j.slave) continue;
-      for (const auto& a : m.spans()) {
-        for (const auto& b : o.map->spans()) {
-          if (a.first == b.first && a.second.first < b.second.second &&
-              b.second.first < a.second.second) {
-            slave.fail("registers overlap: joint " + joint.name + " and joint " + other.joint +
-                       " on slave " + std::to_string(j.slave) + " both use " +
-                       modbus::to_string(a.first) + " register " +
-                       std::to_string(std::max(a.second.first, b.second.first)));
-          }
-        }
-      }
-    }
-    if (m.has_range) {
-      static constexpr const char* kDegKeys[] = {"min_deg", "max_deg"};
-      static constexpr const char* kMetreKeys[] = {"min_m", "max_m"};
-      for (const char* key : prismatic ? kMetreKeys : kDegKeys) {
-        const double rad = key[1] == 'i' ? joint.limits.min_position : joint.limits.max_position;
-        const double si = j.zero + j.per_rad * rad;
-        if (si < m.range_min - 1e-12 || si > m.range_max + 1e-12) {
-          limits_node.at(key).fail(
-              (prismatic ? format_number(rad) + " m" : format_number(rad_to_deg(rad)) + " deg") +
-              " maps to " + format_number(si) + " " + m.unit + ", outside the range of " + given +
-              " (" + format_number(m.range_min) + ".." + format_number(m.range_max) + " " + m.unit +
-              ")");
-        }
-      }
-    }
+    j.map = load_joint_map(node, map_node, given);
+    set_watchdog_counts(map_node, given, joint, bus, j);
+    read_stroke(node, map_node, given, joint, j);
+    check_shared_registers(slave, joint, bus, j);
+    check_range(limits_node, given, joint, j);
     out.device_id = j.slave;
     out.options = j;
   }
