@@ -50,6 +50,18 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
   present_rad_.assign(n, 0.0);
   goal_rad_.assign(n, 0.0);
   answered_.assign(n, 0);
+  group_slaves(bus);
+  // Requests per slave: one read per table over every present/status
+  // register, one write per contiguous run of goal registers.
+  for (Slave& s : slaves_) {
+    plan_reads(s, bus);
+    plan_writes(s, bus);
+  }
+  open_context(bus);
+}
+
+void ModbusBus::group_slaves(const std::string& bus) {
+  const std::size_t n = config_.actuators.size();
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     const auto* j = std::any_cast<ModbusJointOptions>(&b.options);
@@ -64,57 +76,61 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
     }
     slave->devices.push_back(i);
   }
-  // Requests per slave: one read per table over every present/status
-  // register, one write per contiguous run of goal registers.
-  for (Slave& s : slaves_) {
-    for (modbus::Table table : {modbus::Table::holding, modbus::Table::input}) {
-      int lo = 1 << 20, hi = -1;
-      for (std::size_t d : s.devices) {
-        const modbus::RegisterMap& m = *joints_[d].map;
-        auto cover = [&](const modbus::Register& r) {
-          if (r.table != table) return;
-          lo = std::min(lo, r.address);
-          hi = std::max(hi, r.end());
-        };
-        cover(m.present);
-        if (m.has_status) cover(m.status);
-      }
-      if (hi < 0) continue;
-      if (hi - lo > kMaxReadWords) {
-        throw DeviceError(bus + "the " + std::string(modbus::to_string(table)) +
-                          " registers read from slave " + std::to_string(s.id) + " span " +
-                          std::to_string(hi - lo) + " registers, more than one request can read (" +
-                          std::to_string(kMaxReadWords) + ")");
-      }
-      Read r;
-      r.table = table;
-      r.begin = lo;
-      r.count = hi - lo;
-      r.words.assign(static_cast<std::size_t>(r.count), 0);
-      s.reads.push_back(std::move(r));
-    }
-    std::vector<std::pair<int, int>> goals;
-    for (std::size_t d : s.devices)
-      goals.push_back({joints_[d].map->goal.address, joints_[d].map->goal.end()});
-    std::sort(goals.begin(), goals.end());
-    for (std::size_t k = 0; k < goals.size(); ++k) {
-      if (k > 0 && goals[k].first < goals[k - 1].second) {
-        throw DeviceError(bus + "two joints on slave " + std::to_string(s.id) +
-                          " write the same goal register " + std::to_string(goals[k].first));
-      }
-      if (!s.writes.empty() && s.writes.back().begin + s.writes.back().count == goals[k].first &&
-          s.writes.back().count + (goals[k].second - goals[k].first) <= kMaxWriteWords) {
-        s.writes.back().count += goals[k].second - goals[k].first;
-      } else {
-        Write w;
-        w.begin = goals[k].first;
-        w.count = goals[k].second - goals[k].first;
-        s.writes.push_back(std::move(w));
-      }
-    }
-    for (Write& w : s.writes) w.words.assign(static_cast<std::size_t>(w.count), 0);
-  }
+}
 
+void ModbusBus::plan_reads(Slave& s, const std::string& bus) {
+  for (modbus::Table table : {modbus::Table::holding, modbus::Table::input}) {
+    int lo = 1 << 20, hi = -1;
+    for (std::size_t d : s.devices) {
+      const modbus::RegisterMap& m = *joints_[d].map;
+      auto cover = [&](const modbus::Register& r) {
+        if (r.table != table) return;
+        lo = std::min(lo, r.address);
+        hi = std::max(hi, r.end());
+      };
+      cover(m.present);
+      if (m.has_status) cover(m.status);
+    }
+    if (hi < 0) continue;
+    if (hi - lo > kMaxReadWords) {
+      throw DeviceError(bus + "the " + std::string(modbus::to_string(table)) +
+                        " registers read from slave " + std::to_string(s.id) + " span " +
+                        std::to_string(hi - lo) + " registers, more than one request can read (" +
+                        std::to_string(kMaxReadWords) + ")");
+    }
+    Read r;
+    r.table = table;
+    r.begin = lo;
+    r.count = hi - lo;
+    r.words.assign(static_cast<std::size_t>(r.count), 0);
+    s.reads.push_back(std::move(r));
+  }
+}
+
+void ModbusBus::plan_writes(Slave& s, const std::string& bus) {
+  std::vector<std::pair<int, int>> goals;
+  for (std::size_t d : s.devices)
+    goals.push_back({joints_[d].map->goal.address, joints_[d].map->goal.end()});
+  std::sort(goals.begin(), goals.end());
+  for (std::size_t k = 0; k < goals.size(); ++k) {
+    if (k > 0 && goals[k].first < goals[k - 1].second) {
+      throw DeviceError(bus + "two joints on slave " + std::to_string(s.id) +
+                        " write the same goal register " + std::to_string(goals[k].first));
+    }
+    if (!s.writes.empty() && s.writes.back().begin + s.writes.back().count == goals[k].first &&
+        s.writes.back().count + (goals[k].second - goals[k].first) <= kMaxWriteWords) {
+      s.writes.back().count += goals[k].second - goals[k].first;
+    } else {
+      Write w;
+      w.begin = goals[k].first;
+      w.count = goals[k].second - goals[k].first;
+      s.writes.push_back(std::move(w));
+    }
+  }
+  for (Write& w : s.writes) w.words.assign(static_cast<std::size_t>(w.count), 0);
+}
+
+void ModbusBus::open_context(const std::string& bus) {
   if (options_.tcp) {
     const auto colon = config_.port.rfind(':');
     if (colon == std::string::npos)

@@ -116,6 +116,13 @@ class ModbusBus final : public ActuatorBus {
   };
   enum class Failure : std::uint8_t { none, timeout, exception, crc, protocol, connection };
 
+  // The constructor's stages: which slave each joint is on, the slave's
+  // requests (one read per table, one write per run of goal registers), the
+  // libmodbus context. `bus` prefixes their errors.
+  void group_slaves(const std::string& bus);
+  void plan_reads(Slave& slave, const std::string& bus);
+  void plan_writes(Slave& slave, const std::string& bus);
+  void open_context(const std::string& bus);
   bool ensure_connected(bool blocking);
   void disconnect();
   void flush_input();
