@@ -196,6 +196,27 @@ struct DashboardServer::Impl {
 
   // One frame: drain the rings, read the block, build the JSON.
   std::string build_state() {
+    drain_rings();
+    monitor.read(view);
+    phase.store(view.phase, std::memory_order_relaxed);
+    json manual_positions = json::object();
+    json joints = joints_json(manual_positions);
+    json devices = devices_json();
+    json fault_log = fault_log_json(devices);
+    json frame = {{"t_s", view.t_s},
+                  {"phase", to_string(view.phase)},
+                  {"joints", joints},
+                  {"loop", loop_json()},
+                  {"devices", devices},
+                  {"faults", fault_log},
+                  {"motion", motion_json()},
+                  {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
+    if (setup.figure && view.published) add_bodies(frame);
+    return frame.dump();
+  }
+
+  // The cycle timings into the statistics, the events into the fault log.
+  void drain_rings() {
     CycleTiming timing;
     while (monitor.pop_timing(timing)) stats.add(timing);
     CycleEvent event;
@@ -204,11 +225,11 @@ struct DashboardServer::Impl {
       if (text.empty()) continue;
       if (faults.size() < kFaultLogCapacity) faults.emplace_back(event.t, std::move(text));
     }
-    monitor.read(view);
-    phase.store(view.phase, std::memory_order_relaxed);
+  }
+
+  json joints_json(json& manual_positions) const {
     const std::size_t n = model.joint_count();
     json joints = json::array();
-    json manual_positions = json::object();
     for (std::size_t j = 0; j < n; ++j) {
       joints.push_back({{"name", model.joint_names[j]},
                         {"cmd", nullable(view.cmd[j])},
@@ -216,6 +237,10 @@ struct DashboardServer::Impl {
                         {"vel", nullable(view.vel[j])}});
       if (view.manual) manual_positions[model.joint_names[j]] = nullable(view.manual_pose[j]);
     }
+    return joints;
+  }
+
+  json loop_json() const {
     json late = json::object();
     for (std::size_t b = 0; b < model.buses.size(); ++b) late[model.buses[b].name] = view.late[b];
     json edges = json::array(), counts = json::array();
@@ -223,6 +248,17 @@ struct DashboardServer::Impl {
       edges.push_back(kJitterEdgesMs[i]);
       counts.push_back(stats.jitter_bins[i]);
     }
+    return {{"cycles", view.cycles},
+            {"rate_hz", stats.rate_hz()},
+            {"period_ms", timing_json(stats.period)},
+            {"jitter_ms", timing_json(stats.jitter)},
+            {"overruns", view.overruns},
+            {"skipped", view.skipped},
+            {"late", late},
+            {"jitter_hist", {{"edges_ms", edges}, {"counts", counts}}}};
+  }
+
+  json devices_json() const {
     json devices = json::array();
     std::size_t k = 0;
     for (const BusModel& bus : model.buses) {
@@ -242,6 +278,10 @@ struct DashboardServer::Impl {
                            {"last_fault", nullptr}});
       }
     }
+    return devices;
+  }
+
+  json fault_log_json(json& devices) const {
     json fault_log = json::array();
     for (const auto& [t, text] : faults) {
       fault_log.push_back({{"t_s", t}, {"text", text}});
@@ -252,38 +292,27 @@ struct DashboardServer::Impl {
         if (text.rfind(prefix, 0) == 0) d["last_fault"] = text;
       }
     }
-    json frame = {{"t_s", view.t_s},
-                  {"phase", to_string(view.phase)},
-                  {"joints", joints},
-                  {"loop",
-                   {{"cycles", view.cycles},
-                    {"rate_hz", stats.rate_hz()},
-                    {"period_ms", timing_json(stats.period)},
-                    {"jitter_ms", timing_json(stats.jitter)},
-                    {"overruns", view.overruns},
-                    {"skipped", view.skipped},
-                    {"late", late},
-                    {"jitter_hist", {{"edges_ms", edges}, {"counts", counts}}}}},
-                  {"devices", devices},
-                  {"faults", fault_log},
-                  {"motion",
-                   {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
-                    {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
-                    {"position_s", view.show.show ? view.show.position_s : view.motion_time_s},
-                    {"playing", view.phase == RunPhaseView::motion && !view.manual &&
-                                    (!view.show.show || view.show.playing)},
-                    {"duration_s", view.show.show ? json(view.show.duration_s) : json(nullptr)}}},
-                  {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
-    if (setup.figure && view.published) {
-      const std::size_t bodies = setup.figure->bodies().size();
-      measured_bodies.resize(bodies);
-      commanded_bodies.resize(bodies);
-      setup.figure->pose(view.meas, measured_bodies);
-      setup.figure->pose(view.cmd, commanded_bodies);
-      frame["bodies"] = {{"measured", poses_json(measured_bodies)},
-                         {"commanded", poses_json(commanded_bodies)}};
-    }
-    return frame.dump();
+    return fault_log;
+  }
+
+  json motion_json() const {
+    return {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
+            {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
+            {"position_s", view.show.show ? view.show.position_s : view.motion_time_s},
+            {"playing", view.phase == RunPhaseView::motion && !view.manual &&
+                            (!view.show.show || view.show.playing)},
+            {"duration_s", view.show.show ? json(view.show.duration_s) : json(nullptr)}};
+  }
+
+  // The figure posed from the measured and the commanded joints.
+  void add_bodies(json& frame) {
+    const std::size_t bodies = setup.figure->bodies().size();
+    measured_bodies.resize(bodies);
+    commanded_bodies.resize(bodies);
+    setup.figure->pose(view.meas, measured_bodies);
+    setup.figure->pose(view.cmd, commanded_bodies);
+    frame["bodies"] = {{"measured", poses_json(measured_bodies)},
+                       {"commanded", poses_json(commanded_bodies)}};
   }
 
   void sample_loop() {
@@ -342,6 +371,14 @@ struct DashboardServer::Impl {
       controls.manual.store(manual, std::memory_order_release);
       answer(res, 200, {{"ok", true}});
     });
+    route_jog();
+    route_steer();
+    route_show();
+    route_seek(server);
+  }
+
+  // A joint's position in manual mode, clamped to its limits.
+  void route_jog() {
     control("/api/jog", [this](const json& body, httplib::Response& res) {
       const auto joint = body.find("joint");
       if (joint == body.end() || !joint->is_string()) {
@@ -362,6 +399,9 @@ struct DashboardServer::Impl {
       }
       answer(res, 200, {{"ok", true}, {"position", clamped}});
     });
+  }
+
+  void route_steer() {
     control("/api/steer", [this](const json& body, httplib::Response& res) {
       if (!setup.steering) return error(res, 409, "the motion is not steerable");
       const auto speed = number(body, "speed_mps");
@@ -372,6 +412,10 @@ struct DashboardServer::Impl {
       controls.steer.post(MotionCommand{*speed, *turn});
       answer(res, 200, {{"ok", true}});
     });
+  }
+
+  // A show's play, pause or seek.
+  void route_show() {
     control("/api/show", [this](const json& body, httplib::Response& res) {
       if (!setup.show) return error(res, 409, "the motion is not a show");
       const auto action = body.find("action");
@@ -398,7 +442,10 @@ struct DashboardServer::Impl {
       if (seek) answer_body["t_s"] = *seek;
       answer(res, 200, answer_body);
     });
+  }
 
+  // A replay's seek (no token: a replay controls no robot).
+  void route_seek(httplib::Server& server) {
     server.Post("/api/seek", [this](const httplib::Request& req, httplib::Response& res) {
       if (!setup.replay || !setup.seek) return error(res, 409, "not a replay");
       const json body = json::parse(req.body, nullptr, false);
@@ -415,7 +462,6 @@ struct DashboardServer::Impl {
       setup.seek(*t, playing == body.end() || playing->get<bool>());
       answer(res, 200, {{"ok", true}});
     });
-
   }
 };
 
