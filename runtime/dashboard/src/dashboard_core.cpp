@@ -224,6 +224,12 @@ void DashboardCore::routes() {
     const auto frame = latest();
     res.set_content(state_from_ ? state_from_(*frame) : *frame, "application/json");
   });
+  route_stream();
+  route_files();
+}
+
+// Server-sent events: each new frame to every open stream.
+void DashboardCore::route_stream() {
   server_.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     auto seen = std::make_shared<std::uint64_t>(0);
@@ -263,7 +269,9 @@ void DashboardCore::routes() {
           changed_.notify_all();
         });
   });
+}
 
+void DashboardCore::route_files() {
   // The page, and Debian's three.js and Chart.js.
   // Browsers load ES modules only with a JavaScript type.
   server_.set_file_extension_and_mimetype_mapping("js", "text/javascript");

@@ -97,6 +97,8 @@ class DashboardCore {
 
  private:
   void routes();
+  void route_stream();
+  void route_files();
 
   DashboardListen listen_;
   std::string token_;
