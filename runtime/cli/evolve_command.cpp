@@ -51,6 +51,98 @@ std::string with_extension(const std::string& path, const std::string& ext) {
 
 RunControls evolve_signal_controls;  // a search takes only its stop
 
+// The run file with the command line's overrides.
+evolve::RunConfig load_config(const EvolveArgs& a) {
+  evolve::RunConfig config = evolve::load_run_config(a.run_file);
+  if (a.seed) config.search.seed = *a.seed;
+  if (a.population) config.search.population = *a.population;
+  if (a.generations) config.search.generations = *a.generations;
+  if (a.threads) config.threads = *a.threads;
+  if (config.search.elites >= config.search.population) {
+    config.search.elites = std::max(0, config.search.population - 1);
+  }
+  return config;
+}
+
+// The seed gait must drive joints the model has (errors name the gait file).
+void check_seed_drives_model(const GaitFile& seed, const sim::MujocoGaitSimulatorFactory& factory) {
+  std::vector<JointSpec> specs;
+  for (const auto& j : factory.model().actuated_joints) {
+    JointSpec s;
+    s.name = j;
+    s.limits = {-kPi, kPi, 100.0, 10000.0};
+    specs.push_back(s);
+  }
+  (void)make_gait_source(seed, specs);
+}
+
+// The dashboard (rank 0's), which poses `figure` from the model; its line
+// comes first.
+std::unique_ptr<EvolveDashboardServer> serve_dashboard(
+    const EvolveArgs& a, const std::pair<std::string, int>& dashboard_at,
+    const evolve::RunConfig& config, const evolve::ModelInfo& info, int workers,
+    std::unique_ptr<sim::MujocoFigure>& figure) {
+  figure =
+      std::make_unique<sim::MujocoFigure>(config.model, info.joints, Location{config.file, 0, 0});
+  EvolveDashboardSetup setup;
+  setup.host = dashboard_at.first;
+  setup.port = dashboard_at.second;
+  setup.remote = a.dashboard_remote;
+  setup.rate_hz = a.dashboard_rate;
+  setup.www_dir = a.dashboard_www;
+  setup.name = config.name;
+  setup.run_file = config.file;
+  setup.grammar = config.grammar;
+  setup.model_file = config.model;
+  setup.population = config.search.population;
+  setup.generations = config.search.generations;
+  setup.seed = config.search.seed;
+  setup.workers = workers;
+  setup.joints = info.joints;
+  setup.figure = figure.get();
+  auto dashboard = std::make_unique<EvolveDashboardServer>(setup);
+  std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+  return dashboard;
+}
+
+void print_header(const evolve::RunConfig& config, const evolve::ModelInfo& info, int workers,
+                  const evolve::MpiSession* session) {
+  std::cout << "evolve " << config.name << ": grammar " << config.grammar
+            << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)" : "")
+            << ", model " << config.model << " (" << info.joints.size() << " actuators, "
+            << info.mass_kg << " kg), population " << config.search.population << ", "
+            << config.search.generations << " generations, seed " << config.search.seed << ", "
+            << workers << " worker" << (workers == 1 ? "" : "s")
+            << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
+            << std::flush;
+}
+
+// The history (CSV and plot) and the best gait written, the best reported.
+int write_results(const EvolveArgs& a, const evolve::RunConfig& config,
+                  const evolve::SearchResult& result, EvolveDashboardServer* dashboard) {
+  const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
+  const std::string plot = a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
+  evolve::write_history_csv(result.history, csv);
+  evolve::write_history_svg(result.history, config.name, plot);
+  const auto& best = result.best;
+  if (!best.valid) {
+    if (dashboard) dashboard->finish(result.stopped);
+    std::cerr << "error: no valid individual in the last generation; no gait written\n";
+    return 4;
+  }
+  write_gait_file(best.gait, a.out);
+  // The page shows the end once every file is written.
+  if (dashboard) dashboard->finish(result.stopped);
+  const auto& m = best.measures;
+  std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
+            << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
+            << ", energy " << m.energy_per_cycle << " J/cycle\n"
+            << "evaluations " << result.evaluations << " (and " << result.reused
+            << " repeated gaits not walked again), invalid " << result.invalid << '\n'
+            << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
+  return 0;
+}
+
 int run_evolve(const EvolveArgs& a) {
   if (a.pareto && !a.dashboard.empty()) {
     std::cerr << "--dashboard shows the single-objective search; it does not go with --pareto\n";
@@ -60,28 +152,11 @@ int run_evolve(const EvolveArgs& a) {
   const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
   if (!address.ok) return kExitUsage;
   const auto& dashboard_at = address.at;
-  evolve::RunConfig config = evolve::load_run_config(a.run_file);
-  if (a.seed) config.search.seed = *a.seed;
-  if (a.population) config.search.population = *a.population;
-  if (a.generations) config.search.generations = *a.generations;
-  if (a.threads) config.threads = *a.threads;
-  if (config.search.elites >= config.search.population) {
-    config.search.elites = std::max(0, config.search.population - 1);
-  }
+  evolve::RunConfig config = load_config(a);
   evolve::Grammar grammar = evolve::Grammar::load_file(config.grammar);
   GaitFile seed = load_gait_file(config.seed_gait);
   sim::MujocoGaitSimulatorFactory factory(config.model);
-  // The seed gait must drive joints the model has (errors name the gait file).
-  {
-    std::vector<JointSpec> specs;
-    for (const auto& j : factory.model().actuated_joints) {
-      JointSpec s;
-      s.name = j;
-      s.limits = {-kPi, kPi, 100.0, 10000.0};
-      specs.push_back(s);
-    }
-    (void)make_gait_source(seed, specs);
-  }
+  check_seed_drives_model(seed, factory);
   evolve::ModelInfo info{factory.model().actuated_joints, factory.model().hip_height_m,
                          factory.model().mass_kg};
 
@@ -98,42 +173,12 @@ int run_evolve(const EvolveArgs& a) {
       distributed ? static_cast<evolve::Evaluator&>(*distributed) : local;
 
   const int workers = evaluator.workers();
-  // The dashboard (rank 0's): its line comes first.
   std::unique_ptr<sim::MujocoFigure> figure;
   std::unique_ptr<EvolveDashboardServer> dashboard;
   if (dashboard_at && lead) {
-    figure =
-        std::make_unique<sim::MujocoFigure>(config.model, info.joints, Location{config.file, 0, 0});
-    EvolveDashboardSetup setup;
-    setup.host = dashboard_at->first;
-    setup.port = dashboard_at->second;
-    setup.remote = a.dashboard_remote;
-    setup.rate_hz = a.dashboard_rate;
-    setup.www_dir = a.dashboard_www;
-    setup.name = config.name;
-    setup.run_file = config.file;
-    setup.grammar = config.grammar;
-    setup.model_file = config.model;
-    setup.population = config.search.population;
-    setup.generations = config.search.generations;
-    setup.seed = config.search.seed;
-    setup.workers = workers;
-    setup.joints = info.joints;
-    setup.figure = figure.get();
-    dashboard = std::make_unique<EvolveDashboardServer>(setup);
-    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+    dashboard = serve_dashboard(a, *dashboard_at, config, info, workers, figure);
   }
-  if (lead && !a.quiet) {
-    std::cout << "evolve " << config.name << ": grammar " << config.grammar
-              << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)"
-                                                                       : "")
-              << ", model " << config.model << " (" << info.joints.size() << " actuators, "
-              << info.mass_kg << " kg), population " << config.search.population << ", "
-              << config.search.generations << " generations, seed " << config.search.seed << ", "
-              << workers << " worker" << (workers == 1 ? "" : "s")
-              << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
-              << std::flush;
-  }
+  if (lead && !a.quiet) print_header(config, info, workers, session.get());
   if (a.pareto) {
     return run_pareto_search(config, std::move(grammar), seed, info, evaluator,
                              {a.out, lead, a.quiet});
@@ -165,28 +210,7 @@ int run_evolve(const EvolveArgs& a) {
               << " after generation " << result.history.back().generation << " of " << generations
               << '\n';
   }
-
-  const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
-  const std::string plot = a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
-  evolve::write_history_csv(result.history, csv);
-  evolve::write_history_svg(result.history, config.name, plot);
-  const auto& best = result.best;
-  if (!best.valid) {
-    if (dashboard) dashboard->finish(result.stopped);
-    std::cerr << "error: no valid individual in the last generation; no gait written\n";
-    return 4;
-  }
-  write_gait_file(best.gait, a.out);
-  // The page shows the end once every file is written.
-  if (dashboard) dashboard->finish(result.stopped);
-  const auto& m = best.measures;
-  std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
-            << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
-            << ", energy " << m.energy_per_cycle << " J/cycle\n"
-            << "evaluations " << result.evaluations << " (and " << result.reused
-            << " repeated gaits not walked again), invalid " << result.invalid << '\n'
-            << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
-  return 0;
+  return write_results(a, config, result, dashboard.get());
 }
 
 }  // namespace
