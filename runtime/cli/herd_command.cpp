@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -80,53 +81,33 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
 
 RunControls herd_signal_controls;  // a herd takes only its stop
 
-int run_herd(const HerdArgs& a) {
-  herd::HerdScene scene = herd::load_herd_scene(a.scene);
-  if (a.duration) scene.duration_s = *a.duration;
-  const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
-  if (!address.ok) return kExitUsage;
-  const auto& dashboard_at = address.at;
-  herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
+// With a dashboard the herd walks at real time (or a multiple of it), so
+// it can be watched; without one it runs as fast as it can.
+std::unique_ptr<HerdDashboardServer> serve_dashboard(const HerdArgs& a,
+                                                     const std::pair<std::string, int>& at,
+                                                     herd::Herd& herd) {
+  HerdDashboardSetup setup;
+  setup.host = at.first;
+  setup.port = at.second;
+  setup.remote = a.dashboard_remote;
+  setup.www_dir = a.dashboard_www;
+  setup.speed = a.dashboard_speed;
+  auto dashboard = std::make_unique<HerdDashboardServer>(herd, setup);
+  std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
+  // Served, it may be left running: a stop signal ends it as the page's
+  // Stop does, files written (a second one ends it at once).
+  install_stop_signals(herd_signal_controls, SecondSignal::end_process);
+  return dashboard;
+}
+
+// Steps the herd to its end (or a stop), calling `output` at the output
+// rate; with a dashboard, paced to its speed and published at its rate.
+void step_herd(const HerdArgs& a, herd::Herd& herd, HerdDashboardServer* dashboard,
+               const std::function<void()>& output, std::chrono::steady_clock::time_point start) {
   const herd::HerdScene& s = herd.scene();
-  // With a dashboard the herd walks at real time (or a multiple of it), so
-  // it can be watched; without one it runs as fast as it can.
-  std::unique_ptr<HerdDashboardServer> dashboard;
-  if (dashboard_at) {
-    HerdDashboardSetup setup;
-    setup.host = dashboard_at->first;
-    setup.port = dashboard_at->second;
-    setup.remote = a.dashboard_remote;
-    setup.www_dir = a.dashboard_www;
-    setup.speed = a.dashboard_speed;
-    dashboard = std::make_unique<HerdDashboardServer>(herd, setup);
-    std::cout << "dashboard: " << dashboard->url() << '\n' << std::flush;
-    // Served, it may be left running: a stop signal ends it as the page's
-    // Stop does, files written (a second one ends it at once).
-    install_stop_signals(herd_signal_controls, SecondSignal::end_process);
-  }
-  if (!a.quiet) {
-    std::cout << "herd " << (s.name.empty() ? s.file : s.name) << ": " << herd.agents().size()
-              << " figures in " << s.groups.size() << " groups, " << s.duration_s << " s at "
-              << s.step_s << " s steps, seed " << s.seed << '\n'
-              << std::flush;
-  }
-  std::ofstream csv;
-  if (!a.out.empty()) {
-    csv.open(a.out);
-    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
-    herd::write_csv_header(csv);
-  }
-  herd::TrailRecorder trails;
   const long steps = std::lround(s.duration_s / s.step_s);
   const long steps_per_output = std::max(1L, std::lround(1.0 / (s.output_hz * s.step_s)));
-  const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
-  const auto output = [&] {
-    herd.record_metrics();
-    if (csv.is_open()) herd::write_csv_rows(csv, herd);
-    if (!a.svg.empty()) trails.sample(herd);
-  };
-  output();
   const auto publish_period = std::chrono::duration<double>(1.0 / a.dashboard_rate);
   auto last_publish = start;
   for (long k = 1; k <= steps; ++k) {
@@ -153,6 +134,59 @@ int run_herd(const HerdArgs& a) {
                 << std::flush;
     }
   }
+}
+
+// The CSV closed, the trails and the summary written.
+void write_outputs(const HerdArgs& a, std::ofstream& csv, const herd::TrailRecorder& trails,
+                   const herd::Herd& herd, const herd::HerdMetrics& metrics, double wall_s) {
+  if (csv.is_open()) {
+    csv.close();
+    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    std::cout << "wrote " << a.out << '\n';
+  }
+  if (!a.svg.empty()) {
+    trails.write_svg(a.svg, herd);
+    std::cout << "wrote " << a.svg << '\n';
+  }
+  if (!a.summary_json.empty()) {
+    std::ofstream j(a.summary_json);
+    j << to_json(metrics, wall_s).dump(2) << '\n';
+    if (!j) throw std::runtime_error(a.summary_json + ": cannot write the summary");
+    std::cout << "wrote " << a.summary_json << '\n';
+  }
+}
+
+int run_herd(const HerdArgs& a) {
+  herd::HerdScene scene = herd::load_herd_scene(a.scene);
+  if (a.duration) scene.duration_s = *a.duration;
+  const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
+  if (!address.ok) return kExitUsage;
+  const auto& dashboard_at = address.at;
+  herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
+  const herd::HerdScene& s = herd.scene();
+  std::unique_ptr<HerdDashboardServer> dashboard;
+  if (dashboard_at) dashboard = serve_dashboard(a, *dashboard_at, herd);
+  if (!a.quiet) {
+    std::cout << "herd " << (s.name.empty() ? s.file : s.name) << ": " << herd.agents().size()
+              << " figures in " << s.groups.size() << " groups, " << s.duration_s << " s at "
+              << s.step_s << " s steps, seed " << s.seed << '\n'
+              << std::flush;
+  }
+  std::ofstream csv;
+  if (!a.out.empty()) {
+    csv.open(a.out);
+    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    herd::write_csv_header(csv);
+  }
+  herd::TrailRecorder trails;
+  const auto start = std::chrono::steady_clock::now();
+  const auto output = [&] {
+    herd.record_metrics();
+    if (csv.is_open()) herd::write_csv_rows(csv, herd);
+    if (!a.svg.empty()) trails.sample(herd);
+  };
+  output();
+  step_herd(a, herd, dashboard.get(), output, start);
   if (dashboard) {
     dashboard->publish(herd);
     dashboard->stop();
@@ -170,21 +204,7 @@ int run_herd(const HerdArgs& a) {
                 : signalled ? ", stopped by a signal"
                             : "")
             << '\n';
-  if (csv.is_open()) {
-    csv.close();
-    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
-    std::cout << "wrote " << a.out << '\n';
-  }
-  if (!a.svg.empty()) {
-    trails.write_svg(a.svg, herd);
-    std::cout << "wrote " << a.svg << '\n';
-  }
-  if (!a.summary_json.empty()) {
-    std::ofstream j(a.summary_json);
-    j << to_json(metrics, wall_s).dump(2) << '\n';
-    if (!j) throw std::runtime_error(a.summary_json + ": cannot write the summary");
-    std::cout << "wrote " << a.summary_json << '\n';
-  }
+  write_outputs(a, csv, trails, herd, metrics, wall_s);
   return 0;
 }
 
