@@ -297,28 +297,8 @@ int cmd_sim(const std::string& path) {
   return kExitOk;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  auto logger = spdlog::stderr_color_mt("animrt");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("%^[%l]%$ %v");
-
-  // Before any command runs: a fatal error switches torque off first
-  // (emergency_stop.hpp), and a write to a pipe or socket whose reader left
-  // fails with EPIPE instead of killing the process (a dashboard whose
-  // browser closed; run and sim take SIGPIPE as a stop below).
-  animrt::install_fatal_error_handlers();
-  signal(SIGPIPE, SIG_IGN);
-
-  CLI::App app{"animrt: real-time motion for animatronic figures"};
-  app.require_subcommand(1);
-
-  std::string validate_path;
-  auto* validate = app.add_subcommand("validate", "Check a robot file and the files it names");
-  validate->add_option("FILE", validate_path, "robot file (YAML)")->required();
-
-  RunArgs run_args;
+// The run subcommand and its options, parsed into `run_args`.
+CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
   auto* run = app.add_subcommand("run", "Run a robot's motion on hardware or simulated devices");
   run->add_option("CONFIG", run_args.config, "robot file (YAML)")->required();
   run->add_option("--backend", run_args.backend, "sim (simulated devices on ptys) or hardware")
@@ -353,6 +333,32 @@ int main(int argc, char** argv) {
                   "herd scene (YAML): the robot walks as one of its agents (needs --agent)");
   run->add_option("--agent", run_args.agent,
                   "the herd agent the robot is, GROUP.INDEX (e.g. red.0)");
+  return run;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  auto logger = spdlog::stderr_color_mt("animrt");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("%^[%l]%$ %v");
+
+  // Before any command runs: a fatal error switches torque off first
+  // (emergency_stop.hpp), and a write to a pipe or socket whose reader left
+  // fails with EPIPE instead of killing the process (a dashboard whose
+  // browser closed; run and sim take SIGPIPE as a stop below).
+  animrt::install_fatal_error_handlers();
+  signal(SIGPIPE, SIG_IGN);
+
+  CLI::App app{"animrt: real-time motion for animatronic figures"};
+  app.require_subcommand(1);
+
+  std::string validate_path;
+  auto* validate = app.add_subcommand("validate", "Check a robot file and the files it names");
+  validate->add_option("FILE", validate_path, "robot file (YAML)")->required();
+
+  RunArgs run_args;
+  auto* run = add_run_subcommand(app, run_args);
 
   std::string sim_path;
   auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");
