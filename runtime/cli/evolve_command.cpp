@@ -143,6 +143,31 @@ int write_results(const EvolveArgs& a, const evolve::RunConfig& config,
   return 0;
 }
 
+// Progress lines and the dashboard per generation. With `stoppable`, a
+// stop from the dashboard (or a stop signal, while it serves: a second one
+// ends the process at once) ends the search after the generation it arrived
+// in, files written; under MPI rank 0's answer is every rank's.
+evolve::SearchHooks search_hooks(const EvolveArgs& a, bool lead, int generations,
+                                 EvolveDashboardServer* dashboard, evolve::MpiSession* session,
+                                 bool stoppable) {
+  evolve::SearchHooks hooks;
+  hooks.generation = [&a, lead, generations, dashboard](const evolve::GenerationStats& s,
+                                                        const evolve::Individual& best) {
+    if (lead && !a.quiet)
+      std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
+    if (dashboard) dashboard->publish(s, best);
+  };
+  if (stoppable) {
+    install_stop_signals(evolve_signal_controls, SecondSignal::end_process);
+    hooks.stop = [dashboard, session] {
+      const bool stop =
+          (dashboard && dashboard->stop_requested()) || evolve_signal_controls.stop.load();
+      return session ? session->broadcast(stop) : stop;
+    };
+  }
+  return hooks;
+}
+
 int run_evolve(const EvolveArgs& a) {
   if (a.pareto && !a.dashboard.empty()) {
     std::cerr << "--dashboard shows the single-objective search; it does not go with --pareto\n";
@@ -185,24 +210,8 @@ int run_evolve(const EvolveArgs& a) {
   }
   const int generations = config.search.generations;
   evolve::Search search(config, std::move(grammar), seed, info, evaluator);
-  evolve::SearchHooks hooks;
-  hooks.generation = [&](const evolve::GenerationStats& s, const evolve::Individual& best) {
-    if (lead && !a.quiet)
-      std::cout << evolve::format_progress(s, generations) << '\n' << std::flush;
-    if (dashboard) dashboard->publish(s, best);
-  };
-  // A stop from the dashboard (or a stop signal, while it serves: a second
-  // one ends the process at once) ends the search after the generation it
-  // arrived in, files written; under MPI rank 0's answer is every rank's.
-  if (dashboard_at) {
-    install_stop_signals(evolve_signal_controls, SecondSignal::end_process);
-    hooks.stop = [&] {
-      const bool stop =
-          (dashboard && dashboard->stop_requested()) || evolve_signal_controls.stop.load();
-      return session ? session->broadcast(stop) : stop;
-    };
-  }
-  const evolve::SearchResult result = search.run(hooks);
+  const evolve::SearchResult result = search.run(
+      search_hooks(a, lead, generations, dashboard.get(), session.get(), dashboard_at.has_value()));
   if (!lead) return 0;
   if (result.stopped) {
     std::cout << (evolve_signal_controls.stop.load() ? "stopped by a signal"
