@@ -34,7 +34,7 @@ code=$?
 [[ $code -eq 2 && $out == *"bad.yaml:13:"*"groups[0].count"* ]] || fail "bad scene (exit $code): $out"
 
 # The robot as one agent: lockstep physics, the herd steers its gait.
-out=$("$animrt" run "$root/configs/robots/quadruped.yaml" --lockstep --no-realtime --duration 25 \
+out=$("$animrt" run "$root/configs/robots/quadruped.yaml" --lockstep --no-realtime --duration 18 \
   --physics "$root/configs/models/quadruped.xml" --herd "$root/configs/herd/walker.yaml" \
   --agent walker.0 2>&1) || fail "run --herd failed: $out"
 line=$(grep -o 'distance to its goal [0-9.]* -> [0-9.]* m' <<< "$out") || fail "no herd report: $out"
@@ -45,7 +45,7 @@ read -r before after < <(sed 's/distance to its goal \([0-9.]*\) -> \([0-9.]*\) 
 
 # The pony, which turns: a wall stands between it and its goal, so the herd
 # walks it round the wall (off its heading and back) to the goal, on physics.
-out=$("$animrt" run "$root/configs/robots/pony.yaml" --lockstep --no-realtime --duration 50 \
+out=$("$animrt" run "$root/configs/robots/pony.yaml" --lockstep --no-realtime --duration 45 \
   --physics "$root/configs/models/pony.xml" --herd "$root/configs/herd/pony_walker.yaml" \
   --agent pony.0 2>&1) || fail "pony run --herd failed: $out"
 line=$(grep -o 'heading [-0-9.]* rad, .*distance to its goal [0-9.]* -> [0-9.]* m' <<< "$out") ||
