@@ -120,7 +120,7 @@ struct Rig {
       config.buses[2].options = drive;
     };
     figure = std::make_unique<Figure>(load_robot(kRobot), simulated, options);
-    clock = figure->run_options().lockstep_clock;
+    clock = figure->run_options().lockstep_clock;  // a run would advance it; a test does
     clock->set(1000 * kMs);
   }
   sim::CanSimBus& can(std::size_t i) {
