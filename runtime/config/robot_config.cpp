@@ -61,11 +61,56 @@ void check_two_periods(const YamlNode& n, double value, double rate_hz) {
   }
 }
 
+// Device health limits: safety.health, or a bus's health_limits. A warning
+// must come before its fault.
+HealthLimits parse_health_limits(const YamlNode& node, double rate_hz) {
+  node.allow_only({"temperature_warn_c", "temperature_fault_c", "voltage_warn_v", "voltage_fault_v",
+                   "stall_current_a", "stall_time_s", "stall_error_deg", "error_bits"});
+  HealthLimits h;
+  if (auto n = node.find("temperature_warn_c")) h.temperature_warn_c = n->as_double_in(0.0, 200.0);
+  if (auto n = node.find("temperature_fault_c")) {
+    h.temperature_fault_c = n->as_double_in(0.0, 200.0);
+    if (h.temperature_fault_c <= h.temperature_warn_c) {
+      n->fail("expected more than temperature_warn_c (" + format_number(h.temperature_warn_c) +
+              "), found " + n->describe());
+    }
+  }
+  if (auto n = node.find("voltage_warn_v")) h.voltage_warn_v = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("voltage_fault_v")) {
+    h.voltage_fault_v = n->as_double_in(0.0, 100.0);
+    if (h.voltage_fault_v >= h.voltage_warn_v) {
+      n->fail("expected less than voltage_warn_v (" + format_number(h.voltage_warn_v) +
+              "), found " + n->describe());
+    }
+  }
+  if (auto n = node.find("stall_current_a")) h.stall_current_a = n->as_double_in(0.001, 1000.0);
+  if (auto n = node.find("stall_time_s")) {
+    h.stall_time_s = n->as_double_in(0.0, 60.0);
+    check_two_periods(*n, h.stall_time_s, rate_hz);
+  }
+  if (auto n = node.find("stall_error_deg"))
+    h.stall_error_rad = deg_to_rad(n->as_double_in(0.0, 180.0));
+  if (auto n = node.find("error_bits")) {
+    const std::string v = n->is_scalar() ? n->raw().Scalar() : "";
+    if (v == "fault") {
+      h.error_bits = HealthLimits::Bits::fault;
+    } else if (v == "warn") {
+      h.error_bits = HealthLimits::Bits::warn;
+    } else if (v == "ignore") {
+      h.error_bits = HealthLimits::Bits::ignore;
+    } else {
+      n->fail("expected fault, warn or ignore, found " + n->describe());
+    }
+  }
+  return h;
+}
+
 SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
   node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s", "start_ramp_max_s",
                    "stop_deadline_s", "following_error_deg", "following_error_mm",
-                   "following_error_window_s"});
+                   "following_error_window_s", "health"});
   SafetyConfig safety;
+  if (auto n = node.find("health")) safety.health = parse_health_limits(*n, rate_hz);
   if (auto n = node.find("watchdog_timeout_s")) {
     safety.watchdog_timeout_s = n->as_positive_double();
     if (safety.watchdog_timeout_s > kMaxWatchdogS) {
@@ -111,10 +156,65 @@ SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
   return safety;
 }
 
+// sim.health: the simulated servos' thermal, supply and current model.
+void parse_sim_health(const YamlNode& node, SimHealthSettings& h) {
+  node.allow_only({"ambient_c", "thermal_tau_s", "heat_c_per_a2", "supply_v", "supply_ohm",
+                   "idle_current_a", "current_per_rad_s", "stall_current_a", "overload_s"});
+  if (auto n = node.find("ambient_c")) h.ambient_c = n->as_double_in(-40.0, 150.0);
+  if (auto n = node.find("thermal_tau_s")) h.thermal_tau_s = n->as_double_in(0.001, 1e5);
+  if (auto n = node.find("heat_c_per_a2")) h.heat_c_per_a2 = n->as_double_in(0.0, 1000.0);
+  if (auto n = node.find("supply_v")) h.supply_v = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("supply_ohm")) h.supply_ohm = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("idle_current_a")) h.idle_current_a = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("current_per_rad_s")) h.current_per_rad_s = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("stall_current_a")) h.stall_current_a = n->as_double_in(0.0, 100.0);
+  if (auto n = node.find("overload_s")) h.overload_s = n->as_double_in(0.0, 3600.0);
+}
+
+// sim.inject: health changes at a time, one key saying what.
+SimHealthInjection parse_injection(const YamlNode& node) {
+  node.allow_only({"id", "at_s", "temperature_c", "blocked", "supply_v", "hardware_error"});
+  SimHealthInjection i;
+  i.device_id = static_cast<int>(node.at("id").as_int_in(0, 65535));
+  i.at_s = node.at("at_s").as_double_in(0.0, 1e6);
+  int kinds = 0;
+  using Kind = SimHealthInjection::Kind;
+  if (auto n = node.find("temperature_c")) {
+    i.kind = Kind::temperature;
+    i.value = n->as_double_in(-40.0, 250.0);
+    ++kinds;
+  }
+  if (auto n = node.find("blocked")) {
+    i.kind = Kind::blocked;
+    i.value = n->as_bool() ? 1.0 : 0.0;
+    ++kinds;
+  }
+  if (auto n = node.find("supply_v")) {
+    i.kind = Kind::supply;
+    i.value = n->as_double_in(0.0, 100.0);
+    ++kinds;
+  }
+  if (auto n = node.find("hardware_error")) {
+    i.kind = Kind::hardware_error;
+    i.value = static_cast<double>(n->as_int_in(0, 255));
+    ++kinds;
+  }
+  if (kinds != 1) {
+    node.fail("expected exactly one of temperature_c, blocked, supply_v, hardware_error, found " +
+              std::to_string(kinds));
+  }
+  return i;
+}
+
 SimBusSettings parse_sim(const YamlNode& node) {
-  node.allow_only(
-      {"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us", "firmware_version"});
+  node.allow_only({"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us",
+                   "firmware_version", "health", "inject"});
   SimBusSettings sim;
+  if (auto n = node.find("health")) parse_sim_health(*n, sim.health);
+  if (auto n = node.find("inject")) {
+    if (!n->is_sequence()) n->fail("expected a list of injections, found " + n->describe());
+    for (const YamlNode& item : n->items()) sim.health.inject.push_back(parse_injection(item));
+  }
   if (auto n = node.find("time_constant_s")) sim.time_constant_s = n->as_double_in(1e-4, 10.0);
   if (auto n = node.find("max_speed_dps")) {
     sim.max_speed_rad_s = deg_to_rad(n->as_double_in(0.01, 100000.0));
@@ -149,10 +249,12 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   std::vector<std::string_view> keys{"protocol"};
   for (auto key : protocol->bus_keys()) keys.push_back(key);
   keys.push_back("sim");
+  keys.push_back("health_limits");
   node.allow_only(keys);
 
   protocol->read_bus(node, bus);
   if (auto n = node.find("sim")) bus.sim = parse_sim(*n);
+  if (auto n = node.find("health_limits")) bus.health_limits = parse_health_limits(*n, rate_hz);
   return bus;
 }
 

@@ -19,7 +19,34 @@ constexpr std::size_t kEventLogCapacity = 256;
 // "more than 0.1 s" means what it says at 2.4 - 2.3 too.
 constexpr double kTimeEps = 1e-9;
 
+// NaN-aware running extremes: a NaN reading leaves them as they are.
+void keep_min(double& best, double v) {
+  if (!std::isnan(v) && (std::isnan(best) || v < best)) best = v;
+}
+void keep_max(double& best, double v) {
+  if (!std::isnan(v) && (std::isnan(best) || v > best)) best = v;
+}
+// v beyond a limit that is set (a NaN limit or reading is never beyond).
+bool above(double v, double limit) { return !std::isnan(limit) && v > limit; }
+bool below(double v, double limit) { return !std::isnan(limit) && v < limit; }
+
 }  // namespace
+
+const char* to_string(HealthCheck check) {
+  switch (check) {
+    case HealthCheck::temperature:
+      return "temperature";
+    case HealthCheck::voltage:
+      return "undervoltage";
+    case HealthCheck::stall:
+      return "stall";
+    case HealthCheck::error_bits:
+      return "device error bits";
+    case HealthCheck::none:
+      break;
+  }
+  return "none";
+}
 
 CycleState::CycleState(const RobotModel& model)
     : filter_(model.limits, model.dt), ramp_(model.joint_count()), slots_(model.slots) {
@@ -45,6 +72,9 @@ CycleState::CycleState(const RobotModel& model)
   for (const BusModel& bus : model.buses) {
     last_sent_.emplace_back(bus.joint.size(), 0.0);
     faulted_.emplace_back(bus.joint.size(), 0);
+    health_track_.emplace_back(bus.joint.size());
+    health_stats_.emplace_back(bus.joint.size());
+    switch_off_.emplace_back(bus.joint.size(), 0);
     last_ok_.emplace_back(bus.joint.size(), 0.0);
     out_.bus_commands.emplace_back(bus.joint.size(), 0.0);
   }
@@ -152,6 +182,81 @@ struct CycleStages {
           s.faulted_[b][d] = 1;
           fault = true;
           s.emit(CycleEvent{EventKind::device_fault, t, model.buses[b].joint[d], b, d, health});
+        }
+      }
+    }
+    return fault;
+  }
+
+  // Health: each new reading against its bus's limits. A fault switches
+  // the device off and ramps the others home; a warning is an event, once
+  // per episode (until the value is back inside), and counted.
+  static bool watch_health(const RobotModel& model, CycleState& s, const CycleInputs& in) {
+    const double t = in.t;
+    bool fault = false;
+    for (std::size_t b = 0; b < in.buses.size(); ++b) {
+      const BusIo& io = in.buses[b];
+      if (!io.fresh || io.readings.empty()) continue;
+      const HealthLimits& lim = model.buses[b].health;
+      for (std::size_t d = 0; d < s.faulted_[b].size() && d < io.readings.size(); ++d) {
+        const HealthReading& r = io.readings[d];
+        CycleState::HealthTrack& track = s.health_track_[b][d];
+        if (s.faulted_[b][d] || r.reads == track.reads) continue;
+        track.reads = r.reads;
+        HealthStats& st = s.health_stats_[b][d];
+        ++st.readings;
+        keep_min(st.min_temperature_c, r.temperature_c);
+        keep_max(st.max_temperature_c, r.temperature_c);
+        keep_max(st.peak_current_a, r.current_a);
+        keep_min(st.min_voltage_v, r.voltage_v);
+
+        const auto emit = [&](EventKind kind, HealthCheck check, double value) {
+          s.emit(
+              CycleEvent{kind, t, model.buses[b].joint[d], b, d, DeviceHealth::ok, value, check});
+        };
+        // The worst finding of this reading: a fault ends the device.
+        HealthCheck faulty = HealthCheck::none;
+        double faulty_value = 0.0;
+        const auto judge = [&](HealthCheck check, bool is_fault, bool is_warning, double value) {
+          const auto bit = static_cast<std::uint8_t>(1u << static_cast<unsigned>(check));
+          if (is_fault && faulty == HealthCheck::none) {
+            faulty = check;
+            faulty_value = value;
+          } else if (is_warning && !is_fault) {
+            if (!(track.warned & bit)) {
+              track.warned |= bit;
+              ++st.warnings;
+              emit(EventKind::health_warning, check, value);
+            }
+          } else if (!is_fault) {
+            track.warned &= static_cast<std::uint8_t>(~bit);
+          }
+        };
+        judge(HealthCheck::temperature, above(r.temperature_c, lim.temperature_fault_c),
+              above(r.temperature_c, lim.temperature_warn_c), r.temperature_c);
+        judge(HealthCheck::voltage, below(r.voltage_v, lim.voltage_fault_v),
+              below(r.voltage_v, lim.voltage_warn_v), r.voltage_v);
+        const bool bits = r.has_error_bits && r.error_bits != 0;
+        judge(HealthCheck::error_bits, bits && lim.error_bits == HealthLimits::Bits::fault,
+              bits && lim.error_bits == HealthLimits::Bits::warn,
+              static_cast<double>(r.error_bits));
+        // Stall: a high current while the joint stays away from its command.
+        const int j = model.buses[b].joint[d];
+        const double error =
+            j >= 0 ? std::abs(s.last_sent_[b][d] - s.measured_[static_cast<std::size_t>(j)]) : 0.0;
+        if (above(r.current_a, lim.stall_current_a) && error > lim.stall_error_rad) {
+          if (track.stall_since < 0.0) track.stall_since = t;
+          if (t - track.stall_since >= lim.stall_time_s - kTimeEps) {
+            judge(HealthCheck::stall, true, false, r.current_a);
+          }
+        } else {
+          track.stall_since = -1.0;
+        }
+        if (faulty != HealthCheck::none) {
+          s.faulted_[b][d] = 1;
+          s.switch_off_[b][d] = 1;
+          fault = true;
+          emit(EventKind::health_fault, faulty, faulty_value);
         }
       }
     }
@@ -355,7 +460,9 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
 
   S::take_controls(model, motion, s, in);
   S::take_measurements(s, in);
-  const bool device_fault = S::watch_devices(model, s, in);
+  // Health first: a device that reports why it fails is named for it.
+  const bool health_fault = S::watch_health(model, s, in);
+  const bool device_fault = S::watch_devices(model, s, in) || health_fault;
   const bool following_fault = S::watch_following_error(model, s, in.t);
   const bool fault = device_fault || following_fault;
   if (fault) s.end_.fault = true;

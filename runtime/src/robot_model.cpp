@@ -36,6 +36,7 @@ RobotModel make_robot_model(const RobotConfig& config, std::span<const BusConfig
   for (std::size_t b = 0; b < buses.size(); ++b) {
     BusModel bus;
     bus.name = buses[b]->name;
+    bus.health = buses[b]->health_limits.value_or(config.safety.health);
     for (std::size_t d = 0; d < buses[b]->actuators.size(); ++d) {
       const ActuatorBinding& actuator = buses[b]->actuators[d];
       const int j = actuator.joint_index;

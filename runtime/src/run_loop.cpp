@@ -25,6 +25,17 @@ void sleep_until_deadline(Nanos deadline) {
   }
 }
 
+constexpr std::size_t kHealthColumns = 4;  // temperature, current, voltage, error bits
+
+std::vector<JointSlot> health_slots(const std::vector<std::unique_ptr<ActuatorBus>>& buses) {
+  std::vector<JointSlot> slots;
+  for (std::size_t b = 0; b < buses.size(); ++b) {
+    if (!buses[b]->reads_health()) continue;
+    for (std::size_t d = 0; d < buses[b]->config().actuators.size(); ++d) slots.push_back({b, d});
+  }
+  return slots;
+}
+
 const Clock& run_clock(const RunOptions& options, const MonotonicClock& wall) {
   return options.lockstep_clock ? static_cast<const Clock&>(*options.lockstep_clock)
                                 : static_cast<const Clock&>(wall);
@@ -53,11 +64,14 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
       summary_(summary),
       clock_(run_clock(options, wall_)),
       period_(model.period),
-      ring_(1 + 2 * model.joint_count(), kTelemetryCapacity),
-      record_(1 + 2 * model.joint_count()),
+      health_columns_(health_slots(buses)),
+      ring_(1 + 2 * model.joint_count() + kHealthColumns * health_columns_.size(),
+            kTelemetryCapacity),
+      record_(ring_.width()),
       bus_hist_(buses.size()),
       io_(buses.size()),
       health_(buses.size()),
+      readings_(buses.size()),
       view_(buses.size()),
       pending_(buses.size(), 0),
       io_seen_(buses.size(), 0),
@@ -65,11 +79,18 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
       monitor_devices_(buses.size()),
       activation_(buses) {
   if (!options.telemetry_path.empty()) {
-    writer_.emplace(options.telemetry_path, model.joint_names, ring_);
+    for (const JointSlot& slot : health_columns_) {
+      const std::string& joint = buses[slot.bus]->config().actuators[slot.device].joint;
+      for (const char* suffix : {"_temp_c", "_current_a", "_voltage_v", "_error_bits"}) {
+        health_names_.push_back(joint + suffix);
+      }
+    }
+    writer_.emplace(options.telemetry_path, model.joint_names, ring_, health_names_);
   }
   for (std::size_t b = 0; b < buses.size(); ++b) {
     const auto devices = buses[b]->devices();
     health_[b].assign(devices.size(), DeviceHealth::ok);
+    readings_[b].assign(devices.size(), HealthReading{});
     view_[b].assign(devices.begin(), devices.end());
   }
   in_.buses = io_;
@@ -164,9 +185,13 @@ void RunLoop::take_reads() {
     pending_[b] = 0;
     io_[b].fresh = true;
     update_view(b);
-    for (std::size_t d = 0; d < view_[b].size(); ++d) health_[b][d] = view_[b][d].health;
+    for (std::size_t d = 0; d < view_[b].size(); ++d) {
+      health_[b][d] = view_[b][d].health;
+      readings_[b][d] = view_[b][d].reading;
+    }
     io_[b].positions = workers_[b]->positions();
     io_[b].health = health_[b];
+    io_[b].readings = readings_[b];
   }
 }
 
@@ -235,6 +260,14 @@ void RunLoop::record(const CycleOutputs& out) {
   std::copy(out.commands.begin(), out.commands.end(), record_.begin() + 1);
   const auto seen = state_.measured();
   std::copy(seen.begin(), seen.end(), record_.begin() + 1 + static_cast<long>(seen.size()));
+  std::size_t k = 1 + 2 * seen.size();
+  for (const JointSlot& slot : health_columns_) {
+    const HealthReading& r = readings_[slot.bus][slot.device];
+    record_[k++] = r.temperature_c;
+    record_[k++] = r.current_a;
+    record_[k++] = r.voltage_v;
+    record_[k++] = r.has_error_bits ? static_cast<double>(r.error_bits) : HealthReading::kNone;
+  }
   ring_.push(record_);
 }
 
@@ -262,8 +295,14 @@ void RunLoop::mark_faults(std::size_t b) {
   ActuatorBus& bus = *buses_[b];
   const auto devices = bus.devices();
   const auto& faulted = state_.faulted()[b];
+  const auto& off = state_.switch_off()[b];
   for (std::size_t d = 0; d < devices.size(); ++d) {
-    if (faulted[d] && !devices[d].faulted) bus.mark_faulted(d);
+    if (!faulted[d] || devices[d].faulted) continue;
+    if (off[d]) {
+      bus.switch_off(d);
+    } else {
+      bus.mark_faulted(d);
+    }
   }
 }
 

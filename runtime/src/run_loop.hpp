@@ -112,6 +112,10 @@ class RunLoop {
   const Clock& clock_;
   const Nanos period_;
 
+  // Telemetry's health columns: per (bus, device) whose bus reads health,
+  // four values each after the joints' columns.
+  std::vector<JointSlot> health_columns_;
+  std::vector<std::string> health_names_;
   TelemetryRing ring_;
   std::optional<TelemetryWriter> writer_;
   std::vector<double> record_;
@@ -119,6 +123,7 @@ class RunLoop {
   std::vector<MicrosHistogram> bus_hist_;
   std::vector<BusIo> io_;
   std::vector<std::vector<DeviceHealth>> health_;
+  std::vector<std::vector<HealthReading>> readings_;
   std::vector<std::vector<DeviceStatus>> view_;
   std::vector<std::uint8_t> pending_;  // a read posted, not yet used
   std::vector<std::uint64_t> io_seen_;

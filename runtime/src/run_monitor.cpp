@@ -1,5 +1,6 @@
 #include "animrt/runtime/run_monitor.hpp"
 
+#include <cmath>
 #include <thread>
 
 namespace animrt {
@@ -23,8 +24,8 @@ enum Header : std::size_t {
   kShowDuration,
   kHeaderWords
 };
-constexpr std::size_t kJointWords = 4;            // cmd, meas, vel, manual pose
-constexpr std::size_t kDeviceWords = 9;           // id, health, faulted, 6 counters
+constexpr std::size_t kJointWords = 4;    // cmd, meas, vel, manual pose
+constexpr std::size_t kDeviceWords = 13;  // id, health, faulted, 6 counters, 4 health values
 constexpr std::size_t kTimingCapacity = 1 << 13;  // cycles (40 s at 200 Hz unread)
 constexpr std::size_t kEventCapacity = 256;
 constexpr std::size_t kEventWidth = 7;
@@ -150,6 +151,11 @@ void RunMonitor::publish(double t, const CycleState& state, std::span<const doub
       store_u(w + 6, s.protocol_errors);
       store_u(w + 7, s.hardware_errors);
       store_u(w + 8, s.exceptions);
+      store(w + 9, s.reading.temperature_c);
+      store(w + 10, s.reading.current_a);
+      store(w + 11, s.reading.voltage_v);
+      store(w + 12, s.reading.has_error_bits ? static_cast<double>(s.reading.error_bits)
+                                             : HealthReading::kNone);
     }
   }
   end_write();
@@ -251,6 +257,12 @@ void RunMonitor::read(RunView& view) const {
     s.protocol_errors = w[i + 6];
     s.hardware_errors = w[i + 7];
     s.exceptions = w[i + 8];
+    s.reading.temperature_c = as_double(w[i + 9]);
+    s.reading.current_a = as_double(w[i + 10]);
+    s.reading.voltage_v = as_double(w[i + 11]);
+    const double bits = as_double(w[i + 12]);
+    s.reading.has_error_bits = !std::isnan(bits);
+    s.reading.error_bits = s.reading.has_error_bits ? static_cast<std::uint32_t>(bits) : 0;
   }
 }
 

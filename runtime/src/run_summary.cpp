@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "animrt/core/joint.hpp"
 
 namespace animrt {
@@ -11,6 +13,24 @@ std::string ms(double seconds) { return fmt::format("{:.3f} ms", seconds * 1e3);
 
 nlohmann::json timing_json(const TimingSummary& t) {
   return {{"count", t.count}, {"p50_s", t.p50_s}, {"p99_s", t.p99_s}, {"max_s", t.max_s}};
+}
+
+// "3.1 A", or "n/a" for a value never read.
+std::string value_or_na(double v, const char* format_unit) {
+  return std::isnan(v) ? std::string("n/a") : fmt::format(fmt::runtime(format_unit), v);
+}
+
+std::string health_text(const HealthStats& h) {
+  if (h.readings == 0) return {};
+  return fmt::format(
+      "\n      health: temperature {}..{}, peak current {}, min voltage {}, warnings {}",
+      value_or_na(h.min_temperature_c, "{:.0f} C"), value_or_na(h.max_temperature_c, "{:.0f} C"),
+      value_or_na(h.peak_current_a, "{:.2f} A"), value_or_na(h.min_voltage_v, "{:.1f} V"),
+      h.warnings);
+}
+
+nlohmann::json number_or_null(double v) {
+  return std::isnan(v) ? nlohmann::json() : nlohmann::json(v);
 }
 
 std::string device_line(const DeviceReport& d) {
@@ -27,7 +47,8 @@ std::string device_line(const DeviceReport& d) {
               ? fmt::format(" exceptions {} (last code {})", st.exceptions, st.last_error_byte)
               : std::string()) +
          (st.open_loop ? std::string(" [open loop: position is the controller's ramped output]")
-                       : std::string());
+                       : std::string()) +
+         health_text(d.health);
 }
 
 void add_physics(std::string& out, const PhysicsReport& p) {
@@ -74,7 +95,14 @@ nlohmann::json device_json(const DeviceReport& d) {
                         {"hardware_errors", st.hardware_errors},
                         {"hardware_error_status", st.hardware_error_status},
                         {"exceptions", st.exceptions},
-                        {"open_loop", st.open_loop}};
+                        {"open_loop", st.open_loop},
+                        {"readings",
+                         {{"count", d.health.readings},
+                          {"min_temperature_c", number_or_null(d.health.min_temperature_c)},
+                          {"max_temperature_c", number_or_null(d.health.max_temperature_c)},
+                          {"peak_current_a", number_or_null(d.health.peak_current_a)},
+                          {"min_voltage_v", number_or_null(d.health.min_voltage_v)},
+                          {"warnings", d.health.warnings}}}};
 }
 
 nlohmann::json physics_json(const PhysicsReport& p) {
@@ -113,6 +141,7 @@ std::string format_summary(const RunSummary& s) {
       s.robot, s.backend, s.lockstep ? "lockstep" : "real-time", s.rate_hz, to_string(s.end_reason),
       s.motion_time_s));
   for (const auto& fault : s.faults) line("FAULT " + fault);
+  for (const auto& warning : s.health_warnings) line("WARNING " + warning);
   if (!s.torque_cut.empty()) line("TORQUE CUT " + s.torque_cut);
   line(fmt::format("cycles: {}, overruns: {}, skipped cycles: {}", s.cycles, s.overruns,
                    s.skipped_cycles));
@@ -160,6 +189,7 @@ nlohmann::json to_json(const RunSummary& s) {
   j["end_reason"] = to_string(s.end_reason);
   j["exit_code"] = s.exit_code();
   j["faults"] = s.faults;
+  j["health_warnings"] = s.health_warnings;
   j["cycles"] = s.cycles;
   j["overruns"] = s.overruns;
   j["skipped_cycles"] = s.skipped_cycles;

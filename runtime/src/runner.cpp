@@ -42,6 +42,30 @@ std::string slowest_start(const RobotModel& m, std::span<const double> measured,
                      joint_value(first[worst], m.prismatic[worst] != 0));
 }
 
+// "temperature 85 C (fault limit 75 C)", for a health event.
+std::string describe_health(const HealthLimits& lim, const CycleEvent& e) {
+  const bool fault = e.kind == EventKind::health_fault;
+  switch (e.check) {
+    case HealthCheck::temperature:
+      return fmt::format("temperature {:g} C ({} limit {:g} C)", e.value,
+                         fault ? "fault" : "warning",
+                         fault ? lim.temperature_fault_c : lim.temperature_warn_c);
+    case HealthCheck::voltage:
+      return fmt::format("undervoltage: supply {:.1f} V ({} limit {:g} V)", e.value,
+                         fault ? "fault" : "warning",
+                         fault ? lim.voltage_fault_v : lim.voltage_warn_v);
+    case HealthCheck::stall:
+      return fmt::format(
+          "stall: current {:.2f} A (limit {:g} A) for {:g} s while the joint did not follow",
+          e.value, lim.stall_current_a, lim.stall_time_s);
+    case HealthCheck::error_bits:
+      return fmt::format("device error bits 0x{:02X}", static_cast<unsigned>(e.value));
+    case HealthCheck::none:
+      break;
+  }
+  return "health";
+}
+
 std::string describe_event(const RobotModel& m,
                            const std::vector<std::unique_ptr<ActuatorBus>>& buses,
                            const CycleEvent& e) {
@@ -68,6 +92,15 @@ std::string describe_event(const RobotModel& m,
           "other's ids? a blocked or unpowered joint?)",
           bus.name, actuator.device_id, actuator.joint, joint_value(e.value, prismatic, 2),
           m.safety.following_error_window_s, joint_value(limit, prismatic), e.t);
+    }
+    case EventKind::health_fault: {
+      const auto& bus = buses[e.bus]->config();
+      const auto& actuator = bus.actuators[e.device];
+      return fmt::format(
+          "bus {} id {} ({}): {}; at t={:.3f} s; the device was switched off, "
+          "other joints ramped to home",
+          bus.name, actuator.device_id, actuator.joint, describe_health(m.buses[e.bus].health, e),
+          e.t);
     }
     case EventKind::motion_fault:
       return fmt::format(
@@ -232,7 +265,8 @@ void Runner::Impl::report(const RunLoop& loop, const CycleState& state, const Ru
     summary.buses.push_back(BusReport{bus.name, summarize(loop.bus_io(b)), state.late_cycles()[b]});
     const auto devices = loop.device_view(b);
     for (std::size_t d = 0; d < devices.size(); ++d) {
-      summary.devices.push_back(DeviceReport{bus.name, bus.actuators[d].joint, devices[d]});
+      summary.devices.push_back(
+          DeviceReport{bus.name, bus.actuators[d].joint, devices[d], state.health_stats()[b][d]});
     }
   }
   report_events(state, summary);
@@ -259,6 +293,12 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
     } else if (e.kind == EventKind::aborted) {
       summary.torque_cut =
           fmt::format("second stop request at t={:.3f} s: torque switched off at once", e.t);
+    } else if (e.kind == EventKind::health_warning) {
+      const auto& bus = buses[e.bus]->config();
+      const auto& actuator = bus.actuators[e.device];
+      summary.health_warnings.push_back(
+          fmt::format("bus {} id {} ({}): {} at t={:.3f} s", bus.name, actuator.device_id,
+                      actuator.joint, describe_health(model.buses[e.bus].health, e), e.t));
     } else if (std::string line = describe_event(model, buses, e); !line.empty()) {
       summary.faults.push_back(std::move(line));
     }

@@ -43,7 +43,7 @@ bool TelemetryRing::pop(std::span<double> out) {
 }
 
 TelemetryWriter::TelemetryWriter(const std::string& path, std::span<const std::string> joint_names,
-                                 TelemetryRing& ring)
+                                 TelemetryRing& ring, std::span<const std::string> extra_columns)
     : ring_(ring), record_(ring.width(), 0.0) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd_ < 0) {
@@ -54,6 +54,7 @@ TelemetryWriter::TelemetryWriter(const std::string& path, std::span<const std::s
   pending_ = "time_s";
   for (const auto& name : joint_names) pending_ += ',' + name + "_cmd_rad";
   for (const auto& name : joint_names) pending_ += ',' + name + "_meas_rad";
+  for (const auto& name : extra_columns) pending_ += ',' + name;
   pending_ += '\n';
   thread_ = std::thread([this] {
     while (!stop_.load(std::memory_order_acquire)) {

@@ -43,33 +43,44 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   if (!std::getline(in, line)) fail(0, "expected a telemetry CSV header, found an empty file");
   ++line_no;
   const std::vector<std::string> header = split(line);
-  const std::size_t n = header.size() > 1 ? (header.size() - 1) / 2 : 0;
-  if (header.empty() || header[0] != "time_s" || n == 0 || header.size() != 1 + 2 * n) {
+  // time_s, n commands, n measurements, then device health columns (4 per
+  // device whose bus reads health), which a replay does not use.
+  std::size_t n = 0;
+  while (1 + n < header.size() && ends_with(header[1 + n], "_cmd_rad")) ++n;
+  if (header.empty() || header[0] != "time_s" || n == 0 || header.size() < 1 + 2 * n) {
     fail(1,
          "expected the header time_s,<joint>_cmd_rad,...,<joint>_meas_rad,... of animrt run "
          "--telemetry, found " +
              quote(line));
   }
-  int column = static_cast<int>(header[0].size()) + 2;
   for (std::size_t j = 0; j < n; ++j) {
     const std::string& cmd = header[1 + j];
     const std::string& meas = header[1 + n + j];
-    if (!ends_with(cmd, "_cmd_rad")) fail(column, "expected <joint>_cmd_rad, found " + quote(cmd));
     const std::string name = cmd.substr(0, cmd.size() - 8);
     if (meas != name + "_meas_rad") {
       fail(0, "expected " + name + "_meas_rad as column " + std::to_string(2 + n + j) + ", found " +
                   quote(meas));
     }
     rec.joints.push_back(name);
-    column += static_cast<int>(cmd.size()) + 1;
   }
+  for (std::size_t c = 1 + 2 * n; c < header.size(); ++c) {
+    const std::string& h = header[c];
+    if (!ends_with(h, "_temp_c") && !ends_with(h, "_current_a") && !ends_with(h, "_voltage_v") &&
+        !ends_with(h, "_error_bits")) {
+      fail(0,
+           "expected a device health column (<joint>_temp_c, _current_a, _voltage_v or "
+           "_error_bits) as column " +
+               std::to_string(c + 1) + ", found " + quote(h));
+    }
+  }
+  const std::size_t width = header.size();
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty()) continue;
     const std::vector<std::string> fields = split(line);
-    if (fields.size() != 1 + 2 * n) {
-      fail(1, "expected " + std::to_string(1 + 2 * n) + " fields, found " +
-                  std::to_string(fields.size()));
+    if (fields.size() != width) {
+      fail(1,
+           "expected " + std::to_string(width) + " fields, found " + std::to_string(fields.size()));
     }
     int col = 1;
     std::vector<double> values(fields.size());
@@ -86,7 +97,8 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
     }
     rec.t.push_back(values[0]);
     rec.cmd.insert(rec.cmd.end(), values.begin() + 1, values.begin() + 1 + static_cast<long>(n));
-    rec.meas.insert(rec.meas.end(), values.begin() + 1 + static_cast<long>(n), values.end());
+    rec.meas.insert(rec.meas.end(), values.begin() + 1 + static_cast<long>(n),
+                    values.begin() + 1 + static_cast<long>(2 * n));
   }
   if (rec.t.empty()) fail(0, "expected at least one row after the header");
   return rec;

@@ -178,7 +178,8 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_ticks_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
       motor_time_(now),
-      physics_(physics) {
+      physics_(physics),
+      health_(settings.health, binding.device_id, now) {
   if (physics_ != nullptr) {
     physics_joint_ = physics_->joint_index(binding.joint);
     if (physics_joint_ < 0) {
@@ -276,7 +277,7 @@ DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
     m.velocity = scale * physics_->velocity(physics_joint_);
     return m;
   }
-  if (!torque_on() || vmax_ticks_s_ <= 0) {
+  if (!torque_on() || vmax_ticks_s_ <= 0 || health_.blocked()) {  // blocked: held where it is
     m.velocity = 0;
     return m;
   }
@@ -318,6 +319,7 @@ void DynamixelServo::advance(Nanos now) {
   if (physics_ != nullptr) physics_->advance(now);
   motor_ = motor_at(now);
   motor_time_ = now;
+  health_.advance(now, motor_.velocity / binding_.ticks_per_rad, torque_on());
   publish(now);
 }
 
@@ -330,9 +332,24 @@ void DynamixelServo::publish(Nanos now) {
   table_[xreg::moving] = std::abs(velocity) > reg32(xreg_sim::moving_threshold) ? 1 : 0;
   const Nanos ms = now / 1'000'000;
   dxl::put_u16(&table_[xreg_sim::realtime_tick], static_cast<std::uint16_t>(ms % 32768));
-  dxl::put_u16(&table_[xreg_sim::present_input_voltage], kXInputVoltage);
-  table_[xreg::present_temperature] = kXTemperatureC;
-  table_[xreg::hardware_error_status] = injected_error_;
+  // Current signed like the motion, in the XM430's unit (2.69 mA).
+  const double amps = health_.current_a() * (motor_.velocity < 0 ? -1.0 : 1.0);
+  dxl::put_u16(&table_[xreg_sim::present_current],
+               static_cast<std::uint16_t>(static_cast<std::int16_t>(
+                   std::clamp(std::lround(amps / kXCurrentUnitA), -32767L, 32767L))));
+  dxl::put_u16(
+      &table_[xreg_sim::present_input_voltage],
+      static_cast<std::uint16_t>(std::clamp(std::lround(10.0 * health_.voltage_v()), 0L, 65535L)));
+  table_[xreg::present_temperature] =
+      static_cast<std::uint8_t>(std::clamp(std::lround(health_.temperature_c()), 0L, 255L));
+  // The firmware's own checks against its limits, as the Hardware Error
+  // Status bits; one in Shutdown switches torque off until a Reboot.
+  const std::uint8_t model_bits = health_.error_bits(
+      table_[xreg_sim::temperature_limit], 0.1 * dxl::get_u16(&table_[xreg_sim::min_voltage_limit]),
+      0.1 * dxl::get_u16(&table_[xreg_sim::max_voltage_limit]));
+  const std::uint8_t bits = static_cast<std::uint8_t>(injected_error_ | model_bits);
+  if ((bits & table_[xreg_sim::shutdown]) != 0 && !shut_down_) latch_shutdown();
+  table_[xreg::hardware_error_status] = bits;
   table_[xreg_sim::registered_instruction] = pending_length_ > 0 ? 1 : 0;
 }
 

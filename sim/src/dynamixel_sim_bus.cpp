@@ -220,6 +220,29 @@ void DynamixelSimBus::set_device_hardware_error(int device_id, std::uint8_t erro
   servo_or_throw(firmware_, config_, device_id).set_hardware_error(error_bits, clock_.now());
 }
 
+void DynamixelSimBus::inject_device_health(int device_id, const SimHealthInjection& change) {
+  std::lock_guard lock(mutex_);
+  DynamixelServo& servo = servo_or_throw(firmware_, config_, device_id);
+  const Nanos now = clock_.now();
+  servo.advance(now);
+  using Kind = SimHealthInjection::Kind;
+  switch (change.kind) {
+    case Kind::temperature:
+      servo.health().set_temperature(change.value);
+      break;
+    case Kind::blocked:
+      servo.health().set_blocked(change.value != 0.0);
+      break;
+    case Kind::supply:
+      servo.health().set_supply(change.value);
+      break;
+    case Kind::hardware_error:
+      servo.set_hardware_error(static_cast<std::uint8_t>(change.value), now);
+      return;
+  }
+  servo.advance(now);
+}
+
 void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int answers) {
   std::lock_guard lock(mutex_);
   servo_or_throw(firmware_, config_, device_id).set_answer_delay(delay_ns, answers);

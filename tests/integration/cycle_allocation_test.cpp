@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
 #include "support/alloc_counter.hpp"
@@ -178,6 +179,42 @@ TEST(CycleAllocation, DynamixelHardwareError) {
     if (!done && t >= 0.3) rig.sim("legs").set_device_hardware_error(9, 0x04);
     done = done || t >= 0.3;
   });
+}
+
+// Health read with the positions (and one servo per cycle), a warning on
+// the way and a health fault (switching a servo off) at the end.
+test::RigSettings health_on(dxl::HealthRead how) {
+  test::RigSettings settings = short_ramps();
+  settings.edit = [how](RobotConfig& c) {
+    c.safety.start_ramp_s = 0.3;
+    c.safety.stop_ramp_s = 0.3;
+    c.safety.health.temperature_warn_c = 50;
+    c.safety.health.temperature_fault_c = 70;
+    dxl::BusOptions o = dxl::bus_options(c.buses[0]);
+    o.health = how;
+    c.buses[0].options = o;
+  };
+  return settings;
+}
+
+TEST(CycleAllocation, DynamixelHealthPackedWarningAndFault) {
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", health_on(dxl::HealthRead::packed));
+  int step = 0;
+  expect_no_allocation(rig, 2.0, {EndReason::fault}, [&](double t) {
+    using Kind = SimHealthInjection::Kind;
+    if (step == 0 && t >= 0.2) {
+      rig.sim("legs").inject_device_health(4, {4, 0, Kind::temperature, 55});
+      ++step;
+    } else if (step == 1 && t >= 0.4) {
+      rig.sim("legs").inject_device_health(9, {9, 0, Kind::temperature, 75});
+      ++step;
+    }
+  });
+}
+
+TEST(CycleAllocation, DynamixelHealthRoundRobin) {
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", health_on(dxl::HealthRead::round_robin));
+  expect_no_allocation(rig, 1.0, {});
 }
 
 TEST(CycleAllocation, DynamixelMaestroModbusTcpWithTelemetry) {

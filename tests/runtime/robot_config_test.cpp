@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -249,7 +250,7 @@ safety: {watchdog_s: 1}
 )"),
             at("3:10: safety.watchdog_s: unknown key (expected one of: watchdog_timeout_s, "
                "start_ramp_s, stop_ramp_s, start_ramp_max_s, stop_deadline_s, "
-               "following_error_deg, following_error_mm, following_error_window_s)"));
+               "following_error_deg, following_error_mm, following_error_window_s, health)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -259,7 +260,7 @@ buses:
     parity: none
 )"),
             at("7:5: buses.b.parity: unknown key (expected one of: protocol, port, baud, "
-               "timeout_ms, fast_read, model, device_watchdog_ms, sim)"));
+               "timeout_ms, fast_read, model, device_watchdog_ms, health, sim, health_limits)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -270,7 +271,7 @@ buses:
 )"),
             at("7:11: buses.b.sim.max_speed_rad_s: unknown key (expected one of: "
                "time_constant_s, max_speed_dps, wire_time, return_delay_us, "
-               "firmware_version)"));
+               "firmware_version, health, inject)"));
   EXPECT_EQ(
       error_of(R"(name: t
 loop: {rate_hz: 100}
@@ -894,6 +895,72 @@ TEST_F(RobotConfigTest, NewSafetyKeysOutOfRange) {
   EXPECT_EQ(error_of(head + "following_error_window_s: 6}\n"),
             at("3:36: safety.following_error_window_s: expected a number from 0 to 5, found "
                "\"6\""));
+}
+
+TEST_F(RobotConfigTest, HealthLimitsAndTheSimulatedHealthAreRead) {
+  std::string text = kMinimal;
+  text.replace(text.find("loop: {rate_hz: 100}"), 20,
+               "loop: {rate_hz: 100}\nsafety:\n  health: {temperature_warn_c: 60, "
+               "temperature_fault_c: 70, voltage_warn_v: 11, voltage_fault_v: 10, "
+               "stall_current_a: 1.2, stall_time_s: 0.3, stall_error_deg: 4, error_bits: warn}");
+  text.replace(text.find("b: {protocol: dynamixel2, port: /dev/ttyUSB0}"), 45,
+               "b:\n    protocol: dynamixel2\n    port: /dev/ttyUSB0\n    health: packed\n"
+               "    health_limits: {temperature_fault_c: 55}\n"
+               "    sim:\n      health: {ambient_c: 30, supply_v: 11.1}\n"
+               "      inject:\n        - {id: 1, at_s: 2, temperature_c: 80}\n"
+               "        - {id: 1, at_s: 3, blocked: true}");
+  const RobotConfig c = load(text);
+  const HealthLimits& h = c.safety.health;
+  EXPECT_DOUBLE_EQ(h.temperature_warn_c, 60.0);
+  EXPECT_DOUBLE_EQ(h.temperature_fault_c, 70.0);
+  EXPECT_DOUBLE_EQ(h.voltage_warn_v, 11.0);
+  EXPECT_DOUBLE_EQ(h.voltage_fault_v, 10.0);
+  EXPECT_DOUBLE_EQ(h.stall_current_a, 1.2);
+  EXPECT_DOUBLE_EQ(h.stall_time_s, 0.3);
+  EXPECT_DOUBLE_EQ(h.stall_error_rad, deg_to_rad(4.0));
+  EXPECT_EQ(h.error_bits, HealthLimits::Bits::warn);
+  const BusConfig& bus = c.buses[0];
+  ASSERT_TRUE(bus.health_limits.has_value());
+  EXPECT_DOUBLE_EQ(bus.health_limits->temperature_fault_c, 55.0);
+  EXPECT_TRUE(std::isnan(bus.health_limits->temperature_warn_c));
+  EXPECT_EQ(dxl::bus_options(bus).health, dxl::HealthRead::packed);
+  EXPECT_DOUBLE_EQ(bus.sim.health.ambient_c, 30.0);
+  EXPECT_DOUBLE_EQ(bus.sim.health.supply_v, 11.1);
+  ASSERT_EQ(bus.sim.health.inject.size(), 2u);
+  EXPECT_EQ(bus.sim.health.inject[0].kind, SimHealthInjection::Kind::temperature);
+  EXPECT_DOUBLE_EQ(bus.sim.health.inject[0].value, 80.0);
+  EXPECT_EQ(bus.sim.health.inject[1].kind, SimHealthInjection::Kind::blocked);
+  EXPECT_DOUBLE_EQ(bus.sim.health.inject[1].at_s, 3.0);
+}
+
+TEST_F(RobotConfigTest, BadHealthKeysNameTheirPlace) {
+  const std::string head = "name: t\nloop: {rate_hz: 100}\nsafety:\n  health: {";
+  EXPECT_EQ(error_of(head + "temperature_warn_c: 70, temperature_fault_c: 60}\n"),
+            at("4:57: safety.health.temperature_fault_c: expected more than temperature_warn_c "
+               "(70), found \"60\""));
+  EXPECT_EQ(error_of(head + "voltage_warn_v: 10, voltage_fault_v: 11}\n"),
+            at("4:49: safety.health.voltage_fault_v: expected less than voltage_warn_v (10), "
+               "found \"11\""));
+  EXPECT_EQ(error_of(head + "error_bits: maybe}\n"),
+            at("4:24: safety.health.error_bits: expected fault, warn or ignore, found \"maybe\""));
+  EXPECT_EQ(error_of(head + "stall_time_s: 0.001}\n"),
+            at("4:26: safety.health.stall_time_s: expected at least two loop periods (0.02 s at "
+               "loop.rate_hz 100), found \"0.001\""));
+  EXPECT_EQ(error_of(head + "temp_c: 1}\n"),
+            at("4:12: safety.health.temp_c: unknown key (expected one of: temperature_warn_c, "
+               "temperature_fault_c, voltage_warn_v, voltage_fault_v, stall_current_a, "
+               "stall_time_s, stall_error_deg, error_bits)"));
+  std::string text = kMinimal;
+  text.replace(text.find("b: {protocol: dynamixel2, port: /dev/ttyUSB0}"), 45,
+               "b:\n    protocol: dynamixel2\n    port: /dev/ttyUSB0\n    health: always\n");
+  EXPECT_EQ(error_of(text), at("7:13: buses.b.health: expected off, packed or round_robin, found "
+                               "\"always\""));
+  text = kMinimal;
+  text.replace(text.find("b: {protocol: dynamixel2, port: /dev/ttyUSB0}"), 45,
+               "b:\n    protocol: dynamixel2\n    port: /dev/ttyUSB0\n    sim:\n      inject:\n"
+               "        - {id: 1, at_s: 2, temperature_c: 80, blocked: true}\n");
+  EXPECT_EQ(error_of(text), at("9:11: buses.b.sim.inject[0]: expected exactly one of "
+                               "temperature_c, blocked, supply_v, hardware_error, found 2"));
 }
 
 TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {

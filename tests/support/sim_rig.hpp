@@ -82,6 +82,9 @@ class WatchedBus final : public ActuatorBus {
     inner_->write(positions);
   }
   std::span<DeviceStatus> devices() override { return inner_->devices(); }
+  void mark_faulted(std::size_t device) override { inner_->mark_faulted(device); }
+  void switch_off(std::size_t device) override { inner_->switch_off(device); }
+  bool reads_health() const override { return inner_->reads_health(); }
 
   ActuatorBus& inner() { return *inner_; }
   std::uint64_t calls(BusCall call) const { return calls_[static_cast<int>(call)].load(); }

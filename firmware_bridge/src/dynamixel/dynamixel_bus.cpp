@@ -53,6 +53,33 @@ std::string hardware_error_text(std::uint8_t bits) {
   return servo::fault_text("hardware error status", bits, kBits);
 }
 
+// The registers mapped into Indirect Data 1.. (Indirect Address 1..): the
+// position first, so one read of the region carries a cycle, then what the
+// health record needs.
+constexpr std::uint16_t kPresentCurrent = 126;       // 2, signed
+constexpr std::uint16_t kPresentInputVoltage = 144;  // 2, 0.1 V
+constexpr std::uint16_t kHealthMap[] = {
+    dxl::xreg::present_position,
+    dxl::xreg::present_position + 1,
+    dxl::xreg::present_position + 2,
+    dxl::xreg::present_position + 3,
+    kPresentCurrent,
+    kPresentCurrent + 1,
+    kPresentInputVoltage,
+    kPresentInputVoltage + 1,
+    dxl::xreg::present_temperature,
+    dxl::xreg::hardware_error_status,
+};
+constexpr std::uint16_t kPackedLength = std::size(kHealthMap);  // 10
+constexpr std::uint16_t kHealthOffset = 4;                      // after the position
+constexpr std::uint16_t kHealthLength = kPackedLength - kHealthOffset;
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             steady_clock::now().time_since_epoch())
+      .count();
+}
+
 }  // namespace
 
 DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> transport)
@@ -62,7 +89,10 @@ DynamixelBus::DynamixelBus(BusConfig config, std::unique_ptr<ByteTransport> tran
   sync_data_.resize(4 * n);
   model_.resize(n);
   firmware_.resize(n);
+  current_unit_.resize(n);
+  off_pending_.resize(n);
   fast_mode_ = dxl::bus_options(config_).fast_read;
+  health_ = dxl::bus_options(config_).health;
   watchdog_units_ = dxl::bus_options(config_).bus_watchdog;
   watchdog_time_ = std::chrono::milliseconds(20) * watchdog_units_;
   if (watchdog_units_ > kMaxWatchdogUnits) {
@@ -218,9 +248,69 @@ void DynamixelBus::configure() {
   clear_bus_watchdogs();
   outside_warning_ = positions_.start(link_.book(), "position limits");
   for (std::size_t i = 0; i < n; ++i) write_position_limits(i);
+  for (std::size_t i = 0; i < n; ++i) {
+    current_unit_[i] = dxl::current_unit_a(model_[i]);
+    if (health_ != dxl::HealthRead::off) map_health_registers(i);
+  }
+  health_next_ = 0;
   choose_fast_read();
   read_pending_hardware_status();
   positions_.ready();
+}
+
+void DynamixelBus::map_health_registers(std::size_t device) {
+  // Indirect Address n is RAM: written every configure (a reboot clears it).
+  std::uint8_t data[2 * kPackedLength];
+  for (std::size_t k = 0; k < kPackedLength; ++k) dxl::put_u16(data + 2 * k, kHealthMap[k]);
+  const std::size_t length = dxl::encode_write(link_.bus_id(device), dxl::xreg::indirect_address_1,
+                                               {data, sizeof data}, link_.tx());
+  const Answer r = unicast(device, length, 0);
+  if (r != Answer::ok) {
+    throw DeviceError(prefix() + "cannot map the health registers (Indirect Address 1.." +
+                      std::to_string(kPackedLength) + ") of " + describe(device) + ": " +
+                      failure(device, r));
+  }
+}
+
+std::uint16_t DynamixelBus::cycle_address() const {
+  return health_ == dxl::HealthRead::packed ? dxl::xreg::indirect_data_1
+                                            : dxl::xreg::present_position;
+}
+
+std::uint16_t DynamixelBus::cycle_length() const {
+  return health_ == dxl::HealthRead::packed ? kPackedLength : 4;
+}
+
+void DynamixelBus::take_health(std::size_t device, std::span<const std::uint8_t> data) {
+  if (data.size() < kHealthLength) return;
+  HealthReading& h = link_.book()[device].reading;
+  const auto raw_current = static_cast<std::int16_t>(dxl::get_u16(&data[0]));
+  h.current_a = current_unit_[device] > 0.0
+                    ? std::abs(static_cast<double>(raw_current)) * current_unit_[device]
+                    : HealthReading::kNone;
+  h.voltage_v = 0.1 * static_cast<double>(dxl::get_u16(&data[2]));
+  h.temperature_c = static_cast<double>(data[4]);
+  h.error_bits = data[5];
+  h.has_error_bits = true;
+  h.read_ns = steady_ns();
+  ++h.reads;
+}
+
+void DynamixelBus::read_health_round_robin() {
+  const std::size_t n = link_.book().size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = (health_next_ + k) % n;
+    if (link_.book()[i].faulted) continue;
+    health_next_ = (i + 1) % n;
+    DeviceStatus& st = link_.book()[i];
+    const std::size_t length = dxl::encode_read(
+        link_.bus_id(i), dxl::xreg::indirect_data_1 + kHealthOffset, kHealthLength, link_.tx());
+    // A lost health read is counted, but the cycle's verdict is the position's.
+    const DeviceHealth health = st.health;
+    if (unicast(i, length, kHealthLength, 1) == Answer::ok) take_health(i, link_.data(0));
+    st.health = health;
+    return;
+  }
 }
 
 void DynamixelBus::clear_bus_watchdogs() {
@@ -265,9 +355,9 @@ void DynamixelBus::choose_fast_read() {
   const std::vector<DeviceStatus> before(book.begin(), book.end());
   for (std::size_t i = 0; i < n; ++i) link_.ask(i, i);
   const std::size_t length =
-      dxl::encode_fast_sync_read(dxl::xreg::present_position, 4, link_.ids().first(n), link_.tx());
+      dxl::encode_fast_sync_read(cycle_address(), cycle_length(), link_.ids().first(n), link_.tx());
   if (length > 0) {
-    transact_fast(length, n, 4);
+    transact_fast(length, n, cycle_length());
     fast_ = true;
     for (std::size_t s = 0; s < n; ++s) fast_ = fast_ && link_.answer(s) == Answer::ok;
   }
@@ -383,28 +473,45 @@ void DynamixelBus::deactivate() {
 
 // ---- cycle ----------------------------------------------------------------
 
+void DynamixelBus::switch_off(std::size_t device) {
+  mark_faulted(device);
+  off_pending_[device] = 1;
+}
+
 void DynamixelBus::read(std::span<double> positions) {
   positions_.hand_out_found(positions);
   rearm_after_silence();
+  for (std::size_t i = 0; i < off_pending_.size(); ++i) {
+    if (!off_pending_[i]) continue;
+    off_pending_[i] = 0;
+    // One try: a servo that does not hear it is switched off by deactivate().
+    const DeviceHealth health = link_.book()[i].health;
+    write_register(i, dxl::xreg::torque_enable, 0, 1, 1);
+    link_.book()[i].health = health;
+  }
   const std::size_t count = link_.ask_all_healthy();
   if (count > 0) {
+    const std::uint16_t address = cycle_address();
+    const std::uint16_t data_length = cycle_length();
+    const bool packed = health_ == dxl::HealthRead::packed;
     const std::size_t length =
-        fast_ ? dxl::encode_fast_sync_read(dxl::xreg::present_position, 4, link_.ids().first(count),
-                                           link_.tx())
-              : dxl::encode_sync_read(dxl::xreg::present_position, 4, link_.ids().first(count),
-                                      link_.tx());
+        fast_
+            ? dxl::encode_fast_sync_read(address, data_length, link_.ids().first(count), link_.tx())
+            : dxl::encode_sync_read(address, data_length, link_.ids().first(count), link_.tx());
     if (length > 0) {
       if (fast_) {
-        transact_fast(length, count, 4);
+        transact_fast(length, count, data_length);
       } else {
-        link_.transact(length, count, 4);
+        link_.transact(length, count, data_length);
       }
       for (std::size_t s = 0; s < count; ++s) {
         if (link_.answer(s) != Answer::ok) continue;
         last_answered_ = steady_clock::now();
         positions_.measured(link_.asked(s), static_cast<std::int32_t>(link_.value(s)), positions);
+        if (packed) take_health(link_.asked(s), link_.data(s).subspan(kHealthOffset));
       }
     }
+    if (health_ == dxl::HealthRead::round_robin) read_health_round_robin();
   }
   // Only after an alert appeared: one extra transaction in that failure case.
   read_pending_hardware_status();

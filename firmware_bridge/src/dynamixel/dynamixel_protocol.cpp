@@ -25,8 +25,8 @@ constexpr double kMaxTicksPerRev = 1e8;
 constexpr double kWatchdogUnitMs = 20.0;
 constexpr double kWatchdogMaxMs = 127 * kWatchdogUnitMs;
 
-constexpr std::string_view kBusKeys[] = {"port",      "baud",  "timeout_ms",
-                                         "fast_read", "model", "device_watchdog_ms"};
+constexpr std::string_view kBusKeys[] = {
+    "port", "baud", "timeout_ms", "fast_read", "model", "device_watchdog_ms", "health"};
 constexpr std::string_view kActuatorKeys[] = {"id",         "ticks_per_rev", "ticks_per_rad",
                                               "zero_ticks", "direction",     "model"};
 
@@ -46,6 +46,16 @@ dxl::FastRead parse_fast_read(const YamlNode& node) {
     if (s == "off") return dxl::FastRead::off;
   }
   node.fail("expected auto, on or off, found " + node.describe());
+}
+
+dxl::HealthRead parse_health(const YamlNode& node) {
+  if (node.is_scalar()) {
+    const std::string& s = node.raw().Scalar();
+    if (s == "off") return dxl::HealthRead::off;
+    if (s == "packed") return dxl::HealthRead::packed;
+    if (s == "round_robin") return dxl::HealthRead::round_robin;
+  }
+  node.fail("expected off, packed or round_robin, found " + node.describe());
 }
 
 int parse_direction(const YamlNode& node) {
@@ -97,6 +107,7 @@ class Dynamixel2 final : public Protocol {
     dxl::BusOptions options;
     if (auto n = node.find("fast_read")) options.fast_read = parse_fast_read(*n);
     if (auto n = node.find("model")) options.model_number = parse_model(*n);
+    if (auto n = node.find("health")) options.health = parse_health(*n);
     const double watchdog_ms = read_device_watchdog_ms(
         node, bus.loop_period_s, kWatchdogUnitMs, kWatchdogMaxMs, "Bus Watchdog, units of 20 ms");
     options.bus_watchdog = static_cast<std::uint8_t>(std::lround(watchdog_ms / kWatchdogUnitMs));
@@ -155,7 +166,13 @@ class Dynamixel2 final : public Protocol {
   // Read, so it is judged by the longer one.
   double wire_bits_per_cycle(const BusConfig& bus) const override {
     const bool fast = dxl::bus_options(bus).fast_read == dxl::FastRead::on;
-    return 10.0 * static_cast<double>(dynamixel_wire_bytes(bus.actuators.size(), fast));
+    const dxl::HealthRead health = dxl::bus_options(bus).health;
+    // Health packed: 6 more bytes per servo in the read; round robin: one
+    // Read (14) and its status packet (11 + 6) per cycle.
+    const std::size_t data = health == dxl::HealthRead::packed ? 10 : 4;
+    const std::size_t extra = health == dxl::HealthRead::round_robin ? 31 : 0;
+    return 10.0 *
+           static_cast<double>(dynamixel_wire_bytes(bus.actuators.size(), fast, data) + extra);
   }
 
   std::string device_guard_note(const BusConfig& bus) const override {
@@ -171,11 +188,12 @@ class Dynamixel2 final : public Protocol {
 
 }  // namespace
 
-std::size_t dynamixel_wire_bytes(std::size_t devices, bool fast_read) {
+std::size_t dynamixel_wire_bytes(std::size_t devices, bool fast_read, std::size_t read_bytes) {
   const std::size_t n = devices;
   const std::size_t write = 14 + 5 * n;
   const std::size_t read = 14 + n;
-  const std::size_t answers = fast_read ? dxl::fast_status_size(n, 4 * n) : 15 * n;
+  const std::size_t answers =
+      fast_read ? dxl::fast_status_size(n, read_bytes * n) : (11 + read_bytes) * n;
   return write + read + answers;
 }
 

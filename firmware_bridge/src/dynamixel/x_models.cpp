@@ -50,6 +50,25 @@ bool supports_fast_read(std::uint16_t model_number, std::uint8_t firmware) {
   return m != nullptr && m->fast_read_firmware != kNever && firmware >= m->fast_read_firmware;
 }
 
+double current_unit_a(std::uint16_t model_number) {
+  // Units from each model's control table: XH430 1.34 mA, XM430 / X540
+  // 2.69 mA; XL430 and XC430 (and their dual versions) report Present Load.
+  switch (model_number) {
+    case 1010:
+    case 1000:
+      return 0.00134;
+    case 1030:
+    case 1020:
+    case 1130:
+    case 1120:
+    case 1110:
+    case 1100:
+      return 0.00269;
+    default:
+      return 0.0;
+  }
+}
+
 BusOptions bus_options(const BusConfig& bus) {
   if (const auto* o = std::any_cast<BusOptions>(&bus.options)) return *o;
   return {};

@@ -57,6 +57,9 @@ struct LoopStats {
   }
 };
 
+// A health value, or null when the device does not report it.
+json health_number(double v) { return std::isnan(v) ? json() : json(v); }
+
 json timing_json(const MicrosHistogram& h) {
   return {{"p50", h.quantile(0.5) * 1e3}, {"p99", h.quantile(0.99) * 1e3}, {"max", h.max() * 1e3}};
 }
@@ -264,18 +267,23 @@ struct DashboardServer::Impl {
     for (const BusModel& bus : model.buses) {
       for (std::size_t d = 0; d < bus.joint.size(); ++d, ++k) {
         const DeviceStatus& s = view.devices[k];
-        devices.push_back({{"bus", bus.name},
-                           {"id", bus.device_id[d]},
-                           {"joint", model.joint_names[static_cast<std::size_t>(bus.joint[d])]},
-                           {"health", to_string(s.health)},
-                           {"faulted", s.faulted},
-                           {"transactions", s.transactions},
-                           {"timeouts", s.timeouts},
-                           {"crc", s.crc_errors},
-                           {"protocol", s.protocol_errors},
-                           {"hardware", s.hardware_errors},
-                           {"exceptions", s.exceptions},
-                           {"last_fault", nullptr}});
+        devices.push_back(
+            {{"bus", bus.name},
+             {"id", bus.device_id[d]},
+             {"joint", model.joint_names[static_cast<std::size_t>(bus.joint[d])]},
+             {"health", to_string(s.health)},
+             {"faulted", s.faulted},
+             {"transactions", s.transactions},
+             {"timeouts", s.timeouts},
+             {"crc", s.crc_errors},
+             {"protocol", s.protocol_errors},
+             {"hardware", s.hardware_errors},
+             {"exceptions", s.exceptions},
+             {"temperature_c", health_number(s.reading.temperature_c)},
+             {"current_a", health_number(s.reading.current_a)},
+             {"voltage_v", health_number(s.reading.voltage_v)},
+             {"error_bits", s.reading.has_error_bits ? json(s.reading.error_bits) : json()},
+             {"last_fault", nullptr}});
       }
     }
     return devices;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/device_health.hpp"
 
 namespace animrt {
 
@@ -37,6 +38,9 @@ struct DeviceStatus {
   // The measured position is the controller's own output (e.g. a Maestro's
   // ramped pulse for a hobby servo), not a sensor reading.
   bool open_loop = false;
+  // Temperature, current, voltage and error bits, when the bus reads them
+  // (its `health` key); all NaN otherwise.
+  HealthReading reading{};
 };
 
 class ActuatorBus {
@@ -69,6 +73,15 @@ class ActuatorBus {
   // config().actuators): read() and write() skip it until the next
   // configure(). Called while no read() or write() runs.
   virtual void mark_faulted(std::size_t device) { devices()[device].faulted = true; }
+  // A health fault (overheated, stalled, undervoltage): as mark_faulted, and
+  // the device's torque goes off, which the bus does in its next read() (on
+  // its own thread: the caller never waits for the line). Buses that cannot
+  // address one device alone only mark it.
+  virtual void switch_off(std::size_t device) { mark_faulted(device); }
+
+  // Whether read() fills DeviceStatus::reading (temperature, current,
+  // voltage, error bits) as configured.
+  virtual bool reads_health() const { return false; }
 
   // Per device status, indexed like config().actuators; written by this bus
   // alone (see DeviceStatus).

@@ -5,9 +5,11 @@
 #include <any>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "animrt/bridge/device_health.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -38,6 +40,32 @@ struct ActuatorBinding {
   double to_rad(std::int32_t ticks) const;
 };
 
+// A change to a simulated device's health at a time (the robot file's
+// sim.inject list): seconds after the simulated devices start.
+struct SimHealthInjection {
+  enum class Kind : std::uint8_t { temperature, blocked, supply, hardware_error };
+  int device_id = 0;
+  double at_s = 0.0;
+  Kind kind = Kind::temperature;
+  double value = 0.0;  // deg C, 1/0 (blocked), V, or the error bits
+};
+
+// The simulated servos' health model (sim.health in the robot file): a
+// first-order thermal model driven by the motor current, a supply that sags
+// with it, and the current itself (idle, moving, or stalled against a block).
+struct SimHealthSettings {
+  double ambient_c = 36.0;         // where the temperature settles at rest
+  double thermal_tau_s = 120.0;    // thermal time constant
+  double heat_c_per_a2 = 20.0;     // steady rise above ambient per A^2 drawn
+  double supply_v = 12.0;          // supply with no load
+  double supply_ohm = 0.2;         // its source resistance: sag per A drawn
+  double idle_current_a = 0.05;    // holding, not moving
+  double current_per_rad_s = 0.1;  // added per rad/s of motion
+  double stall_current_a = 1.4;    // drawn while the joint is blocked with torque on
+  double overload_s = 1.0;         // stalled this long: the Overload error
+  std::vector<SimHealthInjection> inject{};
+};
+
 // Simulated-device settings of a bus (used only with --backend sim).
 struct SimBusSettings {
   double time_constant_s = 0.02;  // first-order lag of each motor
@@ -45,6 +73,7 @@ struct SimBusSettings {
   bool wire_time = false;         // emulate bytes on the wire at the baud rate
   int return_delay_us = 0;        // device's delay before answering
   int firmware_version = 0;       // Dynamixel: firmware the servos report (0: the default, 38)
+  SimHealthSettings health{};
 };
 
 struct BusConfig {
@@ -58,6 +87,9 @@ struct BusConfig {
   // this; a silent device costs it once.
   double timeout_s = 0.004;
   SimBusSettings sim;
+  // The bus's own health limits (its health_limits key), in place of the
+  // robot file's safety.health.
+  std::optional<HealthLimits> health_limits{};
   std::vector<ActuatorBinding> actuators;  // devices on this bus, in config order
   std::any options;                        // protocol-specific, see ActuatorBinding::options
   Location where;                          // where the bus is declared

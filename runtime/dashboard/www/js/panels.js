@@ -117,6 +117,13 @@ function faultText(f) {
 }
 
 const COUNTERS = ['transactions', 'timeouts', 'crc', 'protocol', 'hardware', 'exceptions'];
+// Device health as read (null: the device or its bus does not report it).
+const HEALTH = [
+  ['temperature_c', (v) => `${v.toFixed(0)} °C`],
+  ['current_a', (v) => `${v.toFixed(2)} A`],
+  ['voltage_v', (v) => `${v.toFixed(1)} V`],
+  ['error_bits', (v) => `0x${v.toString(16).padStart(2, '0')}`],
+];
 
 export class DeviceTable {
   constructor(table) {
@@ -145,6 +152,10 @@ export class DeviceTable {
           cells[c] = el('td', { 'data-field': c, text: '–' });
           tds.push(cells[c]);
         }
+        for (const [c] of HEALTH) {
+          cells[c] = el('td', { 'data-field': c, text: 'n/a' });
+          tds.push(cells[c]);
+        }
         cells.fault = el('td', { class: 'fault', 'data-field': 'last_fault' });
         tds.push(cells.fault);
         const row = el('tr', { 'data-device': key }, ...tds);
@@ -163,6 +174,11 @@ export class DeviceTable {
         const text = fmtInt(d[c]);
         if (r.cells[c].textContent !== text) r.cells[c].textContent = text;
         r.cells[c].classList.toggle('nonzero', c !== 'transactions' && isNum(d[c]) && d[c] > 0);
+      }
+      for (const [c, show] of HEALTH) {
+        const text = isNum(d[c]) ? show(d[c]) : 'n/a';
+        if (r.cells[c].textContent !== text) r.cells[c].textContent = text;
+        r.cells[c].classList.toggle('nonzero', c === 'error_bits' && isNum(d[c]) && d[c] > 0);
       }
       let fault = typeof d.last_fault === 'string' && times.has(d.last_fault)
         ? faultText({ t_s: times.get(d.last_fault), text: d.last_fault })

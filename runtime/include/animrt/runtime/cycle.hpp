@@ -38,6 +38,10 @@ struct BusIo {
   bool fresh = false;
   std::span<const double> positions;     // per device
   std::span<const DeviceHealth> health;  // per device, of the latest transaction
+  // Per device: temperature, current, voltage, error bits as last read
+  // (empty: the bus reads none). A record whose `reads` has not changed
+  // since the last cycle is not judged again.
+  std::span<const HealthReading> readings{};
 };
 
 struct CycleInputs {
@@ -66,7 +70,13 @@ enum class EventKind : std::uint8_t {
   following_error,  // joint, value = error (rad or m)
   stop_deadline,    // the stop ramp ran over safety.stop_deadline_s: torque off now
   aborted,          // torque off now on request
+  health_fault,     // bus, device, check, value: a health limit; the device is switched off
+  health_warning,   // bus, device, check, value: logged and counted; the run goes on
 };
+
+// Which health limit an event is about.
+enum class HealthCheck : std::uint8_t { none, temperature, voltage, stall, error_bits };
+const char* to_string(HealthCheck check);
 
 struct CycleEvent {
   EventKind kind = EventKind::motion_started;
@@ -76,6 +86,7 @@ struct CycleEvent {
   std::size_t device = 0;
   DeviceHealth health = DeviceHealth::ok;
   double value = 0.0;
+  HealthCheck check = HealthCheck::none;
 };
 
 struct CycleOutputs {
@@ -129,6 +140,10 @@ class CycleState {
   std::span<const double> manual_pose() const { return manual_pose_; }
   // The show's playhead as of this cycle (show false: the motion plays none).
   const ShowPosition& show() const { return show_; }
+  // Per bus, per device: health readings over the run, and whether a health
+  // fault asks for the device to be switched off (1).
+  const std::vector<std::vector<HealthStats>>& health_stats() const { return health_stats_; }
+  const std::vector<std::vector<std::uint8_t>>& switch_off() const { return switch_off_; }
 
  private:
   friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
@@ -166,6 +181,15 @@ class CycleState {
   std::vector<double> sq_error_, max_error_;
   std::vector<std::uint64_t> error_samples_;
   std::vector<CycleEvent> log_;
+  // Health watch, per bus and device.
+  struct HealthTrack {
+    std::uint64_t reads = 0;  // the reading's `reads` last judged
+    double stall_since = -1.0;
+    std::uint8_t warned = 0;  // bit per HealthCheck: a warning episode is on
+  };
+  std::vector<std::vector<HealthTrack>> health_track_;
+  std::vector<std::vector<HealthStats>> health_stats_;
+  std::vector<std::vector<std::uint8_t>> switch_off_;
   CycleOutputs out_;
 };
 

@@ -28,6 +28,8 @@ struct SafetyConfig {
   double following_error_rad = 0.2617993877991494;  // 15 deg (revolute joints)
   double following_error_m = 0.015;                 // prismatic joints
   double following_error_window_s = 0.5;
+  // Device health limits (safety.health); a bus may have its own.
+  HealthLimits health{};
 };
 
 struct MotionConfig {

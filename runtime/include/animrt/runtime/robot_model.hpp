@@ -26,6 +26,7 @@ struct BusModel {
   std::string name;
   std::vector<int> joint;      // per device: the robot joint it drives
   std::vector<int> device_id;  // per device: its bus address
+  HealthLimits health{};       // the bus's health_limits, else safety.health
 };
 
 struct RobotModel {

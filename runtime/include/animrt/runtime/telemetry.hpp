@@ -33,7 +33,9 @@ class TelemetryRing {
   std::atomic<std::uint64_t> dropped_{0};
 };
 
-// Drains a ring into a CSV file: `time_s,<joint>_cmd_rad,<joint>_meas_rad,...`.
+// Drains a ring into a CSV file: `time_s,<joint>_cmd_rad,<joint>_meas_rad,...`,
+// then the extra columns (device health: `<joint>_temp_c`, `_current_a`,
+// `_voltage_v`, `_error_bits`; nan where not read).
 // A record that cannot be written (a full disk, /dev/full, a pipe whose
 // reader left) is counted as lost with the first error, never silently: a
 // record that is not on disk is a fault of the record, and the run says so.
@@ -41,7 +43,7 @@ class TelemetryWriter {
  public:
   // Opens the file (throws std::runtime_error naming it if it cannot).
   TelemetryWriter(const std::string& path, std::span<const std::string> joint_names,
-                  TelemetryRing& ring);
+                  TelemetryRing& ring, std::span<const std::string> extra_columns = {});
   ~TelemetryWriter();
   // Drains what is left and closes the file.
   void finish();

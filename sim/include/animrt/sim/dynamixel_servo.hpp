@@ -53,6 +53,7 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -104,6 +105,7 @@ inline constexpr double kXVelocityUnitRpm = 0.229;
 inline constexpr std::uint8_t kXTemperatureC = 36;
 inline constexpr Nanos kBusWatchdogUnitNs = 20'000'000;
 inline constexpr std::uint16_t kXInputVoltage = 120;  // 12.0 V
+inline constexpr double kXCurrentUnitA = 0.00269;     // Present Current unit (XM430)
 
 // Baud Rate register value for a baud (9600 -> 0, 57600 -> 1, 115200 -> 2,
 // 1M -> 3, 2M -> 4, 3M -> 5, 4M -> 6, 4.5M -> 7); the nearest one otherwise.
@@ -193,6 +195,11 @@ class DynamixelServo {
   std::uint64_t goals_received() const { return goals_received_; }
   void clear_goal_log();
 
+  // Current, supply and temperature (servo_health_model.hpp): Present
+  // Current, Present Input Voltage, Present Temperature and the Hardware
+  // Error bits they cause. Changes take effect at the next advance().
+  ServoHealthModel& health() { return health_; }
+
   // Present position in radians through the binding, at time `now`, without
   // changing the state (with physics: where the physics is now).
   double position_rad(Nanos now) const;
@@ -218,6 +225,7 @@ class DynamixelServo {
   Nanos motor_time_;
   JointPhysics* physics_ = nullptr;
   int physics_joint_ = -1;
+  ServoHealthModel health_;
   Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
   bool shut_down_ = false;

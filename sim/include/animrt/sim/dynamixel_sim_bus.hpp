@@ -76,6 +76,7 @@ class DynamixelSimBus final : public SimulatedBus {
   // an id that is not on this bus.
   void set_device_responding(int device_id, bool responding) override;
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
   // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
   void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;

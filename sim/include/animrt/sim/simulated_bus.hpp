@@ -42,6 +42,14 @@ class SimulatedBus {
     (void)answers;
     throw std::logic_error("simulated bus " + endpoint() + ": answer delay is not modelled");
   }
+  // Fault injection: a change to the device's health model at once (its
+  // temperature, a blocked joint, its supply, its error bits; `at_s` is
+  // ignored). Throws std::logic_error where the devices do not model it.
+  virtual void inject_device_health(int device_id, const SimHealthInjection& change) {
+    (void)device_id;
+    (void)change;
+    throw std::logic_error("simulated bus " + endpoint() + ": device health is not modelled");
+  }
   // Position of a device in radians (through its binding), for tests.
   virtual double device_position(int device_id) const = 0;
 };

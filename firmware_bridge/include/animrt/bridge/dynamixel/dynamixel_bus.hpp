@@ -89,11 +89,20 @@ class DynamixelBus final : public ActuatorBus {
   // may have stopped and locked their goals) first clears and re-arms it
   // with two broadcast Writes, so the figure goes on from where it stopped
   // (watchdog_rearms()).
+  // With `health: packed` the cycle's read is of Indirect Data 1..10
+  // (Present Position, Present Current, Present Input Voltage, Present
+  // Temperature, Hardware Error Status, mapped by configure()); with
+  // `round_robin` it reads positions as without, then the health registers
+  // of one servo (the next in turn) in a Read of its own. Either fills
+  // DeviceStatus::reading.
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
+  dxl::HealthRead health_read() const { return health_; }
   std::uint64_t watchdog_rearms() const { return watchdog_rearms_; }
 
   std::span<DeviceStatus> devices() override { return link_.book().devices(); }
+  void switch_off(std::size_t device) override;
+  bool reads_health() const override { return health_ != dxl::HealthRead::off; }
 
   // Where configure() looks for the USB adapter's latency timer (tests point
   // it at a fake tree); "/sys" by default.
@@ -134,6 +143,13 @@ class DynamixelBus final : public ActuatorBus {
   void read_pending_hardware_status();
   Answer write_register(std::size_t device, std::uint16_t address, std::uint32_t value,
                         std::uint16_t size, int tries);
+  // Indirect Address 1..10 -> position and the health registers.
+  void map_health_registers(std::size_t device);
+  // The health registers in `data` (current, voltage, temperature, error).
+  void take_health(std::size_t device, std::span<const std::uint8_t> data);
+  void read_health_round_robin();
+  std::uint16_t cycle_address() const;
+  std::uint16_t cycle_length() const;
 
   // Why a lifecycle transaction failed; for `ok` the hardware error it carried.
   std::string failure(std::size_t device, Answer answer) const;
@@ -159,6 +175,10 @@ class DynamixelBus final : public ActuatorBus {
   std::array<std::uint8_t, 2 * dxl::kMaxPacket> fast_rx_{};
 
   std::vector<std::uint8_t> sync_data_;
+  dxl::HealthRead health_ = dxl::HealthRead::off;
+  std::vector<double> current_unit_;       // per device, A per unit; 0: the model reports load
+  std::size_t health_next_ = 0;            // round robin: the device whose turn is next
+  std::vector<std::uint8_t> off_pending_;  // switch_off(): torque off at the next read
 };
 
 }  // namespace animrt

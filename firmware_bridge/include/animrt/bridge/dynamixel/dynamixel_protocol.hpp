@@ -13,6 +13,7 @@ const Protocol& dynamixel2_protocol();
 // Bytes on the wire per cycle for `devices` servos: Sync Write of 4-byte
 // goals, Sync Read (or Fast Sync Read) of 4-byte present positions and the
 // answers. 12 servos: 280 with Sync Read, 204 with Fast Sync Read.
-std::size_t dynamixel_wire_bytes(std::size_t devices, bool fast_read);
+// `read_bytes`: data bytes read per servo (10 with health packed).
+std::size_t dynamixel_wire_bytes(std::size_t devices, bool fast_read, std::size_t read_bytes = 4);
 
 }  // namespace animrt

@@ -38,8 +38,22 @@ enum class FastRead : std::uint8_t {
   off,        // always plain Sync Read
 };
 
+// Whether and how the bus reads Present Current, Present Input Voltage,
+// Present Temperature and Hardware Error Status (bus key `health`). Both
+// ways map them, after Present Position, into the Indirect Data region.
+enum class HealthRead : std::uint8_t {
+  off,          // positions only
+  packed,       // every cycle, in the same (Fast) Sync Read as the positions
+  round_robin,  // one servo per cycle, in a Read of its own after the positions
+};
+
+// Present Current unit (A) of a model; 0 for models whose register 126 is
+// Present Load (XL430, 2XL430, XC430, 2XC430, XL330, XC330), not current.
+double current_unit_a(std::uint16_t model_number);
+
 // Protocol-specific settings (BusConfig::options / ActuatorBinding::options).
 struct BusOptions {
+  HealthRead health = HealthRead::off;
   FastRead fast_read = FastRead::automatic;
   std::uint16_t model_number = 0;  // the bus's `model`, for devices without one; 0: none
   // Bus Watchdog (address 98) set at activate, in its units of 20 ms; 0: none.

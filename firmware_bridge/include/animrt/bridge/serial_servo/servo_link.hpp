@@ -151,6 +151,8 @@ class Link {
     answer_.resize(n);
     suspect_.resize(n);
     value_.resize(n);
+    data_.resize(n);
+    data_size_.resize(n);
     fault_seen_.resize(n);
     fault_new_.resize(n);
   }
@@ -179,6 +181,12 @@ class Link {
   std::size_t asked(std::size_t slot) const { return asked_[slot]; }
   Answer answer(std::size_t slot) const { return answer_[slot]; }
   std::uint32_t value(std::size_t slot) const { return value_[slot]; }
+  // The answer's data bytes (the first kSlotBytes), for reads of several
+  // registers at once.
+  static constexpr std::size_t kSlotBytes = 16;
+  std::span<const std::uint8_t> data(std::size_t slot) const {
+    return {data_[slot].data(), data_size_[slot]};
+  }
   // Slots 0..count for every device not faulted; returns count.
   std::size_t ask_all_healthy() {
     std::size_t count = 0;
@@ -200,6 +208,8 @@ class Link {
     std::swap(asked_[a], asked_[b]);
     std::swap(answer_[a], answer_[b]);
     std::swap(value_[a], value_[b]);
+    std::swap(data_[a], data_[b]);
+    std::swap(data_size_[a], data_size_[b]);
     std::swap(suspect_[a], suspect_[b]);
   }
 
@@ -357,6 +367,8 @@ class Link {
       return;
     }
     value_[slot] = codec_.value(data);
+    data_size_[slot] = static_cast<std::uint8_t>(std::min(data.size(), kSlotBytes));
+    std::copy_n(data.begin(), data_size_[slot], data_[slot].begin());
     answer_[slot] = Answer::ok;
     book_.answered(device, fault);
   }
@@ -474,6 +486,8 @@ class Link {
   std::vector<Answer> answer_;
   std::vector<std::uint8_t> suspect_;  // blamed for junk or a wrong id, still waited for
   std::vector<std::uint32_t> value_;
+  std::vector<std::array<std::uint8_t, kSlotBytes>> data_;
+  std::vector<std::uint8_t> data_size_;
   std::vector<std::uint8_t> fault_seen_;  // fault bits in the latest status
   std::vector<std::uint8_t> fault_new_;   // a fault appeared: its register is to be read
 
