@@ -43,14 +43,14 @@ struct BusReport {
 struct PhysicsReport {
   std::string model;
   double timestep_s = 0.0;
-  double simulated_s = 0.0;        // physics time from the devices' start to the end
-  double forward_m = 0.0;          // torso's +x displacement over that time (ramps included)
-  double sideways_m = 0.0;         // torso's +y displacement
-  double motion_s = 0.0;           // physics time of the motion proper (0: it never started)
-  double motion_forward_m = 0.0;   // torso's +x displacement during the motion
-  double average_speed_m_s = 0.0;  // motion_forward_m / motion_s
-  int falls = 0;                   // upright -> fallen transitions (the gait fitness's criterion)
-  double first_fall_s = -1.0;      // physics time of the first fall, -1 if none
+  double simulated_s = 0.0;          // physics time from the devices' start to the end
+  double forward_m = 0.0;            // torso's +x displacement over that time (ramps included)
+  double sideways_m = 0.0;           // torso's +y displacement
+  double motion_s = 0.0;             // physics time of the motion proper (0: it never started)
+  double motion_forward_m = 0.0;     // torso's +x displacement during the motion
+  double average_speed_m_s = 0.0;    // motion_forward_m / motion_s
+  int falls = 0;                     // upright -> fallen transitions (the gait fitness's criterion)
+  double first_fall_s = -1.0;        // physics time of the first fall, -1 if none
   int lockstep_waits_timed_out = 0;  // a bus was late to a lockstep step: the run may not repeat
 };
 
@@ -91,6 +91,13 @@ struct RunSummary {
   // failed write; empty when none was lost).
   std::uint64_t telemetry_lost = 0;
   std::string telemetry_error;
+  // The MCAP recording (--record): messages written, dropped (its rings
+  // full), lost (not on disk) and why.
+  std::string record_file;
+  std::uint64_t record_messages = 0;
+  std::uint64_t record_dropped = 0;
+  std::uint64_t record_lost = 0;
+  std::string record_error;
   std::optional<PhysicsReport> physics;  // set by whoever ran the physics
 
   // 0 for a clean run, 4 when a fault ended it, 5 when torque had to be cut
@@ -100,7 +107,9 @@ struct RunSummary {
   int exit_code() const {
     if (end_reason == EndReason::fault) return 4;
     if (!torque_cut.empty()) return 5;
-    return telemetry_lost > 0 || !telemetry_error.empty() ? 6 : 0;
+    const bool lost =
+        telemetry_lost > 0 || !telemetry_error.empty() || record_lost > 0 || !record_error.empty();
+    return lost ? 6 : 0;
   }
 };
 
