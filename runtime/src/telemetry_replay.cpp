@@ -173,7 +173,9 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
            std::to_string(m.sequence));
     }
     positions(*commands[next_command++], rec.cmd);
-    const double t = (static_cast<double>(m.log_time) - static_cast<double>(start)) * 1e-9;
+    // The difference first: nanoseconds since 1970 do not fit a double's mantissa.
+    const double t = m.log_time >= start ? static_cast<double>(m.log_time - start) * 1e-9
+                                         : -static_cast<double>(start - m.log_time) * 1e-9;
     if (!rec.t.empty() && t < rec.t.back()) {
       fail("time goes backwards at /joint_states message " + std::to_string(m.sequence));
     }
