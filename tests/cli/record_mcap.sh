@@ -28,4 +28,11 @@ code=$?
 [[ $code -ne 0 && $code -ne 124 ]] || fail "view of a truncated file: exit $code"
 [[ $(wc -l < "$tmp/view.txt") -eq 1 ]] || fail "not one line: $(cat "$tmp/view.txt")"
 grep -q "cut.mcap.*truncated" "$tmp/view.txt" || fail "unclear error: $(cat "$tmp/view.txt")"
+# A recording that cannot reach the disk is said so, and the run exits 6.
+"$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --lockstep --duration 0.3 \
+  --record /dev/full > "$tmp/full.txt" 2>&1
+code=$?
+[[ $code -eq 6 ]] || fail "recording to /dev/full: exit $code"
+grep -q "^RECORD LOST recording: .* /dev/full: No space left on device" "$tmp/full.txt" \
+  || fail "no RECORD LOST line: $(grep -i record "$tmp/full.txt")"
 echo "ok"
