@@ -143,7 +143,9 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
     }
     for (std::size_t k = 0; k < joints.size(); ++k) {
       const auto& joint = joints[k];
-      if (!joint.is_object() || joint.value("name", std::string()) != rec.joints[k]) {
+      const bool named = joint.is_object() && joint.contains("name") && joint["name"].is_string() &&
+                         joint["name"].get_ref<const std::string&>() == rec.joints[k];
+      if (!named) {
         bad("expected joint " + rec.joints[k] + " at position " + std::to_string(k + 1));
       }
       const auto it = joint.find("position");

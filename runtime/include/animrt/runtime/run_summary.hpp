@@ -43,14 +43,14 @@ struct BusReport {
 struct PhysicsReport {
   std::string model;
   double timestep_s = 0.0;
-  double simulated_s = 0.0;          // physics time from the devices' start to the end
-  double forward_m = 0.0;            // torso's +x displacement over that time (ramps included)
-  double sideways_m = 0.0;           // torso's +y displacement
-  double motion_s = 0.0;             // physics time of the motion proper (0: it never started)
-  double motion_forward_m = 0.0;     // torso's +x displacement during the motion
-  double average_speed_m_s = 0.0;    // motion_forward_m / motion_s
-  int falls = 0;                     // upright -> fallen transitions (the gait fitness's criterion)
-  double first_fall_s = -1.0;        // physics time of the first fall, -1 if none
+  double simulated_s = 0.0;        // physics time from the devices' start to the end
+  double forward_m = 0.0;          // torso's +x displacement over that time (ramps included)
+  double sideways_m = 0.0;         // torso's +y displacement
+  double motion_s = 0.0;           // physics time of the motion proper (0: it never started)
+  double motion_forward_m = 0.0;   // torso's +x displacement during the motion
+  double average_speed_m_s = 0.0;  // motion_forward_m / motion_s
+  int falls = 0;                   // upright -> fallen transitions (the gait fitness's criterion)
+  double first_fall_s = -1.0;      // physics time of the first fall, -1 if none
   int lockstep_waits_timed_out = 0;  // a bus was late to a lockstep step: the run may not repeat
 };
 
