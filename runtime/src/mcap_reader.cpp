@@ -14,7 +14,9 @@ namespace animrt::mcap {
 namespace {
 
 constexpr std::uintmax_t kMaxMcapFileBytes = std::uintmax_t{1} << 30;
-constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{1} << 28;  // uncompressed
+// A chunk is inflated whole: 64 MiB bounds what a header claiming more costs
+// (writers close their chunks at a few MiB).
+constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{1} << 26;  // uncompressed
 
 const char* mcap_record_name(std::uint8_t op) {
   static constexpr const char* kNames[] = {
