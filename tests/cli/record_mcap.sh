@@ -14,7 +14,7 @@ reader="$root/tests/mcap_reader"
 [[ -d $reader/node_modules/@mcap/core ]] \
   || fail "no @mcap/core in $reader/node_modules (scripts/install-deps.sh runs npm ci there)"
 
-"$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --lockstep --duration 1 \
+"$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --lockstep --duration 0.5 \
   --telemetry "$tmp/t.csv" --record "$tmp/r.mcap" --summary-json "$tmp/s.json" \
   > "$tmp/out.txt" 2> "$tmp/err.txt" || fail "run failed: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 grep -q "^recording: .* messages to $tmp/r.mcap (0 dropped)" "$tmp/out.txt" \
