@@ -309,9 +309,9 @@ void McapRecorder::write_record(Channel& c, std::span<const double> r) {
   std::size_t at = 0;
   std::size_t first = 1;
   if (c.spec.per_device) {
+    if (!(r[1] >= 0.0 && r[1] < static_cast<double>(c.ids.size()))) return;  // no such device
     at = static_cast<std::size_t>(r[1]);
     first = 2;
-    if (at >= c.ids.size()) return;  // no such device: nothing to file it under
   }
   json_.clear();
   json_ += '{';
