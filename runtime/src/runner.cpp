@@ -253,13 +253,11 @@ void Runner::Impl::report(const RunLoop& loop, const CycleState& state, const Ru
 // what reached it goes in the summary.
 static void close_recording(McapRecorder& recording, const RunOptions& options,
                             RunSummary& summary) {
-  std::vector<std::pair<LogLevel, std::string>> notes;
-  for (const std::string& fault : summary.faults) notes.emplace_back(LogLevel::error, fault);
-  if (!summary.torque_cut.empty()) notes.emplace_back(LogLevel::warning, summary.torque_cut);
-  notes.emplace_back(
+  // The faults and a torque cut are in /events already, at their cycles.
+  const std::pair<LogLevel, std::string> end{
       summary.end_reason == EndReason::fault ? LogLevel::error : LogLevel::info,
-      fmt::format("run ended: {} after {} cycles", to_string(summary.end_reason), summary.cycles));
-  recording.close(notes);
+      fmt::format("run ended: {} after {} cycles", to_string(summary.end_reason), summary.cycles)};
+  recording.close({&end, 1});
   summary.record_file = options.record_path;
   summary.record_messages = recording.messages();
   summary.record_dropped = recording.dropped();
