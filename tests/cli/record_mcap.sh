@@ -21,6 +21,21 @@ grep -q "^recording: .* messages to $tmp/r.mcap (0 dropped)" "$tmp/out.txt" \
   || fail "no recording line: $(grep -i record "$tmp/out.txt")"
 node "$reader/read_back.js" "$tmp/r.mcap" "$tmp/t.csv" "$tmp/s.json" || fail "read back"
 
+# A stop request is in /events at its cycle, before the run's end.
+"$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --no-realtime \
+  --record "$tmp/stop.mcap" > "$tmp/stop.txt" 2>&1 &
+run_pid=$!
+for _ in $(seq 100); do
+  grep -q "activate: torque on" "$tmp/stop.txt" && break
+  sleep 0.1
+done
+sleep 0.5
+kill -INT $run_pid
+wait $run_pid
+node "$reader/events.js" "$tmp/stop.mcap" > "$tmp/events.txt" || fail "events: $(cat "$tmp/events.txt")"
+grep -q "^2 stop requested" "$tmp/events.txt" || fail "no stop request: $(cat "$tmp/events.txt")"
+tail -1 "$tmp/events.txt" | grep -q "^2 run ended: stop request" || fail "end: $(cat "$tmp/events.txt")"
+
 # Cut short: the file ends in the middle of its data.
 head -c $(($(stat -c %s "$tmp/r.mcap") / 2)) "$tmp/r.mcap" > "$tmp/cut.mcap"
 timeout 10 "$animrt" view "$tmp/cut.mcap" > "$tmp/view.txt" 2>&1
