@@ -59,7 +59,8 @@ class McapRecorder {
   // Writes the schemas, channels and metadata and starts the writer thread.
   void start();
 
-  // The cycle's side: never blocks, allocates or touches a file; false (and
+  // The cycle's side (one producer thread per channel: the rings are
+  // single-producer): never blocks, allocates or touches a file; false (and
   // counted as dropped) when the channel's ring is full. A per-device
   // record's device is its index over the model's buses in order (bus 0's
   // devices, then bus 1's...): device_index().
