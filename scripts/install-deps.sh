@@ -16,6 +16,7 @@ packages=(
   can-utils qemu-system-x86 busybox-static cpio  # HIL tier (tests/hil/run)
   clang libclang-rt-14-dev  # fuzz harnesses (tests/fuzz, make fuzz)
   zlib1g-dev  # gzip-compressed mesh sequences (controllers/seqnet)
+  libzstd-dev  # MCAP recordings' chunks (animrt run --record)
   libirrlicht-doc openarena-data unzip  # real MD2/MD3 clips for tests/seqnet
   # The sequence network (controllers/learn/seqnet/torch); Debian's libtorch falls
   # back to the slow reference BLAS without OpenBLAS.
@@ -32,14 +33,19 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    sudo="sudo"
+  fi
+  echo "installing: ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-sudo=""
-if [ "$(id -u)" -ne 0 ]; then
-  sudo="sudo"
+# The MCAP test's independent reader (@mcap/core from the npm registry, at the
+# versions its lock file pins): Node 20 and npm come with the machine.
+reader="$(dirname "$0")/../tests/mcap_reader"
+if [ ! -d "$reader/node_modules/@mcap/core" ] || [ "$reader/package-lock.json" -nt "$reader/node_modules" ]; then
+  (cd "$reader" && npm ci --no-audit --no-fund --silent)
 fi
-echo "installing: ${missing[*]}"
-$sudo apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

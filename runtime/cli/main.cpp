@@ -139,6 +139,7 @@ struct RunArgs {
   std::string backend = "sim";
   double duration = 0.0;
   std::string telemetry;
+  std::string record;
   std::string summary_json;
   bool lockstep = false;
   bool no_realtime = false;
@@ -252,6 +253,7 @@ int cmd_run(const RunArgs& args) {
   options.duration_s = args.duration;
   options.request_realtime = !args.no_realtime;
   options.telemetry_path = args.telemetry;
+  options.record_path = args.record;
   options.controls = &g_controls;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
   if (herd) options.on_motion_start = [&herd](animrt::Nanos t0) { herd->start(t0); };
@@ -308,6 +310,9 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
                   "seconds of motion, then ramp home (0 = until Ctrl-C)")
       ->check(duration_validator());
   run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file");
+  run->add_option("--record", run_args.record,
+                  "record the run as MCAP to this file: joint states, events, loop statistics, "
+                  "device status (Foxglove, the mcap CLI, animrt view)");
   run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON");
   run->add_flag("--lockstep", run_args.lockstep,
                 "simulated clock: run as fast as the devices answer (sim backend only)");

@@ -32,7 +32,7 @@ int run_view(const ViewArgs& args) {
               << " is not a loopback address; serving other machines needs --dashboard-remote\n";
     return kExitUsage;
   }
-  const TelemetryRecording recording = load_telemetry_csv(args.csv);
+  const TelemetryRecording recording = load_telemetry(args.csv);
   std::unique_ptr<RobotConfig> robot;
   std::unique_ptr<sim::MujocoFigure> figure;
   if (!args.robot.empty()) {
@@ -88,8 +88,11 @@ void add_view_command(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
   auto* cmd = app.add_subcommand(
       "view",
-      "Replay a recorded run (animrt run --telemetry) on the dashboard, with a time slider");
-  cmd->add_option("TELEMETRY", args->csv, "telemetry CSV of animrt run --telemetry")->required();
+      "Replay a recorded run (animrt run --telemetry or --record) on the dashboard, with a time "
+      "slider");
+  cmd->add_option("TELEMETRY", args->csv,
+                  "telemetry CSV of animrt run --telemetry, or MCAP of animrt run --record")
+      ->required();
   cmd->add_option("--robot", args->robot,
                   "the robot file of the run: limits, buses and the figure's model");
   cmd->add_option("--dashboard", args->dashboard, "HOST:PORT to serve at (default 127.0.0.1:0)");

@@ -87,6 +87,12 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
     }
     writer_.emplace(options.telemetry_path, model.joint_names, ring_, health_names_);
   }
+  if (!options.record_path.empty()) {
+    recorder_.emplace(options.record_path, model);
+    // More channels: recorder_->add(RecordChannel{...}) here, push() in record().
+    recorder_->start();
+    status_every_ = std::max<std::size_t>(1, static_cast<std::size_t>(model.rate_hz / 10.0));
+  }
   for (std::size_t b = 0; b < buses.size(); ++b) {
     const auto devices = buses[b]->devices();
     health_[b].assign(devices.size(), DeviceHealth::ok);
@@ -139,6 +145,7 @@ void RunLoop::finish() {
   }
   activation_.release();
   if (writer_) writer_->finish();
+  if (recorder_) recorder_->finish();
 }
 
 RunLoop::Wake RunLoop::wake() {
@@ -255,25 +262,59 @@ void RunLoop::post_writes(const CycleOutputs& out) {
 }
 
 void RunLoop::record(const CycleOutputs& out) {
-  if (!writer_) return;
-  record_[0] = in_.t;
-  std::copy(out.commands.begin(), out.commands.end(), record_.begin() + 1);
-  const auto seen = state_.measured();
-  std::copy(seen.begin(), seen.end(), record_.begin() + 1 + static_cast<long>(seen.size()));
-  std::size_t k = 1 + 2 * seen.size();
-  for (const JointSlot& slot : health_columns_) {
-    const HealthReading& r = readings_[slot.bus][slot.device];
-    record_[k++] = r.temperature_c;
-    record_[k++] = r.current_a;
-    record_[k++] = r.voltage_v;
-    record_[k++] = r.has_error_bits ? static_cast<double>(r.error_bits) : HealthReading::kNone;
+  if (writer_) {
+    record_[0] = in_.t;
+    std::copy(out.commands.begin(), out.commands.end(), record_.begin() + 1);
+    const auto seen = state_.measured();
+    std::copy(seen.begin(), seen.end(), record_.begin() + 1 + static_cast<long>(seen.size()));
+    std::size_t k = 1 + 2 * seen.size();
+    for (const JointSlot& slot : health_columns_) {
+      const HealthReading& r = readings_[slot.bus][slot.device];
+      record_[k++] = r.temperature_c;
+      record_[k++] = r.current_a;
+      record_[k++] = r.voltage_v;
+      record_[k++] = r.has_error_bits ? static_cast<double>(r.error_bits) : HealthReading::kNone;
+    }
+    ring_.push(record_);
   }
-  ring_.push(record_);
+  if (recorder_) record_mcap(out);
+}
+
+void RunLoop::record_mcap(const CycleOutputs& out) {
+  McapRecorder& r = *recorder_;
+  r.push_joints(in_.t, out.commands, state_.measured());
+  if (in_.stop && !stop_recorded_) {
+    stop_recorded_ = true;
+    r.push_stop_request(in_.t);
+  }
+  for (const CycleEvent& e : out.events) r.push_event(e);
+  if (state_.cycles() % status_every_ != 0) return;
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    for (std::size_t d = 0; d < view_[b].size(); ++d) {
+      const DeviceStatus& s = view_[b][d];
+      const double status[] = {in_.t,
+                               static_cast<double>(r.device_index(b, d)),
+                               static_cast<double>(s.health),
+                               s.faulted ? 1.0 : 0.0,
+                               static_cast<double>(s.transactions),
+                               static_cast<double>(s.timeouts),
+                               static_cast<double>(s.crc_errors),
+                               static_cast<double>(s.protocol_errors),
+                               static_cast<double>(s.hardware_errors),
+                               static_cast<double>(s.hardware_error_status)};
+      r.push(r.device_status_channel(), status);
+    }
+  }
 }
 
 void RunLoop::pace(const Wake& woke) {
   const Nanos busy = wall_.now() - woke.wall;
   busy_hist_.add(to_seconds(busy));
+  if (recorder_) {
+    recorder_->push_loop(in_.t, period_hist_.count() ? last_period_s_ : 0.0,
+                         to_seconds(woke.run - deadline_), to_seconds(busy), summary_.overruns,
+                         summary_.skipped_cycles);
+  }
   if (options_.monitor) {
     options_.monitor->push_timing(CycleTiming{in_.t, period_hist_.count() ? last_period_s_ : -1.0,
                                               to_seconds(woke.run - deadline_), to_seconds(busy)});

@@ -25,6 +25,7 @@
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/cycle.hpp"
 #include "animrt/runtime/loop_stats.hpp"
+#include "animrt/runtime/mcap_recorder.hpp"
 #include "animrt/runtime/runner.hpp"
 #include "animrt/runtime/telemetry.hpp"
 #include "bus_worker.hpp"
@@ -81,6 +82,7 @@ class RunLoop {
   const MicrosHistogram& busy() const { return busy_hist_; }
   const MicrosHistogram& bus_io(std::size_t b) const { return bus_hist_[b]; }
   const TelemetryWriter* telemetry() const { return writer_ ? &*writer_ : nullptr; }
+  McapRecorder* recording() { return recorder_ ? &*recorder_ : nullptr; }
   std::uint64_t telemetry_dropped() const { return ring_.dropped(); }
 
  private:
@@ -97,6 +99,7 @@ class RunLoop {
   void notify(const CycleOutputs& out);
   void post_writes(const CycleOutputs& out);
   void record(const CycleOutputs& out);
+  void record_mcap(const CycleOutputs& out);
   void pace(const Wake& woke);
   void mark_faults(std::size_t b);
   void update_view(std::size_t b);
@@ -118,6 +121,9 @@ class RunLoop {
   std::vector<std::string> health_names_;
   TelemetryRing ring_;
   std::optional<TelemetryWriter> writer_;
+  std::optional<McapRecorder> recorder_;
+  std::size_t status_every_ = 1;  // cycles between two device status records
+  bool stop_recorded_ = false;
   std::vector<double> record_;
   MicrosHistogram period_hist_, jitter_hist_, busy_hist_;
   std::vector<MicrosHistogram> bus_hist_;

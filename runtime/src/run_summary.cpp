@@ -79,6 +79,15 @@ void add_telemetry(std::string& out, const RunSummary& s) {
     line(fmt::format("telemetry: {} records to {} ({} dropped)", s.telemetry_records,
                      s.telemetry_file, s.telemetry_dropped));
   }
+  if (!s.record_file.empty() && (s.record_lost > 0 || !s.record_error.empty())) {
+    line(fmt::format("RECORD LOST recording: {} of {} messages could not be written to {}: {}",
+                     s.record_lost, s.record_messages + s.record_lost, s.record_file,
+                     s.record_error) +
+         fmt::format(" ({} written, {} dropped)", s.record_messages, s.record_dropped));
+  } else if (!s.record_file.empty()) {
+    line(fmt::format("recording: {} messages to {} ({} dropped)", s.record_messages, s.record_file,
+                     s.record_dropped));
+  }
 }
 
 nlohmann::json device_json(const DeviceReport& d) {
@@ -222,6 +231,11 @@ nlohmann::json to_json(const RunSummary& s) {
                     {"dropped", s.telemetry_dropped},
                     {"lost", s.telemetry_lost},
                     {"error", s.telemetry_error}};
+  j["recording"] = {{"file", s.record_file},
+                    {"messages", s.record_messages},
+                    {"dropped", s.record_dropped},
+                    {"lost", s.record_lost},
+                    {"error", s.record_error}};
   if (s.physics) j["physics"] = physics_json(*s.physics);
   return j;
 }

@@ -283,6 +283,22 @@ void Runner::Impl::report(const RunLoop& loop, const CycleState& state, const Ru
   }
 }
 
+// The run's end in the recording's /events, then the file is closed and
+// what reached it goes in the summary.
+static void close_recording(McapRecorder& recording, const RunOptions& options,
+                            RunSummary& summary) {
+  // The faults and a torque cut are in /events already, at their cycles.
+  const std::pair<LogLevel, std::string> end{
+      summary.end_reason == EndReason::fault ? LogLevel::error : LogLevel::info,
+      fmt::format("run ended: {} after {} cycles", to_string(summary.end_reason), summary.cycles)};
+  recording.close({&end, 1});
+  summary.record_file = options.record_path;
+  summary.record_messages = recording.messages();
+  summary.record_dropped = recording.dropped();
+  summary.record_lost = recording.lost();
+  if (recording.error() != 0) summary.record_error = std::strerror(recording.error());
+}
+
 void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) const {
   for (const CycleEvent& e : state.log()) {
     if (e.kind == EventKind::stop_deadline) {
@@ -325,6 +341,7 @@ RunSummary Runner::run(const RunOptions& options) {
   m.log(options, torque_cut ? "deactivate: torque switched off at once, without the stop ramp"
                             : "deactivate: torque off");
   m.report(loop, state, options, summary);
+  if (McapRecorder* recording = loop.recording()) close_recording(*recording, options, summary);
   return summary;
 }
 

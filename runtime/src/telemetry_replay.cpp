@@ -6,11 +6,15 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
 
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
+#include "animrt/runtime/mcap_reader.hpp"
 
 namespace animrt {
 namespace {
@@ -102,6 +106,108 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   }
   if (rec.t.empty()) fail(0, "expected at least one row after the header");
   return rec;
+}
+
+TelemetryRecording load_telemetry_mcap(const std::string& path) {
+  const mcap::ReadFile file = mcap::read_file(path);
+  const auto fail = [&](const std::string& message) {
+    throw InputError(Location{path, 0, 0}, "", message);
+  };
+  const mcap::ReadChannel* meas = file.channel("/joint_states");
+  const mcap::ReadChannel* cmd = file.channel("/joint_commands");
+  if (!meas || !cmd) {
+    fail("expected the channels /joint_states and /joint_commands of animrt run --record");
+  }
+  std::uint64_t start = 0;
+  bool have_start = false;
+  for (const auto& [name, entries] : file.metadata) {
+    for (const auto& [key, value] : entries) {
+      if (name != "animrt" || key != "start_time_ns") continue;
+      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), start);
+      have_start = ec == std::errc() && end == value.data() + value.size();
+    }
+  }
+  TelemetryRecording rec;
+  rec.file = path;
+  // A message's positions, in the order of the first message's joints.
+  const auto positions = [&](const mcap::ReadMessage& m, std::vector<double>& out) {
+    nlohmann::json j = nlohmann::json::parse(m.data, nullptr, false);
+    const auto bad = [&](const std::string& what) {
+      fail("message " + std::to_string(m.sequence) + " of " + file.channels.at(m.channel).topic +
+           ": " + what);
+    };
+    if (!j.is_object() || !j.contains("joints") || !j["joints"].is_array()) {
+      bad("expected a foxglove.JointStates JSON object with joints");
+    }
+    const auto& joints = j["joints"];
+    if (rec.joints.empty()) {
+      for (const auto& joint : joints) {
+        if (!joint.is_object() || !joint.contains("name") || !joint["name"].is_string()) {
+          bad("expected each joint to have a name");
+        }
+        rec.joints.push_back(joint["name"].get<std::string>());
+      }
+      if (rec.joints.empty()) bad("expected at least one joint");
+    }
+    if (joints.size() != rec.joints.size()) {
+      bad("expected " + std::to_string(rec.joints.size()) + " joints, found " +
+          std::to_string(joints.size()));
+    }
+    for (std::size_t k = 0; k < joints.size(); ++k) {
+      const auto& joint = joints[k];
+      const bool named = joint.is_object() && joint.contains("name") && joint["name"].is_string() &&
+                         joint["name"].get_ref<const std::string&>() == rec.joints[k];
+      if (!named) {
+        bad("expected joint " + rec.joints[k] + " at position " + std::to_string(k + 1));
+      }
+      const auto it = joint.find("position");
+      out.push_back(it != joint.end() && it->is_number()
+                        ? it->get<double>()
+                        : std::numeric_limits<double>::quiet_NaN());
+    }
+  };
+  std::vector<const mcap::ReadMessage*> commands;
+  for (const mcap::ReadMessage& m : file.messages) {
+    if (m.channel == cmd->id) commands.push_back(&m);
+  }
+  std::size_t next_command = 0;
+  for (const mcap::ReadMessage& m : file.messages) {
+    if (m.channel != meas->id) continue;
+    if (!have_start) {
+      start = m.log_time;
+      have_start = true;
+    }
+    positions(m, rec.meas);
+    // The command of the same cycle: the same log time.
+    while (next_command < commands.size() && commands[next_command]->log_time < m.log_time) {
+      ++next_command;
+    }
+    if (next_command == commands.size() || commands[next_command]->log_time != m.log_time) {
+      fail("no /joint_commands message at the time of /joint_states message " +
+           std::to_string(m.sequence));
+    }
+    positions(*commands[next_command++], rec.cmd);
+    // The difference first: nanoseconds since 1970 do not fit a double's mantissa.
+    const double t = m.log_time >= start ? static_cast<double>(m.log_time - start) * 1e-9
+                                         : -static_cast<double>(start - m.log_time) * 1e-9;
+    if (!rec.t.empty() && t < rec.t.back()) {
+      fail("time goes backwards at /joint_states message " + std::to_string(m.sequence));
+    }
+    rec.t.push_back(t);
+  }
+  if (rec.t.empty()) fail("expected at least one /joint_states message");
+  return rec;
+}
+
+TelemetryRecording load_telemetry(const std::string& path) {
+  char head[sizeof mcap::kMagic] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(head, sizeof head);
+  if (in.gcount() == sizeof head &&
+      mcap::has_magic(std::span(reinterpret_cast<const std::uint8_t*>(head), sizeof head))) {
+    return load_telemetry_mcap(path);
+  }
+  return load_telemetry_csv(path);
 }
 
 RobotModel replay_model(const TelemetryRecording& recording, const RobotConfig* robot) {

@@ -62,6 +62,7 @@ std::string animatronic_on_rtu() {
 struct Expect {
   EndReason end = EndReason::duration;
   bool telemetry = true;
+  bool record = false;  // an MCAP recording beside the CSV
 };
 
 // Runs `rig` for `motion_s` under a watch; `inject(t)` runs on the loop
@@ -83,7 +84,12 @@ void expect_no_allocation(SimRig& rig, double motion_s, const Expect& expect,
           ? ::testing::TempDir() + "/" +
                 ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".csv"
           : "";
-  const RunSummary s = rig.run_watching(watch, rig.options(motion_s, csv));
+  RunOptions options = rig.options(motion_s, csv);
+  if (expect.record) {
+    options.record_path = ::testing::TempDir() + "/" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".mcap";
+  }
+  const RunSummary s = rig.run_watching(watch, options);
   EXPECT_EQ(s.end_reason, expect.end) << (s.faults.empty() ? "" : s.faults[0]);
   ASSERT_TRUE(watch.was_opened()) << "the window never opened: no cycle seen";
   // The window covered the whole run: every phase ran cycles.
@@ -92,10 +98,15 @@ void expect_no_allocation(SimRig& rig, double motion_s, const Expect& expect,
   EXPECT_GT(rig.cycles_in(RunPhase::stop_ramp), 10u);
   // The run's threads were seen for what they are.
   EXPECT_EQ(watch.started(RunThread::bus_io), static_cast<int>(rig.config().buses.size()));
-  EXPECT_EQ(watch.started(RunThread::telemetry_writer), expect.telemetry ? 1 : 0);
+  EXPECT_EQ(watch.started(RunThread::telemetry_writer),
+            (expect.telemetry ? 1 : 0) + (expect.record ? 1 : 0));
   EXPECT_EQ(watch.started(RunThread::other), 0);
   if (expect.telemetry) {
     EXPECT_EQ(s.telemetry_records, s.cycles);
+  }
+  if (expect.record) {
+    EXPECT_EQ(s.record_dropped, 0u);
+    EXPECT_GT(s.record_messages, 2 * s.cycles);
   }
   EXPECT_EQ(watch.counted(), 0u) << "loop thread " << watch.on(RunThread::loop)
                                  << ", bus I/O threads " << watch.on(RunThread::bus_io)
@@ -215,6 +226,17 @@ TEST(CycleAllocation, DynamixelHealthPackedWarningAndFault) {
 TEST(CycleAllocation, DynamixelHealthRoundRobin) {
   SimRig rig(kConfigsDir + "/robots/quadruped.yaml", health_on(dxl::HealthRead::round_robin));
   expect_no_allocation(rig, 1.0, {});
+}
+
+// The MCAP recording's pushes (joints, loop, device status, the fault's
+// event and the stop ramp) on the loop thread.
+TEST(CycleAllocation, DynamixelHardwareErrorRecorded) {
+  SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
+  bool done = false;
+  expect_no_allocation(rig, 2.0, {EndReason::fault, true, true}, [&](double t) {
+    if (!done && t >= 0.3) rig.sim("legs").set_device_hardware_error(9, 0x04);
+    done = done || t >= 0.3;
+  });
 }
 
 TEST(CycleAllocation, DynamixelMaestroModbusTcpWithTelemetry) {

@@ -151,6 +151,7 @@ Role classify(void* (*routine)(void*), void* arg) {
   if (routine != nullptr && routine == std_thread_routine.load()) {
     const char* type = typeid(*static_cast<std::thread::_State*>(arg)).name();
     if (std::strstr(type, "TelemetryWriter") != nullptr) return kWriter;
+    if (std::strstr(type, "McapRecorder") != nullptr) return kWriter;
   }
 #else
   (void)routine;

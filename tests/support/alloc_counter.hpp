@@ -16,8 +16,8 @@
 // threads were started earlier by the test (or by the simulators' own
 // threads) and are not. The telemetry writer is told apart by the callable
 // its std::thread runs (the type name of libstdc++'s thread state names
-// animrt::TelemetryWriter) and is left out of the count: it writes a file,
-// outside the cycle by design. A run thread that cannot be recognised counts.
+// animrt::TelemetryWriter, or animrt::McapRecorder for the MCAP recording's)
+// and is left out of the count: it writes a file, outside the cycle by design. A run thread that cannot be recognised counts.
 // Only allocations made while the window is open count.
 
 #include <cstdint>

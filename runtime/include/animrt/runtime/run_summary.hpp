@@ -94,6 +94,13 @@ struct RunSummary {
   // failed write; empty when none was lost).
   std::uint64_t telemetry_lost = 0;
   std::string telemetry_error;
+  // The MCAP recording (--record): messages written, dropped (its rings
+  // full), lost (not on disk) and why.
+  std::string record_file;
+  std::uint64_t record_messages = 0;
+  std::uint64_t record_dropped = 0;
+  std::uint64_t record_lost = 0;
+  std::string record_error;
   std::optional<PhysicsReport> physics;  // set by whoever ran the physics
 
   // 0 for a clean run, 4 when a fault ended it, 5 when torque had to be cut
@@ -103,7 +110,9 @@ struct RunSummary {
   int exit_code() const {
     if (end_reason == EndReason::fault) return 4;
     if (!torque_cut.empty()) return 5;
-    return telemetry_lost > 0 || !telemetry_error.empty() ? 6 : 0;
+    const bool lost =
+        telemetry_lost > 0 || !telemetry_error.empty() || record_lost > 0 || !record_error.empty();
+    return lost ? 6 : 0;
   }
 };
 

@@ -34,6 +34,7 @@ struct RunOptions {
   bool request_realtime = true;  // SCHED_FIFO + mlockall (real-time runs only)
   int realtime_priority = 80;
   std::string telemetry_path;  // CSV, empty = none
+  std::string record_path;     // MCAP (mcap_recorder.hpp), empty = none
   // Stop, abort, steering and jogs from other threads (a signal handler, a
   // dashboard, a herd); none when null.
   RunControls* controls = nullptr;

@@ -31,6 +31,16 @@ struct TelemetryRecording {
 // backwards, no rows).
 TelemetryRecording load_telemetry_csv(const std::string& path);
 
+// Reads the /joint_states and /joint_commands channels of an MCAP recording
+// (`animrt run --record`): times from the recording's start (its "animrt"
+// metadata, else its first message). Throws InputError naming the file and
+// what is wrong (mcap_reader.hpp's checks, a missing channel, a message
+// that is not a JointStates of the recording's joints).
+TelemetryRecording load_telemetry_mcap(const std::string& path);
+
+// Either: an MCAP file by its magic, else a CSV.
+TelemetryRecording load_telemetry(const std::string& path);
+
 // The model a replay is shown with: the recording's joints, with the robot
 // file's limits and home where it has the joint (else +-pi and 0), and the
 // robot's buses when every one of its joints is in the recording. Throws
