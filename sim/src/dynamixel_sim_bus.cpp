@@ -53,10 +53,12 @@ auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id)
 
 }  // namespace
 
-DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics)
+DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics,
+                                 const ServoStartup& startup)
     : config_(config),
       clock_(clock),
       firmware_(config, clock.now(), physics),
+      keeper_(startup, config.name),
       physics_(physics),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
@@ -85,6 +87,8 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
     close_fds();
     throw;
   }
+  keeper_.start(firmware_, clock.now(),
+                [&](DynamixelServo& s) { s.factory_reset(0xFF, clock.now()); });
   const std::size_t most = (firmware_.size() + 1) * dxl::kMaxPacket;
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
@@ -96,6 +100,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
 DynamixelSimBus::~DynamixelSimBus() {
   stop();
   close_fds();
+  keeper_.save(firmware_, true);
 }
 
 void DynamixelSimBus::close_fds() {
@@ -155,6 +160,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   {
     std::lock_guard lock(mutex_);
     firmware_.handle(packet, now, answers_);
+    keeper_.save(firmware_);
   }
   if (packet.instruction != dxl::inst::status) ++packets_;
 

@@ -80,13 +80,27 @@ class SimulatedBus {
 
 namespace sim {
 class JointPhysics;
-}
+class ServoStateFile;
+}  // namespace sim
+
+// How simulated serial servos (Dynamixel, Feetech) start: as the robot file
+// configures them (ids and baud from it), or as from the factory.
+struct ServoStartup {
+  // EEPROM at factory settings (ID 1; Dynamixel 57600 baud, Feetech 1 Mbaud)
+  // and only the first device of each bus plugged in: a user plugs in one
+  // new servo at a time and gives it its id.
+  bool factory = false;
+  // Restores each servo's EEPROM from it (over the above) and saves it there
+  // whenever it changes (outlives the buses).
+  sim::ServoStateFile* state = nullptr;
+};
 
 // Builds the simulated devices for config.protocol ("dynamixel2": N X-series
 // servos behind one pty). Motor models read time from `clock`, so a lockstep
 // run with a ManualClock is deterministic. With `physics` (dynamixel2 only;
 // InputError for other protocols) the servos take their motor state from it.
 std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock,
-                                                 sim::JointPhysics* physics = nullptr);
+                                                 sim::JointPhysics* physics = nullptr,
+                                                 const ServoStartup& startup = {});
 
 }  // namespace animrt
