@@ -126,6 +126,58 @@ void DynamixelFirmware::answer_fast(std::span<const dxl::BulkReadEntry> entries,
   out.bytes.resize(offset + w.size());
 }
 
+void DynamixelFirmware::ping(const dxl::Packet& packet, Answers& out) {
+  // Answered whatever the Status Return Level; to a broadcast, every servo
+  // in ID order, those sharing an ID at once.
+  by_id_.clear();
+  for (DynamixelServo& s : servos_) {
+    if (s.responding() && (packet.id == dxl::kBroadcastId || s.id() == packet.id)) {
+      by_id_.push_back(&s);
+    }
+  }
+  std::sort(by_id_.begin(), by_id_.end(),
+            [](const DynamixelServo* a, const DynamixelServo* b) { return a->id() < b->id(); });
+  std::size_t first = out.list.size();
+  for (std::size_t k = 0; k < by_id_.size(); ++k) {
+    const DynamixelServo* s = by_id_[k];
+    if (k > 0 && s->id() != by_id_[k - 1]->id()) {
+      collide(out, first);  // the servos before answered in one slot
+      first = out.list.size();
+    }
+    std::array<std::uint8_t, 3> info{};
+    s->read(dxl::xreg::model_number, 2, info);
+    s->read(dxl::xreg::firmware_version, 1, std::span(info).subspan(2));
+    answer(*s, StatusError::none, info, out);
+  }
+  collide(out, first);
+}
+
+void DynamixelFirmware::factory_reset(const dxl::Packet& packet, Nanos now, Answers& out) {
+  // Option 0xFF resets everything, 0x01 all but the ID, 0x02 all but the ID
+  // and the baud rate. The status packet leaves first, with the old ID at
+  // the old baud. From firmware 42 on a broadcast 0xFF is ignored (every
+  // servo would become ID 1).
+  const std::span<const std::uint8_t> p = packet.params;
+  const bool broadcast = packet.id == dxl::kBroadcastId;
+  const std::uint8_t option = p.size() == 1 ? p[0] : 0;
+  const bool known = option == 0xFF || option == 0x01 || option == 0x02;
+  const StatusError error = p.size() != 1 ? StatusError::data_length
+                            : !known      ? StatusError::data_range
+                                          : StatusError::none;
+  auto act = [&](DynamixelServo& s) {
+    if (broadcast && option == 0xFF && s.firmware_version() >= kBroadcastResetAllIgnored) return;
+    if (!broadcast && s.status_return_level() >= kReplyAll) answer(s, error, {}, out);
+    if (error == StatusError::none) s.factory_reset(option, now);
+  };
+  if (!broadcast) {
+    for_id(packet.id, out, act);
+    return;
+  }
+  for (DynamixelServo& s : servos_) {
+    if (s.responding()) act(s);
+  }
+}
+
 void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& out, int line_baud) {
   for (DynamixelServo& s : servos_) {
     s.advance(now);
@@ -152,27 +204,9 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
   };
 
   switch (packet.instruction) {
-    case inst::ping: {
-      // Answered whatever the Status Return Level.
-      by_id_.clear();
-      each_target([&](DynamixelServo& s) { by_id_.push_back(&s); });
-      std::sort(by_id_.begin(), by_id_.end(),
-                [](const DynamixelServo* a, const DynamixelServo* b) { return a->id() < b->id(); });
-      std::size_t first = out.list.size();
-      for (std::size_t k = 0; k < by_id_.size(); ++k) {
-        const DynamixelServo* s = by_id_[k];
-        if (k > 0 && s->id() != by_id_[k - 1]->id()) {
-          collide(out, first);  // the servos before answered in one slot
-          first = out.list.size();
-        }
-        std::array<std::uint8_t, 3> info{};
-        s->read(dxl::xreg::model_number, 2, info);
-        s->read(dxl::xreg::firmware_version, 1, std::span(info).subspan(2));
-        answer(*s, StatusError::none, info, out);
-      }
-      collide(out, first);
+    case inst::ping:
+      ping(packet, out);
       break;
-    }
     case inst::read:
       if (broadcast) break;  // the manual: no status for a broadcast Read
       for_id(packet.id, out, [&](DynamixelServo& s) {
@@ -265,25 +299,9 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
       }
       break;
     }
-    case inst::factory_reset: {
-      // Option 0xFF resets everything, 0x01 all but the ID, 0x02 all but
-      // the ID and the baud rate. The status packet leaves first, with the
-      // old ID at the old baud. From firmware 42 on a broadcast 0xFF is
-      // ignored (every servo would become ID 1).
-      const std::uint8_t option = p.size() == 1 ? p[0] : 0;
-      const bool known = option == 0xFF || option == 0x01 || option == 0x02;
-      each_target([&](DynamixelServo& s) {
-        if (broadcast && option == 0xFF && s.firmware_version() >= kBroadcastResetAllIgnored) {
-          return;
-        }
-        const StatusError error = p.size() != 1 ? StatusError::data_length
-                                  : !known      ? StatusError::data_range
-                                                : StatusError::none;
-        reply(s, s.status_return_level(), error);
-        if (error == StatusError::none) s.factory_reset(option, now);
-      });
+    case inst::factory_reset:
+      factory_reset(packet, now, out);
       break;
-    }
     case inst::status:
       break;  // another device's answer: not for us
     default:

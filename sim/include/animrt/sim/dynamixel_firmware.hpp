@@ -79,6 +79,8 @@ class DynamixelFirmware {
   void answer_read(const DynamixelServo& servo, std::uint16_t address, std::uint16_t length,
                    Answers& out) const;
   void answer_fast(std::span<const dxl::BulkReadEntry> entries, Answers& out);
+  void ping(const dxl::Packet& packet, Answers& out);
+  void factory_reset(const dxl::Packet& packet, Nanos now, Answers& out);
 
   std::vector<DynamixelServo> servos_;
   std::vector<DynamixelServo*> by_id_;  // scratch for broadcast ping
