@@ -218,11 +218,9 @@ void add_evolve_command(CLI::App& app) {
                   "--dashboard-remote): fitness curves, the best gait so far on the model, stop");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
-  cmd->add_option("--dashboard-rate", args->dashboard_rate,
-                  "dashboard stream rate in Hz (default 30)")
+  cmd->add_option("--dashboard-rate", args->dashboard_rate, "dashboard stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
-  cmd->add_option("--dashboard-www", args->dashboard_www,
-                  "folder of the dashboard's page (default: the source tree's)")
+  cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
   set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }

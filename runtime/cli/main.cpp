@@ -313,6 +313,8 @@ int main(int argc, char** argv) {
 
   CLI::App app{"animrt: real-time motion for animatronic figures"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "animrt " ANIMRT_VERSION);
+  app.option_defaults()->always_capture_default();  // every --help shows the defaults
 
   std::string validate_path;
   auto* validate = app.add_subcommand("validate", "Check a robot file and the files it names");
@@ -342,11 +344,9 @@ int main(int argc, char** argv) {
                   "--dashboard-remote); prints its URL with the run's token");
   run->add_flag("--dashboard-remote", run_args.dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
-  run->add_option("--dashboard-rate", run_args.dashboard_rate,
-                  "dashboard stream rate in Hz (default 30)")
+  run->add_option("--dashboard-rate", run_args.dashboard_rate, "dashboard stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
-  run->add_option("--dashboard-www", run_args.dashboard_www,
-                  "folder of the dashboard's page (default: the source tree's)")
+  run->add_option("--dashboard-www", run_args.dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
 
   run->add_option("--herd", run_args.herd,

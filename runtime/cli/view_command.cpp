@@ -92,10 +92,10 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("TELEMETRY", args->csv, "telemetry CSV of animrt run --telemetry")->required();
   cmd->add_option("--robot", args->robot,
                   "the robot file of the run: limits, buses and the figure's model");
-  cmd->add_option("--dashboard", args->dashboard, "HOST:PORT to serve at (default 127.0.0.1:0)");
+  cmd->add_option("--dashboard", args->dashboard, "HOST:PORT to serve at");
   cmd->add_flag("--dashboard-remote", args->remote,
                 "let the dashboard listen on an address other machines can reach");
-  cmd->add_option("--dashboard-rate", args->rate, "stream rate in Hz (default 30)")
+  cmd->add_option("--dashboard-rate", args->rate, "stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);

@@ -9,6 +9,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"animrt-seqnet: train the sequence network"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "animrt-seqnet " ANIMRT_VERSION);
+  app.option_defaults()->always_capture_default();  // every --help shows the defaults
   animrt::cli::add_seq_net_commands(app);
   try {
     app.parse(argc, argv);
