@@ -4,6 +4,7 @@
 #include "evolve_command.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -43,13 +44,36 @@ struct EvolveArgs {
   bool dashboard_remote = false;
   double dashboard_rate = 30.0;
   std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  bool keep_serving = false;
 };
+
 
 std::string with_extension(const std::string& path, const std::string& ext) {
   return std::filesystem::path(path).replace_extension(ext).string();
 }
 
 RunControls evolve_signal_controls;  // a search takes only its stop
+
+// The search has ended and its page shows the end: with --keep-serving the
+// page stays until a stop signal; without, the user is told it closes (a
+// short search ends before anyone opens the page).
+void end_dashboard(EvolveDashboardServer* dashboard, bool keep_serving) {
+  if (!dashboard) return;
+  if (!keep_serving) {
+    std::cout << "dashboard: the search has ended; the page closes now (--keep-serving keeps it "
+                 "until Ctrl-C)\n"
+              << std::flush;
+    return;
+  }
+  if (evolve_signal_controls.stop.load()) return;  // stopped by a signal: no more serving
+  std::cout << "dashboard: the search has ended; serving " << dashboard->url()
+            << " until Ctrl-C\n"
+            << std::flush;
+  while (!evolve_signal_controls.stop.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  dashboard->stop();
+}
 
 int run_evolve(const EvolveArgs& a) {
   if (a.pareto && !a.dashboard.empty()) {
@@ -172,13 +196,14 @@ int run_evolve(const EvolveArgs& a) {
   evolve::write_history_svg(result.history, config.name, plot);
   const auto& best = result.best;
   if (!best.valid) {
-    if (dashboard) dashboard->finish(result.stopped);
+    if (dashboard) dashboard->finish(result.stopped, a.keep_serving);
     std::cerr << "error: no valid individual in the last generation; no gait written\n";
+    end_dashboard(dashboard.get(), a.keep_serving);
     return 4;
   }
   write_gait_file(best.gait, a.out);
   // The page shows the end once every file is written.
-  if (dashboard) dashboard->finish(result.stopped);
+  if (dashboard) dashboard->finish(result.stopped, a.keep_serving);
   const auto& m = best.measures;
   std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
             << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
@@ -186,6 +211,7 @@ int run_evolve(const EvolveArgs& a) {
             << "evaluations " << result.evaluations << " (and " << result.reused
             << " repeated gaits not walked again), invalid " << result.invalid << '\n'
             << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
+  end_dashboard(dashboard.get(), a.keep_serving);
   return 0;
 }
 
@@ -222,6 +248,8 @@ void add_evolve_command(CLI::App& app) {
       ->check(CLI::Range(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--keep-serving", args->keep_serving,
+                "with --dashboard: keep serving the page after the search ends, until Ctrl-C");
   set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }
 

@@ -71,6 +71,7 @@ int cmd_validate(const std::string& path) {
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
+  for (const std::string& warning : robot.warnings) std::cout << "warning: " << warning << "\n";
   // What stops the figure if animrt itself dies, where the user must know.
   for (const std::string& note : animrt::device_guard_notes(robot.config)) {
     std::cout << note << "\n";

@@ -73,6 +73,7 @@ int run_view(const ViewArgs& args) {
   setup.replay = true;
   setup.replay_start_s = recording.t.front();
   setup.replay_end_s = recording.t.back();
+  setup.replay_times_s = recording.t;
   setup.seek = [&replay](double t, bool playing) { replay.seek(t, playing); };
   DashboardServer server(monitor, controls, setup);
   std::cout << "dashboard: " << server.url() << '\n' << std::flush;

@@ -61,6 +61,22 @@ json timing_json(const MicrosHistogram& h) {
   return {{"p50", h.quantile(0.5) * 1e3}, {"p99", h.quantile(0.99) * 1e3}, {"max", h.max() * 1e3}};
 }
 
+// A replay's Loop panel: the recorded run's rate, cycles and periods. Its
+// jitter, overruns and late cycles were not recorded: null (n/a), not 0.
+json recorded_loop_json(const std::vector<double>& t) {
+  MicrosHistogram period;
+  for (std::size_t i = 1; i < t.size(); ++i) period.add(t[i] - t[i - 1]);
+  const double span = t.size() > 1 ? t.back() - t.front() : 0.0;
+  return {{"cycles", t.size()},
+          {"rate_hz", span > 0.0 ? json(static_cast<double>(t.size() - 1) / span) : json(nullptr)},
+          {"period_ms", period.count() ? timing_json(period) : json(nullptr)},
+          {"jitter_ms", nullptr},
+          {"overruns", nullptr},
+          {"skipped", nullptr},
+          {"late", json::object()},
+          {"jitter_hist", nullptr}};
+}
+
 }  // namespace
 
 struct DashboardServer::Impl {
@@ -69,7 +85,8 @@ struct DashboardServer::Impl {
   DashboardSetup setup;
   const RobotModel& model;
   DashboardCore core;
-  std::string info;  // /api/info, built once
+  std::string info;    // /api/info, built once
+  json recorded_loop;  // a replay's Loop panel, built once
   std::thread sampler;
 
   // The sampler's own state (its thread only).
@@ -252,28 +269,29 @@ struct DashboardServer::Impl {
         if (text.rfind(prefix, 0) == 0) d["last_fault"] = text;
       }
     }
-    json frame = {{"t_s", view.t_s},
-                  {"phase", to_string(view.phase)},
-                  {"joints", joints},
-                  {"loop",
-                   {{"cycles", view.cycles},
-                    {"rate_hz", stats.rate_hz()},
-                    {"period_ms", timing_json(stats.period)},
-                    {"jitter_ms", timing_json(stats.jitter)},
-                    {"overruns", view.overruns},
-                    {"skipped", view.skipped},
-                    {"late", late},
-                    {"jitter_hist", {{"edges_ms", edges}, {"counts", counts}}}}},
-                  {"devices", devices},
-                  {"faults", fault_log},
-                  {"motion",
-                   {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
-                    {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
-                    {"position_s", view.show.show ? view.show.position_s : view.motion_time_s},
-                    {"playing", view.phase == RunPhaseView::motion && !view.manual &&
-                                    (!view.show.show || view.show.playing)},
-                    {"duration_s", view.show.show ? json(view.show.duration_s) : json(nullptr)}}},
-                  {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
+    json frame = {
+        {"t_s", view.t_s},
+        {"phase", to_string(view.phase)},
+        {"joints", joints},
+        {"loop", setup.replay ? recorded_loop
+                              : json{{"cycles", view.cycles},
+                                     {"rate_hz", stats.rate_hz()},
+                                     {"period_ms", timing_json(stats.period)},
+                                     {"jitter_ms", timing_json(stats.jitter)},
+                                     {"overruns", view.overruns},
+                                     {"skipped", view.skipped},
+                                     {"late", late},
+                                     {"jitter_hist", {{"edges_ms", edges}, {"counts", counts}}}}},
+        {"devices", devices},
+        {"faults", fault_log},
+        {"motion",
+         {{"speed_mps", view.steered ? json(view.steer.speed_m_s) : json(nullptr)},
+          {"turn_rps", view.steered ? json(view.steer.turn_rad_s) : json(nullptr)},
+          {"position_s", view.show.show ? view.show.position_s : view.motion_time_s},
+          {"playing", view.phase == RunPhaseView::motion && !view.manual &&
+                          (!view.show.show || view.show.playing)},
+          {"duration_s", view.show.show ? json(view.show.duration_s) : json(nullptr)}}},
+        {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};
     if (setup.figure && view.published) {
       const std::size_t bodies = setup.figure->bodies().size();
       measured_bodies.resize(bodies);
@@ -415,7 +433,6 @@ struct DashboardServer::Impl {
       setup.seek(*t, playing == body.end() || playing->get<bool>());
       answer(res, 200, {{"ok", true}});
     });
-
   }
 };
 
@@ -426,6 +443,7 @@ DashboardServer::DashboardServer(RunMonitor& monitor, RunControls& controls, Das
     throw std::invalid_argument("the dashboard rate must be a positive number of Hz");
   }
   m.info = m.build_info();
+  if (m.setup.replay) m.recorded_loop = recorded_loop_json(m.setup.replay_times_s);
   m.core.publish(m.build_state());
   m.routes();
   m.core.start();
