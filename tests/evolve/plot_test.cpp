@@ -51,9 +51,9 @@ TEST(ParetoPlot, RoundTicksAndLabelsThatDoNotOverlap) {
     double x0, y0, x1, y1;
   };
   std::vector<Box> labels;
-  const std::regex label(R"(<text x="([-0-9.e]+)" y = "([-0-9.e]+)" font - size =
-                                                          "10" > (\d +) < / text >) ");
-      for (std::sregex_iterator it(svg.begin(), svg.end(), label), end; it != end; ++it) {
+  const std::regex label(
+      R"re(<text x="([-0-9.e]+)" y="([-0-9.e]+)" font-size="10">(\d+)</text>)re");
+  for (std::sregex_iterator it(svg.begin(), svg.end(), label), end; it != end; ++it) {
     const double x = std::stod((*it)[1]), y = std::stod((*it)[2]);
     const double w = 6.0 * static_cast<double>((*it)[3].length());
     labels.push_back({x, y - 10, x + w, y});
