@@ -47,7 +47,6 @@ struct EvolveArgs {
   bool keep_serving = false;
 };
 
-
 std::string with_extension(const std::string& path, const std::string& ext) {
   return std::filesystem::path(path).replace_extension(ext).string();
 }
@@ -60,13 +59,13 @@ RunControls evolve_signal_controls;  // a search takes only its stop
 void end_dashboard(EvolveDashboardServer* dashboard, bool keep_serving) {
   if (!dashboard) return;
   if (!keep_serving) {
-    std::cout << "dashboard: the search has ended; the page closes now (--keep-serving keeps it "
+    std::cout << "the search has ended: its dashboard page closes now (--keep-serving keeps it "
                  "until Ctrl-C)\n"
               << std::flush;
     return;
   }
   if (evolve_signal_controls.stop.load()) return;  // stopped by a signal: no more serving
-  std::cout << "dashboard: the search has ended; serving " << dashboard->url()
+  std::cout << "the search has ended: its dashboard page stays at " << dashboard->url()
             << " until Ctrl-C\n"
             << std::flush;
   while (!evolve_signal_controls.stop.load()) {

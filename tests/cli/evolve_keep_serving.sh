@@ -22,7 +22,7 @@ out=$("$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/g.yaml" --threads 1 --quie
   --dashboard 127.0.0.1:0 2>&1)
 code=$?
 [[ $code -eq 0 || $code -eq 4 ]] || fail "evolve exited $code: $out"
-[[ $out == *"dashboard: the search has ended; the page closes now (--keep-serving keeps it until Ctrl-C)"* ]] ||
+[[ $out == *"the search has ended: its dashboard page closes now (--keep-serving keeps it until Ctrl-C)"* ]] ||
   fail "the page closed without a word: $out"
 
 "$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/k.yaml" --threads 1 --quiet \
@@ -34,7 +34,7 @@ for _ in $(seq 1 600); do
   sleep 0.05
 done
 line=$(grep "until Ctrl-C" "$tmp/keep.txt")
-[[ $line =~ ^dashboard:\ the\ search\ has\ ended\;\ serving\ (http://127\.0\.0\.1:[0-9]+)/\?token=[0-9a-f]{32}\ until\ Ctrl-C$ ]] ||
+[[ $line =~ ^the\ search\ has\ ended:\ its\ dashboard\ page\ stays\ at\ (http://127\.0\.0\.1:[0-9]+)/\?token=[0-9a-f]{32}\ until\ Ctrl-C$ ]] ||
   fail "no serving line: $(cat "$tmp/keep.txt")"
 base=${BASH_REMATCH[1]}
 sleep 0.3
