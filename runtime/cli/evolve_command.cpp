@@ -86,7 +86,8 @@ int run_evolve(const EvolveArgs& a) {
   evolve::RunConfig config = evolve::load_run_config(a.run_file);
   if (a.seed) config.search.seed = *a.seed;
   if (a.population) config.search.population = *a.population;
-  if (a.generations) config.search.generations = *a.generations;
+  // --generations counts the initial one; the run file counts those after it.
+  if (a.generations) config.search.generations = *a.generations - 1;
   if (a.threads) config.threads = *a.threads;
   if (config.search.elites >= config.search.population) {
     config.search.elites = std::max(0, config.search.population - 1);
@@ -152,8 +153,8 @@ int run_evolve(const EvolveArgs& a) {
                                                                        : "")
               << ", model " << config.model << " (" << info.joints.size() << " actuators, "
               << info.mass_kg << " kg), population " << config.search.population << ", "
-              << config.search.generations << " generations, seed " << config.search.seed << ", "
-              << workers << " worker" << (workers == 1 ? "" : "s")
+              << config.search.generations + 1 << " generations, seed " << config.search.seed
+              << ", " << workers << " worker" << (workers == 1 ? "" : "s")
               << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
               << std::flush;
   }
@@ -229,8 +230,10 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "random seed (overrides the run file)");
   cmd->add_option("--population", args->population, "population size")
       ->check(CLI::Range(2, 1000000));
-  cmd->add_option("--generations", args->generations, "generations after the initial one")
-      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--generations", args->generations,
+                  "generations to run, the initial one included (1: the initial population "
+                  "only; the run file's search.generations counts those after it)")
+      ->check(CLI::Range(1, 1000001));
   cmd->add_option("--csv", args->csv, "per-generation statistics (default: OUT with .csv)");
   cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
   cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
