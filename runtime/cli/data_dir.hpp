@@ -11,4 +11,8 @@ namespace animrt::cli {
 
 std::string data_dir();
 
+// The dashboard's page: the source tree's runtime/dashboard/www from the
+// build tree, else the data folder's www/.
+std::string dashboard_www_dir();
+
 }  // namespace animrt::cli

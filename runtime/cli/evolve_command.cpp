@@ -21,6 +21,7 @@
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "evolve_pareto.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
@@ -43,7 +44,7 @@ struct EvolveArgs {
   std::string dashboard;  // HOST:PORT, "" for none
   bool dashboard_remote = false;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
   bool keep_serving = false;
 };
 

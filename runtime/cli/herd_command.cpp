@@ -19,6 +19,7 @@
 #include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -37,7 +38,7 @@ struct HerdArgs {
   bool dashboard_remote = false;
   double dashboard_speed = 1.0;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
 };
 
 nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {

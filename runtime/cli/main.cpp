@@ -33,6 +33,7 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "evolve_command.hpp"
 #include "fault_injection.hpp"
 #include "gait_command.hpp"
@@ -150,7 +151,7 @@ struct RunArgs {
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
 };
 
 // Options that need one another or the simulated backend: a usage error

@@ -10,6 +10,7 @@
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/telemetry_replay.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
+#include "data_dir.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -22,7 +23,7 @@ struct ViewArgs {
   std::string dashboard = "127.0.0.1:0";
   bool remote = false;
   double rate = 30.0;
-  std::string www = ANIMRT_DASHBOARD_WWW;
+  std::string www = dashboard_www_dir();
 };
 
 int run_view(const ViewArgs& args) {
