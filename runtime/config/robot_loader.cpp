@@ -39,7 +39,8 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     auto source = make_show_source(show, joints);
     double length = show.duration_s;
     for (const ShowTrack& track : show.tracks) length = std::max(length, track.keys.back().t);
-    MotionCheck check{source.get(), length, motion.where, motion.key, {}, &speeds};
+    MotionCheck check{source.get(), length, motion.where, motion.key, {}};
+    check.speeds = &speeds;
     check.joint_where = [&show, &joints](int j) {
       for (const ShowTrack& track : show.tracks) {
         if (track.joint == joints[static_cast<std::size_t>(j)].name) return at(track.where);
@@ -79,9 +80,12 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     // file streamed through the decoder), and its targets are clamped to the
     // joints' limits as they are made, so it is not sampled here.
     if (gait) {
-      MotionCheck check{source.get(), gait_check_duration(gait->stride_frequency()),
-                        motion.where, motion.key,
-                        {},           &speeds};
+      MotionCheck check{source.get(),
+                        gait_check_duration(gait->stride_frequency()),
+                        motion.where,
+                        motion.key,
+                        {}};
+      check.speeds = &speeds;
       check.joint_where = [&gait, &joints](int j) {
         for (const GaitJoint& g : gait->joints) {
           if (g.name == joints[static_cast<std::size_t>(j)].name)
