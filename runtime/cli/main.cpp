@@ -370,6 +370,7 @@ int main(int argc, char** argv) {
   seq->require_subcommand(1);
   animrt::cli::add_seq_corpus_command(*seq);
   animrt::cli::add_seq_command(*seq);
+  animrt::cli::hide_empty_defaults(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -16,6 +16,10 @@ out=$("$animrt" view --help 2>&1) || fail "view --help failed: $out"
 out=$("$animrt" herd --help 2>&1) || fail "herd --help failed: $out"
 [[ $out == *"--dashboard-speed "*"=1"* ]] || fail "herd --help shows no default pace: $out"
 
+out=$("$animrt" seq corpus --help 2>&1) || fail "seq corpus --help failed: $out"
+[[ $out == *"--vertices "*"=1000"* ]] || fail "seq corpus --help shows no default vertices: $out"
+[[ $out != *"=[]"* ]] || fail "an empty list shown as a default: $out"
+
 out=$("$animrt" seq train --help 2>&1) || fail "seq train --help failed: $out"
 [[ $out == *"Usage: animrt seq train "* ]] || fail "seq train --help names another program: $out"
 echo "ok"

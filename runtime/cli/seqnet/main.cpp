@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "../subcommand.hpp"
 #include "seq_net_commands.hpp"
 
 int main(int argc, char** argv) {
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "animrt-seqnet " ANIMRT_VERSION);
   app.option_defaults()->always_capture_default();  // every --help shows the defaults
   animrt::cli::add_seq_net_commands(app);
+  animrt::cli::hide_empty_defaults(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
