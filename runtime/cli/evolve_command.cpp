@@ -4,6 +4,7 @@
 #include "evolve_command.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -20,6 +21,7 @@
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "evolve_pareto.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
@@ -42,7 +44,8 @@ struct EvolveArgs {
   std::string dashboard;  // HOST:PORT, "" for none
   bool dashboard_remote = false;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
+  bool keep_serving = false;
 };
 
 std::string with_extension(const std::string& path, const std::string& ext) {
@@ -51,12 +54,34 @@ std::string with_extension(const std::string& path, const std::string& ext) {
 
 RunControls evolve_signal_controls;  // a search takes only its stop
 
+// The search has ended and its page shows the end: with --keep-serving the
+// page stays until a stop signal; without, the user is told it closes (a
+// short search ends before anyone opens the page).
+void end_dashboard(EvolveDashboardServer* dashboard, bool keep_serving) {
+  if (!dashboard) return;
+  if (!keep_serving) {
+    std::cout << "the search has ended: its dashboard page closes now (--keep-serving keeps it "
+                 "until Ctrl-C)\n"
+              << std::flush;
+    return;
+  }
+  if (evolve_signal_controls.stop.load()) return;  // stopped by a signal: no more serving
+  std::cout << "the search has ended: its dashboard page stays at " << dashboard->url()
+            << " until Ctrl-C\n"
+            << std::flush;
+  while (!evolve_signal_controls.stop.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  dashboard->stop();
+}
+
 // The run file with the command line's overrides.
 evolve::RunConfig load_config(const EvolveArgs& a) {
   evolve::RunConfig config = evolve::load_run_config(a.run_file);
   if (a.seed) config.search.seed = *a.seed;
   if (a.population) config.search.population = *a.population;
-  if (a.generations) config.search.generations = *a.generations;
+  // --generations counts the initial one; the run file counts those after it.
+  if (a.generations) config.search.generations = *a.generations - 1;
   if (a.threads) config.threads = *a.threads;
   if (config.search.elites >= config.search.population) {
     config.search.elites = std::max(0, config.search.population - 1);
@@ -111,8 +136,8 @@ void print_header(const evolve::RunConfig& config, const evolve::ModelInfo& info
             << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)" : "")
             << ", model " << config.model << " (" << info.joints.size() << " actuators, "
             << info.mass_kg << " kg), population " << config.search.population << ", "
-            << config.search.generations << " generations, seed " << config.search.seed << ", "
-            << workers << " worker" << (workers == 1 ? "" : "s")
+            << config.search.generations + 1 << " generations, seed " << config.search.seed
+            << ", " << workers << " worker" << (workers == 1 ? "" : "s")
             << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
             << std::flush;
 }
@@ -126,13 +151,14 @@ int write_results(const EvolveArgs& a, const evolve::RunConfig& config,
   evolve::write_history_svg(result.history, config.name, plot);
   const auto& best = result.best;
   if (!best.valid) {
-    if (dashboard) dashboard->finish(result.stopped);
+    if (dashboard) dashboard->finish(result.stopped, a.keep_serving);
     std::cerr << "error: no valid individual in the last generation; no gait written\n";
+    end_dashboard(dashboard, a.keep_serving);
     return 4;
   }
   write_gait_file(best.gait, a.out);
   // The page shows the end once every file is written.
-  if (dashboard) dashboard->finish(result.stopped);
+  if (dashboard) dashboard->finish(result.stopped, a.keep_serving);
   const auto& m = best.measures;
   std::cout << "best fitness " << best.fitness << (m.fell ? " (falls)" : "") << ": speed "
             << m.speed << " m/s, stride " << m.stride_length << " m, duty factor " << m.duty_factor
@@ -140,6 +166,7 @@ int write_results(const EvolveArgs& a, const evolve::RunConfig& config,
             << "evaluations " << result.evaluations << " (and " << result.reused
             << " repeated gaits not walked again), invalid " << result.invalid << '\n'
             << "wrote " << a.out << ", " << csv << ", " << plot << '\n';
+  end_dashboard(dashboard, a.keep_serving);
   return 0;
 }
 
@@ -237,8 +264,10 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "random seed (overrides the run file)");
   cmd->add_option("--population", args->population, "population size")
       ->check(CLI::Range(2, 1000000));
-  cmd->add_option("--generations", args->generations, "generations after the initial one")
-      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--generations", args->generations,
+                  "generations to run, the initial one included (1: the initial population "
+                  "only; the run file's search.generations counts those after it)")
+      ->check(CLI::Range(1, 1000001));
   cmd->add_option("--csv", args->csv, "per-generation statistics (default: OUT with .csv)");
   cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
   cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
@@ -251,12 +280,12 @@ void add_evolve_command(CLI::App& app) {
                   "--dashboard-remote): fitness curves, the best gait so far on the model, stop");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
-  cmd->add_option("--dashboard-rate", args->dashboard_rate,
-                  "dashboard stream rate in Hz (default 30)")
+  cmd->add_option("--dashboard-rate", args->dashboard_rate, "dashboard stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
-  cmd->add_option("--dashboard-www", args->dashboard_www,
-                  "folder of the dashboard's page (default: the source tree's)")
+  cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--keep-serving", args->keep_serving,
+                "with --dashboard: keep serving the page after the search ends, until Ctrl-C");
   set_subcommand_body(cmd, [args] { return run_evolve(*args); });
 }
 

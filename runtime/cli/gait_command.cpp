@@ -36,11 +36,34 @@ constexpr double kSettleS = 0.5;
 constexpr double kWarmupStrides = 3.0;
 constexpr double kMeasureStrides = 4.0;
 
+// Normalised on both sides, so the table names ../gaits/walk.yaml, not a
+// path through the robot file's folder.
 std::string relative_to(const std::string& path, const std::string& from_file) {
   std::error_code ec;
-  const auto base = std::filesystem::absolute(from_file, ec).parent_path();
-  const auto rel = std::filesystem::absolute(path, ec).lexically_relative(base);
+  const auto base = std::filesystem::absolute(from_file, ec).lexically_normal().parent_path();
+  const auto rel = std::filesystem::absolute(path, ec).lexically_normal().lexically_relative(base);
   return rel.empty() ? path : rel.string();
+}
+
+// A table without a usable turn steers nothing: the runtime walks the gait
+// straight. Said, and why, rather than left to be found on the figure.
+void explain_turns(const GaitCalibration& cal, const GaitSteering& st, int turns) {
+  const bool turning = std::any_of(cal.points.begin(), cal.points.end(), [](const auto& p) {
+    return p.usable && p.commanded.turn_rad_s != 0.0;
+  });
+  if (turning) return;
+  if (turns == 0) {
+    std::printf("--turns 0: no turn was tried; the table walks the gait straight only\n");
+    return;
+  }
+  std::printf("no turn is usable: the table walks the gait straight only");
+  if (turns == 1) {
+    std::printf(
+        " (--turns 1 tries only the fastest turns, +-%.1f deg/s; --turns 2 or more "
+        "tries gentler ones too)",
+        rad_to_deg(st.max_turn_rad_s));
+  }
+  std::printf("\n");
 }
 
 int run_calibrate(const CalibrateArgs& a) {
@@ -115,6 +138,7 @@ int run_calibrate(const CalibrateArgs& a) {
       "%g deg/s, no fall)\nwrote %s\n",
       usable, cal.points.size(), 100.0 * cal.tolerance, 100.0 * cal.tolerance,
       kCalibrationTurnFloorDps, out.c_str());
+  explain_turns(cal, st, a.turns);
   return 0;
 }
 

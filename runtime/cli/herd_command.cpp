@@ -20,6 +20,7 @@
 #include "animrt/runtime/herd_dashboard.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -38,7 +39,7 @@ struct HerdArgs {
   bool dashboard_remote = false;
   double dashboard_speed = 1.0;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
 };
 
 nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
@@ -227,10 +228,10 @@ void add_herd_command(CLI::App& app) {
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "allow a --dashboard host that is not loopback");
   cmd->add_option("--dashboard-speed", args->dashboard_speed,
-                  "with --dashboard: the pace, in multiples of real time (default 1)")
+                  "with --dashboard: the pace, in multiples of real time")
       ->check(CLI::Range(0.01, 1000.0));
   cmd->add_option("--dashboard-rate", args->dashboard_rate,
-                  "with --dashboard: states streamed per second (default 30)")
+                  "with --dashboard: states streamed per second")
       ->check(CLI::Range(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page");
   set_subcommand_body(cmd, [args] { return run_herd(*args); });

@@ -32,6 +32,7 @@
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "evolve_command.hpp"
 #include "fault_injection.hpp"
 #include "gait_command.hpp"
@@ -71,6 +72,7 @@ int cmd_validate(const std::string& path) {
             << robot.config.buses.size() << " bus" << (robot.config.buses.size() == 1 ? "" : "es")
             << ", " << devices << " devices, " << animrt::describe_motion(robot.config.motion)
             << ")\n";
+  for (const std::string& warning : robot.warnings) std::cout << "warning: " << warning << "\n";
   // What stops the figure if animrt itself dies, where the user must know.
   for (const std::string& note : animrt::device_guard_notes(robot.config)) {
     std::cout << note << "\n";
@@ -150,7 +152,7 @@ struct RunArgs {
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
   double dashboard_rate = 30.0;
-  std::string dashboard_www = ANIMRT_DASHBOARD_WWW;
+  std::string dashboard_www = animrt::cli::dashboard_www_dir();
 };
 
 // Options that need one another or the simulated backend: a usage error
@@ -309,11 +311,9 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
                   "--dashboard-remote); prints its URL with the run's token");
   run->add_flag("--dashboard-remote", run_args.dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
-  run->add_option("--dashboard-rate", run_args.dashboard_rate,
-                  "dashboard stream rate in Hz (default 30)")
+  run->add_option("--dashboard-rate", run_args.dashboard_rate, "dashboard stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
-  run->add_option("--dashboard-www", run_args.dashboard_www,
-                  "folder of the dashboard's page (default: the source tree's)")
+  run->add_option("--dashboard-www", run_args.dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
 
   run->add_option("--herd", run_args.herd,
@@ -339,6 +339,8 @@ int main(int argc, char** argv) {
 
   CLI::App app{"animrt: real-time motion for animatronic figures"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "animrt " ANIMRT_VERSION);
+  app.option_defaults()->always_capture_default();  // every --help shows the defaults
 
   std::string validate_path;
   auto* validate = app.add_subcommand("validate", "Check a robot file and the files it names");
@@ -358,6 +360,7 @@ int main(int argc, char** argv) {
   seq->require_subcommand(1);
   animrt::cli::add_seq_corpus_command(*seq);
   animrt::cli::add_seq_command(*seq);
+  animrt::cli::hide_empty_defaults(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

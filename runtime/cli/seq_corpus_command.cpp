@@ -9,6 +9,7 @@
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
+#include "data_dir.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -17,7 +18,7 @@ namespace {
 struct SeqCorpusArgs {
   std::string out;
   std::string model = "quadruped";
-  std::string configs = "configs";
+  std::string configs = data_dir();
   std::vector<std::string> gaits;
   std::vector<double> froude;
   std::vector<double> turns{0.0};

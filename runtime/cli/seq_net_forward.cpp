@@ -27,7 +27,8 @@ std::string tool_path() {
 
 void forward(const std::string& command, const std::vector<std::string>& args) {
   const std::string tool = tool_path();
-  std::vector<std::string> words{tool, command};
+  // argv[0] is the name its usage lines give: the command the user typed.
+  std::vector<std::string> words{"animrt seq", command};
   words.insert(words.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());

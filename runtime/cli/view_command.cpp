@@ -10,6 +10,7 @@
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/telemetry_replay.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
+#include "data_dir.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -22,7 +23,7 @@ struct ViewArgs {
   std::string dashboard = "127.0.0.1:0";
   bool remote = false;
   double rate = 30.0;
-  std::string www = ANIMRT_DASHBOARD_WWW;
+  std::string www = dashboard_www_dir();
 };
 
 int run_view(const ViewArgs& args) {
@@ -73,6 +74,7 @@ int run_view(const ViewArgs& args) {
   setup.replay = true;
   setup.replay_start_s = recording.t.front();
   setup.replay_end_s = recording.t.back();
+  setup.replay_times_s = recording.t;
   setup.seek = [&replay](double t, bool playing) { replay.seek(t, playing); };
   DashboardServer server(monitor, controls, setup);
   std::cout << "dashboard: " << server.url() << '\n' << std::flush;
@@ -95,10 +97,10 @@ void add_view_command(CLI::App& app) {
       ->required();
   cmd->add_option("--robot", args->robot,
                   "the robot file of the run: limits, buses and the figure's model");
-  cmd->add_option("--dashboard", args->dashboard, "HOST:PORT to serve at (default 127.0.0.1:0)");
+  cmd->add_option("--dashboard", args->dashboard, "HOST:PORT to serve at");
   cmd->add_flag("--dashboard-remote", args->remote,
                 "let the dashboard listen on an address other machines can reach");
-  cmd->add_option("--dashboard-rate", args->rate, "stream rate in Hz (default 30)")
+  cmd->add_option("--dashboard-rate", args->rate, "stream rate in Hz")
       ->check(CLI::Range(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);

@@ -16,6 +16,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
+#include "file_kind.hpp"
 
 namespace animrt {
 namespace {
@@ -537,6 +538,7 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
 
 RobotConfig load_robot_config(const std::string& path) {
   const YamlNode root = YamlNode::load_file(path);
+  require_robot_file(root);
   root.allow_only({"name", "loop", "safety", "buses", "joints", "motion", "model"});
 
   RobotConfig config;

@@ -1,6 +1,9 @@
 #include "animrt/runtime/robot_loader.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "animrt/bridge/protocol.hpp"
@@ -8,6 +11,7 @@
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/motion_check.hpp"
+#include "animrt/runtime/robot_model.hpp"
 
 namespace animrt {
 
@@ -21,11 +25,13 @@ std::string at(const Location& where) {
   return text;
 }
 
-std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const RobotConfig& config) {
+std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const RobotConfig& config,
+                                          MotionCheck::Speeds& speeds) {
   const std::vector<JointSpec>& joints = config.joints;
   if (motion.type == "layers") {
     std::vector<std::unique_ptr<MotionSource>> layers;
-    for (const MotionConfig& layer : motion.layers) layers.push_back(make_source(layer, config));
+    for (const MotionConfig& layer : motion.layers)
+      layers.push_back(make_source(layer, config, speeds));
     return make_layered_source(std::move(layers));
   }
   if (motion.type == "show") {
@@ -34,6 +40,7 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     double length = show.duration_s;
     for (const ShowTrack& track : show.tracks) length = std::max(length, track.keys.back().t);
     MotionCheck check{source.get(), length, motion.where, motion.key, {}};
+    check.speeds = &speeds;
     check.joint_where = [&show, &joints](int j) {
       for (const ShowTrack& track : show.tracks) {
         if (track.joint == joints[static_cast<std::size_t>(j)].name) return at(track.where);
@@ -78,6 +85,7 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
                         motion.where,
                         motion.key,
                         {}};
+      check.speeds = &speeds;
       check.joint_where = [&gait, &joints](int j) {
         for (const GaitJoint& g : gait->joints) {
           if (g.name == joints[static_cast<std::size_t>(j)].name)
@@ -98,12 +106,84 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
   }
 }
 
+// A motion that asks a joint for more speed than its simulated servos turn
+// (sim.max_speed_dps, the model of the real ones) lags ever further behind
+// and faults on the following-error watch: said on load, with the numbers.
+// The safety filter never lets a joint go faster than its velocity limit,
+// so that is the most the motion can ask.
+void note_servo_speeds(LoadedRobot& robot, const MotionCheck::Speeds& speeds) {
+  RobotConfig& config = robot.config;
+  config.lag_notes.assign(config.joints.size(), "");
+  if (speeds.peak.size() != config.joints.size()) return;
+  for (const BusConfig& bus : config.buses) {
+    const double servo = bus.sim.max_speed_rad_s;
+    std::size_t worst = config.joints.size(), count = 0;
+    double worst_asked = 0.0;
+    for (const ActuatorBinding& a : bus.actuators) {
+      const auto j = static_cast<std::size_t>(a.joint_index);
+      const JointSpec& joint = config.joints[j];
+      if (joint.type == JointType::prismatic) continue;
+      const double asked = std::min(speeds.peak[j], joint.limits.max_velocity);
+      // A tenth over: the servo's lag absorbs a brief excess.
+      if (!(asked > 1.1 * servo)) continue;
+      config.lag_notes[j] = fmt::format(
+          "its motion asks for up to {:.0f} deg/s, faster than bus {}'s servos turn ({:.0f} deg/s, "
+          "sim.max_speed_dps)",
+          rad_to_deg(asked), bus.name, rad_to_deg(servo));
+      ++count;
+      if (asked > worst_asked) {
+        worst_asked = asked;
+        worst = j;
+      }
+    }
+    if (worst == config.joints.size()) continue;
+    robot.warnings.push_back(fmt::format(
+        "{} asks joint {} for up to {:.0f} deg/s at t = {:.2f} s ({} joint{} of bus {} "
+        "over its servos' speed), but the servos of bus {} turn at most {:.0f} deg/s "
+        "(sim.max_speed_dps{}): a run would lag and fault on its following error; give "
+        "sim.max_speed_dps the real servos' speed, or slow the motion",
+        describe_motion(config.motion), config.joints[worst].name, rad_to_deg(worst_asked),
+        speeds.at_s[worst], count, count == 1 ? "" : "s", bus.name, bus.name, rad_to_deg(servo),
+        servo == SimBusSettings{}.max_speed_rad_s ? ", the default" : ""));
+  }
+}
+
+// A bus's read must be back within the read budget, or the cycle goes on
+// without it (a late cycle): its wire time and the measured overhead of each
+// transaction against the budget, said on load with the numbers.
+void note_read_budget(LoadedRobot& robot) {
+  const RobotConfig& config = robot.config;
+  const double period = 1.0 / config.rate_hz;
+  const double budget = kReadBudgetFraction * period;
+  for (const BusConfig& bus : config.buses) {
+    const Protocol* protocol = find_protocol(bus.protocol);
+    const double bits = protocol ? protocol->read_wire_bits_per_cycle(bus) : 0.0;
+    if (bits <= 0.0) continue;
+    const double wire = bits / bus.baud;
+    const int transactions = protocol->read_transactions_per_cycle(bus);
+    const double overhead = transactions * kReadOverheadS;
+    if (wire + overhead <= budget) continue;
+    robot.warnings.push_back(fmt::format(
+        "bus {}: a read takes about {:.2f} ms ({:.2f} ms on the wire for {} devices at {} baud "
+        "+ {:.2f} ms measured overhead for {} transaction{}), over the read budget of {:.2f} ms "
+        "({:.0f} % of the {:.2f} ms period at {} Hz): expect late cycles; run at most {:.0f} Hz, "
+        "raise the baud rate or split the devices over more buses",
+        bus.name, (wire + overhead) * 1e3, wire * 1e3, bus.actuators.size(), bus.baud,
+        overhead * 1e3, transactions, transactions == 1 ? "" : "s", budget * 1e3,
+        kReadBudgetFraction * 100.0, period * 1e3, format_number(config.rate_hz),
+        std::floor(kReadBudgetFraction / (wire + overhead))));
+  }
+}
+
 }  // namespace
 
 LoadedRobot load_robot(const std::string& path) {
   LoadedRobot robot;
   robot.config = load_robot_config(path);
-  robot.motion = make_source(robot.config.motion, robot.config);
+  MotionCheck::Speeds speeds;
+  robot.motion = make_source(robot.config.motion, robot.config, speeds);
+  note_read_budget(robot);
+  note_servo_speeds(robot, speeds);
   if (robot.config.motion.type == "gait") {
     robot.steering = load_gait_file(robot.config.motion.file).steering;
   }

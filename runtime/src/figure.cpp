@@ -4,6 +4,8 @@
 #include <stdexcept>
 
 #include "animrt/controllers/show/show_audio.hpp"
+#include "animrt/core/error.hpp"
+#include "bus_failures.hpp"
 
 namespace animrt {
 
@@ -26,6 +28,9 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
         " devices keep the wall's");
   }
   if (!robot.motion) throw std::invalid_argument("figure " + robot.config.name + ": no motion");
+  for (const std::string& line : robot.warnings) {
+    if (options.warn) options.warn(line);
+  }
   backend_.check(robot.config, lockstep_);
   backend_.adjust(robot.config, lockstep_);
   if (options.edit) options.edit(robot.config);
@@ -35,12 +40,21 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
   show_ = robot.motion->show_position(0.0);
   config_ = robot.config;
   std::vector<std::unique_ptr<ActuatorBus>> buses;
+  // Every port is tried, so one error names all that cannot be opened.
+  std::vector<std::string> failed;
   for (std::size_t b = 0; b < config_.buses.size(); ++b) {
-    std::unique_ptr<ActuatorBus> bus = make_bus(config_.buses[b]);
+    std::unique_ptr<ActuatorBus> bus;
+    try {
+      bus = make_bus(config_.buses[b]);
+    } catch (const DeviceError& e) {
+      failed.emplace_back(e.what());
+      continue;
+    }
     if (options.wrap_bus) bus = options.wrap_bus(std::move(bus), b);
     buses_.push_back(bus.get());
     buses.push_back(std::move(bus));
   }
+  if (!failed.empty()) throw DeviceError(bus_failures(failed, config_.buses.size()));
   runner_ =
       std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
   if (options.audio_sink) {

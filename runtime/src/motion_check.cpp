@@ -93,11 +93,32 @@ void sample_motion(const RobotConfig& config, const MotionCheck& check,
   const double period = 1.0 / config.rate_hz;
   const double step = std::max(period, check.duration_s / kMaxSamples);
   const auto samples = static_cast<long>(std::ceil(check.duration_s / step));
+  MotionCheck::Speeds* speeds = check.speeds;
+  if (speeds) {
+    speeds->peak.resize(n, 0.0);
+    speeds->at_s.resize(n, 0.0);
+  }
+  std::vector<double> previous(n);
+  double previous_t = 0.0;
   for (long k = 0; k <= samples; ++k) {
     const double t = std::min(static_cast<double>(k) * step, check.duration_s);
     pose = home;
     if (before) before(t);
     check.source->sample(t, pose);
+    // Speeds between samples one loop period apart (a coarser sampling of a
+    // long motion would understate them).
+    if (speeds && k > 0 && t - previous_t > 0.0 && t - previous_t <= 1.001 * period) {
+      for (int j : driven) {
+        const auto i = static_cast<std::size_t>(j);
+        const double v = std::abs(pose[i] - previous[i]) / (t - previous_t);
+        if (std::isfinite(v) && v > speeds->peak[i]) {
+          speeds->peak[i] = v;
+          speeds->at_s[i] = t;
+        }
+      }
+    }
+    previous = pose;
+    previous_t = t;
     for (int j : driven) {
       const auto i = static_cast<std::size_t>(j);
       const JointSpec& joint = config.joints[i];

@@ -5,16 +5,16 @@
 
 #include <algorithm>
 
+#include "animrt/runtime/robot_config.hpp"
 #include "futex.hpp"
 
 namespace animrt {
 namespace {
 
 constexpr std::size_t kTelemetryCapacity = 1 << 14;  // records (~80 s at 200 Hz)
-// Real time: how long after its deadline a cycle waits for the buses' reads,
-// as a fraction of the period. A bus that has not answered by then keeps its
-// last measurement this cycle, and the others go on without it.
-constexpr double kReadBudget = 0.6;
+// A bus that has not answered by then keeps its last measurement this
+// cycle, and the others go on without it.
+constexpr double kReadBudget = kReadBudgetFraction;
 constexpr std::size_t kManualPerCycle = 64;  // manual targets taken per cycle, at most
 
 void sleep_until_deadline(Nanos deadline) {

@@ -11,6 +11,7 @@
 #include "animrt/runtime/cycle.hpp"
 #include "animrt/runtime/realtime.hpp"
 #include "animrt/runtime/robot_model.hpp"
+#include "bus_failures.hpp"
 #include "run_loop.hpp"
 
 namespace animrt {
@@ -68,7 +69,7 @@ std::string describe_health(const HealthLimits& lim, const CycleEvent& e) {
 
 std::string describe_event(const RobotModel& m,
                            const std::vector<std::unique_ptr<ActuatorBus>>& buses,
-                           const CycleEvent& e) {
+                           const std::vector<std::string>& lag_notes, const CycleEvent& e) {
   const bool prismatic = e.joint >= 0 && m.prismatic[static_cast<std::size_t>(e.joint)] != 0;
   switch (e.kind) {
     case EventKind::device_fault: {
@@ -85,13 +86,17 @@ std::string describe_event(const RobotModel& m,
     case EventKind::following_error: {
       const auto& bus = buses[e.bus]->config();
       const auto& actuator = bus.actuators[e.device];
-      const double limit = m.following_error[static_cast<std::size_t>(e.joint)];
+      const auto joint = static_cast<std::size_t>(e.joint);
+      const double limit = m.following_error[joint];
+      // A motion faster than the servos turn (found on load) comes first.
+      const std::string lag =
+          joint < lag_notes.size() && !lag_notes[joint].empty() ? lag_notes[joint] + "? " : "";
       return fmt::format(
           "bus {} id {} ({}): RMS following error {} over the last {} s (limit {}) at t={:.3f} "
-          "s; the joint is held, other joints ramped to home (two servos answering under each "
+          "s; the joint is held, other joints ramped to home ({}two servos answering under each "
           "other's ids? a blocked or unpowered joint?)",
           bus.name, actuator.device_id, actuator.joint, joint_value(e.value, prismatic, 2),
-          m.safety.following_error_window_s, joint_value(limit, prismatic), e.t);
+          m.safety.following_error_window_s, joint_value(limit, prismatic), e.t, lag);
     }
     case EventKind::health_fault: {
       const auto& bus = buses[e.bus]->config();
@@ -196,15 +201,23 @@ RunSummary Runner::Impl::begin_summary(const RunOptions& options) const {
 }
 
 // Opens every bus and reads where its devices are; returns the positions per
-// bus and device.
+// bus and device. Every bus is tried before giving up, so that one error
+// names every port that cannot be opened (a figure with three unplugged
+// adapters is not fixed one run at a time).
 std::vector<std::vector<double>> Runner::Impl::configure(const RunOptions& options) {
   std::vector<std::vector<double>> bus_positions;
+  std::vector<std::string> failed;
   for (auto& bus : buses) {
     log(options, fmt::format("configure: bus {} ({}, {} devices)", bus->config().name,
                              bus->config().port, bus->config().actuators.size()));
-    bus->configure();
+    try {
+      bus->configure();
+    } catch (const DeviceError& e) {
+      failed.emplace_back(e.what());
+    }
     bus_positions.emplace_back(bus->config().actuators.size(), 0.0);
   }
+  if (!failed.empty()) throw DeviceError(bus_failures(failed, buses.size()));
   for (std::size_t b = 0; b < buses.size(); ++b) buses[b]->read(bus_positions[b]);
   return bus_positions;
 }
@@ -315,7 +328,8 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
       summary.health_warnings.push_back(
           fmt::format("bus {} id {} ({}): {} at t={:.3f} s", bus.name, actuator.device_id,
                       actuator.joint, describe_health(model.buses[e.bus].health, e), e.t));
-    } else if (std::string line = describe_event(model, buses, e); !line.empty()) {
+    } else if (std::string line = describe_event(model, buses, config.lag_notes, e);
+               !line.empty()) {
       summary.faults.push_back(std::move(line));
     }
   }

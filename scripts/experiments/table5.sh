@@ -29,7 +29,7 @@ build="${1:-$root/build}"
 out="${2:-$root/build/table5}"
 runs="${RUNS:-10}"
 population="${POPULATION:-75}"
-generations="${GENERATIONS:-50}"
+generations="${GENERATIONS:-50}"  # after the initial one, as in a run file
 ranks="${RANKS:-1}"
 threads="${THREADS:-0}"
 # The paper's seven configurations, then the hybrid grammar with structured
@@ -63,7 +63,7 @@ for ((r = 1; r <= runs; r++)); do
     set +e
     "${launch[@]}" "$build/bin/animrt" evolve "$root/configs/evolve/horse_$g.yaml" \
       --out "$tmp.yaml" --csv "$tmp.csv" --plot "$tmp.svg" --seed "$r" \
-      --population "$population" --generations "$generations" "${mode[@]}" --quiet
+      --population "$population" --generations "$((generations + 1))" "${mode[@]}" --quiet
     code=$?
     set -e
     # Exit 4: the run ended with no valid individual (no gait); still a result.

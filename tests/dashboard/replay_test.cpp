@@ -69,6 +69,7 @@ TEST(Replay, SeekShowsTheRecordedRowAndControlsAreRefused) {
   setup.replay = true;
   setup.replay_start_s = rec.t.front();
   setup.replay_end_s = rec.t.back();
+  setup.replay_times_s = rec.t;
   setup.seek = [&replay](double t, bool playing) { replay.seek(t, playing); };
   DashboardServer server(monitor, controls, setup);
   httplib::Client client("127.0.0.1", server.port());
@@ -94,6 +95,16 @@ TEST(Replay, SeekShowsTheRecordedRowAndControlsAreRefused) {
   EXPECT_EQ(state["joints"][0]["cmd"].get<double>(), 0.2);
   EXPECT_EQ(state["joints"][1]["meas"].get<double>(), -0.15);
   EXPECT_NEAR(state["joints"][0]["vel"].get<double>(), 1.0, 1e-9);
+
+  // The Loop panel is the recorded run's: 4 rows 0.1 s apart, 10 Hz; what
+  // the recording does not hold is null (n/a), not 0.
+  const json& loop = state["loop"];
+  EXPECT_EQ(loop["cycles"].get<int>(), 4);
+  EXPECT_NEAR(loop["rate_hz"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(loop["period_ms"]["p50"].get<double>(), 100.0, 0.01);
+  EXPECT_NEAR(loop["period_ms"]["max"].get<double>(), 100.0, 0.01);
+  EXPECT_TRUE(loop["jitter_ms"].is_null());
+  EXPECT_TRUE(loop["overruns"].is_null());
 
   EXPECT_EQ(client.Post("/api/seek", R"({"t": 1})", "application/json")->status, 400);
   httplib::Headers bearer{{"Authorization", "Bearer " + server.token()}};

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "animrt/core/plot_axis.hpp"
 #include "text_output.hpp"
 
 namespace animrt::evolve {
@@ -64,8 +65,9 @@ void write_pareto_front_svg(const std::vector<ParetoMember>& front, const std::s
     t_lo = std::min(t_lo, p.objectives[2]);
     t_hi = std::max(t_hi, p.objectives[2]);
   }
-  x_hi *= 1.1;
-  y_hi *= 1.1;
+  const PlotAxis x_axis = nice_axis(0.0, x_hi), y_axis = nice_axis(0.0, y_hi);
+  x_hi = x_axis.hi;
+  y_hi = y_axis.hi;
   const auto x = [&](double v) { return kL + (kW - kL - kR) * v / x_hi; };
   const auto y = [&](double v) { return kH - kB - (kH - kT - kB) * v / y_hi; };
   // Tilt from blue (steady) to red (the most tilt on the front).
@@ -85,22 +87,35 @@ void write_pareto_front_svg(const std::vector<ParetoMember>& front, const std::s
       << "<line x1=\"" << kL << "\" x2=\"" << kL << "\" y1=\"" << kT << "\" y2=\"" << kH - kB
       << "\" stroke=\"black\"/>\n<line x1=\"" << kL << "\" x2=\"" << kW - kR << "\" y1=\""
       << kH - kB << "\" y2=\"" << kH - kB << "\" stroke=\"black\"/>\n";
-  for (int k = 0; k <= 4; ++k) {
-    const double vx = x_hi * k / 4, vy = y_hi * k / 4;
+  for (double vx : x_axis.ticks()) {
     out << "<text x=\"" << x(vx) << "\" y=\"" << kH - kB + 16 << "\" text-anchor=\"middle\">"
-        << fmt("%.3g", vx) << "</text>\n<text x=\"" << kL - 6 << "\" y=\"" << y(vy) + 4
-        << "\" text-anchor=\"end\">" << fmt("%.3g", vy) << "</text>\n";
+        << tick_label(vx, x_axis.step) << "</text>\n";
+  }
+  for (double vy : y_axis.ticks()) {
+    out << "<text x=\"" << kL - 6 << "\" y=\"" << y(vy) + 4 << "\" text-anchor=\"end\">"
+        << tick_label(vy, y_axis.step) << "</text>\n";
   }
   out << "<text x=\"" << (kL + kW - kR) / 2 << "\" y=\"" << kH - 12
       << "\" text-anchor=\"middle\">speed error |v - v*| / v*</text>\n"
       << "<text x=\"16\" y=\"" << (kT + kH - kB) / 2 << "\" transform=\"rotate(-90 16 "
       << (kT + kH - kB) / 2 << ")\" text-anchor=\"middle\">cost of transport E / (m g L*)</text>\n";
+  // Every marker first, so no label covers one; then the labels where
+  // they fit (a crowded point keeps its tooltip only).
+  LabelPlacer labels;
+  for (const auto& p : front) {
+    const double cx = x(p.objectives[0]), cy = y(p.objectives[1]);
+    labels.reserve({cx - 5, cy - 5, cx + 5, cy + 5});
+  }
   for (std::size_t i = 0; i < front.size(); ++i) {
     const auto& o = front[i].objectives;
     out << "<circle cx=\"" << x(o[0]) << "\" cy=\"" << y(o[1]) << "\" r=\"5\" fill=\""
         << colour(o[2]) << "\"><title>gait " << i + 1 << ": tilt " << fmt("%.1f", o[2])
-        << " deg</title></circle>\n<text x=\"" << x(o[0]) + 7 << "\" y=\"" << y(o[1]) + 4
-        << "\" font-size=\"10\">" << i + 1 << "</text>\n";
+        << " deg</title></circle>\n";
+    const std::string text = std::to_string(i + 1);
+    double lx = 0, ly = 0;
+    if (labels.place(x(o[0]), y(o[1]), text.size(), 10, lx, ly)) {
+      out << "<text x=\"" << lx << "\" y=\"" << ly << "\" font-size=\"10\">" << text << "</text>\n";
+    }
   }
   out << "<text x=\"" << kW - kR + 10 << "\" y=\"" << kT + 10 << "\">tilt (deg)</text>\n"
       << "<circle cx=\"" << kW - kR + 16 << "\" cy=\"" << kT + 28 << "\" r=\"5\" fill=\""

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "animrt/core/plot_axis.hpp"
 #include "text_output.hpp"
 
 namespace animrt::evolve {
@@ -71,7 +72,7 @@ void write_history_svg(const std::vector<GenerationStats>& history, const std::s
   out << "<line x1=\"" << kL << "\" x2=\"" << kL << "\" y1=\"" << kT << "\" y2=\"" << kH - kB
       << "\" stroke=\"black\"/>\n<line x1=\"" << kL << "\" x2=\"" << kW - kR << "\" y1=\""
       << kH - kB << "\" y2=\"" << kH - kB << "\" stroke=\"black\"/>\n";
-  const int step = std::max(1, static_cast<int>(gens) / 10);
+  const int step = std::max(1, static_cast<int>(nice_number(std::max(1.0, gens / 8), true)));
   for (int g = 0; g <= static_cast<int>(gens); g += step) {
     out << "<text x=\"" << x(g) << "\" y=\"" << kH - kB + 18 << "\" text-anchor=\"middle\">" << g
         << "</text>\n";

@@ -174,6 +174,12 @@ class Dynamixel2 final : public Protocol {
     return 10.0 *
            static_cast<double>(dynamixel_wire_bytes(bus.actuators.size(), fast, data) + extra);
   }
+  // One Sync Read (14 + N bytes) and its answers.
+  double read_wire_bits_per_cycle(const BusConfig& bus) const override {
+    const bool fast = dxl::bus_options(bus).fast_read == dxl::FastRead::on;
+    const std::size_t n = bus.actuators.size();
+    return 10.0 * static_cast<double>(dynamixel_wire_bytes(n, fast) - (14 + 5 * n));
+  }
 
   std::string device_guard_note(const BusConfig& bus) const override {
     if (dxl::bus_options(bus).bus_watchdog != 0) return {};

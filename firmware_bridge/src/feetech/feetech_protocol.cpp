@@ -118,6 +118,13 @@ class Feetech final : public Protocol {
     const double read = series_ == ft::Series::sts ? (8.0 + n) + 8.0 * n : 16.0 * n;
     return 10.0 * (write + read);
   }
+  double read_wire_bits_per_cycle(const BusConfig& bus) const override {
+    const double n = static_cast<double>(bus.actuators.size());
+    return 10.0 * (series_ == ft::Series::sts ? (8.0 + n) + 8.0 * n : 16.0 * n);
+  }
+  int read_transactions_per_cycle(const BusConfig& bus) const override {
+    return series_ == ft::Series::sts ? 1 : static_cast<int>(bus.actuators.size());
+  }
 
   std::unique_ptr<ActuatorBus> make_bus(const BusConfig& config) const override {
     return std::make_unique<FeetechBus>(config, series_, open_bus_serial(config));

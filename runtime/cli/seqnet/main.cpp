@@ -4,12 +4,16 @@
 
 #include <CLI/CLI.hpp>
 
+#include "../subcommand.hpp"
 #include "seq_net_commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"animrt-seqnet: train the sequence network"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "animrt-seqnet " ANIMRT_VERSION);
+  app.option_defaults()->always_capture_default();  // every --help shows the defaults
   animrt::cli::add_seq_net_commands(app);
+  animrt::cli::hide_empty_defaults(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -64,6 +64,22 @@ json timing_json(const MicrosHistogram& h) {
   return {{"p50", h.quantile(0.5) * 1e3}, {"p99", h.quantile(0.99) * 1e3}, {"max", h.max() * 1e3}};
 }
 
+// A replay's Loop panel: the recorded run's rate, cycles and periods. Its
+// jitter, overruns and late cycles were not recorded: null (n/a), not 0.
+json recorded_loop_json(const std::vector<double>& t) {
+  MicrosHistogram period;
+  for (std::size_t i = 1; i < t.size(); ++i) period.add(t[i] - t[i - 1]);
+  const double span = t.size() > 1 ? t.back() - t.front() : 0.0;
+  return {{"cycles", t.size()},
+          {"rate_hz", span > 0.0 ? json(static_cast<double>(t.size() - 1) / span) : json(nullptr)},
+          {"period_ms", period.count() ? timing_json(period) : json(nullptr)},
+          {"jitter_ms", nullptr},
+          {"overruns", nullptr},
+          {"skipped", nullptr},
+          {"late", json::object()},
+          {"jitter_hist", nullptr}};
+}
+
 }  // namespace
 
 struct DashboardServer::Impl {
@@ -72,7 +88,8 @@ struct DashboardServer::Impl {
   DashboardSetup setup;
   const RobotModel& model;
   DashboardCore core;
-  std::string info;  // /api/info, built once
+  std::string info;    // /api/info, built once
+  json recorded_loop;  // a replay's Loop panel, built once
   std::thread sampler;
 
   // The sampler's own state (its thread only).
@@ -244,6 +261,7 @@ struct DashboardServer::Impl {
   }
 
   json loop_json() const {
+    if (setup.replay) return recorded_loop;
     json late = json::object();
     for (std::size_t b = 0; b < model.buses.size(); ++b) late[model.buses[b].name] = view.late[b];
     json edges = json::array(), counts = json::array();
@@ -480,6 +498,7 @@ DashboardServer::DashboardServer(RunMonitor& monitor, RunControls& controls, Das
     throw std::invalid_argument("the dashboard rate must be a positive number of Hz");
   }
   m.info = m.build_info();
+  if (m.setup.replay) m.recorded_loop = recorded_loop_json(m.setup.replay_times_s);
   m.core.publish(m.build_state());
   m.routes();
   m.core.start();

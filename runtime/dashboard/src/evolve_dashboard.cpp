@@ -318,7 +318,7 @@ void EvolveDashboardServer::publish(const evolve::GenerationStats& stats,
 
 bool EvolveDashboardServer::stop_requested() const { return impl_->stop_requested.load(); }
 
-void EvolveDashboardServer::finish(bool stopped) {
+void EvolveDashboardServer::finish(bool stopped, bool keep_serving) {
   Impl& m = *impl_;
   {
     std::lock_guard lock(m.mutex);
@@ -329,7 +329,12 @@ void EvolveDashboardServer::finish(bool stopped) {
   }
   m.changed.notify_all();
   if (m.sampler.joinable()) m.sampler.join();  // after its last frame
-  m.core.stop();
+  if (!keep_serving) m.core.stop();
+}
+
+void EvolveDashboardServer::stop() {
+  finish(false);
+  impl_->core.stop();  // idempotent
 }
 
 }  // namespace animrt

@@ -54,6 +54,18 @@ class Protocol {
     (void)bus;
     return 0.0;
   }
+  // Of those, the bits of the cycle's read (requests and answers), which
+  // must be back within the loop's read budget, and how many transactions
+  // the read takes (each costs a measured overhead beyond its bits). 0 bits:
+  // not estimated.
+  virtual double read_wire_bits_per_cycle(const BusConfig& bus) const {
+    (void)bus;
+    return 0.0;
+  }
+  virtual int read_transactions_per_cycle(const BusConfig& bus) const {
+    (void)bus;
+    return 1;
+  }
 
   // What stops this bus's actuators when the host dies (kill -9, a crash, a
   // power cut), for `animrt validate`, when the user should hear of it: no

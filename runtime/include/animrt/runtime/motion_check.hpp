@@ -28,6 +28,12 @@ struct MotionCheck {
   // Where the motion file defines a robot joint's motion ("" when unknown),
   // e.g. "walk.yaml:14:3: joints.lf_hip".
   std::function<std::string(int joint)> joint_where;
+  // When set: per joint, the fastest the motion moves it from one cycle to
+  // the next (rad/s or m/s) and when, raised to what this check sees.
+  struct Speeds {
+    std::vector<double> peak, at_s;
+  };
+  Speeds* speeds = nullptr;
 };
 
 // Throws InputError at check.where / check.key on the first problem.

@@ -41,6 +41,17 @@ struct MotionConfig {
   std::vector<MotionConfig> layers;  // type "layers": applied in order, later layers win
 };
 
+// Real time: how long after its deadline a cycle waits for the buses'
+// reads, as a fraction of the period. A bus that has not answered by then
+// keeps its last measurement this cycle (a late cycle).
+inline constexpr double kReadBudgetFraction = 0.6;
+// What a read transaction costs beyond its bits on the wire (the host's
+// scheduling, the adapter's USB frames, the servos' turnaround), at the
+// 99th percentile since every read over the budget is a late cycle: the
+// pony's 16-servo Sync Read at 1 Mbaud, 2.70 ms on the wire, took 3.12 ms
+// at p99 (2.86 ms p50) on an idle test machine (docs/results/bus_read_budget.md).
+inline constexpr double kReadOverheadS = 420e-6;
+
 struct RobotConfig {
   std::string file;
   std::string name;
@@ -53,6 +64,9 @@ struct RobotConfig {
   // against the robot file's folder; empty when the file names none.
   std::string model;
   Location model_where;  // of the `model` key's value
+  // Per joint (or empty): why the joint may not keep up with its motion, as
+  // found on load (robot_loader.hpp), for the following-error fault's hint.
+  std::vector<std::string> lag_notes;
 };
 
 // Throws InputError (file, line, column, key) on the first problem found.

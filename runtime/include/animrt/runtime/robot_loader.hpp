@@ -18,6 +18,10 @@ struct LoadedRobot {
   std::unique_ptr<MotionSource> motion;
   // A gait motion with a `steering` section: its command range.
   std::optional<GaitSteering> steering;
+  // What a run would likely fault on though every file is valid (a motion
+  // faster than its servos turn, a bus whose answers come back too late):
+  // one line each, with the numbers.
+  std::vector<std::string> warnings;
 };
 
 // Loads the robot file and its motion source. Throws InputError on the first

@@ -42,6 +42,9 @@ struct DashboardSetup {
   bool replay = false;
   std::function<void(double t_s, bool playing)> seek;
   double replay_start_s = 0.0, replay_end_s = 0.0;  // the recording's times
+  // Every row's time: the Loop panel of a replay is the recorded run's
+  // (rate, cycles, periods); what the recording does not hold is null.
+  std::vector<double> replay_times_s;
 };
 
 // A new random token (32 hex characters), and whether `given` is `token`,

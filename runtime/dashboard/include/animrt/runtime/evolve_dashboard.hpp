@@ -62,9 +62,10 @@ class EvolveDashboardServer {
   bool stop_requested() const;
   // The search is over (`stopped`: by the dashboard's stop): the last state
   // goes out with phase "ended", the streams end, the server stops
-  // (idempotent).
-  void finish(bool stopped);
-  void stop() { finish(false); }
+  // (idempotent). With `keep_serving` the server goes on serving that last
+  // state until stop().
+  void finish(bool stopped, bool keep_serving = false);
+  void stop();
 
  private:
   struct Impl;
