@@ -1,0 +1,209 @@
+#include "scan_command.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "animrt/bridge/commission/serial_scan.hpp"
+#include "animrt/core/error.hpp"
+#include "port_check.hpp"
+#include "scan_draft.hpp"
+#include "subcommand.hpp"
+
+namespace animrt::cli {
+namespace {
+
+using commission::FoundDevice;
+using commission::ScanLimits;
+using commission::ScanResult;
+
+struct ScanArgs {
+  std::string port;
+  std::vector<std::string> protocols;
+  std::vector<int> bauds;
+  std::string ids = "0-252";
+  int timeout_ms = 10;
+  std::string write_robot;
+};
+
+constexpr const char* kProtocols[] = {"maestro", "dynamixel2", "feetech"};
+
+std::string opt(const std::optional<double>& v, const char* format) {
+  if (!v) return "-";
+  char text[32];
+  std::snprintf(text, sizeof text, format, *v);
+  return text;
+}
+
+void print_table(const std::string& port, const ScanResult& result) {
+  const std::vector<std::string> head = {"bus",       "protocol", "baud",     "id",
+                                         "model",     "firmware", "position", "temp_C",
+                                         "voltage_V", "torque",   "note"};
+  std::vector<std::vector<std::string>> rows;
+  for (const FoundDevice& d : result.devices) {
+    rows.push_back({port, d.protocol, std::to_string(d.baud), std::to_string(d.id),
+                    d.model.empty() ? "-" : d.model, d.firmware.empty() ? "-" : d.firmware,
+                    d.position ? std::to_string(*d.position) : "-", opt(d.temperature_c, "%.0f"),
+                    opt(d.voltage_v, "%.1f"), d.torque_on ? (*d.torque_on ? "on" : "off") : "-",
+                    d.note});
+  }
+  std::vector<std::size_t> width(head.size());
+  for (std::size_t c = 0; c < head.size(); ++c) {
+    width[c] = head[c].size();
+    for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
+  }
+  auto line = [&](const std::vector<std::string>& r) {
+    std::string out;
+    for (std::size_t c = 0; c < r.size(); ++c) {
+      out += r[c];
+      if (c + 1 < r.size()) out += std::string(width[c] - r[c].size() + 2, ' ');
+    }
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    std::cout << out << '\n';
+  };
+  line(head);
+  for (const auto& r : rows) line(r);
+}
+
+// "A-B" or "A": the ids asked where ids are asked one by one, and the
+// highest id a broadcast ping waits for.
+bool parse_ids(const std::string& text, int& first, int& last) {
+  const auto dash = text.find('-');
+  const std::string a = text.substr(0, dash);
+  const std::string b = dash == std::string::npos ? a : text.substr(dash + 1);
+  auto number = [](const std::string& s, int& out) {
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size() && !s.empty();
+  };
+  return number(a, first) && number(b, last) && first >= 0 && first <= last && last <= 253;
+}
+
+bool wanted(const ScanArgs& args, const std::string& protocol) {
+  return args.protocols.empty() ||
+         std::find(args.protocols.begin(), args.protocols.end(), protocol) != args.protocols.end();
+}
+
+std::vector<int> bauds_for(const ScanArgs& args, const std::vector<int>& standard) {
+  if (args.bauds.empty()) return standard;
+  std::vector<int> out;
+  for (int b : args.bauds) {
+    if (std::find(standard.begin(), standard.end(), b) != standard.end()) out.push_back(b);
+  }
+  return out;
+}
+
+int run_scan(const ScanArgs& args) {
+  ScanLimits limits;
+  if (!parse_ids(args.ids, limits.first_id, limits.last_id)) {
+    std::cerr << "error: --ids: expected FIRST-LAST within 0-253, found \"" << args.ids << "\"\n";
+    return kExitUsage;
+  }
+  limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
+  if (const std::string busy = port_busy(args.port); !busy.empty()) {
+    std::cerr << "error: serial port " << args.port << " is " << busy
+              << "; stop it first (two programs on one bus garble each other)\n";
+    return kExitDeviceError;
+  }
+  // Each protocol at each of its bauds (Maestro first: once a Maestro
+  // answers, no servo packet goes on its line, since it would read their
+  // bytes as Mini SSC commands and move a channel).
+  struct Step {
+    std::string protocol;
+    int baud;
+  };
+  std::vector<Step> steps;
+  for (const char* p : kProtocols) {
+    if (!wanted(args, p)) continue;
+    const std::vector<int>& standard = std::string(p) == "maestro" ? commission::maestro_bauds()
+                                       : std::string(p) == "dynamixel2"
+                                           ? commission::dynamixel_bauds()
+                                           : commission::feetech_bauds();
+    for (int b : bauds_for(args, standard)) steps.push_back({p, b});
+  }
+  if (steps.empty()) {
+    std::cerr << "error: --baud: none of the given rates is a standard rate of the protocols "
+                 "asked\n";
+    return kExitUsage;
+  }
+  ScanResult result;
+  bool maestro_line = false;
+  const auto started = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const Step& step = steps[i];
+    if (maestro_line && step.protocol != "maestro") continue;
+    std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
+              << step.protocol << " at " << step.baud << " baud...\n";
+    std::unique_ptr<ByteTransport> line = open_serial(args.port, step.baud);
+    if (step.protocol == "maestro") {
+      maestro_line = commission::scan_maestro(*line, step.baud, limits, result) || maestro_line;
+    } else if (step.protocol == "dynamixel2") {
+      commission::scan_dynamixel(*line, step.baud, limits, result);
+    } else {
+      commission::scan_feetech(*line, step.baud, limits, result);
+    }
+    if (line->failure() != nullptr) throw DeviceError(describe_failure(*line));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::cerr << "scan " << args.port << ": done in " << opt(seconds, "%.1f") << " s, "
+            << result.devices.size() << " device(s), " << result.collisions.size()
+            << " collision(s)\n";
+  if (result.devices.empty() && result.collisions.empty()) {
+    std::cout << args.port << ": no device answered\n";
+  } else {
+    print_table(args.port, result);
+  }
+  for (const commission::Collision& c : result.collisions) {
+    std::cout << "collision: " << c.protocol << " id " << c.id << " at " << c.baud
+              << " baud: " << c.how
+              << " (several servos share this id: plug in one at a time and give each its own "
+                 "id with `animrt servo`)\n";
+  }
+  if (maestro_line) {
+    std::cout << args.port << ": a Maestro answered, so no servo protocol was tried on it\n";
+  }
+  if (!args.write_robot.empty()) {
+    const int joints = write_robot_draft(args.write_robot, args.port, result);
+    std::cout << "wrote " << args.write_robot << " (" << joints
+              << " joints; read its comments before the first run)\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_scan_command(CLI::App& app) {
+  auto args = std::make_shared<ScanArgs>();
+  auto* cmd = app.add_subcommand(
+      "scan", "Find the devices on a serial port with safe queries (nothing moves)");
+  cmd->add_option("PORT", args->port, "serial port (e.g. /dev/ttyUSB0)")->required();
+  cmd->add_option("--protocol", args->protocols,
+                  "protocols to try (default all): maestro, dynamixel2, feetech")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"maestro", "dynamixel2", "feetech"}));
+  cmd->add_option("--baud", args->bauds,
+                  "baud rates to try (default each protocol's standard ones)")
+      ->delimiter(',');
+  cmd->add_option("--ids", args->ids,
+                  "ids asked (FIRST-LAST, default 0-252); a smaller range scans faster");
+  cmd->add_option("--timeout-ms", args->timeout_ms, "wait for one answer (default 10)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--write-robot", args->write_robot,
+                  "draft a robot file from what was found (and a hold-still show beside it)");
+  set_subcommand_body(cmd, [args] {
+    try {
+      return run_scan(*args);
+    } catch (const DeviceError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      return kExitDeviceError;
+    }
+  });
+}
+
+}  // namespace animrt::cli
