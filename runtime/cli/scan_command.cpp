@@ -105,6 +105,8 @@ int run_scan(const ScanArgs& args) {
     return kExitUsage;
   }
   limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
+  // A port that is no serial port is told so first (open_serial says why).
+  open_serial(args.port, 57600).reset();
   if (const std::string busy = port_busy(args.port); !busy.empty()) {
     std::cerr << "error: serial port " << args.port << " is " << busy
               << "; stop it first (two programs on one bus garble each other)\n";
@@ -164,6 +166,10 @@ int run_scan(const ScanArgs& args) {
               << " baud: " << c.how
               << " (several servos share this id: plug in one at a time and give each its own "
                  "id with `animrt servo`)\n";
+  }
+  for (const std::string& g : result.garbled) {
+    std::cout << "garbage: " << g
+              << " (a device of another protocol or baud rate, or noise on the line)\n";
   }
   if (maestro_line) {
     std::cout << args.port << ": a Maestro answered, so no servo protocol was tried on it\n";

@@ -73,8 +73,8 @@ int write_robot_draft(const std::string& path, const std::string& port,
   // A loop the line can keep up with: about 24 bytes per servo and cycle
   // (its goal out, its position in), with a fifth to spare.
   const int servos = best->second;
-  const long rate_hz = std::clamp(std::lround(std::floor(0.8 * baud / (240.0 * servos + 100.0))),
-                                  1L, 100L);
+  const long rate_hz =
+      std::clamp(std::lround(std::floor(0.8 * baud / (240.0 * servos + 100.0))), 1L, 100L);
   const fs::path robot(path);
   const std::string stem = robot.stem().string();
   const fs::path show = robot.parent_path() / (stem + ".hold.yaml");

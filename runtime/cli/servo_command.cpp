@@ -39,6 +39,8 @@ int run_servo(const ServoArgs& args, const std::string& action) {
   const Family family = args.protocol == "dynamixel2" ? Family::dynamixel2 : Family::feetech;
   // Factory rates: Dynamixel X 57600, Feetech STS/SCS 1 Mbaud.
   const int baud = args.baud > 0 ? args.baud : (family == Family::dynamixel2 ? 57600 : 1'000'000);
+  // A port that is no serial port is told so first (open_serial says why).
+  open_serial(args.port, 57600).reset();
   if (const std::string busy = port_busy(args.port); !busy.empty()) {
     std::cerr << "error: serial port " << args.port << " is " << busy << "; stop it first\n";
     return kExitDeviceError;

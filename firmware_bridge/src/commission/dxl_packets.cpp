@@ -62,6 +62,7 @@ Statuses decode(std::span<const std::uint8_t> bytes) {
   }
   // A header cut off at the end: a damaged answer too.
   if (decoder.buffered() > 0) ++out.damaged;
+  out.stray = decoder.stray_bytes() + decoder.buffered();
   return out;
 }
 

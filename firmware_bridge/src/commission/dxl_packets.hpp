@@ -32,6 +32,7 @@ struct Statuses {
   std::vector<Status> packets;  // status packets that checked out, in order
   int damaged = 0;              // packets dropped for a bad CRC or length
   std::set<int> header_ids;     // ids named by any status header, damaged or not
+  std::size_t stray = 0;        // bytes outside any packet that checked out
 };
 
 // Decodes every status packet in `bytes` (the echo of an instruction is skipped).

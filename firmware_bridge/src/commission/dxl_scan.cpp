@@ -96,6 +96,11 @@ void scan_dynamixel(ByteTransport& line, int baud, const ScanLimits& limits, Sca
       collided.insert(id);
     }
   }
+  if (answers.packets.empty() && (answers.damaged > 0 || answers.stray > 0) && collided.empty()) {
+    out.garbled.push_back("dynamixel2 at " + std::to_string(baud) + ": " +
+                          std::to_string(bytes.size()) +
+                          " bytes that are no status packet answered the broadcast ping");
+  }
   for (const auto& [id, answered] : count) {
     if (collided.count(id) != 0) continue;
     FoundDevice d;

@@ -11,6 +11,17 @@ using std::chrono::microseconds;
 
 Statuses decode(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> sent) {
   Statuses out;
+  // An adapter's echo of the instruction comes first: not an answer.
+  std::size_t begin = 0;
+  if (bytes.size() >= sent.size() && std::equal(sent.begin(), sent.end(), bytes.begin())) {
+    begin = sent.size();
+  }
+  out.bytes = bytes.size() - begin;
+  for (std::size_t i = begin; i + 2 < bytes.size(); ++i) {
+    if (bytes[i] == 0xFF && bytes[i + 1] == 0xFF && bytes[i + 2] != 0xFF) {
+      out.header_ids.insert(bytes[i + 2]);
+    }
+  }
   ft::Decoder decoder;
   std::size_t fed = 0;
   for (;;) {

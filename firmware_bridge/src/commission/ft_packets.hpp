@@ -22,6 +22,8 @@ struct Status {
 struct Statuses {
   std::vector<Status> packets;
   int damaged = 0;
+  std::set<int> header_ids;  // ids named by any header, damaged or not (the echo left out)
+  std::size_t bytes = 0;     // received, the echo left out
 };
 
 // Every packet in `bytes` except the echo of `sent`.

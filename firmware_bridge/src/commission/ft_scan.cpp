@@ -44,15 +44,20 @@ const std::vector<int>& feetech_bauds() {
 
 void scan_feetech(ByteTransport& line, int baud, const ScanLimits& limits, ScanResult& out) {
   int answered = 0;
+  std::size_t junk = 0;  // bytes that answered no ping
   const int last = std::min(limits.last_id, ft::kMaxDeviceId);
   for (int id = std::max(limits.first_id, 0); id <= last; ++id) {
     const ft_detail::Statuses s = ft_detail::transact(
         line, static_cast<std::uint8_t>(id), ft::inst::ping, {}, 6, baud, limits.answer_timeout);
     int from_id = 0;
     for (const ft_detail::Status& p : s.packets) from_id += p.id == id ? 1 : 0;
-    if (from_id == 0 && s.damaged == 0) continue;
+    const bool overlapped = s.damaged > 0 && s.header_ids.count(id) != 0;
+    if (from_id == 0 && !overlapped) {
+      junk += s.bytes;
+      continue;
+    }
     ++answered;
-    if (from_id > 1 || s.damaged > 0) {
+    if (from_id > 1 || overlapped) {
       out.collisions.push_back({"feetech", baud, id,
                                 from_id > 1 ? std::to_string(from_id) + " answers to one ping"
                                             : "damaged answers to a ping (overlapping replies)"});
@@ -64,6 +69,10 @@ void scan_feetech(ByteTransport& line, int baud, const ScanLimits& limits, ScanR
     d.id = id;
     read_ft_details(line, baud, limits, d);
     out.devices.push_back(std::move(d));
+  }
+  if (junk > 0) {
+    out.garbled.push_back("feetech at " + std::to_string(baud) + ": " + std::to_string(junk) +
+                          " bytes that answer no ping");
   }
   if (limits.progress) {
     limits.progress("feetech at " + std::to_string(baud) + ": " + std::to_string(answered) +

@@ -39,6 +39,9 @@ struct Collision {
 struct ScanResult {
   std::vector<FoundDevice> devices;
   std::vector<Collision> collisions;
+  // Where answers came that are no packet of the protocol asked (a device of
+  // another protocol or baud, or noise): "dynamixel2 at 57600: 12 bytes ...".
+  std::vector<std::string> garbled;
 };
 
 // How long to wait for answers, and which ids to ask where ids are asked one
