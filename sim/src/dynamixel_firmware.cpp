@@ -15,6 +15,7 @@ namespace inst = dxl::inst;
 constexpr int kMaxDeviceId = 252;
 constexpr std::uint8_t kReplyPingAndRead = 1;  // Status Return Level
 constexpr std::uint8_t kReplyAll = 2;
+constexpr std::uint8_t kBroadcastResetAllIgnored = 42;  // firmware version
 
 std::uint16_t u16_at(std::span<const std::uint8_t> p, std::size_t i) { return dxl::get_u16(&p[i]); }
 
@@ -245,10 +246,29 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
       }
       break;
     }
+    case inst::factory_reset: {
+      // Option 0xFF resets everything, 0x01 all but the ID, 0x02 all but
+      // the ID and the baud rate. The status packet leaves first, with the
+      // old ID at the old baud. From firmware 42 on a broadcast 0xFF is
+      // ignored (every servo would become ID 1).
+      const std::uint8_t option = p.size() == 1 ? p[0] : 0;
+      const bool known = option == 0xFF || option == 0x01 || option == 0x02;
+      each_target([&](DynamixelServo& s) {
+        if (broadcast && option == 0xFF && s.firmware_version() >= kBroadcastResetAllIgnored) {
+          return;
+        }
+        const StatusError error = p.size() != 1 ? StatusError::data_length
+                                  : !known      ? StatusError::data_range
+                                                : StatusError::none;
+        reply(s, s.status_return_level(), error);
+        if (error == StatusError::none) s.factory_reset(option, now);
+      });
+      break;
+    }
     case inst::status:
       break;  // another device's answer: not for us
     default:
-      // Factory Reset, Clear and anything unknown.
+      // Clear and anything unknown.
       each_target(
           [&](DynamixelServo& s) { reply(s, s.status_return_level(), StatusError::instruction); });
       break;

@@ -138,8 +138,6 @@ constexpr std::uint16_t kDefaultMinVoltage = 95;
 constexpr std::uint16_t kDefaultPwmLimit = 885;
 constexpr std::uint16_t kDefaultCurrentLimit = 1193;
 
-constexpr int kBauds[] = {9600,      57600,     115200,    1'000'000,
-                          2'000'000, 3'000'000, 4'000'000, 4'500'000};
 constexpr std::uint8_t kDefaultMovingThreshold = 10;
 constexpr std::uint8_t kDefaultTemperatureLimit = 80;
 constexpr std::uint8_t kDefaultShutdown = 0x34;  // overload, electrical shock, overheating
@@ -150,16 +148,7 @@ double ticks_per_s_to_units(double ticks_per_s) {
 
 }  // namespace
 
-std::uint8_t baud_rate_register(int baud) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
-    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
-        std::abs(static_cast<long>(kBauds[best]) - baud)) {
-      best = i;
-    }
-  }
-  return static_cast<std::uint8_t>(best);
-}
+std::uint8_t baud_rate_register(int baud) { return baud_register(kDynamixelX, baud); }
 
 double initial_offset_rad(int device_id) {
   const double degrees = (device_id % 2 == 1 ? 1.0 : -1.0) * (2 + device_id % 3);
@@ -216,6 +205,7 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
                  reg32(xreg::max_position_limit));
   motor_.position = start;
   if (physics_ != nullptr) motor_ = motor_at(now);  // where the physics put the joint
+  eeprom_.build(table_);
   reset_ram();
   publish(now);
   command_physics();
@@ -398,7 +388,9 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     if (item.address != a || a + item.size > end) return StatusError::data_length;
     a += item.size;
   }
-  if (address < xreg_sim::eeprom_end && torque_on()) return StatusError::access;  // ROM lock
+  if (eeprom_write(kDynamixelX, table_, address, data.size()) == EepromWrite::refused) {
+    return StatusError::access;  // EEPROM is locked while torque is on
+  }
   if (table_[xreg_sim::bus_watchdog] == dxl::kBusWatchdogFired) {
     // A fired Bus Watchdog locks the goal values; only 0 at 98 clears it.
     for (std::size_t a = address; a < end;) {
@@ -449,7 +441,9 @@ StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::ui
   // and an Indirect Data at once; the data goes where the old address said.
   std::array<std::uint16_t, xreg::table_size> targets;
   for (std::size_t i = 0; i < data.size(); ++i) targets[i] = resolve(address + i);
+  const bool eeprom = eeprom_write(kDynamixelX, table_, address, data.size()) == EepromWrite::kept;
   for (std::size_t i = 0; i < data.size(); ++i) table_[targets[i]] = data[i];
+  if (eeprom) eeprom_.keep(table_);
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
   command_physics();
@@ -482,6 +476,42 @@ void DynamixelServo::reboot(Nanos now) {
   publish(motor_time_);
   command_physics();
 }
+
+void DynamixelServo::set_plugged(bool plugged, Nanos now) {
+  if (plugged && !plugged_) {
+    eeprom_.load(table_);  // power-on: EEPROM as kept, RAM at its defaults
+    reboot(now);
+  }
+  plugged_ = plugged;
+}
+
+void DynamixelServo::factory_reset(std::uint8_t option, Nanos now) {
+  eeprom_.factory_reset(table_, option == 0x01 || option == 0x02, option == 0x02);
+  table_[xreg::torque_enable] = 0;
+  reboot(now);
+}
+
+bool DynamixelServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos now) {
+  if (!eeprom_.restore(kept, table_)) return false;
+  table_[xreg::torque_enable] = 0;
+  reboot(now);
+  return true;
+}
+
+bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
+  advance(now);
+  if (torque_on() || physics_ != nullptr) return false;
+  motor_.position = ticks;
+  motor_.velocity = 0;
+  publish(motor_time_);
+  return true;
+}
+
+std::int32_t DynamixelServo::present_ticks(Nanos now) const {
+  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
+}
+
+int DynamixelServo::baud() const { return baud_of(kDynamixelX, table_[xreg::baud_rate]); }
 
 std::uint8_t DynamixelServo::status_error(StatusError error) const {
   const auto number = static_cast<std::uint8_t>(error);

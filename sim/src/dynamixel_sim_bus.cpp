@@ -53,10 +53,12 @@ auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id)
 
 }  // namespace
 
-DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics)
+DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics,
+                                 const ServoStartup& startup)
     : config_(config),
       clock_(clock),
       firmware_(config, clock.now(), physics),
+      keeper_(startup, config.name),
       physics_(physics),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
@@ -85,6 +87,8 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
     close_fds();
     throw;
   }
+  keeper_.start(firmware_, clock.now(),
+                [&](DynamixelServo& s) { s.factory_reset(0xFF, clock.now()); });
   const std::size_t most = (firmware_.size() + 1) * dxl::kMaxPacket;
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
@@ -96,6 +100,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
 DynamixelSimBus::~DynamixelSimBus() {
   stop();
   close_fds();
+  keeper_.save(firmware_, true);
 }
 
 void DynamixelSimBus::close_fds() {
@@ -155,6 +160,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   {
     std::lock_guard lock(mutex_);
     firmware_.handle(packet, now, answers_);
+    keeper_.save(firmware_);
   }
   if (packet.instruction != dxl::inst::status) ++packets_;
 
@@ -223,6 +229,31 @@ void DynamixelSimBus::set_device_hardware_error(int device_id, std::uint8_t erro
 void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int answers) {
   std::lock_guard lock(mutex_);
   servo_or_throw(firmware_, config_, device_id).set_answer_delay(delay_ns, answers);
+}
+
+void DynamixelSimBus::hand_move(int device_id, std::int32_t ticks) {
+  std::lock_guard lock(mutex_);
+  DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
+  if (s.torque_on()) throw std::logic_error("torque is on");
+  if (!s.hand_move(ticks, clock_.now())) {
+    throw std::logic_error("the physics model moves this joint");
+  }
+}
+
+SimulatedBus::ServoReadout DynamixelSimBus::servo_readout(int device_id) const {
+  std::lock_guard lock(mutex_);
+  const DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
+  return {s.present_ticks(clock_.now()), s.torque_on(), s.id(), s.baud()};
+}
+
+void DynamixelSimBus::set_device_plugged(std::size_t index, bool plugged) {
+  std::lock_guard lock(mutex_);
+  if (index >= firmware_.size()) {
+    throw std::out_of_range("no device #" + std::to_string(index) + " on simulated bus '" +
+                            elide(config_.name) + "' (it has " + std::to_string(firmware_.size()) +
+                            ")");
+  }
+  firmware_.at(index).set_plugged(plugged, clock_.now());
 }
 
 std::vector<GoalRecord> DynamixelSimBus::device_goal_log(int device_id) const {

@@ -14,7 +14,6 @@ namespace {
 
 namespace reg = ft::reg;
 
-constexpr int kBauds[] = {1'000'000, 500'000, 250'000, 128'000, 115'200, 76'800, 57'600, 38'400};
 // STS3215 identity (memory table v3.6): firmware 3.6, servo version 9.3.
 constexpr std::uint8_t kStsModel[2] = {9, 3};
 constexpr std::uint8_t kScsModel[2] = {5, 4};
@@ -57,17 +56,6 @@ bool writable(std::size_t address) {
   }
 }
 
-std::uint8_t baud_register(int baud) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
-    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
-        std::abs(static_cast<long>(kBauds[best]) - baud)) {
-      best = i;
-    }
-  }
-  return static_cast<std::uint8_t>(best);
-}
-
 }  // namespace
 
 bool feetech_may_answer(const ft::Packet& packet) {
@@ -83,12 +71,13 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
       series_(series),
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_steps_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
+      eeprom_(series == ft::Series::sts ? kFeetechSts : kFeetechScs),
       motor_time_(now) {
   const bool sts = series_ == ft::Series::sts;
   table_[reg::firmware_major] = 3;
   std::memcpy(&table_[reg::model], sts ? kStsModel : kScsModel, 2);
   table_[reg::id] = static_cast<std::uint8_t>(binding.device_id);
-  table_[reg::baud_rate] = baud_register(baud);
+  table_[reg::baud_rate] = baud_register(eeprom_.family(), baud);
   table_[reg::return_delay] =
       static_cast<std::uint8_t>(std::clamp(settings.return_delay_us / 2, 0, 254));
   table_[reg::status_return_level] = 1;
@@ -105,6 +94,7 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
   // Hold still when torque comes on: the goal starts at the present position.
   store_position(reg::goal_position, motor_.position);
   publish();
+  eeprom_.build(table_);
 }
 
 std::uint16_t FeetechServo::u16(std::uint8_t address) const {
@@ -169,6 +159,8 @@ bool FeetechServo::read(std::uint8_t address, std::uint8_t length,
 
 void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> data) {
   const bool torque_was_on = torque_on();
+  const bool keep =
+      eeprom_write(eeprom_.family(), table_, address, data.size()) == EepromWrite::kept;
   bool goal_written = false;
   for (std::size_t i = 0; i < data.size(); ++i) {
     const std::size_t a = address + i;
@@ -182,6 +174,7 @@ void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> dat
     table_[a] = data[i];
     if (a == reg::goal_position + 1u) goal_written = true;
   }
+  if (keep) eeprom_.keep(table_);
   if (goal_written) {
     ++goals_received_;
     last_goal_ = position_value(reg::goal_position);
@@ -214,6 +207,50 @@ void FeetechServo::set_fault(std::uint8_t bits, Nanos now) {
     motor_.velocity = 0;
     publish();
   }
+}
+
+void FeetechServo::power_up(Nanos now) {
+  // EEPROM as kept; torque off, nothing registered, the lock open, the goal
+  // where the shaft is.
+  advance(now);
+  eeprom_.load(table_);
+  table_[reg::torque_enable] = 0;
+  table_[reg::registered] = 0;
+  table_[static_cast<std::size_t>(eeprom_.family().lock_address)] = 0;
+  motor_.velocity = 0;
+  store_position(reg::goal_position, motor_.position);
+  publish();
+}
+
+void FeetechServo::set_plugged(bool plugged, Nanos now) {
+  if (plugged && !plugged_) power_up(now);
+  plugged_ = plugged;
+}
+
+bool FeetechServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos now) {
+  if (!eeprom_.restore(kept, table_)) return false;
+  power_up(now);
+  return true;
+}
+
+void FeetechServo::factory_reset(Nanos now) {
+  eeprom_.factory_reset(table_, false, false);
+  power_up(now);
+}
+
+bool FeetechServo::hand_move(std::int32_t steps, Nanos now) {
+  advance(now);
+  if (torque_on()) return false;
+  motor_.position = steps;
+  motor_.velocity = 0;
+  publish();
+  return true;
+}
+
+int FeetechServo::baud() const { return baud_of(eeprom_.family(), table_[reg::baud_rate]); }
+
+std::int32_t FeetechServo::present_steps(Nanos now) const {
+  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
 }
 
 double FeetechServo::position_rad(Nanos now) const {

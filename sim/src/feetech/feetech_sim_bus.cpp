@@ -10,18 +10,24 @@
 
 namespace animrt::sim {
 
-FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock)
+FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock,
+                             const ServoStartup& startup)
     : config_(config),
       clock_(clock),
       pty_("simulated bus '" + elide(config.name) + "'"),
       board_(config, series, clock.now()),
+      keeper_(startup, config.name),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
+  keeper_.start(board_, clock.now(), [&](FeetechServo& s) { s.factory_reset(clock.now()); });
   answers_.bytes.reserve((board_.size() + 1) * ft::kMaxPacket);
   answers_.list.reserve(board_.size() + 1);
 }
 
-FeetechSimBus::~FeetechSimBus() { stop(); }
+FeetechSimBus::~FeetechSimBus() {
+  stop();
+  keeper_.save(board_, true);
+}
 
 std::string FeetechSimBus::describe() const { return "serial " + config_.name + " " + endpoint(); }
 
@@ -61,6 +67,7 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
   {
     std::lock_guard lock(mutex_);
     board_.handle(packet, now, answers_);
+    keeper_.save(board_);
   }
   ++packets_;
   if (!config_.sim.wire_time) {
@@ -109,6 +116,27 @@ void FeetechSimBus::set_device_hardware_error(int device_id, std::uint8_t error_
 double FeetechSimBus::device_position(int device_id) const {
   std::lock_guard lock(mutex_);
   return servo(device_id).position_rad(clock_.now());
+}
+
+void FeetechSimBus::hand_move(int device_id, std::int32_t ticks) {
+  std::lock_guard lock(mutex_);
+  if (!servo(device_id).hand_move(ticks, clock_.now())) throw std::logic_error("torque is on");
+}
+
+SimulatedBus::ServoReadout FeetechSimBus::servo_readout(int device_id) const {
+  std::lock_guard lock(mutex_);
+  const FeetechServo& s = servo(device_id);
+  return {s.present_steps(clock_.now()), s.torque_on(), s.id(), s.baud()};
+}
+
+void FeetechSimBus::set_device_plugged(std::size_t index, bool plugged) {
+  std::lock_guard lock(mutex_);
+  if (index >= board_.size()) {
+    throw std::out_of_range("no device #" + std::to_string(index) + " on simulated bus '" +
+                            elide(config_.name) + "' (it has " + std::to_string(board_.size()) +
+                            ")");
+  }
+  board_.at(index).set_plugged(plugged, clock_.now());
 }
 
 std::uint64_t FeetechSimBus::device_goals_received(int device_id) const {

@@ -4,13 +4,15 @@
 // status packets go to an Answers list in the order they appear on the wire.
 //
 // Instructions: Ping (broadcast: every servo answers, in id order), Read,
-// Write, Reg Write, Action, Reboot, Sync Read, Sync Write, Bulk Read, Bulk
-// Write, Fast Sync Read, Fast Bulk Read. Factory Reset, Clear and unknown instructions answer
-// Instruction Error. A broadcast Read is ignored; broadcast Write/Reg Write/Action/Reboot act
-// without answering. Status Return Level is respected (Ping always answers; a write that changes
-// the level is answered per the level it arrived under). Sync and Bulk instructions are obeyed only
-// with the broadcast id. A servo that is not responding ignores every packet. A write to ID takes
-// effect at once (its status packet already carries the new ID).
+// Write, Reg Write, Action, Reboot, Factory Reset, Sync Read, Sync Write, Bulk Read, Bulk
+// Write, Fast Sync Read, Fast Bulk Read. Clear and unknown instructions answer
+// Instruction Error. Reboot keeps EEPROM and clears RAM; Factory Reset
+// (option 0xFF, 0x01 or 0x02) restores the EEPROM's factory settings first. A broadcast Read is
+// ignored; broadcast Write/Reg Write/Action/Reboot act without answering. Status Return Level is
+// respected (Ping always answers; a write that changes the level is answered per the level it
+// arrived under). Sync and Bulk instructions are obeyed only with the broadcast id. A servo that is
+// not responding ignores every packet. A write to ID takes effect at once (its status packet
+// already carries the new ID).
 //
 // Fast Sync Read and Fast Bulk Read (servos whose model and firmware support
 // them; see dxl::supports_fast_read) answer with one combined status packet:
@@ -78,6 +80,8 @@ class DynamixelFirmware {
   const DynamixelServo* find_configured(int device_id) const;
 
   std::size_t size() const { return servos_.size(); }
+  // The index-th servo of the BusConfig; std::out_of_range past the end.
+  DynamixelServo& at(std::size_t index) { return servos_.at(index); }
 
  private:
   DynamixelServo* target(std::uint8_t id);  // responding servo with this ID register

@@ -8,7 +8,8 @@
 // Control table: the X430 table (addresses 0..661, kItems in
 // dynamixel_servo.cpp); addresses without an item read as 0 and cannot be
 // written (Access Error); reads and writes past 661 are Access Errors.
-// EEPROM items (below 64) refuse writes while torque is on (Access Error),
+// EEPROM items (below 64; servo_eeprom.hpp keeps them across Reboot, power
+// cycles and state files) refuse writes while torque is on (Access Error),
 // read-only items refuse every write (Access Error), a write of part of an
 // item is a Data Length Error, a value outside the item's range a Data Range
 // Error. Indirect Data n reads and writes the register Indirect Address n
@@ -53,6 +54,7 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
+#include "animrt/sim/servo_eeprom.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -167,6 +169,14 @@ class DynamixelServo {
   dxl::StatusError reg_write(std::uint16_t address, std::span<const std::uint8_t> data);
   dxl::StatusError action();
   void reboot(Nanos now);
+  // Factory Reset: EEPROM to factory settings (option 0xFF: everything,
+  // 0x01: all but the ID, 0x02: all but the ID and the baud rate), then a
+  // restart as after Reboot.
+  void factory_reset(std::uint8_t option, Nanos now);
+  // The EEPROM that survives reboots and power cycles (servo_eeprom.hpp);
+  // restore_eeprom puts one kept by a state file back (false: wrong size).
+  const ServoEeprom& eeprom() const { return eeprom_; }
+  bool restore_eeprom(std::span<const std::uint8_t> kept, Nanos now);
 
   // Error byte of a status packet: the number plus the alert bit while the
   // hardware error status is non-zero.
@@ -176,9 +186,20 @@ class DynamixelServo {
   // electrical shock, overload) switches torque off; as on the real servo,
   // only a Reboot allows torque on again, and it shuts down again if the
   // fault is still there.
-  bool responding() const { return responding_; }
+  bool responding() const { return responding_ && plugged_; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_hardware_error(std::uint8_t bits, Nanos now);
+
+  // Commissioning. Unplugged, the servo hears and says nothing; plugged in
+  // again it powers up (RAM at its defaults, torque off). A hand turns a
+  // limp shaft to raw `ticks` (false, and nothing moves, while torque is on;
+  // with physics the joint is the physics').
+  bool plugged() const { return plugged_; }
+  void set_plugged(bool plugged, Nanos now);
+  bool hand_move(std::int32_t ticks, Nanos now);
+  int baud() const;  // the Baud Rate register in bits per second
+  // Present Position (raw) at `now`, without changing the state.
+  std::int32_t present_ticks(Nanos now) const;
 
   // Fault injection: the next `answers` status packets (every one while
   // answers < 0) leave `delay_ns` of real time late, so a client sees late
@@ -214,12 +235,14 @@ class DynamixelServo {
   double tau_s_;
   double vmax_ticks_s_;
   std::array<std::uint8_t, dxl::xreg::table_size> table_{};
+  ServoEeprom eeprom_{kDynamixelX};
   Motor motor_;
   Nanos motor_time_;
   JointPhysics* physics_ = nullptr;
   int physics_joint_ = -1;
   Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
+  bool plugged_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;
   // Reg Write waiting for Action.

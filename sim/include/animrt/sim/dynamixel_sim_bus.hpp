@@ -43,6 +43,7 @@
 #include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/dynamixel_firmware.hpp"
 #include "animrt/sim/serial_line.hpp"
+#include "animrt/sim/servo_state_file.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -62,7 +63,9 @@ class DynamixelSimBus final : public SimulatedBus {
   // Opens the pty and builds the servos; throws DeviceError if no pty can be
   // opened and InputError for bad device ids. `physics` (optional, outlives
   // the bus) replaces the servos' motor model.
-  DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics = nullptr);
+  // `startup`: factory settings and a state file (simulated_bus.hpp).
+  DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics = nullptr,
+                  const ServoStartup& startup = {});
   ~DynamixelSimBus() override;
   DynamixelSimBus(const DynamixelSimBus&) = delete;
   DynamixelSimBus& operator=(const DynamixelSimBus&) = delete;
@@ -79,6 +82,9 @@ class DynamixelSimBus final : public SimulatedBus {
   double device_position(int device_id) const override;
   // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
   void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
+  void hand_move(int device_id, std::int32_t ticks) override;
+  ServoReadout servo_readout(int device_id) const override;
+  void set_device_plugged(std::size_t index, bool plugged) override;
   std::vector<GoalRecord> device_goal_log(int device_id) const;
   std::uint64_t device_goals_received(int device_id) const;
 
@@ -101,6 +107,7 @@ class DynamixelSimBus final : public SimulatedBus {
 
   mutable std::mutex mutex_;  // guards firmware_
   DynamixelFirmware firmware_;
+  ServoStartupKeeper keeper_;  // under mutex_
 
   JointPhysics* physics_ = nullptr;
   int party_ = -1;  // lockstep with physics: this bus's party (JointPhysics::reach)

@@ -9,7 +9,8 @@
 // Goal Position/Time/Speed, the EEPROM lock, Present Position/Speed/Load/
 // Voltage/Temperature, Registered, Servo Status, Moving. Writes to read-only
 // addresses change nothing (the servo has no error code for that; its error
-// byte only carries fault bits).
+// byte only carries fault bits). EEPROM (below 40) is kept across power
+// cycles only when written while the lock reads 0 (servo_eeprom.hpp).
 //
 // Instructions: Ping, Read, Write, Reg Write, Action, Sync Write, and Sync
 // Read on the STS series only (an SCS servo ignores it). Ping and Read are
@@ -31,6 +32,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/servo_eeprom.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -71,9 +73,22 @@ class FeetechServo {
   void reg_write(std::uint8_t address, std::span<const std::uint8_t> data);
   void action();
 
-  bool responding() const { return responding_; }
+  bool responding() const { return responding_ && plugged_; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
+
+  // Commissioning, as DynamixelServo: unplugged it hears and says nothing,
+  // plugged in again it powers up (torque off, goal at the present
+  // position); a hand turns a limp shaft (false while torque is on).
+  void set_plugged(bool plugged, Nanos now);
+  bool hand_move(std::int32_t steps, Nanos now);
+  int baud() const;  // the Baud Rate register in bits per second
+  std::int32_t present_steps(Nanos now) const;
+  // EEPROM (0..39): a write there is kept while the lock (STS 55, SCS 48)
+  // reads 0, otherwise lost at the next power-up (servo_eeprom.hpp).
+  const ServoEeprom& eeprom() const { return eeprom_; }
+  bool restore_eeprom(std::span<const std::uint8_t> kept, Nanos now);
+  void factory_reset(Nanos now);  // all of it, ID and baud rate included
 
   // Goal positions received (decoded, in steps), for tests.
   std::uint64_t goals_received() const { return goals_received_; }
@@ -87,6 +102,7 @@ class FeetechServo {
   void publish();
   std::int32_t position_value(std::uint8_t address) const;
   void store_position(std::uint8_t address, double steps);
+  void power_up(Nanos now);  // RAM at its defaults, EEPROM as kept
   std::uint16_t u16(std::uint8_t address) const;
 
   ActuatorBinding binding_;
@@ -94,9 +110,11 @@ class FeetechServo {
   double tau_s_;
   double vmax_steps_s_;
   std::array<std::uint8_t, ft::reg::table_size> table_{};
+  ServoEeprom eeprom_;
   Motor motor_;
   Nanos motor_time_;
   bool responding_ = true;
+  bool plugged_ = true;
   std::array<std::uint8_t, ft::reg::table_size> pending_{};
   std::uint8_t pending_address_ = 0;
   std::uint8_t pending_length_ = 0;
@@ -115,6 +133,7 @@ class FeetechBoard {
   FeetechServo* find_configured(int device_id);
   const FeetechServo* find_configured(int device_id) const;
   std::size_t size() const { return servos_.size(); }
+  FeetechServo& at(std::size_t index) { return servos_.at(index); }
   ft::Series series() const { return series_; }
 
  private:

@@ -28,6 +28,7 @@
 #include "animrt/sim/feetech/feetech_board.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
 #include "animrt/sim/serial_line.hpp"
+#include "animrt/sim/servo_state_file.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -43,7 +44,9 @@ struct FeetechSimStats {
 class FeetechSimBus final : public SimulatedBus {
  public:
   // Throws DeviceError if no pty can be opened, InputError for bad ids.
-  FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock);
+  // `startup`: factory settings and a state file (simulated_bus.hpp).
+  FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock,
+                const ServoStartup& startup = {});
   ~FeetechSimBus() override;
   FeetechSimBus(const FeetechSimBus&) = delete;
   FeetechSimBus& operator=(const FeetechSimBus&) = delete;
@@ -59,6 +62,9 @@ class FeetechSimBus final : public SimulatedBus {
   // byte of its status packets, and those in Unload Condition cut torque.
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   double device_position(int device_id) const override;
+  void hand_move(int device_id, std::int32_t ticks) override;
+  ServoReadout servo_readout(int device_id) const override;
+  void set_device_plugged(std::size_t index, bool plugged) override;
   std::uint64_t device_goals_received(int device_id) const;
   std::int32_t device_last_goal(int device_id) const;
 
@@ -79,6 +85,7 @@ class FeetechSimBus final : public SimulatedBus {
 
   mutable std::mutex mutex_;  // guards board_
   FeetechBoard board_;
+  ServoStartupKeeper keeper_;  // under mutex_
 
   bool lockstep_ = false;
   Nanos last_time_ = 0;
