@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/bridge/commission/modbus_scan.hpp"
 #include "animrt/bridge/commission/serial_scan.hpp"
 #include "animrt/core/error.hpp"
 #include "port_check.hpp"
@@ -30,9 +31,10 @@ struct ScanArgs {
   std::string ids = "0-252";
   int timeout_ms = 10;
   std::string write_robot;
+  char parity = 'E';  // Modbus RTU: the standard's default, even
 };
 
-constexpr const char* kProtocols[] = {"maestro", "dynamixel2", "feetech"};
+constexpr const char* kProtocols[] = {"maestro", "dynamixel2", "feetech", "modbus-rtu"};
 
 std::string opt(const std::optional<double>& v, const char* format) {
   if (!v) return "-";
@@ -47,11 +49,11 @@ void print_table(const std::string& port, const ScanResult& result) {
                                          "voltage_V", "torque",   "note"};
   std::vector<std::vector<std::string>> rows;
   for (const FoundDevice& d : result.devices) {
-    rows.push_back({port, d.protocol, std::to_string(d.baud), std::to_string(d.id),
-                    d.model.empty() ? "-" : d.model, d.firmware.empty() ? "-" : d.firmware,
-                    d.position ? std::to_string(*d.position) : "-", opt(d.temperature_c, "%.0f"),
-                    opt(d.voltage_v, "%.1f"), d.torque_on ? (*d.torque_on ? "on" : "off") : "-",
-                    d.note});
+    rows.push_back(
+        {port, d.protocol, d.baud > 0 ? std::to_string(d.baud) : "-", std::to_string(d.id),
+         d.model.empty() ? "-" : d.model, d.firmware.empty() ? "-" : d.firmware,
+         d.position ? std::to_string(*d.position) : "-", opt(d.temperature_c, "%.0f"),
+         opt(d.voltage_v, "%.1f"), d.torque_on ? (*d.torque_on ? "on" : "off") : "-", d.note});
   }
   std::vector<std::size_t> width(head.size());
   for (std::size_t c = 0; c < head.size(); ++c) {
@@ -98,64 +100,7 @@ std::vector<int> bauds_for(const ScanArgs& args, const std::vector<int>& standar
   return out;
 }
 
-int run_scan(const ScanArgs& args) {
-  ScanLimits limits;
-  if (!parse_ids(args.ids, limits.first_id, limits.last_id)) {
-    std::cerr << "error: --ids: expected FIRST-LAST within 0-253, found \"" << args.ids << "\"\n";
-    return kExitUsage;
-  }
-  limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
-  // A port that is no serial port is told so first (open_serial says why).
-  open_serial(args.port, 57600).reset();
-  if (const std::string busy = port_busy(args.port); !busy.empty()) {
-    std::cerr << "error: serial port " << args.port << " is " << busy
-              << "; stop it first (two programs on one bus garble each other)\n";
-    return kExitDeviceError;
-  }
-  // Each protocol at each of its bauds (Maestro first: once a Maestro
-  // answers, no servo packet goes on its line, since it would read their
-  // bytes as Mini SSC commands and move a channel).
-  struct Step {
-    std::string protocol;
-    int baud;
-  };
-  std::vector<Step> steps;
-  for (const char* p : kProtocols) {
-    if (!wanted(args, p)) continue;
-    const std::vector<int>& standard = std::string(p) == "maestro" ? commission::maestro_bauds()
-                                       : std::string(p) == "dynamixel2"
-                                           ? commission::dynamixel_bauds()
-                                           : commission::feetech_bauds();
-    for (int b : bauds_for(args, standard)) steps.push_back({p, b});
-  }
-  if (steps.empty()) {
-    std::cerr << "error: --baud: none of the given rates is a standard rate of the protocols "
-                 "asked\n";
-    return kExitUsage;
-  }
-  ScanResult result;
-  bool maestro_line = false;
-  const auto started = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const Step& step = steps[i];
-    if (maestro_line && step.protocol != "maestro") continue;
-    std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
-              << step.protocol << " at " << step.baud << " baud...\n";
-    std::unique_ptr<ByteTransport> line = open_serial(args.port, step.baud);
-    if (step.protocol == "maestro") {
-      maestro_line = commission::scan_maestro(*line, step.baud, limits, result) || maestro_line;
-    } else if (step.protocol == "dynamixel2") {
-      commission::scan_dynamixel(*line, step.baud, limits, result);
-    } else {
-      commission::scan_feetech(*line, step.baud, limits, result);
-    }
-    if (line->failure() != nullptr) throw DeviceError(describe_failure(*line));
-  }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::cerr << "scan " << args.port << ": done in " << opt(seconds, "%.1f") << " s, "
-            << result.devices.size() << " device(s), " << result.collisions.size()
-            << " collision(s)\n";
+void report(const ScanArgs& args, const ScanResult& result, bool maestro_line) {
   if (result.devices.empty() && result.collisions.empty()) {
     std::cout << args.port << ": no device answered\n";
   } else {
@@ -179,6 +124,81 @@ int run_scan(const ScanArgs& args) {
     std::cout << "wrote " << args.write_robot << " (" << joints
               << " joints; read its comments before the first run)\n";
   }
+}
+
+int run_scan(const ScanArgs& args) {
+  ScanLimits limits;
+  if (!parse_ids(args.ids, limits.first_id, limits.last_id)) {
+    std::cerr << "error: --ids: expected FIRST-LAST within 0-253, found \"" << args.ids << "\"\n";
+    return kExitUsage;
+  }
+  limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
+  ScanResult result;
+  if (args.port.rfind("tcp://", 0) == 0) {
+    // Modbus TCP: unit ids behind one address.
+    std::cerr << "scan " << args.port << ": modbus-tcp unit ids " << std::max(limits.first_id, 1)
+              << "-" << std::min(limits.last_id, 247) << "...\n";
+    commission::scan_modbus_tcp(args.port.substr(6), limits, result);
+    report(args, result, false);
+    return kExitOk;
+  }
+  // A port that is no serial port is told so first (open_serial says why).
+  open_serial(args.port, 57600).reset();
+  if (const std::string busy = port_busy(args.port); !busy.empty()) {
+    std::cerr << "error: serial port " << args.port << " is " << busy
+              << "; stop it first (two programs on one bus garble each other)\n";
+    return kExitDeviceError;
+  }
+  // Each protocol at each of its bauds (Maestro first: once a Maestro
+  // answers, no servo packet goes on its line, since it would read their
+  // bytes as Mini SSC commands and move a channel).
+  struct Step {
+    std::string protocol;
+    int baud;
+  };
+  std::vector<Step> steps;
+  for (const char* p : kProtocols) {
+    if (!wanted(args, p)) continue;
+    const std::string name = p;
+    const std::vector<int>& standard = name == "maestro"      ? commission::maestro_bauds()
+                                       : name == "dynamixel2" ? commission::dynamixel_bauds()
+                                       : name == "feetech"    ? commission::feetech_bauds()
+                                                              : commission::modbus_rtu_bauds();
+    for (int b : bauds_for(args, standard)) steps.push_back({p, b});
+  }
+  if (steps.empty()) {
+    std::cerr << "error: --baud: none of the given rates is a standard rate of the protocols "
+                 "asked\n";
+    return kExitUsage;
+  }
+  bool maestro_line = false;
+  const auto started = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const Step& step = steps[i];
+    if (maestro_line && step.protocol != "maestro") continue;
+    std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
+              << step.protocol << " at " << step.baud << " baud...\n";
+    if (step.protocol == "modbus-rtu") {
+      if (!maestro_line)
+        commission::scan_modbus_rtu(args.port, step.baud, args.parity, limits, result);
+      continue;
+    }
+    std::unique_ptr<ByteTransport> line = open_serial(args.port, step.baud);
+    if (step.protocol == "maestro") {
+      maestro_line = commission::scan_maestro(*line, step.baud, limits, result) || maestro_line;
+    } else if (step.protocol == "dynamixel2") {
+      commission::scan_dynamixel(*line, step.baud, limits, result);
+    } else {
+      commission::scan_feetech(*line, step.baud, limits, result);
+    }
+    if (line->failure() != nullptr) throw DeviceError(describe_failure(*line));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::cerr << "scan " << args.port << ": done in " << opt(seconds, "%.1f") << " s, "
+            << result.devices.size() << " device(s), " << result.collisions.size()
+            << " collision(s)\n";
+  report(args, result, maestro_line);
   return kExitOk;
 }
 
@@ -188,11 +208,14 @@ void add_scan_command(CLI::App& app) {
   auto args = std::make_shared<ScanArgs>();
   auto* cmd = app.add_subcommand(
       "scan", "Find the devices on a serial port with safe queries (nothing moves)");
-  cmd->add_option("PORT", args->port, "serial port (e.g. /dev/ttyUSB0)")->required();
+  cmd->add_option("PORT", args->port,
+                  "serial port (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for Modbus TCP")
+      ->required();
   cmd->add_option("--protocol", args->protocols,
-                  "protocols to try (default all): maestro, dynamixel2, feetech")
+                  "protocols to try on a serial port (default all): maestro, dynamixel2, feetech, "
+                  "modbus-rtu")
       ->delimiter(',')
-      ->check(CLI::IsMember({"maestro", "dynamixel2", "feetech"}));
+      ->check(CLI::IsMember({"maestro", "dynamixel2", "feetech", "modbus-rtu"}));
   cmd->add_option("--baud", args->bauds,
                   "baud rates to try (default each protocol's standard ones)")
       ->delimiter(',');
@@ -200,6 +223,13 @@ void add_scan_command(CLI::App& app) {
                   "ids asked (FIRST-LAST, default 0-252); a smaller range scans faster");
   cmd->add_option("--timeout-ms", args->timeout_ms, "wait for one answer (default 10)")
       ->check(CLI::Range(1, 1000));
+  cmd->add_option_function<std::string>(
+         "--parity",
+         [args](const std::string& p) {
+           args->parity = p == "none" ? 'N' : p == "odd" ? 'O' : 'E';
+         },
+         "Modbus RTU parity: even (the default, as the standard's), odd or none")
+      ->check(CLI::IsMember({"even", "odd", "none"}));
   cmd->add_option("--write-robot", args->write_robot,
                   "draft a robot file from what was found (and a hold-still show beside it)");
   set_subcommand_body(cmd, [args] {
