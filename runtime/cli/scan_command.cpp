@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/bridge/commission/can_scan.hpp"
 #include "animrt/bridge/commission/modbus_scan.hpp"
 #include "animrt/bridge/commission/serial_scan.hpp"
 #include "animrt/core/error.hpp"
@@ -26,6 +27,8 @@ using commission::ScanResult;
 
 struct ScanArgs {
   std::string port;
+  std::string can;  // --can IFACE
+  int listen_ms = 1200;
   std::vector<std::string> protocols;
   std::vector<int> bauds;
   std::string ids = "0-252";
@@ -134,6 +137,20 @@ int run_scan(const ScanArgs& args) {
   }
   limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
   ScanResult result;
+  if (!args.can.empty()) {
+    limits.progress = [](const std::string& line) { std::cerr << "scan: " << line << '\n'; };
+    std::cerr << "scan " << args.can << ": listening " << args.listen_ms
+              << " ms for heartbeats, then SDO reads of 0x1000 and 0x1018...\n";
+    commission::scan_canopen(args.can, std::chrono::milliseconds(args.listen_ms), limits, result);
+    ScanArgs shown = args;
+    shown.port = args.can;
+    report(shown, result, false);
+    return kExitOk;
+  }
+  if (args.port.empty()) {
+    std::cerr << "error: give a serial PORT, tcp://HOST:PORT or --can IFACE\n";
+    return kExitUsage;
+  }
   if (args.port.rfind("tcp://", 0) == 0) {
     // Modbus TCP: unit ids behind one address.
     std::cerr << "scan " << args.port << ": modbus-tcp unit ids " << std::max(limits.first_id, 1)
@@ -209,8 +226,12 @@ void add_scan_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "scan", "Find the devices on a serial port with safe queries (nothing moves)");
   cmd->add_option("PORT", args->port,
-                  "serial port (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for Modbus TCP")
-      ->required();
+                  "serial port (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for Modbus TCP");
+  cmd->add_option("--can", args->can,
+                  "CAN interface (e.g. can0): CANopen heartbeats and SDO reads instead of a port");
+  cmd->add_option("--listen-ms", args->listen_ms,
+                  "with --can: how long to listen for heartbeats (default 1200)")
+      ->check(CLI::Range(0, 60000));
   cmd->add_option("--protocol", args->protocols,
                   "protocols to try on a serial port (default all): maestro, dynamixel2, feetech, "
                   "modbus-rtu")
