@@ -60,6 +60,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
       firmware_(config, clock.now(), physics),
       keeper_(startup, config.name),
       physics_(physics),
+      any_baud_(startup.any_baud),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
   try {
@@ -81,6 +82,8 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
     ::cfmakeraw(&tio);
     tio.c_cflag |= CLOCAL | CREAD;
     if (::tcsetattr(slave_, TCSANOW, &tio) != 0) fail(config_, "tcsetattr", errno);
+    // At the bus's baud until a host sets its own.
+    line::set_line_baud(slave_, config_.baud);
     if (::fcntl(master_, F_SETFL, O_NONBLOCK) != 0) fail(config_, "fcntl", errno);
     if (::pipe2(wake_.data(), O_CLOEXEC | O_NONBLOCK) != 0) fail(config_, "pipe", errno);
   } catch (...) {
@@ -159,7 +162,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   answers_.clear();
   {
     std::lock_guard lock(mutex_);
-    firmware_.handle(packet, now, answers_);
+    firmware_.handle(packet, now, answers_, any_baud_ ? 0 : line::line_baud(master_));
     keeper_.save(firmware_);
   }
   if (packet.instruction != dxl::inst::status) ++packets_;

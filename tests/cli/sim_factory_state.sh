@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# animrt sim --factory --state: new servos start as ID 1 at 57600 baud with
-# only the first one plugged in; an ID given to it is in the state file and
-# is still there after a restart.
+# animrt sim --factory --state: new servos start as ID 1 at 57600 baud (and
+# hear nothing at 1 Mbaud) with only the first one plugged in; an ID given
+# to it is in the state file and is still there after a restart.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -47,6 +47,10 @@ def packet(dev, inst, params=b""):
     body = bytes([0xFF, 0xFF, 0xFD, 0x00, dev]) + (len(params) + 3).to_bytes(2, "little") + bytes([inst]) + params
     return body + crc16(body).to_bytes(2, "little")
 
+fast = serial.Serial(sys.argv[1], 1000000, timeout=0.3)
+fast.write(packet(1, 0x01))  # a new servo does not hear 1 Mbaud
+assert fast.read(14) == b""
+fast.close()
 port = serial.Serial(sys.argv[1], 57600, timeout=0.5)
 port.write(packet(0xFE, 0x01))  # broadcast ping: one new servo plugged in
 assert len(port.read(28)) == 14

@@ -292,11 +292,13 @@ const FeetechServo* FeetechBoard::find_configured(int device_id) const {
   return nullptr;
 }
 
-FeetechServo* FeetechBoard::target(std::uint8_t id) {
+template <class Act>
+void FeetechBoard::for_id(std::uint8_t id, FeetechAnswers& out, Act&& act) {
+  const std::size_t first = out.list.size();
   for (FeetechServo& s : servos_) {
-    if (s.id() == id && s.responding()) return &s;
+    if (s.id() == id && s.responding()) act(s);
   }
-  return nullptr;
+  collide(out, first);
 }
 
 void FeetechBoard::answer(const FeetechServo& servo, std::span<const std::uint8_t> data,
@@ -309,8 +311,11 @@ void FeetechBoard::answer(const FeetechServo& servo, std::span<const std::uint8_
   if (n > 0) out.list.push_back({offset, n, servo.return_delay_us()});
 }
 
-void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out) {
-  for (FeetechServo& s : servos_) s.advance(now);
+void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out, int line_baud) {
+  for (FeetechServo& s : servos_) {
+    s.advance(now);
+    s.set_hearing(line_baud == 0 || s.baud() == line_baud);
+  }
   const std::span<const std::uint8_t> p = packet.params;
   const bool broadcast = packet.id == ft::kBroadcastId;
   auto each_target = [&](auto&& act) {
@@ -318,8 +323,8 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       for (FeetechServo& s : servos_) {
         if (s.responding()) act(s);
       }
-    } else if (FeetechServo* s = target(packet.id)) {
-      act(*s);
+    } else {
+      for_id(packet.id, out, act);
     }
   };
   // Write, Reg Write and Action answer per Status Return Level (the level the
@@ -330,13 +335,23 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
   std::array<std::uint8_t, 256> data{};
   switch (packet.code) {
     case ft::inst::ping:
-      each_target([&](FeetechServo& s) { answer(s, {}, out); });
+      if (broadcast) {
+        // Every servo answers; those sharing an ID at once.
+        std::array<bool, 256> done{};
+        for (const FeetechServo& s : servos_) {
+          if (!s.responding() || done[s.id()]) continue;
+          done[s.id()] = true;
+          for_id(s.id(), out, [&](FeetechServo& t) { answer(t, {}, out); });
+        }
+      } else {
+        each_target([&](FeetechServo& s) { answer(s, {}, out); });
+      }
       break;
     case ft::inst::read:
       if (broadcast || p.size() != 2) break;
-      if (FeetechServo* s = target(packet.id)) {
-        if (s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
-      }
+      for_id(packet.id, out, [&](FeetechServo& s) {
+        if (s.read(p[0], p[1], data)) answer(s, {data.data(), p[1]}, out);
+      });
       break;
     case ft::inst::write:
     case ft::inst::reg_write:
@@ -362,8 +377,9 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       // Only STS servos know Sync Read; each listed servo answers in turn.
       if (series_ != ft::Series::sts || !broadcast || p.size() < 3) break;
       for (std::uint8_t id : p.subspan(2)) {
-        FeetechServo* s = target(id);
-        if (s != nullptr && s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
+        for_id(id, out, [&](FeetechServo& s) {
+          if (s.read(p[0], p[1], data)) answer(s, {data.data(), p[1]}, out);
+        });
       }
       break;
     case ft::inst::sync_write: {
@@ -372,7 +388,8 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       const std::span<const std::uint8_t> blocks = p.subspan(2);
       if (length == 0 || blocks.size() % (length + 1) != 0) break;  // malformed: ignored
       for (std::size_t i = 0; i < blocks.size(); i += length + 1) {
-        if (FeetechServo* s = target(blocks[i])) s->write(p[0], blocks.subspan(i + 1, length));
+        for_id(blocks[i], out,
+               [&](FeetechServo& s) { s.write(p[0], blocks.subspan(i + 1, length)); });
       }
       break;
     }

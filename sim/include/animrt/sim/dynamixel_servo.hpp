@@ -186,7 +186,10 @@ class DynamixelServo {
   // electrical shock, overload) switches torque off; as on the real servo,
   // only a Reboot allows torque on again, and it shuts down again if the
   // fault is still there.
-  bool responding() const { return responding_ && plugged_; }
+  // Takes in packets: responding (fault injection), plugged in, and at the
+  // baud rate of the packet in hand (set_hearing).
+  bool responding() const { return responding_ && plugged_ && hearing_; }
+  void set_hearing(bool hearing) { hearing_ = hearing; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_hardware_error(std::uint8_t bits, Nanos now);
 
@@ -243,6 +246,7 @@ class DynamixelServo {
   Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
   bool plugged_ = true;
+  bool hearing_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;
   // Reg Write waiting for Action.

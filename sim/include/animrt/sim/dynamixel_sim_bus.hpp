@@ -17,6 +17,10 @@
 // A packet cut off by 5 ms of silence is dropped (as a servo's receive
 // timeout does), so a truncated packet never swallows the next one.
 //
+// Baud rate: the pty starts at BusConfig::baud; each packet is heard only
+// by the servos whose Baud Rate matches the rate the host has set on the
+// pty when it arrives (ServoStartup::any_baud: by all).
+//
 // Wire time (SimBusSettings::wire_time): each answer is held back (real time)
 // until the instruction's bytes, the servo's Return Delay Time and the
 // answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
@@ -113,6 +117,7 @@ class DynamixelSimBus final : public SimulatedBus {
   int party_ = -1;  // lockstep with physics: this bus's party (JointPhysics::reach)
 
   // Serving thread only.
+  bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
   Nanos last_time_ = 0;  // when the previous packet took effect
   dxl::Decoder decoder_;

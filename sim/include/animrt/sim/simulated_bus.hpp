@@ -93,6 +93,11 @@ struct ServoStartup {
   // Restores each servo's EEPROM from it (over the above) and saves it there
   // whenever it changes (outlives the buses).
   sim::ServoStateFile* state = nullptr;
+  // A servo answers only packets sent at its own baud rate: the one the host
+  // set on the pseudo-terminal. `any_baud` lets every servo hear every
+  // packet, for a line whose baud setting never reaches the simulator (a
+  // QEMU-emulated UART caps it at 115200 whatever the guest uses).
+  bool any_baud = false;
 };
 
 // Builds the simulated devices for config.protocol ("dynamixel2": N X-series

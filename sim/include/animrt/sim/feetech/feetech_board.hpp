@@ -32,27 +32,14 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/servo_answers.hpp"
 #include "animrt/sim/servo_eeprom.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
 
-struct FeetechAnswers {
-  struct Answer {
-    std::size_t offset = 0;
-    std::size_t size = 0;
-    int return_delay_us = 0;
-  };
-  std::vector<std::uint8_t> bytes;
-  std::vector<Answer> list;
-  void clear() {
-    bytes.clear();
-    list.clear();
-  }
-  std::span<const std::uint8_t> packet(const Answer& a) const {
-    return {bytes.data() + a.offset, a.size};
-  }
-};
+// Status packets for one instruction packet (servo_answers.hpp).
+using FeetechAnswers = Answers;
 
 class FeetechServo {
  public:
@@ -73,7 +60,9 @@ class FeetechServo {
   void reg_write(std::uint8_t address, std::span<const std::uint8_t> data);
   void action();
 
-  bool responding() const { return responding_ && plugged_; }
+  // Takes in packets: responding, plugged in, at the packet's baud rate.
+  bool responding() const { return responding_ && plugged_ && hearing_; }
+  void set_hearing(bool hearing) { hearing_ = hearing; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
 
@@ -115,6 +104,7 @@ class FeetechServo {
   Nanos motor_time_;
   bool responding_ = true;
   bool plugged_ = true;
+  bool hearing_ = true;
   std::array<std::uint8_t, ft::reg::table_size> pending_{};
   std::uint8_t pending_address_ = 0;
   std::uint8_t pending_length_ = 0;
@@ -128,7 +118,9 @@ class FeetechBoard {
   // 0..253 or used twice.
   FeetechBoard(const BusConfig& config, ft::Series series, Nanos now);
 
-  void handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out);
+  // As DynamixelFirmware::handle: only servos at `line_baud` (0: all) hear
+  // the packet; servos sharing an ID all act and their answers collide.
+  void handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out, int line_baud = 0);
 
   FeetechServo* find_configured(int device_id);
   const FeetechServo* find_configured(int device_id) const;
@@ -137,7 +129,8 @@ class FeetechBoard {
   ft::Series series() const { return series_; }
 
  private:
-  FeetechServo* target(std::uint8_t id);
+  template <class Act>
+  void for_id(std::uint8_t id, FeetechAnswers& out, Act&& act);
   void answer(const FeetechServo& servo, std::span<const std::uint8_t> data,
               FeetechAnswers& out) const;
 

@@ -87,6 +87,7 @@ class FeetechSimBus final : public SimulatedBus {
   FeetechBoard board_;
   ServoStartupKeeper keeper_;  // under mutex_
 
+  bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
   Nanos last_time_ = 0;
   ft::Decoder decoder_;
