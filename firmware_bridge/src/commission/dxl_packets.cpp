@@ -66,6 +66,13 @@ Statuses decode(std::span<const std::uint8_t> bytes) {
   return out;
 }
 
+Statuses ping(ByteTransport& line, std::uint8_t id, int baud, microseconds timeout) {
+  std::array<std::uint8_t, 16> tx{};
+  const std::size_t n = dxl::encode_ping(id, tx);
+  return decode(
+      detail::exchange(line, {tx.data(), n}, unicast_wait(n, kPingStatusBytes, baud, timeout)));
+}
+
 int instruct(ByteTransport& line, std::uint8_t id, std::uint8_t instruction,
              std::span<const std::uint8_t> params, int baud, microseconds timeout, int* answers) {
   std::array<std::uint8_t, dxl::kMaxPacket> tx{};

@@ -38,6 +38,9 @@ struct Statuses {
 // Decodes every status packet in `bytes` (the echo of an instruction is skipped).
 Statuses decode(std::span<const std::uint8_t> bytes);
 
+// A unicast ping: every answer, decoded.
+Statuses ping(ByteTransport& line, std::uint8_t id, int baud, std::chrono::microseconds timeout);
+
 // A unicast read: the data, or nothing when no clean status came (or it
 // carried an error number).
 std::optional<std::vector<std::uint8_t>> read(ByteTransport& line, std::uint8_t id,

@@ -96,10 +96,37 @@ void scan_dynamixel(ByteTransport& line, int baud, const ScanLimits& limits, Sca
       collided.insert(id);
     }
   }
-  if (answers.packets.empty() && (answers.damaged > 0 || answers.stray > 0) && collided.empty()) {
-    out.garbled.push_back("dynamixel2 at " + std::to_string(baud) + ": " +
-                          std::to_string(bytes.size()) +
-                          " bytes that are no status packet answered the broadcast ping");
+  if (answers.damaged > 0 || answers.stray > 0) {
+    // Damaged answers: ask each id alone, so that replies overlapping in
+    // one slot show at their id. Junk for every id asked is no collision
+    // but a device of another protocol or baud, or noise.
+    std::vector<int> junk;
+    int asked = 0;
+    for (int id = limits.first_id; id <= std::min(limits.last_id, 252); ++id) {
+      if (count.count(id) != 0 || collided.count(id) != 0) continue;
+      ++asked;
+      const dxl_detail::Statuses s =
+          dxl_detail::ping(line, static_cast<std::uint8_t>(id), baud, limits.answer_timeout);
+      const auto from_id = std::count_if(s.packets.begin(), s.packets.end(),
+                                         [id](const dxl_detail::Status& p) { return p.id == id; });
+      const bool damaged = s.damaged > 0 || s.stray > 0;
+      if (from_id == 1 && !damaged) {
+        count[id] = 1;
+      } else if (from_id > 1 || damaged) {
+        junk.push_back(id);
+      }
+    }
+    if (!junk.empty() && (asked == 1 || static_cast<int>(junk.size()) < asked)) {
+      for (int id : junk) {
+        out.collisions.push_back(
+            {"dynamixel2", baud, id, "damaged answers to a unicast ping (overlapping replies)"});
+        collided.insert(id);
+      }
+    } else if (collided.empty() && count.empty()) {
+      out.garbled.push_back("dynamixel2 at " + std::to_string(baud) + ": " +
+                            std::to_string(bytes.size()) +
+                            " bytes that are no status packet answered the broadcast ping");
+    }
   }
   for (const auto& [id, answered] : count) {
     if (collided.count(id) != 0) continue;
