@@ -193,6 +193,12 @@ int run_scan(const ScanArgs& args) {
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const Step& step = steps[i];
     if (maestro_line && step.protocol != "maestro") continue;
+    if (!carries_baud(args.port, step.baud)) {
+      std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
+                << step.protocol << " at " << step.baud
+                << " baud skipped: a pseudo-terminal cannot be set to that rate\n";
+      continue;
+    }
     std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
               << step.protocol << " at " << step.baud << " baud...\n";
     if (step.protocol == "modbus-rtu") {

@@ -28,7 +28,7 @@ read -r _ _ pty < <(grep "^serial " "$tmp/sim.txt")
 
 # "BAUD:ID" of every servo a scan at BAUD finds, sorted.
 found() {
-  "$animrt" scan "$pty" --protocol dynamixel2 --baud "$1" --ids 0-14 > "$tmp/scan.txt" \
+  "$animrt" scan "$pty" --timeout-ms 30 --protocol dynamixel2 --baud "$1" --ids 0-14 > "$tmp/scan.txt" \
     2> "$tmp/progress.txt" || fail "scan: $(cat "$tmp/scan.txt" "$tmp/progress.txt")"
   grep -q "^collision" "$tmp/scan.txt" && fail "collision with one new servo: $(cat "$tmp/scan.txt")"
   awk 'NR > 1 && $2 == "dynamixel2" {print $3 ":" $4}' "$tmp/scan.txt" | sort | tr '\n' ' '
@@ -54,7 +54,7 @@ for index in $(seq 0 11); do
   [[ $after == "$expected" ]] || fail "servo $index: at 1000000 found: $after, expected $expected"
 done
 
-all=$("$animrt" scan "$pty" --protocol dynamixel2 --baud 1000000 --ids 0-14 2> /dev/null \
+all=$("$animrt" scan "$pty" --timeout-ms 30 --protocol dynamixel2 --baud 1000000 --ids 0-14 2> /dev/null \
   | awk 'NR > 1 && $3 == 1000000 {print $4}' | sort -n | tr '\n' ' ')
 [[ $all == "2 3 4 5 6 7 8 9 10 11 12 13 " ]] || fail "final scan at 1 Mbaud: $all"
 # What the servos themselves now hold, seen through the sim's control interface.

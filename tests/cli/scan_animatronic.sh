@@ -3,7 +3,8 @@
 # serves them: the neck's two Dynamixel servos at 1 Mbaud (ids 1 and 2),
 # the face's Maestro (Get Errors answered, no servo packet sent on its
 # line), and the torso's Modbus TCP drive (unit 1; a refused connection is
-# one line). Then an id collision: the quadruped's servos as a box of new
+# one line). Answer timeouts are generous: a busy machine must not hide a
+# device. Then an id collision: the quadruped's servos as a box of new
 # ones, two plugged in at once, answer as id 1 together, and the scan
 # reports a collision at id 1 (and at no other id).
 set -uo pipefail
@@ -28,17 +29,17 @@ face=$(awk '$1 == "serial" && $2 == "face" {print $3}' "$tmp/sim.txt")
 torso=$(awk '$1 == "modbus-tcp" && $2 == "torso" {print $3}' "$tmp/sim.txt")
 [[ -n $neck && -n $face && -n $torso ]] || fail "sim lines: $(cat "$tmp/sim.txt")"
 
-out=$("$animrt" scan "$neck" --protocol dynamixel2 --baud 57600,1000000 --ids 0-5 2> /dev/null) \
+out=$("$animrt" scan "$neck" --timeout-ms 50 --protocol dynamixel2 --baud 57600,1000000 --ids 0-5 2> /dev/null) \
   || fail "neck: $out"
 rows=$(awk 'NR > 1 && $2 == "dynamixel2" {print $3 ":" $4}' <<< "$out" | sort | tr '\n' ' ')
 [[ $rows == *"1000000:1 1000000:2 "* ]] || fail "neck: $out"
 
-out=$("$animrt" scan "$face" --baud 115200 --ids 0-3 2> /dev/null) || fail "face: $out"
+out=$("$animrt" scan "$face" --timeout-ms 100 --baud 115200 --ids 0-3 2> /dev/null) || fail "face: $out"
 [[ $(awk 'NR > 1 {print $2, $3}' <<< "$out" | head -1) == "maestro 115200" ]] || fail "face: $out"
 [[ $out == *"a Maestro answered, so no servo protocol was tried on it"* ]] || fail "face: $out"
 [[ $out != *dynamixel2* && $out != *feetech* ]] || fail "face: servo rows on a Maestro: $out"
 
-out=$("$animrt" scan "tcp://$torso" --ids 1-8 2> /dev/null) || fail "torso: $out"
+out=$("$animrt" scan "tcp://$torso" --timeout-ms 100 --ids 1-8 2> /dev/null) || fail "torso: $out"
 [[ $(awk 'NR > 1 {print $2, $4}' <<< "$out") == "modbus-tcp 1" ]] || fail "torso: $out"
 out=$("$animrt" scan "tcp://127.0.0.1:1" --ids 1-2 2>&1)
 [[ $? -eq 3 && $out == *"error: cannot connect to Modbus TCP 127.0.0.1:1: "* ]] \
@@ -52,7 +53,7 @@ start_sim "$root/configs/robots/quadruped.yaml" --factory --control "$tmp/ctl"
 pty=$(awk '$1 == "serial" {print $3}' "$tmp/sim.txt")
 /usr/bin/python3 -c 'import socket,sys; s=socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); s.sendall(b"plug legs 1\n"); print(s.makefile().readline(), end="")' "$tmp/ctl" > "$tmp/plug.txt"
 [[ $(cat "$tmp/plug.txt") == ok* ]] || fail "plug: $(cat "$tmp/plug.txt")"
-out=$("$animrt" scan "$pty" --protocol dynamixel2 --baud 57600 --ids 0-3 2> /dev/null) \
+out=$("$animrt" scan "$pty" --timeout-ms 50 --protocol dynamixel2 --baud 57600 --ids 0-3 2> /dev/null) \
   || fail "collision scan: $out"
 [[ $out == *"collision: dynamixel2 id 1 at 57600 baud: "* && $out != *"collision: dynamixel2 id "[02]* ]] \
   || fail "no collision reported: $out"

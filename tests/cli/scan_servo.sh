@@ -23,7 +23,7 @@ done
 read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
 [[ $kind == serial && $pty == /dev/pts/* ]] || fail "sim line: $(cat "$tmp/sim.txt")"
 
-scan() { "$animrt" scan "$pty" --protocol dynamixel2 --baud 1000000 --ids 0-25 "$@"; }
+scan() { "$animrt" scan "$pty" --timeout-ms 30 --protocol dynamixel2 --baud 1000000 --ids 0-25 "$@"; }
 
 # The 12 servos, one row each, as the simulated XM430-W210 reports itself.
 scan > "$tmp/scan.txt" 2> "$tmp/progress.txt" || fail "scan: $(cat "$tmp/scan.txt" "$tmp/progress.txt")"
@@ -96,4 +96,27 @@ junk=$(cat "$tmp/junk_pty")
 out=$("$animrt" scan "$junk" --protocol dynamixel2,feetech --baud 1000000 --ids 0-3 2> /dev/null)
 [[ $? -eq 0 && $out == *"no device answered"* && $out == *"garbage: dynamixel2 at 1000000: "* \
   && $out == *"garbage: feetech at 1000000: "* && $out != *collision* ]] || fail "junk line: $out"
+
+# A factory-new Feetech STS servo (id 1 at 1 Mbaud): given id 3 and
+# 500000 baud, a scan of every Feetech rate finds it there alone; a reboot,
+# which the family has no instruction for, is refused in one line.
+kill $sim_pid
+wait $sim_pid 2> /dev/null
+"$animrt" sim "$root/configs/robots/arm_sts.yaml" --factory > "$tmp/sim.txt" 2>&1 &
+sim_pid=$!
+for _ in $(seq 50); do
+  grep -q "^serial " "$tmp/sim.txt" && break
+  sleep 0.1
+done
+read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
+[[ $pty == /dev/pts/* ]] || fail "feetech sim line: $(cat "$tmp/sim.txt")"
+feetech() { "$animrt" scan "$pty" --timeout-ms 30 --protocol feetech --ids 0-4 2> /dev/null | awk 'NR > 1 {print $2 ":" $3 ":" $4}' | tr '\n' ' '; }
+[[ $(feetech) == "feetech_sts:1000000:1 " ]] || fail "new feetech servo: $(feetech)"
+out=$("$animrt" servo "$pty" --protocol feetech --id 1 set-id 3 2>&1) || fail "feetech set-id: $out"
+out=$("$animrt" servo "$pty" --protocol feetech --id 3 set-baud 500000 2>&1) \
+  || fail "feetech set-baud: $out"
+[[ $(feetech) == "feetech_sts:500000:3 " ]] || fail "feetech after set-id/baud: $(feetech)"
+out=$("$animrt" servo "$pty" --protocol feetech --id 3 --baud 500000 reboot 2>&1)
+[[ $? -eq 3 && $(wc -l <<< "$out") -eq 1 && $out == *"no reboot instruction"* ]] \
+  || fail "feetech reboot: $out"
 echo ok

@@ -70,15 +70,18 @@ void ServoSetup::fail(const std::string& what) const { throw DeviceError(where()
 void ServoSetup::check_answers(int id) {
   int answers = 0;
   bool damaged = false;
-  if (family_ == Family::dynamixel2) {
-    dxl_detail::instruct(*line_, static_cast<std::uint8_t>(id), dxl::inst::ping, {}, baud_,
-                         timeout_, &answers);
-  } else {
-    const auto s = ft_detail::transact(*line_, static_cast<std::uint8_t>(id), ft::inst::ping, {}, 6,
-                                       baud_, timeout_);
-    for (const auto& p : s.packets) answers += p.id == id ? 1 : 0;
-    damaged = s.damaged > 0;
-    if (damaged) ++answers;
+  // A late answer is no absent servo: ask up to three times while silent.
+  for (int attempt = 0; attempt < 3 && answers == 0; ++attempt) {
+    if (family_ == Family::dynamixel2) {
+      dxl_detail::instruct(*line_, static_cast<std::uint8_t>(id), dxl::inst::ping, {}, baud_,
+                           timeout_, &answers);
+    } else {
+      const auto s = ft_detail::transact(*line_, static_cast<std::uint8_t>(id), ft::inst::ping, {},
+                                         6, baud_, timeout_);
+      for (const auto& p : s.packets) answers += p.id == id ? 1 : 0;
+      damaged = s.damaged > 0;
+      if (damaged) ++answers;
+    }
   }
   if (answers == 0) fail("no answer to a ping (check the id, the baud rate and the wiring)");
   if (answers > 1 || damaged) {
@@ -319,7 +322,10 @@ std::string ServoSetup::factory_reset() {
                         timeout_);
   }
   wait_for_answer("Factory Reset");
-  return where() + ": factory reset (id and baud rate kept), answers again";
+  return where() +
+         (family_ == Family::dynamixel2 ? ": factory reset (id and baud rate kept)"
+                                        : ": factory reset") +
+         ", answers again";
 }
 
 }  // namespace animrt::commission
