@@ -99,13 +99,14 @@ out=$("$animrt" scan "$junk" --protocol dynamixel2,feetech --baud 1000000 --ids 
 
 # A factory-new Feetech STS servo (id 1 at 1 Mbaud): given id 3 and
 # 500000 baud, a scan of every Feetech rate finds it there alone; a reboot,
-# which the family has no instruction for, is refused in one line.
+# which the family has no instruction for, is refused in one line; two new
+# servos plugged in at once are a collision at id 1.
 kill $sim_pid
 wait $sim_pid 2> /dev/null
-"$animrt" sim "$root/configs/robots/arm_sts.yaml" --factory > "$tmp/sim.txt" 2>&1 &
+"$animrt" sim "$root/configs/robots/arm_sts.yaml" --factory --control "$tmp/ctl" > "$tmp/sim.txt" 2>&1 &
 sim_pid=$!
 for _ in $(seq 50); do
-  grep -q "^serial " "$tmp/sim.txt" && break
+  grep -q "^control " "$tmp/sim.txt" && break
   sleep 0.1
 done
 read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
@@ -119,4 +120,12 @@ out=$("$animrt" servo "$pty" --protocol feetech --id 3 set-baud 500000 2>&1) \
 out=$("$animrt" servo "$pty" --protocol feetech --id 3 --baud 500000 reboot 2>&1)
 [[ $? -eq 3 && $(wc -l <<< "$out") -eq 1 && $out == *"no reboot instruction"* ]] \
   || fail "feetech reboot: $out"
+# Two more new servos plugged in at once: both answer as id 1.
+for index in 1 2; do
+  /usr/bin/python3 -c 'import socket,sys; s=socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); s.sendall((sys.argv[2]+"\n").encode()); print(s.makefile().readline(), end="")' "$tmp/ctl" "plug arm $index" > "$tmp/plug.txt"
+  [[ $(cat "$tmp/plug.txt") == ok* ]] || fail "plug arm $index: $(cat "$tmp/plug.txt")"
+done
+out=$("$animrt" scan "$pty" --timeout-ms 30 --protocol feetech --baud 1000000 --ids 0-4 2> /dev/null)
+[[ $out == *"collision: feetech id 1 at 1000000 baud: "* && $out != *"collision: feetech id "[0234]* ]] \
+  || fail "feetech collision: $out"
 echo ok

@@ -7,6 +7,9 @@
 namespace animrt::commission {
 namespace {
 
+// A ping's status packet: FF FF ID 02 ERROR CHECKSUM.
+constexpr std::size_t kPingStatusBytes = 6;
+
 void read_ft_details(ByteTransport& line, int baud, const ScanLimits& limits, FoundDevice& d) {
   const auto table = ft_detail::read(line, static_cast<std::uint8_t>(d.id), 0,
                                      ft::reg::servo_status + 1, baud, limits.answer_timeout);
@@ -44,25 +47,29 @@ const std::vector<int>& feetech_bauds() {
 
 void scan_feetech(ByteTransport& line, int baud, const ScanLimits& limits, ScanResult& out) {
   int answered = 0;
-  std::size_t junk = 0;  // bytes that answered no ping
+  int asked = 0;
+  std::size_t junk_bytes = 0;
+  // Ids whose ping drew bytes that are not one clean answer from it: two
+  // servos answering at once (their bytes overlap), or, when every id asked
+  // draws them, a device of another protocol or baud, or noise.
+  std::vector<std::pair<int, std::string>> junk;
   const int last = std::min(limits.last_id, ft::kMaxDeviceId);
   for (int id = std::max(limits.first_id, 0); id <= last; ++id) {
+    ++asked;
     const ft_detail::Statuses s = ft_detail::transact(
         line, static_cast<std::uint8_t>(id), ft::inst::ping, {}, 6, baud, limits.answer_timeout);
     int from_id = 0;
     for (const ft_detail::Status& p : s.packets) from_id += p.id == id ? 1 : 0;
-    const bool overlapped = s.damaged > 0 && s.header_ids.count(id) != 0;
-    if (from_id == 0 && !overlapped) {
-      junk += s.bytes;
+    const bool clean =
+        from_id == 1 && s.damaged == 0 && s.bytes == s.packets.size() * (kPingStatusBytes);
+    if (from_id == 0 && s.bytes == 0) continue;
+    if (!clean) {
+      junk_bytes += s.bytes;
+      junk.emplace_back(id, from_id > 1 ? std::to_string(from_id) + " answers to one ping"
+                                        : "damaged answers to a ping (overlapping replies)");
       continue;
     }
     ++answered;
-    if (from_id > 1 || overlapped) {
-      out.collisions.push_back({"feetech", baud, id,
-                                from_id > 1 ? std::to_string(from_id) + " answers to one ping"
-                                            : "damaged answers to a ping (overlapping replies)"});
-      continue;
-    }
     FoundDevice d;
     d.protocol = "feetech_sts";
     d.baud = baud;
@@ -70,8 +77,10 @@ void scan_feetech(ByteTransport& line, int baud, const ScanLimits& limits, ScanR
     read_ft_details(line, baud, limits, d);
     out.devices.push_back(std::move(d));
   }
-  if (junk > 0) {
-    out.garbled.push_back("feetech at " + std::to_string(baud) + ": " + std::to_string(junk) +
+  if (!junk.empty() && (asked == 1 || static_cast<int>(junk.size()) < asked)) {
+    for (const auto& [id, how] : junk) out.collisions.push_back({"feetech", baud, id, how});
+  } else if (!junk.empty()) {
+    out.garbled.push_back("feetech at " + std::to_string(baud) + ": " + std::to_string(junk_bytes) +
                           " bytes that answer no ping");
   }
   if (limits.progress) {
