@@ -33,7 +33,7 @@ constexpr Item kItems[] = {
     {xreg::baud_rate, 1, true, 0, 7},
     {xreg::return_delay_time, 1, true, 0, 254},
     {xreg_sim::drive_mode, 1, true, 0, 5},
-    {xreg::operating_mode, 1, true, 3, 3},  // only position control is modelled
+    {xreg::operating_mode, 1, true, 3, 4},  // position and extended position control
     {xreg_sim::secondary_id, 1, true, 0, 255},
     {xreg_sim::protocol_type, 1, true, 1, 2},
     {xreg_sim::homing_offset, 4, true, -1'044'479, 1'044'479},
@@ -80,6 +80,9 @@ constexpr Item kItems[] = {
     {xreg::present_temperature, 1, false},
     {xreg_sim::backup_ready, 1, false},
 };
+
+constexpr std::uint8_t kExtendedPositionMode = 4;
+constexpr std::int32_t kExtendedPositionRange = 1'048'575;  // Goal Position, either way
 
 // Indirect Address n: 2 bytes, 64..661. Indirect Data n: 1 byte.
 constexpr std::int64_t kIndirectMin = xreg_sim::eeprom_end;
@@ -213,9 +216,19 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
 
 void DynamixelServo::command_physics() {
   if (physics_ == nullptr) return;
-  const std::int32_t goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
-                                       reg32(xreg::max_position_limit));
-  physics_->command(physics_joint_, binding_.to_rad(goal), torque_on());
+  physics_->command(physics_joint_, binding_.to_rad(motor_goal()), torque_on());
+}
+
+std::int32_t DynamixelServo::motor_goal() const {
+  std::int32_t goal = reg32(xreg::goal_position);
+  if (table_[xreg::operating_mode] != kExtendedPositionMode) {
+    goal = std::clamp(goal, reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
+  }
+  return goal - reg32(xreg_sim::homing_offset);
+}
+
+std::int32_t DynamixelServo::present_of(double motor_ticks) const {
+  return static_cast<std::int32_t>(std::lround(motor_ticks)) + reg32(xreg_sim::homing_offset);
 }
 
 std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
@@ -237,7 +250,7 @@ void DynamixelServo::reset_ram() {
   }
   // Hold still when torque comes on: the goal starts at the present position.
   dxl::put_u32(&table_[xreg::goal_position],
-               static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+               static_cast<std::uint32_t>(present_of(motor_.position)));
   motor_.velocity = 0;
   pending_length_ = 0;
 }
@@ -272,9 +285,7 @@ DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
   }
   if (now <= motor_time_) return m;
   // Limits may have changed while torque was off; the servo never leaves them.
-  const double goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
-                                 reg32(xreg::max_position_limit));
-  return m.after(to_seconds(now - motor_time_), goal, vmax_ticks_s_, tau_s_);
+  return m.after(to_seconds(now - motor_time_), motor_goal(), vmax_ticks_s_, tau_s_);
 }
 
 Nanos DynamixelServo::watchdog_fire_time() const {
@@ -297,9 +308,8 @@ void DynamixelServo::advance(Nanos now) {
     // It stops where it is (Profile Velocity/Acceleration taken as 0) and
     // keeps torque on; the goal values are locked until 98 is written 0.
     if (physics_ == nullptr) motor_.position = std::round(motor_.position);
-    dxl::put_u32(
-        &table_[xreg::goal_position],
-        static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+    dxl::put_u32(&table_[xreg::goal_position],
+                 static_cast<std::uint32_t>(present_of(motor_.position)));
     motor_.velocity = 0;
     table_[xreg_sim::bus_watchdog] = dxl::kBusWatchdogFired;
     publish(fire);
@@ -312,7 +322,7 @@ void DynamixelServo::advance(Nanos now) {
 }
 
 void DynamixelServo::publish(Nanos now) {
-  const auto position = static_cast<std::int32_t>(std::lround(motor_.position));
+  const std::int32_t position = present_of(motor_.position);
   const auto velocity =
       static_cast<std::int32_t>(std::lround(ticks_per_s_to_units(motor_.velocity)));
   dxl::put_u32(&table_[xreg::present_position], static_cast<std::uint32_t>(position));
@@ -413,8 +423,12 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     const std::uint32_t raw = get_le(&after[a], item.size);
     if (item.address == xreg::goal_position) {
       const auto goal = static_cast<std::int32_t>(raw);
-      if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
-          goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
+      if (after[xreg::operating_mode] == kExtendedPositionMode) {
+        if (goal < -kExtendedPositionRange || goal > kExtendedPositionRange) {
+          return StatusError::data_limit;
+        }
+      } else if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
+                 goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
         return StatusError::data_limit;
       }
     } else if (const std::int64_t v = item_value(item, raw); v < item.min || v > item.max) {
@@ -501,14 +515,14 @@ bool DynamixelServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos no
 bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
   advance(now);
   if (torque_on() || physics_ != nullptr) return false;
-  motor_.position = ticks;
+  motor_.position = ticks - reg32(xreg_sim::homing_offset);
   motor_.velocity = 0;
   publish(motor_time_);
   return true;
 }
 
 std::int32_t DynamixelServo::present_ticks(Nanos now) const {
-  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
+  return present_of(motor_at(std::max(now, motor_time_)).position);
 }
 
 int DynamixelServo::baud() const { return baud_of(kDynamixelX, table_[xreg::baud_rate]); }
@@ -565,7 +579,8 @@ Nanos DynamixelServo::take_answer_delay() const {
 
 double DynamixelServo::position_rad(Nanos now) const {
   const Motor m = motor_at(std::max(now, motor_time_));
-  return binding_.direction * (m.position - binding_.zero_ticks) / binding_.ticks_per_rad;
+  const double present = m.position + reg32(xreg_sim::homing_offset);
+  return binding_.direction * (present - binding_.zero_ticks) / binding_.ticks_per_rad;
 }
 
 }  // namespace animrt::sim

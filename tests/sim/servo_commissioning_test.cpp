@@ -197,6 +197,43 @@ TEST(ServoCommissioning, FeetechEepromIsKeptOnlyWhileUnlocked) {
   std::filesystem::remove(path);
 }
 
+std::int32_t read_i32(test::PtyClient& line, std::uint8_t id, std::uint16_t address) {
+  const test::Status s = line.transact(test::read(id, address, 4));
+  return s.data.size() == 4 ? static_cast<std::int32_t>(dxl::get_u32(s.data.data())) : -999999;
+}
+
+TEST(ServoCommissioning, HomingOffsetShiftsPresentAndGoalPosition) {
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(dynamixel_bus({3}), clock);
+  sim.start();
+  test::PtyClient line(sim.endpoint());
+  sim.hand_move(3, 1000);
+  EXPECT_EQ(line.transact(test::write_u32(3, 20, 500)).error, 0);  // Homing Offset
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 1500);
+  EXPECT_EQ(sim.servo_readout(3).ticks, 1500);
+  // Torque on holds where it is; a goal is in the offset frame too.
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {1})).error, 0);
+  EXPECT_EQ(line.transact(test::write_u32(3, xreg::goal_position, 1700)).error, 0);
+  clock.advance(2'000'000'000);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 1700);
+}
+
+TEST(ServoCommissioning, ExtendedPositionModeTurnsPastOneTurn) {
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(dynamixel_bus({3}), clock);
+  sim.start();
+  test::PtyClient line(sim.endpoint());
+  EXPECT_EQ(line.transact(test::write_u32(3, xreg::goal_position, 9000)).error,
+            static_cast<std::uint8_t>(dxl::StatusError::data_limit));  // mode 3: limits
+  EXPECT_EQ(line.transact(test::write(3, xreg::operating_mode, {4})).error, 0);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {1})).error, 0);
+  EXPECT_EQ(line.transact(test::write_u32(3, xreg::goal_position, 9000)).error, 0);
+  clock.advance(20'000'000'000);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 9000);
+  EXPECT_EQ(line.transact(test::write_u32(3, xreg::goal_position, 2'000'000)).error,
+            static_cast<std::uint8_t>(dxl::StatusError::data_limit));
+}
+
 TEST(ServoCommissioning, FeetechFactoryStartupIsId1At1Mbaud) {
   BusConfig config;
   config.name = "arm";

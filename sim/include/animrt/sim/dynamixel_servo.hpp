@@ -16,8 +16,11 @@
 // names (64..661), under that register's rules; a write that covers several
 // Indirect Data maps to one write per run of consecutive target addresses,
 // all checked before any is applied.
-// Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (only 3,
-// position control; other modes answer Data Range Error), Moving Threshold,
+// Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (3,
+// position control, and 4, extended position control: Goal Position
+// +-1,048,575 and no position limits; other modes answer Data Range Error),
+// Homing Offset (Present and Goal Position are the motor's position plus
+// it), Moving Threshold,
 // Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
 // Return Level, Registered Instruction, Hardware Error Status, Goal Position,
 // Realtime Tick, Moving, Present Velocity/Position/Input Voltage/Temperature.
@@ -233,6 +236,10 @@ class DynamixelServo {
   void publish(Nanos now);  // motor state -> present-value registers
   void command_physics();   // goal and torque -> physics
   std::int32_t reg32(std::uint16_t address) const;
+  // The motor turns in its own ticks; Present and Goal Position are those
+  // plus the Homing Offset.
+  std::int32_t motor_goal() const;  // Goal Position (within the limits in mode 3), motor ticks
+  std::int32_t present_of(double motor_ticks) const;
 
   ActuatorBinding binding_;
   double tau_s_;

@@ -57,7 +57,8 @@ class SimulatedBus {
     int id = 0;    // the ID register
     int baud = 0;  // the Baud Rate register, in bits per second
   };
-  // Turns the shaft to raw position `ticks`, as a hand turns a limp servo;
+  // Turns the shaft to raw position `ticks` (as Present Position reads it),
+  // as a hand turns a limp servo;
   // throws std::logic_error("torque is on") when its torque is on.
   virtual void hand_move(int device_id, std::int32_t ticks) {
     (void)device_id;
