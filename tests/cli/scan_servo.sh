@@ -58,6 +58,25 @@ out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 99 --baud 1000000 set-id
 out=$(echo n | "$animrt" servo "$pty" --protocol dynamixel2 --id 21 --baud 1000000 factory-reset 2>&1)
 [[ $? -ne 0 && $out == *"factory reset not confirmed"* ]] || fail "unconfirmed reset: $out"
 
+# Mode, limits, reboot and factory reset, each read back; the scan shows
+# the mode until the reset puts it back to position control.
+servo21() { "$animrt" servo "$pty" --protocol dynamixel2 --id 21 --baud 1000000 "$@" 2>&1; }
+out=$(servo21 set-mode extended-position) && [[ $out == *"operating mode extended-position (read back)"* ]] \
+  || fail "set-mode: $out"
+out=$(servo21 set-limits 1000 3000) && [[ $out == *"position limits 1000..3000 ticks (read back)"* ]] \
+  || fail "set-limits: $out"
+out=$(servo21 reboot) && [[ $out == *"rebooted, answers again"* ]] || fail "reboot: $out"
+scan > "$tmp/scan3.txt" 2>&1
+grep -q "  21  .*operating mode extended-position" "$tmp/scan3.txt" || fail "mode lost: $(cat "$tmp/scan3.txt")"
+out=$(servo21 factory-reset --yes) && [[ $out == *"factory reset (id and baud rate kept)"* ]] \
+  || fail "factory reset: $out"
+scan > "$tmp/scan4.txt" 2>&1
+grep -q "  21  " "$tmp/scan4.txt" && ! grep -q "operating mode" "$tmp/scan4.txt" \
+  || fail "after the reset: $(cat "$tmp/scan4.txt")"
+out=$(servo21 set-mode walking)
+[[ $? -eq 3 && $out == *"unknown mode 'walking': expected one of current, velocity, position"* ]] \
+  || fail "bad mode: $out"
+
 # Not a serial port: one line each.
 out=$("$animrt" scan /dev/null --baud 57600 2>&1)
 [[ $? -eq 3 && $(wc -l <<< "$out") -eq 1 && $out == *"/dev/null"*"not a serial port"* ]] \
