@@ -38,8 +38,10 @@
 #include "gait_command.hpp"
 #include "head_command.hpp"
 #include "herd_command.hpp"
+#include "scan_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "servo_command.hpp"
 #include "sim_command.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
@@ -355,6 +357,8 @@ int main(int argc, char** argv) {
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
   animrt::cli::add_view_command(app);
+  animrt::cli::add_scan_command(app);
+  animrt::cli::add_servo_command(app);
   auto* seq = app.add_subcommand(
       "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
   seq->require_subcommand(1);

@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
+#include <cstdlib>
 #include <cstring>
 
 #include "fd_transport.hpp"
@@ -58,6 +60,23 @@ bool is_pseudo_terminal(const std::string& path) {
   const unsigned m = major(st.st_rdev);
   return (m >= kUnix98PtySlaveFirst && m <= kUnix98PtySlaveLast) || m == kLegacyPtySlave;
 }
+
+}  // namespace animrt::detail
+
+namespace animrt {
+
+bool carries_baud(const std::string& port, int baud) {
+  char resolved[PATH_MAX];
+  if (::realpath(port.c_str(), resolved) == nullptr || !detail::is_pseudo_terminal(resolved)) {
+    return true;
+  }
+  speed_t speed{};
+  return detail::standard_speed(baud, speed);
+}
+
+}  // namespace animrt
+
+namespace animrt::detail {
 
 std::unique_ptr<ByteTransport> open_pty(const std::string& port, const std::string& device,
                                         int baud) {

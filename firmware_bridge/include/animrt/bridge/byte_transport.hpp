@@ -49,6 +49,11 @@ std::string describe_failure(const ByteTransport& transport);
 // through libserialport. Throws DeviceError with the port and the reason.
 std::unique_ptr<ByteTransport> open_serial(const std::string& port, int baud);
 
+// False when `port` is a pseudo-terminal and `baud` is a rate termios has
+// no code for: the pty would keep the rate it had, so a simulated device
+// listening at that rate would answer as if this one were set.
+bool carries_baud(const std::string& port, int baud);
+
 struct BusConfig;
 // open_serial for a serial-line bus (its port and baud rate); the error
 // names the bus.
