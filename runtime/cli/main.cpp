@@ -32,12 +32,15 @@
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "calibrate_command.hpp"
 #include "dashboard_address.hpp"
+#include "doctor_command.hpp"
 #include "evolve_command.hpp"
 #include "fault_injection.hpp"
 #include "gait_command.hpp"
 #include "head_command.hpp"
 #include "herd_command.hpp"
+#include "record_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
 #include "stop_signals.hpp"
@@ -363,6 +366,9 @@ int main(int argc, char** argv) {
   animrt::cli::add_head_command(app);
   animrt::cli::add_herd_command(app);
   animrt::cli::add_view_command(app);
+  animrt::cli::add_calibrate_command(app);
+  animrt::cli::add_record_command(app);
+  animrt::cli::add_doctor_command(app);
   auto* seq = app.add_subcommand(
       "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
   seq->require_subcommand(1);
