@@ -28,7 +28,6 @@
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
-#include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
@@ -43,6 +42,7 @@
 #include "record_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "sim_command.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "view_command.hpp"
@@ -282,24 +282,6 @@ int cmd_run(const RunArgs& args) {
   return code;
 }
 
-int cmd_sim(const std::string& path) {
-  animrt::LoadedRobot robot = animrt::load_robot(path);
-  animrt::MonotonicClock clock;
-  // Served for other programs: CAN devices go on the real interfaces.
-  animrt::sim::set_can_sim_attach(animrt::sim::CanSimAttach::socketcan);
-  auto simulated = animrt::start_simulated_devices(robot.config.buses, clock);
-  // Just below the bus threads of an `animrt run` on this machine (loop 80,
-  // buses 79), so a busy host does not make the devices miss their answers.
-  for (const std::string& note :
-       animrt::raise_simulated_devices(simulated, animrt::RunOptions{}.realtime_priority - 2)) {
-    spdlog::warn("simulated devices: {}", note);
-  }
-  for (const auto& sim : simulated) std::cout << sim->describe() << '\n';
-  std::cout << std::flush;
-  while (!g_controls.stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  return kExitOk;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -357,10 +339,7 @@ int main(int argc, char** argv) {
   run->add_option("--agent", run_args.agent,
                   "the herd agent the robot is, GROUP.INDEX (e.g. red.0)");
 
-  std::string sim_path;
-  auto* sim = app.add_subcommand("sim", "Serve a robot's simulated devices until Ctrl-C");
-  sim->add_option("CONFIG", sim_path, "robot file (YAML)")->required();
-
+  animrt::cli::add_sim_command(app);
   animrt::cli::add_evolve_command(app);
   animrt::cli::add_gait_command(app);
   animrt::cli::add_head_command(app);
@@ -387,7 +366,6 @@ int main(int argc, char** argv) {
   try {
     if (*validate) return cmd_validate(validate_path);
     if (*run) return cmd_run(run_args);
-    if (*sim) return cmd_sim(sim_path);
   } catch (const animrt::InputError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return kExitInvalidInput;

@@ -483,6 +483,29 @@ void DynamixelServo::reboot(Nanos now) {
   command_physics();
 }
 
+void DynamixelServo::set_plugged(bool plugged, Nanos now) {
+  if (plugged && !plugged_) reboot(now);  // power-on: RAM at its defaults
+  plugged_ = plugged;
+}
+
+bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
+  advance(now);
+  if (torque_on() || physics_ != nullptr) return false;
+  motor_.position = ticks;
+  motor_.velocity = 0;
+  publish(motor_time_);
+  return true;
+}
+
+std::int32_t DynamixelServo::present_ticks(Nanos now) const {
+  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
+}
+
+int DynamixelServo::baud() const {
+  const std::uint8_t r = table_[xreg::baud_rate];
+  return r < std::size(kBauds) ? kBauds[r] : 0;
+}
+
 std::uint8_t DynamixelServo::status_error(StatusError error) const {
   const auto number = static_cast<std::uint8_t>(error);
   return table_[xreg::hardware_error_status] != 0 ? (dxl::kAlertBit | number) : number;

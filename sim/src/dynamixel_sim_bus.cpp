@@ -225,6 +225,31 @@ void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int
   servo_or_throw(firmware_, config_, device_id).set_answer_delay(delay_ns, answers);
 }
 
+void DynamixelSimBus::hand_move(int device_id, std::int32_t ticks) {
+  std::lock_guard lock(mutex_);
+  DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
+  if (s.torque_on()) throw std::logic_error("torque is on");
+  if (!s.hand_move(ticks, clock_.now())) {
+    throw std::logic_error("the physics model moves this joint");
+  }
+}
+
+SimulatedBus::ServoReadout DynamixelSimBus::servo_readout(int device_id) const {
+  std::lock_guard lock(mutex_);
+  const DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
+  return {s.present_ticks(clock_.now()), s.torque_on(), s.id(), s.baud()};
+}
+
+void DynamixelSimBus::set_device_plugged(std::size_t index, bool plugged) {
+  std::lock_guard lock(mutex_);
+  if (index >= firmware_.size()) {
+    throw std::out_of_range("no device #" + std::to_string(index) + " on simulated bus '" +
+                            elide(config_.name) + "' (it has " + std::to_string(firmware_.size()) +
+                            ")");
+  }
+  firmware_.at(index).set_plugged(plugged, clock_.now());
+}
+
 std::vector<GoalRecord> DynamixelSimBus::device_goal_log(int device_id) const {
   std::lock_guard lock(mutex_);
   return servo_or_throw(firmware_, config_, device_id).goal_log();

@@ -216,6 +216,37 @@ void FeetechServo::set_fault(std::uint8_t bits, Nanos now) {
   }
 }
 
+void FeetechServo::set_plugged(bool plugged, Nanos now) {
+  if (plugged && !plugged_) {
+    // Power-on: torque off, nothing registered, the goal where the shaft is.
+    advance(now);
+    table_[reg::torque_enable] = 0;
+    table_[reg::registered] = 0;
+    motor_.velocity = 0;
+    store_position(reg::goal_position, motor_.position);
+    publish();
+  }
+  plugged_ = plugged;
+}
+
+bool FeetechServo::hand_move(std::int32_t steps, Nanos now) {
+  advance(now);
+  if (torque_on()) return false;
+  motor_.position = steps;
+  motor_.velocity = 0;
+  publish();
+  return true;
+}
+
+int FeetechServo::baud() const {
+  const std::uint8_t r = table_[reg::baud_rate];
+  return r < std::size(kBauds) ? kBauds[r] : 0;
+}
+
+std::int32_t FeetechServo::present_steps(Nanos now) const {
+  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
+}
+
 double FeetechServo::position_rad(Nanos now) const {
   const Motor m = motor_at(std::max(now, motor_time_));
   return binding_.direction * (m.position - binding_.zero_ticks) / binding_.ticks_per_rad;

@@ -111,6 +111,27 @@ double FeetechSimBus::device_position(int device_id) const {
   return servo(device_id).position_rad(clock_.now());
 }
 
+void FeetechSimBus::hand_move(int device_id, std::int32_t ticks) {
+  std::lock_guard lock(mutex_);
+  if (!servo(device_id).hand_move(ticks, clock_.now())) throw std::logic_error("torque is on");
+}
+
+SimulatedBus::ServoReadout FeetechSimBus::servo_readout(int device_id) const {
+  std::lock_guard lock(mutex_);
+  const FeetechServo& s = servo(device_id);
+  return {s.present_steps(clock_.now()), s.torque_on(), s.id(), s.baud()};
+}
+
+void FeetechSimBus::set_device_plugged(std::size_t index, bool plugged) {
+  std::lock_guard lock(mutex_);
+  if (index >= board_.size()) {
+    throw std::out_of_range("no device #" + std::to_string(index) + " on simulated bus '" +
+                            elide(config_.name) + "' (it has " + std::to_string(board_.size()) +
+                            ")");
+  }
+  board_.at(index).set_plugged(plugged, clock_.now());
+}
+
 std::uint64_t FeetechSimBus::device_goals_received(int device_id) const {
   std::lock_guard lock(mutex_);
   return servo(device_id).goals_received();

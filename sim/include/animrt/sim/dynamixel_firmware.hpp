@@ -78,6 +78,8 @@ class DynamixelFirmware {
   const DynamixelServo* find_configured(int device_id) const;
 
   std::size_t size() const { return servos_.size(); }
+  // The index-th servo of the BusConfig; std::out_of_range past the end.
+  DynamixelServo& at(std::size_t index) { return servos_.at(index); }
 
  private:
   DynamixelServo* target(std::uint8_t id);  // responding servo with this ID register

@@ -176,9 +176,20 @@ class DynamixelServo {
   // electrical shock, overload) switches torque off; as on the real servo,
   // only a Reboot allows torque on again, and it shuts down again if the
   // fault is still there.
-  bool responding() const { return responding_; }
+  bool responding() const { return responding_ && plugged_; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_hardware_error(std::uint8_t bits, Nanos now);
+
+  // Commissioning. Unplugged, the servo hears and says nothing; plugged in
+  // again it powers up (RAM at its defaults, torque off). A hand turns a
+  // limp shaft to raw `ticks` (false, and nothing moves, while torque is on;
+  // with physics the joint is the physics').
+  bool plugged() const { return plugged_; }
+  void set_plugged(bool plugged, Nanos now);
+  bool hand_move(std::int32_t ticks, Nanos now);
+  int baud() const;  // the Baud Rate register in bits per second
+  // Present Position (raw) at `now`, without changing the state.
+  std::int32_t present_ticks(Nanos now) const;
 
   // Fault injection: the next `answers` status packets (every one while
   // answers < 0) leave `delay_ns` of real time late, so a client sees late
@@ -220,6 +231,7 @@ class DynamixelServo {
   int physics_joint_ = -1;
   Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
+  bool plugged_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;
   // Reg Write waiting for Action.

@@ -79,6 +79,9 @@ class DynamixelSimBus final : public SimulatedBus {
   double device_position(int device_id) const override;
   // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
   void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
+  void hand_move(int device_id, std::int32_t ticks) override;
+  ServoReadout servo_readout(int device_id) const override;
+  void set_device_plugged(std::size_t index, bool plugged) override;
   std::vector<GoalRecord> device_goal_log(int device_id) const;
   std::uint64_t device_goals_received(int device_id) const;
 

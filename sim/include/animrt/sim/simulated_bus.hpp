@@ -3,6 +3,7 @@
 // protocol on the device side of a pseudo-terminal (or other endpoint), so the
 // runtime drives it through exactly the code that drives hardware.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -44,6 +45,37 @@ class SimulatedBus {
   }
   // Position of a device in radians (through its binding), for tests.
   virtual double device_position(int device_id) const = 0;
+
+  // Commissioning: what a person does to a serial servo on the bench (the
+  // control interface of `animrt sim`). Devices are named by the id the
+  // robot file gives them (std::out_of_range for one not on this bus),
+  // whatever their ID register says now. Buses whose devices do not model
+  // it throw std::logic_error.
+  struct ServoReadout {
+    std::int32_t ticks = 0;  // Present Position, raw
+    bool torque = false;
+    int id = 0;    // the ID register
+    int baud = 0;  // the Baud Rate register, in bits per second
+  };
+  // Turns the shaft to raw position `ticks`, as a hand turns a limp servo;
+  // throws std::logic_error("torque is on") when its torque is on.
+  virtual void hand_move(int device_id, std::int32_t ticks) {
+    (void)device_id;
+    (void)ticks;
+    throw std::logic_error("simulated bus " + endpoint() + ": hands are not modelled");
+  }
+  virtual ServoReadout servo_readout(int device_id) const {
+    (void)device_id;
+    throw std::logic_error("simulated bus " + endpoint() + ": servo readout is not modelled");
+  }
+  // Connects (powers up, RAM at its defaults) or disconnects the index-th
+  // device of the bus (0-based, the robot file's order); an unplugged device
+  // hears and says nothing. std::out_of_range for an index past the end.
+  virtual void set_device_plugged(std::size_t index, bool plugged) {
+    (void)index;
+    (void)plugged;
+    throw std::logic_error("simulated bus " + endpoint() + ": plugging is not modelled");
+  }
 };
 
 namespace sim {

@@ -71,9 +71,17 @@ class FeetechServo {
   void reg_write(std::uint8_t address, std::span<const std::uint8_t> data);
   void action();
 
-  bool responding() const { return responding_; }
+  bool responding() const { return responding_ && plugged_; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
+
+  // Commissioning, as DynamixelServo: unplugged it hears and says nothing,
+  // plugged in again it powers up (torque off, goal at the present
+  // position); a hand turns a limp shaft (false while torque is on).
+  void set_plugged(bool plugged, Nanos now);
+  bool hand_move(std::int32_t steps, Nanos now);
+  int baud() const;  // the Baud Rate register in bits per second
+  std::int32_t present_steps(Nanos now) const;
 
   // Goal positions received (decoded, in steps), for tests.
   std::uint64_t goals_received() const { return goals_received_; }
@@ -97,6 +105,7 @@ class FeetechServo {
   Motor motor_;
   Nanos motor_time_;
   bool responding_ = true;
+  bool plugged_ = true;
   std::array<std::uint8_t, ft::reg::table_size> pending_{};
   std::uint8_t pending_address_ = 0;
   std::uint8_t pending_length_ = 0;
@@ -115,6 +124,7 @@ class FeetechBoard {
   FeetechServo* find_configured(int device_id);
   const FeetechServo* find_configured(int device_id) const;
   std::size_t size() const { return servos_.size(); }
+  FeetechServo& at(std::size_t index) { return servos_.at(index); }
   ft::Series series() const { return series_; }
 
  private:

@@ -59,6 +59,9 @@ class FeetechSimBus final : public SimulatedBus {
   // byte of its status packets, and those in Unload Condition cut torque.
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   double device_position(int device_id) const override;
+  void hand_move(int device_id, std::int32_t ticks) override;
+  ServoReadout servo_readout(int device_id) const override;
+  void set_device_plugged(std::size_t index, bool plugged) override;
   std::uint64_t device_goals_received(int device_id) const;
   std::int32_t device_last_goal(int device_id) const;
 
