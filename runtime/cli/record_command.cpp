@@ -32,9 +32,11 @@ struct RecordArgs {
   PortOverrides ports;
 };
 
-// Keys are written to 0.001 s and 0.001 of the joint's unit: the rounding
+// Keys are written to 0.001 of the joint's unit: the rounding
 // is taken off the bound the reducer keeps.
 constexpr double kValueQuantum = 0.001;
+// Key times are written to 0.1 ms: samples closer than this would collide.
+constexpr double kMinSampleGap = 0.0002;
 
 std::string number(double value, int decimals) {
   const double scale = std::pow(10.0, decimals);
@@ -83,7 +85,7 @@ int run_record(const RecordArgs& args) {
             << std::endl;
 
   const long period_ns = static_cast<long>(1e9 / config.rate_hz);
-  const std::size_t samples_max =
+  const std::size_t cycles =
       args.duration_s > 0 ? static_cast<std::size_t>(args.duration_s * config.rate_hz) + 1
                           : std::numeric_limits<std::size_t>::max();
   std::vector<double> times;
@@ -92,17 +94,20 @@ int run_record(const RecordArgs& args) {
   clock_gettime(CLOCK_MONOTONIC, &next);
   const timespec start = next;
   RunControls& controls = commissioning_controls();
-  while (!controls.stop.load() && times.size() < samples_max) {
+  for (std::size_t cycle = 0; cycle < cycles && !controls.stop.load(); ++cycle) {
     figure.read(positions);
     timespec now{};
     clock_gettime(CLOCK_MONOTONIC, &now);
-    // The show's time is the sample's deadline, so the keys keep the loop's
-    // period even when a read was late.
-    times.push_back(static_cast<double>(next.tv_sec - start.tv_sec) +
-                    static_cast<double>(next.tv_nsec - start.tv_nsec) * 1e-9);
-    for (Track& t : tracks) {
-      const double v = positions[t.joint];
-      t.values.push_back(t.prismatic ? v : rad_to_deg(v));
+    // A sample's time is when its answers came, not its deadline: a late
+    // read (a busy host) must not shift the motion in time.
+    const double t = static_cast<double>(now.tv_sec - start.tv_sec) +
+                     static_cast<double>(now.tv_nsec - start.tv_nsec) * 1e-9;
+    if (times.empty() || t >= times.back() + kMinSampleGap) {
+      times.push_back(t);
+      for (Track& track : tracks) {
+        const double v = positions[track.joint];
+        track.values.push_back(track.prismatic ? v : rad_to_deg(v));
+      }
     }
     next.tv_nsec += period_ns;
     while (next.tv_nsec >= 1'000'000'000L) {
@@ -120,7 +125,7 @@ int run_record(const RecordArgs& args) {
       "name: {}\nloop: false\nduration_s: {}\njoints:\n",
       std::filesystem::path(config.file).filename().string(), times.size(), config.rate_hz,
       args.tolerance_deg, args.tolerance_deg / 1000.0,
-      std::filesystem::path(args.out).stem().string(), number(times.back(), 3));
+      std::filesystem::path(args.out).stem().string(), number(times.back(), 4));
   std::size_t keys_total = 0;
   std::size_t clamped = 0;
   for (Track& t : tracks) {
@@ -145,7 +150,7 @@ int run_record(const RecordArgs& args) {
       // Rounding must not carry a key at a limit past it.
       double v = std::round(t.values[k] / margin) * margin;
       v = std::clamp(v, lo, hi);
-      text += "      - [" + number(times[k], 3) + ", " + number(v, t.prismatic ? 6 : 3) + "]\n";
+      text += "      - [" + number(times[k], 4) + ", " + number(v, t.prismatic ? 6 : 3) + "]\n";
     }
   }
   {
