@@ -55,16 +55,21 @@ LimpFigure::~LimpFigure() {
   for (std::size_t b = 0; b < figure_->bus_count(); ++b) figure_->bus(b).deactivate();
 }
 
-void LimpFigure::read(std::vector<double>& joints) {
+void LimpFigure::read(std::vector<double>& joints, std::vector<bool>* fresh) {
   joints.resize(config().joints.size(), 0.0);
+  if (fresh) fresh->assign(joints.size(), false);
   for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
     ActuatorBus& bus = figure_->bus(b);
     bus.read(bus_positions_[b]);
     const auto& actuators = bus.config().actuators;
+    const std::span<DeviceStatus> status = bus.devices();
     for (std::size_t i = 0; i < actuators.size(); ++i) {
       const int j = actuators[i].joint_index;
       if (j >= 0 && static_cast<std::size_t>(j) < joints.size()) {
         joints[static_cast<std::size_t>(j)] = bus_positions_[b][i];
+        if (fresh && i < status.size()) {
+          (*fresh)[static_cast<std::size_t>(j)] = status[i].health == DeviceHealth::ok;
+        }
       }
     }
   }

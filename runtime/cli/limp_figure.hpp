@@ -29,9 +29,9 @@ class LimpFigure {
 
   const RobotConfig& config() const { return figure_->config(); }
   // Positions of every joint (rad, or m), in robot joint order; a joint
-  // whose device did not answer keeps its previous value. Throws
-  // DeviceError for a bus that fails.
-  void read(std::vector<double>& joints);
+  // whose device did not answer keeps its previous value and is not
+  // `fresh` (when given). Throws DeviceError for a bus that fails.
+  void read(std::vector<double>& joints, std::vector<bool>* fresh = nullptr);
   // The binding of joint `j` and its bus's protocol (null when no bus drives it).
   const ActuatorBinding* binding(std::size_t joint) const;
   std::string protocol(std::size_t joint) const;

@@ -49,6 +49,7 @@ struct Track {
   std::size_t joint;
   std::string name;
   bool prismatic;
+  std::vector<double> times;   // s since the recording began
   std::vector<double> values;  // deg or m
 };
 
@@ -70,7 +71,7 @@ int run_record(const RecordArgs& args) {
     const bool asked = args.joints.empty() || std::find(args.joints.begin(), args.joints.end(),
                                                         spec.name) != args.joints.end();
     if (!asked || figure.binding(j) == nullptr) continue;
-    tracks.push_back({j, spec.name, spec.type == JointType::prismatic, {}});
+    tracks.push_back({j, spec.name, spec.type == JointType::prismatic, {}, {}});
   }
   for (const std::string& name : args.joints) {
     if (std::none_of(tracks.begin(), tracks.end(),
@@ -85,29 +86,44 @@ int run_record(const RecordArgs& args) {
             << std::endl;
 
   const long period_ns = static_cast<long>(1e9 / config.rate_hz);
-  const std::size_t cycles =
-      args.duration_s > 0 ? static_cast<std::size_t>(args.duration_s * config.rate_hz) + 1
-                          : std::numeric_limits<std::size_t>::max();
-  std::vector<double> times;
+  const std::size_t cycles = args.duration_s > 0
+                                 ? static_cast<std::size_t>(args.duration_s * config.rate_hz) + 1
+                                 : std::numeric_limits<std::size_t>::max();
+  std::size_t reads = 0;
+  double last_t = 0.0;
+  std::size_t missed = 0;
   std::vector<double> positions;
+  std::vector<bool> fresh;
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   const timespec start = next;
   RunControls& controls = commissioning_controls();
   for (std::size_t cycle = 0; cycle < cycles && !controls.stop.load(); ++cycle) {
-    figure.read(positions);
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    // A sample's time is when its answers came, not its deadline: a late
+    timespec asked{};
+    clock_gettime(CLOCK_MONOTONIC, &asked);
+    figure.read(positions, &fresh);
+    timespec answered{};
+    clock_gettime(CLOCK_MONOTONIC, &answered);
+    // A sample's time is the middle of its read, not its deadline: a late
     // read (a busy host) must not shift the motion in time.
-    const double t = static_cast<double>(now.tv_sec - start.tv_sec) +
-                     static_cast<double>(now.tv_nsec - start.tv_nsec) * 1e-9;
-    if (times.empty() || t >= times.back() + kMinSampleGap) {
-      times.push_back(t);
-      for (Track& track : tracks) {
-        const double v = positions[track.joint];
-        track.values.push_back(track.prismatic ? v : rad_to_deg(v));
+    const auto since_start = [&start](const timespec& at) {
+      return static_cast<double>(at.tv_sec - start.tv_sec) +
+             static_cast<double>(at.tv_nsec - start.tv_nsec) * 1e-9;
+    };
+    const double t = 0.5 * (since_start(asked) + since_start(answered));
+    ++reads;
+    last_t = t;
+    // A device that did not answer this time gives no sample: its old
+    // value at a new time would be a motion that never happened.
+    for (Track& track : tracks) {
+      if (!fresh[track.joint]) {
+        ++missed;
+        continue;
       }
+      if (!track.times.empty() && t < track.times.back() + kMinSampleGap) continue;
+      const double v = positions[track.joint];
+      track.times.push_back(t);
+      track.values.push_back(track.prismatic ? v : rad_to_deg(v));
     }
     next.tv_nsec += period_ns;
     while (next.tv_nsec >= 1'000'000'000L) {
@@ -116,16 +132,22 @@ int run_record(const RecordArgs& args) {
     }
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
   }
-  if (times.size() < 2)
-    throw std::runtime_error("recorded fewer than two samples: no show written");
+  std::size_t samples = 0;
+  for (const Track& t : tracks) {
+    if (t.times.size() < 2) {
+      throw std::runtime_error(t.name +
+                               ": fewer than two answers from its device: no show written");
+    }
+    samples += t.times.size();
+  }
 
   std::string text = fmt::format(
-      "# Recorded by hand with animrt record from {}: {} samples at {} Hz, reduced to keys\n"
+      "# Recorded by hand with animrt record from {}: {} reads at {} Hz, reduced to keys\n"
       "# within {} deg ({} m for prismatic joints) under linear interpolation.\n"
       "name: {}\nloop: false\nduration_s: {}\njoints:\n",
-      std::filesystem::path(config.file).filename().string(), times.size(), config.rate_hz,
+      std::filesystem::path(config.file).filename().string(), reads, config.rate_hz,
       args.tolerance_deg, args.tolerance_deg / 1000.0,
-      std::filesystem::path(args.out).stem().string(), number(times.back(), 4));
+      std::filesystem::path(args.out).stem().string(), number(last_t, 4));
   std::size_t keys_total = 0;
   std::size_t clamped = 0;
   for (Track& t : tracks) {
@@ -141,7 +163,7 @@ int run_record(const RecordArgs& args) {
     const double bound = (t.prismatic ? args.tolerance_deg / 1000.0 : args.tolerance_deg);
     const double margin = kValueQuantum * (t.prismatic ? 1e-3 : 1.0);
     const std::vector<std::size_t> keys =
-        show::reduce_keys(times, t.values, std::max(0.0, bound - margin));
+        show::reduce_keys(t.times, t.values, std::max(0.0, bound - margin));
     keys_total += keys.size();
     text += "  " + t.name + ":\n    interpolation: linear\n";
     if (t.prismatic) text += "    unit: m\n";
@@ -150,7 +172,7 @@ int run_record(const RecordArgs& args) {
       // Rounding must not carry a key at a limit past it.
       double v = std::round(t.values[k] / margin) * margin;
       v = std::clamp(v, lo, hi);
-      text += "      - [" + number(times[k], 4) + ", " + number(v, t.prismatic ? 6 : 3) + "]\n";
+      text += "      - [" + number(t.times[k], 4) + ", " + number(v, t.prismatic ? 6 : 3) + "]\n";
     }
   }
   {
@@ -159,12 +181,14 @@ int run_record(const RecordArgs& args) {
     if (!out.flush()) throw std::runtime_error("cannot write " + quote_path(args.out));
   }
   load_show_file(args.out);  // what was written reads back as a show
-  const std::size_t samples = times.size() * tracks.size();
   std::cout << fmt::format(
       "{}: {} joints, {} samples over {:.2f} s -> {} keys (reduction {:.1f}:1 at {} deg)\n",
-      args.out, tracks.size(), samples, times.back(), keys_total,
+      args.out, tracks.size(), samples, last_t, keys_total,
       keys_total > 0 ? static_cast<double>(samples) / static_cast<double>(keys_total) : 0.0,
       args.tolerance_deg);
+  if (missed > 0) {
+    std::cout << missed << " answers were missing (those samples were left out)\n";
+  }
   if (clamped > 0) {
     std::cout << clamped << " samples were past the joints' limits and were clamped to them\n";
   }
