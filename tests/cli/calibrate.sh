@@ -2,7 +2,8 @@
 # animrt calibrate on the quadruped's simulated servos, each joint turned by
 # hand through the control interface while it is followed: zero_ticks and the
 # limits land within 1 deg of what was moved, in place, every other byte of
-# the file as it was. A joint left still, a read-only file and a file edited
+# the file as it was; interactively the user's positive sets the
+# direction. A joint left still, a read-only file and a file edited
 # meanwhile are refused with one line and the file is left alone.
 set -uo pipefail
 animrt=$1
@@ -26,11 +27,20 @@ def hand(bus_id, ticks):
     s = socket.socket(socket.AF_UNIX); s.connect(ctl)
     s.sendall(f"hand legs {bus_id} {ticks}\n".encode())
     assert s.makefile().readline().startswith("ok")
-proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT, text=True)
 log = []
+def enter():
+    time.sleep(0.2)
+    proc.stdin.write("\n"); proc.stdin.flush()
 for line in proc.stdout:
     log.append(line)
-    m = re.match(r"(\w+): move it through", line)
+    m = re.match(r"(\w+): (?:move it|now move it a little in its (positive))", line)
+    if m and m.group(2):  # interactive: the hand turns it 100 ticks up, the user's positive
+        bus_id, lo, hi, home = moves[m.group(1)]
+        hand(bus_id, home + 100)
+        enter()
+        continue
     if m and m.group(1) in moves:
         bus_id, lo, hi, home = moves[m.group(1)]
         if os.environ.get("EDIT_MEANWHILE"):  # someone edits the file during the calibration
@@ -38,6 +48,8 @@ for line in proc.stdout:
         for ticks in (lo, hi, home):
             time.sleep(0.15)
             hand(bus_id, ticks)
+        if "--non-interactive" not in cmd:
+            enter()
 proc.wait()
 open(out, "w").write("".join(log))
 sys.exit(proc.returncode)
@@ -46,13 +58,13 @@ calibrate() {  # calibrate MOVES_JSON OUT ARGS...: with the hand moving the join
   local moves=$1 out=$2
   shift 2
   /usr/bin/python3 "$tmp/hand.py" "$tmp/ctl" "$moves" "$out" \
-    "$animrt" calibrate "$robot" --non-interactive --port "legs=$pty" "$@"
+    "$animrt" calibrate "$robot" --port "legs=$pty" "$@"
 }
 
 cp "$robot" "$tmp/original.yaml"
 # id, min, max, home in ticks. rf_knee is mounted mirrored (direction -1).
 moves='{"lf_hip": [1, 1700, 2600, 2150], "rf_knee": [5, 1500, 2800, 1990], "lh_ankle": [9, 1400, 2700, 2348]}'
-calibrate "$moves" "$tmp/out.txt" --seconds-per-joint 0.9 --joint lf_hip --joint rf_knee \
+calibrate "$moves" "$tmp/out.txt" --non-interactive --seconds-per-joint 0.9 --joint lf_hip --joint rf_knee \
   --joint lh_ankle || fail "calibrate failed: $(cat "$tmp/out.txt")"
 grep -q "3 joints calibrated" "$tmp/out.txt" || fail "no summary: $(cat "$tmp/out.txt")"
 "$animrt" validate "$robot" > /dev/null || fail "the calibrated file does not load"
@@ -90,6 +102,14 @@ for name, (dev, lo, hi, home) in moves.items():
     assert abs(mn - ends[0]) <= 1 and abs(mx - ends[1]) <= 1, f"{name}: {mn}..{mx}, moved {ends}"
 PY
 
+# Interactively, with Enter from the user: rf_hip is mounted mirrored
+# (direction -1) but its user's positive is up the ticks, so it becomes 1.
+calibrate '{"rf_hip": [4, 1500, 2600, 2000]}' "$tmp/inter.txt" --joint rf_hip ||
+  fail "interactive calibrate: $(cat "$tmp/inter.txt")"
+line=$(grep -A3 "^  rf_hip:" "$robot")
+[[ $line == *"min_deg: -43.9, max_deg: 52.7,"* && $line == *"zero_ticks: 2000, direction: 1}"* ]] ||
+  fail "interactive rf_hip: $line"
+
 # A joint left where it is: refused, the file untouched.
 cp "$robot" "$tmp/before.yaml"
 out=$("$animrt" calibrate "$robot" --non-interactive --port "legs=$pty" --joint lf_knee \
@@ -100,7 +120,7 @@ cmp -s "$robot" "$tmp/before.yaml" || fail "file changed after a refused calibra
 
 # A read-only file: one line, exit 2, untouched.
 chmod 444 "$robot"
-calibrate '{"lf_knee": [2, 1800, 2400, 2000]}' "$tmp/ro.txt" --joint lf_knee --seconds-per-joint 0.7
+calibrate '{"lf_knee": [2, 1800, 2400, 2000]}' "$tmp/ro.txt" --non-interactive --joint lf_knee --seconds-per-joint 0.7
 code=$?
 [[ $code -eq 2 ]] && grep -q "quadruped.yaml: is read-only" "$tmp/ro.txt" ||
   fail "read-only (exit $code): $(cat "$tmp/ro.txt")"
@@ -109,7 +129,7 @@ cmp -s "$robot" "$tmp/before.yaml" || fail "read-only file changed"
 
 # Edited on disk while the joint was followed: refused, the edit kept.
 EDIT_MEANWHILE=$robot calibrate '{"lf_knee": [2, 1800, 2400, 2000]}' "$tmp/edit.txt" \
-  --joint lf_knee --seconds-per-joint 0.9
+  --non-interactive --joint lf_knee --seconds-per-joint 0.9
 code=$?
 [[ $code -eq 2 ]] && grep -q "changed on disk" "$tmp/edit.txt" ||
   fail "edited meanwhile (exit $code): $(cat "$tmp/edit.txt")"
