@@ -2,7 +2,9 @@
 # animrt record on the quadruped's simulated servos, two joints puppeteered
 # through the control interface: the show holds far fewer keys than samples,
 # its keys follow what was moved within 1 deg, and played back through
-# `animrt run` the joints move as the hand moved them, within 1 deg.
+# `animrt run` the joints move as the hand moved them, within 1 deg. A port
+# that is not a serial device, an unknown bus and an unwritable show are
+# one line each.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -114,4 +116,17 @@ play_err = min(worst(played, s) for s in [i * 0.005 for i in range(0, int((times
 assert play_err <= 1.0, f"playback strays {play_err:.2f} deg from what was moved"
 print(f"keys within {keys_err:.2f} deg, playback within {play_err:.2f} deg")
 PY
+# Bad input: one line each, no show written.
+bad() {  # bad EXIT TEXT ARGS...
+  local want=$1 text=$2
+  shift 2
+  out=$("$animrt" record "$robot" "$@" 2>&1)
+  code=$?
+  [[ $code -eq $want && $out == *"$text"* && $(wc -l <<< "$out") -eq 1 ]] ||
+    fail "record $* (exit $code): $out"
+}
+bad 3 "not a character device (not a serial port)" --out "$tmp/bad.yaml" --port "legs=$robot"
+bad 1 "has no bus named" --out "$tmp/bad.yaml" --port "arms=/dev/null"
+bad 1 "--out: cannot write" --out "$tmp/no/such/folder/show.yaml"
+[[ ! -e $tmp/bad.yaml ]] || fail "a show was written after an error"
 echo "record: ok"
