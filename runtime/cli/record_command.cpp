@@ -16,6 +16,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "limp_figure.hpp"
+#include "sound_track_recorder.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -30,7 +31,11 @@ struct RecordArgs {
   double duration_s = 0.0;
   std::vector<std::string> joints;
   PortOverrides ports;
+  bool audio = false;
+  std::string audio_device = "default";
 };
+
+constexpr int kSoundTrackRate = 48000;
 
 // Keys are written to 0.001 of the joint's unit: the rounding
 // is taken off the bound the reducer keeps.
@@ -62,6 +67,15 @@ int run_record(const RecordArgs& args) {
     if (!probe) throw std::invalid_argument("--out: cannot write " + quote_path(args.out));
     probe.close();
     if (!existed) std::filesystem::remove(args.out);
+  }
+  // The microphone is opened before the figure: a missing one is found
+  // before anyone starts to puppeteer.
+  const std::filesystem::path out_path(args.out);
+  const std::string track_name = out_path.stem().string() + ".wav";
+  std::unique_ptr<SoundTrackRecorder> microphone;
+  if (args.audio) {
+    microphone = std::make_unique<SoundTrackRecorder>(
+        args.audio_device, kSoundTrackRate, (out_path.parent_path() / track_name).string());
   }
   LimpFigure figure(args.robot, args.ports);
   const RobotConfig& config = figure.config();
@@ -97,6 +111,7 @@ int run_record(const RecordArgs& args) {
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   const timespec start = next;
+  if (microphone) microphone->start();
   RunControls& controls = commissioning_controls();
   for (std::size_t cycle = 0; cycle < cycles && !controls.stop.load(); ++cycle) {
     timespec asked{};
@@ -141,13 +156,24 @@ int run_record(const RecordArgs& args) {
     samples += t.times.size();
   }
 
+  std::string audio_line;
+  if (microphone) {
+    const double first_sample = microphone->finish();
+    const double offset = first_sample - (static_cast<double>(start.tv_sec) + start.tv_nsec * 1e-9);
+    std::string quoted = "\"";
+    for (const char c : track_name) {
+      if (c == '"' || c == '\\') quoted += '\\';
+      quoted += c;
+    }
+    audio_line = "audio: {file: " + quoted + "\", offset_s: " + number(offset, 4) + "}\n";
+  }
   std::string text = fmt::format(
       "# Recorded by hand with animrt record from {}: {} reads at {} Hz, reduced to keys\n"
       "# within {} deg ({} m for prismatic joints) under linear interpolation.\n"
-      "name: {}\nloop: false\nduration_s: {}\njoints:\n",
+      "name: {}\nloop: false\nduration_s: {}\n{}joints:\n",
       std::filesystem::path(config.file).filename().string(), reads, config.rate_hz,
-      args.tolerance_deg, args.tolerance_deg / 1000.0,
-      std::filesystem::path(args.out).stem().string(), number(last_t, 4));
+      args.tolerance_deg, args.tolerance_deg / 1000.0, out_path.stem().string(), number(last_t, 4),
+      audio_line);
   std::size_t keys_total = 0;
   std::size_t clamped = 0;
   for (Track& t : tracks) {
@@ -211,6 +237,9 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--duration", args.duration_s, "seconds to record (0: until Ctrl-C)")
       ->check(CLI::Range(0.0, 24.0 * 3600.0));
   cmd->add_option("--joint", args.joints, "record only this joint (repeatable)");
+  cmd->add_flag("--audio", args.audio,
+                "record the microphone beside the motion as the show's sound track (SHOW.wav)");
+  cmd->add_option("--audio-device", args.audio_device, "ALSA capture device (default: default)");
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {
     try {

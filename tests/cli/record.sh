@@ -3,8 +3,9 @@
 # through the control interface: the show holds far fewer keys than samples,
 # its keys follow what was moved within 1 deg, and played back through
 # `animrt run` the joints move as the hand moved them, within 1 deg. A port
-# that is not a serial device, an unknown bus and an unwritable show are
-# one line each.
+# that is not a serial device, an unknown bus, an unwritable show, a
+# missing microphone and one that is not paced by a clock are one line
+# each, and nothing is written.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -61,6 +62,13 @@ show=$tmp/robots/puppet.yaml
   "$animrt" record "$robot" --out "$show" --duration 3 --port "legs=$pty" ||
   fail "record failed: $(cat "$tmp/out.txt")"
 grep -q "12 joints, [0-9]* samples over 3.0[0-9] s" "$tmp/out.txt" || fail "record: $(cat "$tmp/out.txt")"
+# A sound track from a device that no clock paces (ALSA's null) is refused,
+# and neither the track nor the show is left behind.
+out=$("$animrt" record "$robot" --out "$tmp/take.yaml" --audio --audio-device null --duration 0.5 \
+  --port "legs=$pty" 2>&1)
+code=$?
+[[ $code -eq 3 && $out == *"faster than real time"* ]] || fail "null sound track (exit $code): $out"
+[[ ! -e $tmp/take.yaml && ! -e $tmp/take.wav ]] || fail "files left after a failed sound track"
 stop_sim
 
 # Played back: the robot with the recorded show as its motion.
@@ -128,5 +136,7 @@ bad() {  # bad EXIT TEXT ARGS...
 bad 3 "not a character device (not a serial port)" --out "$tmp/bad.yaml" --port "legs=$robot"
 bad 1 "has no bus named" --out "$tmp/bad.yaml" --port "arms=/dev/null"
 bad 1 "--out: cannot write" --out "$tmp/no/such/folder/show.yaml"
+bad 3 'ALSA capture device "animrt_no_such_device"' --out "$tmp/bad.yaml" --audio \
+  --audio-device animrt_no_such_device
 [[ ! -e $tmp/bad.yaml ]] || fail "a show was written after an error"
 echo "record: ok"
