@@ -34,8 +34,8 @@ hip0 = (ticks_of(1) - 2048) * 360 / 4096
 knee0 = -(ticks_of(5) - 2048) * 360 / 4096
 def angles(t):
     t = min(t, 2.5)  # then held
-    return (hip0 + 15 * math.sin(2 * math.pi * t / 2.0),
-            knee0 + 20 * math.sin(2 * math.pi * t / 2.5))
+    return (hip0 + 15 * math.sin(2 * math.pi * t / 3.0),
+            knee0 + 20 * math.sin(2 * math.pi * t / 3.5))
 proc = subprocess.Popen(sys.argv[4:], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 out = [proc.stdout.readline()]
 assert out[0].startswith("torque is off"), out[0]
