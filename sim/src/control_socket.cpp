@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -115,7 +116,11 @@ ControlSocket::ControlSocket(std::string path, NamedBuses buses)
   };
   listen_fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (listen_fd_ < 0) fail("socket");
-  ::unlink(path_.c_str());  // a socket left by a process that was killed
+  // A socket left by a process that was killed is replaced; anything else
+  // at the path is not ours to remove (bind then fails and says so).
+  if (struct stat st{}; ::lstat(path_.c_str(), &st) == 0 && S_ISSOCK(st.st_mode)) {
+    ::unlink(path_.c_str());
+  }
   if (::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0) fail("bind");
   if (::listen(listen_fd_, kMaxClients) != 0) fail("listen");
   if (::pipe2(wake_.data(), O_CLOEXEC | O_NONBLOCK) != 0) fail("pipe");

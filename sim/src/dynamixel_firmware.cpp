@@ -15,6 +15,7 @@ namespace inst = dxl::inst;
 constexpr int kMaxDeviceId = 252;
 constexpr std::uint8_t kReplyPingAndRead = 1;  // Status Return Level
 constexpr std::uint8_t kReplyAll = 2;
+constexpr std::uint8_t kBroadcastResetAllIgnored = 42;  // firmware version
 
 std::uint16_t u16_at(std::span<const std::uint8_t> p, std::size_t i) { return dxl::get_u16(&p[i]); }
 
@@ -68,6 +69,15 @@ DynamixelServo* DynamixelFirmware::target(std::uint8_t id) {
   return nullptr;
 }
 
+template <class Act>
+void DynamixelFirmware::for_id(std::uint8_t id, Answers& out, Act&& act) {
+  const std::size_t first = out.list.size();
+  for (DynamixelServo& s : servos_) {
+    if (s.id() == id && s.responding()) act(s);
+  }
+  collide(out, first);
+}
+
 void DynamixelFirmware::answer(const DynamixelServo& servo, StatusError error,
                                std::span<const std::uint8_t> data, Answers& out) const {
   const std::size_t offset = out.bytes.size();
@@ -116,8 +126,63 @@ void DynamixelFirmware::answer_fast(std::span<const dxl::BulkReadEntry> entries,
   out.bytes.resize(offset + w.size());
 }
 
-void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& out) {
-  for (DynamixelServo& s : servos_) s.advance(now);
+void DynamixelFirmware::ping(const dxl::Packet& packet, Answers& out) {
+  // Answered whatever the Status Return Level; to a broadcast, every servo
+  // in ID order, those sharing an ID at once.
+  by_id_.clear();
+  for (DynamixelServo& s : servos_) {
+    if (s.responding() && (packet.id == dxl::kBroadcastId || s.id() == packet.id)) {
+      by_id_.push_back(&s);
+    }
+  }
+  std::sort(by_id_.begin(), by_id_.end(),
+            [](const DynamixelServo* a, const DynamixelServo* b) { return a->id() < b->id(); });
+  std::size_t first = out.list.size();
+  for (std::size_t k = 0; k < by_id_.size(); ++k) {
+    const DynamixelServo* s = by_id_[k];
+    if (k > 0 && s->id() != by_id_[k - 1]->id()) {
+      collide(out, first);  // the servos before answered in one slot
+      first = out.list.size();
+    }
+    std::array<std::uint8_t, 3> info{};
+    s->read(dxl::xreg::model_number, 2, info);
+    s->read(dxl::xreg::firmware_version, 1, std::span(info).subspan(2));
+    answer(*s, StatusError::none, info, out);
+  }
+  collide(out, first);
+}
+
+void DynamixelFirmware::factory_reset(const dxl::Packet& packet, Nanos now, Answers& out) {
+  // Option 0xFF resets everything, 0x01 all but the ID, 0x02 all but the ID
+  // and the baud rate. The status packet leaves first, with the old ID at
+  // the old baud. From firmware 42 on a broadcast 0xFF is ignored (every
+  // servo would become ID 1).
+  const std::span<const std::uint8_t> p = packet.params;
+  const bool broadcast = packet.id == dxl::kBroadcastId;
+  const std::uint8_t option = p.size() == 1 ? p[0] : 0;
+  const bool known = option == 0xFF || option == 0x01 || option == 0x02;
+  const StatusError error = p.size() != 1 ? StatusError::data_length
+                            : !known      ? StatusError::data_range
+                                          : StatusError::none;
+  auto act = [&](DynamixelServo& s) {
+    if (broadcast && option == 0xFF && s.firmware_version() >= kBroadcastResetAllIgnored) return;
+    if (!broadcast && s.status_return_level() >= kReplyAll) answer(s, error, {}, out);
+    if (error == StatusError::none) s.factory_reset(option, now);
+  };
+  if (!broadcast) {
+    for_id(packet.id, out, act);
+    return;
+  }
+  for (DynamixelServo& s : servos_) {
+    if (s.responding()) act(s);
+  }
+}
+
+void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& out, int line_baud) {
+  for (DynamixelServo& s : servos_) {
+    s.advance(now);
+    s.set_hearing(line_baud == 0 || s.baud() == line_baud);
+  }
   const std::span<const std::uint8_t> p = packet.params;
   const bool broadcast = packet.id == dxl::kBroadcastId;
 
@@ -128,8 +193,8 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
       for (DynamixelServo& s : servos_) {
         if (s.responding()) act(s);
       }
-    } else if (DynamixelServo* s = target(packet.id)) {
-      act(*s);
+    } else {
+      for_id(packet.id, out, act);
     }
   };
   // `level` is the Status Return Level when the packet arrived: a write that
@@ -139,31 +204,20 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
   };
 
   switch (packet.instruction) {
-    case inst::ping: {
-      // Answered whatever the Status Return Level.
-      by_id_.clear();
-      each_target([&](DynamixelServo& s) { by_id_.push_back(&s); });
-      std::sort(by_id_.begin(), by_id_.end(),
-                [](const DynamixelServo* a, const DynamixelServo* b) { return a->id() < b->id(); });
-      for (const DynamixelServo* s : by_id_) {
-        std::array<std::uint8_t, 3> info{};
-        s->read(dxl::xreg::model_number, 2, info);
-        s->read(dxl::xreg::firmware_version, 1, std::span(info).subspan(2));
-        answer(*s, StatusError::none, info, out);
-      }
+    case inst::ping:
+      ping(packet, out);
       break;
-    }
     case inst::read:
       if (broadcast) break;  // the manual: no status for a broadcast Read
-      if (DynamixelServo* s = target(packet.id)) {
+      for_id(packet.id, out, [&](DynamixelServo& s) {
         if (p.size() != 4) {
-          if (s->status_return_level() >= kReplyPingAndRead) {
-            answer(*s, StatusError::data_length, {}, out);
+          if (s.status_return_level() >= kReplyPingAndRead) {
+            answer(s, StatusError::data_length, {}, out);
           }
         } else {
-          answer_read(*s, u16_at(p, 0), u16_at(p, 2), out);
+          answer_read(s, u16_at(p, 0), u16_at(p, 2), out);
         }
-      }
+      });
       break;
     case inst::write:
     case inst::reg_write:
@@ -193,7 +247,8 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
     case inst::sync_read:
       if (!broadcast || p.size() < 5) break;
       for (std::uint8_t id : p.subspan(4)) {
-        if (DynamixelServo* s = target(id)) answer_read(*s, u16_at(p, 0), u16_at(p, 2), out);
+        for_id(id, out,
+               [&](DynamixelServo& s) { answer_read(s, u16_at(p, 0), u16_at(p, 2), out); });
       }
       break;
     case inst::fast_sync_read: {
@@ -219,17 +274,16 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
       const std::span<const std::uint8_t> blocks = p.subspan(4);
       if (length == 0 || blocks.size() % (length + 1) != 0) break;  // malformed: ignored
       for (std::size_t i = 0; i < blocks.size(); i += length + 1) {
-        if (DynamixelServo* s = target(blocks[i])) {
-          s->write(u16_at(p, 0), blocks.subspan(i + 1, length));
-        }
+        for_id(blocks[i], out,
+               [&](DynamixelServo& s) { s.write(u16_at(p, 0), blocks.subspan(i + 1, length)); });
       }
       break;
     }
     case inst::bulk_read:
       if (!broadcast || p.empty() || p.size() % 5 != 0) break;
       for (std::size_t i = 0; i < p.size(); i += 5) {
-        if (DynamixelServo* s = target(p[i]))
-          answer_read(*s, u16_at(p, i + 1), u16_at(p, i + 3), out);
+        for_id(p[i], out,
+               [&](DynamixelServo& s) { answer_read(s, u16_at(p, i + 1), u16_at(p, i + 3), out); });
       }
       break;
     case inst::bulk_write: {
@@ -239,16 +293,19 @@ void DynamixelFirmware::handle(const dxl::Packet& packet, Nanos now, Answers& ou
       while (i + 5 <= p.size()) i += 5 + u16_at(p, i + 3);
       if (i != p.size() || p.empty()) break;
       for (i = 0; i < p.size(); i += 5 + u16_at(p, i + 3)) {
-        if (DynamixelServo* s = target(p[i])) {
-          s->write(u16_at(p, i + 1), p.subspan(i + 5, u16_at(p, i + 3)));
-        }
+        for_id(p[i], out, [&](DynamixelServo& s) {
+          s.write(u16_at(p, i + 1), p.subspan(i + 5, u16_at(p, i + 3)));
+        });
       }
       break;
     }
+    case inst::factory_reset:
+      factory_reset(packet, now, out);
+      break;
     case inst::status:
       break;  // another device's answer: not for us
     default:
-      // Factory Reset, Clear and anything unknown.
+      // Clear and anything unknown.
       each_target(
           [&](DynamixelServo& s) { reply(s, s.status_return_level(), StatusError::instruction); });
       break;

@@ -33,7 +33,7 @@ constexpr Item kItems[] = {
     {xreg::baud_rate, 1, true, 0, 7},
     {xreg::return_delay_time, 1, true, 0, 254},
     {xreg_sim::drive_mode, 1, true, 0, 5},
-    {xreg::operating_mode, 1, true, 3, 3},  // only position control is modelled
+    {xreg::operating_mode, 1, true, 3, 4},  // position and extended position control
     {xreg_sim::secondary_id, 1, true, 0, 255},
     {xreg_sim::protocol_type, 1, true, 1, 2},
     {xreg_sim::homing_offset, 4, true, -1'044'479, 1'044'479},
@@ -80,6 +80,9 @@ constexpr Item kItems[] = {
     {xreg::present_temperature, 1, false},
     {xreg_sim::backup_ready, 1, false},
 };
+
+constexpr std::uint8_t kExtendedPositionMode = 4;
+constexpr std::int32_t kExtendedPositionRange = 1'048'575;  // Goal Position, either way
 
 // Indirect Address n: 2 bytes, 64..661. Indirect Data n: 1 byte.
 constexpr std::int64_t kIndirectMin = xreg_sim::eeprom_end;
@@ -138,8 +141,6 @@ constexpr std::uint16_t kDefaultMinVoltage = 95;
 constexpr std::uint16_t kDefaultPwmLimit = 885;
 constexpr std::uint16_t kDefaultCurrentLimit = 1193;
 
-constexpr int kBauds[] = {9600,      57600,     115200,    1'000'000,
-                          2'000'000, 3'000'000, 4'000'000, 4'500'000};
 constexpr std::uint8_t kDefaultMovingThreshold = 10;
 constexpr std::uint8_t kDefaultTemperatureLimit = 80;
 constexpr std::uint8_t kDefaultShutdown = 0x34;  // overload, electrical shock, overheating
@@ -150,16 +151,7 @@ double ticks_per_s_to_units(double ticks_per_s) {
 
 }  // namespace
 
-std::uint8_t baud_rate_register(int baud) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
-    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
-        std::abs(static_cast<long>(kBauds[best]) - baud)) {
-      best = i;
-    }
-  }
-  return static_cast<std::uint8_t>(best);
-}
+std::uint8_t baud_rate_register(int baud) { return baud_register(kDynamixelX, baud); }
 
 double initial_offset_rad(int device_id) {
   const double degrees = (device_id % 2 == 1 ? 1.0 : -1.0) * (2 + device_id % 3);
@@ -216,6 +208,7 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
                  reg32(xreg::max_position_limit));
   motor_.position = start;
   if (physics_ != nullptr) motor_ = motor_at(now);  // where the physics put the joint
+  eeprom_.build(table_);
   reset_ram();
   publish(now);
   command_physics();
@@ -223,9 +216,19 @@ DynamixelServo::DynamixelServo(const ActuatorBinding& binding, const SimBusSetti
 
 void DynamixelServo::command_physics() {
   if (physics_ == nullptr) return;
-  const std::int32_t goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
-                                       reg32(xreg::max_position_limit));
-  physics_->command(physics_joint_, binding_.to_rad(goal), torque_on());
+  physics_->command(physics_joint_, binding_.to_rad(motor_goal()), torque_on());
+}
+
+std::int32_t DynamixelServo::motor_goal() const {
+  std::int32_t goal = reg32(xreg::goal_position);
+  if (table_[xreg::operating_mode] != kExtendedPositionMode) {
+    goal = std::clamp(goal, reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
+  }
+  return goal - reg32(xreg_sim::homing_offset);
+}
+
+std::int32_t DynamixelServo::present_of(double motor_ticks) const {
+  return static_cast<std::int32_t>(std::lround(motor_ticks)) + reg32(xreg_sim::homing_offset);
 }
 
 std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
@@ -247,7 +250,7 @@ void DynamixelServo::reset_ram() {
   }
   // Hold still when torque comes on: the goal starts at the present position.
   dxl::put_u32(&table_[xreg::goal_position],
-               static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+               static_cast<std::uint32_t>(present_of(motor_.position)));
   motor_.velocity = 0;
   pending_length_ = 0;
 }
@@ -282,9 +285,7 @@ DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
   }
   if (now <= motor_time_) return m;
   // Limits may have changed while torque was off; the servo never leaves them.
-  const double goal = std::clamp(reg32(xreg::goal_position), reg32(xreg::min_position_limit),
-                                 reg32(xreg::max_position_limit));
-  return m.after(to_seconds(now - motor_time_), goal, vmax_ticks_s_, tau_s_);
+  return m.after(to_seconds(now - motor_time_), motor_goal(), vmax_ticks_s_, tau_s_);
 }
 
 Nanos DynamixelServo::watchdog_fire_time() const {
@@ -307,9 +308,8 @@ void DynamixelServo::advance(Nanos now) {
     // It stops where it is (Profile Velocity/Acceleration taken as 0) and
     // keeps torque on; the goal values are locked until 98 is written 0.
     if (physics_ == nullptr) motor_.position = std::round(motor_.position);
-    dxl::put_u32(
-        &table_[xreg::goal_position],
-        static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position))));
+    dxl::put_u32(&table_[xreg::goal_position],
+                 static_cast<std::uint32_t>(present_of(motor_.position)));
     motor_.velocity = 0;
     table_[xreg_sim::bus_watchdog] = dxl::kBusWatchdogFired;
     publish(fire);
@@ -322,7 +322,7 @@ void DynamixelServo::advance(Nanos now) {
 }
 
 void DynamixelServo::publish(Nanos now) {
-  const auto position = static_cast<std::int32_t>(std::lround(motor_.position));
+  const std::int32_t position = present_of(motor_.position);
   const auto velocity =
       static_cast<std::int32_t>(std::lround(ticks_per_s_to_units(motor_.velocity)));
   dxl::put_u32(&table_[xreg::present_position], static_cast<std::uint32_t>(position));
@@ -398,7 +398,9 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     if (item.address != a || a + item.size > end) return StatusError::data_length;
     a += item.size;
   }
-  if (address < xreg_sim::eeprom_end && torque_on()) return StatusError::access;  // ROM lock
+  if (eeprom_write(kDynamixelX, table_, address, data.size()) == EepromWrite::refused) {
+    return StatusError::access;  // EEPROM is locked while torque is on
+  }
   if (table_[xreg_sim::bus_watchdog] == dxl::kBusWatchdogFired) {
     // A fired Bus Watchdog locks the goal values; only 0 at 98 clears it.
     for (std::size_t a = address; a < end;) {
@@ -421,8 +423,12 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     const std::uint32_t raw = get_le(&after[a], item.size);
     if (item.address == xreg::goal_position) {
       const auto goal = static_cast<std::int32_t>(raw);
-      if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
-          goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
+      if (after[xreg::operating_mode] == kExtendedPositionMode) {
+        if (goal < -kExtendedPositionRange || goal > kExtendedPositionRange) {
+          return StatusError::data_limit;
+        }
+      } else if (goal < static_cast<std::int32_t>(dxl::get_u32(&after[xreg::min_position_limit])) ||
+                 goal > static_cast<std::int32_t>(dxl::get_u32(&after[xreg::max_position_limit]))) {
         return StatusError::data_limit;
       }
     } else if (const std::int64_t v = item_value(item, raw); v < item.min || v > item.max) {
@@ -449,7 +455,9 @@ StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::ui
   // and an Indirect Data at once; the data goes where the old address said.
   std::array<std::uint16_t, xreg::table_size> targets;
   for (std::size_t i = 0; i < data.size(); ++i) targets[i] = resolve(address + i);
+  const bool eeprom = eeprom_write(kDynamixelX, table_, address, data.size()) == EepromWrite::kept;
   for (std::size_t i = 0; i < data.size(); ++i) table_[targets[i]] = data[i];
+  if (eeprom) eeprom_.keep(table_);
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
   command_physics();
@@ -484,27 +492,40 @@ void DynamixelServo::reboot(Nanos now) {
 }
 
 void DynamixelServo::set_plugged(bool plugged, Nanos now) {
-  if (plugged && !plugged_) reboot(now);  // power-on: RAM at its defaults
+  if (plugged && !plugged_) {
+    eeprom_.load(table_);  // power-on: EEPROM as kept, RAM at its defaults
+    reboot(now);
+  }
   plugged_ = plugged;
+}
+
+void DynamixelServo::factory_reset(std::uint8_t option, Nanos now) {
+  eeprom_.factory_reset(table_, option == 0x01 || option == 0x02, option == 0x02);
+  table_[xreg::torque_enable] = 0;
+  reboot(now);
+}
+
+bool DynamixelServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos now) {
+  if (!eeprom_.restore(kept, table_)) return false;
+  table_[xreg::torque_enable] = 0;
+  reboot(now);
+  return true;
 }
 
 bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
   advance(now);
   if (torque_on() || physics_ != nullptr) return false;
-  motor_.position = ticks;
+  motor_.position = ticks - reg32(xreg_sim::homing_offset);
   motor_.velocity = 0;
   publish(motor_time_);
   return true;
 }
 
 std::int32_t DynamixelServo::present_ticks(Nanos now) const {
-  return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
+  return present_of(motor_at(std::max(now, motor_time_)).position);
 }
 
-int DynamixelServo::baud() const {
-  const std::uint8_t r = table_[xreg::baud_rate];
-  return r < std::size(kBauds) ? kBauds[r] : 0;
-}
+int DynamixelServo::baud() const { return baud_of(kDynamixelX, table_[xreg::baud_rate]); }
 
 std::uint8_t DynamixelServo::status_error(StatusError error) const {
   const auto number = static_cast<std::uint8_t>(error);
@@ -558,7 +579,8 @@ Nanos DynamixelServo::take_answer_delay() const {
 
 double DynamixelServo::position_rad(Nanos now) const {
   const Motor m = motor_at(std::max(now, motor_time_));
-  return binding_.direction * (m.position - binding_.zero_ticks) / binding_.ticks_per_rad;
+  const double present = m.position + reg32(xreg_sim::homing_offset);
+  return binding_.direction * (present - binding_.zero_ticks) / binding_.ticks_per_rad;
 }
 
 }  // namespace animrt::sim

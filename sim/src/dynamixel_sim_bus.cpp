@@ -53,11 +53,14 @@ auto& servo_or_throw(Firmware& firmware, const BusConfig& config, int device_id)
 
 }  // namespace
 
-DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics)
+DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics,
+                                 const ServoStartup& startup)
     : config_(config),
       clock_(clock),
       firmware_(config, clock.now(), physics),
+      keeper_(startup, config.name),
       physics_(physics),
+      any_baud_(startup.any_baud),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
   try {
@@ -79,12 +82,16 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
     ::cfmakeraw(&tio);
     tio.c_cflag |= CLOCAL | CREAD;
     if (::tcsetattr(slave_, TCSANOW, &tio) != 0) fail(config_, "tcsetattr", errno);
+    // At the bus's baud until a host sets its own.
+    line::set_line_baud(slave_, config_.baud);
     if (::fcntl(master_, F_SETFL, O_NONBLOCK) != 0) fail(config_, "fcntl", errno);
     if (::pipe2(wake_.data(), O_CLOEXEC | O_NONBLOCK) != 0) fail(config_, "pipe", errno);
   } catch (...) {
     close_fds();
     throw;
   }
+  keeper_.start(firmware_, clock.now(),
+                [&](DynamixelServo& s) { s.factory_reset(0xFF, clock.now()); });
   const std::size_t most = (firmware_.size() + 1) * dxl::kMaxPacket;
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
@@ -96,6 +103,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
 DynamixelSimBus::~DynamixelSimBus() {
   stop();
   close_fds();
+  keeper_.save(firmware_, true);
 }
 
 void DynamixelSimBus::close_fds() {
@@ -154,7 +162,8 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
   answers_.clear();
   {
     std::lock_guard lock(mutex_);
-    firmware_.handle(packet, now, answers_);
+    firmware_.handle(packet, now, answers_, any_baud_ ? 0 : line::line_baud(master_));
+    keeper_.save(firmware_);
   }
   if (packet.instruction != dxl::inst::status) ++packets_;
 

@@ -1,6 +1,7 @@
 #include "animrt/sim/serial_line.hpp"
 
 #include <poll.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -15,6 +16,45 @@ void sleep_until_monotonic(Nanos t) {
   ts.tv_nsec = static_cast<long>(t % 1'000'000'000);
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
+}
+
+namespace {
+
+struct Rate {
+  int baud;
+  speed_t code;
+};
+constexpr Rate kRates[] = {
+    {9600, B9600},       {19200, B19200},     {38400, B38400},     {57600, B57600},
+    {115200, B115200},   {230400, B230400},   {460800, B460800},   {500000, B500000},
+    {576000, B576000},   {921600, B921600},   {1000000, B1000000}, {1152000, B1152000},
+    {1500000, B1500000}, {2000000, B2000000}, {2500000, B2500000}, {3000000, B3000000},
+    {3500000, B3500000}, {4000000, B4000000},
+};
+
+}  // namespace
+
+int line_baud(int fd) {
+  termios tio{};
+  if (::tcgetattr(fd, &tio) != 0) return 0;
+  const speed_t code = ::cfgetospeed(&tio);
+  for (const Rate& r : kRates) {
+    if (r.code == code) return r.baud;
+  }
+  return 0;
+}
+
+bool set_line_baud(int fd, int baud) {
+  termios tio{};
+  if (::tcgetattr(fd, &tio) != 0) return false;
+  for (const Rate& r : kRates) {
+    if (r.baud == baud) {
+      ::cfsetispeed(&tio, r.code);
+      ::cfsetospeed(&tio, r.code);
+      return ::tcsetattr(fd, TCSANOW, &tio) == 0;
+    }
+  }
+  return false;
 }
 
 Nanos wire_ns(std::size_t bytes, int baud) {

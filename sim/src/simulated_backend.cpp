@@ -9,10 +9,11 @@ namespace animrt {
 
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<BusConfig>& buses,
                                                                    const Clock& clock,
-                                                                   sim::JointPhysics* physics) {
+                                                                   sim::JointPhysics* physics,
+                                                                   const ServoStartup& startup) {
   std::vector<std::unique_ptr<SimulatedBus>> simulated;
   for (auto& bus : buses) {
-    auto sim = make_simulated_bus(bus, clock, physics);
+    auto sim = make_simulated_bus(bus, clock, physics, startup);
     sim->start();
     bus.port = sim->endpoint();
     simulated.push_back(std::move(sim));

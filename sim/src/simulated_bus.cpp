@@ -15,9 +15,10 @@
 namespace animrt {
 
 std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock,
-                                                 sim::JointPhysics* physics) {
+                                                 sim::JointPhysics* physics,
+                                                 const ServoStartup& startup) {
   if (config.protocol == "dynamixel2") {
-    return std::make_unique<sim::DynamixelSimBus>(config, clock, physics);
+    return std::make_unique<sim::DynamixelSimBus>(config, clock, physics, startup);
   }
   if (physics != nullptr) {
     throw InputError(config.where, "protocol",
@@ -25,7 +26,7 @@ std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const 
                          config.protocol);
   }
   if (ft::Series series; feetech_series(config.protocol, series)) {
-    return std::make_unique<sim::FeetechSimBus>(config, series, clock);
+    return std::make_unique<sim::FeetechSimBus>(config, series, clock, startup);
   }
   if (config.protocol == "mit" || config.protocol == "cia402")
     return sim::make_can_sim_bus(config, clock);

@@ -29,7 +29,8 @@ struct Status {
 
 class PtyClient {
  public:
-  explicit PtyClient(const std::string& path) {
+  // `baud` (0: leave it) is set on the line, as a host sets its adapter's.
+  explicit PtyClient(const std::string& path, int baud = 0) {
     fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (fd_ < 0) throw std::runtime_error("cannot open " + path);
     termios tio{};
@@ -38,12 +39,21 @@ class PtyClient {
     tio.c_cflag |= CLOCAL | CREAD;
     tio.c_cc[VMIN] = 0;
     tio.c_cc[VTIME] = 0;
+    if (baud != 0) set_speed(tio, baud);
     ::tcsetattr(fd_, TCSANOW, &tio);
     ::tcflush(fd_, TCIOFLUSH);
   }
   ~PtyClient() { ::close(fd_); }
   PtyClient(const PtyClient&) = delete;
   PtyClient& operator=(const PtyClient&) = delete;
+
+  // Changes the line's baud, as a host does between scans.
+  void set_baud(int baud) {
+    termios tio{};
+    ::tcgetattr(fd_, &tio);
+    set_speed(tio, baud);
+    ::tcsetattr(fd_, TCSANOW, &tio);
+  }
 
   void send(const Bytes& bytes) {
     std::size_t done = 0;
@@ -111,6 +121,22 @@ class PtyClient {
   static constexpr std::chrono::milliseconds kTimeout{2000};
 
  private:
+  static void set_speed(termios& tio, int baud) {
+    const speed_t speed = baud == 9600        ? B9600
+                          : baud == 38400     ? B38400
+                          : baud == 57600     ? B57600
+                          : baud == 115200    ? B115200
+                          : baud == 500000    ? B500000
+                          : baud == 1'000'000 ? B1000000
+                          : baud == 2'000'000 ? B2000000
+                          : baud == 3'000'000 ? B3000000
+                          : baud == 4'000'000 ? B4000000
+                                              : B0;
+    if (speed == B0) throw std::invalid_argument("no termios speed for " + std::to_string(baud));
+    ::cfsetispeed(&tio, speed);
+    ::cfsetospeed(&tio, speed);
+  }
+
   int fd_ = -1;
   dxl::Decoder decoder_;
 };

@@ -14,7 +14,6 @@ namespace {
 
 namespace reg = ft::reg;
 
-constexpr int kBauds[] = {1'000'000, 500'000, 250'000, 128'000, 115'200, 76'800, 57'600, 38'400};
 // STS3215 identity (memory table v3.6): firmware 3.6, servo version 9.3.
 constexpr std::uint8_t kStsModel[2] = {9, 3};
 constexpr std::uint8_t kScsModel[2] = {5, 4};
@@ -57,17 +56,6 @@ bool writable(std::size_t address) {
   }
 }
 
-std::uint8_t baud_register(int baud) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < std::size(kBauds); ++i) {
-    if (std::abs(static_cast<long>(kBauds[i]) - baud) <
-        std::abs(static_cast<long>(kBauds[best]) - baud)) {
-      best = i;
-    }
-  }
-  return static_cast<std::uint8_t>(best);
-}
-
 }  // namespace
 
 bool feetech_may_answer(const ft::Packet& packet) {
@@ -83,12 +71,13 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
       series_(series),
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_steps_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
+      eeprom_(series == ft::Series::sts ? kFeetechSts : kFeetechScs),
       motor_time_(now) {
   const bool sts = series_ == ft::Series::sts;
   table_[reg::firmware_major] = 3;
   std::memcpy(&table_[reg::model], sts ? kStsModel : kScsModel, 2);
   table_[reg::id] = static_cast<std::uint8_t>(binding.device_id);
-  table_[reg::baud_rate] = baud_register(baud);
+  table_[reg::baud_rate] = baud_register(eeprom_.family(), baud);
   table_[reg::return_delay] =
       static_cast<std::uint8_t>(std::clamp(settings.return_delay_us / 2, 0, 254));
   table_[reg::status_return_level] = 1;
@@ -105,6 +94,7 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
   // Hold still when torque comes on: the goal starts at the present position.
   store_position(reg::goal_position, motor_.position);
   publish();
+  eeprom_.build(table_);
 }
 
 std::uint16_t FeetechServo::u16(std::uint8_t address) const {
@@ -169,6 +159,8 @@ bool FeetechServo::read(std::uint8_t address, std::uint8_t length,
 
 void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> data) {
   const bool torque_was_on = torque_on();
+  const bool keep =
+      eeprom_write(eeprom_.family(), table_, address, data.size()) == EepromWrite::kept;
   bool goal_written = false;
   for (std::size_t i = 0; i < data.size(); ++i) {
     const std::size_t a = address + i;
@@ -182,6 +174,7 @@ void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> dat
     table_[a] = data[i];
     if (a == reg::goal_position + 1u) goal_written = true;
   }
+  if (keep) eeprom_.keep(table_);
   if (goal_written) {
     ++goals_received_;
     last_goal_ = position_value(reg::goal_position);
@@ -216,17 +209,33 @@ void FeetechServo::set_fault(std::uint8_t bits, Nanos now) {
   }
 }
 
+void FeetechServo::power_up(Nanos now) {
+  // EEPROM as kept; torque off, nothing registered, the lock open, the goal
+  // where the shaft is.
+  advance(now);
+  eeprom_.load(table_);
+  table_[reg::torque_enable] = 0;
+  table_[reg::registered] = 0;
+  table_[static_cast<std::size_t>(eeprom_.family().lock_address)] = 0;
+  motor_.velocity = 0;
+  store_position(reg::goal_position, motor_.position);
+  publish();
+}
+
 void FeetechServo::set_plugged(bool plugged, Nanos now) {
-  if (plugged && !plugged_) {
-    // Power-on: torque off, nothing registered, the goal where the shaft is.
-    advance(now);
-    table_[reg::torque_enable] = 0;
-    table_[reg::registered] = 0;
-    motor_.velocity = 0;
-    store_position(reg::goal_position, motor_.position);
-    publish();
-  }
+  if (plugged && !plugged_) power_up(now);
   plugged_ = plugged;
+}
+
+bool FeetechServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos now) {
+  if (!eeprom_.restore(kept, table_)) return false;
+  power_up(now);
+  return true;
+}
+
+void FeetechServo::factory_reset(Nanos now) {
+  eeprom_.factory_reset(table_, false, false);
+  power_up(now);
 }
 
 bool FeetechServo::hand_move(std::int32_t steps, Nanos now) {
@@ -238,10 +247,7 @@ bool FeetechServo::hand_move(std::int32_t steps, Nanos now) {
   return true;
 }
 
-int FeetechServo::baud() const {
-  const std::uint8_t r = table_[reg::baud_rate];
-  return r < std::size(kBauds) ? kBauds[r] : 0;
-}
+int FeetechServo::baud() const { return baud_of(eeprom_.family(), table_[reg::baud_rate]); }
 
 std::int32_t FeetechServo::present_steps(Nanos now) const {
   return static_cast<std::int32_t>(std::lround(motor_at(std::max(now, motor_time_)).position));
@@ -286,11 +292,13 @@ const FeetechServo* FeetechBoard::find_configured(int device_id) const {
   return nullptr;
 }
 
-FeetechServo* FeetechBoard::target(std::uint8_t id) {
+template <class Act>
+void FeetechBoard::for_id(std::uint8_t id, FeetechAnswers& out, Act&& act) {
+  const std::size_t first = out.list.size();
   for (FeetechServo& s : servos_) {
-    if (s.id() == id && s.responding()) return &s;
+    if (s.id() == id && s.responding()) act(s);
   }
-  return nullptr;
+  collide(out, first);
 }
 
 void FeetechBoard::answer(const FeetechServo& servo, std::span<const std::uint8_t> data,
@@ -303,8 +311,11 @@ void FeetechBoard::answer(const FeetechServo& servo, std::span<const std::uint8_
   if (n > 0) out.list.push_back({offset, n, servo.return_delay_us()});
 }
 
-void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out) {
-  for (FeetechServo& s : servos_) s.advance(now);
+void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out, int line_baud) {
+  for (FeetechServo& s : servos_) {
+    s.advance(now);
+    s.set_hearing(line_baud == 0 || s.baud() == line_baud);
+  }
   const std::span<const std::uint8_t> p = packet.params;
   const bool broadcast = packet.id == ft::kBroadcastId;
   auto each_target = [&](auto&& act) {
@@ -312,8 +323,8 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       for (FeetechServo& s : servos_) {
         if (s.responding()) act(s);
       }
-    } else if (FeetechServo* s = target(packet.id)) {
-      act(*s);
+    } else {
+      for_id(packet.id, out, act);
     }
   };
   // Write, Reg Write and Action answer per Status Return Level (the level the
@@ -324,13 +335,23 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
   std::array<std::uint8_t, 256> data{};
   switch (packet.code) {
     case ft::inst::ping:
-      each_target([&](FeetechServo& s) { answer(s, {}, out); });
+      if (broadcast) {
+        // Every servo answers; those sharing an ID at once.
+        std::array<bool, 256> done{};
+        for (const FeetechServo& s : servos_) {
+          if (!s.responding() || done[s.id()]) continue;
+          done[s.id()] = true;
+          for_id(s.id(), out, [&](FeetechServo& t) { answer(t, {}, out); });
+        }
+      } else {
+        each_target([&](FeetechServo& s) { answer(s, {}, out); });
+      }
       break;
     case ft::inst::read:
       if (broadcast || p.size() != 2) break;
-      if (FeetechServo* s = target(packet.id)) {
-        if (s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
-      }
+      for_id(packet.id, out, [&](FeetechServo& s) {
+        if (s.read(p[0], p[1], data)) answer(s, {data.data(), p[1]}, out);
+      });
       break;
     case ft::inst::write:
     case ft::inst::reg_write:
@@ -356,8 +377,9 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       // Only STS servos know Sync Read; each listed servo answers in turn.
       if (series_ != ft::Series::sts || !broadcast || p.size() < 3) break;
       for (std::uint8_t id : p.subspan(2)) {
-        FeetechServo* s = target(id);
-        if (s != nullptr && s->read(p[0], p[1], data)) answer(*s, {data.data(), p[1]}, out);
+        for_id(id, out, [&](FeetechServo& s) {
+          if (s.read(p[0], p[1], data)) answer(s, {data.data(), p[1]}, out);
+        });
       }
       break;
     case ft::inst::sync_write: {
@@ -366,7 +388,8 @@ void FeetechBoard::handle(const ft::Packet& packet, Nanos now, FeetechAnswers& o
       const std::span<const std::uint8_t> blocks = p.subspan(2);
       if (length == 0 || blocks.size() % (length + 1) != 0) break;  // malformed: ignored
       for (std::size_t i = 0; i < blocks.size(); i += length + 1) {
-        if (FeetechServo* s = target(blocks[i])) s->write(p[0], blocks.subspan(i + 1, length));
+        for_id(blocks[i], out,
+               [&](FeetechServo& s) { s.write(p[0], blocks.subspan(i + 1, length)); });
       }
       break;
     }

@@ -10,18 +10,26 @@
 
 namespace animrt::sim {
 
-FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock)
+FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock,
+                             const ServoStartup& startup)
     : config_(config),
       clock_(clock),
       pty_("simulated bus '" + elide(config.name) + "'"),
       board_(config, series, clock.now()),
+      keeper_(startup, config.name),
+      any_baud_(startup.any_baud),
       lockstep_(dynamic_cast<const ManualClock*>(&clock) != nullptr),
       last_time_(clock.now()) {
+  keeper_.start(board_, clock.now(), [&](FeetechServo& s) { s.factory_reset(clock.now()); });
+  line::set_line_baud(pty_.master(), config_.baud);  // until a host sets its own
   answers_.bytes.reserve((board_.size() + 1) * ft::kMaxPacket);
   answers_.list.reserve(board_.size() + 1);
 }
 
-FeetechSimBus::~FeetechSimBus() { stop(); }
+FeetechSimBus::~FeetechSimBus() {
+  stop();
+  keeper_.save(board_, true);
+}
 
 std::string FeetechSimBus::describe() const { return "serial " + config_.name + " " + endpoint(); }
 
@@ -60,7 +68,8 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
   answers_.clear();
   {
     std::lock_guard lock(mutex_);
-    board_.handle(packet, now, answers_);
+    board_.handle(packet, now, answers_, any_baud_ ? 0 : line::line_baud(pty_.master()));
+    keeper_.save(board_);
   }
   ++packets_;
   if (!config_.sim.wire_time) {

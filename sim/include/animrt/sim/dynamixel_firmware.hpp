@@ -4,13 +4,15 @@
 // status packets go to an Answers list in the order they appear on the wire.
 //
 // Instructions: Ping (broadcast: every servo answers, in id order), Read,
-// Write, Reg Write, Action, Reboot, Sync Read, Sync Write, Bulk Read, Bulk
-// Write, Fast Sync Read, Fast Bulk Read. Factory Reset, Clear and unknown instructions answer
-// Instruction Error. A broadcast Read is ignored; broadcast Write/Reg Write/Action/Reboot act
-// without answering. Status Return Level is respected (Ping always answers; a write that changes
-// the level is answered per the level it arrived under). Sync and Bulk instructions are obeyed only
-// with the broadcast id. A servo that is not responding ignores every packet. A write to ID takes
-// effect at once (its status packet already carries the new ID).
+// Write, Reg Write, Action, Reboot, Factory Reset, Sync Read, Sync Write, Bulk Read, Bulk
+// Write, Fast Sync Read, Fast Bulk Read. Clear and unknown instructions answer
+// Instruction Error. Reboot keeps EEPROM and clears RAM; Factory Reset
+// (option 0xFF, 0x01 or 0x02) restores the EEPROM's factory settings first. A broadcast Read is
+// ignored; broadcast Write/Reg Write/Action/Reboot act without answering. Status Return Level is
+// respected (Ping always answers; a write that changes the level is answered per the level it
+// arrived under). Sync and Bulk instructions are obeyed only with the broadcast id. A servo that is
+// not responding ignores every packet. A write to ID takes effect at once (its status packet
+// already carries the new ID).
 //
 // Fast Sync Read and Fast Bulk Read (servos whose model and firmware support
 // them; see dxl::supports_fast_read) answer with one combined status packet:
@@ -35,28 +37,9 @@
 #include "animrt/bridge/dynamixel/protocol2.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"
+#include "animrt/sim/servo_answers.hpp"
 
 namespace animrt::sim {
-
-// Status packets for one instruction packet, back to back in `bytes`.
-struct Answers {
-  struct Answer {
-    std::size_t offset = 0;
-    std::size_t size = 0;
-    int return_delay_us = 0;  // the answering servo's Return Delay Time
-    Nanos late_ns = 0;        // injected lateness (DynamixelServo::set_answer_delay)
-  };
-  std::vector<std::uint8_t> bytes;
-  std::vector<Answer> list;
-
-  void clear() {
-    bytes.clear();
-    list.clear();
-  }
-  std::span<const std::uint8_t> packet(const Answer& a) const {
-    return {bytes.data() + a.offset, a.size};
-  }
-};
 
 // Whether the protocol lets any servo answer this packet: broadcast packets
 // other than Ping, Sync Read and Bulk Read never get an answer.
@@ -70,7 +53,11 @@ class DynamixelFirmware {
   DynamixelFirmware(const BusConfig& config, Nanos now, JointPhysics* physics = nullptr);
 
   // Handles one instruction packet at time `now` and appends the answers.
-  void handle(const dxl::Packet& packet, Nanos now, Answers& out);
+  // Only servos whose baud rate is `line_baud` (the host's; 0: every servo)
+  // hear it: to the others it is noise. Servos sharing an ID all act, and
+  // their answers collide (collide()); a Fast Sync/Bulk Read takes the
+  // first of them only.
+  void handle(const dxl::Packet& packet, Nanos now, Answers& out, int line_baud = 0);
 
   // By the id configured in the BusConfig (not the ID register, which a
   // client may change); nullptr if there is none.
@@ -82,12 +69,18 @@ class DynamixelFirmware {
   DynamixelServo& at(std::size_t index) { return servos_.at(index); }
 
  private:
-  DynamixelServo* target(std::uint8_t id);  // responding servo with this ID register
+  DynamixelServo* target(std::uint8_t id);  // first responding servo with this ID register
+  // Each responding servo with this ID acts (and may answer); their answers
+  // collide.
+  template <class Act>
+  void for_id(std::uint8_t id, Answers& out, Act&& act);
   void answer(const DynamixelServo& servo, dxl::StatusError error,
               std::span<const std::uint8_t> data, Answers& out) const;
   void answer_read(const DynamixelServo& servo, std::uint16_t address, std::uint16_t length,
                    Answers& out) const;
   void answer_fast(std::span<const dxl::BulkReadEntry> entries, Answers& out);
+  void ping(const dxl::Packet& packet, Answers& out);
+  void factory_reset(const dxl::Packet& packet, Nanos now, Answers& out);
 
   std::vector<DynamixelServo> servos_;
   std::vector<DynamixelServo*> by_id_;  // scratch for broadcast ping

@@ -8,15 +8,19 @@
 // Control table: the X430 table (addresses 0..661, kItems in
 // dynamixel_servo.cpp); addresses without an item read as 0 and cannot be
 // written (Access Error); reads and writes past 661 are Access Errors.
-// EEPROM items (below 64) refuse writes while torque is on (Access Error),
+// EEPROM items (below 64; servo_eeprom.hpp keeps them across Reboot, power
+// cycles and state files) refuse writes while torque is on (Access Error),
 // read-only items refuse every write (Access Error), a write of part of an
 // item is a Data Length Error, a value outside the item's range a Data Range
 // Error. Indirect Data n reads and writes the register Indirect Address n
 // names (64..661), under that register's rules; a write that covers several
 // Indirect Data maps to one write per run of consecutive target addresses,
 // all checked before any is applied.
-// Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (only 3,
-// position control; other modes answer Data Range Error), Moving Threshold,
+// Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (3,
+// position control, and 4, extended position control: Goal Position
+// +-1,048,575 and no position limits; other modes answer Data Range Error),
+// Homing Offset (Present and Goal Position are the motor's position plus
+// it), Moving Threshold,
 // Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
 // Return Level, Registered Instruction, Hardware Error Status, Goal Position,
 // Realtime Tick, Moving, Present Velocity/Position/Input Voltage/Temperature.
@@ -53,6 +57,7 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
+#include "animrt/sim/servo_eeprom.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -167,6 +172,14 @@ class DynamixelServo {
   dxl::StatusError reg_write(std::uint16_t address, std::span<const std::uint8_t> data);
   dxl::StatusError action();
   void reboot(Nanos now);
+  // Factory Reset: EEPROM to factory settings (option 0xFF: everything,
+  // 0x01: all but the ID, 0x02: all but the ID and the baud rate), then a
+  // restart as after Reboot.
+  void factory_reset(std::uint8_t option, Nanos now);
+  // The EEPROM that survives reboots and power cycles (servo_eeprom.hpp);
+  // restore_eeprom puts one kept by a state file back (false: wrong size).
+  const ServoEeprom& eeprom() const { return eeprom_; }
+  bool restore_eeprom(std::span<const std::uint8_t> kept, Nanos now);
 
   // Error byte of a status packet: the number plus the alert bit while the
   // hardware error status is non-zero.
@@ -176,7 +189,10 @@ class DynamixelServo {
   // electrical shock, overload) switches torque off; as on the real servo,
   // only a Reboot allows torque on again, and it shuts down again if the
   // fault is still there.
-  bool responding() const { return responding_ && plugged_; }
+  // Takes in packets: responding (fault injection), plugged in, and at the
+  // baud rate of the packet in hand (set_hearing).
+  bool responding() const { return responding_ && plugged_ && hearing_; }
+  void set_hearing(bool hearing) { hearing_ = hearing; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_hardware_error(std::uint8_t bits, Nanos now);
 
@@ -220,11 +236,16 @@ class DynamixelServo {
   void publish(Nanos now);  // motor state -> present-value registers
   void command_physics();   // goal and torque -> physics
   std::int32_t reg32(std::uint16_t address) const;
+  // The motor turns in its own ticks; Present and Goal Position are those
+  // plus the Homing Offset.
+  std::int32_t motor_goal() const;  // Goal Position (within the limits in mode 3), motor ticks
+  std::int32_t present_of(double motor_ticks) const;
 
   ActuatorBinding binding_;
   double tau_s_;
   double vmax_ticks_s_;
   std::array<std::uint8_t, dxl::xreg::table_size> table_{};
+  ServoEeprom eeprom_{kDynamixelX};
   Motor motor_;
   Nanos motor_time_;
   JointPhysics* physics_ = nullptr;
@@ -232,6 +253,7 @@ class DynamixelServo {
   Nanos watchdog_fed_ = 0;  // the latest instruction packet for this servo
   bool responding_ = true;
   bool plugged_ = true;
+  bool hearing_ = true;
   bool shut_down_ = false;
   std::uint8_t injected_error_ = 0;
   // Reg Write waiting for Action.

@@ -17,6 +17,10 @@
 // A packet cut off by 5 ms of silence is dropped (as a servo's receive
 // timeout does), so a truncated packet never swallows the next one.
 //
+// Baud rate: the pty starts at BusConfig::baud; each packet is heard only
+// by the servos whose Baud Rate matches the rate the host has set on the
+// pty when it arrives (ServoStartup::any_baud: by all).
+//
 // Wire time (SimBusSettings::wire_time): each answer is held back (real time)
 // until the instruction's bytes, the servo's Return Delay Time and the
 // answer's bytes would have passed at 10 bits per byte at BusConfig::baud.
@@ -43,6 +47,7 @@
 #include "animrt/core/thread_priority.hpp"
 #include "animrt/sim/dynamixel_firmware.hpp"
 #include "animrt/sim/serial_line.hpp"
+#include "animrt/sim/servo_state_file.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -62,7 +67,9 @@ class DynamixelSimBus final : public SimulatedBus {
   // Opens the pty and builds the servos; throws DeviceError if no pty can be
   // opened and InputError for bad device ids. `physics` (optional, outlives
   // the bus) replaces the servos' motor model.
-  DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics = nullptr);
+  // `startup`: factory settings and a state file (simulated_bus.hpp).
+  DynamixelSimBus(const BusConfig& config, const Clock& clock, JointPhysics* physics = nullptr,
+                  const ServoStartup& startup = {});
   ~DynamixelSimBus() override;
   DynamixelSimBus(const DynamixelSimBus&) = delete;
   DynamixelSimBus& operator=(const DynamixelSimBus&) = delete;
@@ -104,11 +111,13 @@ class DynamixelSimBus final : public SimulatedBus {
 
   mutable std::mutex mutex_;  // guards firmware_
   DynamixelFirmware firmware_;
+  ServoStartupKeeper keeper_;  // under mutex_
 
   JointPhysics* physics_ = nullptr;
   int party_ = -1;  // lockstep with physics: this bus's party (JointPhysics::reach)
 
   // Serving thread only.
+  bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
   Nanos last_time_ = 0;  // when the previous packet took effect
   dxl::Decoder decoder_;

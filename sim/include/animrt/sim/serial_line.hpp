@@ -23,6 +23,13 @@ inline constexpr int kWriteStallMs = 200;   // a host that stops reading loses a
 inline constexpr int kPacketSilenceMs = 5;  // a servo's receive timeout
 
 void sleep_until_monotonic(Nanos t);
+// A pseudo-terminal has no wire: the baud rate the host chose is the one it
+// set on the line (termios), read here from either side. 0 when it is not a
+// standard rate or cannot be read.
+int line_baud(int fd);
+// Sets the line's baud rate (a host that never sets one talks at it);
+// false for a rate termios has no code for.
+bool set_line_baud(int fd, int baud);
 // Time `bytes` take on a line at `baud`.
 Nanos wire_ns(std::size_t bytes, int baud);
 // Writes `bytes` to the non-blocking `fd`, waiting at most kWriteStallMs at

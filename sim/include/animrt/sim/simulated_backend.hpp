@@ -16,8 +16,10 @@ namespace animrt {
 
 // With `physics` (optional, outlives the devices) the simulated servos take
 // their motor state from it (see make_simulated_bus).
+// `startup`: factory settings and a state file for the serial servos.
 std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(
-    std::vector<BusConfig>& buses, const Clock& clock, sim::JointPhysics* physics = nullptr);
+    std::vector<BusConfig>& buses, const Clock& clock, sim::JointPhysics* physics = nullptr,
+    const ServoStartup& startup = {});
 
 // Puts every simulated bus's thread at SCHED_FIFO `priority` (a real-time
 // run gives them the one just below its bus I/O threads: a busy host must

@@ -57,7 +57,8 @@ class SimulatedBus {
     int id = 0;    // the ID register
     int baud = 0;  // the Baud Rate register, in bits per second
   };
-  // Turns the shaft to raw position `ticks`, as a hand turns a limp servo;
+  // Turns the shaft to raw position `ticks` (as Present Position reads it),
+  // as a hand turns a limp servo;
   // throws std::logic_error("torque is on") when its torque is on.
   virtual void hand_move(int device_id, std::int32_t ticks) {
     (void)device_id;
@@ -80,13 +81,32 @@ class SimulatedBus {
 
 namespace sim {
 class JointPhysics;
-}
+class ServoStateFile;
+}  // namespace sim
+
+// How simulated serial servos (Dynamixel, Feetech) start: as the robot file
+// configures them (ids and baud from it), or as from the factory.
+struct ServoStartup {
+  // EEPROM at factory settings (ID 1; Dynamixel 57600 baud, Feetech 1 Mbaud)
+  // and only the first device of each bus plugged in: a user plugs in one
+  // new servo at a time and gives it its id.
+  bool factory = false;
+  // Restores each servo's EEPROM from it (over the above) and saves it there
+  // whenever it changes (outlives the buses).
+  sim::ServoStateFile* state = nullptr;
+  // A servo answers only packets sent at its own baud rate: the one the host
+  // set on the pseudo-terminal. `any_baud` lets every servo hear every
+  // packet, for a line whose baud setting never reaches the simulator (a
+  // QEMU-emulated UART caps it at 115200 whatever the guest uses).
+  bool any_baud = false;
+};
 
 // Builds the simulated devices for config.protocol ("dynamixel2": N X-series
 // servos behind one pty). Motor models read time from `clock`, so a lockstep
 // run with a ManualClock is deterministic. With `physics` (dynamixel2 only;
 // InputError for other protocols) the servos take their motor state from it.
 std::unique_ptr<SimulatedBus> make_simulated_bus(const BusConfig& config, const Clock& clock,
-                                                 sim::JointPhysics* physics = nullptr);
+                                                 sim::JointPhysics* physics = nullptr,
+                                                 const ServoStartup& startup = {});
 
 }  // namespace animrt

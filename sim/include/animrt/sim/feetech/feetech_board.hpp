@@ -9,7 +9,8 @@
 // Goal Position/Time/Speed, the EEPROM lock, Present Position/Speed/Load/
 // Voltage/Temperature, Registered, Servo Status, Moving. Writes to read-only
 // addresses change nothing (the servo has no error code for that; its error
-// byte only carries fault bits).
+// byte only carries fault bits). EEPROM (below 40) is kept across power
+// cycles only when written while the lock reads 0 (servo_eeprom.hpp).
 //
 // Instructions: Ping, Read, Write, Reg Write, Action, Sync Write, and Sync
 // Read on the STS series only (an SCS servo ignores it). Ping and Read are
@@ -31,26 +32,14 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/servo_answers.hpp"
+#include "animrt/sim/servo_eeprom.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
 
-struct FeetechAnswers {
-  struct Answer {
-    std::size_t offset = 0;
-    std::size_t size = 0;
-    int return_delay_us = 0;
-  };
-  std::vector<std::uint8_t> bytes;
-  std::vector<Answer> list;
-  void clear() {
-    bytes.clear();
-    list.clear();
-  }
-  std::span<const std::uint8_t> packet(const Answer& a) const {
-    return {bytes.data() + a.offset, a.size};
-  }
-};
+// Status packets for one instruction packet (servo_answers.hpp).
+using FeetechAnswers = Answers;
 
 class FeetechServo {
  public:
@@ -71,7 +60,9 @@ class FeetechServo {
   void reg_write(std::uint8_t address, std::span<const std::uint8_t> data);
   void action();
 
-  bool responding() const { return responding_ && plugged_; }
+  // Takes in packets: responding, plugged in, at the packet's baud rate.
+  bool responding() const { return responding_ && plugged_ && hearing_; }
+  void set_hearing(bool hearing) { hearing_ = hearing; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
 
@@ -82,6 +73,11 @@ class FeetechServo {
   bool hand_move(std::int32_t steps, Nanos now);
   int baud() const;  // the Baud Rate register in bits per second
   std::int32_t present_steps(Nanos now) const;
+  // EEPROM (0..39): a write there is kept while the lock (STS 55, SCS 48)
+  // reads 0, otherwise lost at the next power-up (servo_eeprom.hpp).
+  const ServoEeprom& eeprom() const { return eeprom_; }
+  bool restore_eeprom(std::span<const std::uint8_t> kept, Nanos now);
+  void factory_reset(Nanos now);  // all of it, ID and baud rate included
 
   // Goal positions received (decoded, in steps), for tests.
   std::uint64_t goals_received() const { return goals_received_; }
@@ -95,6 +91,7 @@ class FeetechServo {
   void publish();
   std::int32_t position_value(std::uint8_t address) const;
   void store_position(std::uint8_t address, double steps);
+  void power_up(Nanos now);  // RAM at its defaults, EEPROM as kept
   std::uint16_t u16(std::uint8_t address) const;
 
   ActuatorBinding binding_;
@@ -102,10 +99,12 @@ class FeetechServo {
   double tau_s_;
   double vmax_steps_s_;
   std::array<std::uint8_t, ft::reg::table_size> table_{};
+  ServoEeprom eeprom_;
   Motor motor_;
   Nanos motor_time_;
   bool responding_ = true;
   bool plugged_ = true;
+  bool hearing_ = true;
   std::array<std::uint8_t, ft::reg::table_size> pending_{};
   std::uint8_t pending_address_ = 0;
   std::uint8_t pending_length_ = 0;
@@ -119,7 +118,9 @@ class FeetechBoard {
   // 0..253 or used twice.
   FeetechBoard(const BusConfig& config, ft::Series series, Nanos now);
 
-  void handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out);
+  // As DynamixelFirmware::handle: only servos at `line_baud` (0: all) hear
+  // the packet; servos sharing an ID all act and their answers collide.
+  void handle(const ft::Packet& packet, Nanos now, FeetechAnswers& out, int line_baud = 0);
 
   FeetechServo* find_configured(int device_id);
   const FeetechServo* find_configured(int device_id) const;
@@ -128,7 +129,8 @@ class FeetechBoard {
   ft::Series series() const { return series_; }
 
  private:
-  FeetechServo* target(std::uint8_t id);
+  template <class Act>
+  void for_id(std::uint8_t id, FeetechAnswers& out, Act&& act);
   void answer(const FeetechServo& servo, std::span<const std::uint8_t> data,
               FeetechAnswers& out) const;
 

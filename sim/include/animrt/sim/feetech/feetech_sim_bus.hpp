@@ -28,6 +28,7 @@
 #include "animrt/sim/feetech/feetech_board.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
 #include "animrt/sim/serial_line.hpp"
+#include "animrt/sim/servo_state_file.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt::sim {
@@ -43,7 +44,9 @@ struct FeetechSimStats {
 class FeetechSimBus final : public SimulatedBus {
  public:
   // Throws DeviceError if no pty can be opened, InputError for bad ids.
-  FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock);
+  // `startup`: factory settings and a state file (simulated_bus.hpp).
+  FeetechSimBus(const BusConfig& config, ft::Series series, const Clock& clock,
+                const ServoStartup& startup = {});
   ~FeetechSimBus() override;
   FeetechSimBus(const FeetechSimBus&) = delete;
   FeetechSimBus& operator=(const FeetechSimBus&) = delete;
@@ -82,7 +85,9 @@ class FeetechSimBus final : public SimulatedBus {
 
   mutable std::mutex mutex_;  // guards board_
   FeetechBoard board_;
+  ServoStartupKeeper keeper_;  // under mutex_
 
+  bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
   Nanos last_time_ = 0;
   ft::Decoder decoder_;
