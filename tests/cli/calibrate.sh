@@ -118,6 +118,13 @@ code=$?
 [[ $code -ne 0 && $out == *"lf_knee: moved through only"* ]] || fail "still joint (exit $code): $out"
 cmp -s "$robot" "$tmp/before.yaml" || fail "file changed after a refused calibration"
 
+# A joint the robot does not have: one line, before anything is followed.
+out=$("$animrt" calibrate "$robot" --non-interactive --port "legs=$pty" --joint tail 2>&1)
+code=$?
+[[ $code -eq 1 && $out == *'--joint "tail": the robot file'*"has no such joint" &&
+   $(wc -l <<< "$out") -eq 1 ]] || fail "unknown joint (exit $code): $out"
+cmp -s "$robot" "$tmp/before.yaml" || fail "file changed after an unknown joint"
+
 # A read-only file: one line, exit 2, untouched.
 chmod 444 "$robot"
 calibrate '{"lf_knee": [2, 1800, 2400, 2000]}' "$tmp/ro.txt" --non-interactive --joint lf_knee --seconds-per-joint 0.7
