@@ -31,13 +31,16 @@
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "calibrate_command.hpp"
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
+#include "doctor_command.hpp"
 #include "evolve_command.hpp"
 #include "fault_injection.hpp"
 #include "gait_command.hpp"
 #include "head_command.hpp"
 #include "herd_command.hpp"
+#include "record_command.hpp"
 #include "scan_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
@@ -359,6 +362,9 @@ int main(int argc, char** argv) {
   animrt::cli::add_view_command(app);
   animrt::cli::add_scan_command(app);
   animrt::cli::add_servo_command(app);
+  animrt::cli::add_calibrate_command(app);
+  animrt::cli::add_record_command(app);
+  animrt::cli::add_doctor_command(app);
   auto* seq = app.add_subcommand(
       "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
   seq->require_subcommand(1);

@@ -1,0 +1,292 @@
+#include "calibrate_command.hpp"
+
+#include <fmt/format.h>
+#include <poll.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_config.hpp"
+#include "animrt/runtime/yaml_value_editor.hpp"
+#include "limp_figure.hpp"
+#include "stop_signals.hpp"
+#include "subcommand.hpp"
+
+namespace animrt::cli {
+// Named, so that the unity build's other commands do not share these names.
+namespace calibrate_cmd {
+
+struct CalibrateArgs {
+  std::string robot;
+  std::vector<std::string> joints;
+  bool non_interactive = false;
+  double seconds_per_joint = 10.0;
+  double min_range_deg = 2.0;
+  PortOverrides ports;
+};
+
+// What one joint's calibration saw, in the servo's own ticks (so that the
+// file's present zero_ticks and direction do not matter).
+struct Seen {
+  double min_ticks = std::numeric_limits<double>::infinity();
+  double max_ticks = -std::numeric_limits<double>::infinity();
+  double home_ticks = 0.0;
+  int direction = 1;
+  void add(double ticks) {
+    min_ticks = std::min(min_ticks, ticks);
+    max_ticks = std::max(max_ticks, ticks);
+    home_ticks = ticks;
+  }
+};
+
+// The servo ticks of a joint position as the file maps them today.
+double raw_ticks(const ActuatorBinding& a, double position) {
+  return a.zero_ticks + a.direction * position * a.ticks_per_rad;
+}
+
+double ticks_to_deg(const ActuatorBinding& a, double ticks) {
+  return rad_to_deg(ticks / a.ticks_per_rad);
+}
+
+// A value as the file gets it: 0.1 deg, no trailing zeros, never "-0".
+std::string deg_text(double deg) {
+  double r = std::round(deg * 10.0) / 10.0;
+  if (r == 0.0) r = 0.0;
+  return fmt::format("{}", r);
+}
+
+bool protocol_with_ticks(const std::string& protocol) {
+  return protocol == "dynamixel2" || protocol == "feetech_sts" || protocol == "feetech_scs";
+}
+
+void sleep_until(timespec& next, long period_ns) {
+  next.tv_nsec += period_ns;
+  while (next.tv_nsec >= 1'000'000'000L) {
+    next.tv_nsec -= 1'000'000'000L;
+    ++next.tv_sec;
+  }
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+}
+
+bool enter_pressed() {
+  pollfd in{STDIN_FILENO, POLLIN, 0};
+  if (::poll(&in, 1, 0) <= 0 || (in.revents & (POLLIN | POLLHUP)) == 0) return false;
+  char buffer[256];
+  const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+  if (n <= 0) return true;  // end of input: take what was seen
+  return std::find(buffer, buffer + n, '\n') != buffer + n;
+}
+
+// Follows joint `j` until `done()` (or a stop signal): the seen range and
+// the last position; a live line every 0.1 s when `live`.
+void follow(LimpFigure& figure, std::size_t j, Seen& seen, bool live,
+            const std::function<bool(double)>& done) {
+  const ActuatorBinding& a = *figure.binding(j);
+  const long period_ns = static_cast<long>(1e9 / figure.config().rate_hz);
+  std::vector<double> positions;
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  const double t0 = next.tv_sec + next.tv_nsec * 1e-9;
+  double shown = -1.0;
+  RunControls& controls = commissioning_controls();
+  while (!controls.stop.load()) {
+    figure.read(positions);
+    seen.add(raw_ticks(a, positions[j]));
+    const double t = next.tv_sec + next.tv_nsec * 1e-9 - t0;
+    if (live && t - shown >= 0.1) {
+      shown = t;
+      const double now = a.direction * ticks_to_deg(a, seen.home_ticks - a.zero_ticks);
+      const double lo = a.direction * ticks_to_deg(a, seen.min_ticks - a.zero_ticks);
+      const double hi = a.direction * ticks_to_deg(a, seen.max_ticks - a.zero_ticks);
+      std::cout << fmt::format("\r  {}: now {:7.1f} deg   seen {:7.1f} .. {:7.1f} deg   ",
+                               figure.config().joints[j].name, now, std::min(lo, hi),
+                               std::max(lo, hi))
+                << std::flush;
+    }
+    if (done(t)) break;
+    sleep_until(next, period_ns);
+  }
+  if (live) std::cout << '\n';
+}
+
+// The joints to calibrate: --joint or all that a servo with ticks drives.
+std::vector<std::size_t> chosen_joints(const LimpFigure& figure, const CalibrateArgs& args) {
+  const auto& joints = figure.config().joints;
+  std::vector<std::size_t> out;
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    const bool asked =
+        std::find(args.joints.begin(), args.joints.end(), joints[j].name) != args.joints.end();
+    if (!args.joints.empty() && !asked) continue;
+    const std::string protocol = figure.protocol(j);
+    const bool usable = figure.binding(j) != nullptr && protocol_with_ticks(protocol) &&
+                        joints[j].type == JointType::revolute;
+    if (usable) {
+      out.push_back(j);
+    } else if (asked) {
+      throw std::invalid_argument("--joint " + joints[j].name + ": not calibrated here (" +
+                                  (protocol.empty() ? "no bus drives it" : "protocol " + protocol) +
+                                  "); calibrate knows revolute joints on Dynamixel and Feetech "
+                                  "servos");
+    } else {
+      std::cout << joints[j].name << ": skipped (" << (protocol.empty() ? "no bus" : protocol)
+                << "; calibrate knows revolute joints on Dynamixel and Feetech servos)\n";
+    }
+  }
+  for (const std::string& name : args.joints) {
+    const bool known = std::any_of(joints.begin(), joints.end(),
+                                   [&](const JointSpec& s) { return s.name == name; });
+    if (!known) {
+      throw std::invalid_argument("--joint " + quote(name) + ": the robot file " +
+                                  quote_path(figure.config().file) + " has no such joint");
+    }
+  }
+  return out;
+}
+
+// The file's new values for one joint, written into `edit`. Returns the
+// report line.
+std::string write_joint(YamlValueEditor& edit, const std::string& name, const ActuatorBinding& a,
+                        const Seen& seen) {
+  const auto zero = static_cast<long long>(std::lround(seen.home_ticks));
+  const double lo = seen.direction * ticks_to_deg(a, seen.min_ticks - zero);
+  const double hi = seen.direction * ticks_to_deg(a, seen.max_ticks - zero);
+  // Rounded inward: a limit is never past what the hand reached.
+  const double min_deg = std::ceil(std::min(lo, hi) * 10.0 - 1e-9) / 10.0;
+  const double max_deg = std::floor(std::max(lo, hi) * 10.0 + 1e-9) / 10.0;
+  edit.set({"joints", name, "limits", "min_deg"}, deg_text(min_deg));
+  edit.set({"joints", name, "limits", "max_deg"}, deg_text(max_deg));
+  edit.set({"joints", name, "home_deg"}, "0");
+  edit.set({"joints", name, "actuator", "zero_ticks"}, std::to_string(zero));
+  edit.set({"joints", name, "actuator", "direction"}, std::to_string(seen.direction));
+  return fmt::format("{}: limits {} .. {} deg, home at {} ticks (0 deg), direction {}", name,
+                     deg_text(min_deg), deg_text(max_deg), zero, seen.direction);
+}
+
+// The edited file must load as a robot: checked on a copy beside it, so
+// its relative paths resolve, before the original is replaced.
+void check_loads(const std::string& path, const std::string& text) {
+  const std::filesystem::path p(path);
+  const std::string check =
+      (p.parent_path() / ("." + p.filename().string() + ".calibrated")).string();
+  {
+    std::ofstream out(check, std::ios::binary);
+    out << text;
+    if (!out) {
+      throw InputError({path, 0, 0}, "", "cannot write beside the robot file; nothing was written");
+    }
+  }
+  try {
+    load_robot_config(check);
+  } catch (const InputError& e) {
+    std::filesystem::remove(check);
+    throw InputError({path, e.where().line, e.where().column}, e.key(),
+                     e.message() + " (after calibration; nothing was written)");
+  }
+  std::filesystem::remove(check);
+}
+
+int run_calibrate(const CalibrateArgs& args) {
+  install_stop_signals(commissioning_controls(), SecondSignal::end_process);
+  // What the file holds now: written back only if it still holds this.
+  const std::string original = read_whole_file(args.robot);
+  LimpFigure figure(args.robot, args.ports);
+  const std::vector<std::size_t> joints = chosen_joints(figure, args);
+  std::cout << "torque is off on every joint\n";
+  if (args.non_interactive) {
+    std::cout << "direction is not checked in non-interactive mode: each joint keeps the "
+                 "direction its file gives\n";
+  }
+  YamlValueEditor edit(original, args.robot);
+  std::vector<std::string> lines;
+  RunControls& controls = commissioning_controls();
+  for (const std::size_t j : joints) {
+    const std::string& name = figure.config().joints[j].name;
+    const ActuatorBinding& a = *figure.binding(j);
+    Seen seen;
+    seen.direction = a.direction;
+    if (args.non_interactive) {
+      std::cout << fmt::format("{}: move it through its whole range and to its home pose ({} s)",
+                               name, args.seconds_per_joint)
+                << std::endl;
+      const double limit = args.seconds_per_joint;
+      follow(figure, j, seen, false, [limit](double t) { return t >= limit; });
+    } else {
+      std::cout << name
+                << ": move it by hand through its whole range, leave it at its home pose and "
+                   "press Enter"
+                << std::endl;
+      follow(figure, j, seen, true, [](double) { return enter_pressed(); });
+      const double home = seen.home_ticks;
+      std::cout << name
+                << ": now move it a little in its positive direction and press Enter (only "
+                   "Enter: keep direction "
+                << a.direction << ")" << std::endl;
+      Seen moved;
+      follow(figure, j, moved, true, [](double) { return enter_pressed(); });
+      const double delta_deg = ticks_to_deg(a, moved.home_ticks - home);
+      if (std::abs(delta_deg) >= 1.0) seen.direction = delta_deg > 0 ? 1 : -1;
+      seen.home_ticks = home;
+    }
+    if (controls.stop.load()) {
+      std::cout << "stopped: nothing was written\n";
+      return kExitUsage;
+    }
+    const double range = ticks_to_deg(a, seen.max_ticks - seen.min_ticks);
+    if (!(range >= args.min_range_deg)) {
+      throw std::runtime_error(fmt::format(
+          "{}: moved through only {:.1f} deg (at least {} deg needed): nothing was written; move "
+          "the joint through its whole range while it is recorded",
+          name, range, args.min_range_deg));
+    }
+    lines.push_back(write_joint(edit, name, a, seen));
+  }
+  check_loads(args.robot, edit.text());
+  replace_file_contents(args.robot, original, edit.text());
+  for (const std::string& line : lines) std::cout << line << '\n';
+  std::cout << args.robot << ": " << lines.size() << " joint" << (lines.size() == 1 ? "" : "s")
+            << " calibrated\n";
+  return kExitOk;
+}
+
+}  // namespace calibrate_cmd
+
+void add_calibrate_command(CLI::App& app) {
+  using namespace calibrate_cmd;
+  static CalibrateArgs args;
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Torque off, move each joint by hand through its range and to its home pose; writes "
+      "zero_ticks, direction and limits back into the robot file, comments kept");
+  cmd->add_option("ROBOT", args.robot, "robot file (YAML), edited in place")->required();
+  cmd->add_option("--joint", args.joints, "calibrate only this joint (repeatable)");
+  cmd->add_flag("--non-interactive", args.non_interactive,
+                "no questions: each joint is followed for --seconds-per-joint, its home is where "
+                "it rests at the end, its direction stays as the file gives it");
+  cmd->add_option("--seconds-per-joint", args.seconds_per_joint,
+                  "time per joint in non-interactive mode")
+      ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--min-range-deg", args.min_range_deg,
+                  "refuse a joint moved through less than this (default 2)")
+      ->check(CLI::Range(0.0, 360.0));
+  args.ports.add_option(cmd);
+  set_subcommand_body(cmd, [] {
+    try {
+      return run_calibrate(args);
+    } catch (const DeviceError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      return kExitDeviceError;
+    }
+  });
+}
+
+}  // namespace animrt::cli

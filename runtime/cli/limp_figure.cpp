@@ -1,0 +1,101 @@
+#include "limp_figure.hpp"
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "stop_signals.hpp"
+
+namespace animrt::cli {
+
+void PortOverrides::add_option(CLI::App* cmd) {
+  cmd->add_option("--port", entries,
+                  "BUS=PATH: open bus BUS at PATH instead of the robot file's port (the file is "
+                  "not changed); repeatable");
+}
+
+namespace {
+
+void apply_ports(const std::vector<std::string>& entries, RobotConfig& config) {
+  for (const std::string& entry : entries) {
+    const std::size_t eq = entry.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == entry.size()) {
+      throw std::invalid_argument("--port " + quote(entry) + ": expected BUS=PATH");
+    }
+    const std::string name = entry.substr(0, eq);
+    bool found = false;
+    for (BusConfig& bus : config.buses) {
+      if (bus.name == name) {
+        bus.port = entry.substr(eq + 1);
+        found = true;
+      }
+    }
+    if (!found) {
+      throw std::invalid_argument("--port " + quote(entry) + ": the robot file " +
+                                  quote_path(config.file) + " has no bus named " + quote(name));
+    }
+  }
+}
+
+}  // namespace
+
+LimpFigure::LimpFigure(const std::string& robot_path, const PortOverrides& ports) {
+  LoadedRobot robot = load_robot(robot_path);
+  apply_ports(ports.entries, robot.config);
+  figure_ = std::make_unique<Figure>(std::move(robot), backend_);
+  bus_positions_.resize(figure_->bus_count());
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
+    ActuatorBus& bus = figure_->bus(b);
+    bus.configure();
+    // A servo may power up with its torque on: off before anyone touches it.
+    bus.deactivate();
+    bus_positions_[b].assign(bus.config().actuators.size(), 0.0);
+  }
+}
+
+LimpFigure::~LimpFigure() {
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) figure_->bus(b).deactivate();
+}
+
+void LimpFigure::read(std::vector<double>& joints, std::vector<bool>* fresh) {
+  joints.resize(config().joints.size(), 0.0);
+  if (fresh) fresh->assign(joints.size(), false);
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
+    ActuatorBus& bus = figure_->bus(b);
+    bus.read(bus_positions_[b]);
+    const auto& actuators = bus.config().actuators;
+    const std::span<DeviceStatus> status = bus.devices();
+    for (std::size_t i = 0; i < actuators.size(); ++i) {
+      const int j = actuators[i].joint_index;
+      if (j >= 0 && static_cast<std::size_t>(j) < joints.size()) {
+        joints[static_cast<std::size_t>(j)] = bus_positions_[b][i];
+        if (fresh && i < status.size()) {
+          (*fresh)[static_cast<std::size_t>(j)] = status[i].health == DeviceHealth::ok;
+        }
+      }
+    }
+  }
+}
+
+const ActuatorBinding* LimpFigure::binding(std::size_t joint) const {
+  for (const BusConfig& bus : config().buses) {
+    for (const ActuatorBinding& a : bus.actuators) {
+      if (a.joint_index == static_cast<int>(joint)) return &a;
+    }
+  }
+  return nullptr;
+}
+
+std::string LimpFigure::protocol(std::size_t joint) const {
+  for (const BusConfig& bus : config().buses) {
+    for (const ActuatorBinding& a : bus.actuators) {
+      if (a.joint_index == static_cast<int>(joint)) return bus.protocol;
+    }
+  }
+  return "";
+}
+
+RunControls& commissioning_controls() {
+  static RunControls controls;
+  return controls;
+}
+
+}  // namespace animrt::cli

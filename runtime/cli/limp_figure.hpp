@@ -1,0 +1,48 @@
+#pragma once
+// A figure held limp for commissioning (calibrate, record): the robot file's
+// buses opened and their devices found, torque switched off and kept off,
+// the joints' positions read on demand. Nothing here moves a joint.
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animrt/runtime/figure.hpp"
+#include "animrt/runtime/run_controls.hpp"
+
+namespace animrt::cli {
+
+// --port BUS=PATH, repeatable: the bus's port for this command only (the
+// robot file is not changed), e.g. a simulator's pseudo-terminal.
+struct PortOverrides {
+  std::vector<std::string> entries;
+  void add_option(CLI::App* cmd);
+};
+
+class LimpFigure {
+ public:
+  // Loads the robot (InputError), opens its buses at their ports (or the
+  // overrides) and switches every device's torque off (DeviceError).
+  LimpFigure(const std::string& robot_path, const PortOverrides& ports);
+  ~LimpFigure();  // torque off again, the buses close
+
+  const RobotConfig& config() const { return figure_->config(); }
+  // Positions of every joint (rad, or m), in robot joint order; a joint
+  // whose device did not answer keeps its previous value and is not
+  // `fresh` (when given). Throws DeviceError for a bus that fails.
+  void read(std::vector<double>& joints, std::vector<bool>* fresh = nullptr);
+  // The binding of joint `j` and its bus's protocol (null when no bus drives it).
+  const ActuatorBinding* binding(std::size_t joint) const;
+  std::string protocol(std::size_t joint) const;
+
+ private:
+  HardwareBackend backend_;
+  std::unique_ptr<Figure> figure_;
+  std::vector<std::vector<double>> bus_positions_;
+};
+
+// The controls that stop signals write while a commissioning command runs.
+RunControls& commissioning_controls();
+
+}  // namespace animrt::cli
