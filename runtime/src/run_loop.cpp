@@ -73,6 +73,8 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
     view_[b].assign(devices.begin(), devices.end());
   }
   in_.buses = io_;
+  imu_io_.resize(model.imus.size());
+  in_.imus = imu_io_;
   in_.motion_duration_s = options.duration_s;
   for (std::size_t b = 0; b < buses.size(); ++b) {
     workers_.push_back(std::make_unique<BusWorker>(*buses[b], bus_positions[b], io_done_));
@@ -178,6 +180,14 @@ void RunLoop::gather_inputs() {
   in_.steer = controls && controls->steer.take(steer_) ? &steer_ : nullptr;
   in_.jog = controls && controls->jog.take(jog_) ? &jog_ : nullptr;
   in_.show = controls && controls->show.take(show_) ? &show_ : nullptr;
+  for (std::size_t i = 0; i < imu_io_.size() && i < options_.imu_readings.size(); ++i) {
+    Mailbox<ImuReading>* const box = options_.imu_readings[i];
+    ImuIo& io = imu_io_[i];
+    if (box && box->take(io.reading)) {
+      io.valid = true;
+      io.reading.time_s -= to_seconds(start_);  // on the run's clock -> since the run began
+    }
+  }
   // Targets first, then the mode: a target posted after manual mode was
   // switched on is never taken for one sent before it.
   std::size_t count = 0;

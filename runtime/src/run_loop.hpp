@@ -123,6 +123,7 @@ class RunLoop {
   std::vector<std::uint8_t> pending_;  // a read posted, not yet used
   std::vector<std::uint64_t> io_seen_;
   // Controls taken from the mailboxes this cycle.
+  std::vector<ImuIo> imu_io_;  // per IMU: the latest reading taken
   CycleInputs in_;
   MotionCommand steer_;
   ShowCommand show_;

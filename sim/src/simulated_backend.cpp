@@ -66,6 +66,15 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
   }
   devices_ = start_simulated_devices(config.buses, clock, physics);
   for (const auto& device : devices_) lines.push_back("simulated devices: " + device->describe());
+  // Each IMU a simulated part on a pty: level, or pushed over as the robot
+  // file's `sim:` says.
+  for (ImuConfig& imu : config.imus) {
+    imus_.push_back(std::make_unique<sim::RvcSimImu>(imu, clock, clock.now(),
+                                                     sim::scripted_trunk(imu.sim_push)));
+    imu.port = imus_.back()->port();
+    lines.push_back("simulated IMU " + imu.name + " (" + imu.protocol + ") on " + imu.port +
+                    (imu.sim_push.on ? ", pushed over by the robot file's script" : ", level"));
+  }
   return lines;
 }
 

@@ -28,6 +28,11 @@ struct BusModel {
   std::vector<int> device_id;  // per device: its bus address
 };
 
+struct ImuModel {
+  std::string name;
+  double stale_timeout_s = 0.1;
+};
+
 struct RobotModel {
   std::string name;
   double rate_hz = 0.0;
@@ -43,6 +48,7 @@ struct RobotModel {
   std::vector<double> following_error;  // per joint: the watch's threshold (rad or m)
   std::vector<JointSlot> slots;         // per joint
   std::vector<BusModel> buses;
+  std::vector<ImuModel> imus;  // the first is the trunk's
 
   std::size_t joint_count() const { return joint_names.size(); }
 };
