@@ -52,7 +52,8 @@ void RvcSimImu::serve() {
     // only when the run steps it), a wake, or a poll tick.
     if (clock_.now() < due) {
       pollfd p{wake_.read_fd(), POLLIN, 0};
-      ::poll(&p, 1, 1);
+      const timespec tick{0, 200'000};  // a lockstep clock can move a cycle in well under 1 ms
+      ::ppoll(&p, 1, &tick, nullptr);
       continue;
     }
     const TrunkState s = trunk_(to_seconds(due - start_));

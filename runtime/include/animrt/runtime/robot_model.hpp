@@ -30,7 +30,7 @@ struct BusModel {
 
 struct ImuModel {
   std::string name;
-  double stale_timeout_s = 0.1;
+  double stale_timeout_s = 0.25;
 };
 
 struct RobotModel {

@@ -18,7 +18,7 @@ struct ImuConfig {
   double rate_hz = 100.0;  // the part's report rate
   // Stale after this long without a good frame: the cycle's watch faults
   // the sensor (the figure ramps home), as its watchdog does a silent servo.
-  double stale_timeout_s = 0.1;
+  double stale_timeout_s = 0.25;
   // The part's axes in the trunk frame (x forward, y left, z up): yaw, then
   // pitch, then roll, radians.
   std::array<double, 3> mount_ypr_rad{};

@@ -12,6 +12,7 @@
 // below half its standing height, tilted more than 60 degrees, the trunk on
 // the ground, or unstable).
 
+#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -43,12 +44,22 @@ struct PhysicsMeasures {
   double forward_m = 0.0;    // torso's +x displacement since the start
   double sideways_m = 0.0;   // torso's +y displacement since the start
   // The motion proper, between mark_motion_start() and mark_motion_end():
-  double motion_s = 0.0;          // physics time between the marks (0: not marked)
-  double motion_forward_m = 0.0;  // torso's +x displacement between them
-  int falls = 0;                  // times the figure went from upright to fallen
-  double first_fall_s = -1.0;     // simulated time of the first fall, -1 if none
-  bool fallen = false;            // fallen at the end
+  double motion_s = 0.0;             // physics time between the marks (0: not marked)
+  double motion_forward_m = 0.0;     // torso's +x displacement between them
+  int falls = 0;                     // times the figure went from upright to fallen
+  double first_fall_s = -1.0;        // simulated time of the first fall, -1 if none
+  bool fallen = false;               // fallen at the end
   int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
+};
+
+// What an IMU on the torso measures: its attitude in the world (w, x, y, z,
+// MuJoCo's xquat), its angular velocity and the specific force (what an
+// accelerometer feels: +1 g up at rest) in the torso's own frame.
+struct TorsoMotion {
+  std::array<double, 4> quat{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> rate_rad_s{};
+  std::array<double, 3> accel_m_s2{};
+  double time_s = 0.0;  // physics time
 };
 
 class MujocoJointPhysics final : public JointPhysics {
@@ -85,6 +96,7 @@ class MujocoJointPhysics final : public JointPhysics {
 
   PhysicsMeasures measures() const;
   TorsoPose torso_pose() const;
+  TorsoMotion torso_motion() const;
 
  private:
   void step();  // one mj_step and the fall watch; mutex held
