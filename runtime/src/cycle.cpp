@@ -175,7 +175,7 @@ struct CycleStages {
     return fault;
   }
 
-  // IMUs: a reading older than one report period is late (the last one is
+  // IMUs: a reading older than one report and one loop period is late (the last one is
   // kept, as a late bus keeps its measurement); older than the part's stale
   // timeout, the sensor is faulted and the figure ramps home, as after a
   // silent servo. The trunk's reading goes to the motion while it is fresh.
@@ -188,7 +188,7 @@ struct CycleStages {
       const ImuIo* io = i < in.imus.size() ? &in.imus[i] : nullptr;
       const bool valid = io && io->valid;
       const double age = valid ? t - io->reading.time_s : t - s.imu_start_;
-      if (age > model.dt + kTimeEps) ++s.imu_late_[i];
+      if (age > 1.0 / model.imus[i].rate_hz + model.dt + kTimeEps) ++s.imu_late_[i];
       const bool stale = age > model.imus[i].stale_timeout_s + kTimeEps;
       if (stale && !s.imu_faulted_[i]) {
         s.imu_faulted_[i] = 1;

@@ -4,6 +4,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "futex.hpp"
 
@@ -16,6 +17,9 @@ constexpr std::size_t kTelemetryCapacity = 1 << 14;  // records (~80 s at 200 Hz
 // last measurement this cycle, and the others go on without it.
 constexpr double kReadBudget = 0.6;
 constexpr std::size_t kManualPerCycle = 64;  // manual targets taken per cycle, at most
+// Lockstep: how long (wall time) a cycle waits for an IMU's frame due by its
+// time before it goes on without it (the cycle then counts it late).
+constexpr Nanos kLockstepImuWait = 500'000'000;
 
 void sleep_until_deadline(Nanos deadline) {
   timespec ts{};
@@ -172,6 +176,30 @@ void RunLoop::take_reads() {
   }
 }
 
+// The IMU's newest reading. In lockstep the part's frames follow the
+// simulated clock, so the cycle waits (boundedly, as for a lockstep bus)
+// for the frame due by its time: a lockstep run sees every frame whatever
+// the machine's load.
+void RunLoop::take_imu(std::size_t i) {
+  Mailbox<ImuReading>& box = *options_.imu_readings[i];
+  ImuIo& io = imu_io_[i];
+  const auto take = [&] {
+    if (!box.take(io.reading)) return;
+    io.valid = true;
+    io.reading.time_s -= to_seconds(start_);  // on the run's clock -> since the run began
+  };
+  take();
+  if (!options_.lockstep_clock) return;
+  // A simulated part sends on whole multiples of its period on the clock.
+  const double rate = model_.imus[i].rate_hz;
+  const double due = std::floor(to_seconds(deadline_) * rate + 1e-9) / rate - to_seconds(start_);
+  const Nanos give_up = wall_.now() + kLockstepImuWait;
+  while ((!io.valid || io.reading.time_s < due - 1e-9) && wall_.now() < give_up) {
+    sleep_until_deadline(wall_.now() + 100'000);
+    take();
+  }
+}
+
 void RunLoop::gather_inputs() {
   RunControls* const controls = options_.controls;
   in_.t = to_seconds(deadline_ - start_);  // nominal time: smooth motion
@@ -181,12 +209,7 @@ void RunLoop::gather_inputs() {
   in_.jog = controls && controls->jog.take(jog_) ? &jog_ : nullptr;
   in_.show = controls && controls->show.take(show_) ? &show_ : nullptr;
   for (std::size_t i = 0; i < imu_io_.size() && i < options_.imu_readings.size(); ++i) {
-    Mailbox<ImuReading>* const box = options_.imu_readings[i];
-    ImuIo& io = imu_io_[i];
-    if (box && box->take(io.reading)) {
-      io.valid = true;
-      io.reading.time_s -= to_seconds(start_);  // on the run's clock -> since the run began
-    }
+    if (options_.imu_readings[i]) take_imu(i);
   }
   // Targets first, then the mode: a target posted after manual mode was
   // switched on is never taken for one sent before it.

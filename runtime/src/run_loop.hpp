@@ -93,6 +93,7 @@ class RunLoop {
   void wait_for(bool reads, Nanos deadline);
   void take_reads();
   void gather_inputs();
+  void take_imu(std::size_t i);
   void publish(const CycleOutputs& out);
   void notify(const CycleOutputs& out);
   void post_writes(const CycleOutputs& out);

@@ -45,7 +45,9 @@ RvcSimImu::~RvcSimImu() {
 
 void RvcSimImu::serve() {
   const Nanos period = from_seconds(1.0 / config_.rate_hz);
-  Nanos due = start_;
+  // Frames on whole multiples of the period on the clock, so a lockstep run
+  // knows which frame is due by its time.
+  Nanos due = (start_ + period - 1) / period * period;
   std::uint8_t index = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
     // Wait for the frame's time on the run's clock (a lockstep clock moves

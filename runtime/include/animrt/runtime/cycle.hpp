@@ -142,7 +142,8 @@ class CycleState {
   std::span<const double> manual_pose() const { return manual_pose_; }
   // The show's playhead as of this cycle (show false: the motion plays none).
   const ShowPosition& show() const { return show_; }
-  // Per IMU: cycles its reading was older than one report period (late),
+  // Per IMU: cycles its reading was older than one report and one loop
+  // period (late),
   // and whether it went stale past its timeout (faulted).
   std::span<const std::uint64_t> imu_late_cycles() const { return imu_late_; }
   std::span<const std::uint8_t> imu_faulted() const { return imu_faulted_; }

@@ -31,6 +31,7 @@ struct BusModel {
 struct ImuModel {
   std::string name;
   double stale_timeout_s = 0.25;
+  double rate_hz = 100.0;  // its report rate
 };
 
 struct RobotModel {

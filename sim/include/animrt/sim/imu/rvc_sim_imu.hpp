@@ -31,8 +31,8 @@ TrunkProvider scripted_trunk(const ImuConfig::Push& push);
 
 class RvcSimImu {
  public:
-  // Frames are due every 1/rate_hz on `clock` from `start`; the provider is
-  // asked for time (due - start). Throws DeviceError when no pty opens.
+  // Frames are due on whole multiples of 1/rate_hz on `clock`, from
+  // `start` on; the provider is asked for time (due - start). Throws DeviceError when no pty opens.
   RvcSimImu(const ImuConfig& config, const Clock& clock, Nanos start, TrunkProvider trunk);
   ~RvcSimImu();
   RvcSimImu(const RvcSimImu&) = delete;
