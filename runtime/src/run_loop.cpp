@@ -190,9 +190,12 @@ void RunLoop::take_imu(std::size_t i) {
   };
   take();
   if (!options_.lockstep_clock) return;
-  // A simulated part sends on whole multiples of its period on the clock.
+  // A simulated part sends on whole multiples of its period on the clock;
+  // a frame due before the run began may have been dropped as old by the
+  // reader when it opened the line, so only later ones are waited for.
   const double rate = model_.imus[i].rate_hz;
   const double due = std::floor(to_seconds(deadline_) * rate + 1e-9) / rate - to_seconds(start_);
+  if (due <= 1e-9) return;
   const Nanos give_up = wall_.now() + kLockstepImuWait;
   while ((!io.valid || io.reading.time_s < due - 1e-9) && wall_.now() < give_up) {
     sleep_until_deadline(wall_.now() + 100'000);

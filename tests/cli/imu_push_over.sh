@@ -53,4 +53,11 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["end_reason"] == "duration" and s["exit_code"] == 0, s
 ' "$tmp/l.json" || fail "level summary wrong"
+
+# On hardware an IMU needs its port: refused before anything opens.
+"$animrt" run "$tmp/robots/level.yaml" --backend hardware --duration 1 > "$tmp/h.txt" 2>&1
+code=$?
+[[ $code == 2 ]] || fail "hardware without an IMU port: exit $code: $(cat "$tmp/h.txt")"
+grep -q "level.yaml:[0-9]*:[0-9]*: imus\[0\].port: expected the serial port" "$tmp/h.txt" \
+  || fail "no port error: $(cat "$tmp/h.txt")"
 echo ok
