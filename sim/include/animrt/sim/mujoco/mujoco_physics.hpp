@@ -44,11 +44,11 @@ struct PhysicsMeasures {
   double forward_m = 0.0;    // torso's +x displacement since the start
   double sideways_m = 0.0;   // torso's +y displacement since the start
   // The motion proper, between mark_motion_start() and mark_motion_end():
-  double motion_s = 0.0;             // physics time between the marks (0: not marked)
-  double motion_forward_m = 0.0;     // torso's +x displacement between them
-  int falls = 0;                     // times the figure went from upright to fallen
-  double first_fall_s = -1.0;        // simulated time of the first fall, -1 if none
-  bool fallen = false;               // fallen at the end
+  double motion_s = 0.0;          // physics time between the marks (0: not marked)
+  double motion_forward_m = 0.0;  // torso's +x displacement between them
+  int falls = 0;                  // times the figure went from upright to fallen
+  double first_fall_s = -1.0;     // simulated time of the first fall, -1 if none
+  bool fallen = false;            // fallen at the end
   int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
 };
 
