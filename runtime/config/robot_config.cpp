@@ -17,6 +17,7 @@
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
 #include "file_kind.hpp"
+#include "imu_section.hpp"
 
 namespace animrt {
 namespace {
@@ -109,9 +110,11 @@ HealthLimits parse_health_limits(const YamlNode& node, double rate_hz) {
 SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
   node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s", "start_ramp_max_s",
                    "stop_deadline_s", "following_error_deg", "following_error_mm",
-                   "following_error_window_s", "health"});
+                   "following_error_window_s", "health", "tilt_limit_deg", "tilt_time_s",
+                   "on_tilt", "tilt_hold_s"});
   SafetyConfig safety;
   if (auto n = node.find("health")) safety.health = parse_health_limits(*n, rate_hz);
+  parse_tilt_watch(node, safety);
   if (auto n = node.find("watchdog_timeout_s")) {
     safety.watchdog_timeout_s = n->as_positive_double();
     if (safety.watchdog_timeout_s > kMaxWatchdogS) {
@@ -539,7 +542,7 @@ MotionConfig parse_motion(const YamlNode& node, const std::string& robot_path,
 RobotConfig load_robot_config(const std::string& path) {
   const YamlNode root = YamlNode::load_file(path);
   require_robot_file(root);
-  root.allow_only({"name", "loop", "safety", "buses", "joints", "motion", "model"});
+  root.allow_only({"name", "loop", "safety", "buses", "joints", "motion", "model", "imus"});
 
   RobotConfig config;
   config.file = path;
@@ -570,6 +573,10 @@ RobotConfig load_robot_config(const std::string& path) {
     }
   }
 
+  if (auto imus = root.find("imus")) config.imus = parse_imus(*imus, config.rate_hz);
+  if (config.safety.tilt_limit_rad > 0.0 && config.imus.empty()) {
+    safety->at("tilt_limit_deg").fail("the tilt watch needs an IMU; add one under imus:");
+  }
   config.motion = parse_motion(root.at("motion"), path);
   if (auto model = root.find("model")) {
     // Whether MuJoCo can load it is checked where the model is loaded.

@@ -58,10 +58,14 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
       if (gait->balance) {
         // Played without its reflex the gait would not be the walk it was
         // made for: refused before anything moves.
+        // The cycle reads the trunk's attitude (imus:), but the reflex also
+        // needs each leg's ground contact and its Jacobian, which the
+        // runtime does not have.
         throw InputError(gait->balance->where, "balance",
-                         "this gait balances through the trunk's attitude, which the runtime "
-                         "cannot read yet; walk it with `animrt gait measure --physics` or "
-                         "remove balance");
+                         "this gait balances through the trunk's attitude and its legs' ground "
+                         "contact; the runtime reads the attitude (imus:) but does not play the "
+                         "reflex yet; walk it with `animrt gait measure --physics` or remove "
+                         "balance");
       }
       source = make_gait_source(*gait, joints);
     } else {

@@ -78,6 +78,8 @@ CycleState::CycleState(const RobotModel& model)
     last_ok_.emplace_back(bus.joint.size(), 0.0);
     out_.bus_commands.emplace_back(bus.joint.size(), 0.0);
   }
+  imu_late_.assign(model.imus.size(), 0);
+  imu_faulted_.assign(model.imus.size(), 0);
   out_.commands.assign(n, 0.0);
   out_.write.assign(buses, 0);
   // A cycle emits at most a few events per joint and device.
@@ -121,6 +123,21 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
     ramp_to_[j] = joint_faulted(j) ? position[j] : model.home[j];
   }
   ramp_.plan(ramp_from_, ramp_to_, model.limits, model.safety.stop_ramp_s);
+  if (phase_ == Phase::motion) {
+    motion_time_ = t - motion_start_;
+    emit(CycleEvent{EventKind::motion_ended, t});
+  }
+  phase_ = Phase::stop_ramp;
+  phase_start_ = t;
+  stop_start_ = t;
+}
+
+void CycleState::begin_hold(const RobotModel& model, double t) {
+  // Every joint holds where the filter has it: the filter brakes what still
+  // moves within the limits, and nothing heads for home.
+  const auto position = filter_.position();
+  std::copy(position.begin(), position.end(), ramp_from_.begin());
+  ramp_.plan(ramp_from_, ramp_from_, model.limits, model.safety.tilt_hold_s);
   if (phase_ == Phase::motion) {
     motion_time_ = t - motion_start_;
     emit(CycleEvent{EventKind::motion_ended, t});
@@ -263,6 +280,69 @@ struct CycleStages {
     return fault;
   }
 
+  // IMUs: a reading older than one report and one loop period is late (the last one is
+  // kept, as a late bus keeps its measurement); older than the part's stale
+  // timeout, the sensor is faulted and the figure ramps home, as after a
+  // silent servo. The trunk's reading goes to the motion while it is fresh.
+  static bool watch_imus(const RobotModel& model, CycleState& s, const CycleInputs& in) {
+    const double t = in.t;
+    if (s.cycles_ == 0) s.imu_start_ = t;
+    s.sensors_.imu = nullptr;
+    bool fault = false;
+    for (std::size_t i = 0; i < model.imus.size(); ++i) {
+      const ImuIo* io = i < in.imus.size() ? &in.imus[i] : nullptr;
+      const bool valid = io && io->valid;
+      const double age = valid ? t - io->reading.time_s : t - s.imu_start_;
+      if (age > 1.0 / model.imus[i].rate_hz + model.dt + kTimeEps) ++s.imu_late_[i];
+      const bool stale = age > model.imus[i].stale_timeout_s + kTimeEps;
+      if (stale && !s.imu_faulted_[i]) {
+        s.imu_faulted_[i] = 1;
+        fault = true;
+        s.emit(CycleEvent{EventKind::sensor_stale, t, -1, i, 0, DeviceHealth::timeout, age});
+      }
+      if (i == 0 && valid && !s.imu_faulted_[i]) {
+        s.trunk_ = io->reading;
+        s.sensors_.imu = &s.trunk_;
+      }
+    }
+    return fault;
+  }
+
+  // Tilt watch: the trunk's roll or pitch beyond the limit for the set time
+  // ends the motion, by a hold or by torque off (SafetyConfig::on_tilt).
+  // Returns whether torque went off (the run ended here).
+  static bool watch_tilt(const RobotModel& model, CycleState& s, double t, CycleOutputs& out) {
+    if (!s.sensors_.imu) {
+      s.tilt_since_ = -1.0;
+      return false;
+    }
+    const auto& q = s.sensors_.imu->quat;
+    const double tilt = std::max(std::abs(roll_of(q)), std::abs(pitch_of(q)));
+    s.max_tilt_ = std::max(s.max_tilt_, tilt);
+    const SafetyConfig& safety = model.safety;
+    if (safety.tilt_limit_rad <= 0.0 || s.end_.tilted || tilt <= safety.tilt_limit_rad) {
+      s.tilt_since_ = -1.0;
+      return false;
+    }
+    if (s.tilt_since_ < 0.0) s.tilt_since_ = t;
+    if (t - s.tilt_since_ < safety.tilt_time_s - kTimeEps) return false;
+    s.emit(CycleEvent{EventKind::tilted, t, -1, 0, 0, DeviceHealth::ok, tilt});
+    s.end_.tilted = true;
+    s.end_.fault = true;
+    if (safety.on_tilt == SafetyConfig::OnTilt::hold) {
+      s.begin_hold(model, t);
+      return false;
+    }
+    if (s.phase_ == Phase::motion) {
+      s.motion_time_ = t - s.motion_start_;
+      s.emit(CycleEvent{EventKind::motion_ended, t});
+    }
+    s.end_.torque_cut = true;
+    s.phase_ = Phase::done;
+    out.torque_off_now = true;
+    return true;
+  }
+
   // Adds joint j's squared error to its window; returns the window's RMS
   // once the window is full, else -1.
   static double window_rms(CycleState& s, std::size_t j, double sq) {
@@ -389,6 +469,7 @@ struct CycleStages {
   static void sample_motion(const RobotModel& model, MotionSource& motion, CycleState& s,
                             double t) {
     std::copy(model.home.begin(), model.home.end(), s.targets_.begin());
+    motion.sense(s.sensors_);
     motion.sample(t - s.motion_start_, s.targets_);
     bool bad = false;
     for (std::size_t j = 0; j < s.targets_.size(); ++j) {
@@ -464,8 +545,13 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   const bool health_fault = S::watch_health(model, s, in);
   const bool device_fault = S::watch_devices(model, s, in) || health_fault;
   const bool following_fault = S::watch_following_error(model, s, in.t);
-  const bool fault = device_fault || following_fault;
+  const bool sensor_fault = S::watch_imus(model, s, in);
+  const bool fault = device_fault || following_fault || sensor_fault;
   if (fault) s.end_.fault = true;
+  if (S::watch_tilt(model, s, in.t, out)) {
+    ++s.cycles_;
+    return out;
+  }
   if (S::cut_torque(model, s, in, out)) {
     ++s.cycles_;
     return out;

@@ -54,6 +54,11 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
     buses_.push_back(bus.get());
     buses.push_back(std::move(bus));
   }
+  // Each IMU read on its own thread from its port, stamped on the run's clock.
+  for (const ImuConfig& imu : config_.imus) {
+    imus_.push_back(
+        std::make_unique<imu::RvcReader>(open_serial(imu.port, imu.baud), imu, clock(), Nanos{0}));
+  }
   if (!failed.empty()) throw DeviceError(bus_failures(failed, config_.buses.size()));
   runner_ =
       std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
@@ -71,6 +76,7 @@ Figure::~Figure() {
   dashboard_.reset();
   audio_.clear();
   runner_.reset();  // the buses close before their devices stop
+  imus_.clear();
   backend_.stop();
 }
 
@@ -84,6 +90,7 @@ RunOptions Figure::run_options() {
   options.lockstep_clock = lockstep_ ? &lockstep_clock_ : nullptr;
   options.backend_name = backend_.name();
   options.raise_device_threads = [this](int priority) { return backend_.raise_threads(priority); };
+  for (auto& imu : imus_) options.imu_readings.push_back(&imu->readings());
   return options;
 }
 

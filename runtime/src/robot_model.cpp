@@ -53,6 +53,8 @@ RobotModel make_robot_model(const RobotConfig& config, std::span<const BusConfig
   for (std::size_t j = 0; j < n; ++j) {
     if (!bound[j]) throw std::logic_error("joint " + m.joint_names[j] + " has no actuator");
   }
+  for (const ImuConfig& imu : config.imus)
+    m.imus.push_back(ImuModel{imu.name, imu.stale_timeout_s, imu.rate_hz});
   return m;
 }
 

@@ -4,6 +4,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "animrt/runtime/robot_config.hpp"
 #include "futex.hpp"
@@ -16,6 +17,9 @@ constexpr std::size_t kTelemetryCapacity = 1 << 14;  // records (~80 s at 200 Hz
 // cycle, and the others go on without it.
 constexpr double kReadBudget = kReadBudgetFraction;
 constexpr std::size_t kManualPerCycle = 64;  // manual targets taken per cycle, at most
+// Lockstep: how long (wall time) a cycle waits for an IMU's frame due by its
+// time before it goes on without it (the cycle then counts it late).
+constexpr Nanos kLockstepImuWait = 500'000'000;
 
 void sleep_until_deadline(Nanos deadline) {
   timespec ts{};
@@ -100,6 +104,8 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
     view_[b].assign(devices.begin(), devices.end());
   }
   in_.buses = io_;
+  imu_io_.resize(model.imus.size());
+  in_.imus = imu_io_;
   in_.motion_duration_s = options.duration_s;
   for (std::size_t b = 0; b < buses.size(); ++b) {
     workers_.push_back(std::make_unique<BusWorker>(*buses[b], bus_positions[b], io_done_));
@@ -202,6 +208,33 @@ void RunLoop::take_reads() {
   }
 }
 
+// The IMU's newest reading. In lockstep the part's frames follow the
+// simulated clock, so the cycle waits (boundedly, as for a lockstep bus)
+// for the frame due by its time: a lockstep run sees every frame whatever
+// the machine's load.
+void RunLoop::take_imu(std::size_t i) {
+  Mailbox<ImuReading>& box = *options_.imu_readings[i];
+  ImuIo& io = imu_io_[i];
+  const auto take = [&] {
+    if (!box.take(io.reading)) return;
+    io.valid = true;
+    io.reading.time_s -= to_seconds(start_);  // on the run's clock -> since the run began
+  };
+  take();
+  if (!options_.lockstep_clock) return;
+  // A simulated part sends on whole multiples of its period on the clock;
+  // a frame due before the run began may have been dropped as old by the
+  // reader when it opened the line, so only later ones are waited for.
+  const double rate = model_.imus[i].rate_hz;
+  const double due = std::floor(to_seconds(deadline_) * rate + 1e-9) / rate - to_seconds(start_);
+  if (due <= 1e-9) return;
+  const Nanos give_up = wall_.now() + kLockstepImuWait;
+  while ((!io.valid || io.reading.time_s < due - 1e-9) && wall_.now() < give_up) {
+    sleep_until_deadline(wall_.now() + 100'000);
+    take();
+  }
+}
+
 void RunLoop::gather_inputs() {
   RunControls* const controls = options_.controls;
   in_.t = to_seconds(deadline_ - start_);  // nominal time: smooth motion
@@ -210,6 +243,9 @@ void RunLoop::gather_inputs() {
   in_.steer = controls && controls->steer.take(steer_) ? &steer_ : nullptr;
   in_.jog = controls && controls->jog.take(jog_) ? &jog_ : nullptr;
   in_.show = controls && controls->show.take(show_) ? &show_ : nullptr;
+  for (std::size_t i = 0; i < imu_io_.size() && i < options_.imu_readings.size(); ++i) {
+    if (options_.imu_readings[i]) take_imu(i);
+  }
   // Targets first, then the mode: a target posted after manual mode was
   // switched on is never taken for one sent before it.
   std::size_t count = 0;

@@ -95,6 +95,7 @@ class RunLoop {
   void wait_for(bool reads, Nanos deadline);
   void take_reads();
   void gather_inputs();
+  void take_imu(std::size_t i);
   void publish(const CycleOutputs& out);
   void notify(const CycleOutputs& out);
   void post_writes(const CycleOutputs& out);
@@ -134,6 +135,7 @@ class RunLoop {
   std::vector<std::uint8_t> pending_;  // a read posted, not yet used
   std::vector<std::uint64_t> io_seen_;
   // Controls taken from the mailboxes this cycle.
+  std::vector<ImuIo> imu_io_;  // per IMU: the latest reading taken
   CycleInputs in_;
   MotionCommand steer_;
   ShowCommand show_;

@@ -113,6 +113,20 @@ std::string describe_event(const RobotModel& m,
           "reached the joint, which braked from its last command, and the run ramped to home",
           m.motion, m.joint_names[static_cast<std::size_t>(e.joint)],
           std::isnan(e.value) ? "NaN" : (e.value > 0 ? "+inf" : "-inf"), e.t);
+    case EventKind::sensor_stale:
+      return fmt::format(
+          "IMU {}: no reading for {:.3f} s (stale_timeout_s {}) at t={:.3f} s; joints ramped to "
+          "home",
+          m.imus[e.bus].name, e.value, m.imus[e.bus].stale_timeout_s, e.t);
+    case EventKind::tilted:
+      return fmt::format(
+          "tilt watch: the trunk tilted {:.1f} deg (safety.tilt_limit_deg {:.1f} for {} s) at "
+          "t={:.3f} s; {}",
+          e.value * 180.0 / M_PI, m.safety.tilt_limit_rad * 180.0 / M_PI, m.safety.tilt_time_s, e.t,
+          m.safety.on_tilt == SafetyConfig::OnTilt::hold
+              ? fmt::format("every joint held where it was for {} s, then torque off",
+                            m.safety.tilt_hold_s)
+              : std::string("torque switched off at once"));
     default:
       return {};
   }

@@ -214,4 +214,25 @@ TorsoPose MujocoJointPhysics::torso_pose() const {
   return pose;
 }
 
+TorsoMotion MujocoJointPhysics::torso_motion() const {
+  std::lock_guard lock(mutex_);
+  const mjModel* m = model_.get();
+  mjData* d = data_.get();
+  const int torso = meta_.torso_body;
+  TorsoMotion out;
+  for (int i = 0; i < 4; ++i) out.quat[static_cast<std::size_t>(i)] = d->xquat[4 * torso + i];
+  // Body accelerations are filled only for models with acceleration
+  // sensors; computing them changes no state the next step reads.
+  mj_rnePostConstraint(m, d);
+  mjtNum vel[6], acc[6];  // rotational, then translational; in the body's frame
+  mj_objectVelocity(m, d, mjOBJ_BODY, torso, vel, 1);
+  mj_objectAcceleration(m, d, mjOBJ_BODY, torso, acc, 1);
+  for (std::size_t i = 0; i < 3; ++i) {
+    out.rate_rad_s[i] = vel[i];
+    out.accel_m_s2[i] = acc[3 + i];
+  }
+  out.time_s = d->time;
+  return out;
+}
+
 }  // namespace animrt::sim

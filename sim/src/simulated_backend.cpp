@@ -67,6 +67,23 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
   }
   devices_ = start_simulated_devices(config.buses, clock, physics);
   for (const auto& device : devices_) lines.push_back("simulated devices: " + device->describe());
+  // Each IMU a simulated part on a pty: on the physics' torso, or without
+  // physics level or pushed over as the robot file's `sim:` says.
+  for (ImuConfig& imu : config.imus) {
+    sim::TrunkProvider trunk = sim::scripted_trunk(imu.sim_push);
+    std::string source = imu.sim_push.on ? "pushed over by the robot file's script" : "level";
+    if (own_physics_) {
+      trunk = [physics = own_physics_.get()](double) {
+        const sim::TorsoMotion torso = physics->torso_motion();
+        return sim::TrunkState{torso.quat, torso.accel_m_s2};
+      };
+      source = "on the physics' torso";
+    }
+    imus_.push_back(std::make_unique<sim::RvcSimImu>(imu, clock, clock.now(), std::move(trunk)));
+    imu.port = imus_.back()->port();
+    lines.push_back("simulated IMU " + imu.name + " (" + imu.protocol + ") on " + imu.port + ", " +
+                    source);
+  }
   return lines;
 }
 
@@ -101,6 +118,9 @@ void SimulatedBackend::report(RunSummary& summary) const {
   summary.physics = report;
 }
 
-void SimulatedBackend::stop() { devices_.clear(); }
+void SimulatedBackend::stop() {
+  imus_.clear();
+  devices_.clear();
+}
 
 }  // namespace animrt

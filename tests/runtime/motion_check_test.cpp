@@ -78,7 +78,7 @@ TEST_F(MotionCheckTest, ShippedWalkPasses) {
 }
 
 // A gait made with the balance reflex was scored with it, and the runtime
-// cannot read the trunk's attitude: refused at its balance key.
+// does not play the reflex: refused at its balance key.
 TEST_F(MotionCheckTest, AGaitWithTheBalanceReflexIsRefused) {
   const std::string text = gait_text_ + "balance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}\n";
   write_file(dir_ / "gaits" / "walk.yaml", text);

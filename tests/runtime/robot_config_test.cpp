@@ -239,7 +239,7 @@ TEST_F(RobotConfigTest, AbsoluteMotionFileIsKeptAsGiven) {
 TEST_F(RobotConfigTest, UnknownKeysAreRejectedAtEveryLevel) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"),
             at("10:1: colour: unknown key (expected one of: name, loop, safety, buses, joints, "
-               "motion, model)"));
+               "motion, model, imus)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100, rate: 5}
 )"),
@@ -250,7 +250,8 @@ safety: {watchdog_s: 1}
 )"),
             at("3:10: safety.watchdog_s: unknown key (expected one of: watchdog_timeout_s, "
                "start_ramp_s, stop_ramp_s, start_ramp_max_s, stop_deadline_s, "
-               "following_error_deg, following_error_mm, following_error_window_s, health)"));
+               "following_error_deg, following_error_mm, following_error_window_s, health, "
+               "tilt_limit_deg, tilt_time_s, on_tilt, tilt_hold_s)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -1125,6 +1126,61 @@ motion: {type: gait, file: ../gaits/gait.yaml}
 )");
   EXPECT_NE(modbus.find(at("4:70: buses.b.device_watchdog_ms: ")), std::string::npos) << modbus;
   EXPECT_NE(modbus.find("names no watchdog or timeout register"), std::string::npos) << modbus;
+}
+
+}  // namespace
+}  // namespace animrt
+
+namespace animrt {
+namespace {
+
+// ------------------------------------------------------------ IMUs and tilt
+
+class RobotConfigImu : public RobotConfigTest {
+ protected:
+  std::string with(const std::string& extra) { return std::string(kMinimal) + extra; }
+};
+
+TEST_F(RobotConfigImu, AnImuAndTheTiltWatchAreRead) {
+  const RobotConfig c = load(with(R"(imus:
+  - {name: trunk, protocol: bno08x_rvc, port: /dev/ttyUSB1, stale_timeout_s: 0.05,
+     mount: {yaw_deg: 90, roll_deg: 180},
+     sim: {push_at_s: 1.5, push_axis: pitch, push_rate_deg_s: 120, push_to_deg: -85}}
+safety: {tilt_limit_deg: 50, tilt_time_s: 0.3, on_tilt: torque_off}
+)"));
+  ASSERT_EQ(c.imus.size(), 1u);
+  EXPECT_EQ(c.imus[0].name, "trunk");
+  EXPECT_EQ(c.imus[0].port, "/dev/ttyUSB1");
+  EXPECT_DOUBLE_EQ(c.imus[0].stale_timeout_s, 0.05);
+  EXPECT_NEAR(c.imus[0].mount_ypr_rad[0], kPi / 2, 1e-12);
+  EXPECT_NEAR(c.imus[0].mount_ypr_rad[2], kPi, 1e-12);
+  EXPECT_TRUE(c.imus[0].sim_push.on);
+  EXPECT_TRUE(c.imus[0].sim_push.pitch);
+  EXPECT_NEAR(c.imus[0].sim_push.to_rad, -85 * kPi / 180, 1e-12);
+  EXPECT_NEAR(c.safety.tilt_limit_rad, 50 * kPi / 180, 1e-12);
+  EXPECT_DOUBLE_EQ(c.safety.tilt_time_s, 0.3);
+  EXPECT_EQ(c.safety.on_tilt, SafetyConfig::OnTilt::torque_off);
+}
+
+TEST_F(RobotConfigImu, BadImusAreNamedWhereTheyAre) {
+  EXPECT_EQ(error_of(with("imus:\n  - {name: trunk, protocol: mpu6050}\n")),
+            at("11:29: imus[0].protocol: unknown IMU protocol \"mpu6050\" (supported: "
+               "bno08x_rvc)"));
+  EXPECT_NE(error_of(with("imus:\n  - {name: trunk, protocol: bno08x_rvc, rate_hz: 400}\n"))
+                .find("imus[0].rate_hz: expected 100"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("imus:\n  - {name: trunk, protocol: bno08x_rvc, stale_timeout_s: "
+                          "0.01}\n"))
+                .find("imus[0].stale_timeout_s: expected at least two"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("safety: {on_tilt: ramp}\n")).find("safety.on_tilt: expected hold or"),
+            std::string::npos);
+}
+
+TEST_F(RobotConfigImu, ATiltWatchWithoutAnImuIsRefused) {
+  EXPECT_NE(error_of(with("safety: {tilt_limit_deg: 45}\n"))
+                .find("safety.tilt_limit_deg: the tilt watch needs an IMU"),
+            std::string::npos);
 }
 
 }  // namespace

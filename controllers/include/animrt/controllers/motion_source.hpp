@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "animrt/core/clock.hpp"
+#include "animrt/core/imu.hpp"
 
 namespace animrt {
 
@@ -39,6 +40,13 @@ struct ShowPosition {
   double duration_s = 0.0;
 };
 
+// What the figure senses this cycle, handed to a source before sample().
+struct Sensors {
+  // The trunk's IMU (the robot file's first), null when the figure has none
+  // or its reading is stale.
+  const ImuReading* imu = nullptr;
+};
+
 // The run's clock, handed to a source when its motion starts: CLOCK_MONOTONIC
 // in a real-time run, the simulated clock in a lockstep run.
 struct MotionClock {
@@ -65,6 +73,11 @@ class MotionSource {
   // when one arrived (the cycle reads it from a lock-free mailbox). Same
   // rules as sample(): no allocation, lock, log or I/O.
   virtual void steer(const MotionCommand& /*command*/) {}
+
+  // This cycle's sensor readings, handed over by the cycle before sample()
+  // in the motion phase (a gait's balance reflex reads the trunk's
+  // attitude). Same rules as sample(); the pointers live for this call only.
+  virtual void sense(const Sensors& /*sensors*/) {}
 
   // A show's transport: a source that plays a show keeps its own playhead,
   // which maps the motion's time `t` (as sample() gets it) to the show's.

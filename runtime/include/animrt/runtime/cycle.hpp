@@ -21,6 +21,7 @@
 
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/imu.hpp"
 #include "animrt/runtime/pose_ramp.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/run_controls.hpp"
@@ -44,9 +45,18 @@ struct BusIo {
   std::span<const HealthReading> readings{};
 };
 
+// One IMU's latest reading, as its reader thread last published it. The
+// cycle judges its age by reading.time_s: older than the part's stale
+// timeout, the sensor is silent.
+struct ImuIo {
+  bool valid = false;  // a frame has arrived (false until the first)
+  ImuReading reading;
+};
+
 struct CycleInputs {
   double t = 0.0;  // seconds since the run began, at this cycle's deadline
   std::span<const BusIo> buses;
+  std::span<const ImuIo> imus;           // per RobotModel::imus
   double motion_duration_s = 0.0;        // seconds of motion, then ramp home; 0 = until a stop
   bool stop = false;                     // ramp home and end
   bool abort = false;                    // torque off at once
@@ -72,6 +82,8 @@ enum class EventKind : std::uint8_t {
   aborted,          // torque off now on request
   health_fault,     // bus, device, check, value: a health limit; the device is switched off
   health_warning,   // bus, device, check, value: logged and counted; the run goes on
+  sensor_stale,     // an IMU silent past its stale timeout: bus = IMU index, value = age (s)
+  tilted,           // the tilt watch: value = the larger of |roll| and |pitch| (rad)
 };
 
 // Which health limit an event is about.
@@ -105,6 +117,7 @@ struct CycleEnd {
   bool fault = false;       // a device, motion or following-error fault
   bool stopped = false;     // a stop request
   bool torque_cut = false;  // stop deadline or abort: torque went off without a ramp
+  bool tilted = false;      // the tilt watch stopped the motion
 };
 
 class CycleState {
@@ -144,6 +157,13 @@ class CycleState {
   // fault asks for the device to be switched off (1).
   const std::vector<std::vector<HealthStats>>& health_stats() const { return health_stats_; }
   const std::vector<std::vector<std::uint8_t>>& switch_off() const { return switch_off_; }
+  // Per IMU: cycles its reading was older than one report and one loop
+  // period (late),
+  // and whether it went stale past its timeout (faulted).
+  std::span<const std::uint64_t> imu_late_cycles() const { return imu_late_; }
+  std::span<const std::uint8_t> imu_faulted() const { return imu_faulted_; }
+  // The trunk's largest |roll| or |pitch| seen (rad; 0 without an IMU).
+  double max_tilt() const { return max_tilt_; }
 
  private:
   friend const CycleOutputs& step(const RobotModel&, MotionSource&, CycleState&,
@@ -151,6 +171,7 @@ class CycleState {
   friend struct CycleStages;  // step()'s stages (cycle.cpp)
   void emit(const CycleEvent& event);
   void begin_stop(const RobotModel& model, double t);
+  void begin_hold(const RobotModel& model, double t);
 
   Phase phase_ = Phase::start_ramp;
   double phase_start_ = 0.0;
@@ -190,6 +211,15 @@ class CycleState {
   std::vector<std::vector<HealthTrack>> health_track_;
   std::vector<std::vector<HealthStats>> health_stats_;
   std::vector<std::vector<std::uint8_t>> switch_off_;
+  // Sensors: per IMU, late cycles and the fault record; the trunk's reading
+  // handed to the motion, and the tilt watch.
+  std::vector<std::uint64_t> imu_late_;
+  std::vector<std::uint8_t> imu_faulted_;
+  double imu_start_ = 0.0;
+  ImuReading trunk_;
+  Sensors sensors_;
+  double tilt_since_ = -1.0;
+  double max_tilt_ = 0.0;
   CycleOutputs out_;
 };
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "animrt/bridge/actuator_bus.hpp"
+#include "animrt/bridge/imu/rvc_reader.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/figure_backend.hpp"
@@ -85,6 +86,7 @@ class Figure {
   ManualClock lockstep_clock_;
   MonotonicClock wall_clock_;
   std::vector<ActuatorBus*> buses_;
+  std::vector<std::unique_ptr<imu::RvcReader>> imus_;
   std::unique_ptr<Runner> runner_;
   std::vector<std::unique_ptr<ShowAudioPlayer>> audio_;
   std::unique_ptr<RunMonitor> monitor_;

@@ -62,6 +62,17 @@ class HardwareBackend final : public FigureBackend {
  public:
   std::string name() const override { return "hardware"; }
   bool keeps_run_clock() const override { return false; }
+  // A real IMU needs its port (a simulated one is given a pty).
+  void check(const RobotConfig& config, bool lockstep) const override {
+    (void)lockstep;
+    for (std::size_t i = 0; i < config.imus.size(); ++i) {
+      if (config.imus[i].port.empty()) {
+        throw InputError(config.imus[i].where, "imus[" + std::to_string(i) + "].port",
+                         "expected the serial port of IMU " + config.imus[i].name +
+                             " (needed on hardware), found none");
+      }
+    }
+  }
 };
 
 }  // namespace animrt

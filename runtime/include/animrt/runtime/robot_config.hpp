@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/imu/imu_config.hpp"
 #include "animrt/controllers/head/head_source.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
@@ -30,6 +31,16 @@ struct SafetyConfig {
   double following_error_window_s = 0.5;
   // Device health limits (safety.health); a bus may have its own.
   HealthLimits health{};
+  // Tilt watch (needs an IMU): the trunk's roll or pitch beyond
+  // tilt_limit_rad for tilt_time_s ends the motion (0 = off). A figure that
+  // is falling or on its side must not ramp home (the legs would push on the
+  // floor and against the fall): on_tilt `hold` keeps every joint where it
+  // is for tilt_hold_s, then torque goes off as at every end of a run;
+  // `torque_off` lets go at once.
+  double tilt_limit_rad = 0.0;
+  double tilt_time_s = 0.2;
+  enum class OnTilt { hold, torque_off } on_tilt = OnTilt::hold;
+  double tilt_hold_s = 1.0;
 };
 
 struct MotionConfig {
@@ -59,6 +70,7 @@ struct RobotConfig {
   SafetyConfig safety;
   std::vector<JointSpec> joints;
   std::vector<BusConfig> buses;  // each with its actuators (joint_index filled in)
+  std::vector<ImuConfig> imus;   // the first is the trunk's
   MotionConfig motion;
   // Optional MJCF model of the figure (the dashboard draws it): resolved
   // against the robot file's folder; empty when the file names none.

@@ -29,6 +29,12 @@ struct BusModel {
   HealthLimits health{};       // the bus's health_limits, else safety.health
 };
 
+struct ImuModel {
+  std::string name;
+  double stale_timeout_s = 0.25;
+  double rate_hz = 100.0;  // its report rate
+};
+
 struct RobotModel {
   std::string name;
   double rate_hz = 0.0;
@@ -44,6 +50,7 @@ struct RobotModel {
   std::vector<double> following_error;  // per joint: the watch's threshold (rad or m)
   std::vector<JointSlot> slots;         // per joint
   std::vector<BusModel> buses;
+  std::vector<ImuModel> imus;  // the first is the trunk's
 
   std::size_t joint_count() const { return joint_names.size(); }
 };

@@ -18,6 +18,8 @@
 #include "animrt/bridge/actuator_bus.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/core/imu.hpp"
+#include "animrt/core/mailbox.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/run_controls.hpp"
@@ -59,6 +61,11 @@ struct RunOptions {
   // the bus I/O threads'; returns why, for each thread that could not have it
   // (the summary's notes).
   std::function<std::vector<std::string>(int priority)> raise_device_threads;
+  // Per IMU of the robot file (in its order): where the IMU's reader posts
+  // its readings, time_s in seconds on the run's clock (the loop makes it
+  // time since the run began). A configured IMU without one
+  // never reports and is faulted as stale.
+  std::vector<Mailbox<ImuReading>*> imu_readings;
 };
 
 class Runner {

@@ -10,6 +10,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/runtime/figure_backend.hpp"
+#include "animrt/sim/imu/rvc_sim_imu.hpp"
 #include "animrt/sim/simulated_bus.hpp"
 
 namespace animrt {
@@ -76,6 +77,7 @@ class SimulatedBackend final : public FigureBackend {
   Settings settings_;
   std::unique_ptr<sim::MujocoJointPhysics> own_physics_;  // outlives the devices
   std::vector<std::unique_ptr<SimulatedBus>> devices_;
+  std::vector<std::unique_ptr<sim::RvcSimImu>> imus_;
 };
 
 }  // namespace animrt

@@ -12,6 +12,7 @@
 // below half its standing height, tilted more than 60 degrees, the trunk on
 // the ground, or unstable).
 
+#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -51,6 +52,16 @@ struct PhysicsMeasures {
   int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
 };
 
+// What an IMU on the torso measures: its attitude in the world (w, x, y, z,
+// MuJoCo's xquat), its angular velocity and the specific force (what an
+// accelerometer feels: +1 g up at rest) in the torso's own frame.
+struct TorsoMotion {
+  std::array<double, 4> quat{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> rate_rad_s{};
+  std::array<double, 3> accel_m_s2{};
+  double time_s = 0.0;  // physics time
+};
+
 class MujocoJointPhysics final : public JointPhysics {
  public:
   // Loads `model_path` and binds every joint of `joints` (the robot's, named
@@ -85,6 +96,7 @@ class MujocoJointPhysics final : public JointPhysics {
 
   PhysicsMeasures measures() const;
   TorsoPose torso_pose() const;
+  TorsoMotion torso_motion() const;
 
  private:
   void step();  // one mj_step and the fall watch; mutex held
