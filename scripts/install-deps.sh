@@ -26,6 +26,9 @@ packages=(
   libcpp-httplib-dev libjs-three libjs-chart.js
   chromium chromium-driver python3-selenium
 )
+# npm for the MCAP test's reader (below): Debian's, unless a Node.js with npm
+# is installed already (Debian's npm package conflicts with other Node builds).
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
