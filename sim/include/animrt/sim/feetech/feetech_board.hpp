@@ -31,6 +31,7 @@
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/feetech/feetech_codec.hpp"
 #include "animrt/core/clock.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -74,6 +75,8 @@ class FeetechServo {
   bool responding() const { return responding_; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
+  // Current, supply and temperature (servo_health_model.hpp).
+  ServoHealthModel& health() { return health_; }
 
   // Goal positions received (decoded, in steps), for tests.
   std::uint64_t goals_received() const { return goals_received_; }
@@ -96,6 +99,8 @@ class FeetechServo {
   std::array<std::uint8_t, ft::reg::table_size> table_{};
   Motor motor_;
   Nanos motor_time_;
+  ServoHealthModel health_;
+  std::uint8_t injected_ = 0;  // set_fault()'s bits
   bool responding_ = true;
   std::array<std::uint8_t, ft::reg::table_size> pending_{};
   std::uint8_t pending_address_ = 0;
