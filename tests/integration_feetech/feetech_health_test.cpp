@@ -36,8 +36,9 @@ TEST(FeetechHealth, EveryCycleCarriesSupplyTemperatureAndCurrent) {
   EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
   for (const auto& d : s.devices) {
     EXPECT_GE(d.health.readings + 2, s.cycles) << d.joint;
-    EXPECT_NEAR(d.health.min_temperature_c, 36.0, 0.5) << d.joint;
-    EXPECT_NEAR(d.health.min_voltage_v, 11.9, 0.15) << d.joint;
+    // The board's rest values (the manual's 30 C, 12.1 V), sagging with the load.
+    EXPECT_NEAR(d.health.min_temperature_c, 30.0, 0.5) << d.joint;
+    EXPECT_NEAR(d.health.min_voltage_v, 12.0, 0.15) << d.joint;
     // 6.5 mA units: the idle 50 mA and more while moving.
     EXPECT_GT(d.health.peak_current_a, 0.04) << d.joint;
     EXPECT_LT(d.health.peak_current_a, 1.0) << d.joint;

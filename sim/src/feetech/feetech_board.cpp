@@ -68,6 +68,15 @@ std::uint8_t baud_register(int baud) {
   return static_cast<std::uint8_t>(best);
 }
 
+// The health model at the board's own rest values (the manual's 12.1 V and
+// 30 C) unless the robot file's sim.health sets them.
+SimHealthSettings feetech_health(SimHealthSettings h) {
+  const SimHealthSettings defaults;
+  if (h.ambient_c == defaults.ambient_c) h.ambient_c = kTemperatureC;
+  if (h.supply_v == defaults.supply_v) h.supply_v = kVoltageDeciV / 10.0;
+  return h;
+}
+
 }  // namespace
 
 bool feetech_may_answer(const ft::Packet& packet) {
@@ -84,7 +93,7 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_steps_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
       motor_time_(now),
-      health_(settings.health, binding.device_id, now) {
+      health_(feetech_health(settings.health), binding.device_id, now) {
   const bool sts = series_ == ft::Series::sts;
   table_[reg::firmware_major] = 3;
   std::memcpy(&table_[reg::model], sts ? kStsModel : kScsModel, 2);
@@ -163,8 +172,11 @@ void FeetechServo::publish() {
   // (6.5 mA units); its status bits from them, as its firmware sets them
   // (voltage, temperature, overload share the layout the model uses).
   const double amps = health_.current_a();
-  const double stall = std::max(1e-3, 1.4);
-  const auto load = static_cast<std::int32_t>(std::lround(std::min(1000.0, 1000.0 * amps / stall)));
+  // Load: the current beyond holding, against the stall current (0 at rest).
+  const SimHealthSettings& model = health_.settings();
+  const double span = std::max(1e-3, model.stall_current_a - model.idle_current_a);
+  const auto load = static_cast<std::int32_t>(
+      std::lround(std::clamp(1000.0 * (amps - model.idle_current_a) / span, 0.0, 1000.0)));
   ft::put_u16(series_, &table_[reg::present_load],
               ft::encode_signed(motor_.velocity < 0 ? -load : load, ft::kScsSignBit));
   table_[reg::present_voltage] =
