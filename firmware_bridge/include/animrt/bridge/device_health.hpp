@@ -19,7 +19,7 @@ struct HealthReading {
   double voltage_v = kNone;  // the device's supply input
   double torque_nm = kNone;  // magnitude of the torque the device reports (MIT replies)
   // The device's own fault register (Dynamixel Hardware Error Status,
-  // Feetech status, CiA 402 error code, a Modbus fault register), as read;
+  // Feetech status bits, CiA 402 Error Code), as read;
   // meaningful only when has_error_bits.
   std::uint32_t error_bits = 0;
   bool has_error_bits = false;
