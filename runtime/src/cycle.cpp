@@ -226,6 +226,7 @@ struct CycleStages {
         keep_max(st.max_temperature_c, r.temperature_c);
         keep_max(st.peak_current_a, r.current_a);
         keep_min(st.min_voltage_v, r.voltage_v);
+        keep_max(st.peak_torque_nm, r.torque_nm);
 
         const auto emit = [&](EventKind kind, HealthCheck check, double value) {
           s.emit(

@@ -29,7 +29,7 @@ void sleep_until_deadline(Nanos deadline) {
   }
 }
 
-constexpr std::size_t kHealthColumns = 4;  // temperature, current, voltage, error bits
+constexpr std::size_t kHealthColumns = 5;  // temperature, current, voltage, torque, error bits
 
 std::vector<JointSlot> health_slots(const std::vector<std::unique_ptr<ActuatorBus>>& buses) {
   std::vector<JointSlot> slots;
@@ -85,7 +85,8 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
   if (!options.telemetry_path.empty()) {
     for (const JointSlot& slot : health_columns_) {
       const std::string& joint = buses[slot.bus]->config().actuators[slot.device].joint;
-      for (const char* suffix : {"_temp_c", "_current_a", "_voltage_v", "_error_bits"}) {
+      for (const char* suffix :
+           {"_temp_c", "_current_a", "_voltage_v", "_torque_nm", "_error_bits"}) {
         health_names_.push_back(joint + suffix);
       }
     }
@@ -309,6 +310,7 @@ void RunLoop::record(const CycleOutputs& out) {
       record_[k++] = r.temperature_c;
       record_[k++] = r.current_a;
       record_[k++] = r.voltage_v;
+      record_[k++] = r.torque_nm;
       record_[k++] = r.has_error_bits ? static_cast<double>(r.error_bits) : HealthReading::kNone;
     }
     ring_.push(record_);

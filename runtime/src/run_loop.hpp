@@ -117,7 +117,7 @@ class RunLoop {
   const Nanos period_;
 
   // Telemetry's health columns: per (bus, device) whose bus reads health,
-  // four values each after the joints' columns.
+  // five values each after the joints' columns.
   std::vector<JointSlot> health_columns_;
   std::vector<std::string> health_names_;
   TelemetryRing ring_;

@@ -25,10 +25,10 @@ enum Header : std::size_t {
   kHeaderWords
 };
 constexpr std::size_t kJointWords = 4;    // cmd, meas, vel, manual pose
-constexpr std::size_t kDeviceWords = 13;  // id, health, faulted, 6 counters, 4 health values
+constexpr std::size_t kDeviceWords = 14;  // id, health, faulted, 6 counters, 5 health values
 constexpr std::size_t kTimingCapacity = 1 << 13;  // cycles (40 s at 200 Hz unread)
 constexpr std::size_t kEventCapacity = 256;
-constexpr std::size_t kEventWidth = 7;
+constexpr std::size_t kEventWidth = 8;
 
 RunPhaseView view_of(Phase phase) {
   switch (phase) {
@@ -154,6 +154,7 @@ void RunMonitor::publish(double t, const CycleState& state, std::span<const doub
       store(w + 9, s.reading.temperature_c);
       store(w + 10, s.reading.current_a);
       store(w + 11, s.reading.voltage_v);
+      store(w + 13, s.reading.torque_nm);
       store(w + 12, s.reading.has_error_bits ? static_cast<double>(s.reading.error_bits)
                                              : HealthReading::kNone);
     }
@@ -197,7 +198,8 @@ void RunMonitor::push_event(const CycleEvent& e) {
                                       static_cast<double>(e.bus),
                                       static_cast<double>(e.device),
                                       static_cast<double>(e.health),
-                                      e.value};
+                                      e.value,
+                                      static_cast<double>(e.check)};
   events_.push(record);
 }
 
@@ -260,6 +262,7 @@ void RunMonitor::read(RunView& view) const {
     s.reading.temperature_c = as_double(w[i + 9]);
     s.reading.current_a = as_double(w[i + 10]);
     s.reading.voltage_v = as_double(w[i + 11]);
+    s.reading.torque_nm = as_double(w[i + 13]);
     const double bits = as_double(w[i + 12]);
     s.reading.has_error_bits = !std::isnan(bits);
     s.reading.error_bits = s.reading.has_error_bits ? static_cast<std::uint32_t>(bits) : 0;
@@ -282,7 +285,8 @@ bool RunMonitor::pop_event(CycleEvent& e) {
                  static_cast<std::size_t>(r[3]),
                  static_cast<std::size_t>(r[4]),
                  static_cast<DeviceHealth>(static_cast<int>(r[5])),
-                 r[6]};
+                 r[6],
+                 static_cast<HealthCheck>(static_cast<int>(r[7]))};
   return true;
 }
 

@@ -23,9 +23,11 @@ std::string value_or_na(double v, const char* format_unit) {
 std::string health_text(const HealthStats& h) {
   if (h.readings == 0) return {};
   return fmt::format(
-      "\n      health: temperature {}..{}, peak current {}, min voltage {}, warnings {}",
+      "\n      health: temperature {}..{}, peak current {}, min voltage {}{}, warnings {}",
       value_or_na(h.min_temperature_c, "{:.0f} C"), value_or_na(h.max_temperature_c, "{:.0f} C"),
       value_or_na(h.peak_current_a, "{:.2f} A"), value_or_na(h.min_voltage_v, "{:.1f} V"),
+      std::isnan(h.peak_torque_nm) ? std::string()
+                                   : fmt::format(", peak torque {:.2f} Nm", h.peak_torque_nm),
       h.warnings);
 }
 
@@ -111,6 +113,7 @@ nlohmann::json device_json(const DeviceReport& d) {
                           {"max_temperature_c", number_or_null(d.health.max_temperature_c)},
                           {"peak_current_a", number_or_null(d.health.peak_current_a)},
                           {"min_voltage_v", number_or_null(d.health.min_voltage_v)},
+                          {"peak_torque_nm", number_or_null(d.health.peak_torque_nm)},
                           {"warnings", d.health.warnings}}}};
 }
 

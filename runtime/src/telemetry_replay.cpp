@@ -47,7 +47,7 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   if (!std::getline(in, line)) fail(0, "expected a telemetry CSV header, found an empty file");
   ++line_no;
   const std::vector<std::string> header = split(line);
-  // time_s, n commands, n measurements, then device health columns (4 per
+  // time_s, n commands, n measurements, then device health columns (5 per
   // device whose bus reads health), which a replay does not use.
   std::size_t n = 0;
   while (1 + n < header.size() && ends_with(header[1 + n], "_cmd_rad")) ++n;
@@ -70,9 +70,9 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   for (std::size_t c = 1 + 2 * n; c < header.size(); ++c) {
     const std::string& h = header[c];
     if (!ends_with(h, "_temp_c") && !ends_with(h, "_current_a") && !ends_with(h, "_voltage_v") &&
-        !ends_with(h, "_error_bits")) {
+        !ends_with(h, "_torque_nm") && !ends_with(h, "_error_bits")) {
       fail(0,
-           "expected a device health column (<joint>_temp_c, _current_a, _voltage_v or "
+           "expected a device health column (<joint>_temp_c, _current_a, _voltage_v, _torque_nm or "
            "_error_bits) as column " +
                std::to_string(c + 1) + ", found " + quote(h));
     }

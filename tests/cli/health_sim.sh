@@ -3,7 +3,7 @@
 # reads health packed, with limits in the safety section and an overheat
 # injected in the sim section, runs on the simulated backend in lockstep;
 # the run ends with exit 4 naming the servo and its temperature, its
-# telemetry carries four health columns per servo after the joints', and
+# telemetry carries five health columns per servo after the joints', and
 # the JSON summary each servo's temperature range, peak current and lowest
 # voltage. A bad health key stops the load with its file, line and column.
 set -uo pipefail
@@ -47,10 +47,10 @@ for d in s["devices"]:
     assert 11 < h["min_voltage_v"] < 12.1, h
     assert 0.04 < h["peak_current_a"] < 1.0, h
 rows = list(csv.reader(open(sys.argv[2])))
-assert len(rows[0]) == 25 + 48, len(rows[0])
+assert len(rows[0]) == 25 + 60, len(rows[0])
 first = rows[0][1][: -len("_cmd_rad")]
-assert rows[0][25:29] == [first + "_temp_c", first + "_current_a", first + "_voltage_v",
-                          first + "_error_bits"], rows[0][25:29]
+assert rows[0][25:30] == [first + "_temp_c", first + "_current_a", first + "_voltage_v",
+                          first + "_torque_nm", first + "_error_bits"], rows[0][25:30]
 # The hot servo's column shows the overheat before the run ended.
 col = rows[0].index("lh_ankle_temp_c")
 assert max(float(r[col]) for r in rows[1:]) >= 74.5

@@ -59,6 +59,30 @@ TEST(Replay, ARecordingLoadsAndBadOnesAreErrorsAtTheirPlace) {
             ":1: expected at least one row after the header");
 }
 
+// A run that read device health writes five columns per device after the
+// joints'; a replay reads the joints' and leaves those.
+TEST(Replay, ARecordingWithHealthColumnsLoads) {
+  const TelemetryRecording rec = load_telemetry_csv(write_csv(
+      "health",
+      "time_s,a_cmd_rad,a_meas_rad,a_temp_c,a_current_a,a_voltage_v,a_torque_nm,a_error_bits\n"
+      "0,0.1,0.05,36,0.05,11.9,nan,0\n"
+      "0.1,0.2,0.15,37,nan,11.8,nan,4\n"));
+  EXPECT_EQ(rec.joints, (std::vector<std::string>{"a"}));
+  ASSERT_EQ(rec.rows(), 2u);
+  EXPECT_DOUBLE_EQ(rec.cmd[1], 0.2);
+  EXPECT_DOUBLE_EQ(rec.meas[1], 0.15);
+  const std::string bad =
+      write_csv("health_bad", "time_s,a_cmd_rad,a_meas_rad,a_colour\n0,0,0,1\n");
+  try {
+    (void)load_telemetry_csv(bad);
+    ADD_FAILURE() << "an unknown extra column was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).substr(bad.size()),
+              ":1: expected a device health column (<joint>_temp_c, _current_a, _voltage_v, "
+              "_torque_nm or _error_bits) as column 4, found \"a_colour\"");
+  }
+}
+
 TEST(Replay, SeekShowsTheRecordedRowAndControlsAreRefused) {
   const TelemetryRecording rec = load_telemetry_csv(write_csv("api", kRecording));
   const RobotModel model = replay_model(rec, nullptr);

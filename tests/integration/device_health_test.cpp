@@ -74,15 +74,16 @@ TEST(DeviceHealth, PackedReadsReportTemperatureCurrentAndVoltageOfEveryServo) {
     EXPECT_EQ(d.status.reading.error_bits, 0u) << d.joint;
     EXPECT_TRUE(d.status.reading.has_error_bits) << d.joint;
   }
-  // The existing columns come first and unchanged; four per servo follow.
+  // The existing columns come first and unchanged; five per servo follow.
   const auto header = csv_header(csv);
-  ASSERT_EQ(header.size(), 1u + 24u + 48u);
+  ASSERT_EQ(header.size(), 1u + 24u + 60u);
   EXPECT_EQ(header[0], "time_s");
   EXPECT_EQ(header[1], s.joints[0].name + "_cmd_rad");
   EXPECT_EQ(header[25], s.joints[0].name + "_temp_c");
   EXPECT_EQ(header[26], s.joints[0].name + "_current_a");
   EXPECT_EQ(header[27], s.joints[0].name + "_voltage_v");
-  EXPECT_EQ(header[28], s.joints[0].name + "_error_bits");
+  EXPECT_EQ(header[28], s.joints[0].name + "_torque_nm");
+  EXPECT_EQ(header[29], s.joints[0].name + "_error_bits");
 }
 
 TEST(DeviceHealth, RoundRobinReadsOneServoPerCycle) {

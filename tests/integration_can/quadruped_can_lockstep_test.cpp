@@ -252,5 +252,30 @@ TEST(QuadrupedCanLockstep, DriveInFaultIsResetAtActivation) {
   EXPECT_TRUE(s.faults.empty());
 }
 
+// With `health: on` the drive's Error Code (603Fh) rides in TPDO1 with the
+// statusword and position; a drive fault then ends the run naming the code.
+TEST(QuadrupedCanLockstep, HealthOnCarriesTheDrivesErrorCode) {
+  test::RigSettings settings;
+  settings.edit = [](RobotConfig& c) {
+    Cia402BusOptions o = options_of<Cia402BusOptions>(c.buses[2].options);
+    o.health = true;
+    c.buses[2].options = o;
+  };
+  test::SimRig rig(kRobot, settings);
+  const int node = rig.config().buses[2].actuators[0].device_id;
+  rig.probe->on_sample = [&](double t) {
+    if (t >= 0.5) rig.sims[2]->set_device_hardware_error(node, 0x04);  // overheating
+  };
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_FALSE(s.faults.empty());
+  EXPECT_NE(s.faults[0].find("device error bits 0x4310"), std::string::npos) << s.faults[0];
+  for (const auto& d : s.devices) {
+    if (d.bus == rig.config().buses[2].name) {
+      EXPECT_GT(d.health.readings, 50u) << d.joint;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace animrt

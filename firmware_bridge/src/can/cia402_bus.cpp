@@ -122,9 +122,18 @@ void Cia402Bus::handle(const can_frame& f) {
       slot = slot_of(cob, canopen::kTpdo1Base);
       if (slot < 0) return;
       const auto device = static_cast<std::size_t>(slot);
-      if (f.len != 6) {
+      if (f.len != (options_.health ? 8 : 6)) {
         book_.garbled(device);
         return;
+      }
+      if (options_.health) {
+        HealthReading& h = book_[device].reading;
+        h.error_bits = static_cast<std::uint32_t>(canopen::get_le(f.data + 6, 2));
+        h.has_error_bits = true;
+        h.read_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::steady_clock::now().time_since_epoch())
+                        .count();
+        ++h.reads;
       }
       DriveReport& d = drive_[slot];
       d.statusword = static_cast<std::uint16_t>(canopen::get_le(f.data, 2));
@@ -366,7 +375,8 @@ void Cia402Bus::configure() {
     sdo_write(i, tpdo1_map, 0, 0, 1);
     sdo_write(i, tpdo1_map, 1, canopen::mapping(statusword, 0, 16), 4);
     sdo_write(i, tpdo1_map, 2, canopen::mapping(position_actual, 0, 32), 4);
-    sdo_write(i, tpdo1_map, 0, 2, 1);
+    if (options_.health) sdo_write(i, tpdo1_map, 3, canopen::mapping(error_code, 0, 16), 4);
+    sdo_write(i, tpdo1_map, 0, options_.health ? 3 : 2, 1);
     sdo_write(i, tpdo1_comm, 2, 1, 1);
     sdo_write(i, tpdo1_comm, 1, canopen::kTpdo1Base + node, 4);
 

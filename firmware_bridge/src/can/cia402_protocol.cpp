@@ -14,9 +14,15 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kCia402BusKeys[] = {
-    "interface",          "bitrate",          "timeout_ms",  "heartbeat_ms", "heartbeat_timeout_ms",
-    "device_watchdog_ms", "abort_connection", "host_node_id"};
+constexpr std::string_view kCia402BusKeys[] = {"interface",
+                                               "bitrate",
+                                               "timeout_ms",
+                                               "heartbeat_ms",
+                                               "heartbeat_timeout_ms",
+                                               "device_watchdog_ms",
+                                               "abort_connection",
+                                               "host_node_id",
+                                               "health"};
 
 // The consumer time of 1016h is 16 bits of milliseconds.
 constexpr int kMaxConsumerMs = 65535;
@@ -63,6 +69,7 @@ class Cia402 final : public Protocol {
     if (auto n = node.find("host_node_id")) {
       options.host_node_id = static_cast<int>(n->as_int_in(1, canopen::kMaxNodeId));
     }
+    if (auto n = node.find("health")) options.health = n->as_bool();
     bus.options = options;
   }
 

@@ -73,6 +73,14 @@ std::size_t MitBus::exchange() {
       continue;
     }
     reply_[device] = reply;
+    HealthReading& h = book_[device].reading;
+    h.torque_nm = std::abs(reply.torque);
+    h.temperature_c =
+        reply.extended ? static_cast<double>(reply.temperature) : HealthReading::kNone;
+    h.read_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::steady_clock::now().time_since_epoch())
+                    .count();
+    ++h.reads;
     if (reply.error != 0) {
       book_.hardware_fault(device, reply.error);
       book_[device].last_error_byte = reply.error;

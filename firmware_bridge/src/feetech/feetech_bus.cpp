@@ -40,6 +40,7 @@ FeetechBus::FeetechBus(BusConfig config, ft::Series series,
   servo::check_bindings(config_, ft::kMaxDeviceId, kMaxDevices);
   const std::size_t n = config_.actuators.size();
   sync_data_.resize(2 * n);
+  health_ = ft::bus_options(config_).health;
   positions_.init(config_, min_ticks_, max_ticks_);
 }
 
@@ -168,11 +169,41 @@ void FeetechBus::deactivate() {
 
 // ---- cycle ----------------------------------------------------------------
 
+namespace {
+// Health read: Present Position (56) up to Present Current (69, 2 bytes) on
+// STS, up to Present Temperature (63) on SCS.
+constexpr std::size_t kStsHealthBytes = 15;
+constexpr std::size_t kScsHealthBytes = 8;
+constexpr double kStsCurrentUnitA = 0.0065;
+}  // namespace
+
+void FeetechBus::take_health(std::size_t device, std::span<const std::uint8_t> data) {
+  if (data.size() < kScsHealthBytes) return;
+  DeviceStatus& st = link_.book()[device];
+  HealthReading& h = st.reading;
+  h.voltage_v = 0.1 * data[ft::reg::present_voltage - ft::reg::present_position];
+  h.temperature_c = data[ft::reg::present_temperature - ft::reg::present_position];
+  if (data.size() >= kStsHealthBytes) {
+    const std::uint16_t raw = ft::get_u16(series_, &data[69 - ft::reg::present_position]);
+    h.current_a = std::abs(ft::decode_signed(raw, ft::kStsSignBit)) * kStsCurrentUnitA;
+    h.error_bits = data[ft::reg::servo_status - ft::reg::present_position];
+  } else {
+    h.error_bits = st.last_error_byte;
+  }
+  h.has_error_bits = true;
+  h.read_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                  std::chrono::steady_clock::now().time_since_epoch())
+                  .count();
+  ++h.reads;
+}
+
 void FeetechBus::read_positions(std::size_t count) {
   if (series_ == ft::Series::sts) {
+    const std::size_t bytes = health_ ? kStsHealthBytes : 2;
     const std::size_t length =
-        ft::encode_sync_read(ft::reg::present_position, 2, link_.ids().first(count), link_.tx());
-    if (length > 0) link_.transact(length, count, 2);
+        ft::encode_sync_read(ft::reg::present_position, static_cast<std::uint8_t>(bytes),
+                             link_.ids().first(count), link_.tx());
+    if (length > 0) link_.transact(length, count, bytes);
     return;
   }
   // SCS servos have no Sync Read: one Read each, in turn, each with its own
@@ -180,9 +211,10 @@ void FeetechBus::read_positions(std::size_t count) {
   // while it is asked, and swapped back with its result.
   for (std::size_t s = 0; s < count; ++s) {
     link_.swap_slots(0, s);
-    const std::size_t length =
-        ft::encode_read(link_.ids()[0], ft::reg::present_position, 2, link_.tx());
-    link_.transact(length, 1, 2);
+    const std::size_t bytes = health_ ? kScsHealthBytes : 2;
+    const std::size_t length = ft::encode_read(link_.ids()[0], ft::reg::present_position,
+                                               static_cast<std::uint8_t>(bytes), link_.tx());
+    link_.transact(length, 1, bytes);
     link_.swap_slots(0, s);
   }
 }
@@ -196,6 +228,7 @@ void FeetechBus::read(std::span<double> positions) {
     if (link_.answer(s) != Answer::ok) continue;
     positions_.measured(link_.asked(s), to_position(static_cast<std::uint16_t>(link_.value(s))),
                         positions);
+    if (health_) take_health(link_.asked(s), link_.data(s));
   }
 }
 

@@ -17,7 +17,8 @@ constexpr int kBauds[] = {1'000'000, 500'000, 250'000, 128'000, 115'200, 76'800,
 constexpr double kMinTicksPerRev = 16.0;
 constexpr double kMaxTicksPerRev = 1e6;
 
-constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms", "device_watchdog_ms"};
+constexpr std::string_view kBusKeys[] = {"port", "baud", "timeout_ms", "device_watchdog_ms",
+                                         "health"};
 constexpr std::string_view kActuatorKeys[] = {"id", "ticks_per_rev", "ticks_per_rad", "zero_ticks",
                                               "direction"};
 
@@ -66,6 +67,9 @@ class Feetech final : public Protocol {
       }
       bus.timeout_s = ms / 1000.0;
     }
+    ft::BusOptions options;
+    if (auto n = node.find("health")) options.health = n->as_bool();
+    bus.options = options;
   }
 
   void read_actuator(const YamlNode& node, const JointSpec& joint, const YamlNode& limits_node,

@@ -137,6 +137,11 @@ struct DashboardServer::Impl {
                            model.prismatic[static_cast<std::size_t>(e.joint)] ? "m" : "rad");
       case EventKind::motion_fault:
         return fmt::format("motion fault: joint {} got a non-finite target", joint(e.joint));
+      case EventKind::health_fault:
+      case EventKind::health_warning:
+        return fmt::format("{}: {} {} {:g}{}", device(), to_string(e.check),
+                           e.kind == EventKind::health_fault ? "fault" : "warning", e.value,
+                           e.kind == EventKind::health_fault ? ", switched off" : "");
       case EventKind::stop_deadline:
         return "the stop ramp ran over its deadline: torque switched off";
       case EventKind::aborted:
@@ -300,6 +305,7 @@ struct DashboardServer::Impl {
              {"temperature_c", health_number(s.reading.temperature_c)},
              {"current_a", health_number(s.reading.current_a)},
              {"voltage_v", health_number(s.reading.voltage_v)},
+             {"torque_nm", health_number(s.reading.torque_nm)},
              {"error_bits", s.reading.has_error_bits ? json(s.reading.error_bits) : json()},
              {"last_fault", nullptr}});
       }

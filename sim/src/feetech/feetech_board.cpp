@@ -56,6 +56,15 @@ bool writable(std::size_t address) {
   }
 }
 
+// The health model at the board's own rest values (the manual's 12.1 V and
+// 30 C) unless the robot file's sim.health sets them.
+SimHealthSettings feetech_health(SimHealthSettings h) {
+  const SimHealthSettings defaults;
+  if (h.ambient_c == defaults.ambient_c) h.ambient_c = kTemperatureC;
+  if (h.supply_v == defaults.supply_v) h.supply_v = kVoltageDeciV / 10.0;
+  return h;
+}
+
 }  // namespace
 
 bool feetech_may_answer(const ft::Packet& packet) {
@@ -72,7 +81,8 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
       tau_s_(std::max(0.0, settings.time_constant_s)),
       vmax_steps_s_(std::max(0.0, settings.max_speed_rad_s * binding.ticks_per_rad)),
       eeprom_(series == ft::Series::sts ? kFeetechSts : kFeetechScs),
-      motor_time_(now) {
+      motor_time_(now),
+      health_(feetech_health(settings.health), binding.device_id, now) {
   const bool sts = series_ == ft::Series::sts;
   table_[reg::firmware_major] = 3;
   std::memcpy(&table_[reg::model], sts ? kStsModel : kScsModel, 2);
@@ -125,7 +135,7 @@ std::int32_t FeetechServo::goal_position() const {
 
 FeetechServo::Motor FeetechServo::motor_at(Nanos now) const {
   Motor m = motor_;
-  if (!torque_on() || vmax_steps_s_ <= 0) {
+  if (!torque_on() || vmax_steps_s_ <= 0 || health_.blocked()) {
     m.velocity = 0;
     return m;
   }
@@ -137,6 +147,7 @@ void FeetechServo::advance(Nanos now) {
   if (now <= motor_time_) return;
   motor_ = motor_at(now);
   motor_time_ = now;
+  health_.advance(now, motor_.velocity / binding_.ticks_per_rad, torque_on());
   publish();
 }
 
@@ -146,6 +157,33 @@ void FeetechServo::publish() {
   // Speeds carry their direction in bit 15 on both series.
   ft::put_u16(series_, &table_[reg::present_speed], ft::encode_signed(speed, ft::kStsSignBit));
   table_[reg::moving] = std::abs(motor_.velocity) > 1.0 ? 1 : 0;
+  // What the servo reads about itself: load (0.1 % of the stall current,
+  // direction in bit 10), supply, temperature, and on STS the current
+  // (6.5 mA units); its status bits from them, as its firmware sets them
+  // (voltage, temperature, overload share the layout the model uses).
+  const double amps = health_.current_a();
+  // Load: the current beyond holding, against the stall current (0 at rest).
+  const SimHealthSettings& model = health_.settings();
+  const double span = std::max(1e-3, model.stall_current_a - model.idle_current_a);
+  const auto load = static_cast<std::int32_t>(
+      std::lround(std::clamp(1000.0 * (amps - model.idle_current_a) / span, 0.0, 1000.0)));
+  ft::put_u16(series_, &table_[reg::present_load],
+              ft::encode_signed(motor_.velocity < 0 ? -load : load, ft::kScsSignBit));
+  table_[reg::present_voltage] =
+      static_cast<std::uint8_t>(std::clamp(std::lround(10.0 * health_.voltage_v()), 0L, 255L));
+  table_[reg::present_temperature] =
+      static_cast<std::uint8_t>(std::clamp(std::lround(health_.temperature_c()), 0L, 255L));
+  if (series_ == ft::Series::sts) {
+    const auto units = static_cast<std::int32_t>(std::lround(amps / 0.0065));
+    ft::put_u16(series_, &table_[69], ft::encode_signed(units, ft::kStsSignBit));
+  }
+  const std::uint8_t bits = static_cast<std::uint8_t>(
+      injected_ | health_.error_bits(table_[reg::max_temperature], 0.0, 1e9));
+  table_[reg::servo_status] = bits;
+  if ((bits & table_[reg::unload_condition]) != 0 && torque_on()) {
+    table_[reg::torque_enable] = 0;
+    motor_.velocity = 0;
+  }
 }
 
 bool FeetechServo::read(std::uint8_t address, std::uint8_t length,
@@ -201,12 +239,8 @@ void FeetechServo::action() {
 
 void FeetechServo::set_fault(std::uint8_t bits, Nanos now) {
   advance(now);
-  table_[reg::servo_status] = bits;
-  if ((bits & table_[reg::unload_condition]) != 0 && torque_on()) {
-    table_[reg::torque_enable] = 0;
-    motor_.velocity = 0;
-    publish();
-  }
+  injected_ = bits;
+  publish();
 }
 
 void FeetechServo::power_up(Nanos now) {

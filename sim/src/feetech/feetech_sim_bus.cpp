@@ -110,6 +110,29 @@ void FeetechSimBus::set_device_responding(int device_id, bool responding) {
   servo(device_id).set_responding(responding);
 }
 
+void FeetechSimBus::inject_device_health(int device_id, const SimHealthInjection& change) {
+  std::lock_guard lock(mutex_);
+  FeetechServo& s = servo(device_id);
+  const Nanos now = clock_.now();
+  s.advance(now);
+  using Kind = SimHealthInjection::Kind;
+  switch (change.kind) {
+    case Kind::temperature:
+      s.health().set_temperature(change.value);
+      break;
+    case Kind::blocked:
+      s.health().set_blocked(change.value != 0.0);
+      break;
+    case Kind::supply:
+      s.health().set_supply(change.value);
+      break;
+    case Kind::hardware_error:
+      s.set_fault(static_cast<std::uint8_t>(change.value), now);
+      return;
+  }
+  s.advance(now + 1);
+}
+
 void FeetechSimBus::set_device_hardware_error(int device_id, std::uint8_t error_bits) {
   std::lock_guard lock(mutex_);
   servo(device_id).set_fault(error_bits, clock_.now());

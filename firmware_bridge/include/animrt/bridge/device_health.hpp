@@ -17,8 +17,9 @@ struct HealthReading {
   double temperature_c = kNone;
   double current_a = kNone;  // magnitude of the motor current (or torque-producing current)
   double voltage_v = kNone;  // the device's supply input
+  double torque_nm = kNone;  // magnitude of the torque the device reports (MIT replies)
   // The device's own fault register (Dynamixel Hardware Error Status,
-  // Feetech status, CiA 402 error code, a Modbus fault register), as read;
+  // Feetech status bits, CiA 402 Error Code), as read;
   // meaningful only when has_error_bits.
   std::uint32_t error_bits = 0;
   bool has_error_bits = false;
@@ -36,6 +37,7 @@ struct HealthStats {
   double max_temperature_c = HealthReading::kNone;
   double peak_current_a = HealthReading::kNone;
   double min_voltage_v = HealthReading::kNone;
+  double peak_torque_nm = HealthReading::kNone;
   std::uint64_t readings = 0;
   std::uint64_t warnings = 0;
 };

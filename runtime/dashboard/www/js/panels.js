@@ -122,6 +122,7 @@ const HEALTH = [
   ['temperature_c', (v) => `${v.toFixed(0)} °C`],
   ['current_a', (v) => `${v.toFixed(2)} A`],
   ['voltage_v', (v) => `${v.toFixed(1)} V`],
+  ['torque_nm', (v) => `${v.toFixed(2)} Nm`],
   ['error_bits', (v) => `0x${v.toString(16).padStart(2, '0')}`],
 ];
 

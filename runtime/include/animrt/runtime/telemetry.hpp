@@ -35,7 +35,7 @@ class TelemetryRing {
 
 // Drains a ring into a CSV file: `time_s,<joint>_cmd_rad,<joint>_meas_rad,...`,
 // then the extra columns (device health: `<joint>_temp_c`, `_current_a`,
-// `_voltage_v`, `_error_bits`; nan where not read).
+// `_voltage_v`, `_torque_nm`, `_error_bits`; nan where not read).
 // A record that cannot be written (a full disk, /dev/full, a pipe whose
 // reader left) is counted as lost with the first error, never silently: a
 // record that is not on disk is a fault of the record, and the run says so.

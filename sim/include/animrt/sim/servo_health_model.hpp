@@ -38,6 +38,7 @@ class ServoHealthModel {
   // applies the injections due by then. Never goes back.
   void advance(Nanos now, double speed_rad_s, bool torque_on);
 
+  const SimHealthSettings& settings() const { return settings_; }
   bool blocked() const { return blocked_; }
   double current_a() const { return current_a_; }
   double temperature_c() const { return temperature_c_; }

@@ -61,6 +61,9 @@ struct Cia402BusOptions {
   int host_node_id = 127;
   AbortConnection abort_connection = AbortConnection::quick_stop;
   int sync_timeout_ms = 0;  // 0: BusConfig::timeout_s
+  // Error Code (603Fh) mapped into TPDO1 after statusword and position
+  // actual (8 bytes, the same frame each SYNC): bus key `health`.
+  bool health = false;
 };
 
 // Options of a bus / binding of the given type; a default when absent.

@@ -72,6 +72,9 @@ class Cia402Bus final : public ActuatorBus {
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
   std::span<DeviceStatus> devices() override { return book_.devices(); }
+  // With `health: on`, each SYNC's TPDO1 also carries the drive's Error
+  // Code (603Fh), kept as DeviceStatus::reading's error bits.
+  bool reads_health() const override { return options_.health; }
 
   // What the runtime knows about each drive.
   struct DriveReport {

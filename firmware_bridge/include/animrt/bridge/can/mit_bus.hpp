@@ -40,6 +40,10 @@ class MitBus final : public ActuatorBus {
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
   std::span<DeviceStatus> devices() override { return book_.devices(); }
+  // Every reply carries the torque, and an 8-byte one the temperature: both
+  // go to DeviceStatus::reading at no cost to the cycle. (The error code
+  // takes the fault path of DeviceStatus::hardware_error_status.)
+  bool reads_health() const override { return true; }
 
   const CanFrameTransport& transport() const { return *transport_; }
   std::uint64_t foreign_frames() const { return foreign_frames_; }  // replies from ids not ours

@@ -12,6 +12,7 @@
 // The transactions, the status book, the timeout (one timeout_s per answer)
 // and the ping rounds are the serial-servo core's (serial_servo/servo_link.hpp).
 
+#include <any>
 #include <array>
 #include <chrono>
 #include <cstddef>
@@ -29,6 +30,19 @@
 #include "animrt/bridge/serial_servo/servo_positions.hpp"
 
 namespace animrt {
+
+namespace ft {
+// Protocol-specific bus settings (BusConfig::options).
+struct BusOptions {
+  // Read Present Load, Voltage, Temperature, the status bits and (STS)
+  // Present Current with the positions (bus key `health`).
+  bool health = false;
+};
+inline BusOptions bus_options(const BusConfig& bus) {
+  if (const auto* o = std::any_cast<BusOptions>(&bus.options)) return *o;
+  return {};
+}
+}  // namespace ft
 
 class FeetechBus final : public ActuatorBus {
  public:
@@ -72,6 +86,12 @@ class FeetechBus final : public ActuatorBus {
   void write(std::span<const double> positions) override;
 
   std::span<DeviceStatus> devices() override { return link_.book().devices(); }
+  // With `health: on` the cycle's read covers Present Position to Present
+  // Current (56..70, 15 bytes, STS) or to Present Temperature (56..63, SCS)
+  // and fills DeviceStatus::reading: STS current in 6.5 mA units, supply
+  // voltage, temperature and the status bits (65; SCS: the status packet's
+  // error byte).
+  bool reads_health() const override { return health_; }
   // The last configure()'s warning about joints resting outside their
   // limits, empty when none did.
   const std::string& outside_warning() const { return outside_warning_; }
@@ -102,6 +122,8 @@ class FeetechBus final : public ActuatorBus {
   servo::ServoPositions positions_;
   std::string outside_warning_;
   std::vector<std::uint8_t> sync_data_;
+  bool health_ = false;
+  void take_health(std::size_t device, std::span<const std::uint8_t> data);
 };
 
 }  // namespace animrt

@@ -34,6 +34,7 @@
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/servo_answers.hpp"
 #include "animrt/sim/servo_eeprom.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -65,6 +66,8 @@ class FeetechServo {
   void set_hearing(bool hearing) { hearing_ = hearing; }
   void set_responding(bool responding) { responding_ = responding; }
   void set_fault(std::uint8_t bits, Nanos now);
+  // Current, supply and temperature (servo_health_model.hpp).
+  ServoHealthModel& health() { return health_; }
 
   // Commissioning, as DynamixelServo: unplugged it hears and says nothing,
   // plugged in again it powers up (torque off, goal at the present
@@ -102,6 +105,8 @@ class FeetechServo {
   ServoEeprom eeprom_;
   Motor motor_;
   Nanos motor_time_;
+  ServoHealthModel health_;
+  std::uint8_t injected_ = 0;  // set_fault()'s bits
   bool responding_ = true;
   bool plugged_ = true;
   bool hearing_ = true;

@@ -61,6 +61,7 @@ class FeetechSimBus final : public SimulatedBus {
   // Sets the servo's fault bits (ft::error_bit): they appear in the error
   // byte of its status packets, and those in Unload Condition cut torque.
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
   void hand_move(int device_id, std::int32_t ticks) override;
   ServoReadout servo_readout(int device_id) const override;
