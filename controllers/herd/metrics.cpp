@@ -8,6 +8,12 @@ namespace animrt::herd {
 namespace {
 
 constexpr double kStuckWindow_s = 5.0;
+// A figure walks, for the order, when faster than this part of its top speed
+// (or than kMovingFloor_mps when its top speed is unknown); a flock stands
+// when its mean speed is under this part of its leader's.
+constexpr double kMovingFraction = 0.1;
+constexpr double kMovingFloor_mps = 0.005;
+constexpr double kStandingFraction = 0.1;
 
 }  // namespace
 
@@ -94,12 +100,20 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
     GroupSums& s = sums_[g];
     if (info.members.empty()) continue;
     Vec2 sum_v, centre;
-    double sum_speed = 0.0, nn = 0.0;
-    int nn_count = 0;
+    double sum_speed = 0.0, all_speed = 0.0, nn = 0.0;
+    int nn_count = 0, moving = 0;
     for (int i : info.members) {
       const Agent& a = agents[static_cast<std::size_t>(i)];
-      sum_v += a.velocity();
-      sum_speed += std::abs(a.speed);
+      const double top = static_cast<std::size_t>(i) < max_speed.size()
+                             ? max_speed[static_cast<std::size_t>(i)]
+                             : 0.0;
+      const double floor = top > 0 ? kMovingFraction * top : kMovingFloor_mps;
+      all_speed += std::abs(a.speed);
+      if (std::abs(a.speed) > floor) {
+        sum_v += a.velocity();
+        sum_speed += std::abs(a.speed);
+        ++moving;
+      }
       centre += a.position;
       if (nearest[static_cast<std::size_t>(i)] < 1e299) {
         nn += nearest[static_cast<std::size_t>(i)];
@@ -111,13 +125,25 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
       s.nn_sum += nn / nn_count;
       ++s.nn_steps;
     }
-    if (t >= settle_s_ && sum_speed > 0.0) {
+    if (t >= settle_s_) {
+      s.speed_sum += all_speed / static_cast<double>(info.members.size());
+      ++s.speed_steps;
+    }
+    if (t >= settle_s_ && moving >= 2) {
       const double order = norm(sum_v) / sum_speed;
       s.order_sum += order;
       s.order_min = std::min(s.order_min, order);
       ++s.order_steps;
     }
     if (g < leaders.size() && leaders[g]) {
+      // The leader's speed from its positions, over the steps the flock's
+      // speed is averaged over.
+      if (s.leader_last && t >= settle_s_ && t > s.leader_last_t) {
+        s.leader_walked += norm(*leaders[g] - *s.leader_last);
+        s.leader_time += t - s.leader_last_t;
+      }
+      s.leader_last = leaders[g];
+      s.leader_last_t = t;
       const double d = norm(centre - *leaders[g]);
       s.leader_sum += d;
       s.leader_max = std::max(s.leader_max, d);
@@ -164,9 +190,15 @@ HerdMetrics MetricsRecorder::finish() const {
     gm.agents = static_cast<int>(info.members.size());
     gm.collisions = s.collisions;
     gm.min_pair_distance_m = s.min_pair < 1e299 ? s.min_pair : 0.0;
+    gm.order_steps = s.order_steps;
     if (s.order_steps > 0) {
       gm.order_mean = s.order_sum / static_cast<double>(s.order_steps);
       gm.order_min = s.order_min;
+    }
+    if (s.speed_steps > 0) gm.speed_mean_mps = s.speed_sum / static_cast<double>(s.speed_steps);
+    if (s.leader_time > 0) {
+      gm.leader_speed_mean_mps = s.leader_walked / s.leader_time;
+      gm.standing = gm.speed_mean_mps < kStandingFraction * gm.leader_speed_mean_mps;
     }
     if (s.nn_steps > 0) gm.nearest_neighbour_mean_m = s.nn_sum / static_cast<double>(s.nn_steps);
     if (s.leader_steps > 0) {

@@ -57,8 +57,17 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
     k["agents"] = g.agents;
     k["collisions"] = g.collisions;
     k["min_pair_distance_m"] = g.min_pair_distance_m;
-    k["order_mean"] = g.order_mean;
-    k["order_min"] = g.order_min;
+    // A standing flock or one never seen moving has no order to report.
+    k["standing"] = g.standing;
+    if (g.standing || g.order_steps == 0) {
+      k["order_mean"] = nullptr;
+      k["order_min"] = nullptr;
+    } else {
+      k["order_mean"] = g.order_mean;
+      k["order_min"] = g.order_min;
+    }
+    k["speed_mean_mps"] = g.speed_mean_mps;
+    if (g.leader_speed_mean_mps >= 0) k["leader_speed_mean_mps"] = g.leader_speed_mean_mps;
     k["nearest_neighbour_mean_m"] = g.nearest_neighbour_mean_m;
     if (g.leader_distance_mean_m >= 0) {
       k["leader_distance_mean_m"] = g.leader_distance_mean_m;

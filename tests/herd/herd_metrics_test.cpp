@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "animrt/controllers/herd/herd_output.hpp"
 #include "animrt/controllers/herd/metrics.hpp"
 
 namespace animrt::herd {
@@ -96,6 +97,60 @@ TEST(HerdMetrics, OrderParameterAfterSettling) {
   EXPECT_NEAR(a.finish().groups[0].order_mean, 1.0, 1e-12);
   EXPECT_NEAR(b.finish().groups[0].order_mean, 0.0, 1e-12);
   EXPECT_NEAR(b.finish().groups[0].order_min, 0.0, 1e-12);
+}
+
+// A flock of 6 all facing one way, its leader walking 0.11 m/s along x for
+// 20 s; the flock walks at `speed`.
+GroupMetrics flock_behind_walking_leader(double speed) {
+  std::vector<Agent> agents;
+  for (int i = 0; i < 6; ++i) agents.push_back(at(i, 0, 0.0, speed));
+  Fixture f(agents, 1);
+  f.max_speed.assign(agents.size(), 0.12);
+  GroupInfo g{"f", "unity", {0, 1, 2, 3, 4, 5}, {}};
+  MetricsRecorder r({g}, f.agents, 2.0);
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.1 * k;
+    f.leaders[0] = Vec2{10 + 0.11 * t, 0};
+    for (Agent& a : f.agents) a.position.x += speed * 0.1;
+    r.sample(t, f.agents, f.leaders, f.arrived, f.max_speed);
+  }
+  return r.finish().groups[0];
+}
+
+TEST(HerdMetrics, AFlockThatStandsWhileItsLeaderWalksIsStandingNotOrdered) {
+  // All facing one way at 0.004 m/s: |sum v| / sum |v| is 1, yet nobody walks.
+  const GroupMetrics g = flock_behind_walking_leader(0.004);
+  EXPECT_TRUE(g.standing);
+  EXPECT_EQ(g.order_steps, 0);  // under a tenth of its top speed, no figure counts as moving
+  EXPECT_NEAR(g.speed_mean_mps, 0.004, 1e-9);
+  EXPECT_NEAR(g.leader_speed_mean_mps, 0.11, 1e-9);
+  EXPECT_EQ(format_order(g), "standing");
+  HerdMetrics m;
+  m.groups.push_back(g);
+  const std::string text = format_metrics(m);
+  EXPECT_NE(text.find("standing"), std::string::npos) << text;
+  EXPECT_EQ(text.find("order"), std::string::npos) << text;
+}
+
+TEST(HerdMetrics, AFlockWalkingWithItsLeaderIsOrdered) {
+  const GroupMetrics g = flock_behind_walking_leader(0.1);
+  EXPECT_FALSE(g.standing);
+  EXPECT_GT(g.order_steps, 0);
+  EXPECT_NEAR(g.order_mean, 1.0, 1e-12);
+  EXPECT_NEAR(g.speed_mean_mps, 0.1, 1e-9);
+  EXPECT_NEAR(g.leader_speed_mean_mps, 0.11, 1e-9);
+  EXPECT_EQ(format_order(g), "order 1.000 mean / 1.000 min");
+}
+
+TEST(HerdMetrics, OrderCountsOnlyMovingFigures) {
+  // Two walk east; two stand (0.001 m/s, top speed 0.1) facing west: they
+  // have no direction to disagree with.
+  Fixture f({at(0, 0, 0, 0.1), at(2, 0, 0, 0.1), at(4, 0, M_PI, 0.001), at(6, 0, M_PI, 0.001)}, 1);
+  MetricsRecorder r(one_group(4), f.agents, 0.0);
+  r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
+  const GroupMetrics g = r.finish().groups[0];
+  EXPECT_EQ(g.order_steps, 1);
+  EXPECT_NEAR(g.order_mean, 1.0, 1e-12);
 }
 
 TEST(HerdMetrics, NearestNeighbourWithinTheGroupOnly) {

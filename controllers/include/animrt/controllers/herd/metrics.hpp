@@ -1,9 +1,11 @@
 #pragma once
 // What a herd run is judged by, sampled at every output step: figures that
 // touch (pairs closer than the sum of their radii, whatever their groups),
-// how ordered each group walks, how tight it keeps, how far a flock is from
-// its leader, and for crowds the arrivals, their times and detours, and the
-// figures that got stuck.
+// how ordered each group walks (over its moving figures only: standing
+// figures have no direction to agree on), how fast it walks against its
+// leader, how tight it keeps, how far a flock is from its leader, and for
+// crowds the arrivals, their times and detours, and the figures that got
+// stuck.
 
 #include <optional>
 #include <span>
@@ -18,10 +20,15 @@ struct GroupMetrics {
   std::string name;
   std::string kind;
   int agents = 0;
-  long collisions = 0;                    // agent-pair-steps with one member in this group
-  double min_pair_distance_m = 0.0;       // centre distance, over pairs touching this group
-  double order_mean = 0.0;                // |sum v| / (N mean |v|), mean over steps after settling
-  double order_min = 0.0;                 // its minimum over those steps
+  long collisions = 0;               // agent-pair-steps with one member in this group
+  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group
+  double order_mean = 0.0;      // |sum v| / (N mean |v|) over moving members, mean over steps after
+                                // settling with at least two moving
+  double order_min = 0.0;       // its minimum over those steps
+  long order_steps = 0;         // steps the order was measured in (0: not measured)
+  double speed_mean_mps = 0.0;  // mean |speed| of all members, over steps after settling
+  double leader_speed_mean_mps = -1.0;  // flocks: the leader's, over the same steps (-1: none)
+  bool standing = false;  // mean speed under a tenth of the leader's: order means nothing
   double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
   double leader_distance_mean_m = -1.0;   // flocks: centre to leader (-1: no leader)
   double leader_distance_max_m = -1.0;
@@ -83,6 +90,11 @@ class MetricsRecorder {
     double min_pair = 1e300;
     double order_sum = 0.0, order_min = 1e300;
     long order_steps = 0;
+    double speed_sum = 0.0;
+    long speed_steps = 0;
+    double leader_walked = 0.0, leader_time = 0.0;
+    std::optional<Vec2> leader_last;
+    double leader_last_t = 0.0;
     double nn_sum = 0.0;
     long nn_steps = 0;
     double leader_sum = 0.0, leader_max = -1.0;
