@@ -189,5 +189,63 @@ TEST(HerdMetrics, ArrivalTimesPathsAndStuckFigures) {
   EXPECT_EQ(g.stuck, 1);  // agent 1: still for more than 5 s
 }
 
+TEST(HerdMetrics, OneFigureHasNoPairDistanceNorNeighbour) {
+  Fixture f({at(0, 0, 0, 0.1)}, 1);
+  MetricsRecorder r(one_group(1), f.agents, 0.0);
+  r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
+  const HerdMetrics m = r.finish();
+  EXPECT_FALSE(m.has_pair);
+  EXPECT_FALSE(m.groups[0].has_pair);
+  EXPECT_FALSE(m.groups[0].has_neighbour);
+  EXPECT_EQ(m.groups[0].order_steps, 0);  // one walking figure has nobody to agree with
+  const std::string text = format_metrics(m);
+  EXPECT_NE(text.find("min pair distance n/a"), std::string::npos) << text;
+  EXPECT_NE(text.find("nearest neighbour n/a"), std::string::npos) << text;
+  EXPECT_NE(text.find("order n/a"), std::string::npos) << text;
+  EXPECT_EQ(text.find("0.000"), std::string::npos) << text;
+}
+
+TEST(HerdMetrics, MinPairDistanceOfFiguresFarApartIsMeasured) {
+  Fixture f({at(0, 0, 0, 0.1), at(10, 0, 0, 0.1), at(30, 0, 0, 0.1)}, 1);
+  MetricsRecorder r(one_group(3), f.agents, 0.0);
+  r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
+  const HerdMetrics m = r.finish();
+  EXPECT_TRUE(m.has_pair);
+  EXPECT_NEAR(m.min_pair_distance_m, 10.0, 1e-12);
+  EXPECT_NEAR(m.min_clearance_m, 9.5, 1e-12);
+  EXPECT_EQ(m.collisions, 0);
+}
+
+TEST(HerdMetrics, NoArrivalHasNoTimeToGoal) {
+  Fixture f({at(0, 0, 0, 0.1), at(3, 0, 0, 0.1)}, 1);
+  MetricsRecorder r(one_group(2, Vec2{50, 0}), f.agents, 0.0);
+  for (int k = 0; k <= 20; ++k) {
+    for (Agent& a : f.agents) a.position.x += 0.01;
+    r.sample(0.1 * k, f.agents, f.leaders, f.arrived, f.max_speed);
+  }
+  HerdMetrics m = r.finish();
+  EXPECT_EQ(m.groups[0].arrivals, 0);
+  const std::string text = format_metrics(m);
+  EXPECT_NE(text.find("arrived 0/2, time to goal n/a, path n/a, stuck 0"), std::string::npos)
+      << text;
+}
+
+TEST(HerdMetrics, AFigureThatWaitedAndThenArrivedIsNotStuck) {
+  // Agent 0 waits 8 s (longer than the 5 s stuck window), then walks 2 m to
+  // its target; agent 1 never moves nor arrives.
+  Fixture f({at(0, 0, 0, 0.0), at(0, 5, 0, 0.0)}, 1);
+  f.max_speed = {1.0, 1.0};
+  MetricsRecorder r(one_group(2, Vec2{2, 0}), f.agents, 0.0);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.1 * k;
+    f.agents[0].position = {std::max(0.0, t - 8.0), 0};
+    f.arrived[0] = t >= 10.0 - 1e-9 ? 1 : 0;
+    r.sample(t, f.agents, f.leaders, f.arrived, f.max_speed);
+  }
+  const GroupMetrics g = r.finish().groups[0];
+  EXPECT_EQ(g.arrivals, 1);
+  EXPECT_EQ(g.stuck, 1);  // agent 1 only
+}
+
 }  // namespace
 }  // namespace animrt::herd

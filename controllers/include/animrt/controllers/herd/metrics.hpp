@@ -21,7 +21,9 @@ struct GroupMetrics {
   std::string kind;
   int agents = 0;
   long collisions = 0;               // agent-pair-steps with one member in this group
-  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group
+  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group that came
+                                     // within two figure widths (has_pair false: none did)
+  bool has_pair = false;
   double order_mean = 0.0;      // |sum v| / (N mean |v|) over moving members, mean over steps after
                                 // settling with at least two moving
   double order_min = 0.0;       // its minimum over those steps
@@ -30,25 +32,28 @@ struct GroupMetrics {
   double leader_speed_mean_mps = -1.0;  // flocks: the leader's, over the same steps (-1: none)
   bool standing = false;  // mean speed under a tenth of the leader's: order means nothing
   double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
+  bool has_neighbour = false;             // false: a group of one, nothing measured
   double leader_distance_mean_m = -1.0;   // flocks: centre to leader (-1: no leader)
   double leader_distance_max_m = -1.0;
   // Crowds (arrivals -1 for flocks):
-  int arrivals = -1;
+  int arrivals = -1;  // the times and ratios below only mean something when above 0
   double time_to_goal_mean_s = 0.0;
   double time_to_goal_max_s = 0.0;
   double time_ratio_max = 0.0;   // time to goal / straight-line time (distance / max speed)
   double path_ratio_mean = 0.0;  // walked length / straight-line length
   double path_ratio_max = 0.0;
-  int stuck = 0;  // agents that once moved less than one radius in 5 s before arriving
+  int stuck = 0;  // agents that never arrived and once moved less than one radius in 5 s
 };
 
 struct HerdMetrics {
   double duration_s = 0.0;
-  long steps = 0;       // output steps sampled
-  long collisions = 0;  // agent-pair-steps, whole scene
-  double min_pair_distance_m = 0.0;
-  double min_clearance_m = 0.0;  // min over pairs of distance - sum of radii
-  long contact_stops = 0;        // figure-steps stopped by the herd's contact guard
+  long steps = 0;                    // output steps sampled
+  long collisions = 0;               // agent-pair-steps, whole scene
+  double min_pair_distance_m = 0.0;  // closest two figures ever came (has_pair false: fewer
+                                     // than two figures, nothing measured)
+  double min_clearance_m = 0.0;      // min over pairs of distance - sum of radii
+  bool has_pair = false;
+  long contact_stops = 0;  // figure-steps stopped by the herd's contact guard
   std::vector<GroupMetrics> groups;
 };
 
