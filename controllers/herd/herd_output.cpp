@@ -125,10 +125,10 @@ std::string format_metrics(const HerdMetrics& m) {
   std::string s = fmt::format("herd: {:.1f} s, {} collisions, {}, {} contact stops\n", m.duration_s,
                               m.collisions, pair, m.contact_stops);
   for (const GroupMetrics& g : m.groups) {
-    s += fmt::format("  {} ({}, {} figures): {} collisions, {}, speed {:.3f} m/s mean", g.name,
+    s += fmt::format("  {} ({}, {} figures): {} collisions, {}, speed {:.4f} m/s mean", g.name,
                      g.kind, g.agents, g.collisions, format_order(g), g.speed_mean_mps);
     if (g.leader_speed_mean_mps >= 0)
-      s += fmt::format(" (leader {:.3f} m/s)", g.leader_speed_mean_mps);
+      s += fmt::format(" (leader {:.4f} m/s)", g.leader_speed_mean_mps);
     s += g.has_neighbour ? fmt::format(", nearest neighbour {:.2f} m", g.nearest_neighbour_mean_m)
                          : std::string(", nearest neighbour n/a");
     if (g.leader_distance_mean_m >= 0) {

@@ -12,7 +12,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 
 out=$("$animrt" herd "$root/configs/herd/unity.yaml" --summary-json "$tmp/u.json" --quiet 2>&1) ||
   fail "herd failed: $out"
-[[ $out == *"flock (unity, 30 figures): 0 collisions, standing, speed "*"(leader 0.110 m/s)"* ]] ||
+[[ $out == *"flock (unity, 30 figures): 0 collisions, standing, speed "*"(leader 0.1100 m/s)"* ]] ||
   fail "unity summary: $out"
 [[ $out != *"order"* ]] || fail "a standing flock printed an order: $out"
 /usr/bin/python3 - "$tmp/u.json" <<'PY' || fail "unity JSON: $(cat "$tmp/u.json")"
