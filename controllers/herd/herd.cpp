@@ -7,6 +7,7 @@
 #include "animrt/controllers/herd/crowd.hpp"
 #include "animrt/controllers/herd/nav_world.hpp"
 #include "herd_groups.hpp"
+#include "spawn.hpp"
 
 namespace animrt::herd {
 namespace {
@@ -29,9 +30,24 @@ Vec2 closest_on_box(const Box& box, Vec2 p, bool& inside) {
   return box.center + ax * std::clamp(u, -hu, hu) + ay * std::clamp(v, -hv, hv);
 }
 
-// Figures start this many times the sum of their radii apart: closer, a
-// flock's first steps push neighbours into each other.
-constexpr double kSpawnSpacing = 1.6;
+// Which other groups' figures stand in `area` (or within spawn spacing of
+// it), for the error when it has no room: "a (20 figures), b (3 figures)".
+std::string occupants(const HerdScene& scene, std::span<const Agent> placed, const Rect& area,
+                      double radius) {
+  std::vector<int> count(scene.groups.size(), 0);
+  for (const Agent& b : placed) {
+    const double m = kSpawnSpacing * (radius + b.radius);
+    const Rect near{area.xmin - m, area.ymin - m, area.xmax + m, area.ymax + m};
+    if (near.contains(b.position)) ++count[static_cast<std::size_t>(b.group)];
+  }
+  std::string out;
+  for (std::size_t g = 0; g < count.size(); ++g) {
+    if (count[g] == 0) continue;
+    if (!out.empty()) out += ", ";
+    out += scene.groups[g].name + " (" + std::to_string(count[g]) + " figures)";
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -60,33 +76,26 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
     int figure = 0;
     while (figures_[static_cast<std::size_t>(figure)].name != spec.figure) ++figure;
     const double r = figures_[static_cast<std::size_t>(figure)].radius_m;
-    std::uniform_real_distribution<double> ux(spec.spawn_m.xmin, spec.spawn_m.xmax);
-    std::uniform_real_distribution<double> uy(spec.spawn_m.ymin, spec.spawn_m.ymax);
+    const auto clear = [&](Vec2 p) {
+      for (const Box& w : scene_.walls) {
+        if (overlaps_box(w, p, r)) return false;
+      }
+      return !(nav_ && spec.kind == GroupKind::crowd) || nav_->on_mesh(p);
+    };
+    const auto positions = spawn_positions(spec.spawn_m, spec.count, r, agents_, clear, rng);
+    if (!positions) {
+      const std::string others = occupants(scene_, agents_, spec.spawn_m, r);
+      throw InputError(
+          spec.spawn_where, "groups." + spec.name + ".spawn_m",
+          "the spawn area has no room for " + std::to_string(spec.count) + " figures of radius " +
+              format_number(r) + " m clear of each other and of the walls" +
+              (others.empty() ? std::string() : "; other groups' figures fill it: " + others));
+    }
     for (int k = 0; k < spec.count; ++k) {
-      // Rejection sampling: apart from every figure placed so far and clear
-      // of walls.
       Agent a;
       a.radius = r;
       a.group = static_cast<int>(g);
-      bool placed = false;
-      for (int attempt = 0; attempt < 10000 && !placed; ++attempt) {
-        a.position = {ux(rng), uy(rng)};
-        placed = true;
-        for (const Agent& b : agents_) {
-          if (norm(b.position - a.position) < kSpawnSpacing * (a.radius + b.radius)) {
-            placed = false;
-            break;
-          }
-        }
-        for (const Box& w : scene_.walls) placed = placed && !overlaps_box(w, a.position, r);
-        if (placed && nav_ && spec.kind == GroupKind::crowd) placed = nav_->on_mesh(a.position);
-      }
-      if (!placed) {
-        throw InputError(spec.spawn_where, "groups." + spec.name + ".spawn_m",
-                         "the spawn area has no room for " + std::to_string(spec.count) +
-                             " figures of radius " + format_number(r) +
-                             " m clear of each other and of the walls");
-      }
+      a.position = (*positions)[static_cast<std::size_t>(k)];
       const Vec2 aim =
           spec.target_m ? *spec.target_m
                         : (spec.leader ? spec.leader->wander_m.center() : scene_.bounds_m.center());

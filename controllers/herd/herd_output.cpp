@@ -110,27 +110,39 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
   if (!out) throw std::runtime_error(path + ": cannot write the top view");
 }
 
+std::string format_order(const GroupMetrics& g) {
+  if (g.standing) return "standing";
+  if (g.order_steps == 0) return "order n/a";
+  return fmt::format("order {:.3f} mean / {:.3f} min", g.order_mean, g.order_min);
+}
+
 std::string format_metrics(const HerdMetrics& m) {
-  std::string s = fmt::format(
-      "herd: {:.1f} s, {} collisions, min pair distance {:.3f} m (clearance {:.3f} m), {} contact "
-      "stops\n",
-      m.duration_s, m.collisions, m.min_pair_distance_m, m.min_clearance_m, m.contact_stops);
+  // Whatever was not measured reads n/a, never a zero that looks measured.
+  const std::string pair = m.has_pair
+                               ? fmt::format("min pair distance {:.3f} m (clearance {:.3f} m)",
+                                             m.min_pair_distance_m, m.min_clearance_m)
+                               : std::string("min pair distance n/a");
+  std::string s = fmt::format("herd: {:.1f} s, {} collisions, {}, {} contact stops\n", m.duration_s,
+                              m.collisions, pair, m.contact_stops);
   for (const GroupMetrics& g : m.groups) {
-    s += fmt::format(
-        "  {} ({}, {} figures): {} collisions, order {:.3f} mean / {:.3f} min, "
-        "nearest neighbour {:.2f} m",
-        g.name, g.kind, g.agents, g.collisions, g.order_mean, g.order_min,
-        g.nearest_neighbour_mean_m);
+    s += fmt::format("  {} ({}, {} figures): {} collisions, {}, speed {:.4f} m/s mean", g.name,
+                     g.kind, g.agents, g.collisions, format_order(g), g.speed_mean_mps);
+    if (g.leader_speed_mean_mps >= 0)
+      s += fmt::format(" (leader {:.4f} m/s)", g.leader_speed_mean_mps);
+    s += g.has_neighbour ? fmt::format(", nearest neighbour {:.2f} m", g.nearest_neighbour_mean_m)
+                         : std::string(", nearest neighbour n/a");
     if (g.leader_distance_mean_m >= 0) {
       s += fmt::format(", leader {:.2f} m mean / {:.2f} m max", g.leader_distance_mean_m,
                        g.leader_distance_max_m);
     }
-    if (g.arrivals >= 0) {
+    if (g.arrivals > 0) {
       s += fmt::format(
           ", arrived {}/{}, time to goal {:.1f} s mean / {:.1f} s max ({:.2f} x straight-line "
           "time at most), path {:.2f} x straight mean / {:.2f} max, stuck {}",
           g.arrivals, g.agents, g.time_to_goal_mean_s, g.time_to_goal_max_s, g.time_ratio_max,
           g.path_ratio_mean, g.path_ratio_max, g.stuck);
+    } else if (g.arrivals == 0) {
+      s += fmt::format(", arrived 0/{}, time to goal n/a, path n/a, stuck {}", g.agents, g.stuck);
     }
     s += "\n";
   }

@@ -8,6 +8,12 @@ namespace animrt::herd {
 namespace {
 
 constexpr double kStuckWindow_s = 5.0;
+// A figure walks, for the order, when faster than this part of its top speed
+// (or than kMovingFloor_mps when its top speed is unknown); a flock stands
+// when its mean speed is under this part of its leader's.
+constexpr double kMovingFraction = 0.1;
+constexpr double kMovingFloor_mps = 0.005;
+constexpr double kStandingFraction = 0.1;
 
 }  // namespace
 
@@ -37,23 +43,29 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
   double max_radius = 0.0;
   for (const Agent& a : agents) max_radius = std::max(max_radius, a.radius);
 
-  // Pairs closer than the sum of radii, by a sweep over x.
+  // Pairs closer than the sum of radii, by a sweep over x; the sweep also
+  // reaches as far as the closest pair found so far, so the scene's minimum
+  // pair distance is exact even for figures far apart.
   std::iota(order_.begin(), order_.end(), 0);
   std::sort(order_.begin(), order_.end(), [&](int a, int b) {
     return agents[static_cast<std::size_t>(a)].position.x <
            agents[static_cast<std::size_t>(b)].position.x;
   });
+  const double contact_reach = 2 * max_radius;
+  double step_min = 1e300;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = static_cast<std::size_t>(order_[k]);
     const Agent& a = agents[i];
     for (std::size_t m = k + 1; m < n; ++m) {
       const std::size_t j = static_cast<std::size_t>(order_[m]);
       const Agent& b = agents[j];
-      if (b.position.x - a.position.x > 2 * max_radius) break;
+      const double dx = b.position.x - a.position.x;
+      if (dx > contact_reach && dx > step_min) break;
       const double d = norm(b.position - a.position);
       const double clearance = d - (a.radius + b.radius);
       min_clearance_ = std::min(min_clearance_, clearance);
-      min_pair_ = std::min(min_pair_, d);
+      step_min = std::min(step_min, d);
+      if (dx > contact_reach) continue;  // beyond contact: only the scene's minimum
       const int gi = group_of_[i], gj = group_of_[j];
       for (int g : {gi, gj}) {
         if (g >= 0) {
@@ -68,6 +80,7 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
       }
     }
   }
+  min_pair_ = std::min(min_pair_, step_min);
   // Nearest neighbour within the own group: scan both ways in x order until
   // the x gap alone exceeds the best distance found.
   std::vector<double> nearest(n, 1e300);
@@ -94,12 +107,20 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
     GroupSums& s = sums_[g];
     if (info.members.empty()) continue;
     Vec2 sum_v, centre;
-    double sum_speed = 0.0, nn = 0.0;
-    int nn_count = 0;
+    double sum_speed = 0.0, all_speed = 0.0, nn = 0.0;
+    int nn_count = 0, moving = 0;
     for (int i : info.members) {
       const Agent& a = agents[static_cast<std::size_t>(i)];
-      sum_v += a.velocity();
-      sum_speed += std::abs(a.speed);
+      const double top = static_cast<std::size_t>(i) < max_speed.size()
+                             ? max_speed[static_cast<std::size_t>(i)]
+                             : 0.0;
+      const double floor = top > 0 ? kMovingFraction * top : kMovingFloor_mps;
+      all_speed += std::abs(a.speed);
+      if (std::abs(a.speed) > floor) {
+        sum_v += a.velocity();
+        sum_speed += std::abs(a.speed);
+        ++moving;
+      }
       centre += a.position;
       if (nearest[static_cast<std::size_t>(i)] < 1e299) {
         nn += nearest[static_cast<std::size_t>(i)];
@@ -111,13 +132,25 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
       s.nn_sum += nn / nn_count;
       ++s.nn_steps;
     }
-    if (t >= settle_s_ && sum_speed > 0.0) {
+    if (t >= settle_s_) {
+      s.speed_sum += all_speed / static_cast<double>(info.members.size());
+      ++s.speed_steps;
+    }
+    if (t >= settle_s_ && moving >= 2) {
       const double order = norm(sum_v) / sum_speed;
       s.order_sum += order;
       s.order_min = std::min(s.order_min, order);
       ++s.order_steps;
     }
     if (g < leaders.size() && leaders[g]) {
+      // The leader's speed from its positions, over the steps the flock's
+      // speed is averaged over.
+      if (s.leader_last && t >= settle_s_ && t > s.leader_last_t) {
+        s.leader_walked += norm(*leaders[g] - *s.leader_last);
+        s.leader_time += t - s.leader_last_t;
+      }
+      s.leader_last = leaders[g];
+      s.leader_last_t = t;
       const double d = norm(centre - *leaders[g]);
       s.leader_sum += d;
       s.leader_max = std::max(s.leader_max, d);
@@ -153,8 +186,9 @@ HerdMetrics MetricsRecorder::finish() const {
   m.steps = steps_;
   m.collisions = collisions_;
   m.contact_stops = contact_stops_;
-  m.min_pair_distance_m = min_pair_ < 1e299 ? min_pair_ : 0.0;
-  m.min_clearance_m = min_clearance_ < 1e299 ? min_clearance_ : 0.0;
+  m.has_pair = min_pair_ < 1e299;
+  m.min_pair_distance_m = m.has_pair ? min_pair_ : 0.0;
+  m.min_clearance_m = m.has_pair ? min_clearance_ : 0.0;
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const GroupInfo& info = groups_[g];
     const GroupSums& s = sums_[g];
@@ -163,11 +197,19 @@ HerdMetrics MetricsRecorder::finish() const {
     gm.kind = info.kind;
     gm.agents = static_cast<int>(info.members.size());
     gm.collisions = s.collisions;
-    gm.min_pair_distance_m = s.min_pair < 1e299 ? s.min_pair : 0.0;
+    gm.has_pair = s.min_pair < 1e299;
+    gm.min_pair_distance_m = gm.has_pair ? s.min_pair : 0.0;
+    gm.order_steps = s.order_steps;
     if (s.order_steps > 0) {
       gm.order_mean = s.order_sum / static_cast<double>(s.order_steps);
       gm.order_min = s.order_min;
     }
+    if (s.speed_steps > 0) gm.speed_mean_mps = s.speed_sum / static_cast<double>(s.speed_steps);
+    if (s.leader_time > 0) {
+      gm.leader_speed_mean_mps = s.leader_walked / s.leader_time;
+      gm.standing = gm.speed_mean_mps < kStandingFraction * gm.leader_speed_mean_mps;
+    }
+    gm.has_neighbour = s.nn_steps > 0;
     if (s.nn_steps > 0) gm.nearest_neighbour_mean_m = s.nn_sum / static_cast<double>(s.nn_steps);
     if (s.leader_steps > 0) {
       gm.leader_distance_mean_m = s.leader_sum / static_cast<double>(s.leader_steps);
@@ -178,8 +220,10 @@ HerdMetrics MetricsRecorder::finish() const {
       double time_sum = 0.0, path_sum = 0.0;
       for (int i : info.members) {
         const AgentTrack& tr = tracks_[static_cast<std::size_t>(i)];
-        if (tr.stuck) ++gm.stuck;
-        if (tr.arrived_at < 0) continue;
+        if (tr.arrived_at < 0) {
+          if (tr.stuck) ++gm.stuck;  // one that waited, then arrived, was not stuck
+          continue;
+        }
         ++gm.arrivals;
         time_sum += tr.arrived_at;
         gm.time_to_goal_max_s = std::max(gm.time_to_goal_max_s, tr.arrived_at);

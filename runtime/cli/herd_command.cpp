@@ -49,8 +49,12 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
   j["real_time_factor"] = wall_s > 0 ? m.duration_s / wall_s : 0.0;
   j["output_steps"] = m.steps;
   j["collisions"] = m.collisions;
-  j["min_pair_distance_m"] = m.min_pair_distance_m;
-  j["min_clearance_m"] = m.min_clearance_m;
+  // Whatever was not measured is null, never a zero that looks measured.
+  const auto measured = [](bool has, double v) -> nlohmann::json {
+    return has ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
+  j["min_pair_distance_m"] = measured(m.has_pair, m.min_pair_distance_m);
+  j["min_clearance_m"] = measured(m.has_pair, m.min_clearance_m);
   j["contact_stops"] = m.contact_stops;
   for (const herd::GroupMetrics& g : m.groups) {
     nlohmann::json k;
@@ -58,21 +62,27 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
     k["kind"] = g.kind;
     k["agents"] = g.agents;
     k["collisions"] = g.collisions;
-    k["min_pair_distance_m"] = g.min_pair_distance_m;
-    k["order_mean"] = g.order_mean;
-    k["order_min"] = g.order_min;
-    k["nearest_neighbour_mean_m"] = g.nearest_neighbour_mean_m;
+    k["min_pair_distance_m"] = measured(g.has_pair, g.min_pair_distance_m);
+    // A standing flock or one never seen moving has no order to report.
+    k["standing"] = g.standing;
+    const bool ordered = !g.standing && g.order_steps > 0;
+    k["order_mean"] = measured(ordered, g.order_mean);
+    k["order_min"] = measured(ordered, g.order_min);
+    k["speed_mean_mps"] = g.speed_mean_mps;
+    if (g.leader_speed_mean_mps >= 0) k["leader_speed_mean_mps"] = g.leader_speed_mean_mps;
+    k["nearest_neighbour_mean_m"] = measured(g.has_neighbour, g.nearest_neighbour_mean_m);
     if (g.leader_distance_mean_m >= 0) {
       k["leader_distance_mean_m"] = g.leader_distance_mean_m;
       k["leader_distance_max_m"] = g.leader_distance_max_m;
     }
     if (g.arrivals >= 0) {
       k["arrivals"] = g.arrivals;
-      k["time_to_goal_mean_s"] = g.time_to_goal_mean_s;
-      k["time_to_goal_max_s"] = g.time_to_goal_max_s;
-      k["time_ratio_max"] = g.time_ratio_max;
-      k["path_ratio_mean"] = g.path_ratio_mean;
-      k["path_ratio_max"] = g.path_ratio_max;
+      const bool any = g.arrivals > 0;
+      k["time_to_goal_mean_s"] = measured(any, g.time_to_goal_mean_s);
+      k["time_to_goal_max_s"] = measured(any, g.time_to_goal_max_s);
+      k["time_ratio_max"] = measured(any, g.time_ratio_max);
+      k["path_ratio_mean"] = measured(any, g.path_ratio_mean);
+      k["path_ratio_max"] = measured(any, g.path_ratio_max);
       k["stuck"] = g.stuck;
     }
     j["groups"].push_back(k);

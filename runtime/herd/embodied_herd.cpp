@@ -118,8 +118,8 @@ std::string EmbodiedHerd::report() const {
   }
   if (!failure_.empty()) s += "\nherd: stopped the run: " + failure_;
   const herd::HerdMetrics m = herd_->metrics();
-  s +=
-      fmt::format("\nherd: {} collisions, min clearance {:.3f} m", m.collisions, m.min_clearance_m);
+  s += fmt::format("\nherd: {} collisions, min clearance {}", m.collisions,
+                   m.has_pair ? fmt::format("{:.3f} m", m.min_clearance_m) : std::string("n/a"));
   return s;
 }
 

@@ -26,6 +26,10 @@ class TrailRecorder {
   std::vector<std::vector<Vec2>> trails_;  // per agent
 };
 
+// A group's order as printed: "standing" for a flock that does not keep up
+// with its leader, "order n/a" when it was never measured.
+std::string format_order(const GroupMetrics& g);
+
 // The summary as text lines (printed at the end of a run).
 std::string format_metrics(const HerdMetrics& metrics);
 

@@ -1,9 +1,11 @@
 #pragma once
 // What a herd run is judged by, sampled at every output step: figures that
 // touch (pairs closer than the sum of their radii, whatever their groups),
-// how ordered each group walks, how tight it keeps, how far a flock is from
-// its leader, and for crowds the arrivals, their times and detours, and the
-// figures that got stuck.
+// how ordered each group walks (over its moving figures only: standing
+// figures have no direction to agree on), how fast it walks against its
+// leader, how tight it keeps, how far a flock is from its leader, and for
+// crowds the arrivals, their times and detours, and the figures that got
+// stuck.
 
 #include <optional>
 #include <span>
@@ -18,30 +20,40 @@ struct GroupMetrics {
   std::string name;
   std::string kind;
   int agents = 0;
-  long collisions = 0;                    // agent-pair-steps with one member in this group
-  double min_pair_distance_m = 0.0;       // centre distance, over pairs touching this group
-  double order_mean = 0.0;                // |sum v| / (N mean |v|), mean over steps after settling
-  double order_min = 0.0;                 // its minimum over those steps
+  long collisions = 0;               // agent-pair-steps with one member in this group
+  double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group that came
+                                     // within two figure widths (has_pair false: none did)
+  bool has_pair = false;
+  double order_mean = 0.0;      // |sum v| / (N mean |v|) over moving members, mean over steps after
+                                // settling with at least two moving
+  double order_min = 0.0;       // its minimum over those steps
+  long order_steps = 0;         // steps the order was measured in (0: not measured)
+  double speed_mean_mps = 0.0;  // mean |speed| of all members, over steps after settling
+  double leader_speed_mean_mps = -1.0;  // flocks: the leader's, over the same steps (-1: none)
+  bool standing = false;  // mean speed under a tenth of the leader's: order means nothing
   double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
+  bool has_neighbour = false;             // false: a group of one, nothing measured
   double leader_distance_mean_m = -1.0;   // flocks: centre to leader (-1: no leader)
   double leader_distance_max_m = -1.0;
   // Crowds (arrivals -1 for flocks):
-  int arrivals = -1;
+  int arrivals = -1;  // the times and ratios below only mean something when above 0
   double time_to_goal_mean_s = 0.0;
   double time_to_goal_max_s = 0.0;
   double time_ratio_max = 0.0;   // time to goal / straight-line time (distance / max speed)
   double path_ratio_mean = 0.0;  // walked length / straight-line length
   double path_ratio_max = 0.0;
-  int stuck = 0;  // agents that once moved less than one radius in 5 s before arriving
+  int stuck = 0;  // agents that never arrived and once moved less than one radius in 5 s
 };
 
 struct HerdMetrics {
   double duration_s = 0.0;
-  long steps = 0;       // output steps sampled
-  long collisions = 0;  // agent-pair-steps, whole scene
-  double min_pair_distance_m = 0.0;
-  double min_clearance_m = 0.0;  // min over pairs of distance - sum of radii
-  long contact_stops = 0;        // figure-steps stopped by the herd's contact guard
+  long steps = 0;                    // output steps sampled
+  long collisions = 0;               // agent-pair-steps, whole scene
+  double min_pair_distance_m = 0.0;  // closest two figures ever came (has_pair false: fewer
+                                     // than two figures, nothing measured)
+  double min_clearance_m = 0.0;      // min over pairs of distance - sum of radii
+  bool has_pair = false;
+  long contact_stops = 0;  // figure-steps stopped by the herd's contact guard
   std::vector<GroupMetrics> groups;
 };
 
@@ -83,6 +95,11 @@ class MetricsRecorder {
     double min_pair = 1e300;
     double order_sum = 0.0, order_min = 1e300;
     long order_steps = 0;
+    double speed_sum = 0.0;
+    long speed_steps = 0;
+    double leader_walked = 0.0, leader_time = 0.0;
+    std::optional<Vec2> leader_last;
+    double leader_last_t = 0.0;
     double nn_sum = 0.0;
     long nn_steps = 0;
     double leader_sum = 0.0, leader_max = -1.0;

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# animrt herd's summary reports only what it measured: the Unity scene's
+# flock, which stands while its leader walks, is reported as standing with
+# no order (text and JSON, with both speeds); a one-figure crowd that cannot
+# reach its goal in time has no pair distance, neighbour or time to goal.
+set -uo pipefail
+animrt=$1
+root=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+out=$("$animrt" herd "$root/configs/herd/unity.yaml" --summary-json "$tmp/u.json" --quiet 2>&1) ||
+  fail "herd failed: $out"
+[[ $out == *"flock (unity, 30 figures): 0 collisions, standing, speed "*"(leader 0.1100 m/s)"* ]] ||
+  fail "unity summary: $out"
+[[ $out != *"order"* ]] || fail "a standing flock printed an order: $out"
+/usr/bin/python3 - "$tmp/u.json" <<'PY' || fail "unity JSON: $(cat "$tmp/u.json")"
+import json, sys
+g = json.load(open(sys.argv[1]))["groups"][0]
+assert g["standing"] is True and g["order_mean"] is None and g["order_min"] is None
+assert g["speed_mean_mps"] < 0.1 * g["leader_speed_mean_mps"]
+assert abs(g["leader_speed_mean_mps"] - 0.11) < 0.005
+PY
+
+cat > "$tmp/one.yaml" <<YAML
+bounds_m: [-5, -5, 5, 5]
+duration_s: 10
+figures:
+  pony: {gait: $root/configs/gaits/herd_pony.yaml, radius_m: 0.25}
+groups:
+  - {name: solo, kind: crowd, figure: pony, count: 1, spawn_m: [-4, -1, -3, 1],
+     target_m: [4, 0], speed_mps: [0.1, 0.1]}
+YAML
+out=$("$animrt" herd "$tmp/one.yaml" --summary-json "$tmp/one.json" --quiet 2>&1) ||
+  fail "one-figure herd failed: $out"
+[[ $out == *"min pair distance n/a"* && $out == *"order n/a"* && $out == *"nearest neighbour n/a"* &&
+  $out == *"arrived 0/1, time to goal n/a, path n/a, stuck 0"* ]] || fail "one-figure summary: $out"
+/usr/bin/python3 - "$tmp/one.json" <<'PY' || fail "one-figure JSON: $(cat "$tmp/one.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+g = j["groups"][0]
+assert j["min_pair_distance_m"] is None and j["min_clearance_m"] is None
+assert g["order_mean"] is None and g["nearest_neighbour_mean_m"] is None
+assert g["arrivals"] == 0 and g["time_to_goal_mean_s"] is None and g["stuck"] == 0
+PY
+echo "herd_summary: ok"
