@@ -4,13 +4,48 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <regex>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "animrt/learn/evolve/pareto_report.hpp"
 #include "support/files.hpp"
 
 namespace animrt::evolve {
 namespace {
+
+// One <text> element of the SVG: its attributes and its content.
+struct SvgText {
+  std::string tag;  // everything between "<text" and ">"
+  std::string content;
+  std::optional<std::string> attr(const std::string& name) const {
+    const std::string key = " " + name + "=\"";
+    const auto at = tag.find(key);
+    if (at == std::string::npos) return std::nullopt;
+    const auto from = at + key.size();
+    return tag.substr(from, tag.find('"', from) - from);
+  }
+};
+
+std::vector<SvgText> svg_texts(const std::string& svg) {
+  std::vector<SvgText> texts;
+  for (auto at = svg.find("<text "); at != std::string::npos; at = svg.find("<text ", at + 1)) {
+    const auto close = svg.find('>', at);
+    const auto end = svg.find("</text>", close);
+    if (close == std::string::npos || end == std::string::npos) break;
+    texts.push_back({svg.substr(at + 5, close - at - 5), svg.substr(close + 1, end - close - 1)});
+  }
+  return texts;
+}
+
+bool is_number(const std::string& s, bool digits_only) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    const bool digit = c >= '0' && c <= '9';
+    if (!digit && (digits_only || (c != '-' && c != '.' && c != 'e'))) return false;
+  }
+  return true;
+}
 
 // 1, 2 or 5 times a power of ten.
 bool round_step(double step) {
@@ -31,10 +66,10 @@ TEST(ParetoPlot, RoundTicksAndLabelsThatDoNotOverlap) {
   // Axis ticks: x along the bottom (text-anchor middle), y on the left (end).
   for (const char* anchor : {"middle", "end"}) {
     std::vector<double> ticks;
-    const std::regex tick(std::string(R"(<text x="[^"]*" y="[^"]*" text-anchor=")") + anchor +
-                          R"(">([-0-9.e]+)</text>)");
-    for (std::sregex_iterator it(svg.begin(), svg.end(), tick), end; it != end; ++it) {
-      ticks.push_back(std::stod((*it)[1]));
+    for (const SvgText& t : svg_texts(svg)) {
+      if (t.attr("text-anchor") == anchor && is_number(t.content, false)) {
+        ticks.push_back(std::stod(t.content));
+      }
     }
     ASSERT_GE(ticks.size(), 3u) << anchor;
     const double step = ticks[1] - ticks[0];
@@ -51,11 +86,10 @@ TEST(ParetoPlot, RoundTicksAndLabelsThatDoNotOverlap) {
     double x0, y0, x1, y1;
   };
   std::vector<Box> labels;
-  const std::regex label(
-      R"re(<text x="([-0-9.e]+)" y="([-0-9.e]+)" font-size="10">(\d+)</text>)re");
-  for (std::sregex_iterator it(svg.begin(), svg.end(), label), end; it != end; ++it) {
-    const double x = std::stod((*it)[1]), y = std::stod((*it)[2]);
-    const double w = 6.0 * static_cast<double>((*it)[3].length());
+  for (const SvgText& t : svg_texts(svg)) {
+    if (t.attr("font-size") != "10" || !is_number(t.content, true)) continue;
+    const double x = std::stod(t.attr("x").value_or("0")), y = std::stod(t.attr("y").value_or("0"));
+    const double w = 6.0 * static_cast<double>(t.content.size());
     labels.push_back({x, y - 10, x + w, y});
   }
   EXPECT_GE(labels.size(), 3u);
