@@ -58,26 +58,17 @@ struct Track {
   std::vector<double> values;  // deg or m
 };
 
-int run_record(const RecordArgs& args) {
-  install_stop_signals(commissioning_controls(), SecondSignal::end_process);
-  // The show must be writable before anything is recorded.
-  {
-    const bool existed = std::filesystem::exists(args.out);
-    std::ofstream probe(args.out, std::ios::app);
-    if (!probe) throw std::invalid_argument("--out: cannot write " + quote_path(args.out));
-    probe.close();
-    if (!existed) std::filesystem::remove(args.out);
-  }
-  // The microphone is opened before the figure: a missing one is found
-  // before anyone starts to puppeteer.
-  const std::filesystem::path out_path(args.out);
-  const std::string track_name = out_path.stem().string() + ".wav";
-  std::unique_ptr<SoundTrackRecorder> microphone;
-  if (args.audio) {
-    microphone = std::make_unique<SoundTrackRecorder>(
-        args.audio_device, kSoundTrackRate, (out_path.parent_path() / track_name).string());
-  }
-  LimpFigure figure(args.robot, args.ports);
+// The show must be writable before anything is recorded.
+void check_writable(const std::string& out) {
+  const bool existed = std::filesystem::exists(out);
+  std::ofstream probe(out, std::ios::app);
+  if (!probe) throw std::invalid_argument("--out: cannot write " + quote_path(out));
+  probe.close();
+  if (!existed) std::filesystem::remove(out);
+}
+
+// The tracks to record: the joints asked for (all by default) that are on a bus.
+std::vector<Track> choose_tracks(const RecordArgs& args, const LimpFigure& figure) {
   const RobotConfig& config = figure.config();
   std::vector<Track> tracks;
   for (std::size_t j = 0; j < config.joints.size(); ++j) {
@@ -94,23 +85,32 @@ int run_record(const RecordArgs& args) {
                                   quote_path(config.file) + " has no joint of that name on a bus");
     }
   }
-  std::cout << "torque is off: move the figure; recording at " << config.rate_hz << " Hz "
-            << (args.duration_s > 0 ? fmt::format("for {} s", args.duration_s)
-                                    : std::string("until Ctrl-C"))
-            << std::endl;
+  return tracks;
+}
 
-  const long period_ns = static_cast<long>(1e9 / config.rate_hz);
-  const std::size_t cycles = args.duration_s > 0
-                                 ? static_cast<std::size_t>(args.duration_s * config.rate_hz) + 1
-                                 : std::numeric_limits<std::size_t>::max();
+struct Sampling {
+  timespec start{};
   std::size_t reads = 0;
   double last_t = 0.0;
   std::size_t missed = 0;
+};
+
+// Reads the figure at its rate until the duration ends or a stop signal
+// arrives, appending each fresh position to its track.
+Sampling sample(LimpFigure& figure, std::vector<Track>& tracks, double duration_s,
+                SoundTrackRecorder* microphone) {
+  const RobotConfig& config = figure.config();
+  const long period_ns = static_cast<long>(1e9 / config.rate_hz);
+  const std::size_t cycles = duration_s > 0
+                                 ? static_cast<std::size_t>(duration_s * config.rate_hz) + 1
+                                 : std::numeric_limits<std::size_t>::max();
+  Sampling run;
   std::vector<double> positions;
   std::vector<bool> fresh;
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   const timespec start = next;
+  run.start = start;
   if (microphone) microphone->start();
   RunControls& controls = commissioning_controls();
   for (std::size_t cycle = 0; cycle < cycles && !controls.stop.load(); ++cycle) {
@@ -126,13 +126,13 @@ int run_record(const RecordArgs& args) {
              static_cast<double>(at.tv_nsec - start.tv_nsec) * 1e-9;
     };
     const double t = 0.5 * (since_start(asked) + since_start(answered));
-    ++reads;
-    last_t = t;
+    ++run.reads;
+    run.last_t = t;
     // A device that did not answer this time gives no sample: its old
     // value at a new time would be a motion that never happened.
     for (Track& track : tracks) {
       if (!fresh[track.joint]) {
-        ++missed;
+        ++run.missed;
         continue;
       }
       if (!track.times.empty() && t < track.times.back() + kMinSampleGap) continue;
@@ -147,6 +147,11 @@ int run_record(const RecordArgs& args) {
     }
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
   }
+  return run;
+}
+
+// All samples kept; a track with fewer than two cannot make a show.
+std::size_t count_samples(const std::vector<Track>& tracks) {
   std::size_t samples = 0;
   for (const Track& t : tracks) {
     if (t.times.size() < 2) {
@@ -155,27 +160,32 @@ int run_record(const RecordArgs& args) {
     }
     samples += t.times.size();
   }
+  return samples;
+}
 
-  std::string audio_line;
-  if (microphone) {
-    const double first_sample = microphone->finish();
-    const double offset = first_sample - (static_cast<double>(start.tv_sec) + start.tv_nsec * 1e-9);
-    std::string quoted = "\"";
-    for (const char c : track_name) {
-      if (c == '"' || c == '\\') quoted += '\\';
-      quoted += c;
-    }
-    audio_line = "audio: {file: " + quoted + "\", offset_s: " + number(offset, 4) + "}\n";
+// The show's audio line: the sound track's file and its offset from the motion.
+std::string finish_audio_line(SoundTrackRecorder& microphone, const timespec& start,
+                              const std::string& track_name) {
+  const double first_sample = microphone.finish();
+  const double offset = first_sample - (static_cast<double>(start.tv_sec) + start.tv_nsec * 1e-9);
+  std::string quoted = "\"";
+  for (const char c : track_name) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
   }
-  std::string text = fmt::format(
-      "# Recorded by hand with animrt record from {}: {} reads at {} Hz, reduced to keys\n"
-      "# within {} deg ({} m for prismatic joints) under linear interpolation.\n"
-      "name: {}\nloop: false\nduration_s: {}\n{}joints:\n",
-      std::filesystem::path(config.file).filename().string(), reads, config.rate_hz,
-      args.tolerance_deg, args.tolerance_deg / 1000.0, out_path.stem().string(), number(last_t, 4),
-      audio_line);
+  return "audio: {file: " + quoted + "\", offset_s: " + number(offset, 4) + "}\n";
+}
+
+struct Reduction {
   std::size_t keys_total = 0;
   std::size_t clamped = 0;
+};
+
+// Appends each track to the show text as the keys that stay within the
+// tolerance of what was recorded.
+Reduction reduce_tracks(std::vector<Track>& tracks, const RobotConfig& config, double tolerance_deg,
+                        std::string& text) {
+  Reduction reduction;
   for (Track& t : tracks) {
     const JointSpec& spec = config.joints[t.joint];
     const double scale = t.prismatic ? 1.0 : rad_to_deg(1.0);
@@ -183,14 +193,14 @@ int run_record(const RecordArgs& args) {
     const double hi = spec.limits.max_position * scale;
     // A hand may push a joint past its limits; a show may not go there.
     for (double& v : t.values) {
-      if (v < lo || v > hi) ++clamped;
+      if (v < lo || v > hi) ++reduction.clamped;
       v = std::clamp(v, lo, hi);
     }
-    const double bound = (t.prismatic ? args.tolerance_deg / 1000.0 : args.tolerance_deg);
+    const double bound = (t.prismatic ? tolerance_deg / 1000.0 : tolerance_deg);
     const double margin = kValueQuantum * (t.prismatic ? 1e-3 : 1.0);
     const std::vector<std::size_t> keys =
         show::reduce_keys(t.times, t.values, std::max(0.0, bound - margin));
-    keys_total += keys.size();
+    reduction.keys_total += keys.size();
     text += "  " + t.name + ":\n    interpolation: linear\n";
     if (t.prismatic) text += "    unit: m\n";
     text += "    keys:\n";
@@ -201,22 +211,65 @@ int run_record(const RecordArgs& args) {
       text += "      - [" + number(t.times[k], 4) + ", " + number(v, t.prismatic ? 6 : 3) + "]\n";
     }
   }
+  return reduction;
+}
+
+void write_show(const std::string& out_file, const std::string& text) {
   {
-    std::ofstream out(args.out, std::ios::binary | std::ios::trunc);
+    std::ofstream out(out_file, std::ios::binary | std::ios::trunc);
     out << text;
-    if (!out.flush()) throw std::runtime_error("cannot write " + quote_path(args.out));
+    if (!out.flush()) throw std::runtime_error("cannot write " + quote_path(out_file));
   }
-  load_show_file(args.out);  // what was written reads back as a show
+  load_show_file(out_file);  // what was written reads back as a show
+}
+
+int run_record(const RecordArgs& args) {
+  install_stop_signals(commissioning_controls(), SecondSignal::end_process);
+  check_writable(args.out);
+  // The microphone is opened before the figure: a missing one is found
+  // before anyone starts to puppeteer.
+  const std::filesystem::path out_path(args.out);
+  const std::string track_name = out_path.stem().string() + ".wav";
+  std::unique_ptr<SoundTrackRecorder> microphone;
+  if (args.audio) {
+    microphone = std::make_unique<SoundTrackRecorder>(
+        args.audio_device, kSoundTrackRate, (out_path.parent_path() / track_name).string());
+  }
+  LimpFigure figure(args.robot, args.ports);
+  const RobotConfig& config = figure.config();
+  std::vector<Track> tracks = choose_tracks(args, figure);
+  std::cout << "torque is off: move the figure; recording at " << config.rate_hz << " Hz "
+            << (args.duration_s > 0 ? fmt::format("for {} s", args.duration_s)
+                                    : std::string("until Ctrl-C"))
+            << std::endl;
+
+  const Sampling run = sample(figure, tracks, args.duration_s, microphone.get());
+  const std::size_t samples = count_samples(tracks);
+
+  const std::string audio_line =
+      microphone ? finish_audio_line(*microphone, run.start, track_name) : std::string();
+  std::string text = fmt::format(
+      "# Recorded by hand with animrt record from {}: {} reads at {} Hz, reduced to keys\n"
+      "# within {} deg ({} m for prismatic joints) under linear interpolation.\n"
+      "name: {}\nloop: false\nduration_s: {}\n{}joints:\n",
+      std::filesystem::path(config.file).filename().string(), run.reads, config.rate_hz,
+      args.tolerance_deg, args.tolerance_deg / 1000.0, out_path.stem().string(),
+      number(run.last_t, 4), audio_line);
+  const Reduction reduction = reduce_tracks(tracks, config, args.tolerance_deg, text);
+  write_show(args.out, text);
   std::cout << fmt::format(
       "{}: {} joints, {} samples over {:.2f} s -> {} keys (reduction {:.1f}:1 at {} deg)\n",
-      args.out, tracks.size(), samples, last_t, keys_total,
-      keys_total > 0 ? static_cast<double>(samples) / static_cast<double>(keys_total) : 0.0,
+      args.out, tracks.size(), samples, run.last_t, reduction.keys_total,
+      reduction.keys_total > 0
+          ? static_cast<double>(samples) / static_cast<double>(reduction.keys_total)
+          : 0.0,
       args.tolerance_deg);
-  if (missed > 0) {
-    std::cout << missed << " answers were missing (those samples were left out)\n";
+  if (run.missed > 0) {
+    std::cout << run.missed << " answers were missing (those samples were left out)\n";
   }
-  if (clamped > 0) {
-    std::cout << clamped << " samples were past the joints' limits and were clamped to them\n";
+  if (reduction.clamped > 0) {
+    std::cout << reduction.clamped
+              << " samples were past the joints' limits and were clamped to them\n";
   }
   return kExitOk;
 }
