@@ -75,6 +75,91 @@ class RecordOut {
   std::vector<std::uint8_t>& b_;
 };
 
+// The Summary section's records, group by group. The Writer's record lists
+// are passed as they are (their types are its own).
+void put_schema_records(RecordOut& out, const auto& schemas) {
+  for (const auto& s : schemas) {
+    const std::size_t rec = out.record(Op::schema);
+    out.u16(s.id);
+    out.str(s.name);
+    out.str(s.encoding);
+    out.str(s.data);
+    out.end_record(rec);
+  }
+}
+
+void put_channel_records(RecordOut& out, const auto& channels) {
+  for (const auto& c : channels) {
+    const std::size_t rec = out.record(Op::channel);
+    out.u16(c.id);
+    out.u16(c.schema_id);
+    out.str(c.topic);
+    out.str(c.encoding);
+    out.string_map(c.metadata);
+    out.end_record(rec);
+  }
+}
+
+void put_chunk_index_records(RecordOut& out, const auto& chunk_indexes) {
+  for (const auto& c : chunk_indexes) {
+    const std::size_t rec = out.record(Op::chunk_index);
+    out.u64(c.start);
+    out.u64(c.end);
+    out.u64(c.offset);
+    out.u64(c.length);
+    const std::size_t at = out.prefix();
+    for (const auto& [channel, where] : c.index_offsets) {
+      out.u16(channel);
+      out.u64(where);
+    }
+    out.end_prefix(at);
+    out.u64(c.index_length);
+    out.str(c.zstd ? "zstd" : "");
+    out.u64(c.compressed);
+    out.u64(c.uncompressed);
+    out.end_record(rec);
+  }
+}
+
+void put_metadata_index_records(RecordOut& out, const auto& metadata_indexes) {
+  for (const auto& m : metadata_indexes) {
+    const std::size_t rec = out.record(Op::metadata_index);
+    out.u64(m.offset);
+    out.u64(m.length);
+    out.str(m.name);
+    out.end_record(rec);
+  }
+}
+
+// A group of Summary records, found again by its Summary Offset.
+struct SummaryGroup {
+  Op op;
+  std::uint64_t start, length;
+};
+
+// The Summary Offsets, the Footer and the closing magic, after the summary
+// in `bytes`, which begins at `summary_start` in the file.
+void put_summary_offsets_and_footer(std::vector<std::uint8_t>& bytes,
+                                    const std::vector<SummaryGroup>& groups,
+                                    std::uint64_t summary_start) {
+  RecordOut out(bytes);
+  const std::uint64_t offsets_start = summary_start + out.size();
+  for (const SummaryGroup& g : groups) {
+    const std::size_t rec = out.record(Op::summary_offset);
+    out.u8(static_cast<std::uint8_t>(g.op));
+    out.u64(g.start);
+    out.u64(g.length);
+    out.end_record(rec);
+  }
+  // The footer's length goes in before its CRC, which covers it.
+  out.u8(static_cast<std::uint8_t>(Op::footer));
+  out.u64(8 + 8 + 4);
+  out.u64(summary_start);
+  out.u64(groups.empty() ? 0 : offsets_start);
+  out.u32(crc32(bytes));  // the summary up to and including summary_offset_start
+  out.raw(std::string_view(reinterpret_cast<const char*>(kMagic), sizeof kMagic));
+}
+
 }  // namespace
 
 std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc) {
@@ -245,7 +330,7 @@ void Writer::close() {
   closed_ = true;
   std::vector<std::uint8_t> bytes;
   RecordOut out(bytes);
-  std::size_t rec = out.record(Op::data_end);
+  const std::size_t rec = out.record(Op::data_end);
   out.u32(data_crc_);
   out.end_record(rec);
   emit(bytes, false);
@@ -253,98 +338,38 @@ void Writer::close() {
   // The summary: groups of records, each found again by a Summary Offset.
   const std::uint64_t summary_start = offset_;
   bytes.clear();
-  struct Group {
-    Op op;
-    std::uint64_t start, length;
+  std::vector<SummaryGroup> groups;
+  const auto group = [&](Op op, const auto& put) {
+    const std::size_t from = out.size();
+    put();
+    if (out.size() > from) {
+      groups.push_back(SummaryGroup{op, summary_start + from, out.size() - from});
+    }
   };
-  std::vector<Group> groups;
-  const auto group = [&](Op op, std::size_t from) {
-    if (out.size() > from) groups.push_back(Group{op, summary_start + from, out.size() - from});
-  };
-  std::size_t from = out.size();
-  for (const Schema& s : schemas_) {
-    rec = out.record(Op::schema);
-    out.u16(s.id);
-    out.str(s.name);
-    out.str(s.encoding);
-    out.str(s.data);
-    out.end_record(rec);
-  }
-  group(Op::schema, from);
-  from = out.size();
-  for (const Channel& c : channels_) {
-    rec = out.record(Op::channel);
-    out.u16(c.id);
-    out.u16(c.schema_id);
-    out.str(c.topic);
-    out.str(c.encoding);
-    out.string_map(c.metadata);
-    out.end_record(rec);
-  }
-  group(Op::channel, from);
-  from = out.size();
-  rec = out.record(Op::statistics);
-  const std::uint64_t written = messages_ - lost_;
-  out.u64(written);
-  out.u16(static_cast<std::uint16_t>(schemas_.size()));
-  out.u32(static_cast<std::uint32_t>(channels_.size()));
-  out.u32(0);  // attachments
-  out.u32(static_cast<std::uint32_t>(metadata_indexes_.size()));
-  out.u32(static_cast<std::uint32_t>(chunk_indexes_.size()));
-  out.u64(written ? start_time_ : 0);
-  out.u64(written ? end_time_ : 0);
-  std::size_t at = out.prefix();
-  for (const auto& [channel, count] : channel_counts_) {
-    out.u16(channel);
-    out.u64(count);
-  }
-  out.end_prefix(at);
-  out.end_record(rec);
-  group(Op::statistics, from);
-  from = out.size();
-  for (const ChunkIndex& c : chunk_indexes_) {
-    rec = out.record(Op::chunk_index);
-    out.u64(c.start);
-    out.u64(c.end);
-    out.u64(c.offset);
-    out.u64(c.length);
-    at = out.prefix();
-    for (const auto& [channel, where] : c.index_offsets) {
+  group(Op::schema, [&] { put_schema_records(out, schemas_); });
+  group(Op::channel, [&] { put_channel_records(out, channels_); });
+  group(Op::statistics, [&] {
+    const std::size_t stats = out.record(Op::statistics);
+    const std::uint64_t written = messages_ - lost_;
+    out.u64(written);
+    out.u16(static_cast<std::uint16_t>(schemas_.size()));
+    out.u32(static_cast<std::uint32_t>(channels_.size()));
+    out.u32(0);  // attachments
+    out.u32(static_cast<std::uint32_t>(metadata_indexes_.size()));
+    out.u32(static_cast<std::uint32_t>(chunk_indexes_.size()));
+    out.u64(written ? start_time_ : 0);
+    out.u64(written ? end_time_ : 0);
+    const std::size_t at = out.prefix();
+    for (const auto& [channel, count] : channel_counts_) {
       out.u16(channel);
-      out.u64(where);
+      out.u64(count);
     }
     out.end_prefix(at);
-    out.u64(c.index_length);
-    out.str(c.zstd ? "zstd" : "");
-    out.u64(c.compressed);
-    out.u64(c.uncompressed);
-    out.end_record(rec);
-  }
-  group(Op::chunk_index, from);
-  from = out.size();
-  for (const MetadataIndex& m : metadata_indexes_) {
-    rec = out.record(Op::metadata_index);
-    out.u64(m.offset);
-    out.u64(m.length);
-    out.str(m.name);
-    out.end_record(rec);
-  }
-  group(Op::metadata_index, from);
-  const std::uint64_t offsets_start = summary_start + out.size();
-  for (const Group& g : groups) {
-    rec = out.record(Op::summary_offset);
-    out.u8(static_cast<std::uint8_t>(g.op));
-    out.u64(g.start);
-    out.u64(g.length);
-    out.end_record(rec);
-  }
-  // The footer's length goes in before its CRC, which covers it.
-  out.u8(static_cast<std::uint8_t>(Op::footer));
-  out.u64(8 + 8 + 4);
-  out.u64(summary_start);
-  out.u64(groups.empty() ? 0 : offsets_start);
-  out.u32(crc32(bytes));  // the summary up to and including summary_offset_start
-  out.raw(std::string_view(reinterpret_cast<const char*>(kMagic), sizeof kMagic));
+    out.end_record(stats);
+  });
+  group(Op::chunk_index, [&] { put_chunk_index_records(out, chunk_indexes_); });
+  group(Op::metadata_index, [&] { put_metadata_index_records(out, metadata_indexes_); });
+  put_summary_offsets_and_footer(bytes, groups, summary_start);
   emit(bytes, false);
 }
 
