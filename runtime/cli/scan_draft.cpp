@@ -47,19 +47,21 @@ std::string fixed1(double v) {
 
 bool is_servo(const FoundDevice& d) { return d.protocol != "maestro"; }
 
-}  // namespace
+// Servos that answered with their limits, counted by protocol and baud.
+using DraftBusCounts = std::map<std::pair<std::string, int>, int>;
 
-int write_robot_draft(const std::string& path, const std::string& port,
-                      const commission::ScanResult& found) {
-  // One bus per port: the protocol and baud with the most servos; the
-  // others are listed for the user to move there.
-  std::map<std::pair<std::string, int>, int> groups;
+DraftBusCounts count_draft_buses(const commission::ScanResult& found) {
+  DraftBusCounts groups;
   for (const FoundDevice& d : found.devices) {
     if (is_servo(d) && d.min_limit && d.max_limit) ++groups[{d.protocol, d.baud}];
   }
   if (groups.empty()) {
     throw std::runtime_error("--write-robot: no servo answered with its limits; nothing to draft");
   }
+  return groups;
+}
+
+DraftBusCounts::const_iterator choose_draft_bus(const DraftBusCounts& groups) {
   auto best = groups.begin();
   for (auto it = groups.begin(); it != groups.end(); ++it) {
     // The most servos; of equals, the fastest line.
@@ -68,18 +70,12 @@ int write_robot_draft(const std::string& path, const std::string& port,
       best = it;
     }
   }
-  const auto [protocol, baud] = best->first;
+  return best;
+}
 
-  // A loop the line can keep up with: about 24 bytes per servo and cycle
-  // (its goal out, its position in), with a fifth to spare.
-  const int servos = best->second;
-  const long rate_hz =
-      std::clamp(std::lround(std::floor(0.8 * baud / (240.0 * servos + 100.0))), 1L, 100L);
-  const fs::path robot(path);
-  const std::string stem = robot.stem().string();
-  const fs::path show = robot.parent_path() / (stem + ".hold.yaml");
-
-  std::ostringstream y;
+// The comments on what to check, the name, the loop and the safety section.
+void put_draft_header(std::ostream& y, const std::string& port, const std::string& stem,
+                      long rate_hz, int baud) {
   y << "# Drafted by `animrt scan " << port << " --write-robot` from the devices that\n"
     << "# answered. Check before the first run:\n"
     << "#  - joint names: each joint is named after its servo's id; rename them;\n"
@@ -94,8 +90,14 @@ int write_robot_draft(const std::string& path, const std::string& port,
     << "safety:\n  watchdog_timeout_s: " << fixed1(std::max(0.1, std::ceil(30.0 / rate_hz) / 10.0))
     << (rate_hz < 5 ? "\n  following_error_window_s: " + fixed1(std::ceil(30.0 / rate_hz) / 10.0)
                     : std::string())
-    << "\n  start_ramp_s: 2.0\n  stop_ramp_s: 2.0\n\n"
-    << "buses:\n  bus0:\n"
+    << "\n  start_ramp_s: 2.0\n  stop_ramp_s: 2.0\n\n";
+}
+
+// The one bus, and as comments the devices left off it.
+void put_draft_bus(std::ostream& y, const std::string& port, const commission::ScanResult& found,
+                   const DraftBusCounts& groups, DraftBusCounts::const_iterator best) {
+  const auto& [protocol, baud] = best->first;
+  y << "buses:\n  bus0:\n"
     << "    protocol: " << protocol << "\n"
     << "    port: " << port << "   # a /dev/serial/by-id/... link survives replugging\n"
     << "    baud: " << baud << "\n    timeout_ms: 10\n";
@@ -115,9 +117,14 @@ int write_robot_draft(const std::string& path, const std::string& port,
     y << "    # left out: id " << c.id << " at " << c.baud << " baud (" << c.how
       << "): plug in one servo at a time and give each its own id\n";
   }
+}
+
+// A joint per servo on the bus, and its keys in the hold show. Returns the
+// number of joints.
+int put_draft_joints(std::ostream& y, std::ostream& keys, const commission::ScanResult& found,
+                     const std::string& protocol, int baud) {
   y << "\njoints:\n";
   int joints = 0;
-  std::ostringstream keys;
   for (const FoundDevice& d : found.devices) {
     if (d.protocol != protocol || d.baud != baud || !d.min_limit || !d.max_limit) continue;
     const double tpr = d.ticks_per_rev.value_or(4096.0);
@@ -137,6 +144,33 @@ int write_robot_draft(const std::string& path, const std::string& port,
     keys << "  " << name << ":\n    keys:\n      - [0.0, 0]\n      - [1.0, 0]\n";
     ++joints;
   }
+  return joints;
+}
+
+}  // namespace
+
+int write_robot_draft(const std::string& path, const std::string& port,
+                      const commission::ScanResult& found) {
+  // One bus per port: the protocol and baud with the most servos; the
+  // others are listed for the user to move there.
+  const DraftBusCounts groups = count_draft_buses(found);
+  const auto best = choose_draft_bus(groups);
+  const auto [protocol, baud] = best->first;
+
+  // A loop the line can keep up with: about 24 bytes per servo and cycle
+  // (its goal out, its position in), with a fifth to spare.
+  const int servos = best->second;
+  const long rate_hz =
+      std::clamp(std::lround(std::floor(0.8 * baud / (240.0 * servos + 100.0))), 1L, 100L);
+  const fs::path robot(path);
+  const std::string stem = robot.stem().string();
+  const fs::path show = robot.parent_path() / (stem + ".hold.yaml");
+
+  std::ostringstream y;
+  put_draft_header(y, port, stem, rate_hz, baud);
+  put_draft_bus(y, port, found, groups, best);
+  std::ostringstream keys;
+  const int joints = put_draft_joints(y, keys, found, protocol, baud);
   y << "\n# Holds every joint at its home pose: replace with the figure's motion.\n"
     << "motion:\n  type: show\n  file: " << show.filename().string() << "\n";
 
