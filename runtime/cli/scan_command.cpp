@@ -129,51 +129,37 @@ void report(const ScanArgs& args, const ScanResult& result, bool maestro_line) {
   }
 }
 
-int run_scan(const ScanArgs& args) {
-  ScanLimits limits;
-  if (!parse_ids(args.ids, limits.first_id, limits.last_id)) {
-    std::cerr << "error: --ids: expected FIRST-LAST within 0-253, found \"" << args.ids << "\"\n";
-    return kExitUsage;
-  }
-  limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
-  ScanResult result;
-  if (!args.can.empty()) {
-    limits.progress = [](const std::string& line) { std::cerr << "scan: " << line << '\n'; };
-    std::cerr << "scan " << args.can << ": listening " << args.listen_ms
-              << " ms for heartbeats, then SDO reads of 0x1000 and 0x1018...\n";
-    commission::scan_canopen(args.can, std::chrono::milliseconds(args.listen_ms), limits, result);
-    ScanArgs shown = args;
-    shown.port = args.can;
-    report(shown, result, false);
-    return kExitOk;
-  }
-  if (args.port.empty()) {
-    std::cerr << "error: give a serial PORT, tcp://HOST:PORT or --can IFACE\n";
-    return kExitUsage;
-  }
-  if (args.port.rfind("tcp://", 0) == 0) {
-    // Modbus TCP: unit ids behind one address.
-    std::cerr << "scan " << args.port << ": modbus-tcp unit ids " << std::max(limits.first_id, 1)
-              << "-" << std::min(limits.last_id, 247) << "...\n";
-    commission::scan_modbus_tcp(args.port.substr(6), limits, result);
-    report(args, result, false);
-    return kExitOk;
-  }
-  // A port that is no serial port is told so first (open_serial says why).
-  open_serial(args.port, 57600).reset();
-  if (const std::string busy = port_busy(args.port); !busy.empty()) {
-    std::cerr << "error: serial port " << args.port << " is " << busy
-              << "; stop it first (two programs on one bus garble each other)\n";
-    return kExitDeviceError;
-  }
-  // Each protocol at each of its bauds (Maestro first: once a Maestro
-  // answers, no servo packet goes on its line, since it would read their
-  // bytes as Mini SSC commands and move a channel).
-  struct Step {
-    std::string protocol;
-    int baud;
-  };
-  std::vector<Step> steps;
+// CANopen: heartbeats, then SDO reads of each node that answered.
+int scan_can_bus(const ScanArgs& args, ScanLimits& limits, ScanResult& result) {
+  limits.progress = [](const std::string& line) { std::cerr << "scan: " << line << '\n'; };
+  std::cerr << "scan " << args.can << ": listening " << args.listen_ms
+            << " ms for heartbeats, then SDO reads of 0x1000 and 0x1018...\n";
+  commission::scan_canopen(args.can, std::chrono::milliseconds(args.listen_ms), limits, result);
+  ScanArgs shown = args;
+  shown.port = args.can;
+  report(shown, result, false);
+  return kExitOk;
+}
+
+// Modbus TCP: unit ids behind one address.
+int scan_tcp_units(const ScanArgs& args, const ScanLimits& limits, ScanResult& result) {
+  std::cerr << "scan " << args.port << ": modbus-tcp unit ids " << std::max(limits.first_id, 1)
+            << "-" << std::min(limits.last_id, 247) << "...\n";
+  commission::scan_modbus_tcp(args.port.substr(6), limits, result);
+  report(args, result, false);
+  return kExitOk;
+}
+
+struct ScanStep {
+  std::string protocol;
+  int baud;
+};
+
+// Each protocol at each of its bauds (Maestro first: once a Maestro
+// answers, no servo packet goes on its line, since it would read their
+// bytes as Mini SSC commands and move a channel).
+std::vector<ScanStep> serial_scan_steps(const ScanArgs& args) {
+  std::vector<ScanStep> steps;
   for (const char* p : kProtocols) {
     if (!wanted(args, p)) continue;
     const std::string name = p;
@@ -183,15 +169,15 @@ int run_scan(const ScanArgs& args) {
                                                               : commission::modbus_rtu_bauds();
     for (int b : bauds_for(args, standard)) steps.push_back({p, b});
   }
-  if (steps.empty()) {
-    std::cerr << "error: --baud: none of the given rates is a standard rate of the protocols "
-                 "asked\n";
-    return kExitUsage;
-  }
+  return steps;
+}
+
+// Runs the steps on the serial port; returns whether a Maestro answered.
+bool run_serial_scan_steps(const ScanArgs& args, const std::vector<ScanStep>& steps,
+                           const ScanLimits& limits, ScanResult& result) {
   bool maestro_line = false;
-  const auto started = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < steps.size(); ++i) {
-    const Step& step = steps[i];
+    const ScanStep& step = steps[i];
     if (maestro_line && step.protocol != "maestro") continue;
     if (!carries_baud(args.port, step.baud)) {
       std::cerr << "scan " << args.port << ": [" << (i + 1) << "/" << steps.size() << "] "
@@ -216,6 +202,25 @@ int run_scan(const ScanArgs& args) {
     }
     if (line->failure() != nullptr) throw DeviceError(describe_failure(*line));
   }
+  return maestro_line;
+}
+
+int scan_serial_port(const ScanArgs& args, const ScanLimits& limits, ScanResult& result) {
+  // A port that is no serial port is told so first (open_serial says why).
+  open_serial(args.port, 57600).reset();
+  if (const std::string busy = port_busy(args.port); !busy.empty()) {
+    std::cerr << "error: serial port " << args.port << " is " << busy
+              << "; stop it first (two programs on one bus garble each other)\n";
+    return kExitDeviceError;
+  }
+  const std::vector<ScanStep> steps = serial_scan_steps(args);
+  if (steps.empty()) {
+    std::cerr << "error: --baud: none of the given rates is a standard rate of the protocols "
+                 "asked\n";
+    return kExitUsage;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const bool maestro_line = run_serial_scan_steps(args, steps, limits, result);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::cerr << "scan " << args.port << ": done in " << opt(seconds, "%.1f") << " s, "
@@ -223,6 +228,23 @@ int run_scan(const ScanArgs& args) {
             << " collision(s)\n";
   report(args, result, maestro_line);
   return kExitOk;
+}
+
+int run_scan(const ScanArgs& args) {
+  ScanLimits limits;
+  if (!parse_ids(args.ids, limits.first_id, limits.last_id)) {
+    std::cerr << "error: --ids: expected FIRST-LAST within 0-253, found \"" << args.ids << "\"\n";
+    return kExitUsage;
+  }
+  limits.answer_timeout = std::chrono::milliseconds(args.timeout_ms);
+  ScanResult result;
+  if (!args.can.empty()) return scan_can_bus(args, limits, result);
+  if (args.port.empty()) {
+    std::cerr << "error: give a serial PORT, tcp://HOST:PORT or --can IFACE\n";
+    return kExitUsage;
+  }
+  if (args.port.rfind("tcp://", 0) == 0) return scan_tcp_units(args, limits, result);
+  return scan_serial_port(args, limits, result);
 }
 
 }  // namespace
