@@ -121,6 +121,75 @@ void read_mcap_records(const McapParser& p, McapParser::Cursor& all, McapState& 
   if (!in_chunk) p.fail(all.base + all.i, "truncated: no DataEnd record (a recording cut short?)");
 }
 
+void take_mcap_channel(const McapParser& p, McapParser::Cursor& c, McapState& s) {
+  ReadChannel ch;
+  ch.id = c.u16();
+  const std::uint16_t schema = c.u16();
+  ch.topic = c.str();
+  ch.message_encoding = c.str();
+  (void)c.string_map();
+  if (schema != 0) {
+    const auto it = s.schemas.find(schema);
+    if (it == s.schemas.end()) {
+      p.fail(c.base, "channel " + ch.topic + " names schema " + std::to_string(schema) +
+                         ", which no earlier Schema record defines");
+    }
+    ch.schema_name = it->second.first;
+    ch.schema_encoding = it->second.second;
+  }
+  s.out.channels[ch.id] = std::move(ch);
+}
+
+void take_mcap_message(const McapParser& p, McapParser::Cursor& c, McapState& s) {
+  ReadMessage m;
+  m.channel = c.u16();
+  m.sequence = c.u32();
+  m.log_time = c.u64();
+  (void)c.u64();
+  const auto data = c.bytes(c.b.size() - c.i);
+  m.data.assign(data.begin(), data.end());
+  if (!s.out.channels.contains(m.channel)) {
+    p.fail(c.base, "a message on channel " + std::to_string(m.channel) +
+                       ", which no earlier Channel record defines");
+  }
+  s.out.messages.push_back(std::move(m));
+}
+
+// A chunk's records as they were before compression, checked against its
+// header's size and CRC.
+std::vector<std::uint8_t> inflate_mcap_chunk(const McapParser& p, McapParser::Cursor& c) {
+  (void)c.u64();
+  (void)c.u64();
+  const std::uint64_t size = c.u64();
+  const std::uint32_t crc = c.u32();
+  const std::string compression = c.str();
+  const auto records = c.bytes(c.u64());
+  if (size > kMaxChunkBytes) {
+    p.fail(c.base, "a chunk of " + std::to_string(size) + " bytes uncompressed is too large");
+  }
+  std::vector<std::uint8_t> plain;
+  if (compression.empty()) {
+    plain.assign(records.begin(), records.end());
+  } else if (compression == "zstd") {
+    plain.resize(static_cast<std::size_t>(size));
+    const std::size_t n =
+        ZSTD_decompress(plain.data(), plain.size(), records.data(), records.size());
+    if (ZSTD_isError(n) || n != size) {
+      p.fail(c.base, std::string("a zstd chunk does not inflate to its ") + std::to_string(size) +
+                         " bytes" +
+                         (ZSTD_isError(n) ? std::string(": ") + ZSTD_getErrorName(n) : ""));
+    }
+  } else {
+    p.fail(c.base, "chunk compression \"" + compression + "\" is not supported (zstd or none)");
+  }
+  if (plain.size() != size) {
+    p.fail(c.base, "a chunk holds " + std::to_string(plain.size()) + " bytes, its header says " +
+                       std::to_string(size));
+  }
+  if (crc != 0 && crc32(plain) != crc) p.fail(c.base, "chunk CRC does not match its records");
+  return plain;
+}
+
 void take(const McapParser& p, std::uint8_t op, McapParser::Cursor c, McapState& s, bool in_chunk) {
   switch (static_cast<Op>(op)) {
     case Op::schema: {
@@ -129,71 +198,15 @@ void take(const McapParser& p, std::uint8_t op, McapParser::Cursor c, McapState&
       s.schemas[id] = {std::move(name), c.str()};
       break;
     }
-    case Op::channel: {
-      ReadChannel ch;
-      ch.id = c.u16();
-      const std::uint16_t schema = c.u16();
-      ch.topic = c.str();
-      ch.message_encoding = c.str();
-      (void)c.string_map();
-      if (schema != 0) {
-        const auto it = s.schemas.find(schema);
-        if (it == s.schemas.end()) {
-          p.fail(c.base, "channel " + ch.topic + " names schema " + std::to_string(schema) +
-                             ", which no earlier Schema record defines");
-        }
-        ch.schema_name = it->second.first;
-        ch.schema_encoding = it->second.second;
-      }
-      s.out.channels[ch.id] = std::move(ch);
+    case Op::channel:
+      take_mcap_channel(p, c, s);
       break;
-    }
-    case Op::message: {
-      ReadMessage m;
-      m.channel = c.u16();
-      m.sequence = c.u32();
-      m.log_time = c.u64();
-      (void)c.u64();
-      const auto data = c.bytes(c.b.size() - c.i);
-      m.data.assign(data.begin(), data.end());
-      if (!s.out.channels.contains(m.channel)) {
-        p.fail(c.base, "a message on channel " + std::to_string(m.channel) +
-                           ", which no earlier Channel record defines");
-      }
-      s.out.messages.push_back(std::move(m));
+    case Op::message:
+      take_mcap_message(p, c, s);
       break;
-    }
     case Op::chunk: {
       if (in_chunk) p.fail(c.base, "a Chunk inside a chunk");
-      (void)c.u64();
-      (void)c.u64();
-      const std::uint64_t size = c.u64();
-      const std::uint32_t crc = c.u32();
-      const std::string compression = c.str();
-      const auto records = c.bytes(c.u64());
-      if (size > kMaxChunkBytes) {
-        p.fail(c.base, "a chunk of " + std::to_string(size) + " bytes uncompressed is too large");
-      }
-      std::vector<std::uint8_t> plain;
-      if (compression.empty()) {
-        plain.assign(records.begin(), records.end());
-      } else if (compression == "zstd") {
-        plain.resize(static_cast<std::size_t>(size));
-        const std::size_t n =
-            ZSTD_decompress(plain.data(), plain.size(), records.data(), records.size());
-        if (ZSTD_isError(n) || n != size) {
-          p.fail(c.base, std::string("a zstd chunk does not inflate to its ") +
-                             std::to_string(size) + " bytes" +
-                             (ZSTD_isError(n) ? std::string(": ") + ZSTD_getErrorName(n) : ""));
-        }
-      } else {
-        p.fail(c.base, "chunk compression \"" + compression + "\" is not supported (zstd or none)");
-      }
-      if (plain.size() != size) {
-        p.fail(c.base, "a chunk holds " + std::to_string(plain.size()) +
-                           " bytes, its header says " + std::to_string(size));
-      }
-      if (crc != 0 && crc32(plain) != crc) p.fail(c.base, "chunk CRC does not match its records");
+      const std::vector<std::uint8_t> plain = inflate_mcap_chunk(p, c);
       McapParser inner(p.name_,
                        p.where_ + " (in the chunk at byte " + std::to_string(c.base - 9) + ")");
       McapParser::Cursor all{inner, plain, 0, 0, "chunk"};
