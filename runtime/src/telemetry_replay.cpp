@@ -32,6 +32,59 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() > tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
+// The recording's start from its animrt metadata; false when it has none.
+bool telemetry_mcap_start(const mcap::ReadFile& file, std::uint64_t& start) {
+  bool have_start = false;
+  for (const auto& [name, entries] : file.metadata) {
+    for (const auto& [key, value] : entries) {
+      if (name != "animrt" || key != "start_time_ns") continue;
+      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), start);
+      have_start = ec == std::errc() && end == value.data() + value.size();
+    }
+  }
+  return have_start;
+}
+
+// A message's positions, in the order of the first message's joints.
+void append_telemetry_positions(const std::string& path, const mcap::ReadFile& file,
+                                const mcap::ReadMessage& m, std::vector<std::string>& names,
+                                std::vector<double>& out) {
+  nlohmann::json j = nlohmann::json::parse(m.data, nullptr, false);
+  const auto bad = [&](const std::string& what) {
+    throw InputError(Location{path, 0, 0}, "",
+                     "message " + std::to_string(m.sequence) + " of " +
+                         file.channels.at(m.channel).topic + ": " + what);
+  };
+  if (!j.is_object() || !j.contains("joints") || !j["joints"].is_array()) {
+    bad("expected a foxglove.JointStates JSON object with joints");
+  }
+  const auto& joints = j["joints"];
+  if (names.empty()) {
+    for (const auto& joint : joints) {
+      if (!joint.is_object() || !joint.contains("name") || !joint["name"].is_string()) {
+        bad("expected each joint to have a name");
+      }
+      names.push_back(joint["name"].get<std::string>());
+    }
+    if (names.empty()) bad("expected at least one joint");
+  }
+  if (joints.size() != names.size()) {
+    bad("expected " + std::to_string(names.size()) + " joints, found " +
+        std::to_string(joints.size()));
+  }
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const auto& joint = joints[k];
+    const bool named = joint.is_object() && joint.contains("name") && joint["name"].is_string() &&
+                       joint["name"].get_ref<const std::string&>() == names[k];
+    if (!named) {
+      bad("expected joint " + names[k] + " at position " + std::to_string(k + 1));
+    }
+    const auto it = joint.find("position");
+    out.push_back(it != joint.end() && it->is_number() ? it->get<double>()
+                                                       : std::numeric_limits<double>::quiet_NaN());
+  }
+}
+
 }  // namespace
 
 TelemetryRecording load_telemetry_csv(const std::string& path) {
@@ -119,53 +172,9 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
     fail("expected the channels /joint_states and /joint_commands of animrt run --record");
   }
   std::uint64_t start = 0;
-  bool have_start = false;
-  for (const auto& [name, entries] : file.metadata) {
-    for (const auto& [key, value] : entries) {
-      if (name != "animrt" || key != "start_time_ns") continue;
-      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), start);
-      have_start = ec == std::errc() && end == value.data() + value.size();
-    }
-  }
+  bool have_start = telemetry_mcap_start(file, start);
   TelemetryRecording rec;
   rec.file = path;
-  // A message's positions, in the order of the first message's joints.
-  const auto positions = [&](const mcap::ReadMessage& m, std::vector<double>& out) {
-    nlohmann::json j = nlohmann::json::parse(m.data, nullptr, false);
-    const auto bad = [&](const std::string& what) {
-      fail("message " + std::to_string(m.sequence) + " of " + file.channels.at(m.channel).topic +
-           ": " + what);
-    };
-    if (!j.is_object() || !j.contains("joints") || !j["joints"].is_array()) {
-      bad("expected a foxglove.JointStates JSON object with joints");
-    }
-    const auto& joints = j["joints"];
-    if (rec.joints.empty()) {
-      for (const auto& joint : joints) {
-        if (!joint.is_object() || !joint.contains("name") || !joint["name"].is_string()) {
-          bad("expected each joint to have a name");
-        }
-        rec.joints.push_back(joint["name"].get<std::string>());
-      }
-      if (rec.joints.empty()) bad("expected at least one joint");
-    }
-    if (joints.size() != rec.joints.size()) {
-      bad("expected " + std::to_string(rec.joints.size()) + " joints, found " +
-          std::to_string(joints.size()));
-    }
-    for (std::size_t k = 0; k < joints.size(); ++k) {
-      const auto& joint = joints[k];
-      const bool named = joint.is_object() && joint.contains("name") && joint["name"].is_string() &&
-                         joint["name"].get_ref<const std::string&>() == rec.joints[k];
-      if (!named) {
-        bad("expected joint " + rec.joints[k] + " at position " + std::to_string(k + 1));
-      }
-      const auto it = joint.find("position");
-      out.push_back(it != joint.end() && it->is_number()
-                        ? it->get<double>()
-                        : std::numeric_limits<double>::quiet_NaN());
-    }
-  };
   std::vector<const mcap::ReadMessage*> commands;
   for (const mcap::ReadMessage& m : file.messages) {
     if (m.channel == cmd->id) commands.push_back(&m);
@@ -177,7 +186,7 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
       start = m.log_time;
       have_start = true;
     }
-    positions(m, rec.meas);
+    append_telemetry_positions(path, file, m, rec.joints, rec.meas);
     // The command of the same cycle: the same log time.
     while (next_command < commands.size() && commands[next_command]->log_time < m.log_time) {
       ++next_command;
@@ -186,7 +195,7 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
       fail("no /joint_commands message at the time of /joint_states message " +
            std::to_string(m.sequence));
     }
-    positions(*commands[next_command++], rec.cmd);
+    append_telemetry_positions(path, file, *commands[next_command++], rec.joints, rec.cmd);
     // The difference first: nanoseconds since 1970 do not fit a double's mantissa.
     const double t = m.log_time >= start ? static_cast<double>(m.log_time - start) * 1e-9
                                          : -static_cast<double>(start - m.log_time) * 1e-9;
