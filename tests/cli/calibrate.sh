@@ -104,7 +104,7 @@ PY
 
 # Interactively, with Enter from the user: rf_hip is mounted mirrored
 # (direction -1) but its user's positive is up the ticks, so it becomes 1.
-calibrate '{"rf_hip": [4, 1500, 2600, 2000]}' "$tmp/inter.txt" --joint rf_hip ||
+calibrate '{"rf_hip": [4, 1500, 2600, 2000]}' "$tmp/inter.txt" --joint rf_hip --no-jog ||
   fail "interactive calibrate: $(cat "$tmp/inter.txt")"
 line=$(grep -A3 "^  rf_hip:" "$robot")
 [[ $line == *"min_deg: -43.9, max_deg: 52.7,"* && $line == *"zero_ticks: 2000, direction: 1}"* ]] ||
