@@ -39,18 +39,44 @@ struct CalibrateArgs {
 };
 
 // What one joint's calibration saw, in the servo's own ticks (so that the
-// file's present zero_ticks and direction do not matter).
+// file's present zero_ticks and direction do not matter), unwrapped: a
+// servo that reports one turn (0..4095) jumps by a turn where its shaft
+// crosses the seam, and no hand turns a joint half a turn in one read.
 struct Seen {
   double min_ticks = std::numeric_limits<double>::infinity();
   double max_ticks = -std::numeric_limits<double>::infinity();
   double home_ticks = 0.0;
   int direction = 1;
-  void add(double ticks) {
+  double turn = 4096.0;  // the servo's ticks per turn of its shaft
+  double last_raw = std::numeric_limits<double>::quiet_NaN();
+  double unwrap = 0.0;  // whole turns added to the raw ticks
+  void add(double raw) {
+    if (!std::isnan(last_raw)) {
+      if (raw - last_raw > turn / 2) unwrap -= turn;
+      if (raw - last_raw < -turn / 2) unwrap += turn;
+    }
+    last_raw = raw;
+    const double ticks = raw + unwrap;
     min_ticks = std::min(min_ticks, ticks);
     max_ticks = std::max(max_ticks, ticks);
     home_ticks = ticks;
   }
+  // Whole turns off, so the home is one the servo reports; false when the
+  // range then crosses the seam (the servo cannot be driven across it in
+  // position mode).
+  bool within_one_turn() {
+    const double shift = std::floor(home_ticks / turn) * turn;
+    min_ticks -= shift;
+    max_ticks -= shift;
+    home_ticks -= shift;
+    return min_ticks >= 0 && max_ticks <= turn - 1;
+  }
 };
+
+// Ticks per turn of a servo's shaft, as it reports its position.
+double ticks_per_turn(const std::string& protocol) {
+  return protocol == "feetech_scs" ? 1024.0 : 4096.0;
+}
 
 // The servo ticks of a joint position as the file maps them today.
 double raw_ticks(const ActuatorBinding& a, double position) {
@@ -199,8 +225,9 @@ int direction_by_hand(LimpFigure& figure, std::size_t j, double home) {
                "Enter: keep direction "
             << a.direction << ")" << std::endl;
   Seen moved;
+  moved.turn = ticks_per_turn(figure.protocol(j));
   follow(figure, j, moved, true, [](double) { return enter_pressed(); });
-  const double delta_deg = ticks_to_deg(a, moved.home_ticks - home);
+  const double delta_deg = ticks_to_deg(a, std::remainder(moved.home_ticks - home, moved.turn));
   if (std::abs(delta_deg) >= 1.0) return delta_deg > 0 ? 1 : -1;
   return a.direction;
 }
@@ -300,6 +327,7 @@ int run_calibrate(const CalibrateArgs& args) {
     const ActuatorBinding& a = *figure.binding(j);
     Seen seen;
     seen.direction = a.direction;
+    seen.turn = ticks_per_turn(figure.protocol(j));
     const bool jogged = args.jog == 1 || (args.jog < 0 && !args.non_interactive &&
                                           ask_yes(name + ": check its direction by a small jog "
                                                          "under a weak torque?"));
@@ -328,6 +356,13 @@ int run_calibrate(const CalibrateArgs& args) {
           "{}: moved through only {:.1f} deg (at least {} deg needed): nothing was written; move "
           "the joint through its whole range while it is recorded",
           name, range, args.min_range_deg));
+    }
+    if (!seen.within_one_turn()) {
+      throw std::runtime_error(fmt::format(
+          "{}: its range, {:.0f} .. {:.0f} ticks, crosses its servo's {:.0f} -> 0 seam, which a "
+          "servo in position mode cannot be driven across: nothing was written; turn the horn "
+          "on its spline so that the range lies within one turn",
+          name, seen.min_ticks, seen.max_ticks, seen.turn - 1));
     }
     lines.push_back(write_joint(edit, name, a, seen));
   }
