@@ -5,6 +5,7 @@
 # leaves it (the recorder's goal follows the hand), the show holds what was
 # moved within 1 deg, and afterwards torque is off and the servo is back in
 # position mode. A torque a hand cannot overpower (40 %) refuses the hand.
+# A Feetech STS servo is held the same way by its Torque Limit.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -65,4 +66,20 @@ scan=$("$animrt" scan "$pty" --protocol dynamixel2 --baud 1000000 --ids 1-1 2>&1
 out=$(/usr/bin/python3 "$tmp/hand.py" "$tmp/ctl" "$animrt" record "$robot" --out "$tmp/strong.yaml" \
   --joint lf_hip --compliant 40 --duration 1.5 --port "legs=$pty" 2>&1) || fail "record 40 %: $out"
 grep -q "^hand 2348 error: torque is on" <<< "$out" || fail "a hand overpowered 40 %: $out"
+stop_sim
+
+# A Feetech STS arm: held by a Torque Limit of 10 % of its maximum torque.
+copy_robot arm_sts
+ln -sfn "$root/configs/shows" "$tmp/shows"
+rm -f "$tmp/ctl"
+start_sim "$tmp/robots/arm_sts.yaml"
+sed -i 's/legs/arm/g' "$tmp/hand.py"
+out=$(/usr/bin/python3 "$tmp/hand.py" "$tmp/ctl" "$animrt" record "$tmp/robots/arm_sts.yaml" \
+  --out "$tmp/arm.yaml" --joint shoulder_pan --compliant 10 --duration 2 --port "arm=$pty" 2>&1) ||
+  fail "record the arm: $out"
+for ticks in 2348 1848; do
+  grep -q "^hand $ticks ok" <<< "$out" && grep -Eq "^then ok ticks=$ticks torque=1 " <<< "$out" ||
+    fail "arm not held at $ticks: $out"
+done
+[[ $(ctl "get arm 1") == "ok ticks="*" torque=0 "* ]] || fail "arm: torque left on: $(ctl "get arm 1")"
 echo "record compliant: ok"
