@@ -345,8 +345,8 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--audio-device", args.audio_device, "ALSA capture device (default: default)");
   cmd->add_option("--compliant", args.compliant_percent,
                   "PERCENT: hold the figure by a weak torque, this share of each servo's current "
-                  "limit (Dynamixel current-based position mode), so it does not sag while it is "
-                  "moved; servos without current control stay limp (default 0: all limp)")
+                  "limit (Dynamixel current-based position mode; Feetech STS: its Torque Limit), so "
+                  "it does not sag while it is moved; the others stay limp (default 0: all limp)")
       ->check(CLI::Range(0.0, 50.0));
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {
