@@ -168,7 +168,7 @@ bool ask_yes(const std::string& question) {
 
 // The jog: joint `j` held by a weak torque, its goal jog_deg ahead in the
 // file's positive direction for half a second, then limp again. How far it
-// went, in the file's degrees (NaN: its servo has no current control).
+// went, in the file's degrees (NaN: its servo has no current or torque control).
 double jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
   if (!figure.hold_weakly(j, args.jog_percent / 100.0)) return std::nan("");
   std::vector<double> positions;
@@ -193,11 +193,13 @@ double jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
 int direction_by_jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
   const std::string& name = figure.config().joints[j].name;
   const ActuatorBinding& a = *figure.binding(j);
-  std::cout << name << ": jog " << deg_text(args.jog_deg) << " deg under " << args.jog_percent
-            << " % current" << std::endl;
+  std::cout << name << ": jog " << deg_text(args.jog_deg) << " deg under a weak torque ("
+            << args.jog_percent << " %)" << std::endl;
   const double moved = jog(figure, j, args);
   if (std::isnan(moved)) {
-    std::cout << name << ": its servo has no current control: not jogged, direction kept "
+    std::cout << name
+              << ": its servo has no current or torque control: not jogged, "
+                 "direction kept "
               << a.direction << '\n';
     return a.direction;
   }

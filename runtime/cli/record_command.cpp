@@ -246,8 +246,9 @@ void write_show(const std::string& out_file, const std::string& text) {
   load_show_file(out_file);  // what was written reads back as a show
 }
 
-// --compliant: each recorded joint whose servo has current control held by
-// that share of its current limit, the others limp (and named).
+// --compliant: each recorded joint whose servo has current or torque control
+// held by that share of its current limit (or full torque), the others limp
+// (and named).
 Hold hold_compliant(LimpFigure& figure, const std::vector<Track>& tracks, double percent) {
   Hold hold;
   hold.goals.assign(figure.config().joints.size(), std::nan(""));
@@ -264,7 +265,7 @@ Hold hold_compliant(LimpFigure& figure, const std::vector<Track>& tracks, double
     }
   }
   if (!limp.empty()) {
-    std::cout << "limp (their servos have no current control): "
+    std::cout << "limp (their servos have no current or torque control): "
               << fmt::format("{}", fmt::join(limp, ", ")) << '\n';
   }
   return hold;
@@ -343,10 +344,11 @@ void add_record_command(CLI::App& app) {
   cmd->add_flag("--audio", args.audio,
                 "record the microphone beside the motion as the show's sound track (SHOW.wav)");
   cmd->add_option("--audio-device", args.audio_device, "ALSA capture device (default: default)");
-  cmd->add_option("--compliant", args.compliant_percent,
-                  "PERCENT: hold the figure by a weak torque, this share of each servo's current "
-                  "limit (Dynamixel current-based position mode; Feetech STS: its Torque Limit), so "
-                  "it does not sag while it is moved; the others stay limp (default 0: all limp)")
+  cmd->add_option(
+         "--compliant", args.compliant_percent,
+         "PERCENT: hold the figure by a weak torque, this share of each servo's current "
+         "limit (Dynamixel current-based position mode; Feetech STS: its Torque Limit), so "
+         "it does not sag while it is moved; the others stay limp (default 0: all limp)")
       ->check(CLI::Range(0.0, 50.0));
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {

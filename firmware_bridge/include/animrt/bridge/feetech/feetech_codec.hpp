@@ -56,28 +56,26 @@ inline constexpr std::uint8_t overload = 0x20;
 // Memory table addresses common to STS3215 and SCS0009/SCS15 (their values'
 // byte order differs, see above).
 namespace reg {
-inline constexpr std::uint8_t firmware_major = 0;       // 1
-inline constexpr std::uint8_t model = 3;                // 2 (servo main/sub version)
-inline constexpr std::uint8_t id = 5;                   // 1
-inline constexpr std::uint8_t baud_rate = 6;            // 1, 0 = 1 Mbaud .. 7 = 38400
-inline constexpr std::uint8_t return_delay = 7;         // 1, unit 2 us
-inline constexpr std::uint8_t status_return_level = 8;  // 1: 0 = only Read and Ping answer
-inline constexpr std::uint8_t min_angle_limit = 9;      // 2, steps
-inline constexpr std::uint8_t max_angle_limit = 11;     // 2, steps
-inline constexpr std::uint8_t max_temperature = 13;     // 1, deg C
-inline constexpr std::uint8_t unload_condition = 19;    // 1, error bits that cut torque
-inline constexpr std::uint8_t position_offset = 31;     // 2, STS: sign bit 11
-inline constexpr std::uint8_t operating_mode = 33;      // 1, STS: 0 = position
-inline constexpr std::uint8_t torque_enable = 40;       // 1
-inline constexpr std::uint8_t acceleration = 41;        // 1, STS only
-inline constexpr std::uint8_t goal_position = 42;       // 2
-inline constexpr std::uint8_t goal_time = 44;           // 2
-inline constexpr std::uint8_t goal_speed = 46;          // 2
-inline constexpr std::uint8_t sts_lock = 55;            // 1, EEPROM write lock (STS)
-inline constexpr std::uint8_t scs_lock = 48;            // 1, EEPROM write lock (SCS)
-// 2, STS: Torque Limit (RAM), 0.1 % of the maximum torque; 1000 at power-up
-// (its Max Torque, EEPROM 16, by default). The SCS series has its lock here.
-inline constexpr std::uint8_t sts_torque_limit = 48;
+inline constexpr std::uint8_t firmware_major = 0;        // 1
+inline constexpr std::uint8_t model = 3;                 // 2 (servo main/sub version)
+inline constexpr std::uint8_t id = 5;                    // 1
+inline constexpr std::uint8_t baud_rate = 6;             // 1, 0 = 1 Mbaud .. 7 = 38400
+inline constexpr std::uint8_t return_delay = 7;          // 1, unit 2 us
+inline constexpr std::uint8_t status_return_level = 8;   // 1: 0 = only Read and Ping answer
+inline constexpr std::uint8_t min_angle_limit = 9;       // 2, steps
+inline constexpr std::uint8_t max_angle_limit = 11;      // 2, steps
+inline constexpr std::uint8_t max_temperature = 13;      // 1, deg C
+inline constexpr std::uint8_t unload_condition = 19;     // 1, error bits that cut torque
+inline constexpr std::uint8_t position_offset = 31;      // 2, STS: sign bit 11
+inline constexpr std::uint8_t operating_mode = 33;       // 1, STS: 0 = position
+inline constexpr std::uint8_t torque_enable = 40;        // 1
+inline constexpr std::uint8_t acceleration = 41;         // 1, STS only
+inline constexpr std::uint8_t goal_position = 42;        // 2
+inline constexpr std::uint8_t goal_time = 44;            // 2
+inline constexpr std::uint8_t goal_speed = 46;           // 2
+inline constexpr std::uint8_t sts_lock = 55;             // 1, EEPROM write lock (STS)
+inline constexpr std::uint8_t scs_lock = 48;             // 1, EEPROM write lock (SCS)
+inline constexpr std::uint8_t sts_torque_limit = 48;     // 2, STS: RAM, 0.1 % of full torque
 inline constexpr std::uint8_t present_position = 56;     // 2
 inline constexpr std::uint8_t present_speed = 58;        // 2
 inline constexpr std::uint8_t present_load = 60;         // 2
@@ -89,7 +87,8 @@ inline constexpr std::uint8_t moving = 66;               // 1
 inline constexpr std::uint8_t table_size = 71;
 }  // namespace reg
 
-// STS Torque Limit of the full torque.
+// STS Torque Limit at full torque (its power-up value: Max Torque, EEPROM 16,
+// 1000 by default).
 inline constexpr std::uint16_t kStsFullTorque = 1000;
 
 // Steps per turn of the position sensor, and the range goal positions take
