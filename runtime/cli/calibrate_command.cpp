@@ -33,21 +33,50 @@ struct CalibrateArgs {
   double seconds_per_joint = 10.0;
   double min_range_deg = 2.0;
   PortOverrides ports;
+  int jog = -1;  // --jog 1, --no-jog 0; -1: asked (interactive), none (non-interactive)
+  double jog_deg = 5.0;
+  double jog_percent = 10.0;
 };
 
 // What one joint's calibration saw, in the servo's own ticks (so that the
-// file's present zero_ticks and direction do not matter).
+// file's present zero_ticks and direction do not matter), unwrapped: a
+// servo that reports one turn (0..4095) jumps by a turn where its shaft
+// crosses the seam, and no hand turns a joint half a turn in one read.
 struct Seen {
   double min_ticks = std::numeric_limits<double>::infinity();
   double max_ticks = -std::numeric_limits<double>::infinity();
   double home_ticks = 0.0;
   int direction = 1;
-  void add(double ticks) {
+  double turn = 4096.0;  // the servo's ticks per turn of its shaft
+  double last_raw = std::numeric_limits<double>::quiet_NaN();
+  double unwrap = 0.0;  // whole turns added to the raw ticks
+  void add(double raw) {
+    if (!std::isnan(last_raw)) {
+      if (raw - last_raw > turn / 2) unwrap -= turn;
+      if (raw - last_raw < -turn / 2) unwrap += turn;
+    }
+    last_raw = raw;
+    const double ticks = raw + unwrap;
     min_ticks = std::min(min_ticks, ticks);
     max_ticks = std::max(max_ticks, ticks);
     home_ticks = ticks;
   }
+  // Whole turns off, so the home is one the servo reports; false when the
+  // range then crosses the seam (the servo cannot be driven across it in
+  // position mode).
+  bool within_one_turn() {
+    const double shift = std::floor(home_ticks / turn) * turn;
+    min_ticks -= shift;
+    max_ticks -= shift;
+    home_ticks -= shift;
+    return min_ticks >= 0 && max_ticks <= turn - 1;
+  }
 };
+
+// Ticks per turn of a servo's shaft, as it reports its position.
+double ticks_per_turn(const std::string& protocol) {
+  return protocol == "feetech_scs" ? 1024.0 : 4096.0;
+}
 
 // The servo ticks of a joint position as the file maps them today.
 double raw_ticks(const ActuatorBinding& a, double position) {
@@ -117,6 +146,92 @@ void follow(LimpFigure& figure, std::size_t j, Seen& seen, bool live,
     sleep_until(next, period_ns);
   }
   if (live) std::cout << '\n';
+}
+
+// One answer line from the user (raw reads: enter_pressed() reads the same
+// descriptor); empty at the end of input.
+std::string read_line() {
+  std::string line;
+  char c = 0;
+  while (::read(STDIN_FILENO, &c, 1) == 1 && c != '\n') line += c;
+  return line;
+}
+
+bool ask_yes(const std::string& question) {
+  for (;;) {
+    std::cout << question << " [y/n] " << std::flush;
+    const std::string answer = read_line();
+    if (answer == "y" || answer == "yes") return true;
+    if (answer == "n" || answer == "no" || answer.empty()) return false;
+  }
+}
+
+// The jog: joint `j` held by a weak torque, its goal jog_deg ahead in the
+// file's positive direction for half a second, then limp again. How far it
+// went, in the file's degrees (NaN: its servo has no current or torque control).
+double jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
+  if (!figure.hold_weakly(j, args.jog_percent / 100.0)) return std::nan("");
+  std::vector<double> positions;
+  figure.read(positions);
+  const double start = positions[j];
+  std::vector<double> goals(positions.size(), std::nan(""));
+  goals[j] = start + deg_to_rad(args.jog_deg);
+  figure.write(goals);
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  for (int k = 0; k < 10 && !commissioning_controls().stop.load(); ++k) {
+    sleep_until(next, 50'000'000L);
+  }
+  figure.read(positions);
+  figure.let_go();
+  return rad_to_deg(positions[j] - start);
+}
+
+// The direction from a jog: which way the servo turned for the file's
+// positive, and (asked interactively) whether the user saw the joint turn
+// its positive way. Returns the file's direction when the jog told nothing.
+int direction_by_jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
+  const std::string& name = figure.config().joints[j].name;
+  const ActuatorBinding& a = *figure.binding(j);
+  std::cout << name << ": jog " << deg_text(args.jog_deg) << " deg under a weak torque ("
+            << args.jog_percent << " %)" << std::endl;
+  const double moved = jog(figure, j, args);
+  if (std::isnan(moved)) {
+    std::cout << name
+              << ": its servo has no current or torque control: not jogged, "
+                 "direction kept "
+              << a.direction << '\n';
+    return a.direction;
+  }
+  if (!(std::abs(moved) >= 0.5 * args.jog_deg)) {
+    std::cout << fmt::format(
+        "{}: moved {:.1f} deg of {}: blocked, at a limit or too weak (--jog-percent); direction "
+        "kept {}\n",
+        name, moved, deg_text(args.jog_deg), a.direction);
+    return a.direction;
+  }
+  const int servo = moved > 0 ? 1 : -1;  // the servo turned the file's positive way
+  std::cout << fmt::format("{}: it turned {:+.1f} deg as the file counts them\n", name, moved);
+  const bool seen_positive =
+      args.non_interactive || ask_yes(name + ": did it move in its positive direction?");
+  return a.direction * servo * (seen_positive ? 1 : -1);
+}
+
+// The direction the user shows by hand (interactive, without a jog): the
+// joint moved a little its positive way from `home` (ticks).
+int direction_by_hand(LimpFigure& figure, std::size_t j, double home) {
+  const std::string& name = figure.config().joints[j].name;
+  const ActuatorBinding& a = *figure.binding(j);
+  std::cout << name
+            << ": now move it a little in its positive direction and press Enter (only "
+               "Enter: keep direction "
+            << a.direction << ")" << std::endl;
+  Seen moved;
+  moved.turn = ticks_per_turn(figure.protocol(j));
+  follow(figure, j, moved, true, [](double) { return enter_pressed(); });
+  const double delta_deg = ticks_to_deg(a, std::remainder(moved.home_ticks - home, moved.turn));
+  if (std::abs(delta_deg) >= 1.0) return delta_deg > 0 ? 1 : -1;
+  return a.direction;
 }
 
 // The joints to calibrate: --joint or all that a servo with ticks drives.
@@ -202,9 +317,9 @@ int run_calibrate(const CalibrateArgs& args) {
   LimpFigure figure(args.robot, args.ports);
   const std::vector<std::size_t> joints = chosen_joints(figure, args);
   std::cout << "torque is off on every joint\n";
-  if (args.non_interactive) {
-    std::cout << "direction is not checked in non-interactive mode: each joint keeps the "
-                 "direction its file gives\n";
+  if (args.non_interactive && args.jog != 1) {
+    std::cout << "direction is not checked in non-interactive mode without --jog: each joint "
+                 "keeps the direction its file gives\n";
   }
   YamlValueEditor edit(original, args.robot);
   std::vector<std::string> lines;
@@ -214,6 +329,11 @@ int run_calibrate(const CalibrateArgs& args) {
     const ActuatorBinding& a = *figure.binding(j);
     Seen seen;
     seen.direction = a.direction;
+    seen.turn = ticks_per_turn(figure.protocol(j));
+    const bool jogged = args.jog == 1 || (args.jog < 0 && !args.non_interactive &&
+                                          ask_yes(name + ": check its direction by a small jog "
+                                                         "under a weak torque?"));
+    if (jogged) seen.direction = direction_by_jog(figure, j, args);
     if (args.non_interactive) {
       std::cout << fmt::format("{}: move it through its whole range and to its home pose ({} s)",
                                name, args.seconds_per_joint)
@@ -226,16 +346,7 @@ int run_calibrate(const CalibrateArgs& args) {
                    "press Enter"
                 << std::endl;
       follow(figure, j, seen, true, [](double) { return enter_pressed(); });
-      const double home = seen.home_ticks;
-      std::cout << name
-                << ": now move it a little in its positive direction and press Enter (only "
-                   "Enter: keep direction "
-                << a.direction << ")" << std::endl;
-      Seen moved;
-      follow(figure, j, moved, true, [](double) { return enter_pressed(); });
-      const double delta_deg = ticks_to_deg(a, moved.home_ticks - home);
-      if (std::abs(delta_deg) >= 1.0) seen.direction = delta_deg > 0 ? 1 : -1;
-      seen.home_ticks = home;
+      if (!jogged) seen.direction = direction_by_hand(figure, j, seen.home_ticks);
     }
     if (controls.stop.load()) {
       std::cout << "stopped: nothing was written\n";
@@ -247,6 +358,13 @@ int run_calibrate(const CalibrateArgs& args) {
           "{}: moved through only {:.1f} deg (at least {} deg needed): nothing was written; move "
           "the joint through its whole range while it is recorded",
           name, range, args.min_range_deg));
+    }
+    if (!seen.within_one_turn()) {
+      throw std::runtime_error(fmt::format(
+          "{}: its range, {:.0f} .. {:.0f} ticks, crosses its servo's {:.0f} -> 0 seam, which a "
+          "servo in position mode cannot be driven across: nothing was written; turn the horn "
+          "on its spline so that the range lies within one turn",
+          name, seen.min_ticks, seen.max_ticks, seen.turn - 1));
     }
     lines.push_back(write_joint(edit, name, a, seen));
   }
@@ -275,6 +393,18 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--seconds-per-joint", args.seconds_per_joint,
                   "time per joint in non-interactive mode")
       ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_flag_callback(
+      "--jog", [] { args.jog = 1; },
+      "check each joint's direction by a small jog under a weak torque "
+      "(interactive: without asking first; non-interactive: the servo's "
+      "turn decides)");
+  cmd->add_flag_callback(
+      "--no-jog", [] { args.jog = 0; }, "no direction jog, and no question");
+  cmd->add_option("--jog-deg", args.jog_deg, "how far the jog goes (default 5)")
+      ->check(CLI::Range(0.5, 30.0));
+  cmd->add_option("--jog-percent", args.jog_percent,
+                  "the jog's torque: this share of the servo's current limit (default 10)")
+      ->check(CLI::Range(1.0, 50.0));
   cmd->add_option("--min-range-deg", args.min_range_deg,
                   "refuse a joint moved through less than this (default 2)")
       ->check(CLI::Range(0.0, 360.0));

@@ -1,5 +1,7 @@
 #include "limp_figure.hpp"
 
+#include <cmath>
+
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "stop_signals.hpp"
@@ -49,10 +51,45 @@ LimpFigure::LimpFigure(const std::string& robot_path, const PortOverrides& ports
     bus.deactivate();
     bus_positions_[b].assign(bus.config().actuators.size(), 0.0);
   }
+  bus_goals_ = bus_positions_;
+  held_buses_.assign(figure_->bus_count(), false);
 }
 
-LimpFigure::~LimpFigure() {
+LimpFigure::~LimpFigure() { let_go(); }
+
+void LimpFigure::let_go() {
   for (std::size_t b = 0; b < figure_->bus_count(); ++b) figure_->bus(b).deactivate();
+  held_buses_.assign(figure_->bus_count(), false);
+}
+
+bool LimpFigure::hold_weakly(std::size_t joint, double share) {
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
+    ActuatorBus& bus = figure_->bus(b);
+    const auto& actuators = bus.config().actuators;
+    for (std::size_t i = 0; i < actuators.size(); ++i) {
+      if (actuators[i].joint_index == static_cast<int>(joint)) {
+        if (!bus.activate_compliant(i, share)) return false;
+        held_buses_[b] = true;
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+void LimpFigure::write(const std::vector<double>& joints) {
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
+    // Only buses with a joint held: a goal would switch a limp hobby servo's pulse on.
+    if (!held_buses_[b]) continue;
+    ActuatorBus& bus = figure_->bus(b);
+    const auto& actuators = bus.config().actuators;
+    for (std::size_t i = 0; i < actuators.size(); ++i) {
+      const int j = actuators[i].joint_index;
+      const bool known = j >= 0 && static_cast<std::size_t>(j) < joints.size();
+      bus_goals_[b][i] = known ? joints[static_cast<std::size_t>(j)] : std::nan("");
+    }
+    bus.write(bus_goals_[b]);
+  }
 }
 
 void LimpFigure::read(std::vector<double>& joints, std::vector<bool>* fresh) {

@@ -32,6 +32,17 @@ class LimpFigure {
   // whose device did not answer keeps its previous value and is not
   // `fresh` (when given). Throws DeviceError for a bus that fails.
   void read(std::vector<double>& joints, std::vector<bool>* fresh = nullptr);
+  // Joint `j` held by a weak torque (`share` of its servo's current limit)
+  // where it is: a hand moves it, and it stays where it is left once write()
+  // follows it. False when its servo has no current control (it stays
+  // limp). Throws DeviceError.
+  bool hold_weakly(std::size_t joint, double share);
+  // Goals of the joints held (rad, or m; NaN keeps a goal), in robot joint
+  // order. Limp joints take no notice.
+  void write(const std::vector<double>& joints);
+  // Torque off on every joint again.
+  void let_go();
+
   // The binding of joint `j` and its bus's protocol (null when no bus drives it).
   const ActuatorBinding* binding(std::size_t joint) const;
   std::string protocol(std::size_t joint) const;
@@ -40,6 +51,8 @@ class LimpFigure {
   HardwareBackend backend_;
   std::unique_ptr<Figure> figure_;
   std::vector<std::vector<double>> bus_positions_;
+  std::vector<std::vector<double>> bus_goals_;
+  std::vector<bool> held_buses_;
 };
 
 // The controls that stop signals write while a commissioning command runs.

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,24 @@ struct RecordArgs {
   PortOverrides ports;
   bool audio = false;
   std::string audio_device = "default";
+  double compliant_percent = 0.0;  // 0: limp
+};
+
+// A compliant joint's goal follows the hand once it is pushed this far from
+// it; closer, the weak torque holds the goal against the figure's weight.
+constexpr double kFollowHandRad = 0.5 * std::numbers::pi / 180.0;
+
+// The joints held by a weak torque: their goals, NaN for the limp ones.
+struct Hold {
+  std::vector<double> goals;
+  bool any = false;
+  // After a read: a goal pushed past kFollowHandRad moves to where the hand put it.
+  void follow(const std::vector<double>& positions, const std::vector<bool>& fresh) {
+    for (std::size_t j = 0; j < goals.size(); ++j) {
+      if (std::isnan(goals[j]) || !fresh[j]) continue;
+      if (std::abs(positions[j] - goals[j]) > kFollowHandRad) goals[j] = positions[j];
+    }
+  }
 };
 
 constexpr int kSoundTrackRate = 48000;
@@ -98,7 +117,7 @@ struct Sampling {
 // Reads the figure at its rate until the duration ends or a stop signal
 // arrives, appending each fresh position to its track.
 Sampling sample(LimpFigure& figure, std::vector<Track>& tracks, double duration_s,
-                SoundTrackRecorder* microphone) {
+                SoundTrackRecorder* microphone, Hold& hold) {
   const RobotConfig& config = figure.config();
   const long period_ns = static_cast<long>(1e9 / config.rate_hz);
   const std::size_t cycles = duration_s > 0
@@ -119,6 +138,10 @@ Sampling sample(LimpFigure& figure, std::vector<Track>& tracks, double duration_
     figure.read(positions, &fresh);
     timespec answered{};
     clock_gettime(CLOCK_MONOTONIC, &answered);
+    if (hold.any) {
+      hold.follow(positions, fresh);
+      figure.write(hold.goals);
+    }
     // A sample's time is the middle of its read, not its deadline: a late
     // read (a busy host) must not shift the motion in time.
     const auto since_start = [&start](const timespec& at) {
@@ -223,6 +246,31 @@ void write_show(const std::string& out_file, const std::string& text) {
   load_show_file(out_file);  // what was written reads back as a show
 }
 
+// --compliant: each recorded joint whose servo has current or torque control
+// held by that share of its current limit (or full torque), the others limp
+// (and named).
+Hold hold_compliant(LimpFigure& figure, const std::vector<Track>& tracks, double percent) {
+  Hold hold;
+  hold.goals.assign(figure.config().joints.size(), std::nan(""));
+  if (percent <= 0.0) return hold;
+  std::vector<double> positions;
+  figure.read(positions);
+  std::vector<std::string> limp;
+  for (const Track& t : tracks) {
+    if (figure.hold_weakly(t.joint, percent / 100.0)) {
+      hold.goals[t.joint] = positions[t.joint];
+      hold.any = true;
+    } else {
+      limp.push_back(t.name);
+    }
+  }
+  if (!limp.empty()) {
+    std::cout << "limp (their servos have no current or torque control): "
+              << fmt::format("{}", fmt::join(limp, ", ")) << '\n';
+  }
+  return hold;
+}
+
 int run_record(const RecordArgs& args) {
   install_stop_signals(commissioning_controls(), SecondSignal::end_process);
   check_writable(args.out);
@@ -238,12 +286,15 @@ int run_record(const RecordArgs& args) {
   LimpFigure figure(args.robot, args.ports);
   const RobotConfig& config = figure.config();
   std::vector<Track> tracks = choose_tracks(args, figure);
-  std::cout << "torque is off: move the figure; recording at " << config.rate_hz << " Hz "
+  Hold hold = hold_compliant(figure, tracks, args.compliant_percent);
+  std::cout << (hold.any ? "held by a weak torque" : "torque is off")
+            << ": move the figure; recording at " << config.rate_hz << " Hz "
             << (args.duration_s > 0 ? fmt::format("for {} s", args.duration_s)
                                     : std::string("until Ctrl-C"))
             << std::endl;
 
-  const Sampling run = sample(figure, tracks, args.duration_s, microphone.get());
+  const Sampling run = sample(figure, tracks, args.duration_s, microphone.get(), hold);
+  figure.let_go();
   const std::size_t samples = count_samples(tracks);
 
   const std::string audio_line =
@@ -293,6 +344,12 @@ void add_record_command(CLI::App& app) {
   cmd->add_flag("--audio", args.audio,
                 "record the microphone beside the motion as the show's sound track (SHOW.wav)");
   cmd->add_option("--audio-device", args.audio_device, "ALSA capture device (default: default)");
+  cmd->add_option(
+         "--compliant", args.compliant_percent,
+         "PERCENT: hold the figure by a weak torque, this share of each servo's current "
+         "limit (Dynamixel current-based position mode; Feetech STS: its Torque Limit), so "
+         "it does not sag while it is moved; the others stay limp (default 0: all limp)")
+      ->check(CLI::Range(0.0, 50.0));
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {
     try {

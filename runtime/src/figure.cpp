@@ -59,7 +59,20 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
     imus_.push_back(
         std::make_unique<imu::RvcReader>(open_serial(imu.port, imu.baud), imu, clock(), Nanos{0}));
   }
-  if (!failed.empty()) throw DeviceError(bus_failures(failed, config_.buses.size()));
+  if (!failed.empty()) {
+    // The buses that did open are configured too, so that a link that
+    // connects only then (Modbus TCP) or devices that do not answer are
+    // named in the same error; nothing is switched on.
+    for (ActuatorBus* bus : buses_) {
+      try {
+        bus->configure();
+      } catch (const DeviceError& e) {
+        failed.emplace_back(e.what());
+      }
+      bus->deactivate();
+    }
+    throw DeviceError(bus_failures(failed, config_.buses.size()));
+  }
   runner_ =
       std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
   if (options.audio_sink) {

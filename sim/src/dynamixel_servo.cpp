@@ -33,7 +33,7 @@ constexpr Item kItems[] = {
     {xreg::baud_rate, 1, true, 0, 7},
     {xreg::return_delay_time, 1, true, 0, 254},
     {xreg_sim::drive_mode, 1, true, 0, 5},
-    {xreg::operating_mode, 1, true, 3, 4},  // position and extended position control
+    {xreg::operating_mode, 1, true, 3, 5},  // position, extended and current-based position
     {xreg_sim::secondary_id, 1, true, 0, 255},
     {xreg_sim::protocol_type, 1, true, 1, 2},
     {xreg_sim::homing_offset, 4, true, -1'044'479, 1'044'479},
@@ -82,6 +82,17 @@ constexpr Item kItems[] = {
 };
 
 constexpr std::uint8_t kExtendedPositionMode = 4;
+constexpr std::uint8_t kCurrentBasedPositionMode = 5;
+// A hand overpowers a servo whose Goal Current is at most this share of its
+// Current Limit (about 0.7 Nm on an XM430-W210), and lets go of a joint it
+// holds once the servo's goal is this close to where the hand holds it.
+constexpr double kHandOverpowersShare = 0.25;
+constexpr double kHandLetsGoTicks = 4.0;
+
+// Extended and current-based position control: multi-turn, no position limits.
+bool multi_turn(std::uint8_t mode) {
+  return mode == kExtendedPositionMode || mode == kCurrentBasedPositionMode;
+}
 constexpr std::int32_t kExtendedPositionRange = 1'048'575;  // Goal Position, either way
 
 // Indirect Address n: 2 bytes, 64..661. Indirect Data n: 1 byte.
@@ -222,7 +233,7 @@ void DynamixelServo::command_physics() {
 
 std::int32_t DynamixelServo::motor_goal() const {
   std::int32_t goal = reg32(xreg::goal_position);
-  if (table_[xreg::operating_mode] != kExtendedPositionMode) {
+  if (!multi_turn(table_[xreg::operating_mode])) {
     goal = std::clamp(goal, reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
   }
   return goal - reg32(xreg_sim::homing_offset);
@@ -254,6 +265,7 @@ void DynamixelServo::reset_ram() {
                static_cast<std::uint32_t>(present_of(motor_.position)));
   motor_.velocity = 0;
   pending_length_ = 0;
+  held_by_hand_ = false;
 }
 
 void DynamixelServo::latch_shutdown() {
@@ -280,7 +292,8 @@ DynamixelServo::Motor DynamixelServo::motor_until(Nanos now) const {
     m.velocity = scale * physics_->velocity(physics_joint_);
     return m;
   }
-  if (!torque_on() || vmax_ticks_s_ <= 0 || health_.blocked()) {  // blocked: held where it is
+  // Blocked, or a hand holds it against a weak torque: held where it is.
+  if (!torque_on() || vmax_ticks_s_ <= 0 || health_.blocked() || held_by_hand_) {
     m.velocity = 0;
     return m;
   }
@@ -440,7 +453,7 @@ StatusError DynamixelServo::check_direct(std::uint16_t address,
     const std::uint32_t raw = get_le(&after[a], item.size);
     if (item.address == xreg::goal_position) {
       const auto goal = static_cast<std::int32_t>(raw);
-      if (after[xreg::operating_mode] == kExtendedPositionMode) {
+      if (multi_turn(after[xreg::operating_mode])) {
         if (goal < -kExtendedPositionRange || goal > kExtendedPositionRange) {
           return StatusError::data_limit;
         }
@@ -476,6 +489,7 @@ StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::ui
   for (std::size_t i = 0; i < data.size(); ++i) table_[targets[i]] = data[i];
   if (eeprom) eeprom_.keep(table_);
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
+  let_go_of_hand();
   publish(motor_time_);  // a torque change shows in Present Velocity and Moving at once
   command_physics();
   return StatusError::none;
@@ -529,11 +543,29 @@ bool DynamixelServo::restore_eeprom(std::span<const std::uint8_t> kept, Nanos no
   return true;
 }
 
+bool DynamixelServo::yields_to_hand() const {
+  if (!torque_on()) return true;
+  if (table_[xreg::operating_mode] != kCurrentBasedPositionMode) return false;
+  const auto goal = static_cast<std::int16_t>(dxl::get_u16(&table_[xreg_sim::goal_current]));
+  const double limit = dxl::get_u16(&table_[xreg_sim::current_limit]);
+  return std::abs(goal) <= kHandOverpowersShare * limit;
+}
+
+void DynamixelServo::let_go_of_hand() {
+  if (!held_by_hand_) return;
+  const bool pulls_away = std::abs(motor_goal() - motor_.position) > kHandLetsGoTicks;
+  if (!torque_on() || !yields_to_hand() || !pulls_away) held_by_hand_ = false;
+}
+
 bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
   advance(now);
-  if (torque_on() || physics_ != nullptr) return false;
+  if (!yields_to_hand() || physics_ != nullptr) return false;
   motor_.position = ticks - reg32(xreg_sim::homing_offset);
   motor_.velocity = 0;
+  // Against a weak torque the hand holds the joint until the servo's goal
+  // comes to it; a limp joint simply stays.
+  held_by_hand_ = torque_on();
+  let_go_of_hand();
   publish(motor_time_);
   return true;
 }

@@ -260,7 +260,7 @@ void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int
 void DynamixelSimBus::hand_move(int device_id, std::int32_t ticks) {
   std::lock_guard lock(mutex_);
   DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
-  if (s.torque_on()) throw std::logic_error("torque is on");
+  if (!s.yields_to_hand()) throw std::logic_error("torque is on");
   if (!s.hand_move(ticks, clock_.now())) {
     throw std::logic_error("the physics model moves this joint");
   }

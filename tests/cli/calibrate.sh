@@ -3,7 +3,7 @@
 # hand through the control interface while it is followed: zero_ticks and the
 # limits land within 1 deg of what was moved, in place, every other byte of
 # the file as it was; interactively the user's positive sets the
-# direction. A joint left still, a read-only file and a file edited
+# direction. A range across the servo's seam, a joint left still, a read-only file and a file edited
 # meanwhile are refused with one line and the file is left alone.
 set -uo pipefail
 animrt=$1
@@ -104,14 +104,24 @@ PY
 
 # Interactively, with Enter from the user: rf_hip is mounted mirrored
 # (direction -1) but its user's positive is up the ticks, so it becomes 1.
-calibrate '{"rf_hip": [4, 1500, 2600, 2000]}' "$tmp/inter.txt" --joint rf_hip ||
+calibrate '{"rf_hip": [4, 1500, 2600, 2000]}' "$tmp/inter.txt" --joint rf_hip --no-jog ||
   fail "interactive calibrate: $(cat "$tmp/inter.txt")"
 line=$(grep -A3 "^  rf_hip:" "$robot")
 [[ $line == *"min_deg: -43.9, max_deg: 52.7,"* && $line == *"zero_ticks: 2000, direction: 1}"* ]] ||
   fail "interactive rf_hip: $line"
 
-# A joint left where it is: refused, the file untouched.
+# A range across the servo's 4095 -> 0 seam (the servo reports 4146 as 50):
+# refused with the range unwrapped, the file untouched.
 cp "$robot" "$tmp/before.yaml"
+calibrate '{"lh_hip": [7, 3900, 50, 3950]}' "$tmp/seam.txt" --non-interactive --joint lh_hip \
+  --seconds-per-joint 0.9
+code=$?
+[[ $code -ne 0 ]] && grep -q "lh_hip: its range, [0-9]* .. 4146 ticks, crosses its servo's 4095 -> 0 seam" \
+  "$tmp/seam.txt" || fail "seam (exit $code): $(cat "$tmp/seam.txt")"
+cmp -s "$robot" "$tmp/before.yaml" || fail "file changed after a range across the seam"
+ctl "hand legs 7 2048" > /dev/null  # back inside its limits
+
+# A joint left where it is: refused, the file untouched.
 out=$("$animrt" calibrate "$robot" --non-interactive --port "legs=$pty" --joint lf_knee \
   --seconds-per-joint 0.3 2>&1)
 code=$?

@@ -90,6 +90,15 @@ if [ "$(grep -c '^can ' /tmp/can_sim.txt)" -lt 3 ]; then
 else
   pass can_sim
 fi
+# animrt scan --can on the real SocketCAN interface: the simulated CiA 402
+# drive (node 32) answers its SDO reads of 0x1000 and 0x1018.
+animrt scan --can vcan0 --listen-ms 300 --ids 30-34 --timeout-ms 200 > /tmp/can_scan.txt 2>&1
+rc=$?
+if [ $rc = 0 ] && grep -Eq '^vcan0 +canopen +- +32 +device type 0x' /tmp/can_scan.txt; then
+  pass can_scan
+else
+  fail can_scan "animrt scan exited $rc: $(head -c 300 /tmp/can_scan.txt)"
+fi
 animrt run /configs/robots/quadruped_can_vcan0.yaml --backend hardware --duration 3 --no-realtime \
   --summary-json /tmp/can_summary.json > /tmp/can_run.txt 2>&1
 rc=$?

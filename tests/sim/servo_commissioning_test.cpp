@@ -234,6 +234,35 @@ TEST(ServoCommissioning, ExtendedPositionModeTurnsPastOneTurn) {
             static_cast<std::uint8_t>(dxl::StatusError::data_limit));
 }
 
+TEST(ServoCommissioning, AWeakCurrentBasedPositionHoldYieldsToAHand) {
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(dynamixel_bus({3}), clock);
+  sim.start();
+  test::PtyClient line(sim.endpoint());
+  sim.hand_move(3, 2000);
+  EXPECT_EQ(line.transact(test::write(3, xreg::operating_mode, {5})).error, 0);
+  // Goal Current 100 of the Current Limit 1193: weaker than a hand.
+  EXPECT_EQ(line.transact(test::write(3, xreg::goal_current, {100, 0})).error, 0);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {1})).error, 0);
+  sim.hand_move(3, 2300);  // the hand holds it there against the servo's pull
+  clock.advance(1'000'000'000);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 2300);
+  // The goal comes to the hand: it lets go, and the servo holds the joint.
+  EXPECT_EQ(line.transact(test::write_u32(3, xreg::goal_position, 2302)).error, 0);
+  clock.advance(1'000'000'000);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 2302);
+  // Let go while the goal is elsewhere, the weak torque still moves it there.
+  sim.hand_move(3, 2400);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {0})).error, 0);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {1})).error, 0);
+  clock.advance(1'000'000'000);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 2302);
+  // Half the Current Limit: stronger than a hand.
+  EXPECT_EQ(line.transact(test::write(3, xreg::goal_current, {0x54, 0x02})).error, 0);  // 596
+  EXPECT_THROW(sim.hand_move(3, 2100), std::logic_error);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 2302);
+}
+
 TEST(ServoCommissioning, FeetechFactoryStartupIsId1At1Mbaud) {
   BusConfig config;
   config.name = "arm";

@@ -465,6 +465,7 @@ void DynamixelBus::deactivate() {
         write_register(i, dxl::xreg::bus_watchdog, 0, 1, kTries);
       }
       write_register(i, dxl::xreg::torque_enable, 0, 1, kTries);
+      restore_operating_mode(i);
     }
   } catch (...) {
     // The line is gone: nothing more can be sent, and deactivate never throws.

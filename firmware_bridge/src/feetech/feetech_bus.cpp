@@ -161,7 +161,13 @@ void FeetechBus::activate() {
 
 void FeetechBus::deactivate() {
   try {
-    for (std::size_t i = 0; i < link_.book().size(); ++i) write_byte(i, ft::reg::torque_enable, 0);
+    for (std::size_t i = 0; i < link_.book().size(); ++i) {
+      write_byte(i, ft::reg::torque_enable, 0);
+      if (i < limit_before_.size() && limit_before_[i] != 0) {
+        write_torque_limit(i, limit_before_[i]);
+        limit_before_[i] = 0;
+      }
+    }
   } catch (...) {
     // The line is gone; deactivate never throws.
   }

@@ -14,6 +14,12 @@ namespace {
 
 namespace reg = ft::reg;
 
+// A hand overpowers an STS whose Torque Limit is at most a quarter of its
+// maximum torque, and lets go of a joint it holds once the servo's goal is
+// this close to where the hand holds it (as the Dynamixel simulation).
+constexpr std::uint16_t kHandOverpowersLimit = ft::kStsFullTorque / 4;
+constexpr double kHandLetsGoSteps = 4.0;
+
 // STS3215 identity (memory table v3.6): firmware 3.6, servo version 9.3.
 constexpr std::uint8_t kStsModel[2] = {9, 3};
 constexpr std::uint8_t kScsModel[2] = {5, 4};
@@ -48,7 +54,8 @@ bool writable(std::size_t address) {
     case reg::goal_time + 1:
     case reg::goal_speed:
     case reg::goal_speed + 1:
-    case reg::scs_lock:
+    case reg::scs_lock:  // STS: Torque Limit's low byte
+    case reg::sts_torque_limit + 1:
     case reg::sts_lock:
       return true;
     default:
@@ -98,6 +105,7 @@ FeetechServo::FeetechServo(const ActuatorBinding& binding, ft::Series series,
   table_[reg::unload_condition] = kDefaultUnload;
   table_[reg::present_voltage] = kVoltageDeciV;
   table_[reg::present_temperature] = kTemperatureC;
+  if (sts) ft::put_u16(series_, &table_[reg::sts_torque_limit], ft::kStsFullTorque);
   const double start = binding.to_ticks(initial_position_rad(binding));
   motor_.position = std::clamp(start, static_cast<double>(position_value(reg::min_angle_limit)),
                                static_cast<double>(position_value(reg::max_angle_limit)));
@@ -135,7 +143,8 @@ std::int32_t FeetechServo::goal_position() const {
 
 FeetechServo::Motor FeetechServo::motor_at(Nanos now) const {
   Motor m = motor_;
-  if (!torque_on() || vmax_steps_s_ <= 0 || health_.blocked()) {
+  // Blocked, or a hand holds it against a weak torque: held where it is.
+  if (!torque_on() || vmax_steps_s_ <= 0 || health_.blocked() || held_by_hand_) {
     m.velocity = 0;
     return m;
   }
@@ -221,6 +230,7 @@ void FeetechServo::write(std::uint8_t address, std::span<const std::uint8_t> dat
     motor_.velocity = 0;
     publish();
   }
+  let_go_of_hand();
 }
 
 void FeetechServo::reg_write(std::uint8_t address, std::span<const std::uint8_t> data) {
@@ -251,6 +261,10 @@ void FeetechServo::power_up(Nanos now) {
   table_[reg::torque_enable] = 0;
   table_[reg::registered] = 0;
   table_[static_cast<std::size_t>(eeprom_.family().lock_address)] = 0;
+  if (series_ == ft::Series::sts) {
+    ft::put_u16(series_, &table_[reg::sts_torque_limit], ft::kStsFullTorque);
+  }
+  held_by_hand_ = false;
   motor_.velocity = 0;
   store_position(reg::goal_position, motor_.position);
   publish();
@@ -272,11 +286,26 @@ void FeetechServo::factory_reset(Nanos now) {
   power_up(now);
 }
 
+bool FeetechServo::yields_to_hand() const {
+  if (!torque_on()) return true;
+  return series_ == ft::Series::sts && u16(reg::sts_torque_limit) <= kHandOverpowersLimit;
+}
+
+void FeetechServo::let_go_of_hand() {
+  if (!held_by_hand_) return;
+  const bool pulls_away = std::abs(goal_position() - motor_.position) > kHandLetsGoSteps;
+  if (!torque_on() || !yields_to_hand() || !pulls_away) held_by_hand_ = false;
+}
+
 bool FeetechServo::hand_move(std::int32_t steps, Nanos now) {
   advance(now);
-  if (torque_on()) return false;
+  if (!yields_to_hand()) return false;
   motor_.position = steps;
   motor_.velocity = 0;
+  // Against a weak torque the hand holds the joint until the servo's goal
+  // comes to it; a limp joint simply stays.
+  held_by_hand_ = torque_on();
+  let_go_of_hand();
   publish();
   return true;
 }

@@ -79,6 +79,18 @@ class ActuatorBus {
   // address one device alone only mark it.
   virtual void switch_off(std::size_t device) { mark_faulted(device); }
 
+  // Commissioning (a direction jog, a compliant recording): torque on for
+  // `device` alone at a weak current, `share` of the device's own current
+  // limit, holding its present position; write() then moves it with that
+  // weak torque, and a hand can move it. False, and nothing changes, when the
+  // device has no current control. deactivate() ends it. Throws DeviceError
+  // naming the device.
+  virtual bool activate_compliant(std::size_t device, double share) {
+    (void)device;
+    (void)share;
+    return false;
+  }
+
   // Whether read() fills DeviceStatus::reading (temperature, current,
   // voltage, error bits) as configured.
   virtual bool reads_health() const { return false; }

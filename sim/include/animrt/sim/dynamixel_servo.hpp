@@ -17,8 +17,10 @@
 // Indirect Data maps to one write per run of consecutive target addresses,
 // all checked before any is applied.
 // Modelled items: ID, Baud Rate, Return Delay Time, Operating Mode (3,
-// position control, and 4, extended position control: Goal Position
-// +-1,048,575 and no position limits; other modes answer Data Range Error),
+// position control; 4, extended position control: Goal Position
+// +-1,048,575 and no position limits; 5, current-based position control:
+// as 4, and Goal Current limits the torque, see the hand below; other
+// modes answer Data Range Error),
 // Homing Offset (Present and Goal Position are the motor's position plus
 // it), Moving Threshold,
 // Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
@@ -57,8 +59,8 @@
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/clock.hpp"
 #include "animrt/sim/joint_physics.hpp"
-#include "animrt/sim/servo_health_model.hpp"
 #include "animrt/sim/servo_eeprom.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 #include "animrt/sim/servo_motor.hpp"
 
 namespace animrt::sim {
@@ -200,11 +202,16 @@ class DynamixelServo {
 
   // Commissioning. Unplugged, the servo hears and says nothing; plugged in
   // again it powers up (RAM at its defaults, torque off). A hand turns a
-  // limp shaft to raw `ticks` (false, and nothing moves, while torque is on;
-  // with physics the joint is the physics').
+  // limp shaft to raw `ticks`, or one held by a weak torque (current-based
+  // position mode with Goal Current at most a quarter of Current Limit),
+  // which it then holds there against the servo until the servo's goal comes
+  // within 4 ticks of it (a compliant recorder follows the hand) or the
+  // torque goes off or up. False, and nothing moves, against a full torque;
+  // with physics the joint is the physics' (which has no torque limit).
   bool plugged() const { return plugged_; }
   void set_plugged(bool plugged, Nanos now);
   bool hand_move(std::int32_t ticks, Nanos now);
+  bool yields_to_hand() const;
   int baud() const;  // the Baud Rate register in bits per second
   // Present Position (raw) at `now`, without changing the state.
   std::int32_t present_ticks(Nanos now) const;
@@ -240,6 +247,7 @@ class DynamixelServo {
   dxl::StatusError check_direct(std::uint16_t address, std::span<const std::uint8_t> data) const;
   void reset_ram();
   void latch_shutdown();
+  void let_go_of_hand();    // after a write: the hand holds on only against a weak pull
   void publish(Nanos now);  // motor state -> present-value registers
   void command_physics();   // goal and torque -> physics
   std::int32_t reg32(std::uint16_t address) const;
@@ -263,6 +271,7 @@ class DynamixelServo {
   bool plugged_ = true;
   bool hearing_ = true;
   bool shut_down_ = false;
+  bool held_by_hand_ = false;
   std::uint8_t injected_error_ = 0;
   // Reg Write waiting for Action.
   std::array<std::uint8_t, dxl::xreg::table_size> pending_{};

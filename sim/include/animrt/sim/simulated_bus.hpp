@@ -66,8 +66,9 @@ class SimulatedBus {
     int baud = 0;  // the Baud Rate register, in bits per second
   };
   // Turns the shaft to raw position `ticks` (as Present Position reads it),
-  // as a hand turns a limp servo;
-  // throws std::logic_error("torque is on") when its torque is on.
+  // as a hand turns a limp servo (or one held by a weak torque: see the
+  // servo's own model); throws std::logic_error("torque is on") against a
+  // torque stronger than a hand.
   virtual void hand_move(int device_id, std::int32_t ticks) {
     (void)device_id;
     (void)ticks;

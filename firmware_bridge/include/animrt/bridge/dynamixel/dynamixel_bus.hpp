@@ -74,8 +74,13 @@ class DynamixelBus final : public ActuatorBus {
   // servos at 57600 baud take longer than 60 ms).
   void arm_device_guard() override;
   // Bus Watchdog 0 (if set; not on faulted devices), then torque off, on
-  // every device, best effort; never throws.
+  // every device, and the Operating Mode a compliant hold changed put back;
+  // best effort, never throws.
   void deactivate() override;
+  // Current-based position mode (5) at `share` of the servo's Current Limit
+  // (Goal Current), goal = present position, torque on. False for a model
+  // without current sensing (it reports load: XL430, XC430, ...).
+  bool activate_compliant(std::size_t device, double share) override;
 
   // One Sync Read / Sync Write. Counters: `transactions` counts instruction
   // packets that expected an answer from the device (Sync Write expects none).
@@ -179,6 +184,10 @@ class DynamixelBus final : public ActuatorBus {
   std::vector<double> current_unit_;       // per device, A per unit; 0: the model reports load
   std::size_t health_next_ = 0;            // round robin: the device whose turn is next
   std::vector<std::uint8_t> off_pending_;  // switch_off(): torque off at the next read
+  // Per device, the Operating Mode before a compliant hold (kModeKept: none).
+  static constexpr std::uint8_t kModeKept = 0xFF;
+  std::vector<std::uint8_t> mode_before_;
+  void restore_operating_mode(std::size_t device);
 };
 
 }  // namespace animrt

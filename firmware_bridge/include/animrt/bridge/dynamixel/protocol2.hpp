@@ -50,6 +50,9 @@ enum class StatusError : std::uint8_t {
   access = 7,
 };
 
+// Operating Mode 5: position control whose torque Goal Current limits.
+inline constexpr std::uint8_t kCurrentBasedPositionMode = 5;
+
 // X-series control table (the addresses the runtime and simulator use).
 namespace xreg {
 inline constexpr std::uint16_t model_number = 0;            // 2 bytes
@@ -58,6 +61,7 @@ inline constexpr std::uint16_t id = 7;                      // 1
 inline constexpr std::uint16_t baud_rate = 8;               // 1
 inline constexpr std::uint16_t return_delay_time = 9;       // 1, unit 2 us
 inline constexpr std::uint16_t operating_mode = 11;         // 1, 3 = position
+inline constexpr std::uint16_t current_limit = 38;          // 2, unit as Present Current
 inline constexpr std::uint16_t velocity_limit = 44;         // 4, unit 0.229 rpm
 inline constexpr std::uint16_t max_position_limit = 48;     // 4
 inline constexpr std::uint16_t min_position_limit = 52;     // 4
@@ -69,6 +73,7 @@ inline constexpr std::uint16_t hardware_error_status = 70;  // 1
 // Goal PWM/Current/Velocity/Position refuse writes (Data Range Error) until
 // 0 is written.
 inline constexpr std::uint16_t bus_watchdog = 98;
+inline constexpr std::uint16_t goal_current = 102;         // 2, signed
 inline constexpr std::uint16_t goal_position = 116;        // 4
 inline constexpr std::uint16_t moving = 122;               // 1
 inline constexpr std::uint16_t present_velocity = 128;     // 4

@@ -75,8 +75,12 @@ class FeetechBus final : public ActuatorBus {
   // Per servo: goal position = present position, then torque on. On failure
   // (or a servo reporting a fault) turns torque off again and throws.
   void activate() override;
-  // Torque off on every servo, best effort; never throws.
+  // Torque off on every servo, and the Torque Limit a compliant hold
+  // lowered put back; best effort, never throws.
   void deactivate() override;
+  // STS: Torque Limit (48) at `share` of the servo's maximum torque, goal =
+  // present position, torque on. False on the SCS series.
+  bool activate_compliant(std::size_t device, double share) override;
 
   // One cycle; neither throws nor allocates. read() waits at most one
   // timeout per servo (one for each answer of the Sync Read, STS; one for
@@ -123,6 +127,9 @@ class FeetechBus final : public ActuatorBus {
   std::string outside_warning_;
   std::vector<std::uint8_t> sync_data_;
   bool health_ = false;
+  // Per device, the Torque Limit before a compliant hold (0: unchanged).
+  std::vector<std::uint16_t> limit_before_;
+  Answer write_torque_limit(std::size_t device, std::uint16_t limit);
   void take_health(std::size_t device, std::span<const std::uint8_t> data);
 };
 

@@ -75,6 +75,7 @@ inline constexpr std::uint8_t goal_time = 44;            // 2
 inline constexpr std::uint8_t goal_speed = 46;           // 2
 inline constexpr std::uint8_t sts_lock = 55;             // 1, EEPROM write lock (STS)
 inline constexpr std::uint8_t scs_lock = 48;             // 1, EEPROM write lock (SCS)
+inline constexpr std::uint8_t sts_torque_limit = 48;     // 2, STS: RAM, 0.1 % of full torque
 inline constexpr std::uint8_t present_position = 56;     // 2
 inline constexpr std::uint8_t present_speed = 58;        // 2
 inline constexpr std::uint8_t present_load = 60;         // 2
@@ -85,6 +86,10 @@ inline constexpr std::uint8_t servo_status = 65;         // 1, error bits
 inline constexpr std::uint8_t moving = 66;               // 1
 inline constexpr std::uint8_t table_size = 71;
 }  // namespace reg
+
+// STS Torque Limit at full torque (its power-up value: Max Torque, EEPROM 16,
+// 1000 by default).
+inline constexpr std::uint16_t kStsFullTorque = 1000;
 
 // Steps per turn of the position sensor, and the range goal positions take
 // in position mode.

@@ -73,7 +73,12 @@ class FeetechServo {
   // plugged in again it powers up (torque off, goal at the present
   // position); a hand turns a limp shaft (false while torque is on).
   void set_plugged(bool plugged, Nanos now);
+  // A hand turns a limp shaft, or one held by a weak torque (STS Torque
+  // Limit at most 250, a quarter), which it then holds against the servo
+  // until the servo's goal comes within 4 steps of it or the torque goes off
+  // or up. False, and nothing moves, against a stronger torque.
   bool hand_move(std::int32_t steps, Nanos now);
+  bool yields_to_hand() const;
   int baud() const;  // the Baud Rate register in bits per second
   std::int32_t present_steps(Nanos now) const;
   // EEPROM (0..39): a write there is kept while the lock (STS 55, SCS 48)
@@ -95,6 +100,8 @@ class FeetechServo {
   std::int32_t position_value(std::uint8_t address) const;
   void store_position(std::uint8_t address, double steps);
   void power_up(Nanos now);  // RAM at its defaults, EEPROM as kept
+  void let_go_of_hand();     // after a write: the hand holds on only against a weak pull
+  bool held_by_hand_ = false;
   std::uint16_t u16(std::uint8_t address) const;
 
   ActuatorBinding binding_;
