@@ -119,6 +119,25 @@ TEST(ModbusHealth, AnUndervoltageFaultsTheDrive) {
       << s.faults[0];
 }
 
+TEST(ModbusHealth, TheDrivesOwnLimitOverridesItsBuss) {
+  HealthLimits bus;
+  bus.temperature_fault_c = 70;
+  SimHealthInjection heat{1, 0.5, SimHealthInjection::Kind::temperature, 60.0};
+  test::RigSettings settings = health(ModbusBusOptions::Health::packed, bus, {heat});
+  settings.edit = [edit = settings.edit](RobotConfig& c) {
+    edit(c);
+    HealthLimits own = *c.buses[kTorso].health_limits;
+    own.temperature_fault_c = 50;
+    c.buses[kTorso].actuators[0].health_limits = own;
+  };
+  test::SimRig rig(kAnimatronic, settings);
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("temperature 60 C (fault limit 50 C)"), std::string::npos)
+      << s.faults[0];
+}
+
 TEST(ModbusHealth, AWarningDoesNotStopTheRun) {
   HealthLimits limits;
   limits.temperature_warn_c = 60;
