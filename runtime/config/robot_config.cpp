@@ -65,25 +65,34 @@ void check_two_periods(const YamlNode& n, double value, double rate_hz) {
 
 // Device health limits: safety.health, or a bus's health_limits. A warning
 // must come before its fault.
-HealthLimits parse_health_limits(const YamlNode& node, double rate_hz) {
+HealthLimits parse_health_limits(const YamlNode& node, double rate_hz,
+                                 const HealthLimits& base = {}) {
   node.allow_only({"temperature_warn_c", "temperature_fault_c", "voltage_warn_v", "voltage_fault_v",
                    "stall_current_a", "stall_time_s", "stall_error_deg", "error_bits"});
-  HealthLimits h;
-  if (auto n = node.find("temperature_warn_c")) h.temperature_warn_c = n->as_double_in(0.0, 200.0);
-  if (auto n = node.find("temperature_fault_c")) {
-    h.temperature_fault_c = n->as_double_in(0.0, 200.0);
-    if (h.temperature_fault_c <= h.temperature_warn_c) {
-      n->fail("expected more than temperature_warn_c (" + format_number(h.temperature_warn_c) +
-              "), found " + n->describe());
+  HealthLimits h = base;  // a device's own limits: the keys given over its bus's
+  const auto t_warn = node.find("temperature_warn_c");
+  const auto t_fault = node.find("temperature_fault_c");
+  if (t_warn) h.temperature_warn_c = t_warn->as_double_in(0.0, 200.0);
+  if (t_fault) h.temperature_fault_c = t_fault->as_double_in(0.0, 200.0);
+  if (h.temperature_fault_c <= h.temperature_warn_c) {
+    if (t_fault) {
+      t_fault->fail("expected more than temperature_warn_c (" +
+                    format_number(h.temperature_warn_c) + "), found " + t_fault->describe());
     }
+    t_warn->fail("expected less than temperature_fault_c (" + format_number(h.temperature_fault_c) +
+                 "), found " + t_warn->describe());
   }
-  if (auto n = node.find("voltage_warn_v")) h.voltage_warn_v = n->as_double_in(0.0, 100.0);
-  if (auto n = node.find("voltage_fault_v")) {
-    h.voltage_fault_v = n->as_double_in(0.0, 100.0);
-    if (h.voltage_fault_v >= h.voltage_warn_v) {
-      n->fail("expected less than voltage_warn_v (" + format_number(h.voltage_warn_v) +
-              "), found " + n->describe());
+  const auto v_warn = node.find("voltage_warn_v");
+  const auto v_fault = node.find("voltage_fault_v");
+  if (v_warn) h.voltage_warn_v = v_warn->as_double_in(0.0, 100.0);
+  if (v_fault) h.voltage_fault_v = v_fault->as_double_in(0.0, 100.0);
+  if (h.voltage_fault_v >= h.voltage_warn_v) {
+    if (v_fault) {
+      v_fault->fail("expected less than voltage_warn_v (" + format_number(h.voltage_warn_v) +
+                    "), found " + v_fault->describe());
     }
+    v_warn->fail("expected more than voltage_fault_v (" + format_number(h.voltage_fault_v) +
+                 "), found " + v_warn->describe());
   }
   if (auto n = node.find("stall_current_a")) h.stall_current_a = n->as_double_in(0.001, 1000.0);
   if (auto n = node.find("stall_time_s")) {
@@ -110,8 +119,8 @@ HealthLimits parse_health_limits(const YamlNode& node, double rate_hz) {
 SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
   node.allow_only({"watchdog_timeout_s", "start_ramp_s", "stop_ramp_s", "start_ramp_max_s",
                    "stop_deadline_s", "following_error_deg", "following_error_mm",
-                   "following_error_window_s", "health", "tilt_limit_deg", "tilt_time_s",
-                   "on_tilt", "tilt_hold_s"});
+                   "following_error_window_s", "health", "tilt_limit_deg", "tilt_time_s", "on_tilt",
+                   "tilt_hold_s"});
   SafetyConfig safety;
   if (auto n = node.find("health")) safety.health = parse_health_limits(*n, rate_hz);
   parse_tilt_watch(node, safety);
@@ -377,6 +386,7 @@ std::size_t parse_actuator(const YamlNode& node, const JointSpec& joint,
   }
   std::vector<std::string_view> keys{"bus"};
   for (auto key : protocol.actuator_keys()) keys.push_back(key);
+  keys.push_back("health_limits");
   node.allow_only(keys);
   protocol.read_actuator(node, joint, limits_node, bus, binding);
   return bus_index;
@@ -399,8 +409,14 @@ void parse_joints(const YamlNode& node, RobotConfig& config) {
     binding.joint_index = static_cast<int>(config.joints.size());
     binding.min_position = joint.limits.min_position;
     binding.max_position = joint.limits.max_position;
+    const YamlNode actuator = value.at("actuator");
     const std::size_t bus_index =
-        parse_actuator(value.at("actuator"), joint, limits_node, config.buses, binding);
+        parse_actuator(actuator, joint, limits_node, config.buses, binding);
+    const BusConfig& bus = config.buses[bus_index];
+    if (auto n = actuator.find("health_limits")) {
+      binding.health_limits =
+          parse_health_limits(*n, config.rate_hz, bus.health_limits.value_or(config.safety.health));
+    }
     config.buses[bus_index].actuators.push_back(binding);
     config.joints.push_back(std::move(joint));
   }

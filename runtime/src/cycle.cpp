@@ -214,8 +214,8 @@ struct CycleStages {
     for (std::size_t b = 0; b < in.buses.size(); ++b) {
       const BusIo& io = in.buses[b];
       if (!io.fresh || io.readings.empty()) continue;
-      const HealthLimits& lim = model.buses[b].health;
       for (std::size_t d = 0; d < s.faulted_[b].size() && d < io.readings.size(); ++d) {
+        const HealthLimits& lim = model.buses[b].health_of(d);
         const HealthReading& r = io.readings[d];
         CycleState::HealthTrack& track = s.health_track_[b][d];
         if (s.faulted_[b][d] || r.reads == track.reads) continue;

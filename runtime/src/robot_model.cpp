@@ -47,6 +47,7 @@ RobotModel make_robot_model(const RobotConfig& config, std::span<const BusConfig
       bound[static_cast<std::size_t>(j)] = true;
       bus.joint.push_back(j);
       bus.device_id.push_back(actuator.device_id);
+      bus.device_health.push_back(actuator.health_limits.value_or(bus.health));
     }
     m.buses.push_back(std::move(bus));
   }

@@ -104,8 +104,8 @@ std::string describe_event(const RobotModel& m,
       return fmt::format(
           "bus {} id {} ({}): {}; at t={:.3f} s; the device was switched off, "
           "other joints ramped to home",
-          bus.name, actuator.device_id, actuator.joint, describe_health(m.buses[e.bus].health, e),
-          e.t);
+          bus.name, actuator.device_id, actuator.joint,
+          describe_health(m.buses[e.bus].health_of(e.device), e), e.t);
     }
     case EventKind::motion_fault:
       return fmt::format(
@@ -339,9 +339,9 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
     } else if (e.kind == EventKind::health_warning) {
       const auto& bus = buses[e.bus]->config();
       const auto& actuator = bus.actuators[e.device];
-      summary.health_warnings.push_back(
-          fmt::format("bus {} id {} ({}): {} at t={:.3f} s", bus.name, actuator.device_id,
-                      actuator.joint, describe_health(model.buses[e.bus].health, e), e.t));
+      summary.health_warnings.push_back(fmt::format(
+          "bus {} id {} ({}): {} at t={:.3f} s", bus.name, actuator.device_id, actuator.joint,
+          describe_health(model.buses[e.bus].health_of(e.device), e), e.t));
     } else if (std::string line = describe_event(model, buses, config.lag_notes, e);
                !line.empty()) {
       summary.faults.push_back(std::move(line));

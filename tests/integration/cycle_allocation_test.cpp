@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "animrt/bridge/dynamixel/x_models.hpp"
+#include "animrt/bridge/modbus/modbus_bus.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
 #include "support/alloc_counter.hpp"
@@ -264,6 +265,27 @@ TEST(CycleAllocation, ModbusTcpDroppedConnection) {
       torso.stop();
       torso.drop_connections();
     }
+    done = done || t >= 0.3;
+  });
+}
+
+// Health read apart (round robin) and recorded; a fault code switches the
+// drive off from inside the cycle.
+TEST(CycleAllocation, ModbusTcpHealthAndAFaultCode) {
+  test::RigSettings settings = short_ramps();
+  settings.edit = [](RobotConfig& c) {
+    c.safety.start_ramp_s = 0.3;
+    c.safety.stop_ramp_s = 0.3;
+    auto o = std::any_cast<ModbusBusOptions>(c.buses[2].options);
+    o.health = ModbusBusOptions::Health::round_robin;
+    c.buses[2].options = o;
+  };
+  SimRig rig(kConfigsDir + "/robots/animatronic.yaml", settings);
+  bool done = false;
+  expect_no_allocation(rig, 2.0, {EndReason::fault, true, true}, [&](double t) {
+    if (!done && t >= 0.3)
+      rig.sim("torso").inject_device_health(
+          1, SimHealthInjection{1, 0.0, SimHealthInjection::Kind::hardware_error, 0x21});
     done = done || t >= 0.3;
   });
 }

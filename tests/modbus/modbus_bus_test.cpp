@@ -191,6 +191,22 @@ TEST_P(ModbusTransports, GoalsAreClampedIntoTheJointLimitsAndNaNHolds) {
   EXPECT_EQ(r.bus->devices()[0].exceptions, 0u);
 }
 
+TEST_P(ModbusTransports, ADriveSwitchedOffForItsHealthHasItsEnableOff) {
+  Rig r(GetParam());
+  r.bus->configure();
+  r.bus->activate();
+  r.step({0.0, 0.0}, 20);
+  r.bus->switch_off(1);
+  EXPECT_TRUE(r.bus->devices()[1].faulted);
+  // The enable goes off in the next read: the drive no longer follows a goal.
+  r.step({0.0, deg_to_rad(10)});
+  const double held = r.sim->device_position(2);
+  EXPECT_NEAR(held, 0.0, 1e-3);
+  r.step({0.0, deg_to_rad(10)}, 30);
+  EXPECT_DOUBLE_EQ(r.sim->device_position(2), held);
+  EXPECT_NEAR(r.sim->device_position(1), 0.0, 1e-3);  // the other drive carries on
+}
+
 INSTANTIATE_TEST_SUITE_P(TcpAndRtu, ModbusTransports, ::testing::Values("modbus-tcp", "modbus-rtu"),
                          [](const auto& p) { return p.param == "modbus-tcp" ? "tcp" : "rtu"; });
 
@@ -413,6 +429,21 @@ TEST(ModbusConfig, ErrorsNameFileLineAndKey) {
           "joints.tilt.actuator.slave: registers overlap: joint tilt and joint pan on slave 1"),
       std::string::npos)
       << twice;
+
+  // Health read from a map that names no health registers (position_drive.yaml).
+  text = robot_text("modbus-tcp");
+  text.replace(text.find("timeout_ms: 200"), 15, "timeout_ms: 200\n    health: packed");
+  const std::string no_health = error_of(text);
+  EXPECT_NE(no_health.find("bad.yaml:13:"), std::string::npos) << no_health;
+  EXPECT_NE(no_health.find("joints.pan.actuator.map: bus drives reads health, but the register "
+                           "map"),
+            std::string::npos)
+      << no_health;
+  text.replace(text.find("health: packed"), 14, "health: always");
+  EXPECT_NE(error_of(text).find(
+                "buses.drives.health: expected off, packed or round_robin, found \"always\""),
+            std::string::npos)
+      << error_of(text);
 
   text = robot_text("modbus-tcp");
   text.replace(text.find("port: 127.0.0.1:1502"), 20, "port: localhost");

@@ -111,5 +111,30 @@ TEST(RegisterMap, ValidationErrorsNameFileLineAndKey) {
       "map.yaml:9:36: status.fault_bits.16: expected a bit number 0..15 as the key, found \"16\"");
 }
 
+TEST(RegisterMap, AHealthSectionNamesCurrentTemperatureVoltageAndFaultCode) {
+  const std::string text = kGood +
+                           "health:\n"
+                           "  current: {table: input, address: 5, type: int16, scale: 0.01}\n"
+                           "  temperature: {table: input, address: 6, type: int16, scale: 0.1}\n"
+                           "  fault_code: {table: holding, address: 7, type: uint16}\n";
+  auto m = load_register_map_text(text, "map.yaml");
+  ASSERT_TRUE(m->health.current && m->health.temperature && m->health.fault_code);
+  EXPECT_FALSE(m->health.voltage);
+  const std::uint16_t raw = static_cast<std::uint16_t>(-250);
+  EXPECT_DOUBLE_EQ(m->health.current->decode(&raw), -2.5);
+  EXPECT_EQ(m->spans().size(), 7u);
+  EXPECT_EQ(error_of(replaced(text, "address: 6", "address: 2")),
+            "map.yaml:13:16: health.temperature: registers overlap: health.temperature (input 2) "
+            "overlaps status (input 2)");
+  EXPECT_EQ(error_of(replaced(text, "address: 7, type: uint16}",
+                              "address: 7, type: uint16, "
+                              "scale: 2}")),
+            "map.yaml:14:58: health.fault_code.scale: unknown key (expected one of: table, "
+            "address, type)");
+  EXPECT_EQ(error_of(kGood + "health: {}\n"),
+            "map.yaml:11:9: health: expected at least one of current, temperature, voltage, "
+            "fault_code");
+}
+
 }  // namespace
 }  // namespace animrt::modbus

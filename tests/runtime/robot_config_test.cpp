@@ -11,6 +11,7 @@
 #include <string>
 
 #include "animrt/bridge/dynamixel/x_models.hpp"
+#include "animrt/runtime/robot_model.hpp"
 #include "support/files.hpp"
 
 namespace animrt {
@@ -304,7 +305,7 @@ joints:
     actuator: {bus: b, id: 1, inverted: true}
 )"),
             at("8:31: joints.j1.actuator.inverted: unknown key (expected one of: bus, id, "
-               "ticks_per_rev, ticks_per_rad, zero_ticks, direction, model)"));
+               "ticks_per_rev, ticks_per_rad, zero_ticks, direction, model, health_limits)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -932,6 +933,38 @@ TEST_F(RobotConfigTest, HealthLimitsAndTheSimulatedHealthAreRead) {
   EXPECT_DOUBLE_EQ(bus.sim.health.inject[0].value, 80.0);
   EXPECT_EQ(bus.sim.health.inject[1].kind, SimHealthInjection::Kind::blocked);
   EXPECT_DOUBLE_EQ(bus.sim.health.inject[1].at_s, 3.0);
+}
+
+TEST_F(RobotConfigTest, ADevicesOwnHealthLimitsOverrideItsBussKeyByKey) {
+  std::string text = kMinimal;
+  text.replace(text.find("loop: {rate_hz: 100}"), 20,
+               "loop: {rate_hz: 100}\nsafety:\n  health: {temperature_warn_c: 60, "
+               "temperature_fault_c: 70, voltage_warn_v: 11, voltage_fault_v: 10}");
+  text.replace(text.find("    actuator: {bus: b, id: 1}"), 29,
+               "    actuator: {bus: b, id: 1, health_limits: {temperature_fault_c: 50, "
+               "temperature_warn_c: 45}}\n"
+               "  j2:\n"
+               "    limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: "
+               "1000}\n"
+               "    actuator: {bus: b, id: 2}");
+  const RobotConfig c = load(text);
+  const auto& own = c.buses[0].actuators[0].health_limits;
+  ASSERT_TRUE(own.has_value());
+  EXPECT_DOUBLE_EQ(own->temperature_fault_c, 50.0);
+  EXPECT_DOUBLE_EQ(own->temperature_warn_c, 45.0);
+  EXPECT_DOUBLE_EQ(own->voltage_fault_v, 10.0);  // the rest from safety.health
+  EXPECT_FALSE(c.buses[0].actuators[1].health_limits.has_value());
+  std::vector<const BusConfig*> buses{&c.buses[0]};
+  const RobotModel m = make_robot_model(c, buses);
+  EXPECT_DOUBLE_EQ(m.buses[0].health_of(0).temperature_fault_c, 50.0);
+  EXPECT_DOUBLE_EQ(m.buses[0].health_of(1).temperature_fault_c, 70.0);
+
+  // A warning the device raises past the fault it inherits.
+  text.replace(text.find("temperature_fault_c: 50, temperature_warn_c: 45"), 47,
+               "temperature_warn_c: 75");
+  EXPECT_EQ(error_of(text),
+            at("10:67: joints.j1.actuator.health_limits.temperature_warn_c: expected less than "
+               "temperature_fault_c (70), found \"75\""));
 }
 
 TEST_F(RobotConfigTest, BadHealthKeysNameTheirPlace) {

@@ -76,6 +76,7 @@ Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transp
   hw_fault_.resize(n);
   min_rad_.resize(n);
   max_rad_.resize(n);
+  rated_current_a_.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
@@ -147,6 +148,23 @@ void Cia402Bus::handle(const can_frame& f) {
           (running_ && d.state != State::operation_enabled)) {
         hw_fault_[slot] = 1;
       }
+      return;
+    }
+    case canopen::kTpdo2Base: {
+      slot = slot_of(cob, canopen::kTpdo2Base);
+      if (slot < 0 || !options_.health) return;
+      const auto device = static_cast<std::size_t>(slot);
+      if (f.len != 6) {
+        book_.garbled(device);
+        return;
+      }
+      // Current actual: per mille of the motor's rated current (6075h, mA).
+      HealthReading& h = book_[device].reading;
+      const auto per_mille = static_cast<std::int16_t>(canopen::get_le(f.data, 2));
+      h.current_a = rated_current_a_[device] > 0.0
+                        ? std::abs(per_mille) / 1000.0 * rated_current_a_[device]
+                        : HealthReading::kNone;
+      h.voltage_v = canopen::get_le(f.data + 2, 4) / 1000.0;
       return;
     }
     case canopen::kHeartbeatBase: {
@@ -325,6 +343,7 @@ void Cia402Bus::configure() {
          {canopen::kTpdo1Base, canopen::kTsdoBase, canopen::kHeartbeatBase, canopen::kEmcyBase}) {
       filters.push_back({base + node, kExact});
     }
+    if (options_.health) filters.push_back({canopen::kTpdo2Base + node, kExact});
   }
   transport_->set_filters(filters);
   running_ = false;
@@ -379,6 +398,7 @@ void Cia402Bus::configure() {
     sdo_write(i, tpdo1_map, 0, options_.health ? 3 : 2, 1);
     sdo_write(i, tpdo1_comm, 2, 1, 1);
     sdo_write(i, tpdo1_comm, 1, canopen::kTpdo1Base + node, 4);
+    if (options_.health) map_health_tpdo(i);
 
     actual_counts_[i] = static_cast<std::int32_t>(sdo_read(i, position_actual, 0));
     target_counts_[i] = actual_counts_[i];
@@ -389,6 +409,21 @@ void Cia402Bus::configure() {
   }
   for (std::size_t i = 0; i < book_.size(); ++i) last_heartbeat_[i] = transport_->now();
   fresh_ = true;
+}
+
+// TPDO2: current actual + DC link voltage on every SYNC, scaled by the
+// motor's rated current read once here.
+void Cia402Bus::map_health_tpdo(std::size_t i) {
+  using namespace cia402::obj;
+  const auto node = static_cast<std::uint32_t>(config_.actuators[i].device_id);
+  rated_current_a_[i] = sdo_read(i, motor_rated_current, 0) / 1000.0;
+  sdo_write(i, tpdo2_comm, 1, cia402::kPdoInvalid | (canopen::kTpdo2Base + node), 4);
+  sdo_write(i, tpdo2_map, 0, 0, 1);
+  sdo_write(i, tpdo2_map, 1, canopen::mapping(current_actual, 0, 16), 4);
+  sdo_write(i, tpdo2_map, 2, canopen::mapping(dc_link_voltage, 0, 32), 4);
+  sdo_write(i, tpdo2_map, 0, 2, 1);
+  sdo_write(i, tpdo2_comm, 2, 1, 1);
+  sdo_write(i, tpdo2_comm, 1, canopen::kTpdo2Base + node, 4);
 }
 
 std::string Cia402Bus::walk_to(State goal) {

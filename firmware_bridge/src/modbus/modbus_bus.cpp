@@ -50,6 +50,8 @@ ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
   present_rad_.assign(n, 0.0);
   goal_rad_.assign(n, 0.0);
   answered_.assign(n, 0);
+  off_pending_.assign(n, 0);
+  kept_health_.assign(n, DeviceHealth::ok);
   group_slaves(bus);
   // Requests per slave: one read per table over every present/status
   // register, one write per contiguous run of goal registers.
@@ -78,33 +80,51 @@ void ModbusBus::group_slaves(const std::string& bus) {
   }
 }
 
-void ModbusBus::plan_reads(Slave& s, const std::string& bus) {
+template <class Pick>
+std::vector<ModbusBus::Read> ModbusBus::plan_table_reads(const Slave& s, const std::string& bus,
+                                                         Pick&& pick) {
+  std::vector<Read> reads;
   for (modbus::Table table : {modbus::Table::holding, modbus::Table::input}) {
     int lo = 1 << 20, hi = -1;
     for (std::size_t d : s.devices) {
-      const modbus::RegisterMap& m = *joints_[d].map;
-      auto cover = [&](const modbus::Register& r) {
+      pick(*joints_[d].map, [&](const modbus::Register& r) {
         if (r.table != table) return;
         lo = std::min(lo, r.address);
         hi = std::max(hi, r.end());
-      };
-      cover(m.present);
-      if (m.has_status) cover(m.status);
+      });
     }
     if (hi < 0) continue;
     if (hi - lo > kMaxReadWords) {
       throw DeviceError(bus + "the " + std::string(modbus::to_string(table)) +
                         " registers read from slave " + std::to_string(s.id) + " span " +
                         std::to_string(hi - lo) + " registers, more than one request can read (" +
-                        std::to_string(kMaxReadWords) + ")");
+                        std::to_string(kMaxReadWords) + ")" +
+                        (options_.health == ModbusBusOptions::Health::packed
+                             ? " (with health: packed; round_robin reads health apart)"
+                             : ""));
     }
     Read r;
     r.table = table;
     r.begin = lo;
     r.count = hi - lo;
     r.words.assign(static_cast<std::size_t>(r.count), 0);
-    s.reads.push_back(std::move(r));
+    reads.push_back(std::move(r));
   }
+  return reads;
+}
+
+void ModbusBus::plan_reads(Slave& s, const std::string& bus) {
+  using Health = ModbusBusOptions::Health;
+  const Health health = options_.health;
+  const auto health_registers = [](const modbus::RegisterMap& m, const auto& cover) {
+    for (const modbus::Register* r : m.health.list()) cover(*r);
+  };
+  s.reads = plan_table_reads(s, bus, [&](const modbus::RegisterMap& m, const auto& cover) {
+    cover(m.present);
+    if (m.has_status) cover(m.status);
+    if (health == Health::packed) health_registers(m, cover);
+  });
+  if (health == Health::round_robin) s.health_reads = plan_table_reads(s, bus, health_registers);
 }
 
 void ModbusBus::plan_writes(Slave& s, const std::string& bus) {
@@ -240,8 +260,9 @@ ModbusBus::Failure ModbusBus::fail_slave(const Slave& slave, int error) {
   return f;
 }
 
-const std::uint16_t* ModbusBus::words_of(const Slave& slave, const modbus::Register& r) const {
-  for (const Read& rd : slave.reads) {
+const std::uint16_t* ModbusBus::words_of(const std::vector<Read>& reads,
+                                         const modbus::Register& r) {
+  for (const Read& rd : reads) {
     if (rd.table == r.table && r.address >= rd.begin && r.end() <= rd.begin + rd.count) {
       return rd.words.data() + (r.address - rd.begin);
     }
@@ -293,8 +314,65 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
       if (faults != 0 && count) book_.fault_reported(d);
     }
     book_.answered(d, faults != 0);
+    if (options_.health == ModbusBusOptions::Health::packed) take_health(d, slave.reads);
   }
   return true;
+}
+
+void ModbusBus::take_health(std::size_t d, const std::vector<Read>& reads) {
+  const modbus::HealthRegisters& regs = joints_[d].map->health;
+  if (!regs.any()) return;
+  HealthReading& h = book_[d].reading;
+  const auto value = [&](const std::optional<modbus::Register>& r) {
+    const std::uint16_t* w = r ? words_of(reads, *r) : nullptr;
+    return w ? r->decode(w) : HealthReading::kNone;
+  };
+  h.current_a = std::abs(value(regs.current));
+  h.temperature_c = value(regs.temperature);
+  h.voltage_v = value(regs.voltage);
+  if (regs.fault_code) {
+    const std::uint16_t* w = words_of(reads, *regs.fault_code);
+    h.has_error_bits = w != nullptr;
+    h.error_bits = w ? *w : 0u;
+  }
+  h.read_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(steady_clock::now().time_since_epoch())
+          .count();
+  ++h.reads;
+}
+
+// One slave's health registers in requests of their own; a lost health
+// read is counted, but the cycle's verdict on the device is its position's.
+void ModbusBus::read_health_round_robin() {
+  for (std::size_t k = 0; k < slaves_.size(); ++k) {
+    Slave& s = slaves_[(health_next_ + k) % slaves_.size()];
+    if (s.silent || s.health_reads.empty()) continue;
+    bool live = false;
+    for (std::size_t d : s.devices) live = live || !book_[d].faulted;
+    if (!live) continue;
+    health_next_ = (health_next_ + k + 1) % slaves_.size();
+    for (std::size_t d : s.devices) {
+      if (!book_[d].faulted) book_.asked(d);
+    }
+    for (Read& r : s.health_reads) {
+      if (!connected_) return;
+      modbus_set_slave(ctx_, s.id);
+      ++requests_;
+      const int rc = r.table == modbus::Table::holding
+                         ? modbus_read_registers(ctx_, r.begin, r.count, r.words.data())
+                         : modbus_read_input_registers(ctx_, r.begin, r.count, r.words.data());
+      if (rc != r.count) {
+        for (std::size_t d : s.devices) kept_health_[d] = book_[d].health;
+        fail_slave(s, rc < 0 ? errno : EMBMDATA);
+        for (std::size_t d : s.devices) book_[d].health = kept_health_[d];
+        return;
+      }
+    }
+    for (std::size_t d : s.devices) {
+      if (!book_[d].faulted) take_health(d, s.health_reads);
+    }
+    return;
+  }
 }
 
 bool ModbusBus::write_slave(Slave& slave) {
@@ -447,6 +525,29 @@ void ModbusBus::deactivate() {
 
 // ---- cycle ----------------------------------------------------------------
 
+void ModbusBus::switch_off(std::size_t device) {
+  mark_faulted(device);
+  off_pending_[device] = 1;
+}
+
+// The enable of each device switched off since the last read(), one
+// request each, best effort (the drive's fault or watchdog is the backstop).
+void ModbusBus::switch_off_pending() {
+  for (Slave& s : slaves_) {
+    for (std::size_t d : s.devices) {
+      if (!off_pending_[d]) continue;
+      off_pending_[d] = 0;
+      const modbus::Enable& e = joints_[d].map->enable;
+      if (!e.configured || !connected_) continue;
+      modbus_set_slave(ctx_, s.id);
+      ++requests_;
+      const int rc = e.coil ? modbus_write_bit(ctx_, e.address, e.off)
+                            : modbus_write_register(ctx_, e.address, e.off);
+      if (rc != 1 && classify(errno) == Failure::connection && options_.tcp) disconnect();
+    }
+  }
+}
+
 void ModbusBus::read(std::span<double> positions) {
   const std::size_t n = std::min(positions.size(), book_.size());
   if (fresh_) {
@@ -464,6 +565,7 @@ void ModbusBus::read(std::span<double> positions) {
     return;
   }
   flush_input();  // late answers of timed-out requests must not pass for these
+  switch_off_pending();
   for (Slave& s : slaves_) {
     if (!connected_) {
       s.silent = true;
@@ -476,6 +578,7 @@ void ModbusBus::read(std::span<double> positions) {
     }
     s.silent = !read_slave(s, true);
   }
+  if (options_.health == ModbusBusOptions::Health::round_robin) read_health_round_robin();
   for (std::size_t i = 0; i < n; ++i) {
     if (answered_[i]) positions[i] = present_rad_[i];
   }

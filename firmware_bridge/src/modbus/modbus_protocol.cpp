@@ -11,10 +11,10 @@
 namespace animrt {
 namespace {
 
-constexpr std::string_view kTcpKeys[] = {"port", "timeout_ms", "reconnect_ms",
-                                         "device_watchdog_ms"};
-constexpr std::string_view kRtuKeys[] = {"port",      "baud",       "parity",
-                                         "stop_bits", "timeout_ms", "device_watchdog_ms"};
+constexpr std::string_view kTcpKeys[] = {"port", "timeout_ms", "reconnect_ms", "device_watchdog_ms",
+                                         "health"};
+constexpr std::string_view kRtuKeys[] = {
+    "port", "baud", "parity", "stop_bits", "timeout_ms", "device_watchdog_ms", "health"};
 constexpr std::string_view kActuatorKeys[] = {"slave", "map", "m_per_rad", "zero_m"};
 
 // The longest communication timeout set from the robot file: a guard of a
@@ -30,6 +30,17 @@ void read_timeout(const YamlNode& node, BusConfig& bus) {
     }
     bus.timeout_s = ms / 1000.0;
   }
+}
+
+ModbusBusOptions::Health read_health(const YamlNode& node) {
+  using Health = ModbusBusOptions::Health;
+  const auto n = node.find("health");
+  if (!n) return Health::off;
+  const std::string v = n->is_scalar() ? n->as_string() : "";
+  if (v == "off") return Health::off;
+  if (v == "packed") return Health::packed;
+  if (v == "round_robin") return Health::round_robin;
+  n->fail("expected off, packed or round_robin, found " + n->describe());
 }
 
 // The joint's register map, resolved against the robot file's folder.
@@ -195,6 +206,7 @@ class ModbusProtocol final : public Protocol {
       options.device_watchdog_path = given->path();
     }
     options.tcp = tcp_;
+    options.health = read_health(node);
     if (tcp_) {
       const auto colon = bus.port.rfind(':');
       bool ok = colon != std::string::npos && colon > 0 && colon + 1 < bus.port.size();
@@ -243,6 +255,12 @@ class ModbusProtocol final : public Protocol {
     const std::string given = map_node.as_string();
     j.map = load_joint_map(node, map_node, given);
     set_watchdog_counts(map_node, given, joint, bus, j);
+    const auto& bus_options = std::any_cast<const ModbusBusOptions&>(bus.options);
+    if (bus_options.health != ModbusBusOptions::Health::off && !j.map->health.any()) {
+      map_node.fail("bus " + bus.name + " reads health, but the register map " + quote_path(given) +
+                    " names no health registers (a health section with current, temperature, "
+                    "voltage or fault_code)");
+    }
     read_stroke(node, map_node, given, joint, j);
     check_shared_registers(slave, joint, bus, j);
     check_range(limits_node, given, joint, j);

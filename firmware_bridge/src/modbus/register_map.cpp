@@ -120,6 +120,27 @@ void parse_status(const YamlNode& status, RegisterMap& map, std::vector<Named>& 
       {"status", map.status.table, map.status.address, map.status.end(), map.status.where});
 }
 
+// The registers the drive reports its health in.
+void parse_health(const YamlNode& health, RegisterMap& map, std::vector<Named>& used) {
+  if (!health.is_map()) health.fail("expected a map, found " + health.describe());
+  health.allow_only({"current", "temperature", "voltage", "fault_code"});
+  HealthRegisters& h = map.health;
+  h.where = health.location();
+  if (auto n = health.find("current")) h.current = parse_register(*n, true, true);
+  if (auto n = health.find("temperature")) h.temperature = parse_register(*n, true, true);
+  if (auto n = health.find("voltage")) h.voltage = parse_register(*n, true, true);
+  if (auto n = health.find("fault_code")) h.fault_code = parse_register(*n, true, false);
+  if (!h.any()) health.fail("expected at least one of current, temperature, voltage, fault_code");
+  static constexpr const char* kKeys[] = {"health.current", "health.temperature", "health.voltage",
+                                          "health.fault_code"};
+  const std::optional<Register>* regs[] = {&h.current, &h.temperature, &h.voltage, &h.fault_code};
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (*regs[k])
+      used.push_back(
+          {kKeys[k], (*regs[k])->table, (*regs[k])->address, (*regs[k])->end(), (*regs[k])->where});
+  }
+}
+
 // The coil or register that switches the drive on and off.
 void parse_enable(const YamlNode& enable, RegisterMap& map, std::vector<Named>& used) {
   if (!enable.is_map()) enable.fail("expected a map, found " + enable.describe());
@@ -182,7 +203,8 @@ void check_overlaps(const std::vector<Named>& used) {
 }
 
 std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
-  root.allow_only({"name", "unit", "goal", "present", "status", "enable", "watchdog", "range"});
+  root.allow_only(
+      {"name", "unit", "goal", "present", "status", "health", "enable", "watchdog", "range"});
   auto map = std::make_shared<RegisterMap>();
   map->file = root.file();
   map->name = root.get_string("name", "");
@@ -198,6 +220,7 @@ std::shared_ptr<const RegisterMap> parse(const YamlNode& root) {
       {"present", map->present.table, map->present.address, map->present.end(),
        map->present.where}};
   if (auto status = root.find("status")) parse_status(*status, *map, used);
+  if (auto health = root.find("health")) parse_health(*health, *map, used);
   if (auto enable = root.find("enable")) parse_enable(*enable, *map, used);
   if (auto watchdog = root.find("watchdog")) parse_watchdog(*watchdog, *map, used);
   if (auto range = root.find("range")) parse_range(*range, *map);
@@ -285,10 +308,19 @@ std::string RegisterMap::fault_text(std::uint16_t value) const {
   return out;
 }
 
+std::vector<const Register*> HealthRegisters::list() const {
+  std::vector<const Register*> out;
+  for (const std::optional<Register>* r : {&current, &temperature, &voltage, &fault_code}) {
+    if (*r) out.push_back(&**r);
+  }
+  return out;
+}
+
 std::vector<std::pair<Table, std::pair<int, int>>> RegisterMap::spans() const {
   std::vector<std::pair<Table, std::pair<int, int>>> out{
       {goal.table, {goal.address, goal.end()}}, {present.table, {present.address, present.end()}}};
   if (has_status) out.push_back({status.table, {status.address, status.end()}});
+  for (const Register* r : health.list()) out.push_back({r->table, {r->address, r->end()}});
   if (enable.configured && !enable.coil)
     out.push_back({Table::holding, {enable.address, enable.address + 1}});
   if (watchdog.configured)

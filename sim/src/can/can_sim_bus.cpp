@@ -125,6 +125,13 @@ void CanSimBus::set_device_hardware_error(int device_id, std::uint8_t error_bits
   flush(out);
 }
 
+void CanSimBus::inject_device_health(int device_id, const SimHealthInjection& change) {
+  std::lock_guard lock(mutex_);
+  FrameList out;
+  node(device_id).inject_health(change, clock_.now(), out);
+  flush(out);
+}
+
 void CanSimBus::reboot_device(int device_id) {
   std::lock_guard lock(mutex_);
   FrameList out;

@@ -59,7 +59,8 @@ Cia402DriveNode::Cia402DriveNode(const ActuatorBinding& binding, const SimBusSet
       settings_(settings),
       node_(static_cast<std::uint8_t>(binding.device_id)),
       motor_(static_cast<double>(binding.to_ticks(initial_offset_rad(binding.device_id))),
-             settings.time_constant_s, settings.max_speed_rad_s * binding.ticks_per_rad, now) {
+             settings.time_constant_s, settings.max_speed_rad_s * binding.ticks_per_rad, now),
+      health_(settings.health, binding.device_id, now) {
   reset_application(now);
 }
 
@@ -98,6 +99,9 @@ void Cia402DriveNode::reset_application(Nanos now) {
       {obj::position_actual, 0, 4, Access::ro, false, true, 0},
       {obj::velocity_actual, 0, 4, Access::ro, false, true, 0},
       {obj::target_position, 0, 4, Access::rw, true, false, 0},
+      {obj::motor_rated_current, 0, 4, Access::rw, false, false, kRatedCurrentMa},
+      {obj::current_actual, 0, 2, Access::ro, false, true, 0},
+      {obj::dc_link_voltage, 0, 4, Access::ro, false, true, 0},
   };
   reset_communication();
   state_ = State::switch_on_disabled;  // transitions 0 and 1 are immediate here
@@ -128,6 +132,12 @@ void Cia402DriveNode::reset_communication() {
     od_.push_back({0x1A00, s, 4, Access::rw, false, false,
                    s == 1 ? canopen::mapping(obj::statusword, 0, 16) : 0});
   }
+  od_.push_back({0x1801, 0, 1, Access::ro, false, false, 2});
+  od_.push_back(
+      {0x1801, 1, 4, Access::rw, false, false, cia402::kPdoInvalid | (canopen::kTpdo2Base + node)});
+  od_.push_back({0x1801, 2, 1, Access::rw, false, false, 255});
+  od_.push_back({0x1A01, 0, 1, Access::rw, false, false, 0});
+  for (std::uint8_t s = 1; s <= 8; ++s) od_.push_back({0x1A01, s, 4, Access::rw, false, false, 0});
   if (Entry* e = find(obj::heartbeat_time, 0)) e->value = 0;
   if (Entry* e = find(obj::heartbeat_consumer, 1)) e->value = 0;
   consumer_armed_ = false;
@@ -180,6 +190,16 @@ std::uint32_t Cia402DriveNode::read_value(const Entry& e, Nanos now) const {
     case obj::velocity_actual:
       return static_cast<std::uint32_t>(
           static_cast<std::int32_t>(std::lround(motor_.velocity(now))));
+    case obj::current_actual: {
+      const double rated_a =
+          const_cast<Cia402DriveNode*>(this)->find(obj::motor_rated_current, 0)->value / 1000.0;
+      const double per_mille =
+          rated_a > 0.0 ? std::clamp(1000.0 * health_.current_a() / rated_a, -32768.0, 32767.0)
+                        : 0.0;
+      return static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(per_mille)));
+    }
+    case obj::dc_link_voltage:
+      return static_cast<std::uint32_t>(std::lround(std::max(0.0, health_.voltage_v()) * 1000.0));
     default:
       return e.value;
   }
@@ -231,7 +251,7 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
   if (!e) return index_exists(index) ? ac::no_subindex : ac::no_object;
   if (e->access == Access::ro) return ac::read_only;
   if (size != 0 && size != e->size) return ac::length_mismatch;
-  for (const Pdo& pdo : {kRpdo, kTpdo}) {
+  for (const Pdo& pdo : {kRpdo, kTpdo, kTpdo2}) {
     if (index == pdo.map) {
       if (const std::uint32_t a = check_mapping(pdo, sub, value)) return a;
     }
@@ -247,7 +267,7 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
       return 0;
     case obj::target_position:
       e->value = value;
-      if (state_ == State::operation_enabled) {
+      if (state_ == State::operation_enabled && !health_.blocked()) {
         motor_.set_goal(static_cast<double>(static_cast<std::int32_t>(value)), now);
       }
       return 0;
@@ -481,13 +501,13 @@ void Cia402DriveNode::apply_rpdo(Nanos now, FrameList& out) {
   }
 }
 
-void Cia402DriveNode::send_tpdo(Nanos now, FrameList& out) {
+void Cia402DriveNode::send_tpdo(const Pdo& pdo, Nanos now, FrameList& out) {
   can_frame f{};
-  f.can_id = cob_id(kTpdo) & CAN_SFF_MASK;
-  const auto count = static_cast<std::uint8_t>(find(kTpdo.map, 0)->value);
+  f.can_id = cob_id(pdo) & CAN_SFF_MASK;
+  const auto count = static_cast<std::uint8_t>(find(pdo.map, 0)->value);
   std::size_t offset = 0;
   for (std::uint8_t s = 1; s <= count; ++s) {
-    const std::uint32_t m = find(kTpdo.map, s)->value;
+    const std::uint32_t m = find(pdo.map, s)->value;
     const Entry* e = find(static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8));
     const int size = static_cast<int>((m & 0xFF) / 8);
     if (!e || offset + size > 8) return;
@@ -503,10 +523,41 @@ void Cia402DriveNode::on_sync(Nanos now, FrameList& out) {
   const std::uint8_t rx_type = transmission_type(kRpdo);
   if (rx_type <= 240) apply_rpdo(now, out);
   ++sync_count_;
-  const std::uint8_t tx_type = transmission_type(kTpdo);
-  if ((cob_id(kTpdo) & cia402::kPdoInvalid) == 0 && tx_type >= 1 && tx_type <= 240 &&
-      sync_count_ % tx_type == 0) {
-    send_tpdo(now, out);
+  advance_health(now, out);
+  for (const Pdo& pdo : {kTpdo, kTpdo2}) {
+    const std::uint8_t tx_type = transmission_type(pdo);
+    if ((cob_id(pdo) & cia402::kPdoInvalid) == 0 && tx_type >= 1 && tx_type <= 240 &&
+        sync_count_ % tx_type == 0) {
+      send_tpdo(pdo, now, out);
+    }
+  }
+}
+
+void Cia402DriveNode::advance_health(Nanos now, FrameList& out) {
+  const double speed = motor_.velocity(now) / binding_.ticks_per_rad;
+  const bool was_blocked = health_.blocked();
+  health_.advance(now, speed, state_ == State::operation_enabled);
+  if (health_.blocked() && !was_blocked) motor_.hold(now);
+  if (health_.injected_bits() != 0 && condition_ == 0) set_fault(health_.injected_bits(), now, out);
+}
+
+void Cia402DriveNode::inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) {
+  advance_health(now, out);
+  using Kind = SimHealthInjection::Kind;
+  switch (change.kind) {
+    case Kind::temperature:
+      health_.set_temperature(change.value);
+      break;
+    case Kind::blocked:
+      health_.set_blocked(change.value != 0.0);
+      if (health_.blocked()) motor_.hold(now);
+      break;
+    case Kind::supply:
+      health_.set_supply(change.value);
+      break;
+    case Kind::hardware_error:
+      set_fault(static_cast<std::uint8_t>(change.value), now, out);
+      break;
   }
 }
 

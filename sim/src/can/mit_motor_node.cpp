@@ -1,20 +1,18 @@
 #include "animrt/sim/can/mit_motor_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
 
 namespace animrt::sim {
-namespace {
-constexpr std::uint8_t kTemperatureC = 40;
-}
-
 MitMotorNode::MitMotorNode(const ActuatorBinding& binding, canid_t master_id,
                            const SimBusSettings& settings, Nanos now, int can_timeout_ms)
     : binding_(binding),
       options_(options_of<MitMotorOptions>(binding.options)),
       master_id_(master_id),
       motor_(0.0, settings.time_constant_s, settings.max_speed_rad_s, now),
+      health_(settings.health, binding.device_id, now),
       can_timeout_(static_cast<Nanos>(std::max(0, can_timeout_ms)) * 1'000'000),
       last_frame_(now) {
   // Start a little away from the home pose, so the start ramp has work to do.
@@ -41,7 +39,8 @@ can_frame MitMotorNode::reply(Nanos now) const {
                command_.kd * (command_.velocity - r.velocity) + command_.torque;
   }
   r.extended = true;
-  r.temperature = kTemperatureC;
+  r.temperature =
+      static_cast<std::uint8_t>(std::clamp(std::lround(health_.temperature_c()), 0L, 255L));
   r.error = error_;
   return mit::pack_reply(master_id_, r, options_.ranges);
 }
@@ -60,6 +59,7 @@ void MitMotorNode::handle(const can_frame& frame, Nanos now, FrameList& out) {
   if ((frame.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG)) != 0) return;
   if ((frame.can_id & CAN_SFF_MASK) != static_cast<canid_t>(binding_.device_id)) return;
   poll(now, out);  // the loop ran out the timeout before this frame came
+  advance_health(now, out);
   // Any frame addressed to the motor restarts the count; the zeroed command
   // stays until a command frame sets a new one.
   last_frame_ = now;
@@ -87,7 +87,7 @@ void MitMotorNode::handle(const can_frame& frame, Nanos now, FrameList& out) {
       if (motor_mode_) {
         command_ = c;
         timed_out_ = false;
-        if (c.kp > 0.0) {
+        if (c.kp > 0.0 && !health_.blocked()) {
           motor_.set_goal(c.position + zero_, now);
         } else {
           motor_.hold(now);
@@ -104,6 +104,33 @@ void MitMotorNode::set_fault(std::uint8_t bits, Nanos now, FrameList&) {
   if (bits != 0) {
     motor_mode_ = false;
     motor_.hold(now);
+  }
+}
+
+void MitMotorNode::advance_health(Nanos now, FrameList& out) {
+  const bool was_blocked = health_.blocked();
+  health_.advance(now, motor_.velocity(now), motor_mode_);
+  if (health_.blocked() && !was_blocked) motor_.hold(now);
+  if (health_.injected_bits() != 0 && error_ == 0) set_fault(health_.injected_bits(), now, out);
+}
+
+void MitMotorNode::inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) {
+  advance_health(now, out);
+  using Kind = SimHealthInjection::Kind;
+  switch (change.kind) {
+    case Kind::temperature:
+      health_.set_temperature(change.value);
+      break;
+    case Kind::blocked:
+      health_.set_blocked(change.value != 0.0);
+      if (health_.blocked()) motor_.hold(now);
+      break;
+    case Kind::supply:
+      health_.set_supply(change.value);
+      break;
+    case Kind::hardware_error:
+      set_fault(static_cast<std::uint8_t>(change.value), now, out);
+      break;
   }
 }
 

@@ -20,6 +20,7 @@
 #include "animrt/sim/dynamixel_servo.hpp"
 #include "animrt/sim/maestro/pty_pair.hpp"
 #include "animrt/sim/modbus/modbus_frame.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 
 namespace animrt::sim {
 namespace {
@@ -40,6 +41,7 @@ struct ModbusSimBus::Joint {
   ModbusJointOptions options;
   double position = 0.0;  // joint rad
   double goal = 0.0;
+  ServoHealthModel health;  // its motor's current, temperature, supply
 };
 
 struct ModbusSimBus::Drive {
@@ -48,6 +50,7 @@ struct ModbusSimBus::Drive {
   modbus_mapping_t* mapping = nullptr;
   bool responding = true;
   std::uint16_t faults = 0;
+  std::uint16_t fault_code = 0;  // the health section's fault code (injected)
   bool enabled = false;
   Nanos time = 0;
   // The communication timeout: the register (if a map names one), the time
@@ -79,6 +82,7 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
     j.binding = &b;
     j.options = o;
     j.position = j.goal = initial_offset_rad(o.slave + static_cast<int>(d->joints.size()));
+    j.health = ServoHealthModel(config_.sim.health, o.slave, now);
     d->joints.push_back(j);
   }
   for (auto& dp : drives_) {
@@ -199,11 +203,16 @@ void ModbusSimBus::advance(Drive& d, Nanos now) {
   const double vmax = config_.sim.max_speed_rad_s;
   const auto integrate = [&](Nanos until) {
     for (; d.time + kStep <= until; d.time += kStep) {
-      if (!d.enabled || d.faults) continue;
+      const bool on = d.enabled && !d.faults && !d.fault_code;
       const double dt = to_seconds(kStep);
       for (Joint& j : d.joints) {
-        const double v = std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax);
+        // A blocked joint stays where it is and draws its stall current.
+        const double v = on && !j.health.blocked()
+                             ? std::clamp((j.goal - j.position) / std::max(tau, dt), -vmax, vmax)
+                             : 0.0;
         j.position += v * dt;
+        j.health.advance(d.time + kStep, v, on);
+        d.fault_code = static_cast<std::uint16_t>(d.fault_code | j.health.injected_bits());
       }
     }
   };
@@ -242,7 +251,24 @@ void ModbusSimBus::publish(Drive& d) {
                     (m.status.address - d.mapping->start_input_registers);
       *st = d.faults;
     }
+    publish_health(d, j);
   }
+}
+
+void ModbusSimBus::publish_health(Drive& d, Joint& j) {
+  const modbus::HealthRegisters& h = j.options.map->health;
+  const auto put = [&](const std::optional<modbus::Register>& r, double value) {
+    if (!r) return;
+    std::uint16_t* tab =
+        r->table == modbus::Table::holding
+            ? d.mapping->tab_registers + (r->address - d.mapping->start_registers)
+            : d.mapping->tab_input_registers + (r->address - d.mapping->start_input_registers);
+    r->encode(value, tab);
+  };
+  put(h.current, j.health.current_a());
+  put(h.temperature, j.health.temperature_c());
+  put(h.voltage, j.health.voltage_v());
+  put(h.fault_code, d.fault_code);
 }
 
 void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
@@ -475,6 +501,33 @@ void ModbusSimBus::set_device_hardware_error(int device_id, std::uint8_t error_b
                             elide(config_.name) + "'");
   advance(*d, clock_.now());
   d->faults = static_cast<std::uint16_t>(d->faults | error_bits);
+  publish(*d);
+}
+
+void ModbusSimBus::inject_device_health(int device_id, const SimHealthInjection& change) {
+  std::lock_guard lock(mutex_);
+  Drive* d = drive(device_id);
+  if (!d)
+    throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
+                            elide(config_.name) + "'");
+  advance(*d, clock_.now());
+  using Kind = SimHealthInjection::Kind;
+  for (Joint& j : d->joints) {
+    switch (change.kind) {
+      case Kind::temperature:
+        j.health.set_temperature(change.value);
+        break;
+      case Kind::blocked:
+        j.health.set_blocked(change.value != 0.0);
+        break;
+      case Kind::supply:
+        j.health.set_supply(change.value);
+        break;
+      case Kind::hardware_error:
+        d->fault_code = static_cast<std::uint16_t>(change.value);
+        break;
+    }
+  }
   publish(*d);
 }
 

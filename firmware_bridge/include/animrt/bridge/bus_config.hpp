@@ -27,6 +27,9 @@ struct ActuatorBinding {
   // reach the wire, whatever the layers above did. Unbounded by default.
   double min_position = -std::numeric_limits<double>::infinity();
   double max_position = std::numeric_limits<double>::infinity();
+  // The device's own health limits (its actuator's health_limits key: the
+  // keys given there over its bus's limits), if any.
+  std::optional<HealthLimits> health_limits{};
   // Protocol-specific settings, owned by the protocol module that read them
   // (for example a register map or a pulse calibration).
   std::any options;

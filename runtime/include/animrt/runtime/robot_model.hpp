@@ -27,6 +27,12 @@ struct BusModel {
   std::vector<int> joint;      // per device: the robot joint it drives
   std::vector<int> device_id;  // per device: its bus address
   HealthLimits health{};       // the bus's health_limits, else safety.health
+  // Per device: its own health_limits (over the bus's), else `health`.
+  std::vector<HealthLimits> device_health{};
+
+  const HealthLimits& health_of(std::size_t device) const {
+    return device < device_health.size() ? device_health[device] : health;
+  }
 };
 
 struct ImuModel {

@@ -16,6 +16,7 @@ inline constexpr canid_t kSyncId = 0x080;
 inline constexpr canid_t kEmcyBase = 0x080;       // + node
 inline constexpr canid_t kTpdo1Base = 0x180;      // + node, device -> master
 inline constexpr canid_t kRpdo1Base = 0x200;      // + node, master -> device
+inline constexpr canid_t kTpdo2Base = 0x280;      // + node, device -> master
 inline constexpr canid_t kTsdoBase = 0x580;       // + node, SDO server -> client
 inline constexpr canid_t kRsdoBase = 0x600;       // + node, SDO client -> server
 inline constexpr canid_t kHeartbeatBase = 0x700;  // + node

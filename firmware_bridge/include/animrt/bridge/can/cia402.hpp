@@ -18,6 +18,8 @@ inline constexpr std::uint16_t rpdo1_comm = 0x1400;          // :1 COB-ID, :2 tr
 inline constexpr std::uint16_t rpdo1_map = 0x1600;
 inline constexpr std::uint16_t tpdo1_comm = 0x1800;
 inline constexpr std::uint16_t tpdo1_map = 0x1A00;
+inline constexpr std::uint16_t tpdo2_comm = 0x1801;
+inline constexpr std::uint16_t tpdo2_map = 0x1A01;
 inline constexpr std::uint16_t abort_connection_option = 0x6007;     // i16
 inline constexpr std::uint16_t error_code = 0x603F;                  // u16, last EMCY code
 inline constexpr std::uint16_t controlword = 0x6040;                 // u16
@@ -27,7 +29,10 @@ inline constexpr std::uint16_t modes_of_operation = 0x6060;          // i8
 inline constexpr std::uint16_t modes_of_operation_display = 0x6061;  // i8
 inline constexpr std::uint16_t position_actual = 0x6064;             // i32
 inline constexpr std::uint16_t velocity_actual = 0x606C;             // i32
-inline constexpr std::uint16_t target_position = 0x607A;             // i32
+inline constexpr std::uint16_t motor_rated_current = 0x6075;         // u32, mA
+inline constexpr std::uint16_t current_actual = 0x6078;   // i16, per mille of rated current
+inline constexpr std::uint16_t dc_link_voltage = 0x6079;  // u32, mV
+inline constexpr std::uint16_t target_position = 0x607A;  // i32
 }  // namespace obj
 
 inline constexpr std::uint32_t kDeviceProfile = 402;      // low word of 1000h

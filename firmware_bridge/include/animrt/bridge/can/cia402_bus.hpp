@@ -4,9 +4,11 @@
 // configure(): per drive, expedited SDOs check the device type (402), set the
 // heartbeat producer time, the mode (CSP) and the PDO mapping (RPDO1:
 // controlword + target position; TPDO1: statusword + position actual, both
-// synchronous), read the position, then NMT start. activate(): walks the
-// controlword state machine to Operation Enabled (fault reset first if the
-// drive is in Fault) with the target held at the actual position.
+// synchronous; with `health`, TPDO1 adds the error code and TPDO2 carries
+// current actual and DC link voltage), read the position, then NMT start.
+// activate(): walks the controlword state machine to Operation Enabled
+// (fault reset first if the drive is in Fault) with the target held at the
+// actual position.
 // Each cycle read() produces SYNC and collects every TPDO (one deadline);
 // write() sends each RPDO, applied by the drives at the next SYNC.
 // deactivate(): back down to Switch On Disabled, NMT pre-operational.
@@ -73,7 +75,9 @@ class Cia402Bus final : public ActuatorBus {
   void write(std::span<const double> positions) override;
   std::span<DeviceStatus> devices() override { return book_.devices(); }
   // With `health: on`, each SYNC's TPDO1 also carries the drive's Error
-  // Code (603Fh), kept as DeviceStatus::reading's error bits.
+  // Code (603Fh), kept as DeviceStatus::reading's error bits, and a TPDO2
+  // its current actual value (6078h, scaled by 6075h) and DC link voltage
+  // (6079h).
   bool reads_health() const override { return options_.health; }
 
   // What the runtime knows about each drive.
@@ -110,6 +114,7 @@ class Cia402Bus final : public ActuatorBus {
   void handle(const can_frame& frame);
   void supervise();
   void send_rpdo(std::size_t device, std::uint16_t controlword, std::int32_t target);
+  void map_health_tpdo(std::size_t device);
   // The host's heartbeat, when one is due (guard armed).
   void produce_heartbeat();
   // Writes 1016h:01 = 0 on every drive (errors ignored) and stops producing.
@@ -137,6 +142,7 @@ class Cia402Bus final : public ActuatorBus {
   std::vector<std::uint8_t> hw_fault_;     // sticky hardware error (EMCY, reboot, fault state)
   std::vector<int> slot_of_node_;          // node id -> device index
   std::vector<double> min_rad_, max_rad_;  // goals that stay inside int32 counts
+  std::vector<double> rated_current_a_;    // 6075h, for 6078h (health)
   bool running_ = false;                   // between activate() and deactivate(): OE expected
   bool fresh_ = false;
   bool producing_ = false;  // host heartbeats between arm_device_guard() and deactivate()

@@ -9,6 +9,16 @@
 // are contiguous). Exceptions, CRC errors and timeouts are counted per
 // device; a status register with fault bits set is a hardware error.
 //
+// Health (the bus's `health` key, for maps with a `health` section): with
+// `packed` the current, temperature, voltage and fault code registers join
+// the cycle's read requests (still one request per slave and table when
+// they lie near the position); with `round_robin` the cycle reads positions
+// as without health and then one slave's health registers in a request of
+// its own, the next slave in the next cycle. A fault code other than 0 is
+// the device's error bits; the runtime's health limits judge the values.
+// A device switched off for its health gets its enable off in the next
+// read().
+//
 // A TCP connection that drops is closed and reopened with exponential
 // backoff (reconnect_min_s doubling to reconnect_max_s); in between, every
 // device counts a timeout per cycle and nothing blocks, so the watchdog
@@ -42,6 +52,8 @@ struct ModbusBusOptions {
   bool tcp = true;
   char parity = 'N';  // RTU: N, E or O
   int stop_bits = 1;  // RTU
+  enum class Health : std::uint8_t { off, packed, round_robin };
+  Health health = Health::off;
   double reconnect_min_s = 0.1;
   double reconnect_max_s = 2.0;
   // device_watchdog_ms (0: off), written to each drive whose register map
@@ -89,6 +101,9 @@ class ModbusBus final : public ActuatorBus {
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
   std::span<DeviceStatus> devices() override { return book_.devices(); }
+  // Marks the device faulted; its enable goes off in the next read().
+  void switch_off(std::size_t device) override;
+  bool reads_health() const override { return options_.health != ModbusBusOptions::Health::off; }
 
   std::uint64_t reconnects() const { return reconnects_; }
   bool connected() const { return connected_; }
@@ -109,6 +124,7 @@ class ModbusBus final : public ActuatorBus {
     int id = 0;
     std::vector<std::size_t> devices;
     std::vector<Read> reads;
+    std::vector<Read> health_reads;  // round_robin: the health registers alone
     std::vector<Write> writes;
     // Did not answer this cycle's read: its write is skipped, so a dead
     // slave costs one timeout per cycle, not two.
@@ -122,6 +138,9 @@ class ModbusBus final : public ActuatorBus {
   void group_slaves(const std::string& bus);
   void plan_reads(Slave& slave, const std::string& bus);
   void plan_writes(Slave& slave, const std::string& bus);
+  // Requests covering, per table, every register `pick` gives of the slave's joints.
+  template <class Pick>
+  std::vector<Read> plan_table_reads(const Slave& slave, const std::string& bus, Pick&& pick);
   void open_context(const std::string& bus);
   bool ensure_connected(bool blocking);
   void disconnect();
@@ -130,7 +149,13 @@ class ModbusBus final : public ActuatorBus {
   // Counts a failed request against the slave's devices; returns the failure.
   Failure fail_slave(const Slave& slave, int error);
   bool read_slave(Slave& slave, bool count);
-  const std::uint16_t* words_of(const Slave& slave, const modbus::Register& r) const;
+  static const std::uint16_t* words_of(const std::vector<Read>& reads, const modbus::Register& r);
+  const std::uint16_t* words_of(const Slave& slave, const modbus::Register& r) const {
+    return words_of(slave.reads, r);
+  }
+  void take_health(std::size_t device, const std::vector<Read>& reads);
+  void read_health_round_robin();
+  void switch_off_pending();
   bool write_slave(Slave& slave);
   bool set_enable(Slave& slave, bool on, int* error);
   bool set_watchdog(Slave& slave, bool on, int* error);
@@ -144,6 +169,9 @@ class ModbusBus final : public ActuatorBus {
   std::vector<double> present_rad_;
   std::vector<double> goal_rad_;
   std::vector<std::uint8_t> answered_;
+  std::vector<std::uint8_t> off_pending_;  // switch_off(): enable off in the next read()
+  std::vector<DeviceHealth> kept_health_;  // round_robin: a lost health read keeps these
+  std::size_t health_next_ = 0;            // round_robin: the slave read next
   _modbus* ctx_ = nullptr;
   bool connected_ = false;
   bool fresh_ = false;

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -64,6 +65,22 @@ struct Watchdog {
   Location where;
 };
 
+// What the drive says about itself (the map's `health` section), read by a
+// bus with `health` on: each register optional; current (A), temperature
+// (deg C) and supply voltage (V) scaled like goal and present, the fault
+// code unscaled (0: no fault; any other value is the drive's own fault).
+struct HealthRegisters {
+  std::optional<Register> current;
+  std::optional<Register> temperature;
+  std::optional<Register> voltage;
+  std::optional<Register> fault_code;
+  Location where;
+
+  bool any() const { return current || temperature || voltage || fault_code; }
+  // Those given, for planning reads and overlap checks.
+  std::vector<const Register*> list() const;
+};
+
 struct FaultBit {
   int bit = 0;
   std::string name;
@@ -79,6 +96,7 @@ struct RegisterMap {
   Register status;  // holding or input, int16/uint16
   std::uint16_t fault_mask = 0;
   std::vector<FaultBit> faults;
+  HealthRegisters health;
   Enable enable;
   Watchdog watchdog;
   bool has_range = false;

@@ -6,8 +6,10 @@
 #include <linux/can.h>
 
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
+#include "animrt/bridge/bus_config.hpp"
 #include "animrt/core/clock.hpp"
 
 namespace animrt::sim {
@@ -35,6 +37,11 @@ class CanNode {
   virtual void set_fault(std::uint8_t bits, Nanos now, FrameList& out) = 0;
   // Power cycle: the device restarts with its defaults and says so.
   virtual void reboot(Nanos now, FrameList& out) = 0;
+  // A change to the device's health model at once (SimulatedBus::
+  // inject_device_health); devices without one throw std::logic_error.
+  virtual void inject_health(const SimHealthInjection&, Nanos, FrameList&) {
+    throw std::logic_error("this simulated CAN device models no health");
+  }
   // Whether the device's own guard against a dead host (heartbeat consumer,
   // CAN timeout) has fired and not yet been cleared.
   virtual bool guard_fired() const { return false; }

@@ -48,6 +48,8 @@ class CanSimBus final : public SimulatedBus {
   std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   void set_device_responding(int device_id, bool responding) override;
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  // The device's health model (CiA 402 drives, MIT motors), at once.
+  void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
 
   // CAN-specific fault injection: power-cycle one device (it restarts with

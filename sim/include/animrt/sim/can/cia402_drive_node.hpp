@@ -34,7 +34,13 @@
 //   heartbeat that comes back clears the communication error (EMCY 0000h
 //   unless in Fault, which needs a fault reset).
 // - Motor: in Operation Enabled the position follows the target (LagMotor,
-//   in counts); otherwise it holds.
+//   in counts); otherwise it holds. A blocked joint (sim.inject) holds too.
+// - Health: 6075h motor rated current (mA), 6078h current actual (per mille
+//   of 6075h) and 6079h DC link circuit voltage (mV), from the servos'
+//   health model (current driven by the motion or a stall, a supply that
+//   sags with it), mappable into TPDO2 (1801h, 1A01h; COB-ID 280h + node,
+//   invalid by default). The profile has no temperature object, so none is
+//   reported; an injected hardware error is a fault with its EMCY.
 
 #include <array>
 #include <cstdint>
@@ -46,6 +52,7 @@
 #include "animrt/bridge/can/cia402.hpp"
 #include "animrt/sim/can/can_node.hpp"
 #include "animrt/sim/can/motor_model.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 
 namespace animrt::sim {
 
@@ -64,6 +71,7 @@ class Cia402DriveNode final : public CanNode {
   double joint_position(Nanos now) const override;
   void set_fault(std::uint8_t bits, Nanos now, FrameList& out) override;
   void reboot(Nanos now, FrameList& out) override;
+  void inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) override;
 
   cia402::State state() const { return state_; }
   canopen::NmtState nmt_state() const { return nmt_; }
@@ -107,7 +115,9 @@ class Cia402DriveNode final : public CanNode {
   void handle_rpdo(const can_frame& frame, Nanos now, FrameList& out);
   void apply_rpdo(Nanos now, FrameList& out);
   void on_sync(Nanos now, FrameList& out);
-  void send_tpdo(Nanos now, FrameList& out);
+  void send_tpdo(const Pdo& pdo, Nanos now, FrameList& out);
+  // The health model on to `now`; an injected fault condition faults the drive.
+  void advance_health(Nanos now, FrameList& out);
   void controlword(std::uint16_t value, Nanos now, FrameList& out);
   void enter_state(cia402::State state, Nanos now);
   void emit_emcy(std::uint16_t code, FrameList& out);
@@ -123,7 +133,8 @@ class Cia402DriveNode final : public CanNode {
   canopen::NmtState nmt_ = canopen::NmtState::pre_operational;
   cia402::State state_ = cia402::State::switch_on_disabled;
   std::uint16_t last_controlword_ = 0;
-  LagMotor motor_;              // counts
+  LagMotor motor_;  // counts
+  ServoHealthModel health_;
   std::uint8_t condition_ = 0;  // injected fault condition (0: none)
   bool boot_pending_ = true;
   Nanos next_heartbeat_ = 0;
@@ -138,6 +149,8 @@ class Cia402DriveNode final : public CanNode {
   std::uint32_t sync_count_ = 0;
   static constexpr Pdo kRpdo{0x1400, 0x1600, true};
   static constexpr Pdo kTpdo{0x1800, 0x1A00, false};
+  static constexpr Pdo kTpdo2{0x1801, 0x1A01, false};
+  static constexpr std::uint32_t kRatedCurrentMa = 2000;
 };
 
 }  // namespace animrt::sim

@@ -11,11 +11,16 @@
 // for longer than the timeout, the command is zeroed (kp, kd, torque): the
 // motor goes limp (here: it stops where it is) and stays in motor mode; the
 // next command drives it again.
+// Temperature: the servos' health model (sim.health, sim.inject): a
+// thermal model driven by the current the motion draws, or the stall
+// current while the joint is blocked (it then stays where it is); an
+// injected hardware error is the reply's error code.
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/sim/can/can_node.hpp"
 #include "animrt/sim/can/motor_model.hpp"
+#include "animrt/sim/servo_health_model.hpp"
 
 namespace animrt::sim {
 
@@ -32,6 +37,7 @@ class MitMotorNode final : public CanNode {
   double joint_position(Nanos now) const override;
   void set_fault(std::uint8_t bits, Nanos now, FrameList& out) override;
   void reboot(Nanos now, FrameList& out) override;
+  void inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) override;
 
   bool motor_mode() const { return motor_mode_; }
   const mit::Command& command() const { return command_; }
@@ -43,11 +49,13 @@ class MitMotorNode final : public CanNode {
 
  private:
   can_frame reply(Nanos now) const;
+  void advance_health(Nanos now, FrameList& out);
 
   ActuatorBinding binding_;
   MitMotorOptions options_;
   canid_t master_id_;
   LagMotor motor_;
+  ServoHealthModel health_;
   double zero_ = 0.0;  // rotor angle that reads as 0
   bool motor_mode_ = false;
   mit::Command command_;

@@ -6,7 +6,12 @@
 // the drive itself answers exception 3 to a goal outside the map's range or
 // an enable value that is neither on nor off. Motor per joint: first-order
 // lag (SimBusSettings::time_constant_s) with a speed limit (max_speed), moving
-// only while enabled (or always, when the map has no enable). Any standard
+// only while enabled (or always, when the map has no enable). The registers
+// of a map's health section report each motor's current, temperature and
+// supply from the servos' health model (sim.health, sim.inject: a thermal
+// model driven by the current, a supply that sags with it, a joint that can
+// be blocked); an injected hardware_error is the fault code, and a drive
+// with a fault code stops its motors, as with status fault bits. Any standard
 // Modbus master can talk to it (mbpoll, pymodbus).
 //
 // TCP: every connection has its own receive buffer, so a client that sends
@@ -64,6 +69,9 @@ class ModbusSimBus final : public SimulatedBus {
   void set_device_responding(int device_id, bool responding) override;
   // Sets bits in the drive's status register (and disables its motors).
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  // Its temperature, a blocked joint, its supply or its fault code (every
+  // joint of the slave), at once.
+  void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
 
   // TCP: closes every open client connection (the server keeps listening).
@@ -81,6 +89,7 @@ class ModbusSimBus final : public SimulatedBus {
   Drive* drive(int slave);
   void advance(Drive& d, Nanos now);
   void publish(Drive& d);
+  void publish_health(Drive& d, Joint& j);
 
   BusConfig config_;
   const Clock& clock_;

@@ -1,0 +1,156 @@
+// Device health of a Modbus drive on the simulated animatronic, in
+// lockstep: the linear actuator's register map names its current,
+// temperature, supply and fault code registers; with the bus's `health`
+// key they are read with the position (packed) or apart (round_robin), and
+// an overheat, a fault code or an undervoltage faults the drive while the
+// other buses ramp home.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "animrt/bridge/modbus/modbus_bus.hpp"
+#include "support/sim_rig.hpp"
+
+namespace animrt {
+namespace modbus_health_test {
+
+const std::string kAnimatronic =
+    std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/animatronic.yaml";
+constexpr std::size_t kTorso = 2;
+
+test::RigSettings health(ModbusBusOptions::Health how, const HealthLimits& limits,
+                         std::vector<SimHealthInjection> inject) {
+  test::RigSettings settings;
+  settings.edit = [how, limits, inject](RobotConfig& c) {
+    c.safety.start_ramp_s = 0.3;
+    c.safety.stop_ramp_s = 0.3;
+    BusConfig& torso = c.buses[kTorso];
+    auto o = std::any_cast<ModbusBusOptions>(torso.options);
+    o.health = how;
+    torso.options = o;
+    torso.health_limits = limits;
+    torso.sim.health.inject = inject;
+  };
+  return settings;
+}
+
+const DeviceReport* torso(const RunSummary& s) {
+  for (const auto& d : s.devices) {
+    if (d.joint == "torso_lean") return &d;
+  }
+  return nullptr;
+}
+
+TEST(ModbusHealth, PackedEveryCycleCarriesCurrentTemperatureSupplyAndFaultCode) {
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::packed, HealthLimits{}, {}));
+  const std::uint64_t before = dynamic_cast<ModbusBus&>(rig.bus(kTorso)).requests();
+  const RunSummary s = rig.run(1.0);
+  EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
+  const auto* d = torso(s);
+  ASSERT_NE(d, nullptr);
+  EXPECT_GE(d->health.readings + 2, s.cycles);
+  // The simulated drive's rest values: ambient 36 C, 12 V sagging with the load.
+  EXPECT_NEAR(d->health.min_temperature_c, 36.0, 0.2);
+  EXPECT_NEAR(d->health.min_voltage_v, 12.0, 0.1);
+  EXPECT_GT(d->health.peak_current_a, 0.04);
+  EXPECT_TRUE(d->status.reading.has_error_bits);
+  EXPECT_EQ(d->status.reading.error_bits, 0u);
+  // Still one read and one write request per cycle (and the lifecycle's).
+  const std::uint64_t requests = dynamic_cast<ModbusBus&>(rig.bus(kTorso)).requests() - before;
+  EXPECT_LE(requests, 2 * s.cycles + 12);
+}
+
+TEST(ModbusHealth, RoundRobinReadsHealthInARequestOfItsOwn) {
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::round_robin, HealthLimits{}, {}));
+  const std::uint64_t before = dynamic_cast<ModbusBus&>(rig.bus(kTorso)).requests();
+  const RunSummary s = rig.run(1.0);
+  EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
+  const auto* d = torso(s);
+  ASSERT_NE(d, nullptr);
+  // One slave: its health every cycle, in a third request per cycle.
+  EXPECT_GE(d->health.readings + 2, s.cycles);
+  EXPECT_NEAR(d->health.min_temperature_c, 36.0, 0.2);
+  const std::uint64_t requests = dynamic_cast<ModbusBus&>(rig.bus(kTorso)).requests() - before;
+  EXPECT_GE(requests, 3 * s.cycles - 3);
+}
+
+TEST(ModbusHealth, AnOverheatFaultsTheDriveNamingItsTemperature) {
+  HealthLimits limits;
+  limits.temperature_warn_c = 60;
+  limits.temperature_fault_c = 70;
+  SimHealthInjection heat{1, 0.5, SimHealthInjection::Kind::temperature, 85.0};
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::packed, limits, {heat}));
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("id 1 (torso_lean)"), std::string::npos) << s.faults[0];
+  EXPECT_NE(s.faults[0].find("temperature 85 C (fault limit 70 C)"), std::string::npos)
+      << s.faults[0];
+  // The others ramped home and stopped cleanly: only the drive faulted.
+  for (const auto& d : s.devices) {
+    if (d.joint != "torso_lean") {
+      EXPECT_FALSE(d.status.faulted) << d.joint;
+    }
+  }
+}
+
+TEST(ModbusHealth, AFaultCodeFaultsTheDrive) {
+  SimHealthInjection code{1, 0.5, SimHealthInjection::Kind::hardware_error, 0x21};
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::packed, HealthLimits{}, {code}));
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("id 1 (torso_lean)"), std::string::npos) << s.faults[0];
+  EXPECT_NE(s.faults[0].find("device error bits 0x21"), std::string::npos) << s.faults[0];
+}
+
+TEST(ModbusHealth, AnUndervoltageFaultsTheDrive) {
+  HealthLimits limits;
+  limits.voltage_warn_v = 11;
+  limits.voltage_fault_v = 10;
+  SimHealthInjection sag{1, 0.5, SimHealthInjection::Kind::supply, 9.0};
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::round_robin, limits, {sag}));
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("id 1 (torso_lean)"), std::string::npos) << s.faults[0];
+  EXPECT_NE(s.faults[0].find("undervoltage: supply 9.0 V (fault limit 10 V)"), std::string::npos)
+      << s.faults[0];
+}
+
+TEST(ModbusHealth, TheDrivesOwnLimitOverridesItsBuss) {
+  HealthLimits bus;
+  bus.temperature_fault_c = 70;
+  SimHealthInjection heat{1, 0.5, SimHealthInjection::Kind::temperature, 60.0};
+  test::RigSettings settings = health(ModbusBusOptions::Health::packed, bus, {heat});
+  settings.edit = [edit = settings.edit](RobotConfig& c) {
+    edit(c);
+    HealthLimits own = *c.buses[kTorso].health_limits;
+    own.temperature_fault_c = 50;
+    c.buses[kTorso].actuators[0].health_limits = own;
+  };
+  test::SimRig rig(kAnimatronic, settings);
+  const RunSummary s = rig.run(3.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("temperature 60 C (fault limit 50 C)"), std::string::npos)
+      << s.faults[0];
+}
+
+TEST(ModbusHealth, AWarningDoesNotStopTheRun) {
+  HealthLimits limits;
+  limits.temperature_warn_c = 60;
+  limits.temperature_fault_c = 90;
+  SimHealthInjection heat{1, 0.3, SimHealthInjection::Kind::temperature, 65.0};
+  test::SimRig rig(kAnimatronic, health(ModbusBusOptions::Health::packed, limits, {heat}));
+  const RunSummary s = rig.run(1.0);
+  EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
+  const auto* d = torso(s);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->health.warnings, 1u);
+  EXPECT_GT(d->health.max_temperature_c, 60.0);
+}
+
+}  // namespace modbus_health_test
+}  // namespace animrt
