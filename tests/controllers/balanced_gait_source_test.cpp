@@ -105,11 +105,11 @@ TEST_F(BalancedGaitSourceTest, TheTiltRateIsTakenBetweenNewReadingsOnly) {
   const ImuReading a = pitched(0.1, 0.01);
   sense(&a);
   sense(&a);  // the same reading handed again: no new rate
-  const ImuReading b = pitched(0.12, 0.02);
+  const ImuReading b = pitched(0.101, 0.02);
   sense(&b);
   sense(&b);
-  const double rate = (std::sin(0.12) - std::sin(0.1)) / 0.01;
-  const double stretch = 0.3 * std::sin(0.12) + 0.1 * rate;
+  const double rate = (std::sin(0.101) - std::sin(0.1)) / 0.01;
+  const double stretch = 0.3 * std::sin(0.101) + 0.1 * rate;
   EXPECT_NEAR(sampled(source_)[0], 0.1 + 2.0 * stretch, 1e-9);
   EXPECT_EQ(source_.readings(), 2u);
 }
@@ -117,7 +117,7 @@ TEST_F(BalancedGaitSourceTest, TheTiltRateIsTakenBetweenNewReadingsOnly) {
 TEST_F(BalancedGaitSourceTest, ASilentImuHoldsTheReflexWithoutAJump) {
   const ImuReading a = pitched(0.1, 0.01);
   sense(&a);
-  const ImuReading b = pitched(0.12, 0.02);
+  const ImuReading b = pitched(0.101, 0.02);
   sense(&b);
   const auto before = sampled(source_);
   sense(nullptr);
@@ -125,9 +125,10 @@ TEST_F(BalancedGaitSourceTest, ASilentImuHoldsTheReflexWithoutAJump) {
   EXPECT_EQ(sampled(source_), before);
   EXPECT_EQ(source_.held_cycles(), 2u);
   // Back: the rate is taken over the whole gap.
-  const ImuReading c = pitched(0.12, 0.05);
+  const ImuReading c = pitched(0.11, 0.05);
   sense(&c);
-  EXPECT_NEAR(sampled(source_)[0], 0.1 + 2.0 * 0.3 * std::sin(0.12), 1e-12);
+  const double stretch = 0.3 * std::sin(0.11) + 0.1 * (std::sin(0.11) - std::sin(0.101)) / 0.03;
+  EXPECT_NEAR(sampled(source_)[0], 0.1 + 2.0 * stretch, 1e-9);
 }
 
 TEST(BalancedGaitSource, WithoutLegsTheCurvesPlayAsTheyAre) {
