@@ -10,7 +10,11 @@ namespace animrt {
 
 BalancedGaitSource::BalancedGaitSource(std::unique_ptr<MotionSource> gait, const GaitBalance& gains,
                                        std::size_t joint_count)
-    : gait_(std::move(gait)), gains_(gains), reflex_(gains), curves_(joint_count, 0.0) {}
+    : gait_(std::move(gait)),
+      gains_(gains),
+      reflex_(gains),
+      measured_(joint_count, 0.0),
+      curves_(joint_count, 0.0) {}
 
 void BalancedGaitSource::attach(std::unique_ptr<LegModel> legs) {
   legs_ = std::move(legs);
@@ -18,6 +22,9 @@ void BalancedGaitSource::attach(std::unique_ptr<LegModel> legs) {
 }
 
 void BalancedGaitSource::sense(const Sensors& sensors) {
+  measured_known_ = sensors.positions.size() == measured_.size();
+  if (measured_known_)
+    std::copy(sensors.positions.begin(), sensors.positions.end(), measured_.begin());
   if (!sensors.imu) {
     if (readings_ > 0) ++held_;
     return;
@@ -37,9 +44,14 @@ void BalancedGaitSource::sense(const Sensors& sensors) {
 void BalancedGaitSource::sample(double t, std::span<double> targets) const {
   gait_->sample(t, targets);
   if (!legs_ || readings_ == 0) return;
-  // The legs posed where the curves put them, the trunk where the IMU says.
-  std::copy(targets.begin(), targets.end(), curves_.begin());
-  legs_->pose(curves_, trunk_);
+  // The legs posed where they were measured (or the curves put them), the
+  // trunk where the IMU says.
+  if (measured_known_) {
+    legs_->pose(measured_, trunk_);
+  } else {
+    std::copy(targets.begin(), targets.end(), curves_.begin());
+    legs_->pose(curves_, trunk_);
+  }
   apply_balance(reflex_, *legs_, targets, scratch_);
 }
 

@@ -79,7 +79,7 @@ class BalancedGaitSourceTest : public ::testing::Test {
     legs_ = legs.get();
     source_.attach(std::move(legs));
   }
-  void sense(const ImuReading* reading) { source_.sense(Sensors{reading}); }
+  void sense(const ImuReading* reading) { source_.sense(Sensors{reading, {}}); }
 
   BalancedGaitSource source_;
   TwoLegs* legs_ = nullptr;
@@ -99,6 +99,16 @@ TEST_F(BalancedGaitSourceTest, NoseDownStretchesTheFrontLegAndShortensTheHindOne
   // The legs were posed at the curves' targets with the IMU's attitude.
   EXPECT_EQ(legs_->posed, (std::vector<double>{0.1, 0.2}));
   EXPECT_EQ(legs_->trunk_quat, r.quat);
+}
+
+// Where the cycle measured the joints, the legs are posed there: the physics
+// the fitness walk reads is where the joints are, not where they were sent.
+TEST_F(BalancedGaitSourceTest, TheLegsArePosedWhereTheJointsWereMeasured) {
+  const ImuReading r = pitched(0.1, 0.01);
+  const std::array<double, 2> measured{0.15, 0.25};
+  source_.sense(Sensors{&r, measured});
+  (void)sampled(source_);
+  EXPECT_EQ(legs_->posed, (std::vector<double>{0.15, 0.25}));
 }
 
 TEST_F(BalancedGaitSourceTest, TheTiltRateIsTakenBetweenNewReadingsOnly) {
@@ -135,7 +145,7 @@ TEST(BalancedGaitSource, WithoutLegsTheCurvesPlayAsTheyAre) {
   BalancedGaitSource source(std::make_unique<StillGait>(), gains(), 2);
   EXPECT_FALSE(source.has_legs());
   const ImuReading r = pitched(0.1, 0.01);
-  source.sense(Sensors{&r});
+  source.sense(Sensors{&r, {}});
   EXPECT_EQ(sampled(source), (std::array<double, 2>{0.1, 0.2}));
 }
 

@@ -4,6 +4,8 @@
 // as the fitness walk adds it (apply_balance, leg_model.hpp). The trunk's
 // attitude comes from the cycle's IMU through sense(); the tilt's rate is
 // the difference between successive readings over the time between them.
+// The legs are posed at the joints' measured positions when the cycle gives
+// them (as the fitness walk reads its physics), else at the curves' targets.
 // While the IMU is silent the reflex holds its last tilt and rate, so the
 // stretch does not jump; held cycles are counted. The legs come from the
 // figure's model (attach()); without them the gait plays as its curves.
@@ -48,6 +50,8 @@ class BalancedGaitSource final : public MotionSource {
   double last_time_s_ = 0.0;
   std::uint64_t readings_ = 0;
   std::uint64_t held_ = 0;
+  std::vector<double> measured_;  // the joints' last measured positions
+  bool measured_known_ = false;
   // Scratch for sample(), which is const: the curves' targets before the reflex.
   mutable std::vector<double> curves_;
   mutable std::vector<double> scratch_;
