@@ -17,7 +17,7 @@ grep -q '^balance:' "$gait" || fail "the fixture has no balance"
 grep -v '^balance:' "$gait" > "$tmp/plain.yaml"
 robot() {  # $1 gait file, $2 "imu" (with the tilt watch) or not
   local watch=""
-  [[ $2 == imu ]] && watch="\\n  tilt_limit_deg: 40\\n  tilt_time_s: 0.1\\n  on_tilt: hold"
+  [[ $2 == imu ]] && watch="\\n  tilt_limit_deg: 40\\n  tilt_time_s: 0.1\\n  on_tilt: hold\\n  tilt_hold_s: 0.2"
   sed -e "s#file: ../gaits/horse_walk.yaml.*#file: $1#" \
     -e "s#start_ramp_s: 2.0 #start_ramp_s: 1.0 #" -e "s#^safety:\$#safety:$watch#" \
     -e "s#^model: ../models/horse.xml#model: $root/configs/models/horse.xml#" \
