@@ -126,8 +126,7 @@ void MujocoJointPhysics::reach(int party, Nanos now) {
 void MujocoJointPhysics::step() {
   mj_step(model_.get(), data_.get());
   ++steps_;
-  if (torso_history_.empty()) torso_history_.resize(kTorsoHistory);
-  torso_history_[steps_ % kTorsoHistory] = measure_torso();
+  if (!torso_history_.empty()) torso_history_[steps_ % kTorsoHistory] = measure_torso();
   const bool fallen = has_fallen(meta_, data_.get(), standing_z_);
   if (fallen && !fallen_) {
     if (falls_ == 0) first_fall_s_ = static_cast<double>(steps_) * model_->opt.timestep;
@@ -224,6 +223,11 @@ TorsoMotion MujocoJointPhysics::torso_motion() const {
   return measure_torso();
 }
 
+void MujocoJointPhysics::keep_torso_history() {
+  std::lock_guard lock(mutex_);
+  if (torso_history_.empty()) torso_history_.resize(kTorsoHistory);
+}
+
 TorsoMotion MujocoJointPhysics::torso_motion_at(double t_s) const {
   std::unique_lock lock(mutex_);
   const double dt = model_->opt.timestep;
@@ -232,7 +236,9 @@ TorsoMotion MujocoJointPhysics::torso_motion_at(double t_s) const {
   while (steps_ < step) {
     if (party_moved_.wait_until(lock, give_up) == std::cv_status::timeout) break;
   }
-  if (step == 0 || steps_ < step || steps_ - step >= kTorsoHistory) return measure_torso();
+  if (torso_history_.empty() || step == 0 || steps_ < step || steps_ - step >= kTorsoHistory) {
+    return measure_torso();
+  }
   return torso_history_[step % kTorsoHistory];
 }
 

@@ -19,6 +19,7 @@ TEST(MujocoJointPhysics, ReportsTheTorsoAsItWasAtAnEarlierTime) {
     const JointSpec& joint = robot.config.joints[static_cast<std::size_t>(j)];
     physics.command(j, joint.home, joint.name[0] != 'r');
   }
+  physics.keep_torso_history();
   physics.advance(100'000'000);
   const sim::TorsoMotion then = physics.torso_motion();
   physics.advance(200'000'000);

@@ -103,6 +103,8 @@ class MujocoJointPhysics final : public JointPhysics {
   // there. A simulated IMU asks for its frame's time this way, so that in
   // lockstep a frame reports the same state whichever thread runs first.
   TorsoMotion torso_motion_at(double t_s) const;
+  // Keeps that history from now on (each step then also measures the torso).
+  void keep_torso_history();
   static constexpr std::size_t kTorsoHistory = 128;
 
  private:
