@@ -29,6 +29,7 @@
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
+#include "animrt/sim/mujoco/mujoco_leg_model.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "calibrate_command.hpp"
@@ -68,9 +69,20 @@ std::unique_ptr<animrt::sim::MujocoFigure> load_figure(const animrt::RobotConfig
   return std::make_unique<animrt::sim::MujocoFigure>(config.model, names, config.model_where);
 }
 
+// A gait with `balance:` plays its reflex through the legs of the robot's
+// model (the loader has made sure it names one).
+void attach_legs(animrt::LoadedRobot& robot) {
+  if (!robot.balanced) return;
+  std::vector<std::string> names;
+  for (const auto& joint : robot.config.joints) names.push_back(joint.name);
+  robot.balanced->attach(std::make_unique<animrt::sim::MujocoLegModel>(robot.config.model, names,
+                                                                       robot.config.model_where));
+}
+
 int cmd_validate(const std::string& path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
   load_figure(robot.config);
+  attach_legs(robot);
   std::size_t devices = 0;
   for (const auto& bus : robot.config.buses) devices += bus.actuators.size();
   std::cout << path << ": ok (" << robot.config.joints.size() << " joints, "
@@ -222,6 +234,7 @@ int cmd_run(const RunArgs& args) {
   const std::pair<std::string, int> dashboard_at =
       address.at.value_or(std::pair<std::string, int>{});
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
+  attach_legs(robot);
   // The figure the dashboard draws: the robot file's model, or else the physics model.
   std::unique_ptr<animrt::sim::MujocoFigure> figure_model = load_figure(robot.config);
   if (!figure_model && !args.physics.empty() && !args.dashboard.empty()) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "animrt/bridge/protocol.hpp"
+#include "animrt/controllers/gait/balanced_gait_source.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/error.hpp"
@@ -25,13 +26,36 @@ std::string at(const Location& where) {
   return text;
 }
 
+// A gait with `balance:` plays its reflex on the trunk's IMU (the first of
+// imus:) through the legs of the figure's model (model:): without either it
+// would not be the walk that was scored, so it is refused before anything moves.
+void check_balance(const GaitBalance& balance, const RobotConfig& config) {
+  if (config.imus.empty()) {
+    throw InputError(balance.where, "balance",
+                     "this gait balances on the trunk's attitude, and " + config.file +
+                         " has no IMU: give it one under imus: (the first is the trunk's), or "
+                         "remove balance");
+  }
+  if (config.model.empty()) {
+    throw InputError(balance.where, "balance",
+                     "this gait stretches the legs through the figure's model, and " + config.file +
+                         " names none: give it model: (the figure's MJCF), or remove balance");
+  }
+}
+
 std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const RobotConfig& config,
                                           MotionCheck::Speeds& speeds) {
   const std::vector<JointSpec>& joints = config.joints;
   if (motion.type == "layers") {
     std::vector<std::unique_ptr<MotionSource>> layers;
-    for (const MotionConfig& layer : motion.layers)
+    for (const MotionConfig& layer : motion.layers) {
       layers.push_back(make_source(layer, config, speeds));
+      if (dynamic_cast<BalancedGaitSource*>(layers.back().get())) {
+        throw InputError(layer.where, layer.key,
+                         "a gait with balance: stretches the legs under the whole figure and "
+                         "plays on its own, not as a layer");
+      }
+    }
     return make_layered_source(std::move(layers));
   }
   if (motion.type == "show") {
@@ -55,19 +79,12 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
     std::unique_ptr<MotionSource> source;
     if (motion.type == "gait") {
       gait = std::make_unique<GaitFile>(load_gait_file(motion.file));
-      if (gait->balance) {
-        // Played without its reflex the gait would not be the walk it was
-        // made for: refused before anything moves.
-        // The cycle reads the trunk's attitude (imus:), but the reflex also
-        // needs each leg's ground contact and its Jacobian, which the
-        // runtime does not have.
-        throw InputError(gait->balance->where, "balance",
-                         "this gait balances through the trunk's attitude and its legs' ground "
-                         "contact; the runtime reads the attitude (imus:) but does not play the "
-                         "reflex yet; walk it with `animrt gait measure --physics` or remove "
-                         "balance");
-      }
+      if (gait->balance) check_balance(*gait->balance, config);
       source = make_gait_source(*gait, joints);
+      if (gait->balance) {
+        source =
+            std::make_unique<BalancedGaitSource>(std::move(source), *gait->balance, joints.size());
+      }
     } else {
       source = head::make_head_source(*motion.head, joints);
     }
@@ -188,6 +205,7 @@ LoadedRobot load_robot(const std::string& path) {
   robot.motion = make_source(robot.config.motion, robot.config, speeds);
   note_read_budget(robot);
   note_servo_speeds(robot, speeds);
+  robot.balanced = dynamic_cast<BalancedGaitSource*>(robot.motion.get());
   if (robot.config.motion.type == "gait") {
     robot.steering = load_gait_file(robot.config.motion.file).steering;
   }

@@ -470,6 +470,7 @@ struct CycleStages {
   static void sample_motion(const RobotModel& model, MotionSource& motion, CycleState& s,
                             double t) {
     std::copy(model.home.begin(), model.home.end(), s.targets_.begin());
+    s.sensors_.positions = s.measured_;
     motion.sense(s.sensors_);
     motion.sample(t - s.motion_start_, s.targets_);
     bool bad = false;

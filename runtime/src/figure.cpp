@@ -20,7 +20,10 @@ void collect_shows(const MotionConfig& motion, std::vector<std::string>& out) {
 }  // namespace
 
 Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& options)
-    : steering_(std::move(robot.steering)), backend_(backend), lockstep_(options.lockstep) {
+    : steering_(std::move(robot.steering)),
+      balanced_(robot.balanced),
+      backend_(backend),
+      lockstep_(options.lockstep) {
   // Every refusal comes before the first device starts.
   if (lockstep_ && !backend_.keeps_run_clock()) {
     throw std::invalid_argument(
@@ -123,6 +126,12 @@ DashboardServer& Figure::serve_dashboard(DashboardSetup setup, RunControls& cont
 }
 
 RunSummary Figure::run(const RunOptions& options) {
+  // Its curves alone are not the walk that was scored: refused before anything moves.
+  if (balanced_ && !balanced_->has_legs()) {
+    throw InputError(balanced_->gains().where, "balance",
+                     "the gait's reflex has no legs: build them from the robot's model "
+                     "(BalancedGaitSource::attach) before the run");
+  }
   RunOptions run = options;
   run.on_motion_start = [this, start = options.on_motion_start](Nanos t0) {
     for (auto& player : audio_) player->start(t0);

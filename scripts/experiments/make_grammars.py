@@ -421,8 +421,8 @@ HORSE_WALK_COMMENT = """# The horse's seed walk (horse_seed.yaml) for the runtim
 HORSE_BALANCE_COMMENT = """# The horse's seed walk (horse_seed.yaml) with the balance reflex: each leg
 # on the ground stretches along the trunk's vertical by 0.3 m per unit of sine
 # of its side's or end's tilt and 0.1 m per unit per second of its rate (docs/evolve.md,
-# "A balance reflex"). Walks in `animrt evolve` and `animrt gait measure`;
-# the runtime refuses it until it can read the trunk's attitude.
+# "A balance reflex"). Walks in `animrt evolve`, `animrt gait measure`, and
+# `animrt run` on a robot with an IMU (imus:) and a model (model:).
 # Written by scripts/experiments/make_grammars.py."""
 
 HORSE_BALANCE = "\nbalance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}\n"

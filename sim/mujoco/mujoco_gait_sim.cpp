@@ -11,6 +11,7 @@
 #include "animrt/controllers/gait/balance_reflex.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
+#include "animrt/sim/mujoco/mujoco_leg_model.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
 namespace animrt::sim {
@@ -28,78 +29,30 @@ int root_qpos(const mjModel* m, int torso) {
   return (j >= 0 && m->jnt_type[j] == mjJNT_FREE) ? m->jnt_qposadr[j] : -1;
 }
 
-// The gait's balance reflex (balance_reflex.hpp) on the physics: measures
-// the trunk's tilt and which feet touch something, and turns each leg's
-// stretch into actuator targets through the foot's Jacobian along the
-// trunk's vertical.
+// The gait's balance reflex (balance_reflex.hpp) on the physics: the trunk's
+// tilt and the legs (which feet touch something, their Jacobians along the
+// trunk's vertical) measured on the walk's data, the stretch added to the
+// actuator targets by the same apply_balance() the runtime plays.
 class LegBalance {
  public:
   LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains)
-      : mm_(mm), reflex_(gains), jacp_(3 * static_cast<std::size_t>(mm.model->nv)) {
-    const mjModel* m = mm.model.get();
-    const double* r = d->xmat + 9 * mm.torso_body;  // row-major: world = r * body
-    const double* c = d->xpos + 3 * mm.torso_body;
-    for (int g : mm.foot_geoms) {
-      Leg leg;
-      leg.geom = g;
-      const double w[3] = {d->geom_xpos[3 * g] - c[0], d->geom_xpos[3 * g + 1] - c[1],
-                           d->geom_xpos[3 * g + 2] - c[2]};
-      leg.where.front = (r[0] * w[0] + r[3] * w[1] + r[6] * w[2]) > 0 ? 1.0 : -1.0;
-      leg.where.left = (r[1] * w[0] + r[4] * w[1] + r[7] * w[2]) > 0 ? 1.0 : -1.0;
-      for (int b = m->geom_bodyid[g]; b > 0 && b != mm.torso_body; b = m->body_parentid[b]) {
-        for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j) {
-          const char* name = mj_id2name(m, mjOBJ_JOINT, j);
-          const int a = name ? mm.actuator_of(name) : -1;
-          if (a >= 0) leg.actuators.push_back(a);
-        }
-      }
-      if (!leg.actuators.empty()) legs_.push_back(std::move(leg));
-    }
-  }
+      : mm_(mm), reflex_(gains), legs_(mm, d), scratch_(2 * legs_.max_leg_joints(), 0.0) {}
 
   // Adds the reflex to the actuator targets already in d->ctrl.
   void apply(mjData* d, double dt) {
-    const mjModel* m = mm_.model.get();
-    const int nv = m->nv;
     const double* r = d->xmat + 9 * mm_.torso_body;
     // World z of the trunk's forward and left axes.
     reflex_.update(TrunkTilt{r[6], r[7]}, dt);
-    for (const Leg& leg : legs_) {
-      const bool on_ground = touches(d, leg.geom);
-      if (!on_ground) continue;
-      const double stretch = reflex_.stretch(leg.where, on_ground);
-      mj_jac(m, d, jacp_.data(), nullptr, d->geom_xpos + 3 * leg.geom, m->geom_bodyid[leg.geom]);
-      // How far the foot moves down the trunk's vertical per radian of each joint.
-      down_per_rad_.assign(leg.actuators.size(), 0.0);
-      for (std::size_t i = 0; i < leg.actuators.size(); ++i) {
-        const int dof = mm_.actuator_dof[static_cast<std::size_t>(leg.actuators[i])];
-        down_per_rad_[i] =
-            -(r[2] * jacp_[dof] + r[5] * jacp_[nv + dof] + r[8] * jacp_[2 * nv + dof]);
-      }
-      delta_.assign(leg.actuators.size(), 0.0);
-      if (!leg_stretch_to_joints(stretch, down_per_rad_, delta_)) continue;
-      for (std::size_t i = 0; i < leg.actuators.size(); ++i) d->ctrl[leg.actuators[i]] += delta_[i];
-    }
+    legs_.pose({}, {});
+    apply_balance(reflex_, legs_,
+                  std::span<double>(d->ctrl, static_cast<std::size_t>(mm_.model->nu)), scratch_);
   }
 
  private:
-  static bool touches(const mjData* d, int geom) {
-    for (int c = 0; c < d->ncon; ++c) {
-      if (d->contact[c].geom1 == geom || d->contact[c].geom2 == geom) return true;
-    }
-    return false;
-  }
-  struct Leg {
-    int geom = -1;
-    BalanceLeg where;
-    std::vector<int> actuators;  // of the joints between the trunk and the foot
-  };
   const MujocoModel& mm_;
   BalanceReflex reflex_;
-  std::vector<Leg> legs_;
-  std::vector<double> jacp_;
-  std::vector<double> down_per_rad_;
-  std::vector<double> delta_;
+  MujocoLegModel legs_;
+  std::vector<double> scratch_;
 };
 
 }  // namespace

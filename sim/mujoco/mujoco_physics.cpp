@@ -67,8 +67,11 @@ int MujocoJointPhysics::joint_index(const std::string& joint) const {
 }
 
 void MujocoJointPhysics::advance(Nanos now) {
-  std::lock_guard lock(mutex_);
-  step_towards(now);
+  {
+    std::lock_guard lock(mutex_);
+    step_towards(now);
+  }
+  party_moved_.notify_all();
 }
 
 void MujocoJointPhysics::step_towards(Nanos now) {
@@ -123,6 +126,7 @@ void MujocoJointPhysics::reach(int party, Nanos now) {
 void MujocoJointPhysics::step() {
   mj_step(model_.get(), data_.get());
   ++steps_;
+  if (!torso_history_.empty()) torso_history_[steps_ % kTorsoHistory] = measure_torso();
   const bool fallen = has_fallen(meta_, data_.get(), standing_z_);
   if (fallen && !fallen_) {
     if (falls_ == 0) first_fall_s_ = static_cast<double>(steps_) * model_->opt.timestep;
@@ -216,6 +220,29 @@ TorsoPose MujocoJointPhysics::torso_pose() const {
 
 TorsoMotion MujocoJointPhysics::torso_motion() const {
   std::lock_guard lock(mutex_);
+  return measure_torso();
+}
+
+void MujocoJointPhysics::keep_torso_history() {
+  std::lock_guard lock(mutex_);
+  if (torso_history_.empty()) torso_history_.resize(kTorsoHistory);
+}
+
+TorsoMotion MujocoJointPhysics::torso_motion_at(double t_s) const {
+  std::unique_lock lock(mutex_);
+  const double dt = model_->opt.timestep;
+  const auto step = static_cast<std::uint64_t>(std::max(0.0, std::floor(t_s / dt + 1e-9)));
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::nanoseconds(lockstep_wait_);
+  while (steps_ < step) {
+    if (party_moved_.wait_until(lock, give_up) == std::cv_status::timeout) break;
+  }
+  if (torso_history_.empty() || step == 0 || steps_ < step || steps_ - step >= kTorsoHistory) {
+    return measure_torso();
+  }
+  return torso_history_[step % kTorsoHistory];
+}
+
+TorsoMotion MujocoJointPhysics::measure_torso() const {
   const mjModel* m = model_.get();
   mjData* d = data_.get();
   const int torso = meta_.torso_body;

@@ -73,8 +73,12 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
     sim::TrunkProvider trunk = sim::scripted_trunk(imu.sim_push);
     std::string source = imu.sim_push.on ? "pushed over by the robot file's script" : "level";
     if (own_physics_) {
-      trunk = [physics = own_physics_.get()](double) {
-        const sim::TorsoMotion torso = physics->torso_motion();
+      // A frame reports the torso one report period before it is sent: the
+      // physics has got there by then at any loop rate from the part's up,
+      // so a lockstep run reads the same frames whichever thread runs first.
+      own_physics_->keep_torso_history();
+      trunk = [physics = own_physics_.get(), period = 1.0 / imu.rate_hz](double t) {
+        const sim::TorsoMotion torso = physics->torso_motion_at(t - period);
         return sim::TrunkState{torso.quat, torso.accel_m_s2};
       };
       source = "on the physics' torso";

@@ -78,16 +78,27 @@ TEST_F(MotionCheckTest, ShippedWalkPasses) {
 }
 
 // A gait made with the balance reflex was scored with it, and the runtime
-// does not play the reflex: refused at its balance key.
-TEST_F(MotionCheckTest, AGaitWithTheBalanceReflexIsRefused) {
+// plays the reflex on the trunk's IMU: a robot without one is refused at the
+// gait's balance key, naming the robot file; with one it loads as a balanced
+// gait that wants the figure's legs.
+TEST_F(MotionCheckTest, AGaitWithTheBalanceReflexNeedsAnImu) {
   const std::string text = gait_text_ + "balance: {tilt_m: 0.3, tilt_rate_m_s: 0.1}\n";
   write_file(dir_ / "gaits" / "walk.yaml", text);
   const std::string e = error();
   EXPECT_NE(e.find(gait() + ":" + std::to_string(line_of(text, "balance:")) + ":"),
             std::string::npos)
       << e;
-  EXPECT_NE(e.find("balance: this gait balances through the trunk's attitude"), std::string::npos)
+  EXPECT_NE(e.find("balance: this gait balances on the trunk's attitude, and " + robot() +
+                   " has no IMU: give it one under imus:"),
+            std::string::npos)
       << e;
+
+  write_file(robot(), robot_text_ + "imus:\n  - {name: trunk, protocol: bno08x_rvc}\n");
+  const LoadedRobot loaded = load_robot(robot());
+  ASSERT_NE(loaded.balanced, nullptr);
+  EXPECT_EQ(loaded.balanced, loaded.motion.get());
+  EXPECT_FALSE(loaded.balanced->has_legs());
+  EXPECT_EQ(loaded.balanced->gains().tilt_m, 0.3);
 }
 
 TEST_F(MotionCheckTest, NotFiniteLaterInTheRunIsRejected) {

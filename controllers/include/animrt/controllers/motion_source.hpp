@@ -45,6 +45,9 @@ struct Sensors {
   // The trunk's IMU (the robot file's first), null when the figure has none
   // or its reading is stale.
   const ImuReading* imu = nullptr;
+  // The joints' measured positions (rad, or m), indexed by robot joint; empty
+  // when not known. A joint whose bus was late keeps its last measurement.
+  std::span<const double> positions;
 };
 
 // The run's clock, handed to a source when its motion starts: CLOCK_MONOTONIC

@@ -80,6 +80,7 @@ class Figure {
  private:
   RobotConfig config_;
   std::optional<GaitSteering> steering_;
+  const BalancedGaitSource* balanced_ = nullptr;  // a gait with balance:, or null
   ShowPosition show_;
   FigureBackend& backend_;
   bool lockstep_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/gait/balanced_gait_source.hpp"
 #include "animrt/controllers/gait/gait_steering.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/runtime/robot_config.hpp"
@@ -22,6 +23,10 @@ struct LoadedRobot {
   // faster than its servos turn, a bus whose answers come back too late):
   // one line each, with the numbers.
   std::vector<std::string> warnings;
+  // The motion when it is a gait with `balance:` (null otherwise): it plays
+  // its reflex once given the figure's legs (BalancedGaitSource::attach),
+  // which the caller builds from the robot's model.
+  BalancedGaitSource* balanced = nullptr;
 };
 
 // Loads the robot file and its motion source. Throws InputError on the first

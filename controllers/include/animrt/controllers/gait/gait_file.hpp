@@ -59,8 +59,8 @@ constexpr double kMaxBalanceStretchM = 0.1;
 // roll for left and right, of the pitch for front and back) and d' its rate,
 // so the low side is pushed back up and a swaying trunk is damped. The law
 // is BalanceReflex (balance_reflex.hpp). It needs the trunk's attitude, which
-// the fitness walk and `gait measure` read from the physics; the runtime has
-// no attitude input yet and refuses such a gait.
+// the fitness walk and `gait measure` read from the physics and the runtime
+// from the robot's IMU (BalancedGaitSource), and the legs (LegModel).
 struct GaitBalance {
   double tilt_m = 0.0;         // m of leg length per unit of tilt sine
   double tilt_rate_m_s = 0.0;  // m of leg length per unit of tilt sine per second

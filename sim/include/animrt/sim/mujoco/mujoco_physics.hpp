@@ -44,11 +44,11 @@ struct PhysicsMeasures {
   double forward_m = 0.0;    // torso's +x displacement since the start
   double sideways_m = 0.0;   // torso's +y displacement since the start
   // The motion proper, between mark_motion_start() and mark_motion_end():
-  double motion_s = 0.0;          // physics time between the marks (0: not marked)
-  double motion_forward_m = 0.0;  // torso's +x displacement between them
-  int falls = 0;                  // times the figure went from upright to fallen
-  double first_fall_s = -1.0;     // simulated time of the first fall, -1 if none
-  bool fallen = false;            // fallen at the end
+  double motion_s = 0.0;             // physics time between the marks (0: not marked)
+  double motion_forward_m = 0.0;     // torso's +x displacement between them
+  int falls = 0;                     // times the figure went from upright to fallen
+  double first_fall_s = -1.0;        // simulated time of the first fall, -1 if none
+  bool fallen = false;               // fallen at the end
   int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
 };
 
@@ -97,9 +97,19 @@ class MujocoJointPhysics final : public JointPhysics {
   PhysicsMeasures measures() const;
   TorsoPose torso_pose() const;
   TorsoMotion torso_motion() const;
+  // The torso's motion as it was at physics time `t_s` (the newest step at
+  // or before it, from a history of the last kTorsoHistory steps), waiting
+  // (wall time, as long as a lockstep party waits) for the physics to get
+  // there. A simulated IMU asks for its frame's time this way, so that in
+  // lockstep a frame reports the same state whichever thread runs first.
+  TorsoMotion torso_motion_at(double t_s) const;
+  // Keeps that history from now on (each step then also measures the torso).
+  void keep_torso_history();
+  static constexpr std::size_t kTorsoHistory = 128;
 
  private:
-  void step();  // one mj_step and the fall watch; mutex held
+  void step();  // one mj_step, the fall watch and the torso's history; mutex held
+  TorsoMotion measure_torso() const;  // mutex held
   // Steps on to `now`, never past a lockstep party's time; mutex held.
   void step_towards(Nanos now);
   Nanos slowest_party() const;  // mutex held; the largest Nanos without parties
@@ -118,7 +128,7 @@ class MujocoJointPhysics final : public JointPhysics {
   double yaw0_ = 0.0;
 
   mutable std::mutex mutex_;
-  std::condition_variable party_moved_;
+  mutable std::condition_variable party_moved_;
   struct Party {
     Nanos time = 0;
     bool waited_for = true;  // false: left, or passed over after a wait timed out
@@ -127,6 +137,7 @@ class MujocoJointPhysics final : public JointPhysics {
   Nanos lockstep_wait_ = kDefaultLockstepWait;
   int waits_timed_out_ = 0;
   std::uint64_t steps_ = 0;
+  std::vector<TorsoMotion> torso_history_;  // by step % kTorsoHistory
   int falls_ = 0;
   double first_fall_s_ = -1.0;
   bool fallen_ = false;
