@@ -12,7 +12,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "passage.hpp"
+#include "animrt/controllers/herd/passage.hpp"
 
 namespace animrt::herd {
 namespace {
@@ -229,7 +229,10 @@ Vec2 Crowd::planned_velocity(int i, bool unstick) const {
   // is lost unless the figures walk it.
   Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
   const Vec2 want = NavWorld::from_recast(ag->dvel);
-  if (!unstick || norm(v) >= 0.2 * norm(want)) return v;
+  // A step too short for the figure to walk (under half its slowest walk,
+  // as a collision push often is) leaves it standing just as well.
+  const double walkable = 0.5 * params_.figure_start_speed_m_s;
+  if (!unstick || (norm(v) >= 0.2 * norm(want) && norm(v) >= walkable)) return v;
   // Stalled: agents resting exactly at contact make every sampled velocity
   // look like a collision but standing still, so they would never move
   // again. Follow the path instead, less any part that closes on a

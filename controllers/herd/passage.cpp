@@ -1,4 +1,4 @@
-#include "passage.hpp"
+#include "animrt/controllers/herd/passage.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -128,7 +128,7 @@ void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agent
     // passage (figures coming out keep to their own right, the other side).
     const Vec2 way = u * dir, right{way.y, -way.x};
     held_[i] = 1;
-    hold_[i] = p.centre - way * (hl + 2.0 + avoid_radius_) + right * (hw + 1.5);
+    hold_[i] = p.centre - way * (hl + 3.0 + avoid_radius_) + right * (hw + 2.5);
   }
 }
 
