@@ -204,11 +204,11 @@ Vec2 Crowd::passage_wait(int i, Vec2 v, std::span<const Agent> agents) const {
   const auto k = static_cast<std::size_t>(i);
   if (!passages_ || !was_held_[k]) return v;
   const Agent& a = agents[k];
-  if (norm(a.position - hold_at_[k]) < kWaitRadius) return {};
+  const double here = norm(a.position - hold_at_[k]);
+  if (here < kWaitRadius) return {};
   // A queue: standing where it meets a waiting figure that stands nearer
   // the place (only near it: elsewhere the figures it meets may be in the
   // way out, and standing for each other they would never leave).
-  const double here = norm(a.position - hold_at_[k]);
   if (here > kQueueReach) return v;
   const dtCrowdAgent* ag = crowd_->getAgent(i);
   for (int n = 0; n < ag->nneis; ++n) {
