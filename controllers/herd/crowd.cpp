@@ -12,12 +12,17 @@
 #include <random>
 #include <stdexcept>
 
+#include "animrt/controllers/herd/passage.hpp"
+
 namespace animrt::herd {
 namespace {
 
 constexpr double kPassiveSpeed =
     10.0;  // passive agents are moved by velocity requests, never limited
 constexpr double kResnapDistance = 0.5;  // a figure this far from its crowd agent is placed afresh
+constexpr double kWaitRadius = 1.0;  // a figure waiting for a passage stands this near its place
+constexpr double kQueueGap = 0.3;    // or this near another that stands waiting there
+constexpr double kQueueReach = 2.5;  // within this of its place
 
 // A uniform draw in [0, 1) from the top 53 bits: the same numbers on every
 // standard library, unlike std::uniform_real_distribution.
@@ -49,6 +54,17 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   has_target_.assign(agents.size(), false);
   target_.assign(agents.size(), Vec2{});
   synced_.assign(agents.size(), Vec2{});
+  asking_.assign(agents.size(), false);
+  was_held_.assign(agents.size(), 0);
+  hold_at_.assign(agents.size(), Vec2{});
+  if (params_.passage_width_radii > 0.0) {
+    PassageParams pp;
+    pp.max_width_radii = params_.passage_width_radii;
+    pp.max_hold_s = params_.passage_max_hold_s;
+    passages_ = std::make_unique<PassageRules>(world_.config().walls,
+                                               rmax + params_.avoidance_margin_m, pp);
+    if (passages_->empty()) passages_.reset();
+  }
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const double r = agents[i].radius + params_.avoidance_margin_m;
     dtCrowdAgentParams ap{};
@@ -132,7 +148,11 @@ void Crowd::sync(int i, const Agent& a) {
     ag->state = DT_CROWDAGENT_STATE_WALKING;
     dtVcopy(ag->npos, nearest);
     if (active_[static_cast<std::size_t>(i)] && has_target_[static_cast<std::size_t>(i)]) {
-      request_target(i, target_[static_cast<std::size_t>(i)]);
+      if (was_held_[static_cast<std::size_t>(i)]) {
+        retarget(i, hold_at_[static_cast<std::size_t>(i)]);
+      } else {
+        request_target(i, target_[static_cast<std::size_t>(i)]);
+      }
     }
   }
   const auto v = NavWorld::to_recast(a.velocity());
@@ -150,8 +170,55 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     sync(static_cast<int>(i), agents[i]);
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
+  if (passages_) apply_passages(t, agents);
   crowd_->update(static_cast<float>(dt), nullptr);
   dt_ = dt;
+}
+
+bool Crowd::retarget(int i, Vec2 target) {
+  const auto p = NavWorld::to_recast(target);
+  const float ext[3] = {1.0f, 2.0f, 1.0f};
+  dtPolyRef ref = 0;
+  float nearest[3];
+  world_.query()->findNearestPoly(p.data(), ext, &world_.filter(), &ref, nearest);
+  return ref && crowd_->requestMoveTarget(i, ref, nearest);
+}
+
+void Crowd::apply_passages(double t, std::span<const Agent> agents) {
+  for (std::size_t i = 0; i < agents.size(); ++i) asking_[i] = active_[i] && has_target_[i];
+  passages_->update(t, agents, target_, asking_);
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const int k = static_cast<int>(i);
+    const char held = passages_->held(k) ? 1 : 0;
+    if (held && (!was_held_[i] || norm(passages_->hold_point(k) - hold_at_[i]) > 1e-9)) {
+      retarget(k, passages_->hold_point(k));
+      hold_at_[i] = passages_->hold_point(k);
+    } else if (!held && was_held_[i] && has_target_[i]) {
+      retarget(k, target_[i]);
+    }
+    was_held_[i] = held;
+  }
+}
+
+Vec2 Crowd::passage_wait(int i, Vec2 v, std::span<const Agent> agents) const {
+  const auto k = static_cast<std::size_t>(i);
+  if (!passages_ || !was_held_[k]) return v;
+  const Agent& a = agents[k];
+  const double here = norm(a.position - hold_at_[k]);
+  if (here < kWaitRadius) return {};
+  // A queue: standing where it meets a waiting figure that stands nearer
+  // the place (only near it: elsewhere the figures it meets may be in the
+  // way out, and standing for each other they would never leave).
+  if (here > kQueueReach) return v;
+  const dtCrowdAgent* ag = crowd_->getAgent(i);
+  for (int n = 0; n < ag->nneis; ++n) {
+    const auto j = static_cast<std::size_t>(ag->neis[n].idx);
+    const Agent& b = agents[j];
+    if (!was_held_[j] || b.speed != 0.0 || norm(hold_at_[j] - hold_at_[k]) > 1e-9) continue;
+    if (norm(b.position - hold_at_[k]) >= here) continue;
+    if (norm(b.position - a.position) < a.radius + b.radius + kQueueGap) return {};
+  }
+  return v;
 }
 
 Vec2 Crowd::planned_velocity(int i, bool unstick) const {
@@ -162,7 +229,10 @@ Vec2 Crowd::planned_velocity(int i, bool unstick) const {
   // is lost unless the figures walk it.
   Vec2 v = (NavWorld::from_recast(ag->npos) - synced_[static_cast<std::size_t>(i)]) / dt_;
   const Vec2 want = NavWorld::from_recast(ag->dvel);
-  if (!unstick || norm(v) >= 0.2 * norm(want)) return v;
+  // A step too short for the figure to walk (under half its slowest walk,
+  // as a collision push often is) leaves it standing just as well.
+  const double walkable = 0.5 * params_.figure_start_speed_m_s;
+  if (!unstick || (norm(v) >= 0.2 * norm(want) && norm(v) >= walkable)) return v;
   // Stalled: agents resting exactly at contact make every sampled velocity
   // look like a collision but standing still, so they would never move
   // again. Follow the path instead, less any part that closes on a
@@ -464,14 +534,17 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
             ? Vec2{}
             : crowd_.safe_velocity(
                   m,
-                  crowd_.keep_right(
+                  crowd_.passage_wait(
                       m,
-                      crowd_.planned_velocity(
-                          m, crowd_.params().unstick &&
-                                 (norm(agents[static_cast<std::size_t>(m)].position - target) <
-                                      assign_distance_ ||
-                                  (crowd_.params().unstick_after_s > 0.0 &&
-                                   t - stall_since_[k] >= crowd_.params().unstick_after_s))),
+                      crowd_.keep_right(
+                          m,
+                          crowd_.planned_velocity(
+                              m, crowd_.params().unstick &&
+                                     (norm(agents[static_cast<std::size_t>(m)].position - target) <
+                                          assign_distance_ ||
+                                      (crowd_.params().unstick_after_s > 0.0 &&
+                                       t - stall_since_[k] >= crowd_.params().unstick_after_s))),
+                          agents),
                       agents),
                   agents);
   }

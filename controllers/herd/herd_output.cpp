@@ -34,6 +34,85 @@ constexpr double kPixelsPerMetre = 25.0;
 double to_x(double x, const Rect& r) { return (x - r.xmin) * kPixelsPerMetre; }
 double to_y(double y, const Rect& r) { return (r.ymax - y) * kPixelsPerMetre; }  // y up on screen
 
+std::string xml_text(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+std::string path_data(const std::vector<Vec2>& points, const Rect& r) {
+  std::string d;
+  for (const Vec2& p : points) {
+    d += fmt::format("{}{:.2f},{:.2f} ", d.empty() ? "M" : "L", to_x(p.x, r), to_y(p.y, r));
+  }
+  return d;
+}
+
+// The longest of 1, 2, 5, 10, 20, ... m that fits a fifth of the width.
+double scale_length(double width_m) {
+  double len = 1.0;
+  for (double m = 1.0; m <= width_m / 5; m *= 10) {
+    for (double f : {1.0, 2.0, 5.0}) {
+      if (f * m <= width_m / 5) len = f * m;
+    }
+  }
+  return len;
+}
+
+void write_scale_bar(std::ostream& out, const Rect& r) {
+  const double len = scale_length(r.xmax - r.xmin);
+  const double h = (r.ymax - r.ymin) * kPixelsPerMetre, x0 = 10, y0 = h - 12;
+  const double x1 = x0 + len * kPixelsPerMetre;
+  out << fmt::format(
+      "<g class=\"scale\"><path d=\"M{0:.1f},{1:.1f} V{2:.1f} H{3:.1f} V{1:.1f}\" "
+      "fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/><text x=\"{4:.1f}\" y=\"{5:.1f}\" "
+      "font-family=\"sans-serif\" font-size=\"11\" text-anchor=\"middle\">{6} m</text></g>\n",
+      x0, y0 - 5, y0, x1, (x0 + x1) / 2, y0 - 4, len);
+}
+
+void write_legend(std::ostream& out, const HerdScene& scene, bool has_leader) {
+  const double row = 15, x = 8, y = 8;
+  const std::size_t n = scene.groups.size() + 1 + (has_leader ? 1 : 0);
+  out << fmt::format(
+      "<g class=\"legend\" font-family=\"sans-serif\" font-size=\"11\"><rect x=\"{}\" "
+      "y=\"{}\" width=\"230\" height=\"{:.0f}\" fill=\"#fff\" fill-opacity=\"0.85\" "
+      "stroke=\"#999\"/>\n",
+      x, y, row * static_cast<double>(n) + 6);
+  double ty = y + row;
+  for (std::size_t g = 0; g < scene.groups.size(); ++g, ty += row) {
+    const GroupSpec& spec = scene.groups[g];
+    const char* kind = spec.kind == GroupKind::crowd   ? "crowd"
+                       : spec.kind == GroupKind::unity ? "unity flock"
+                                                       : "reynolds flock";
+    out << fmt::format(
+        "<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"5\" fill=\"{}\"/><text x=\"{:.1f}\" "
+        "y=\"{:.1f}\">{} ({}, {} figures)</text>\n",
+        x + 12, ty - 4, group_colour(static_cast<int>(g)), x + 24, ty, xml_text(spec.name), kind,
+        spec.count);
+  }
+  out << fmt::format(
+      "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"7\" height=\"7\" fill=\"none\" "
+      "stroke=\"#000\"/><text x=\"{:.1f}\" y=\"{:.1f}\">start, trail, end; ring: target</text>\n",
+      x + 8.5, ty - 7.5, x + 24, ty);
+  if (has_leader) {
+    ty += row;
+    out << fmt::format(
+        "<path d=\"M{:.1f},{:.1f} h14\" stroke=\"#000\" stroke-width=\"2\" "
+        "stroke-dasharray=\"5 3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">leader's path</text>\n",
+        x + 5, ty - 4, x + 24, ty);
+  }
+  out << "</g>\n";
+}
+
 }  // namespace
 
 void write_csv_header(std::ostream& out) {
@@ -55,6 +134,11 @@ void TrailRecorder::sample(const Herd& herd) {
   const auto agents = herd.agents();
   trails_.resize(agents.size());
   for (std::size_t i = 0; i < agents.size(); ++i) trails_[i].push_back(agents[i].position);
+  const std::size_t groups = herd.scene().groups.size();
+  leader_trails_.resize(groups);
+  for (std::size_t g = 0; g < groups; ++g) {
+    if (const auto l = herd.leader(static_cast<int>(g))) leader_trails_[g].push_back(*l);
+  }
 }
 
 void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
@@ -91,6 +175,23 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
         "stroke-opacity=\"0.6\"/>\n",
         pts, group_colour(g));
   }
+  bool has_leader = false;
+  for (std::size_t g = 0; g < leader_trails_.size(); ++g) {
+    if (leader_trails_[g].empty()) continue;
+    has_leader = true;
+    out << fmt::format(
+        "<path class=\"leader\" d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\" "
+        "stroke-dasharray=\"5 3\"/>\n",
+        path_data(leader_trails_[g], r), group_colour(static_cast<int>(g)));
+  }
+  for (std::size_t i = 0; i < trails_.size(); ++i) {
+    if (trails_[i].empty()) continue;
+    const Vec2 p = trails_[i].front();
+    out << fmt::format(
+        "<rect class=\"start\" x=\"{:.2f}\" y=\"{:.2f}\" width=\"5\" height=\"5\" "
+        "fill=\"none\" stroke=\"{}\"/>\n",
+        to_x(p.x, r) - 2.5, to_y(p.y, r) - 2.5, group_colour(herd.agents()[i].group));
+  }
   for (std::size_t i = 0; i < herd.agents().size(); ++i) {
     const Agent& a = herd.agents()[i];
     out << fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"{:.2f}\" fill=\"{}\"/>\n",
@@ -106,6 +207,8 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
         "stroke-width=\"3\"/>\n",
         to_x(t.x, r), to_y(t.y, r), group_colour(static_cast<int>(g)));
   }
+  write_scale_bar(out, r);
+  write_legend(out, scene, has_leader);
   out << "</svg>\n";
   if (!out) throw std::runtime_error(path + ": cannot write the top view");
 }

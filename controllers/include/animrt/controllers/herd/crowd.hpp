@@ -68,9 +68,16 @@ struct CrowdParams {
   double keep_right_rad = 0.6;
   // How far ahead (m) an oncoming figure is looked for.
   double keep_right_range_m = 3.0;
+  // Right of way at narrow passages (a gap between two walls narrower than
+  // this many avoidance radii; 0: none): one way at a time, the other
+  // waits beside the mouth, and the way swaps once the waiting side has
+  // waited passage_max_hold_s (see passage.hpp).
+  double passage_width_radii = 6.5;
+  double passage_max_hold_s = 60.0;
 };
 
 class CrowdGroup;
+class PassageRules;
 
 class Crowd {
  public:
@@ -96,10 +103,15 @@ class Crowd {
   void sync(int i, const Agent& a);
   void make_active(int i, double max_speed);
   bool request_target(int i, Vec2 target);
+  bool retarget(int i, Vec2 target);  // moves the crowd's target only (target_ stays)
   void stop(int i);
   Vec2 planned_velocity(int i, bool unstick) const;
   Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
   Vec2 keep_right(int i, Vec2 v, std::span<const Agent> agents) const;
+  // A member the passage rules hold walks to its waiting place and stands
+  // there, or where it meets one already standing.
+  Vec2 passage_wait(int i, Vec2 v, std::span<const Agent> agents) const;
+  void apply_passages(double t, std::span<const Agent> agents);
 
   NavWorld& world_;
   CrowdParams params_;
@@ -108,6 +120,10 @@ class Crowd {
   std::vector<bool> has_target_;
   std::vector<Vec2> target_;
   std::vector<Vec2> synced_;  // each agent's position before the last crowd update
+  std::unique_ptr<PassageRules> passages_;
+  std::vector<bool> asking_;  // active members with a target
+  std::vector<char> was_held_;
+  std::vector<Vec2> hold_at_;  // where each held member waits
   double dt_ = 0.0;
   double last_t_ = -1e300;
   bool stepped_ = false;

@@ -20,10 +20,14 @@ class TrailRecorder {
  public:
   void sample(const Herd& herd);
   // Throws std::runtime_error when the file cannot be written.
+  // The top view: walls, obstacles, each figure's trail from a start mark
+  // (a square) to where it stands, targets (rings), each leader's path
+  // (dashed), a legend of the groups and a scale bar.
   void write_svg(const std::string& path, const Herd& herd) const;
 
  private:
-  std::vector<std::vector<Vec2>> trails_;  // per agent
+  std::vector<std::vector<Vec2>> trails_;         // per agent
+  std::vector<std::vector<Vec2>> leader_trails_;  // per group (empty without a leader)
 };
 
 // A group's order as printed: "standing" for a flock that does not keep up
