@@ -91,6 +91,11 @@ done
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --out "$tmp/two.bin" 2>&1) || fail "features of two folders: $out"
 [[ $out == *"2 inputs: 36 vertices, 50 triangles, frames 0..29"* && $out == *"clip plate_a "*"15 frames"* &&
   $out == *"clip plate_b "*"15 frames"* ]] || fail "two folders: $out"
+# Folders given with a trailing slash are named after the folder all the same.
+out=$("$animrt" seq features "$tmp/plate_a/" "$tmp/plate_b/" --out "$tmp/slash.bin" 2>&1) ||
+  fail "features of two folders with trailing slashes: $out"
+[[ $out == *"clip plate_a "*"15 frames"* && $out == *"clip plate_b "*"15 frames"* ]] ||
+  fail "trailing slash: $out"
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --clip plate_a --out "$tmp/bad.bin" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/plate_a: --clip: --clip takes one input, not 2"* ]] ||
