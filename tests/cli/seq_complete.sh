@@ -15,14 +15,24 @@ if ldd "$animrt" | grep -q torch; then fail "animrt links libtorch: $(ldd "$anim
 
 source "$(dirname "$0")/seq_data.bash"
 write_walk_csv "$tmp/walk.csv"
-out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --report-every 10 \
-  "${small[@]}" 2>&1) || fail "train failed: $out"
+train_out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --report-every 10 \
+  "${small[@]}" 2>&1) || fail "train failed: $train_out"
 
 printf 'time_s,hip,knee\n0,0.25,-0.125\n1,-0.4,0.3\n2,0.1,0.2\n' > "$tmp/keys.csv"
 out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/keys.csv" --gap 4 --out "$tmp/done.csv" 2>&1) ||
   fail "complete failed: $out"
 gap='gap 1 \(keys 1-2, 4 frames\): (merged at frame [1-4] \(output frame [1-4]\), difference [0-9.]+ %, [0-9]+ tr(y|ies)|not merged below 5 %, best difference [0-9.]+ % at frame [1-4] \(output frame [1-4]\) used, 21 tries)'
 [[ $out =~ $gap ]] || fail "no report for gap 1: $out"
+# Training ended with a held-out line; completion warns exactly when that
+# line says the model lost to linear interpolation.
+[[ $train_out =~ held\ out\ at\ iteration\ 10:\ completion\ of\ 9-frame\ gaps\ [0-9.]+\ %,\ linear\ interpolation\ [0-9.]+\ %\ \([0-9]+\ %\ (better|worse)\ than\ interpolation\) ]] ||
+  fail "no held-out line: $train_out"
+if [[ ${BASH_REMATCH[1]} == worse ]]; then
+  [[ $out == *"warning: $tmp/m.model: never measured better than linear interpolation on held-out data ("*"10 iterations); train it longer"* ]] ||
+    fail "no warning for a model worse than interpolation: $out"
+else
+  [[ $out != *warning* ]] || fail "a warning for a model better than interpolation: $out"
+fi
 [[ $out == *"gap 2 (keys 2-3, 4 frames): "* ]] || fail "no report for gap 2: $out"
 [[ $(head -1 "$tmp/done.csv") == "hip,knee" ]] || fail "header: $(head -1 "$tmp/done.csv")"
 [[ $(wc -l < "$tmp/done.csv") -eq 12 ]] || fail "$(wc -l < "$tmp/done.csv") lines, expected 1 + 11"
