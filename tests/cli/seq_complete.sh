@@ -7,6 +7,7 @@
 # one feature file of two clips, and seq evaluate on a model trained on it.
 set -uo pipefail
 animrt=$1
+root=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -125,4 +126,25 @@ out=$("$animrt" seq evaluate "$tmp/plate.model" "$tmp/b.bin" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/plate.model: template: trained on another template"* ]] ||
   fail "other template: exit $code: $out"
+
+# A show with learned in-betweens: validate warns when its model lost to
+# interpolation on held-out data, and only then.
+mkdir "$tmp/robots"
+awk 'BEGIN { print "time_s,eye_pan,eye_tilt";
+  for (f = 0; f < 60; f++) { t = f / 25; printf "%g,%g,%g\n", t, 0.3 * sin(7.85 * t), 0.2 * cos(7.85 * t) } }' \
+  > "$tmp/eyes.csv"
+train_out=$("$animrt" seq train "$tmp/eyes.csv" --out "$tmp/eyes.model" --iterations 10 "${small[@]}" 2>&1) ||
+  fail "training the eyes failed: $train_out"
+printf 'name: eyes\nlearned: {model: ../eyes.model, frame_s: 0.04}\njoints:\n  eye_pan: {interpolation: learned, keys: [[0, 0], [0.4, 10], [0.8, -10]]}\n  eye_tilt: {interpolation: learned, keys: [[0, 5], [0.4, 0], [0.8, 5]]}\n' \
+  > "$tmp/robots/eyes.yaml"
+sed -e "s#\.\./modbus/#$root/configs/modbus/#" -e '/^motion:/,$d' "$root/configs/robots/animatronic.yaml" > "$tmp/robots/r.yaml"
+printf 'motion: {type: show, file: eyes.yaml}\n' >> "$tmp/robots/r.yaml"
+out=$("$animrt" validate "$tmp/robots/r.yaml" 2>&1) || fail "validate of the learned show failed: $out"
+[[ $train_out =~ held\ out\ at\ iteration\ 10:.*\ (better|worse)\ than\ interpolation\) ]] || fail "no held-out line: $train_out"
+if [[ ${BASH_REMATCH[1]} == worse ]]; then
+  [[ $out == *"warning: $tmp/robots/../eyes.model: never measured better than linear interpolation"* ]] ||
+    fail "validate did not warn of the learned show's model: $out"
+else
+  [[ $out != *"never measured better"* ]] || fail "validate warned of a model better than interpolation: $out"
+fi
 echo ok
