@@ -46,17 +46,66 @@ struct Reader {
   }
 };
 
+// The number of connected pieces of the triangles (an unused vertex is a
+// piece of its own), as Neighbourhood counts them.
+std::uint32_t count_pieces(std::uint32_t vertices, const Triangles& triangles) {
+  std::vector<std::uint32_t> parent(vertices);
+  for (std::uint32_t i = 0; i < vertices; ++i) parent[i] = i;
+  auto root = [&parent](std::uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::uint32_t pieces = vertices;
+  for (const auto& t : triangles) {
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t a = root(static_cast<std::uint32_t>(t[k]));
+      const std::uint32_t b = root(static_cast<std::uint32_t>(t[k + 1]));
+      if (a != b) {
+        parent[a] = b;
+        --pieces;
+      }
+    }
+  }
+  return pieces;
+}
+
+void read_placement(Reader& r, const std::string& file, SequenceFeatures& out,
+                    std::uint32_t pieces) {
+  const std::uint32_t expected =
+      count_pieces(static_cast<std::uint32_t>(out.rest.cols()), out.triangles);
+  if (pieces != expected) {
+    detail::fail(file, "header",
+                 "placement of " + std::to_string(pieces) + " pieces, the triangles make " +
+                     std::to_string(expected));
+  }
+  out.placement.reserve(out.frames.size());
+  for (std::size_t f = 0; f < out.frames.size(); ++f) {
+    Eigen::Matrix3Xd p(3, 1 + pieces);
+    for (Eigen::Index i = 0; i < p.size(); ++i) p.data()[i] = r.f64_unchecked();
+    if (!p.allFinite())
+      detail::fail(file, "frame " + std::to_string(f), "a placement is not finite");
+    out.placement.push_back(std::move(p));
+  }
+}
+
 }  // namespace
 
 void write_feature_file(const std::string& file, const SequenceFeatures& f) {
   Writer w;
   w.bytes.insert(w.bytes.end(), kFeatureFileMagic, kFeatureFileMagic + 8);
-  w.u32(kFeatureFileVersion);
+  // Features without a placement (made in memory) keep the version-1 layout.
+  const bool placed = !f.placement.empty();
+  for (const auto& p : f.placement) {
+    if (f.placement.size() != f.frames.size() || p.cols() != f.placement.front().cols())
+      throw std::invalid_argument(file + ": placement does not match the frames");
+  }
+  w.u32(placed ? kFeatureFileVersion : 1);
   w.u32(static_cast<std::uint32_t>(f.vertex_count()));
   w.u32(static_cast<std::uint32_t>(f.triangles.size()));
   w.u32(static_cast<std::uint32_t>(f.frames.size()));
   w.u32(static_cast<std::uint32_t>(f.clips.size()));
   w.u32(kFeatureDims);
+  if (placed) w.u32(static_cast<std::uint32_t>(f.placement.front().cols() - 1));
   for (Eigen::Index i = 0; i < f.rest.size(); ++i) w.f64(f.rest.data()[i]);
   for (const auto& t : f.triangles) {
     for (int c : t) w.u32(static_cast<std::uint32_t>(c));
@@ -73,6 +122,9 @@ void write_feature_file(const std::string& file, const SequenceFeatures& f) {
   for (Eigen::Index i = 0; i < f.scale.high.size(); ++i) w.f64(f.scale.high.data()[i]);
   for (const auto& frame : f.frames) {
     for (Eigen::Index i = 0; i < frame.size(); ++i) w.f64(frame.data()[i]);
+  }
+  for (const auto& p : f.placement) {
+    for (Eigen::Index i = 0; i < p.size(); ++i) w.f64(p.data()[i]);
   }
   w.u32(static_cast<std::uint32_t>(crc32(0L, w.bytes.data(), static_cast<uInt>(w.bytes.size()))));
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
@@ -92,16 +144,17 @@ SequenceFeatures read_feature_file(const std::string& file) {
   }
   Reader r{in, 8};
   const std::uint32_t version = r.u32("header", "version");
-  if (version != kFeatureFileVersion) {
+  if (version != 1 && version != kFeatureFileVersion) {
     detail::fail(file, "header",
                  "feature file version " + std::to_string(version) + ", this build reads " +
-                     std::to_string(kFeatureFileVersion));
+                     std::to_string(kFeatureFileVersion) + " and 1");
   }
   const std::uint32_t v = r.u32("header", "vertex count");
   const std::uint32_t t = r.u32("header", "triangle count");
   const std::uint32_t n = r.u32("header", "frame count");
   const std::uint32_t c = r.u32("header", "clip count");
   const std::uint32_t dims = r.u32("header", "dimensions");
+  const std::uint32_t pieces = version >= 2 ? r.u32("header", "piece count") : 0;
   if (dims != kFeatureDims) {
     detail::fail(file, "header", std::to_string(dims) + " numbers per vertex, expected 9");
   }
@@ -152,7 +205,12 @@ SequenceFeatures read_feature_file(const std::string& file) {
   }
   const std::uint64_t per_frame = std::uint64_t{v} * kFeatureDims;
   in.need(r.at, 2 + std::uint64_t{n}, per_frame * 8, "header", "the normalisation and the frames");
-  if (r.at + (2 + std::uint64_t{n}) * per_frame * 8 + 4 != bytes.size()) {
+  if (pieces > v) detail::fail(file, "header", "more pieces than vertices");
+  const std::uint64_t placement_bytes =
+      version >= 2 ? std::uint64_t{n} * (1 + std::uint64_t{pieces}) * 24 : 0;
+  in.need(r.at + (2 + std::uint64_t{n}) * per_frame * 8, 1, placement_bytes, "header",
+          "the placement");
+  if (r.at + (2 + std::uint64_t{n}) * per_frame * 8 + placement_bytes + 4 != bytes.size()) {
     detail::fail(file, "header", "file length does not match its counts (trailing bytes)");
   }
   if (stored != computed) detail::fail(file, "checksum", "CRC-32 mismatch: the file is corrupt");
@@ -173,6 +231,7 @@ SequenceFeatures read_feature_file(const std::string& file) {
       detail::fail(file, "frame " + std::to_string(f), "a feature is not finite");
     out.frames.push_back(std::move(frame));
   }
+  if (version >= 2) read_placement(r, file, out, pieces);
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <queue>
 #include <stdexcept>
 
+#include "animrt/controllers/seqnet/placement.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 
 namespace animrt::seqnet {
@@ -107,6 +108,7 @@ SequenceFeatures compute_features(const MeshSequence& sequence, int first, int c
     if (exact_round_trip) gradients = solver.exact_gradients(gradients, sequence.frames[f]);
     raw.push_back(features_from_gradients(gradients, ring, previous));
     previous = raw.back();
+    out.placement.push_back(placement_of(ring, sequence.frames[f]));
   }
   out.scale = FeatureScale::fit(raw);
   for (const auto& f : raw) out.frames.push_back(out.scale.normalise(f));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
@@ -162,7 +163,7 @@ std::uint64_t connectivity_hash(int vertex_count,
 std::vector<std::uint8_t> model_file_bytes(const ModelFile& m) {
   ModelWriter w;
   w.bytes.insert(w.bytes.end(), kModelFileMagic, kModelFileMagic + 8);
-  w.u32(kModelFileVersion);
+  w.u32(m.version);
   w.u32(static_cast<std::uint32_t>(m.shape.kind));
   const NetShape& s = m.shape;
   for (int v : {s.vertex_count, s.joint_count, s.conv_layers, s.channels, s.dense_width, s.latent,
@@ -173,6 +174,11 @@ std::vector<std::uint8_t> model_file_bytes(const ModelFile& m) {
   w.u64(m.seed);
   w.u32(m.threads);
   w.u64(m.iteration);
+  if (m.version >= 2) {
+    w.f64(m.held_out_completion);
+    w.f64(m.held_out_interpolation);
+    w.i32(m.held_out_gap);
+  }
   if (s.kind == ModelKind::mesh) {
     w.u32(static_cast<std::uint32_t>(m.triangles.size()));
     for (Eigen::Index i = 0; i < m.rest.size(); ++i) w.f64(m.rest.data()[i]);
@@ -218,9 +224,10 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
   r.at = 8;
   ModelFile m;
   const std::uint32_t version = r.u32("header", "version");
-  if (version != kModelFileVersion) {
+  m.version = version;
+  if (version != 1 && version != kModelFileVersion) {
     detail::fail(file, "header",
-                 "version " + std::to_string(version) + ", this build reads version " +
+                 "version " + std::to_string(version) + ", this build reads versions 1 and " +
                      std::to_string(kModelFileVersion));
   }
   const std::uint32_t kind = r.u32("header", "kind");
@@ -247,6 +254,14 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
   m.seed = r.u64("header", "seed");
   m.threads = r.u32("header", "threads");
   m.iteration = r.u64("header", "iteration");
+  if (version >= 2) {
+    m.held_out_completion = r.f64("header", "held-out completion");
+    m.held_out_interpolation = r.f64("header", "held-out interpolation");
+    m.held_out_gap = r.bounded("held-out gap", 0, 1000000);
+    if (!std::isfinite(m.held_out_completion) || !std::isfinite(m.held_out_interpolation)) {
+      detail::fail(file, "header", "the held-out measurement is not finite");
+    }
+  }
   if (mesh) {
     const std::uint32_t triangles = r.u32("header", "triangle count");
     const auto v = static_cast<std::uint64_t>(s.vertex_count);
@@ -314,6 +329,24 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
 
 ModelFile read_model_file(const std::string& file) {
   return parse_model_file(detail::read_file_bytes(file, detail::kMaxModelFileBytes), file);
+}
+
+std::string interpolation_warning(const ModelFile& m, const std::string& file) {
+  if (m.held_out_completion < 0 || m.held_out_interpolation < 0) {
+    return "warning: " + file +
+           ": never measured against linear interpolation on held-out data (trained by an older "
+           "build, or no held-out piece was long enough); it may complete worse than a straight "
+           "line";
+  }
+  if (m.held_out_completion < m.held_out_interpolation) return "";
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers,
+                " (%.2f %% against %.2f %% for linear interpolation, %d-frame gaps, after %llu "
+                "iterations)",
+                100.0 * m.held_out_completion, 100.0 * m.held_out_interpolation, m.held_out_gap,
+                static_cast<unsigned long long>(m.iteration));
+  return "warning: " + file + ": never measured better than linear interpolation on held-out data" +
+         numbers + "; train it longer";
 }
 
 void check_model_mesh(const ModelFile& model, const std::string& file, int vertex_count,

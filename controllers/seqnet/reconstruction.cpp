@@ -1,7 +1,10 @@
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 
 #include <Eigen/Sparse>
+#include <algorithm>
 #include <stdexcept>
+
+#include "animrt/controllers/seqnet/placement.hpp"
 
 namespace animrt::seqnet {
 
@@ -142,8 +145,12 @@ std::vector<Eigen::Matrix3d> Reconstructor::exact_gradients(
 std::vector<Positions> reconstruct_all(const SequenceFeatures& features) {
   const Reconstructor solver(features.rest, features.triangles);
   std::vector<Positions> out;
-  for (int f = 0; f < static_cast<int>(features.frames.size()); ++f)
+  for (int f = 0; f < static_cast<int>(features.frames.size()); ++f) {
     out.push_back(solver.solve(features.raw(f)));
+    if (!features.placement.empty()) {
+      place(solver.neighbourhood(), out.back(), features.placement[static_cast<std::size_t>(f)]);
+    }
+  }
   return out;
 }
 

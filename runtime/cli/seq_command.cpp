@@ -16,6 +16,7 @@
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/features.hpp"
 #include "animrt/controllers/seqnet/mesh_io.hpp"
+#include "animrt/controllers/seqnet/placement.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
 #include "seq_model_commands.hpp"
@@ -33,6 +34,13 @@ struct SeqArgs {
   bool plain = false;
 };
 
+// A clip named after its file or folder; "walk/" names the folder too.
+std::string clip_name(const std::string& path) {
+  std::filesystem::path p(path);
+  if (!p.has_filename()) p = p.parent_path();
+  return p.filename().string();
+}
+
 // Several inputs become one sequence: each input is a clip of its own (named
 // after its file or folder) or keeps its clips; all must share the first
 // input's connectivity.
@@ -42,8 +50,7 @@ seqnet::MeshSequence read_inputs(const std::vector<std::string>& inputs) {
   std::vector<seqnet::Clip> clips;
   auto add_clips = [&clips](const seqnet::MeshSequence& s, const std::string& path, int offset) {
     if (s.clips.empty()) {
-      clips.push_back(seqnet::Clip{std::filesystem::path(path).filename().string(), offset,
-                                   s.frame_count(), 0.0});
+      clips.push_back(seqnet::Clip{clip_name(path), offset, s.frame_count(), 0.0});
     }
     for (seqnet::Clip c : s.clips) {
       c.first += offset;
@@ -65,6 +72,39 @@ seqnet::MeshSequence read_inputs(const std::vector<std::string>& inputs) {
   }
   all.clips = std::move(clips);
   return all;
+}
+
+// Round trip per clip (or the whole range when it has none): absolute (the
+// frames `seq reconstruct` writes) and per piece (each piece's centroid
+// aligned first, the deformation features alone).
+void print_round_trip(const seqnet::MeshSequence& sequence, int first, int count,
+                      const seqnet::SequenceFeatures& features) {
+  const seqnet::Reconstructor solver(features.rest, features.triangles);
+  std::vector<seqnet::Clip> clips = features.clips;
+  if (clips.empty()) clips.push_back(seqnet::Clip{"all", 0, count, 0.0});
+  for (const auto& c : clips) {
+    double mean = 0.0, max = 0.0, piece_mean = 0.0, piece_max = 0.0, turn = 0.0;
+    for (int f = c.first; f < c.first + c.count; ++f) {
+      const seqnet::FeatureFrame raw = features.raw(f);
+      const seqnet::Positions& truth = sequence.frames[static_cast<std::size_t>(first + f)];
+      seqnet::Positions got = solver.solve(raw);
+      const seqnet::FrameError p =
+          seqnet::error_up_to_translation(truth, got, solver.neighbourhood());
+      seqnet::place(solver.neighbourhood(), got, features.placement[static_cast<std::size_t>(f)]);
+      const seqnet::AbsoluteError e = seqnet::absolute_error(truth, got);
+      mean += e.mean / c.count;
+      max = std::max(max, e.max);
+      piece_mean += p.mean / c.count;
+      piece_max = std::max(piece_max, p.max);
+      turn = std::max(turn, raw.topRows<3>().colwise().norm().maxCoeff());
+    }
+    // turn: the largest local rotation from the first frame, in degrees.
+    std::printf(
+        "  clip %-14s %3d frames  turn %4.0f deg  round trip mean %.2e  max %.2e  per piece mean "
+        "%.2e  max %.2e (of the bounding-box diagonal)\n",
+        c.name.c_str(), c.count, turn * 180.0 / 3.14159265358979323846, mean, max, piece_mean,
+        piece_max);
+  }
 }
 
 int run_features(const SeqArgs& a) {
@@ -93,32 +133,18 @@ int run_features(const SeqArgs& a) {
             << ": " << sequence.vertex_count() << " vertices, " << sequence.triangles.size()
             << " triangles, frames " << first << ".." << first + count - 1 << " -> " << a.out
             << '\n';
-  // Round trip per clip (or the whole range when it has none).
-  const seqnet::Reconstructor solver(features.rest, features.triangles);
-  std::vector<seqnet::Clip> clips = features.clips;
-  if (clips.empty()) clips.push_back(seqnet::Clip{"all", 0, count, 0.0});
-  for (const auto& c : clips) {
-    double mean = 0.0, max = 0.0, turn = 0.0;
-    for (int f = c.first; f < c.first + c.count; ++f) {
-      const seqnet::FeatureFrame raw = features.raw(f);
-      const seqnet::FrameError e =
-          seqnet::error_up_to_translation(sequence.frames[static_cast<std::size_t>(first + f)],
-                                          solver.solve(raw), solver.neighbourhood());
-      mean += e.mean / c.count;
-      max = std::max(max, e.max);
-      turn = std::max(turn, raw.topRows<3>().colwise().norm().maxCoeff());
-    }
-    // turn: the largest local rotation from the first frame, in degrees.
-    std::printf(
-        "  clip %-14s %3d frames  turn %4.0f deg  round trip mean %.2e  max %.2e (of the "
-        "bounding-box diagonal)\n",
-        c.name.c_str(), c.count, turn * 180.0 / 3.14159265358979323846, mean, max);
-  }
+  print_round_trip(sequence, first, count, features);
   return 0;
 }
 
 int run_reconstruct(const SeqArgs& a) {
   const seqnet::SequenceFeatures features = seqnet::read_feature_file(a.input);
+  if (features.placement.empty()) {
+    std::cerr << "warning: " << a.input
+              << ": a version-1 feature file holds no placement (piece translations and root "
+                 "trajectory); every piece is placed at its template vertex. Run seq features "
+                 "again for absolute frames.\n";
+  }
   const std::vector<seqnet::Positions> frames = seqnet::reconstruct_all(features);
   seqnet::MeshSequence out;
   out.triangles.assign(features.triangles.begin(), features.triangles.end());

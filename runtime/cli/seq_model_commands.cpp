@@ -173,6 +173,9 @@ int run_complete(const CompleteArgs& a) {
     seqnet::write_obj_sequence(a.out, out);
   }
   print_report(c.gaps, a.options.threshold);
+  if (const std::string w = seqnet::interpolation_warning(model, a.model); !w.empty()) {
+    std::cerr << w << '\n';
+  }
   std::cout << a.model << ": " << c.gaps.size() + 1 << " keys, " << c.frames.cols() << " frames -> "
             << a.out << (model.shape.kind == seqnet::ModelKind::mesh ? "/frame_*.obj" : "") << '\n';
   return 0;

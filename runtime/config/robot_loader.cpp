@@ -44,12 +44,13 @@ void check_balance(const GaitBalance& balance, const RobotConfig& config) {
 }
 
 std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const RobotConfig& config,
-                                          MotionCheck::Speeds& speeds) {
+                                          MotionCheck::Speeds& speeds,
+                                          std::vector<std::string>& warnings) {
   const std::vector<JointSpec>& joints = config.joints;
   if (motion.type == "layers") {
     std::vector<std::unique_ptr<MotionSource>> layers;
     for (const MotionConfig& layer : motion.layers) {
-      layers.push_back(make_source(layer, config, speeds));
+      layers.push_back(make_source(layer, config, speeds, warnings));
       if (dynamic_cast<BalancedGaitSource*>(layers.back().get())) {
         throw InputError(layer.where, layer.key,
                          "a gait with balance: stretches the legs under the whole figure and "
@@ -60,6 +61,10 @@ std::unique_ptr<MotionSource> make_source(const MotionConfig& motion, const Robo
   }
   if (motion.type == "show") {
     const ShowFile show = load_show_file(motion.file);
+    if (show.has_learned) {
+      std::string w = seqnet::interpolation_warning(*show.learned.model, show.learned.model_file);
+      if (!w.empty()) warnings.push_back(w.substr(w.find(' ') + 1));  // without "warning: "
+    }
     auto source = make_show_source(show, joints);
     double length = show.duration_s;
     for (const ShowTrack& track : show.tracks) length = std::max(length, track.keys.back().t);
@@ -202,7 +207,7 @@ LoadedRobot load_robot(const std::string& path) {
   LoadedRobot robot;
   robot.config = load_robot_config(path);
   MotionCheck::Speeds speeds;
-  robot.motion = make_source(robot.config.motion, robot.config, speeds);
+  robot.motion = make_source(robot.config.motion, robot.config, speeds, robot.warnings);
   note_read_budget(robot);
   note_servo_speeds(robot, speeds);
   robot.balanced = dynamic_cast<BalancedGaitSource*>(robot.motion.get());

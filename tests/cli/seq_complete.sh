@@ -7,6 +7,7 @@
 # one feature file of two clips, and seq evaluate on a model trained on it.
 set -uo pipefail
 animrt=$1
+root=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -15,14 +16,24 @@ if ldd "$animrt" | grep -q torch; then fail "animrt links libtorch: $(ldd "$anim
 
 source "$(dirname "$0")/seq_data.bash"
 write_walk_csv "$tmp/walk.csv"
-out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --report-every 10 \
-  "${small[@]}" 2>&1) || fail "train failed: $out"
+train_out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --report-every 10 \
+  "${small[@]}" 2>&1) || fail "train failed: $train_out"
 
 printf 'time_s,hip,knee\n0,0.25,-0.125\n1,-0.4,0.3\n2,0.1,0.2\n' > "$tmp/keys.csv"
 out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/keys.csv" --gap 4 --out "$tmp/done.csv" 2>&1) ||
   fail "complete failed: $out"
 gap='gap 1 \(keys 1-2, 4 frames\): (merged at frame [1-4] \(output frame [1-4]\), difference [0-9.]+ %, [0-9]+ tr(y|ies)|not merged below 5 %, best difference [0-9.]+ % at frame [1-4] \(output frame [1-4]\) used, 21 tries)'
 [[ $out =~ $gap ]] || fail "no report for gap 1: $out"
+# Training ended with a held-out line; completion warns exactly when that
+# line says the model lost to linear interpolation.
+[[ $train_out =~ held\ out\ at\ iteration\ 10:\ completion\ of\ 9-frame\ gaps\ [0-9.]+\ %,\ linear\ interpolation\ [0-9.]+\ %\ \([0-9]+\ %\ (better|worse)\ than\ interpolation\) ]] ||
+  fail "no held-out line: $train_out"
+if [[ ${BASH_REMATCH[1]} == worse ]]; then
+  [[ $out == *"warning: $tmp/m.model: never measured better than linear interpolation on held-out data ("*"10 iterations); train it longer"* ]] ||
+    fail "no warning for a model worse than interpolation: $out"
+else
+  [[ $out != *warning* ]] || fail "a warning for a model better than interpolation: $out"
+fi
 [[ $out == *"gap 2 (keys 2-3, 4 frames): "* ]] || fail "no report for gap 2: $out"
 [[ $(head -1 "$tmp/done.csv") == "hip,knee" ]] || fail "header: $(head -1 "$tmp/done.csv")"
 [[ $(wc -l < "$tmp/done.csv") -eq 12 ]] || fail "$(wc -l < "$tmp/done.csv") lines, expected 1 + 11"
@@ -91,6 +102,11 @@ done
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --out "$tmp/two.bin" 2>&1) || fail "features of two folders: $out"
 [[ $out == *"2 inputs: 36 vertices, 50 triangles, frames 0..29"* && $out == *"clip plate_a "*"15 frames"* &&
   $out == *"clip plate_b "*"15 frames"* ]] || fail "two folders: $out"
+# Folders given with a trailing slash are named after the folder all the same.
+out=$("$animrt" seq features "$tmp/plate_a/" "$tmp/plate_b/" --out "$tmp/slash.bin" 2>&1) ||
+  fail "features of two folders with trailing slashes: $out"
+[[ $out == *"clip plate_a "*"15 frames"* && $out == *"clip plate_b "*"15 frames"* ]] ||
+  fail "trailing slash: $out"
 out=$("$animrt" seq features "$tmp/plate_a" "$tmp/plate_b" --clip plate_a --out "$tmp/bad.bin" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/plate_a: --clip: --clip takes one input, not 2"* ]] ||
@@ -110,4 +126,25 @@ out=$("$animrt" seq evaluate "$tmp/plate.model" "$tmp/b.bin" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/plate.model: template: trained on another template"* ]] ||
   fail "other template: exit $code: $out"
+
+# A show with learned in-betweens: validate warns when its model lost to
+# interpolation on held-out data, and only then.
+mkdir "$tmp/robots"
+awk 'BEGIN { print "time_s,eye_pan,eye_tilt";
+  for (f = 0; f < 60; f++) { t = f / 25; printf "%g,%g,%g\n", t, 0.3 * sin(7.85 * t), 0.2 * cos(7.85 * t) } }' \
+  > "$tmp/eyes.csv"
+train_out=$("$animrt" seq train "$tmp/eyes.csv" --out "$tmp/eyes.model" --iterations 10 "${small[@]}" 2>&1) ||
+  fail "training the eyes failed: $train_out"
+printf 'name: eyes\nlearned: {model: ../eyes.model, frame_s: 0.04}\njoints:\n  eye_pan: {interpolation: learned, keys: [[0, 0], [0.4, 10], [0.8, -10]]}\n  eye_tilt: {interpolation: learned, keys: [[0, 5], [0.4, 0], [0.8, 5]]}\n' \
+  > "$tmp/robots/eyes.yaml"
+sed -e "s#\.\./modbus/#$root/configs/modbus/#" -e '/^motion:/,$d' "$root/configs/robots/animatronic.yaml" > "$tmp/robots/r.yaml"
+printf 'motion: {type: show, file: eyes.yaml}\n' >> "$tmp/robots/r.yaml"
+out=$("$animrt" validate "$tmp/robots/r.yaml" 2>&1) || fail "validate of the learned show failed: $out"
+[[ $train_out =~ held\ out\ at\ iteration\ 10:.*\ (better|worse)\ than\ interpolation\) ]] || fail "no held-out line: $train_out"
+if [[ ${BASH_REMATCH[1]} == worse ]]; then
+  [[ $out == *"warning: $tmp/robots/../eyes.model: never measured better than linear interpolation"* ]] ||
+    fail "validate did not warn of the learned show's model: $out"
+else
+  [[ $out != *"never measured better"* ]] || fail "validate warned of a model better than interpolation: $out"
+fi
 echo ok

@@ -52,6 +52,8 @@ TEST(FeatureFile, RoundTripKeepsEverything) {
   EXPECT_EQ(g.scale.high, f.scale.high);
   ASSERT_EQ(g.frames.size(), f.frames.size());
   for (std::size_t k = 0; k < f.frames.size(); ++k) EXPECT_EQ(g.frames[k], f.frames[k]);
+  ASSERT_EQ(g.placement.size(), f.frames.size());
+  for (std::size_t k = 0; k < f.frames.size(); ++k) EXPECT_EQ(g.placement[k], f.placement[k]);
 }
 
 TEST(FeatureFile, BrokenFilesAreClearErrors) {
@@ -75,8 +77,8 @@ TEST(FeatureFile, BrokenFilesAreClearErrors) {
   EXPECT_NE(error_reading(magic, "magic.bin").find("magic"), std::string::npos);
 
   auto version = good;
-  version[8] = 2;
-  EXPECT_NE(error_reading(version, "version.bin").find("version 2"), std::string::npos);
+  version[8] = 3;
+  EXPECT_NE(error_reading(version, "version.bin").find("version 3"), std::string::npos);
 
   auto longer = good;
   longer.push_back(0);

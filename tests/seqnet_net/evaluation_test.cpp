@@ -29,6 +29,7 @@ SequenceFeatures linear_features() {
   SequenceFeatures f = nettest::bending_bar(3, 5, 16);
   const FeatureFrame start = f.frames.front() * 0.5;
   f.frames.clear();
+  f.placement.clear();  // made-up frames: no placement
   for (int t = 0; t < kFrames; ++t) {
     FeatureFrame x = start;
     for (int c = 0; c < kFeatureDims; ++c) x.row(c).array() += static_cast<double>(kStep[c]) * t;

@@ -141,7 +141,7 @@ TEST_F(ModelFileTest, OtherMagicOrVersionIsRefused) {
   std::vector<std::uint8_t> b = load_bytes(path);
   b[8] = 9;  // version
   save_bytes(path, b);
-  EXPECT_NE(error_of([&] { read_model_file(path); }).find("version 9, this build reads version 1"),
+  EXPECT_NE(error_of([&] { read_model_file(path); }).find("version 9, this build reads versions 1 and 2"),
             std::string::npos);
   b[0] = 'X';
   save_bytes(path, b);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <cstdio>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -57,6 +58,56 @@ TEST(SeqTraining, JointLossFallsOnATinyCorpus) {
   std::ifstream svg(o.out + ".svg");
   std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("<polyline"), std::string::npos);
+}
+
+// Every held_out_every iterations and at the end a line compares held-out
+// completion with linear interpolation; the model file keeps the last one
+// and it decides the warning.
+TEST(SeqTraining, PrintsHeldOutCompletionAgainstInterpolationAndKeepsIt) {
+  TrainOptions o = tiny_options(nettest::write_joint_csv("progress.csv", 80), "progress.model");
+  o.iterations = 25;
+  o.held_out_every = 10;
+  std::ostringstream log;
+  const TrainResult r = train(o, log);
+  const std::string text = log.str();
+  for (int at : {10, 20, 25}) {
+    const std::string head = "held out at iteration " + std::to_string(at) +
+                             ": completion of 9-frame gaps ";  // 16 held-out frames
+    const auto line = text.find(head);
+    ASSERT_NE(line, std::string::npos) << text;
+    EXPECT_NE(text.find(" than interpolation)", line), std::string::npos) << text;
+  }
+  EXPECT_EQ(text.find("held out at iteration 5:"), std::string::npos) << text;
+  ASSERT_GT(r.held_out_completion, 0.0);
+  ASSERT_GT(r.held_out_interpolation, 0.0);
+  char numbers[128];
+  std::snprintf(numbers, sizeof numbers, "9-frame gaps %.2f %%, linear interpolation %.2f %% (",
+                100.0 * r.held_out_completion, 100.0 * r.held_out_interpolation);
+  EXPECT_NE(text.find(std::string("held out at iteration 25: completion of ") + numbers),
+            std::string::npos)
+      << text;
+  const ModelFile m = read_model_file(o.out);
+  EXPECT_EQ(m.held_out_completion, r.held_out_completion);
+  EXPECT_EQ(m.held_out_interpolation, r.held_out_interpolation);
+  EXPECT_EQ(m.held_out_gap, 9);
+  const std::string warning = interpolation_warning(m, o.out);
+  EXPECT_EQ(warning.empty(), r.held_out_completion < r.held_out_interpolation) << warning;
+}
+
+TEST(SeqTraining, AModelNeverBetterThanInterpolationIsWarnedOf) {
+  ModelFile m;
+  m.iteration = 200;
+  EXPECT_NE(interpolation_warning(m, "m.model").find("m.model: never measured against linear"),
+            std::string::npos);
+  m.held_out_completion = 0.023;
+  m.held_out_interpolation = 0.0139;
+  m.held_out_gap = 9;
+  EXPECT_EQ(interpolation_warning(m, "m.model"),
+            "warning: m.model: never measured better than linear interpolation on held-out data "
+            "(2.30 % against 1.39 % for linear interpolation, 9-frame gaps, after 200 "
+            "iterations); train it longer");
+  m.held_out_completion = 0.01;
+  EXPECT_EQ(interpolation_warning(m, "m.model"), "");
 }
 
 TEST(SeqTraining, MeshLossFallsOnATinyBar) {

@@ -59,6 +59,10 @@ void add_seq_net_commands(CLI::App& app) {
       ->check(CLI::Range(1, 100000000));
   train->add_option("--report-every", train_args->report_every, "iterations per progress line")
       ->check(CLI::Range(1, 100000000));
+  train
+      ->add_option("--held-out-every", train_args->held_out_every,
+                   "iterations between held-out completion lines (0: only at the end)")
+      ->check(CLI::NonNegativeNumber);
   train->add_option("--latent", train_args->latent, "latent size")->check(CLI::Range(1, 4096));
   train->add_option("--hidden", train_args->hidden, "LSTM hidden units")
       ->check(CLI::Range(1, 4096));

@@ -16,6 +16,7 @@
 #include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
+#include "animrt/learn/seqnet/held_out_completion.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 
 namespace animrt::seqnet {
@@ -71,6 +72,27 @@ std::vector<std::string> parameter_names(const SeqNetImpl& net) {
   std::vector<std::string> names;
   for (const auto& item : net.named_parameters()) names.push_back(item.key());
   return names;
+}
+
+// "held out at iteration 200: completion of 9-frame gaps 2.30 %, linear
+// interpolation 1.39 % (65 % worse than interpolation)".
+std::string held_out_line(const HeldOutCompletion& h, int iteration) {
+  if (h.gaps == 0) {
+    return "held out at iteration " + std::to_string(iteration) +
+           ": no held-out piece is long enough to complete a gap";
+  }
+  if (h.network < 0) {
+    return "held out at iteration " + std::to_string(iteration) +
+           ": the model's completion is not finite";
+  }
+  const double change = h.interpolation > 0 ? h.network / h.interpolation - 1.0 : 0.0;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "held out at iteration %d: completion of %d-frame gaps %.2f %%, linear "
+                "interpolation %.2f %% (%.0f %% %s than interpolation)",
+                iteration, h.gap, 100.0 * h.network, 100.0 * h.interpolation,
+                100.0 * std::abs(change), change < 0 ? "better" : "worse");
+  return line;
 }
 
 }  // namespace
@@ -288,6 +310,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     }
   }
 
+  HeldOutCompletion measured;
   auto model_file = [&](bool with_state) {
     ModelFile m = set.description;
     m.shape = shape;
@@ -295,6 +318,9 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     m.threads = static_cast<std::uint32_t>(o.threads);
     m.iteration = static_cast<std::uint64_t>(iteration);
     m.parameters = save_parameters(*net);
+    m.held_out_completion = measured.network;
+    m.held_out_interpolation = measured.interpolation;
+    m.held_out_gap = measured.gap;
     if (with_state) {
       m.optimiser = adam.state(names);
       NamedArray h;
@@ -333,6 +359,12 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
       ++count;
     }
     return count == 0 ? -1.0 : sum / count;
+  };
+
+  auto measure = [&] {
+    measured = HeldOutCompletion{};
+    measured = measure_held_out_completion(model_file(false), set);
+    progress << held_out_line(measured, iteration) << std::endl;
   };
 
   TrainResult result;
@@ -386,12 +418,16 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
                     duration((o.iterations - iteration) / rate).c_str());
       progress << line << std::endl;
     }
+    if (last || (o.held_out_every > 0 && iteration % o.held_out_every == 0)) measure();
     if (o.checkpoint_every > 0 && (iteration % o.checkpoint_every == 0 || last)) {
       write_model_file(o.out + ".ckpt", model_file(true));
       write_plot();
     }
   }
+  if (iteration == first_iteration) measure();  // nothing left to train: measured as it is
   result.held_out = held_out_loss();
+  result.held_out_completion = measured.network;
+  result.held_out_interpolation = measured.interpolation;
   write_model_file(o.out, model_file(false));
   write_plot();
   result.iterations = iteration;

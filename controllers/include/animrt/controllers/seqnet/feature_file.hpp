@@ -10,7 +10,7 @@
 namespace animrt::seqnet {
 
 constexpr char kFeatureFileMagic[8] = {'A', 'N', 'S', 'E', 'Q', 'F', 'T', '\n'};
-constexpr std::uint32_t kFeatureFileVersion = 1;
+constexpr std::uint32_t kFeatureFileVersion = 2;  // 2 added the placement; 1 is still read
 
 // Throws std::runtime_error when the file cannot be written.
 void write_feature_file(const std::string& file, const SequenceFeatures& features);

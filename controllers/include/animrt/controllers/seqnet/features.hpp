@@ -44,6 +44,9 @@ struct SequenceFeatures {
   std::vector<Clip> clips;  // frame ranges within `frames`
   FeatureScale scale;
   std::vector<FeatureFrame> frames;  // normalised
+  // Per frame, the root and every piece's offset from it (placement.hpp);
+  // empty when read from a version-1 feature file, which did not store it.
+  std::vector<Eigen::Matrix3Xd> placement;
 
   int vertex_count() const { return static_cast<int>(rest.cols()); }
   FeatureFrame raw(int frame) const {

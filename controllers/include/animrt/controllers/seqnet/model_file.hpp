@@ -15,7 +15,7 @@
 namespace animrt::seqnet {
 
 constexpr char kModelFileMagic[8] = {'A', 'N', 'S', 'E', 'Q', 'N', 'N', '\n'};
-constexpr std::uint32_t kModelFileVersion = 1;
+constexpr std::uint32_t kModelFileVersion = 2;  // 2 added the held-out measurement; 1 is still read
 
 enum class ModelKind : std::uint32_t { mesh = 1, joints = 2 };
 
@@ -47,6 +47,8 @@ struct NamedArray {
 };
 
 struct ModelFile {
+  // Written as read: a version-1 file (no held-out measurement) stays one.
+  std::uint32_t version = kModelFileVersion;
   NetShape shape;
   // Mesh models: the template and its connectivity (the features are
   // deformations of this mesh).
@@ -62,6 +64,12 @@ struct ModelFile {
   std::uint64_t seed = 0;
   std::uint32_t threads = 1;
   std::uint64_t iteration = 0;  // iterations trained
+  // The last held-out measurement during training: completion of gaps of
+  // `held_out_gap` frames by the network and by linear interpolation of the
+  // keys, as fractions of the data's range; negative when never measured.
+  double held_out_completion = -1.0;
+  double held_out_interpolation = -1.0;
+  int held_out_gap = 0;
   std::vector<NamedArray> parameters;
   std::vector<NamedArray> optimiser;  // empty in a final model; Adam moments in a checkpoint
 };
@@ -83,6 +91,11 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
 // was trained on another mesh or another joint set (or is of the other kind).
 void check_model_mesh(const ModelFile& model, const std::string& file, int vertex_count,
                       const std::vector<std::array<int, 3>>& triangles);
+// One line warning that the model was never measured better than linear
+// interpolation on held-out data (or never measured at all), naming the
+// file; empty when it was.
+std::string interpolation_warning(const ModelFile& model, const std::string& file);
+
 void check_model_joints(const ModelFile& model, const std::string& file,
                         const std::vector<std::string>& joint_names);
 

@@ -42,7 +42,9 @@ class Reconstructor {
   std::unique_ptr<Factor> factor_;
 };
 
-// Every frame of a feature set back to positions.
+// Every frame of a feature set back to positions: in absolute coordinates
+// when the features carry their placement, else each piece pinned at its
+// template vertex.
 std::vector<Positions> reconstruct_all(const SequenceFeatures& features);
 
 // The mean offset of every connected piece of `placed` from the same piece

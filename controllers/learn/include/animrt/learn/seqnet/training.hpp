@@ -51,6 +51,10 @@ struct TrainOptions {
   double learning_rate = 1e-3;
   int checkpoint_every = 100;
   int report_every = 10;
+  // Held-out completion against linear interpolation, printed every so many
+  // iterations (0: only at the end) and at the end, where the model file
+  // keeps it.
+  int held_out_every = 100;
   double held_out = 0.2;
   // Network size (paper values by default).
   int latent = 128;
@@ -74,6 +78,9 @@ struct TrainResult {
   int run = 0;           // trained in this call
   LossRecord last;       // last iteration's batch
   double held_out = -1;  // held-out reconstruction loss (-1: no held-out window)
+  // Held-out completion and linear interpolation at the end (-1: not measured).
+  double held_out_completion = -1;
+  double held_out_interpolation = -1;
   double seconds = 0;
 };
 
