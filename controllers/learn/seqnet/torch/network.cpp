@@ -196,6 +196,14 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
   return l;
 }
 
+LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
+                     bool bidirectional, double l2_weight) {
+  LossTerms l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+  l.total.backward();
+  adam.step();
+  return l;
+}
+
 Adam::Adam(std::vector<torch::Tensor> parameters, double learning_rate)
     : params_(std::move(parameters)), lr_(learning_rate) {
   for (const auto& p : params_) {

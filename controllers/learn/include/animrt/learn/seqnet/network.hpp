@@ -108,6 +108,13 @@ struct LossTerms {
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight = 1.0,
                      bool bidirectional = true, double l2_weight = 1.0);
 
+class Adam;
+
+// One training iteration on the windows X [n, B, D]: batch_loss with
+// latent sampling, its gradients, one Adam step. Returns the loss terms.
+LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight = 1.0,
+                     bool bidirectional = true, double l2_weight = 1.0);
+
 // Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
 // that a checkpoint saves and restores exactly.
 class Adam {
