@@ -38,8 +38,11 @@ class MeshConvImpl : public torch::nn::Module {
  public:
   MeshConvImpl(int in, int out, MeshGraph graph, bool transpose);
   torch::Tensor forward(const torch::Tensor& x);
-  // The neighbour mean (or its adjoint) alone.
+  // The same on [V, B, C] (vertices first, contiguous), as the network runs it.
+  torch::Tensor forward_vertices_first(const torch::Tensor& x);
+  // The neighbour mean (or its adjoint) alone, on [B, V, C] and on [V, B, C].
   torch::Tensor ring(const torch::Tensor& x) const;
+  torch::Tensor ring_vertices_first(const torch::Tensor& x) const;
 
   torch::nn::Linear self{nullptr};
   torch::nn::Linear neighbours{nullptr};
@@ -47,6 +50,7 @@ class MeshConvImpl : public torch::nn::Module {
  private:
   MeshGraph graph_;
   bool transpose_;
+  torch::Tensor matrix_, adjoint_;  // sparse V x V: the product and its adjoint
 };
 TORCH_MODULE(MeshConv);
 
@@ -65,6 +69,8 @@ class SeqNetImpl : public torch::nn::Module {
   const NetShape& shape() const { return shape_; }
   // [B, D] -> mean and log-variance [B, latent].
   std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& x);
+  // [B, D] -> the encoder's output, flattened [B, V C] (or [B, width]).
+  torch::Tensor encoded(const torch::Tensor& x);
   // [B, hidden] -> feature change [B, D].
   torch::Tensor decode(const torch::Tensor& h);
   // Every state entry sign * s0 (sign +1 forward, -1 backward).
