@@ -171,11 +171,91 @@ std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& 
 }
 
 torch::Tensor SeqNetImpl::decode(const torch::Tensor& hidden) {
-  const std::int64_t batch = hidden.size(0);
-  torch::Tensor h = torch::tanh(from_hidden->forward(hidden));
+  return decode_from(from_hidden->forward(hidden));
+}
+
+torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
+  const std::int64_t batch = dense.size(0);
+  torch::Tensor h = torch::tanh(dense);
   if (shape_.kind != ModelKind::mesh) return decoder->forward(h);
   h = h.view({batch, shape_.vertex_count, shape_.channels}).transpose(0, 1).contiguous();
   return run_vertices_first(decoder, h).transpose(0, 1).reshape({batch, -1});
+}
+
+// Inputs and output gradients of one dense layer over the steps of a run.
+struct DenseTape {
+  std::vector<torch::Tensor> inputs, grads;
+
+  // y = x W^T + b with W and b outside autograd; x's gradient still flows.
+  torch::Tensor apply(const std::shared_ptr<DenseTape>& self, const torch::Tensor& x,
+                      const torch::Tensor& weight, const torch::Tensor& bias) {
+    torch::Tensor y = torch::addmm(bias.detach(), x, weight.detach().t());
+    const std::size_t slot = inputs.size();
+    inputs.push_back(x.detach());
+    grads.emplace_back();
+    std::weak_ptr<DenseTape> tape = self;
+    y.register_hook([tape, slot](const torch::Tensor& g) {
+      if (auto t = tape.lock()) t->grads[slot] = g;
+    });
+    return y;
+  }
+
+  // sum_t g_t^T x_t and sum_t g_t over the steps that got a gradient.
+  std::pair<torch::Tensor, torch::Tensor> gradients() const {
+    std::vector<torch::Tensor> x, g;
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      if (!grads[k].defined()) continue;
+      x.push_back(inputs[k]);
+      g.push_back(grads[k]);
+    }
+    if (g.empty()) return {};
+    const torch::Tensor gs = torch::cat(g), xs = torch::cat(x);
+    return {torch::mm(gs.t(), xs), gs.sum(0)};
+  }
+};
+
+struct DenseTapes {
+  bool on = false;
+  std::vector<std::shared_ptr<DenseTape>> latent, hidden;  // one per run
+};
+
+namespace {
+
+void add_gradient(torch::Tensor& parameter, const torch::Tensor& g) {
+  if (parameter.grad().defined()) {
+    parameter.mutable_grad().add_(g);
+  } else {
+    parameter.mutable_grad() = g.clone();
+  }
+}
+
+}  // namespace
+
+void SeqNetImpl::collect_dense_gradients(bool on) {
+  if (!tapes_) tapes_ = std::make_shared<DenseTapes>();
+  tapes_->on = on;
+}
+
+void SeqNetImpl::finish_gradients() {
+  if (!tapes_) return;
+  torch::NoGradGuard no_grad;
+  const std::int64_t latent = shape_.latent;
+  for (const auto& tape : tapes_->latent) {
+    auto [w, b] = tape->gradients();
+    if (!w.defined()) continue;
+    add_gradient(to_mu->weight, w.slice(0, 0, latent));
+    add_gradient(to_logvar->weight, w.slice(0, latent));
+    add_gradient(to_mu->bias, b.slice(0, 0, latent));
+    add_gradient(to_logvar->bias, b.slice(0, latent));
+  }
+  for (const auto& tape : tapes_->hidden) {
+    auto [w, b] = tape->gradients();
+    if (!w.defined()) continue;
+    add_gradient(from_hidden->weight, w);
+    add_gradient(from_hidden->bias, b);
+  }
+  tapes_->latent.clear();
+  tapes_->hidden.clear();
 }
 
 LstmState SeqNetImpl::initial_state(int batch, double sign) const {
@@ -190,18 +270,31 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   torch::Tensor x = given[0];
   // Mean and log-variance in one product per step (the same numbers as
   // two): the weights are stacked once per chain.
+  const bool tape = tapes_ && tapes_->on && torch::GradMode::is_enabled();
+  std::shared_ptr<DenseTape> latent_tape, hidden_tape;
+  if (tape) {
+    latent_tape = tapes_->latent.emplace_back(std::make_shared<DenseTape>());
+    hidden_tape = tapes_->hidden.emplace_back(std::make_shared<DenseTape>());
+  }
   const torch::Tensor weight = torch::cat({to_mu->weight, to_logvar->weight});
   const torch::Tensor bias = torch::cat({to_mu->bias, to_logvar->bias});
   for (int t = 1; t < n; ++t) {
+    const torch::Tensor h = encoded(x);
     const std::vector<torch::Tensor> latent =
-        torch::addmm(bias, encoded(x), weight.t()).chunk(2, 1);
+        (tape ? latent_tape->apply(latent_tape, h, weight, bias)
+              : torch::addmm(bias, h, weight.t()))
+            .chunk(2, 1);
     const torch::Tensor& mu = latent[0];
     const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
     if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
     auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
     state = next_state;
-    const torch::Tensor generated = x + decode(out.squeeze(0));
+    const torch::Tensor o = out.squeeze(0);
+    const torch::Tensor generated =
+        x + (tape ? decode_from(
+                        hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias))
+                  : decode(o));
     x = t < u ? given[t] : generated;
     frames.push_back(x);
     mus.push_back(mu);
@@ -269,8 +362,17 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
                      bool bidirectional, double l2_weight) {
-  LossTerms l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+  net->collect_dense_gradients(true);
+  LossTerms l;
+  try {
+    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+  } catch (...) {
+    net->collect_dense_gradients(false);
+    throw;
+  }
+  net->collect_dense_gradients(false);
   l.total.backward();
+  net->finish_gradients();
   adam.step();
   return l;
 }

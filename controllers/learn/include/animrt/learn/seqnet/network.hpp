@@ -13,6 +13,7 @@
 #include <torch/nn/modules/rnn.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -73,12 +74,22 @@ class SeqNetImpl : public torch::nn::Module {
   torch::Tensor encoded(const torch::Tensor& x);
   // [B, hidden] -> feature change [B, D].
   torch::Tensor decode(const torch::Tensor& h);
+  // The same from the decoder's first dense layer's output (before tanh).
+  torch::Tensor decode_from(const torch::Tensor& dense);
   // Every state entry sign * s0 (sign +1 forward, -1 backward).
   LstmState initial_state(int batch, double sign) const;
   // Runs the chain from `given` ([u, B, D], u >= 1) to n frames: the given
   // frames are fed in order, then each output is the next input. With
   // `sample` the latent is drawn (training), else its mean is used.
   Chain run(const torch::Tensor& given, int n, LstmState state, bool sample);
+
+  // While on, the chains' dense layers (mean and log-variance, the
+  // decoder's first layer) leave their weight gradients out of autograd and
+  // keep each step's input and output gradient instead; after backward,
+  // finish_gradients forms each weight's gradient in one product over all
+  // steps (the same sum as autograd's, without one full-size matrix per step).
+  void collect_dense_gradients(bool on);
+  void finish_gradients();
 
   torch::nn::Sequential encoder{nullptr};  // mesh convolutions or dense layers, tanh
   torch::nn::Linear to_mu{nullptr};
@@ -89,6 +100,7 @@ class SeqNetImpl : public torch::nn::Module {
 
  private:
   NetShape shape_;
+  std::shared_ptr<struct DenseTapes> tapes_;
 };
 TORCH_MODULE(SeqNet);
 
