@@ -5,9 +5,12 @@
 #include <CLI/CLI.hpp>
 
 #include "../subcommand.hpp"
+#include "animrt/learn/seqnet/blas_kernels.hpp"
 #include "seq_net_commands.hpp"
 
 int main(int argc, char** argv) {
+  // Before anything else: the BLAS kernels are fixed when it loads.
+  animrt::seqnet::restart_with_better_blas_kernels(argv);
   CLI::App app{"animrt-seqnet: train the sequence network"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "animrt-seqnet " ANIMRT_VERSION);

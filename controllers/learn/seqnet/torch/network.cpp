@@ -39,38 +39,70 @@ MeshGraph mesh_graph(int vertex_count, const std::vector<std::array<int, 3>>& tr
   return g;
 }
 
+namespace {
+
+// The ring mean as an autograd function: a sparse product forward, the
+// product with the precomputed adjoint backward (libtorch would transpose
+// and sort the sparse matrix again at every step).
+struct RingProduct : torch::autograd::Function<RingProduct> {
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& columns,
+                               const torch::Tensor& matrix, const torch::Tensor& adjoint) {
+    ctx->saved_data["adjoint"] = adjoint;
+    return torch::mm(matrix, columns);
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grad) {
+    return {torch::mm(ctx->saved_data["adjoint"].toTensor(), grad[0]), torch::Tensor(),
+            torch::Tensor()};
+  }
+};
+
+// The V x V matrix with `weights` at (rows, cols), coalesced.
+torch::Tensor ring_matrix(const torch::Tensor& rows, const torch::Tensor& cols,
+                          const torch::Tensor& weights, std::int64_t v) {
+  return torch::sparse_coo_tensor(torch::stack({rows, cols}), weights, {v, v}).coalesce();
+}
+
+}  // namespace
+
 MeshConvImpl::MeshConvImpl(int in, int out, MeshGraph graph, bool transpose)
     : graph_(std::move(graph)), transpose_(transpose) {
   self = register_module("self", torch::nn::Linear(torch::nn::LinearOptions(in, out)));
   neighbours = register_module("neighbours",
                                torch::nn::Linear(torch::nn::LinearOptions(in, out).bias(false)));
+  // The neighbour mean (row i: 1/d_i at its neighbours) and its adjoint,
+  // built once; a transpose convolution multiplies by the adjoint.
+  const std::int64_t v = graph_.vertex_count;
+  if (v > 0) {
+    torch::Tensor mean = ring_matrix(graph_.rows, graph_.cols, graph_.weights, v);
+    torch::Tensor adjoint = ring_matrix(graph_.cols, graph_.rows, graph_.weights, v);
+    matrix_ = transpose_ ? adjoint : mean;
+    adjoint_ = transpose_ ? mean : adjoint;
+  }
+}
+
+torch::Tensor MeshConvImpl::ring_vertices_first(const torch::Tensor& x) const {
+  const std::int64_t v = x.size(0);
+  const torch::Tensor columns = x.reshape({v, -1});
+  return RingProduct::apply(columns, matrix_, adjoint_).view(x.sizes());
 }
 
 torch::Tensor MeshConvImpl::ring(const torch::Tensor& x) const {
-  // A sparse V x V matrix times the vertices-first [V, B C] view: the
-  // neighbour mean (row i: 1/d_i at its neighbours), or with the indices
-  // swapped its adjoint. A gather and index_add over dimension 1 of
-  // [B, V, C] gives the same numbers but is several times slower, forward
-  // and backward. mesh_graph lists the pairs sorted by row and then column,
-  // so the matrix is already coalesced; the adjoint's pairs are sorted here.
-  const std::int64_t v = graph_.vertex_count;
-  torch::Tensor matrix;
-  if (transpose_) {
-    matrix =
-        torch::sparse_coo_tensor(torch::stack({graph_.cols, graph_.rows}), graph_.weights, {v, v})
-            .coalesce();
-  } else {
-    matrix = torch::_sparse_coo_tensor_unsafe(torch::stack({graph_.rows, graph_.cols}),
-                                              graph_.weights, {v, v})
-                 ._coalesced_(true);
-  }
-  const std::int64_t batch = x.size(0), channels = x.size(2);
-  const torch::Tensor columns = x.transpose(0, 1).reshape({v, batch * channels});
-  return torch::mm(matrix, columns).view({v, batch, channels}).transpose(0, 1);
+  return ring_vertices_first(x.transpose(0, 1).contiguous()).transpose(0, 1);
 }
 
 torch::Tensor MeshConvImpl::forward(const torch::Tensor& x) {
-  return self->forward(x) + neighbours->forward(ring(x));
+  return forward_vertices_first(x.transpose(0, 1).contiguous()).transpose(0, 1);
+}
+
+torch::Tensor MeshConvImpl::forward_vertices_first(const torch::Tensor& x) {
+  // [V, B, C] rows are vertex-major, so the ring product needs no copy and
+  // both weight matrices act on [V B, C] in one product each.
+  const std::int64_t v = x.size(0), batch = x.size(1), c = x.size(2);
+  const torch::Tensor flat = x.reshape({v * batch, c});
+  const torch::Tensor r = ring_vertices_first(x).view({v * batch, c});
+  const torch::Tensor y = torch::addmm(self->bias, flat, self->weight.t());
+  return torch::addmm(y, r, neighbours->weight.t()).view({v, batch, -1});
 }
 
 SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
@@ -108,18 +140,122 @@ SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
   decoder = register_module("decoder", decoder);
 }
 
-std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& x) {
+namespace {
+
+// A Sequential of mesh convolutions and tanh on [V, B, C].
+torch::Tensor run_vertices_first(torch::nn::Sequential& layers, torch::Tensor h) {
+  for (const auto& module : layers->children()) {
+    if (auto* conv = module->as<MeshConvImpl>()) {
+      h = conv->forward_vertices_first(h);
+    } else {
+      h = torch::tanh(h);
+    }
+  }
+  return h;
+}
+
+}  // namespace
+
+torch::Tensor SeqNetImpl::encoded(const torch::Tensor& x) {
   const std::int64_t batch = x.size(0);
-  torch::Tensor h = shape_.kind == ModelKind::mesh ? x.view({batch, shape_.vertex_count, 9}) : x;
-  h = encoder->forward(h).reshape({batch, -1});
+  if (shape_.kind != ModelKind::mesh) return encoder->forward(x);
+  // Vertices first through the convolutions, back to [B, V C] for the
+  // dense layers.
+  torch::Tensor h = x.view({batch, shape_.vertex_count, 9}).transpose(0, 1).contiguous();
+  return run_vertices_first(encoder, h).transpose(0, 1).reshape({batch, -1});
+}
+
+std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& x) {
+  const torch::Tensor h = encoded(x);
   return {to_mu->forward(h), to_logvar->forward(h)};
 }
 
 torch::Tensor SeqNetImpl::decode(const torch::Tensor& hidden) {
-  const std::int64_t batch = hidden.size(0);
-  torch::Tensor h = torch::tanh(from_hidden->forward(hidden));
-  if (shape_.kind == ModelKind::mesh) h = h.view({batch, shape_.vertex_count, shape_.channels});
-  return decoder->forward(h).reshape({batch, -1});
+  return decode_from(from_hidden->forward(hidden));
+}
+
+torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
+  const std::int64_t batch = dense.size(0);
+  torch::Tensor h = torch::tanh(dense);
+  if (shape_.kind != ModelKind::mesh) return decoder->forward(h);
+  h = h.view({batch, shape_.vertex_count, shape_.channels}).transpose(0, 1).contiguous();
+  return run_vertices_first(decoder, h).transpose(0, 1).reshape({batch, -1});
+}
+
+// Inputs and output gradients of one dense layer over the steps of a run.
+struct DenseTape {
+  std::vector<torch::Tensor> inputs, grads;
+
+  // y = x W^T + b with W and b outside autograd; x's gradient still flows.
+  torch::Tensor apply(const std::shared_ptr<DenseTape>& self, const torch::Tensor& x,
+                      const torch::Tensor& weight, const torch::Tensor& bias) {
+    torch::Tensor y = torch::addmm(bias.detach(), x, weight.detach().t());
+    const std::size_t slot = inputs.size();
+    inputs.push_back(x.detach());
+    grads.emplace_back();
+    std::weak_ptr<DenseTape> tape = self;
+    y.register_hook([tape, slot](const torch::Tensor& g) {
+      if (auto t = tape.lock()) t->grads[slot] = g;
+    });
+    return y;
+  }
+
+  // sum_t g_t^T x_t and sum_t g_t over the steps that got a gradient.
+  std::pair<torch::Tensor, torch::Tensor> gradients() const {
+    std::vector<torch::Tensor> x, g;
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      if (!grads[k].defined()) continue;
+      x.push_back(inputs[k]);
+      g.push_back(grads[k]);
+    }
+    if (g.empty()) return {};
+    const torch::Tensor gs = torch::cat(g), xs = torch::cat(x);
+    return {torch::mm(gs.t(), xs), gs.sum(0)};
+  }
+};
+
+struct DenseTapes {
+  bool on = false;
+  std::vector<std::shared_ptr<DenseTape>> latent, hidden;  // one per run
+};
+
+namespace {
+
+void add_gradient(torch::Tensor& parameter, const torch::Tensor& g) {
+  if (parameter.grad().defined()) {
+    parameter.mutable_grad().add_(g);
+  } else {
+    parameter.mutable_grad() = g.clone();
+  }
+}
+
+}  // namespace
+
+void SeqNetImpl::collect_dense_gradients(bool on) {
+  if (!tapes_) tapes_ = std::make_shared<DenseTapes>();
+  tapes_->on = on;
+}
+
+void SeqNetImpl::finish_gradients() {
+  if (!tapes_) return;
+  torch::NoGradGuard no_grad;
+  const std::int64_t latent = shape_.latent;
+  for (const auto& tape : tapes_->latent) {
+    auto [w, b] = tape->gradients();
+    if (!w.defined()) continue;
+    add_gradient(to_mu->weight, w.slice(0, 0, latent));
+    add_gradient(to_logvar->weight, w.slice(0, latent));
+    add_gradient(to_mu->bias, b.slice(0, 0, latent));
+    add_gradient(to_logvar->bias, b.slice(0, latent));
+  }
+  for (const auto& tape : tapes_->hidden) {
+    auto [w, b] = tape->gradients();
+    if (!w.defined()) continue;
+    add_gradient(from_hidden->weight, w);
+    add_gradient(from_hidden->bias, b);
+  }
+  tapes_->latent.clear();
+  tapes_->hidden.clear();
 }
 
 LstmState SeqNetImpl::initial_state(int batch, double sign) const {
@@ -132,13 +268,33 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   const std::int64_t u = given.size(0);
   std::vector<torch::Tensor> frames{given[0]}, mus, logvars;
   torch::Tensor x = given[0];
+  // Mean and log-variance in one product per step (the same numbers as
+  // two): the weights are stacked once per chain.
+  const bool tape = tapes_ && tapes_->on && torch::GradMode::is_enabled();
+  std::shared_ptr<DenseTape> latent_tape, hidden_tape;
+  if (tape) {
+    latent_tape = tapes_->latent.emplace_back(std::make_shared<DenseTape>());
+    hidden_tape = tapes_->hidden.emplace_back(std::make_shared<DenseTape>());
+  }
+  const torch::Tensor weight = torch::cat({to_mu->weight, to_logvar->weight});
+  const torch::Tensor bias = torch::cat({to_mu->bias, to_logvar->bias});
   for (int t = 1; t < n; ++t) {
-    auto [mu, logvar] = encode(x);
+    const torch::Tensor h = encoded(x);
+    const std::vector<torch::Tensor> latent =
+        (tape ? latent_tape->apply(latent_tape, h, weight, bias)
+              : torch::addmm(bias, h, weight.t()))
+            .chunk(2, 1);
+    const torch::Tensor& mu = latent[0];
+    const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
     if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
     auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
     state = next_state;
-    const torch::Tensor generated = x + decode(out.squeeze(0));
+    const torch::Tensor o = out.squeeze(0);
+    const torch::Tensor generated =
+        x + (tape ? decode_from(
+                        hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias))
+                  : decode(o));
     x = t < u ? given[t] : generated;
     frames.push_back(x);
     mus.push_back(mu);
@@ -178,21 +334,46 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
-  const Chain f = net->run(truth.slice(0, 0, 1), n, net->initial_state(batch, 1.0), sample);
-  torch::Tensor kl = kl_loss(f.mu, f.logvar);
   if (bidirectional) {
-    const Chain b = net->run(truth.slice(0, n - 1, n), n, net->initial_state(batch, -1.0), sample);
-    l.recon = recon_loss(f.frames, b.frames, truth);
-    l.bidir = bidir_loss(f.frames, b.frames);
-    kl = 0.5 * (kl + kl_loss(b.mu, b.logvar));
+    // Both chains as one batch of 2 B sequences: the same numbers as two
+    // runs, in half the steps (forward first, +s0; backward, -s0).
+    const LstmState f0 = net->initial_state(batch, 1.0), b0 = net->initial_state(batch, -1.0);
+    const LstmState both{torch::cat({std::get<0>(f0), std::get<0>(b0)}, 1),
+                         torch::cat({std::get<1>(f0), std::get<1>(b0)}, 1)};
+    const torch::Tensor starts = torch::cat({truth.slice(0, 0, 1), truth.slice(0, n - 1, n)}, 1);
+    const Chain c = net->run(starts, n, both, sample);
+    const torch::Tensor f = c.frames.slice(1, 0, batch), b = c.frames.slice(1, batch);
+    l.recon = recon_loss(f, b, truth);
+    l.bidir = bidir_loss(f, b);
+    // Both halves are the same size: the mean over both is the mean of the
+    // two chains' means.
+    l.kl = kl_loss(c.mu, c.logvar);
   } else {
+    const Chain f = net->run(truth.slice(0, 0, 1), n, net->initial_state(batch, 1.0), sample);
+    l.kl = kl_loss(f.mu, f.logvar);
     // One direction: its reconstruction counted twice, to keep the scale.
     l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
     l.bidir = torch::zeros({});
   }
-  l.kl = kl;
   l.l2 = l2_loss(*net);
   l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l2_weight * l.l2);
+  return l;
+}
+
+LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
+                     bool bidirectional, double l2_weight) {
+  net->collect_dense_gradients(true);
+  LossTerms l;
+  try {
+    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+  } catch (...) {
+    net->collect_dense_gradients(false);
+    throw;
+  }
+  net->collect_dense_gradients(false);
+  l.total.backward();
+  net->finish_gradients();
+  adam.step();
   return l;
 }
 

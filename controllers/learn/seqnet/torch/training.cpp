@@ -15,6 +15,7 @@
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/blas_kernels.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
 #include "animrt/learn/seqnet/held_out_completion.hpp"
 #include "animrt/learn/seqnet/network.hpp"
@@ -367,6 +368,10 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     progress << held_out_line(measured, iteration) << std::endl;
   };
 
+  // Said once the data and checkpoint are accepted (an error stays one line).
+  const std::string kernels = blas_kernels();
+  progress << "libtorch threads " << torch::get_num_threads() << ", BLAS kernels "
+           << (kernels.empty() ? "not OpenBLAS" : kernels) << '\n';
   TrainResult result;
   const auto t0 = std::chrono::steady_clock::now();
   const int first_iteration = iteration;
@@ -394,9 +399,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     }
     const torch::Tensor truth =
         torch::from_blob(values.data(), {shape.window, o.batch, set.dims}, torch::kFloat32);
-    const LossTerms l = batch_loss(net, truth, true, o.kl_weight, o.bidirectional, o.l2_weight);
-    l.total.backward();
-    adam.step();
+    const LossTerms l = train_step(net, adam, truth, o.kl_weight, o.bidirectional, o.l2_weight);
     ++iteration;
     result.last = record(l);
     if (!std::isfinite(result.last.total)) {

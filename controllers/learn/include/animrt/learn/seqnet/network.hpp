@@ -13,6 +13,7 @@
 #include <torch/nn/modules/rnn.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,8 +39,11 @@ class MeshConvImpl : public torch::nn::Module {
  public:
   MeshConvImpl(int in, int out, MeshGraph graph, bool transpose);
   torch::Tensor forward(const torch::Tensor& x);
-  // The neighbour mean (or its adjoint) alone.
+  // The same on [V, B, C] (vertices first, contiguous), as the network runs it.
+  torch::Tensor forward_vertices_first(const torch::Tensor& x);
+  // The neighbour mean (or its adjoint) alone, on [B, V, C] and on [V, B, C].
   torch::Tensor ring(const torch::Tensor& x) const;
+  torch::Tensor ring_vertices_first(const torch::Tensor& x) const;
 
   torch::nn::Linear self{nullptr};
   torch::nn::Linear neighbours{nullptr};
@@ -47,6 +51,7 @@ class MeshConvImpl : public torch::nn::Module {
  private:
   MeshGraph graph_;
   bool transpose_;
+  torch::Tensor matrix_, adjoint_;  // sparse V x V: the product and its adjoint
 };
 TORCH_MODULE(MeshConv);
 
@@ -65,14 +70,26 @@ class SeqNetImpl : public torch::nn::Module {
   const NetShape& shape() const { return shape_; }
   // [B, D] -> mean and log-variance [B, latent].
   std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& x);
+  // [B, D] -> the encoder's output, flattened [B, V C] (or [B, width]).
+  torch::Tensor encoded(const torch::Tensor& x);
   // [B, hidden] -> feature change [B, D].
   torch::Tensor decode(const torch::Tensor& h);
+  // The same from the decoder's first dense layer's output (before tanh).
+  torch::Tensor decode_from(const torch::Tensor& dense);
   // Every state entry sign * s0 (sign +1 forward, -1 backward).
   LstmState initial_state(int batch, double sign) const;
   // Runs the chain from `given` ([u, B, D], u >= 1) to n frames: the given
   // frames are fed in order, then each output is the next input. With
   // `sample` the latent is drawn (training), else its mean is used.
   Chain run(const torch::Tensor& given, int n, LstmState state, bool sample);
+
+  // While on, the chains' dense layers (mean and log-variance, the
+  // decoder's first layer) leave their weight gradients out of autograd and
+  // keep each step's input and output gradient instead; after backward,
+  // finish_gradients forms each weight's gradient in one product over all
+  // steps (the same sum as autograd's, without one full-size matrix per step).
+  void collect_dense_gradients(bool on);
+  void finish_gradients();
 
   torch::nn::Sequential encoder{nullptr};  // mesh convolutions or dense layers, tanh
   torch::nn::Linear to_mu{nullptr};
@@ -83,6 +100,7 @@ class SeqNetImpl : public torch::nn::Module {
 
  private:
   NetShape shape_;
+  std::shared_ptr<struct DenseTapes> tapes_;
 };
 TORCH_MODULE(SeqNet);
 
@@ -106,6 +124,13 @@ struct LossTerms {
 // chain from X_n with -s0. `kl_weight`, `l2_weight` and `bidirectional`
 // switch terms off for ablations (1, 1 and true: the paper).
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight = 1.0,
+                     bool bidirectional = true, double l2_weight = 1.0);
+
+class Adam;
+
+// One training iteration on the windows X [n, B, D]: batch_loss with
+// latent sampling, its gradients, one Adam step. Returns the loss terms.
+LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight = 1.0,
                      bool bidirectional = true, double l2_weight = 1.0);
 
 // Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
