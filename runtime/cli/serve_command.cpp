@@ -1,0 +1,155 @@
+#include "serve_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/cue_file.hpp"
+#include "animrt/runtime/figure.hpp"
+#include "animrt/runtime/osc_receiver.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+#include "fault_injection.hpp"
+#include "stop_signals.hpp"
+#include "subcommand.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct ServeArgs {
+  std::string robot;
+  std::string cues;
+  std::string backend = "sim";
+  double duration = 0.0;
+  bool lockstep = false;
+  bool no_realtime = false;
+  std::string osc_bind = "127.0.0.1";
+  int osc_port = 9000;
+  bool no_osc = false;
+};
+
+// Written by the signal handlers, OSC's /stop and the dashboard; read by the cycle.
+RunControls serve_controls;
+
+// What an OSC message asks: /cue/NAME, /stop, /pause (an argument 0
+// resumes), /resume. False for any other address.
+bool answer_osc(const OscMessage& message, const std::vector<Cue>& cues, CueRequests& requests) {
+  const std::string& address = message.address;
+  if (address == "/stop") {
+    serve_controls.stop.store(true);
+    return true;
+  }
+  if (address == "/pause") {
+    requests.pause(message.numbers.empty() || message.numbers.front() != 0.0);
+    return true;
+  }
+  if (address == "/resume") {
+    requests.pause(false);
+    return true;
+  }
+  constexpr std::string_view kCue = "/cue/";
+  if (address.rfind(kCue, 0) != 0) return false;
+  const int cue = find_cue(cues, address.substr(kCue.size()));
+  if (cue < 0) return false;
+  requests.cue(cue);
+  return true;
+}
+
+// What was played and what the triggers sent, after the run's summary.
+void print_cue_report(const CuePlayer& player, const CueRequests& requests,
+                      const OscReceiver* osc) {
+  std::cout << "cues started:";
+  for (std::size_t c = 0; c < player.cues().size(); ++c) {
+    std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
+  }
+  std::cout << '\n'
+            << "cue requests: " << requests.posted() << " posted, " << requests.taken()
+            << " taken by the cycle (the rest replaced by a newer one first), "
+            << player.deferred() << " cycles waited for a crossfade to end\n";
+  if (osc) {
+    std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
+              << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
+  }
+}
+
+int serve(const ServeArgs& args) {
+  install_stop_signals(serve_controls);
+  if (args.lockstep && args.backend != "sim") {
+    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
+    return kExitUsage;
+  }
+  LoadedRobot robot = load_robot(args.robot);
+  // Every cue file and what it names is valid before any device starts.
+  LoadedCues loaded = load_cues(args.cues, robot.config);
+  CueRequests requests;
+  auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
+                                            robot.config.joints, requests);
+  const CuePlayer& playing = *player;
+  robot.motion = std::move(player);
+  robot.steering.reset();
+  std::unique_ptr<OscReceiver> osc;
+  if (!args.no_osc) {
+    osc = std::make_unique<OscReceiver>(
+        args.osc_bind, args.osc_port, [&playing, &requests](const OscMessage& message) {
+          return answer_osc(message, playing.cues(), requests);
+        });
+    std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
+  }
+
+  HardwareBackend hardware;
+  SimulatedBackend simulated(SimulatedBackend::Settings{});
+  FigureBackend& backend =
+      args.backend == "sim" ? static_cast<FigureBackend&>(simulated) : hardware;
+  FigureOptions figure_options;
+  figure_options.lockstep = args.lockstep;
+  figure_options.log = [](const std::string& line) { spdlog::info("{}", line); };
+  figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
+  Figure figure(std::move(robot), backend, figure_options);
+
+  RunOptions options = figure.run_options();
+  options.duration_s = args.duration;
+  options.request_realtime = !args.no_realtime;
+  options.controls = &serve_controls;
+  options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  start_fault_injection();
+  const RunSummary summary = figure.run(options);
+  std::cout << format_summary(summary);
+  print_cue_report(playing, requests, osc.get());
+  std::cout << std::flush;
+  return summary.exit_code();
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto args = std::make_shared<ServeArgs>();
+  auto* cmd = app.add_subcommand(
+      "serve", "Serve a figure: play a cue file's idle cue and triggered cues until stopped");
+  cmd->add_option("ROBOT", args->robot, "robot file (YAML)")->required();
+  cmd->add_option("--cues", args->cues, "cue file (YAML)")->required();
+  cmd->add_option("--backend", args->backend, "sim (simulated devices on ptys) or hardware")
+      ->check(CLI::IsMember({"sim", "hardware"}));
+  cmd->add_option("--duration", args->duration, "seconds, then ramp home (0 = until stopped)")
+      ->check(CLI::Range(0.0, 365.0 * 24 * 3600));
+  cmd->add_flag("--lockstep", args->lockstep,
+                "simulated clock: run as fast as the devices answer (sim backend only)");
+  cmd->add_flag("--no-realtime", args->no_realtime, "do not request SCHED_FIFO or mlockall");
+  cmd->add_option("--osc-bind", args->osc_bind,
+                  "address OSC listens on (loopback unless another is given)");
+  cmd->add_option("--osc-port", args->osc_port, "UDP port for OSC (0: a free one, printed)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
+  set_subcommand_body(cmd, [args]() -> int {
+    try {
+      return serve(*args);
+    } catch (const DeviceError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      return kExitDeviceError;
+    }
+  });
+}
+
+}  // namespace animrt::cli

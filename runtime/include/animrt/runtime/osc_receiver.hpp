@@ -1,0 +1,58 @@
+#pragma once
+// Open Sound Control 1.0 over UDP: show controllers, lighting desks and
+// sensors send cues this way. The receiver runs on its own thread (never in
+// the cycle); each message it parses is handed to a handler, which reaches
+// the cycle through lock-free controls. A malformed packet is counted and
+// dropped; the receiver goes on.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace animrt {
+
+struct OscMessage {
+  std::string address;          // "/cue/hello"
+  std::vector<double> numbers;  // the int32 and float32 arguments, in order
+};
+
+// Appends the messages of one packet (a message, or a bundle of them, nested
+// up to a few levels) to `out`. False when the packet is malformed (then
+// `out` may hold part of it and should be dropped). Address patterns are
+// matched literally.
+bool parse_osc_packet(std::span<const std::uint8_t> packet, std::vector<OscMessage>& out);
+
+class OscReceiver {
+ public:
+  // Returns false for an address nobody answers (counted as unknown).
+  using Handler = std::function<bool(const OscMessage&)>;
+
+  // Binds UDP `host`:`port` (port 0: a free one). Throws std::runtime_error
+  // naming the address when it cannot.
+  OscReceiver(const std::string& host, int port, Handler handler);
+  ~OscReceiver();
+  OscReceiver(const OscReceiver&) = delete;
+  OscReceiver& operator=(const OscReceiver&) = delete;
+
+  int port() const { return port_; }
+  std::uint64_t packets() const { return packets_.load(); }
+  std::uint64_t malformed() const { return malformed_.load(); }
+  std::uint64_t messages() const { return messages_.load(); }
+  std::uint64_t unknown() const { return unknown_.load(); }
+
+ private:
+  void receive();
+
+  int fd_ = -1;
+  int port_ = 0;
+  Handler handler_;
+  std::atomic<bool> running_{true};
+  std::atomic<std::uint64_t> packets_{0}, malformed_{0}, messages_{0}, unknown_{0};
+  std::thread thread_;
+};
+
+}  // namespace animrt
