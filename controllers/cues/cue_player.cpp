@@ -143,8 +143,8 @@ void CuePlayer::advance(double t) const {
   // both smoothly.
   const double goal = requests_.paused() ? 0.0 : 1.0;
   const double ease = dt / kPauseRampS;
-  rate_phase_ = goal > rate_phase_ ? std::min(goal, rate_phase_ + ease)
-                                   : std::max(goal, rate_phase_ - ease);
+  rate_phase_ =
+      goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
   play_ += smootherstep(rate_phase_) * dt;
   int asked = 0;
   if (requests_.take(asked) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {

@@ -67,8 +67,8 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests,
   }
   std::cout << '\n'
             << "cue requests: " << requests.posted() << " posted, " << requests.taken()
-            << " taken by the cycle (the rest replaced by a newer one first), "
-            << player.deferred() << " cycles waited for a crossfade to end\n";
+            << " taken by the cycle (the rest replaced by a newer one first), " << player.deferred()
+            << " cycles waited for a crossfade to end\n";
   if (osc) {
     std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
               << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
@@ -92,10 +92,10 @@ int serve(const ServeArgs& args) {
   robot.steering.reset();
   std::unique_ptr<OscReceiver> osc;
   if (!args.no_osc) {
-    osc = std::make_unique<OscReceiver>(
-        args.osc_bind, args.osc_port, [&playing, &requests](const OscMessage& message) {
-          return answer_osc(message, playing.cues(), requests);
-        });
+    osc = std::make_unique<OscReceiver>(args.osc_bind, args.osc_port,
+                                        [&playing, &requests](const OscMessage& message) {
+                                          return answer_osc(message, playing.cues(), requests);
+                                        });
     std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
   }
 

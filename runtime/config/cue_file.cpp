@@ -29,9 +29,8 @@ std::string resolve(const YamlNode& file, const std::string& cue_path) {
   const std::string given = file.as_string();
   if (given.empty()) file.fail("expected a file path, found \"\"");
   namespace fs = std::filesystem;
-  const fs::path path = fs::path(given).is_absolute()
-                            ? fs::path(given)
-                            : fs::path(cue_path).parent_path() / given;
+  const fs::path path =
+      fs::path(given).is_absolute() ? fs::path(given) : fs::path(cue_path).parent_path() / given;
   const std::string problem = input_file_problem(path.string());
   if (problem == kFileMissing) file.fail("file not found: " + quote_path(path.string()));
   if (!problem.empty()) file.fail(quote_path(path.string()) + " " + problem);
@@ -78,15 +77,16 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
   }
   CueStep step;
   std::vector<std::unique_ptr<MotionSource>> layers;
-  if (auto gait = node.find("gait")) layers.push_back(load_file_motion(*gait, "gait", cue_path, robot));
+  if (auto gait = node.find("gait"))
+    layers.push_back(load_file_motion(*gait, "gait", cue_path, robot));
   if (auto show = node.find("show")) {
     layers.push_back(load_file_motion(*show, "show", cue_path, robot));
     const ShowFile file = load_show_file(resolve(*show, cue_path));
     if (!file.loop) step.duration_s = file.duration_s;
   }
   if (auto pose = node.find("pose")) layers.push_back(make_pose(*pose, robot));
-  step.source = layers.size() == 1 ? std::move(layers.front())
-                                   : make_layered_source(std::move(layers));
+  step.source =
+      layers.size() == 1 ? std::move(layers.front()) : make_layered_source(std::move(layers));
   if (auto d = node.find("duration_s")) step.duration_s = d->as_positive_double();
   return step;
 }
@@ -104,8 +104,9 @@ Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
   for (const YamlNode& step : steps) cue.steps.push_back(make_step(step, cue_path, robot));
   for (std::size_t s = 0; s + 1 < cue.steps.size(); ++s) {
     if (cue.steps[s].duration_s == kForever) {
-      steps[s].fail("this step never ends (a gait, a pose or a looping show), so the steps after "
-                    "it never play; give it duration_s");
+      steps[s].fail(
+          "this step never ends (a gait, a pose or a looping show), so the steps after "
+          "it never play; give it duration_s");
     }
   }
   cue.loop = node.get_bool("loop", false);
@@ -163,8 +164,8 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
   root.allow_only({"idle", "crossfade_s", "cues"});
-  const double crossfade = root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0)
-                                                   : 1.0;
+  const double crossfade =
+      root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
   LoadedCues loaded;
   std::vector<CueDraft> drafts;
   const YamlNode list = root.at("cues");
@@ -183,8 +184,8 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode idle = root.at("idle");
   loaded.idle = find_cue(loaded.cues, idle.as_string());
   if (loaded.idle < 0) {
-    idle.fail("no cue named " + quote(idle.as_string()) + " (the cues: " +
-              cue_names(loaded.cues) + ")");
+    idle.fail("no cue named " + quote(idle.as_string()) + " (the cues: " + cue_names(loaded.cues) +
+              ")");
   }
   for (std::size_t c = 0; c < loaded.cues.size(); ++c) {
     link_cue(loaded.cues, c, loaded.idle, drafts[c]);

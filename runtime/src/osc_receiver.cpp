@@ -1,3 +1,5 @@
+#include "animrt/runtime/osc_receiver.hpp"
+
 #include <arpa/inet.h>
 #include <netdb.h>
 #include <poll.h>
@@ -7,8 +9,6 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
-
-#include "animrt/runtime/osc_receiver.hpp"
 
 namespace animrt {
 namespace {
@@ -78,8 +78,7 @@ void OscReceiver::receive() {
     packets_.fetch_add(1);
     messages.clear();
     const auto size = static_cast<std::size_t>(n);
-    if (size > buffer.size() ||
-        !parse_osc_packet(std::span(buffer.data(), size), messages)) {
+    if (size > buffer.size() || !parse_osc_packet(std::span(buffer.data(), size), messages)) {
       malformed_.fetch_add(1);
       continue;
     }

@@ -52,8 +52,7 @@ inline constexpr double kCrossfadeLimitShare = 0.3;
 class CuePlayer final : public MotionSource {
  public:
   // `idle` indexes `cues`. `joints` are the robot's (limits and home pose).
-  CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joints,
-            CueRequests& requests);
+  CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joints, CueRequests& requests);
 
   std::span<const int> driven_joints() const override { return driven_; }
   void sample(double t, std::span<double> targets) const override;
