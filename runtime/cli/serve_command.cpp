@@ -12,6 +12,8 @@
 #include "animrt/runtime/osc_receiver.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/sim/simulated_backend.hpp"
+#include "dashboard_address.hpp"
+#include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
@@ -29,6 +31,8 @@ struct ServeArgs {
   std::string osc_bind = "127.0.0.1";
   int osc_port = 9000;
   bool no_osc = false;
+  std::string dashboard;  // HOST:PORT, empty = none
+  bool dashboard_remote = false;
 };
 
 // Written by the signal handlers, OSC's /stop and the dashboard; read by the cycle.
@@ -75,12 +79,33 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests,
   }
 }
 
+// --dashboard: the run's page, which also asks for cues and pauses them.
+void serve_dashboard(Figure& figure, const std::pair<std::string, int>& at, bool remote,
+                     const CuePlayer& player, CueRequests& requests) {
+  DashboardSetup setup;
+  setup.host = at.first;
+  setup.port = at.second;
+  setup.remote = remote;
+  setup.www_dir = dashboard_www_dir();
+  setup.cue = [&player, &requests](const std::string& name) {
+    const int cue = find_cue(player.cues(), name);
+    if (cue >= 0) requests.cue(cue);
+    return cue >= 0;
+  };
+  setup.pause_cues = [&requests](bool paused) { requests.pause(paused); };
+  std::cout << "dashboard: " << figure.serve_dashboard(std::move(setup), serve_controls).url()
+            << '\n'
+            << std::flush;
+}
+
 int serve(const ServeArgs& args) {
   install_stop_signals(serve_controls);
   if (args.lockstep && args.backend != "sim") {
     spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
     return kExitUsage;
   }
+  const DashboardAddress address = check_dashboard_address(args.dashboard, args.dashboard_remote);
+  if (!address.ok) return kExitUsage;
   LoadedRobot robot = load_robot(args.robot);
   // Every cue file and what it names is valid before any device starts.
   LoadedCues loaded = load_cues(args.cues, robot.config);
@@ -108,6 +133,7 @@ int serve(const ServeArgs& args) {
   figure_options.log = [](const std::string& line) { spdlog::info("{}", line); };
   figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
   Figure figure(std::move(robot), backend, figure_options);
+  if (address.at) serve_dashboard(figure, *address.at, args.dashboard_remote, playing, requests);
 
   RunOptions options = figure.run_options();
   options.duration_s = args.duration;
@@ -142,6 +168,10 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--osc-port", args->osc_port, "UDP port for OSC (0: a free one, printed)")
       ->check(CLI::Range(0, 65535));
   cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
+  cmd->add_option("--dashboard", args->dashboard,
+                  "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
+  cmd->add_flag("--dashboard-remote", args->dashboard_remote,
+                "let the dashboard listen on an address other machines can reach");
   set_subcommand_body(cmd, [args]() -> int {
     try {
       return serve(*args);
