@@ -7,6 +7,7 @@
 #include <string>
 
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/artnet_receiver.hpp"
 #include "animrt/runtime/cue_file.hpp"
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/osc_receiver.hpp"
@@ -31,6 +32,9 @@ struct ServeArgs {
   std::string osc_bind = "127.0.0.1";
   int osc_port = 9000;
   bool no_osc = false;
+  std::string artnet_bind = "127.0.0.1";
+  int artnet_port = kArtNetPort;
+  bool no_artnet = false;
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
 };
@@ -63,8 +67,8 @@ bool answer_osc(const OscMessage& message, const std::vector<Cue>& cues, CueRequ
 }
 
 // What was played and what the triggers sent, after the run's summary.
-void print_cue_report(const CuePlayer& player, const CueRequests& requests,
-                      const OscReceiver* osc) {
+void print_cue_report(const CuePlayer& player, const CueRequests& requests, const OscReceiver* osc,
+                      const ArtNetReceiver* artnet) {
   std::cout << "cues started:";
   for (std::size_t c = 0; c < player.cues().size(); ++c) {
     std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
@@ -76,6 +80,11 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests,
   if (osc) {
     std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
               << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
+  }
+  if (artnet) {
+    std::cout << "artnet: " << artnet->packets() << " packets, " << artnet->frames()
+              << " frames of the cue universe, " << artnet->malformed() << " malformed, "
+              << artnet->ignored() << " ignored\n";
   }
 }
 
@@ -98,6 +107,35 @@ void serve_dashboard(Figure& figure, const std::pair<std::string, int>& at, bool
             << std::flush;
 }
 
+// The triggers' receivers, each on its own thread, listening before the figure moves.
+std::unique_ptr<OscReceiver> start_osc(const ServeArgs& args, const CuePlayer& playing,
+                                       CueRequests& requests) {
+  if (args.no_osc) return nullptr;
+  auto osc = std::make_unique<OscReceiver>(args.osc_bind, args.osc_port,
+                                           [&playing, &requests](const OscMessage& message) {
+                                             return answer_osc(message, playing.cues(), requests);
+                                           });
+  std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
+  return osc;
+}
+
+std::unique_ptr<ArtNetReceiver> start_artnet(const ServeArgs& args, const LoadedCues& loaded,
+                                             CueRequests& requests) {
+  if (args.no_artnet || loaded.artnet_channel == 0) return nullptr;
+  auto artnet = std::make_unique<ArtNetReceiver>(
+      args.artnet_bind, args.artnet_port, loaded.artnet_universe, loaded.artnet_channel,
+      [&requests, values = loaded.dmx_values](int value) {
+        for (std::size_t c = 0; c < values.size(); ++c) {
+          if (values[c] == value) requests.cue(static_cast<int>(c));
+        }
+      });
+  std::cout << "artnet: listening on " << args.artnet_bind << ':' << artnet->port()
+            << " for universe " << loaded.artnet_universe << ", channel " << loaded.artnet_channel
+            << '\n'
+            << std::flush;
+  return artnet;
+}
+
 int serve(const ServeArgs& args) {
   install_stop_signals(serve_controls);
   if (args.lockstep && args.backend != "sim") {
@@ -115,14 +153,8 @@ int serve(const ServeArgs& args) {
   const CuePlayer& playing = *player;
   robot.motion = std::move(player);
   robot.steering.reset();
-  std::unique_ptr<OscReceiver> osc;
-  if (!args.no_osc) {
-    osc = std::make_unique<OscReceiver>(args.osc_bind, args.osc_port,
-                                        [&playing, &requests](const OscMessage& message) {
-                                          return answer_osc(message, playing.cues(), requests);
-                                        });
-    std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
-  }
+  const std::unique_ptr<OscReceiver> osc = start_osc(args, playing, requests);
+  const std::unique_ptr<ArtNetReceiver> artnet = start_artnet(args, loaded, requests);
 
   HardwareBackend hardware;
   SimulatedBackend simulated(SimulatedBackend::Settings{});
@@ -143,7 +175,7 @@ int serve(const ServeArgs& args) {
   start_fault_injection();
   const RunSummary summary = figure.run(options);
   std::cout << format_summary(summary);
-  print_cue_report(playing, requests, osc.get());
+  print_cue_report(playing, requests, osc.get(), artnet.get());
   std::cout << std::flush;
   return summary.exit_code();
 }
@@ -168,6 +200,11 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--osc-port", args->osc_port, "UDP port for OSC (0: a free one, printed)")
       ->check(CLI::Range(0, 65535));
   cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
+  cmd->add_option("--artnet-bind", args->artnet_bind,
+                  "address Art-Net listens on (loopback unless another is given)");
+  cmd->add_option("--artnet-port", args->artnet_port, "UDP port for Art-Net (0: a free one)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_flag("--no-artnet", args->no_artnet, "take no Art-Net triggers");
   cmd->add_option("--dashboard", args->dashboard,
                   "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,

@@ -163,7 +163,7 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"idle", "crossfade_s", "cues"});
+  root.allow_only({"idle", "crossfade_s", "cues", "artnet"});
   const double crossfade =
       root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
   LoadedCues loaded;
@@ -197,6 +197,14 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
         drafts[a].node->at("dmx").fail("cue " + loaded.cues[b].name + " has this DMX value too");
       }
     }
+  }
+  if (auto artnet = root.find("artnet")) {
+    artnet->allow_only({"universe", "channel"});
+    loaded.artnet_universe = static_cast<int>(artnet->at("universe").as_int_in(0, 32767));
+    loaded.artnet_channel = static_cast<int>(artnet->at("channel").as_int_in(1, 512));
+    bool any = false;
+    for (int value : loaded.dmx_values) any = any || value != 0;
+    if (!any) artnet->fail("no cue has a dmx value, so Art-Net would ask for none");
   }
   return loaded;
 }

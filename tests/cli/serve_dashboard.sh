@@ -11,7 +11,7 @@ trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 "$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
-  --backend sim --lockstep --no-realtime --no-osc --dashboard 127.0.0.1:0 \
+  --backend sim --lockstep --no-realtime --no-osc --no-artnet --dashboard 127.0.0.1:0 \
   > "$tmp/out.txt" 2> "$tmp/err.txt" &
 pid=$!
 for _ in $(seq 150); do

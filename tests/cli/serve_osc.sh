@@ -16,7 +16,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 # Serves until stopped; sets `port` to OSC's once the motion is under way.
 start_serve() {
   "$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
-    --backend sim --lockstep --no-realtime --osc-port 0 > "$tmp/out.txt" 2> "$tmp/err.txt" &
+    --backend sim --lockstep --no-realtime --osc-port 0 --no-artnet > "$tmp/out.txt" 2> "$tmp/err.txt" &
   pid=$!
   for _ in $(seq 150); do
     grep -q "activate: torque on" "$tmp/err.txt" && break

@@ -3,6 +3,7 @@
 //
 //   idle: rest                      # the cue played at the start and between cues
 //   crossfade_s: 1.0                # default crossfade into every cue
+//   artnet: {universe: 0, channel: 1}   # a DMX channel's value (a cue's dmx) asks for it
 //   cues:
 //     rest:  {play: {gait: ../shows/neck_idle_gait.yaml}}
 //     hello: {play: {show: ../shows/hello.yaml}, crossfade_s: 0.5}
@@ -24,8 +25,11 @@ namespace animrt {
 struct LoadedCues {
   std::vector<Cue> cues;
   int idle = 0;
-  // Art-Net: the DMX value (1-255) that asks for each cue, 0 for none.
+  // Art-Net: the DMX value (1-255) that asks for each cue, 0 for none, and
+  // the channel (1-512, 0: no Art-Net) of the universe that carries it.
   std::vector<int> dmx_values;
+  int artnet_universe = 0;
+  int artnet_channel = 0;
 };
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot);

@@ -10,8 +10,9 @@
 #include <functional>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "animrt/runtime/udp_receiver.hpp"
 
 namespace animrt {
 
@@ -34,25 +35,20 @@ class OscReceiver {
   // Binds UDP `host`:`port` (port 0: a free one). Throws std::runtime_error
   // naming the address when it cannot.
   OscReceiver(const std::string& host, int port, Handler handler);
-  ~OscReceiver();
-  OscReceiver(const OscReceiver&) = delete;
-  OscReceiver& operator=(const OscReceiver&) = delete;
 
-  int port() const { return port_; }
-  std::uint64_t packets() const { return packets_.load(); }
+  int port() const { return udp_.port(); }
+  std::uint64_t packets() const { return udp_.datagrams(); }
   std::uint64_t malformed() const { return malformed_.load(); }
   std::uint64_t messages() const { return messages_.load(); }
   std::uint64_t unknown() const { return unknown_.load(); }
 
  private:
-  void receive();
+  void take(std::span<const std::uint8_t> datagram);
 
-  int fd_ = -1;
-  int port_ = 0;
   Handler handler_;
-  std::atomic<bool> running_{true};
-  std::atomic<std::uint64_t> packets_{0}, malformed_{0}, messages_{0}, unknown_{0};
-  std::thread thread_;
+  std::vector<OscMessage> messages_buffer_;  // the receiving thread's
+  std::atomic<std::uint64_t> malformed_{0}, messages_{0}, unknown_{0};
+  UdpReceiver udp_;  // last: its thread stops before the rest goes
 };
 
 }  // namespace animrt
