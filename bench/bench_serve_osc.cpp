@@ -2,8 +2,9 @@
 // animatronic figure serves its shipped cues in real time; a sender thread
 // sends /cue/NAME over UDP on loopback at random phases of the cycle, and
 // the time from sendto() to the first bus write of the cycle that began
-// the cue (the neck bus's Sync Write) is measured. Run idle and with every
-// core kept busy by spinning threads at ordinary priority (load).
+// the cue (the neck bus's Sync Write) is measured. Run as the machine is and
+// with a thread spinning at ordinary priority (added load).
+// Each case ends early if a fault ends the run (its summary is printed).
 //
 //   bench_serve_osc [triggers-per-case]
 
@@ -88,6 +89,7 @@ std::vector<std::uint8_t> osc_cue(const std::string& name) {
 }
 
 double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
 }
@@ -118,7 +120,7 @@ void run_case(bool load, int triggers) {
   run.controls = &controls;
   std::atomic<bool> spinning{load};
   std::vector<std::thread> spinners;
-  for (unsigned i = 0; load && i < std::thread::hardware_concurrency(); ++i) {
+  for (unsigned i = 0; load && i < 1; ++i) {
     spinners.emplace_back([&spinning] {
       volatile std::uint64_t x = 0;
       while (spinning.load(std::memory_order_relaxed)) x = x + 1;
@@ -126,6 +128,7 @@ void run_case(bool load, int triggers) {
   }
   std::vector<double> latencies;
   int missed = 0;
+  std::atomic<bool> ended{false};  // a fault ends the run early
   std::thread sender([&] {
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
     sockaddr_in to{};
@@ -135,8 +138,10 @@ void run_case(bool load, int triggers) {
     std::mt19937 random(7);
     std::this_thread::sleep_for(std::chrono::seconds(3));  // past the start ramp
     const char* names[] = {"look_left", "hello"};
-    for (int i = 0; i < triggers; ++i) {
-      std::this_thread::sleep_for(std::chrono::microseconds(150000 + random() % 10000));
+    for (int i = 0; i < triggers && !ended.load(); ++i) {
+      // Past the last crossfade, so the cue is not kept waiting for a blend slot.
+      const auto fade = std::chrono::duration<double>(player.last_crossfade_s());
+      std::this_thread::sleep_for(fade + std::chrono::microseconds(100000 + random() % 10000));
       const std::vector<std::uint8_t> packet = osc_cue(names[i % 2]);
       pending.latency_ns.store(-1);
       pending.cue.store(find_cue(player.cues(), names[i % 2]));
@@ -157,16 +162,18 @@ void run_case(bool load, int triggers) {
     controls.stop.store(true);
   });
   const RunSummary summary = figure.run(run);
+  ended.store(true);
   sender.join();
   spinning.store(false);
   for (auto& t : spinners) t.join();
   std::printf(
       "%-34s triggers %4zu (missed %d) | OSC send -> bus write p50 %6.2f p99 %6.2f max %6.2f "
-      "ms | loop %3.0f Hz %s, overruns %llu\n",
-      load ? "loaded (a spinning thread per core)" : "idle", latencies.size(), missed,
+      "ms | loop %3.0f Hz %s, overruns %llu, ended by %s\n",
+      load ? "added load (a spinning thread)" : "no added load", latencies.size(), missed,
       percentile(latencies, 0.5), percentile(latencies, 0.99), percentile(latencies, 1.0),
       figure.config().rate_hz, summary.sched_fifo ? "SCHED_FIFO" : "SCHED_OTHER",
-      static_cast<unsigned long long>(summary.overruns));
+      static_cast<unsigned long long>(summary.overruns), to_string(summary.end_reason));
+  if (summary.end_reason == EndReason::fault) std::printf("%s", format_summary(summary).c_str());
 }
 
 }  // namespace

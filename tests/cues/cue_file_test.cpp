@@ -53,6 +53,17 @@ TEST(CueFile, ShippedCuesLoadWithTheirStepsAndHandovers) {
   EXPECT_EQ(loaded.dmx_values[static_cast<std::size_t>(find_cue(loaded.cues, "hello"))], 2);
 }
 
+TEST(CueFile, EveryShippedCueFileLoadsForItsRobot) {
+  int files = 0;
+  for (const char* name : {"animatronic", "head"}) {
+    const RobotConfig robot = load_robot_config(kCueRoot + "/configs/robots/" + name + ".yaml");
+    const LoadedCues loaded = load_cues(kCueRoot + "/configs/cues/" + name + ".yaml", robot);
+    EXPECT_GE(loaded.cues.size(), 2u) << name;
+    ++files;
+  }
+  EXPECT_EQ(files, 2);
+}
+
 TEST(CueFile, ACueNamingAMissingShowNamesFileLineAndKey) {
   const std::string path = write_cues("missing.yaml",
                                       "idle: rest\n"
