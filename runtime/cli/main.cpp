@@ -45,6 +45,7 @@
 #include "scan_command.hpp"
 #include "seq_command.hpp"
 #include "seq_corpus_command.hpp"
+#include "serve_command.hpp"
 #include "servo_command.hpp"
 #include "sim_command.hpp"
 #include "stop_signals.hpp"
@@ -378,6 +379,7 @@ int main(int argc, char** argv) {
   animrt::cli::add_calibrate_command(app);
   animrt::cli::add_record_command(app);
   animrt::cli::add_doctor_command(app);
+  animrt::cli::add_serve_command(app);
   auto* seq = app.add_subcommand(
       "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
   seq->require_subcommand(1);

@@ -217,6 +217,12 @@ LoadedRobot load_robot(const std::string& path) {
   return robot;
 }
 
+std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
+                                                 const RobotConfig& config) {
+  MotionCheck::Speeds speeds;
+  return make_source(motion, config, speeds);
+}
+
 std::vector<std::string> device_guard_notes(const RobotConfig& config) {
   std::vector<std::string> notes;
   for (const BusConfig& bus : config.buses) {

@@ -406,7 +406,27 @@ struct DashboardServer::Impl {
     route_jog();
     route_steer();
     route_show();
+    route_cue();
     route_seek(server);
+  }
+
+  // A served figure's cues: one asked for, or a pause.
+  void route_cue() {
+    control("/api/cue", [this](const json& body, httplib::Response& res) {
+      if (!setup.cue) return error(res, 409, "the figure plays no cues (animrt serve does)");
+      const auto cue = body.find("cue");
+      const auto pause = body.find("pause");
+      if (cue != body.end() && cue->is_string()) {
+        if (!setup.cue(cue->get<std::string>())) {
+          return error(res, 400, "no cue named " + cue->dump());
+        }
+      } else if (pause != body.end() && pause->is_boolean()) {
+        setup.pause_cues(pause->get<bool>());
+      } else {
+        return error(res, 400, "expected {\"cue\": NAME} or {\"pause\": true|false}");
+      }
+      answer(res, 200, {{"ok", true}});
+    });
   }
 
   // A joint's position in manual mode, clamped to its limits.

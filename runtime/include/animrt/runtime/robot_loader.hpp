@@ -33,6 +33,12 @@ struct LoadedRobot {
 // problem in any of the files.
 LoadedRobot load_robot(const std::string& path);
 
+// One motion for the robot (a show, a gait or layers, as its motion section
+// names them), built and checked against its joints as load_robot does.
+// Throws InputError.
+std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
+                                                 const RobotConfig& config);
+
 // One line per bus whose actuators nothing stops if animrt dies (kill -9, a
 // crash, a power cut), or whose guard must be set outside animrt:
 // "bus NAME (PROTOCOL): what to know".

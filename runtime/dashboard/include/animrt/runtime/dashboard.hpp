@@ -37,6 +37,11 @@ struct DashboardSetup {
   double show_duration_s = 0.0;            // its length
   double duration_s = 0.0;                 // 0: until stopped
   FigureKinematics* figure = nullptr;      // the figure's model, if any
+  // A figure in service (`animrt serve`): POST /api/cue {"cue": NAME} asks
+  // for a cue (`cue` is false for a name the cue file lacks), {"pause":
+  // true|false} pauses or resumes. Unset: the run plays no cues (409).
+  std::function<bool(const std::string& name)> cue;
+  std::function<void(bool paused)> pause_cues;
   // A replay (`animrt view`): POST /api/seek calls `seek` (no token: it
   // moves no robot), and the run's controls answer 409.
   bool replay = false;

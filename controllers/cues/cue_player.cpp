@@ -1,0 +1,196 @@
+#include "animrt/controllers/cues/cue_player.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace animrt {
+namespace {
+
+// 6x^5 - 15x^4 + 10x^3: from 0 to 1 with zero slope and curvature at both ends.
+double smootherstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * x * (x * (6.0 * x - 15.0) + 10.0);
+}
+// Its largest slope (at x = 1/2) and largest curvature (at x = (3 - sqrt 3) / 6).
+constexpr double kPeakSlope = 1.875;
+constexpr double kPeakCurvature = 5.773502691896258;  // 10 / sqrt(3)
+// The step over which a motion's velocity at its start is estimated.
+constexpr double kVelocityStepS = 0.01;
+
+}  // namespace
+
+CuePlayer::CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joints,
+                     CueRequests& requests)
+    : cues_(std::move(cues)), idle_(idle), joints_(std::move(joints)), requests_(requests) {
+  if (idle_ < 0 || static_cast<std::size_t>(idle_) >= cues_.size()) {
+    throw std::invalid_argument("cue player: the idle cue is not one of the cues");
+  }
+  std::vector<bool> driven(joints_.size(), false);
+  for (const Cue& cue : cues_) {
+    if (cue.steps.empty()) throw std::invalid_argument("cue " + cue.name + ": no steps");
+    for (const CueStep& step : cue.steps) {
+      for (int j : step.source->driven_joints()) {
+        if (j >= 0 && static_cast<std::size_t>(j) < driven.size()) driven[j] = true;
+      }
+    }
+  }
+  for (std::size_t j = 0; j < driven.size(); ++j) {
+    if (driven[j]) driven_.push_back(static_cast<int>(j));
+  }
+  starts_ = std::make_unique<std::atomic<std::uint64_t>[]>(cues_.size());
+  for (Layer& layer : layers_) layer.pose.assign(joints_.size(), 0.0);
+  out_.assign(joints_.size(), 0.0);
+  prev_out_.assign(joints_.size(), 0.0);
+  scratch_.assign(joints_.size(), 0.0);
+}
+
+std::uint64_t CuePlayer::starts(int cue) const {
+  if (cue < 0 || static_cast<std::size_t>(cue) >= cues_.size()) return 0;
+  return starts_[static_cast<std::size_t>(cue)].load(std::memory_order_relaxed);
+}
+
+void CuePlayer::start(const MotionClock& clock) {
+  for (Cue& cue : cues_) {
+    for (CueStep& step : cue.steps) step.source->start(clock);
+  }
+}
+
+void CuePlayer::stop() {
+  for (Cue& cue : cues_) {
+    for (CueStep& step : cue.steps) step.source->stop();
+  }
+}
+
+double CuePlayer::weight(const Layer& layer) const {
+  if (layer.fade_s <= 0.0) return 1.0;
+  return smootherstep((play_ - layer.fade_start) / layer.fade_s);
+}
+
+void CuePlayer::sample_layer(Layer& layer) const {
+  for (std::size_t j = 0; j < joints_.size(); ++j) layer.pose[j] = joints_[j].home;
+  const CueStep& step = cues_[static_cast<std::size_t>(layer.cue)].steps[layer.step];
+  step.source->sample(play_ - layer.t0, layer.pose);
+}
+
+// The crossfade's length: the cue's, or longer where the gap between the
+// present targets and the next motion's start (in position, and in velocity)
+// would ask a joint for more than its share of its limits.
+double CuePlayer::ease_in_time(const Cue& cue, const MotionSource& next) const {
+  std::vector<double>& at0 = layers_[count_].pose;  // the slot the layer will take
+  for (std::size_t j = 0; j < joints_.size(); ++j) at0[j] = scratch_[j] = joints_[j].home;
+  next.sample(0.0, at0);
+  next.sample(kVelocityStepS, scratch_);
+  double fade = cue.crossfade_s;
+  for (int index : driven_) {
+    const auto j = static_cast<std::size_t>(index);
+    const double a = kCrossfadeLimitShare * joints_[j].limits.max_acceleration;
+    const double v = kCrossfadeLimitShare * joints_[j].limits.max_velocity;
+    const double gap = std::abs(at0[j] - out_[j]);
+    const double now_v = last_dt_ > 0.0 ? (out_[j] - prev_out_[j]) / last_dt_ : 0.0;
+    const double dv = std::abs((scratch_[j] - at0[j]) / kVelocityStepS - now_v);
+    if (a > 0.0) {
+      fade = std::max({fade, std::sqrt(kPeakCurvature * gap / a), 2.0 * kPeakSlope * dv / a});
+    }
+    if (v > 0.0) fade = std::max(fade, kPeakSlope * gap / v);
+  }
+  return fade;
+}
+
+void CuePlayer::push(int cue, int step) const {
+  const bool changes = count_ == 0 || layers_[count_ - 1].cue != cue;
+  const Cue& c = cues_[static_cast<std::size_t>(cue)];
+  const double fade =
+      count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source);
+  Layer& layer = layers_[count_];
+  layer.cue = cue;
+  layer.step = step;
+  layer.t0 = play_;
+  layer.fade_start = play_;
+  layer.fade_s = fade;
+  ++count_;
+  if (step == 0 && changes) starts_[static_cast<std::size_t>(cue)].fetch_add(1);
+  current_.store(cue, std::memory_order_relaxed);
+  last_fade_.store(fade, std::memory_order_relaxed);
+}
+
+// Layers under one fully faded in are no longer seen: dropped (their pose
+// buffers are kept for later layers, so nothing allocates).
+void CuePlayer::compact() const {
+  std::size_t base = 0;
+  for (std::size_t i = count_; i-- > 1;) {
+    if (weight(layers_[i]) >= 1.0) {
+      base = i;
+      break;
+    }
+  }
+  if (base == 0) return;
+  for (std::size_t i = base; i < count_; ++i) std::swap(layers_[i - base], layers_[i]);
+  count_ -= base;
+}
+
+void CuePlayer::advance(double t) const {
+  if (!begun_) {
+    begun_ = true;
+    last_t_ = t;
+    push(idle_, 0);
+  }
+  const double dt = std::max(0.0, t - last_t_);
+  last_t_ = t;
+  step_dt_ = dt;
+  // A pause slows the play time to a halt and a resume speeds it up again,
+  // both smoothly.
+  const double goal = requests_.paused() ? 0.0 : 1.0;
+  const double ease = dt / kPauseRampS;
+  rate_phase_ =
+      goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
+  play_ += smootherstep(rate_phase_) * dt;
+  int asked = 0;
+  if (requests_.take(asked) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {
+    waiting_ = true;
+    waiting_cue_ = asked;
+  }
+  compact();
+  if (waiting_) {
+    if (count_ < kMaxLayers) {
+      push(waiting_cue_, 0);
+      waiting_ = false;
+    } else {
+      deferred_.fetch_add(1, std::memory_order_relaxed);
+    }
+    return;
+  }
+  const Layer& top = layers_[count_ - 1];
+  const Cue& cue = cues_[static_cast<std::size_t>(top.cue)];
+  if (play_ - top.t0 < cue.steps[static_cast<std::size_t>(top.step)].duration_s) return;
+  if (count_ >= kMaxLayers) return;  // the next step waits for a free slot
+  if (static_cast<std::size_t>(top.step) + 1 < cue.steps.size()) {
+    push(top.cue, top.step + 1);
+  } else if (cue.loop || top.cue == idle_) {
+    push(top.cue, 0);
+  } else {
+    push(cue.then < 0 ? idle_ : cue.then, 0);
+  }
+}
+
+void CuePlayer::sample(double t, std::span<double> targets) const {
+  advance(t);
+  for (std::size_t i = 0; i < count_; ++i) sample_layer(layers_[i]);
+  std::swap(prev_out_, out_);
+  std::copy(layers_[0].pose.begin(), layers_[0].pose.end(), out_.begin());
+  for (std::size_t i = 1; i < count_; ++i) {
+    const double w = weight(layers_[i]);
+    for (int j : driven_) {
+      const auto k = static_cast<std::size_t>(j);
+      out_[k] += w * (layers_[i].pose[k] - out_[k]);
+    }
+  }
+  last_dt_ = step_dt_;
+  for (int j : driven_) {
+    const auto k = static_cast<std::size_t>(j);
+    if (k < targets.size()) targets[k] = out_[k];
+  }
+}
+
+}  // namespace animrt

@@ -1,0 +1,114 @@
+#pragma once
+// A figure in service plays cues: an idle cue, and cues that triggers ask
+// for (cue_requests.hpp). Each cue is a sequence of steps (a show, a gait, a
+// held pose), each played for its time, then the next step, the cue again
+// (a loop) or the cue it hands over to. Every change of motion is a
+// crossfade: the new motion's targets are blended in with a weight whose
+// first and second derivatives are zero at both ends, so the blend adds no
+// velocity or acceleration step of its own; a crossfade that would ask a
+// joint for more than a share of its velocity or acceleration limit (a cue
+// that starts far from the present pose) is lengthened until it does not.
+// Joints a step does not drive go to their home pose.
+//
+// The player is a motion source: everything it plays is built and allocated
+// before the run, and sample() only reads requests and blends.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/cues/cue_requests.hpp"
+#include "animrt/controllers/motion_source.hpp"
+#include "animrt/core/joint.hpp"
+
+namespace animrt {
+
+inline constexpr double kForever = std::numeric_limits<double>::infinity();
+
+struct CueStep {
+  std::unique_ptr<MotionSource> source;
+  double duration_s = kForever;  // kForever: until another cue is asked for
+};
+
+struct Cue {
+  std::string name;
+  std::vector<CueStep> steps;
+  double crossfade_s = 1.0;  // into this cue, and between its steps
+  bool loop = false;         // after its last step, its first again
+  int then = -1;             // after its last step (not looping): this cue; -1 the idle cue
+};
+
+// How playback slows to a pause and speeds up again (the motion's time is
+// warped with the same smooth weight, so a pause is no velocity step).
+inline constexpr double kPauseRampS = 0.5;
+// The share of a joint's velocity and acceleration limits a crossfade may
+// use on its own.
+inline constexpr double kCrossfadeLimitShare = 0.3;
+
+class CuePlayer final : public MotionSource {
+ public:
+  // `idle` indexes `cues`. `joints` are the robot's (limits and home pose).
+  CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joints, CueRequests& requests);
+
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double t, std::span<double> targets) const override;
+  void start(const MotionClock& clock) override;
+  void stop() override;
+
+  // Read from any thread while it plays.
+  int current_cue() const { return current_.load(std::memory_order_relaxed); }
+  std::uint64_t starts(int cue) const;  // how often each cue began
+  // Requests taken while every crossfade slot was busy, played when one freed.
+  std::uint64_t deferred() const { return deferred_.load(std::memory_order_relaxed); }
+  const std::vector<Cue>& cues() const { return cues_; }
+  // The crossfade time of the newest change (after any lengthening).
+  double last_crossfade_s() const { return last_fade_.load(std::memory_order_relaxed); }
+
+ private:
+  // One motion being blended in; the newest is on top.
+  struct Layer {
+    int cue = 0;
+    int step = 0;
+    double t0 = 0.0;          // play time at which the step's source had t = 0
+    double fade_start = 0.0;  // play time
+    double fade_s = 0.0;
+    std::vector<double> pose;
+  };
+  static constexpr std::size_t kMaxLayers = 4;
+
+  void advance(double t) const;
+  void push(int cue, int step) const;
+  double ease_in_time(const Cue& cue, const MotionSource& next) const;
+  void sample_layer(Layer& layer) const;
+  void compact() const;
+  double weight(const Layer& layer) const;
+
+  std::vector<Cue> cues_;
+  int idle_;
+  std::vector<JointSpec> joints_;
+  std::vector<int> driven_;
+  CueRequests& requests_;
+  std::unique_ptr<std::atomic<std::uint64_t>[]> starts_;
+  mutable std::atomic<int> current_{-1};
+  mutable std::atomic<std::uint64_t> deferred_{0};
+  mutable std::atomic<double> last_fade_{0.0};
+
+  // The playback state: the cycle's alone (sample() is const to its caller).
+  mutable std::array<Layer, kMaxLayers> layers_;
+  mutable std::size_t count_ = 0;
+  mutable bool begun_ = false;
+  mutable double last_t_ = 0.0;
+  mutable double play_ = 0.0;        // play time: motion time slowed by pauses
+  mutable double rate_phase_ = 1.0;  // 1 playing, 0 paused, between: easing
+  mutable bool waiting_ = false;     // a request waits for a free slot
+  mutable int waiting_cue_ = 0;
+  mutable std::vector<double> out_, prev_out_, scratch_;
+  mutable double last_dt_ = 0.0;  // motion time between prev_out_ and out_
+  mutable double step_dt_ = 0.0;  // this call's
+};
+
+}  // namespace animrt

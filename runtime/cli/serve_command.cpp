@@ -1,0 +1,222 @@
+#include "serve_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/artnet_receiver.hpp"
+#include "animrt/runtime/cue_file.hpp"
+#include "animrt/runtime/figure.hpp"
+#include "animrt/runtime/osc_receiver.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+#include "animrt/sim/simulated_backend.hpp"
+#include "dashboard_address.hpp"
+#include "data_dir.hpp"
+#include "fault_injection.hpp"
+#include "stop_signals.hpp"
+#include "subcommand.hpp"
+
+namespace animrt::cli {
+namespace {
+
+struct ServeArgs {
+  std::string robot;
+  std::string cues;
+  std::string backend = "sim";
+  double duration = 0.0;
+  bool lockstep = false;
+  bool no_realtime = false;
+  std::string osc_bind = "127.0.0.1";
+  int osc_port = 9000;
+  bool no_osc = false;
+  std::string artnet_bind = "127.0.0.1";
+  int artnet_port = kArtNetPort;
+  bool no_artnet = false;
+  std::string dashboard;  // HOST:PORT, empty = none
+  bool dashboard_remote = false;
+};
+
+// Written by the signal handlers, OSC's /stop and the dashboard; read by the cycle.
+RunControls serve_controls;
+
+// What an OSC message asks: /cue/NAME, /stop, /pause (an argument 0
+// resumes), /resume. False for any other address.
+bool answer_osc(const OscMessage& message, const std::vector<Cue>& cues, CueRequests& requests) {
+  const std::string& address = message.address;
+  if (address == "/stop") {
+    serve_controls.stop.store(true);
+    return true;
+  }
+  if (address == "/pause") {
+    requests.pause(message.numbers.empty() || message.numbers.front() != 0.0);
+    return true;
+  }
+  if (address == "/resume") {
+    requests.pause(false);
+    return true;
+  }
+  constexpr std::string_view kCue = "/cue/";
+  if (address.rfind(kCue, 0) != 0) return false;
+  const int cue = find_cue(cues, address.substr(kCue.size()));
+  if (cue < 0) return false;
+  requests.cue(cue);
+  return true;
+}
+
+// What was played and what the triggers sent, after the run's summary.
+void print_cue_report(const CuePlayer& player, const CueRequests& requests, const OscReceiver* osc,
+                      const ArtNetReceiver* artnet) {
+  std::cout << "cues started:";
+  for (std::size_t c = 0; c < player.cues().size(); ++c) {
+    std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
+  }
+  std::cout << '\n'
+            << "cue requests: " << requests.posted() << " posted, " << requests.taken()
+            << " taken by the cycle (the rest replaced by a newer one first), " << player.deferred()
+            << " cycles waited for a crossfade to end\n";
+  if (osc) {
+    std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
+              << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
+  }
+  if (artnet) {
+    std::cout << "artnet: " << artnet->packets() << " packets, " << artnet->frames()
+              << " frames of the cue universe, " << artnet->malformed() << " malformed, "
+              << artnet->ignored() << " ignored\n";
+  }
+}
+
+// --dashboard: the run's page, which also asks for cues and pauses them.
+void serve_dashboard(Figure& figure, const std::pair<std::string, int>& at, bool remote,
+                     const CuePlayer& player, CueRequests& requests) {
+  DashboardSetup setup;
+  setup.host = at.first;
+  setup.port = at.second;
+  setup.remote = remote;
+  setup.www_dir = dashboard_www_dir();
+  setup.cue = [&player, &requests](const std::string& name) {
+    const int cue = find_cue(player.cues(), name);
+    if (cue >= 0) requests.cue(cue);
+    return cue >= 0;
+  };
+  setup.pause_cues = [&requests](bool paused) { requests.pause(paused); };
+  std::cout << "dashboard: " << figure.serve_dashboard(std::move(setup), serve_controls).url()
+            << '\n'
+            << std::flush;
+}
+
+// The triggers' receivers, each on its own thread, listening before the figure moves.
+std::unique_ptr<OscReceiver> start_osc(const ServeArgs& args, const CuePlayer& playing,
+                                       CueRequests& requests) {
+  if (args.no_osc) return nullptr;
+  auto osc = std::make_unique<OscReceiver>(args.osc_bind, args.osc_port,
+                                           [&playing, &requests](const OscMessage& message) {
+                                             return answer_osc(message, playing.cues(), requests);
+                                           });
+  std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
+  return osc;
+}
+
+std::unique_ptr<ArtNetReceiver> start_artnet(const ServeArgs& args, const LoadedCues& loaded,
+                                             CueRequests& requests) {
+  if (args.no_artnet || loaded.artnet_channel == 0) return nullptr;
+  auto artnet = std::make_unique<ArtNetReceiver>(
+      args.artnet_bind, args.artnet_port, loaded.artnet_universe, loaded.artnet_channel,
+      [&requests, values = loaded.dmx_values](int value) {
+        for (std::size_t c = 0; c < values.size(); ++c) {
+          if (values[c] == value) requests.cue(static_cast<int>(c));
+        }
+      });
+  std::cout << "artnet: listening on " << args.artnet_bind << ':' << artnet->port()
+            << " for universe " << loaded.artnet_universe << ", channel " << loaded.artnet_channel
+            << '\n'
+            << std::flush;
+  return artnet;
+}
+
+int serve(const ServeArgs& args) {
+  install_stop_signals(serve_controls);
+  if (args.lockstep && args.backend != "sim") {
+    spdlog::error("--lockstep needs --backend sim (hardware runs in real time)");
+    return kExitUsage;
+  }
+  const DashboardAddress address = check_dashboard_address(args.dashboard, args.dashboard_remote);
+  if (!address.ok) return kExitUsage;
+  LoadedRobot robot = load_robot(args.robot);
+  // Every cue file and what it names is valid before any device starts.
+  LoadedCues loaded = load_cues(args.cues, robot.config);
+  CueRequests requests;
+  auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
+                                            robot.config.joints, requests);
+  const CuePlayer& playing = *player;
+  robot.motion = std::move(player);
+  robot.steering.reset();
+  const std::unique_ptr<OscReceiver> osc = start_osc(args, playing, requests);
+  const std::unique_ptr<ArtNetReceiver> artnet = start_artnet(args, loaded, requests);
+
+  HardwareBackend hardware;
+  SimulatedBackend simulated(SimulatedBackend::Settings{});
+  FigureBackend& backend =
+      args.backend == "sim" ? static_cast<FigureBackend&>(simulated) : hardware;
+  FigureOptions figure_options;
+  figure_options.lockstep = args.lockstep;
+  figure_options.log = [](const std::string& line) { spdlog::info("{}", line); };
+  figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
+  Figure figure(std::move(robot), backend, figure_options);
+  if (address.at) serve_dashboard(figure, *address.at, args.dashboard_remote, playing, requests);
+
+  RunOptions options = figure.run_options();
+  options.duration_s = args.duration;
+  options.request_realtime = !args.no_realtime;
+  options.controls = &serve_controls;
+  options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  start_fault_injection();
+  const RunSummary summary = figure.run(options);
+  std::cout << format_summary(summary);
+  print_cue_report(playing, requests, osc.get(), artnet.get());
+  std::cout << std::flush;
+  return summary.exit_code();
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto args = std::make_shared<ServeArgs>();
+  auto* cmd = app.add_subcommand(
+      "serve", "Serve a figure: play a cue file's idle cue and triggered cues until stopped");
+  cmd->add_option("ROBOT", args->robot, "robot file (YAML)")->required();
+  cmd->add_option("--cues", args->cues, "cue file (YAML)")->required();
+  cmd->add_option("--backend", args->backend, "sim (simulated devices on ptys) or hardware")
+      ->check(CLI::IsMember({"sim", "hardware"}));
+  cmd->add_option("--duration", args->duration, "seconds, then ramp home (0 = until stopped)")
+      ->check(CLI::Range(0.0, 365.0 * 24 * 3600));
+  cmd->add_flag("--lockstep", args->lockstep,
+                "simulated clock: run as fast as the devices answer (sim backend only)");
+  cmd->add_flag("--no-realtime", args->no_realtime, "do not request SCHED_FIFO or mlockall");
+  cmd->add_option("--osc-bind", args->osc_bind,
+                  "address OSC listens on (loopback unless another is given)");
+  cmd->add_option("--osc-port", args->osc_port, "UDP port for OSC (0: a free one, printed)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
+  cmd->add_option("--artnet-bind", args->artnet_bind,
+                  "address Art-Net listens on (loopback unless another is given)");
+  cmd->add_option("--artnet-port", args->artnet_port, "UDP port for Art-Net (0: a free one)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_flag("--no-artnet", args->no_artnet, "take no Art-Net triggers");
+  cmd->add_option("--dashboard", args->dashboard,
+                  "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
+  cmd->add_flag("--dashboard-remote", args->dashboard_remote,
+                "let the dashboard listen on an address other machines can reach");
+  set_subcommand_body(cmd, [args]() -> int {
+    try {
+      return serve(*args);
+    } catch (const DeviceError& e) {
+      std::cerr << "error: " << e.what() << '\n';
+      return kExitDeviceError;
+    }
+  });
+}
+
+}  // namespace animrt::cli

@@ -1,0 +1,212 @@
+#include "animrt/runtime/cue_file.hpp"
+
+#include <filesystem>
+#include <map>
+
+#include "animrt/controllers/cues/pose_source.hpp"
+#include "animrt/controllers/show/show_file.hpp"
+#include "animrt/core/input_file.hpp"
+#include "animrt/core/yaml_doc.hpp"
+#include "animrt/runtime/robot_loader.hpp"
+
+namespace animrt {
+namespace {
+
+// What a cue says while it is read, before the cues it names are known.
+struct CueDraft {
+  std::optional<YamlNode> then_node;
+  std::optional<YamlNode> loop_node;
+  std::optional<YamlNode> node;
+};
+
+std::string cue_names(const std::vector<Cue>& cues) {
+  std::string names;
+  for (const Cue& cue : cues) names += (names.empty() ? "" : ", ") + cue.name;
+  return names;
+}
+
+std::string resolve(const YamlNode& file, const std::string& cue_path) {
+  const std::string given = file.as_string();
+  if (given.empty()) file.fail("expected a file path, found \"\"");
+  namespace fs = std::filesystem;
+  const fs::path path =
+      fs::path(given).is_absolute() ? fs::path(given) : fs::path(cue_path).parent_path() / given;
+  const std::string problem = input_file_problem(path.string());
+  if (problem == kFileMissing) file.fail("file not found: " + quote_path(path.string()));
+  if (!problem.empty()) file.fail(quote_path(path.string()) + " " + problem);
+  return path.string();
+}
+
+std::unique_ptr<MotionSource> make_pose(const YamlNode& node, const RobotConfig& robot) {
+  std::vector<std::pair<int, double>> pose;
+  for (const auto& [name, value] : node.entries()) {
+    int index = -1;
+    for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+      if (robot.joints[j].name == name) index = static_cast<int>(j);
+    }
+    if (index < 0) value.fail("no joint " + quote(name) + " in robot " + robot.name);
+    const JointSpec& joint = robot.joints[static_cast<std::size_t>(index)];
+    const bool metres = joint.type == JointType::prismatic;
+    const double lo = metres ? joint.limits.min_position : rad_to_deg(joint.limits.min_position);
+    const double hi = metres ? joint.limits.max_position : rad_to_deg(joint.limits.max_position);
+    const double given = value.as_double_in(lo, hi);
+    pose.emplace_back(index, metres ? given : deg_to_rad(given));
+  }
+  if (pose.empty()) node.fail("expected joint: degrees pairs, found none");
+  return make_pose_source(std::move(pose));
+}
+
+std::unique_ptr<MotionSource> load_file_motion(const YamlNode& file, const std::string& type,
+                                               const std::string& cue_path,
+                                               const RobotConfig& robot) {
+  MotionConfig motion;
+  motion.type = type;
+  motion.file = resolve(file, cue_path);
+  motion.where = file.location();
+  motion.key = file.path();
+  return load_motion_source(motion, robot);
+}
+
+// One step: a gait, a show, a pose, or several of them layered in that order
+// (later ones win on the joints they drive), and how long it plays: a show
+// that does not loop for its length, everything else until the next cue.
+CueStep make_step(const YamlNode& node, const std::string& cue_path, const RobotConfig& robot) {
+  node.allow_only({"gait", "show", "pose", "duration_s"});
+  if (!node.has("show") && !node.has("gait") && !node.has("pose")) {
+    node.fail("expected a gait, a show or a pose (or several, layered), found none");
+  }
+  CueStep step;
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  if (auto gait = node.find("gait"))
+    layers.push_back(load_file_motion(*gait, "gait", cue_path, robot));
+  if (auto show = node.find("show")) {
+    layers.push_back(load_file_motion(*show, "show", cue_path, robot));
+    const ShowFile file = load_show_file(resolve(*show, cue_path));
+    if (!file.loop) step.duration_s = file.duration_s;
+  }
+  if (auto pose = node.find("pose")) layers.push_back(make_pose(*pose, robot));
+  step.source =
+      layers.size() == 1 ? std::move(layers.front()) : make_layered_source(std::move(layers));
+  if (auto d = node.find("duration_s")) step.duration_s = d->as_positive_double();
+  return step;
+}
+
+Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
+             const std::string& cue_path, const RobotConfig& robot) {
+  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx"});
+  Cue cue;
+  cue.name = name;
+  cue.crossfade_s = crossfade;
+  if (auto c = node.find("crossfade_s")) cue.crossfade_s = c->as_double_in(0.0, 60.0);
+  const YamlNode play = node.at("play");
+  std::vector<YamlNode> steps = play.is_sequence() ? play.items() : std::vector<YamlNode>{play};
+  if (steps.empty()) play.fail("expected at least one step, found an empty list");
+  for (const YamlNode& step : steps) cue.steps.push_back(make_step(step, cue_path, robot));
+  for (std::size_t s = 0; s + 1 < cue.steps.size(); ++s) {
+    if (cue.steps[s].duration_s == kForever) {
+      steps[s].fail(
+          "this step never ends (a gait, a pose or a looping show), so the steps after "
+          "it never play; give it duration_s");
+    }
+  }
+  cue.loop = node.get_bool("loop", false);
+  return cue;
+}
+
+// A cue hands over to another when it ends (`then`, or the idle cue); cues
+// that hand over to one another in a ring that never reaches the idle cue
+// would never stop playing on their own.
+void check_handovers(const std::vector<Cue>& cues, int idle, const std::vector<CueDraft>& drafts) {
+  for (std::size_t first = 0; first < cues.size(); ++first) {
+    std::vector<bool> seen(cues.size(), false);
+    std::string path = cues[first].name;
+    int at = static_cast<int>(first);
+    while (at != idle && cues[static_cast<std::size_t>(at)].then >= 0) {
+      seen[static_cast<std::size_t>(at)] = true;
+      at = cues[static_cast<std::size_t>(at)].then;
+      path += " -> " + cues[static_cast<std::size_t>(at)].name;
+      if (at != idle && seen[static_cast<std::size_t>(at)]) {
+        drafts[first].then_node->fail("the cues hand over in a loop without an exit (" + path +
+                                      "): one of them must end at the idle cue " +
+                                      quote(cues[static_cast<std::size_t>(idle)].name));
+      }
+    }
+  }
+}
+
+void link_cue(std::vector<Cue>& cues, std::size_t c, int idle, const CueDraft& draft) {
+  Cue& cue = cues[c];
+  const bool forever = cue.steps.back().duration_s == kForever;
+  if (draft.then_node) {
+    const YamlNode& then = *draft.then_node;
+    if (static_cast<int>(c) == idle) then.fail("the idle cue repeats; it hands over to no cue");
+    if (cue.loop) then.fail("a looping cue never ends, so `then` never comes; drop one");
+    if (forever) then.fail("the cue's last step never ends, so `then` never comes");
+    cue.then = find_cue(cues, then.as_string());
+    if (cue.then < 0) {
+      then.fail("no cue named " + quote(then.as_string()) + " (the cues: " + cue_names(cues) + ")");
+    }
+  }
+  if (cue.loop && forever) {
+    draft.loop_node->fail("the cue's last step never ends, so it never loops; drop loop");
+  }
+}
+
+}  // namespace
+
+int find_cue(const std::vector<Cue>& cues, const std::string& name) {
+  for (std::size_t c = 0; c < cues.size(); ++c) {
+    if (cues[c].name == name) return static_cast<int>(c);
+  }
+  return -1;
+}
+
+LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
+  const YamlNode root = YamlNode::load_file(path);
+  root.allow_only({"idle", "crossfade_s", "cues", "artnet"});
+  const double crossfade =
+      root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
+  LoadedCues loaded;
+  std::vector<CueDraft> drafts;
+  const YamlNode list = root.at("cues");
+  if (!list.is_map()) list.fail("expected a map of cue names to cues, found " + list.describe());
+  for (const auto& [name, node] : list.entries()) {
+    const bool plain = !name.empty() && name.find_first_not_of(
+                                            "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                            "0123456789_-") == std::string::npos;
+    if (!plain) node.fail("a cue's name is letters, digits, _ and - (it is an OSC address)");
+    loaded.cues.push_back(make_cue(name, node, crossfade, path, robot));
+    drafts.push_back({node.find("then"), node.find("loop"), node});
+    const auto dmx = node.find("dmx");
+    loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);
+  }
+  if (loaded.cues.empty()) list.fail("expected at least one cue, found none");
+  const YamlNode idle = root.at("idle");
+  loaded.idle = find_cue(loaded.cues, idle.as_string());
+  if (loaded.idle < 0) {
+    idle.fail("no cue named " + quote(idle.as_string()) + " (the cues: " + cue_names(loaded.cues) +
+              ")");
+  }
+  for (std::size_t c = 0; c < loaded.cues.size(); ++c) {
+    link_cue(loaded.cues, c, loaded.idle, drafts[c]);
+  }
+  check_handovers(loaded.cues, loaded.idle, drafts);
+  for (std::size_t a = 0; a < loaded.dmx_values.size(); ++a) {
+    for (std::size_t b = 0; b < a; ++b) {
+      if (loaded.dmx_values[a] != 0 && loaded.dmx_values[a] == loaded.dmx_values[b]) {
+        drafts[a].node->at("dmx").fail("cue " + loaded.cues[b].name + " has this DMX value too");
+      }
+    }
+  }
+  if (auto artnet = root.find("artnet")) {
+    artnet->allow_only({"universe", "channel"});
+    loaded.artnet_universe = static_cast<int>(artnet->at("universe").as_int_in(0, 32767));
+    loaded.artnet_channel = static_cast<int>(artnet->at("channel").as_int_in(1, 512));
+    bool any = false;
+    for (int value : loaded.dmx_values) any = any || value != 0;
+    if (!any) artnet->fail("no cue has a dmx value, so Art-Net would ask for none");
+  }
+  return loaded;
+}
+
+}  // namespace animrt

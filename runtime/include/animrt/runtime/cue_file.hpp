@@ -1,0 +1,40 @@
+#pragma once
+// A cue file: what a figure in service plays (configs/cues/, docs/show_control.md).
+//
+//   idle: rest                      # the cue played at the start and between cues
+//   crossfade_s: 1.0                # default crossfade into every cue
+//   artnet: {universe: 0, channel: 1}   # a DMX channel's value (a cue's dmx) asks for it
+//   cues:
+//     rest:  {play: {gait: ../shows/neck_idle_gait.yaml}}
+//     hello: {play: {show: ../shows/hello.yaml}, crossfade_s: 0.5}
+//     look:  {play: [{pose: {neck_pan: 40}, duration_s: 2}, {show: ../shows/hello.yaml}],
+//             then: rest}
+//
+// Every file a cue names is loaded and checked against the robot before
+// anything moves; a bad cue file is one InputError naming its file, line
+// and key.
+
+#include <string>
+#include <vector>
+
+#include "animrt/controllers/cues/cue_player.hpp"
+#include "animrt/runtime/robot_config.hpp"
+
+namespace animrt {
+
+struct LoadedCues {
+  std::vector<Cue> cues;
+  int idle = 0;
+  // Art-Net: the DMX value (1-255) that asks for each cue, 0 for none, and
+  // the channel (1-512, 0: no Art-Net) of the universe that carries it.
+  std::vector<int> dmx_values;
+  int artnet_universe = 0;
+  int artnet_channel = 0;
+};
+
+LoadedCues load_cues(const std::string& path, const RobotConfig& robot);
+
+// The index of the cue called `name`, or -1.
+int find_cue(const std::vector<Cue>& cues, const std::string& name);
+
+}  // namespace animrt

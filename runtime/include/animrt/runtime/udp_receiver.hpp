@@ -1,0 +1,41 @@
+#pragma once
+// A UDP port read on a thread of its own (never the cycle's): each datagram
+// is handed to a handler on that thread. Show-control triggers (OSC,
+// Art-Net) arrive this way.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <thread>
+
+namespace animrt {
+
+class UdpReceiver {
+ public:
+  // A datagram longer than the largest UDP payload comes as an empty span.
+  using Handler = std::function<void(std::span<const std::uint8_t> datagram)>;
+
+  // Binds UDP `host`:`port` (port 0: a free one). Throws std::runtime_error
+  // naming `what` and the address when it cannot.
+  UdpReceiver(const std::string& what, const std::string& host, int port, Handler handler);
+  ~UdpReceiver();
+  UdpReceiver(const UdpReceiver&) = delete;
+  UdpReceiver& operator=(const UdpReceiver&) = delete;
+
+  int port() const { return port_; }
+  std::uint64_t datagrams() const { return datagrams_.load(); }
+
+ private:
+  void receive();
+
+  int fd_ = -1;
+  int port_ = 0;
+  Handler handler_;
+  std::atomic<bool> running_{true};
+  std::atomic<std::uint64_t> datagrams_{0};
+  std::thread thread_;
+};
+
+}  // namespace animrt

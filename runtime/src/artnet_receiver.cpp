@@ -1,0 +1,58 @@
+#include "animrt/runtime/artnet_receiver.hpp"
+
+#include <cstring>
+
+namespace animrt {
+namespace {
+
+constexpr std::size_t kHeader = 18;
+constexpr std::uint16_t kOpDmx = 0x5000;
+
+}  // namespace
+
+ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
+  static constexpr char kId[8] = {'A', 'r', 't', '-', 'N', 'e', 't', '\0'};
+  if (packet.size() < 10 || std::memcmp(packet.data(), kId, sizeof kId) != 0) {
+    return ArtNetParse::malformed;
+  }
+  const std::uint16_t opcode = static_cast<std::uint16_t>(packet[8] | (packet[9] << 8));
+  if (opcode != kOpDmx) return ArtNetParse::other;
+  if (packet.size() < kHeader) return ArtNetParse::malformed;
+  const std::size_t length = (std::size_t{packet[16]} << 8) | packet[17];
+  if (length < 2 || length > 512 || length % 2 != 0 || packet.size() != kHeader + length) {
+    return ArtNetParse::malformed;
+  }
+  out.universe = ((packet[15] & 0x7f) << 8) | packet[14];
+  out.data = packet.subspan(kHeader, length);
+  return ArtNetParse::dmx;
+}
+
+ArtNetReceiver::ArtNetReceiver(const std::string& host, int port, int universe, int channel,
+                               Handler handler)
+    : universe_(universe),
+      channel_(channel),
+      handler_(std::move(handler)),
+      udp_("Art-Net", host, port,
+           [this](std::span<const std::uint8_t> datagram) { take(datagram); }) {}
+
+void ArtNetReceiver::take(std::span<const std::uint8_t> datagram) {
+  ArtDmx dmx;
+  const ArtNetParse parsed = parse_artnet(datagram, dmx);
+  if (parsed == ArtNetParse::malformed) {
+    malformed_.fetch_add(1);
+    return;
+  }
+  if (parsed == ArtNetParse::other || dmx.universe != universe_) {
+    ignored_.fetch_add(1);
+    return;
+  }
+  frames_.fetch_add(1);
+  // A frame too short to hold the channel leaves it as it was.
+  if (static_cast<std::size_t>(channel_) > dmx.data.size()) return;
+  const int value = dmx.data[static_cast<std::size_t>(channel_ - 1)];
+  if (value == last_) return;
+  last_ = value;
+  handler_(value);
+}
+
+}  // namespace animrt

@@ -1,0 +1,88 @@
+#include "animrt/runtime/udp_receiver.hpp"
+
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace animrt {
+namespace {
+
+// How often the thread looks whether it should end.
+constexpr int kPollMs = 100;
+constexpr std::size_t kMaxDatagram = 65536;
+
+int bind_udp(const std::string& what, const std::string& host, int port, int& bound_port) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_DGRAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  const int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found);
+  if (rc != 0) {
+    throw std::runtime_error(what + ": cannot bind " + host + ":" + service + ": " +
+                             ::gai_strerror(rc));
+  }
+  int fd = -1;
+  int error = 0;
+  for (addrinfo* a = found; a != nullptr && fd < 0; a = a->ai_next) {
+    fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd >= 0 && ::bind(fd, a->ai_addr, a->ai_addrlen) != 0) {
+      error = errno;
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  ::freeaddrinfo(found);
+  if (fd < 0) {
+    throw std::runtime_error(what + ": cannot bind " + host + ":" + service + ": " +
+                             std::strerror(error));
+  }
+  sockaddr_storage at{};
+  socklen_t length = sizeof at;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&at), &length);
+  bound_port = at.ss_family == AF_INET6
+                   ? ntohs(reinterpret_cast<const sockaddr_in6*>(&at)->sin6_port)
+                   : ntohs(reinterpret_cast<const sockaddr_in*>(&at)->sin_port);
+  return fd;
+}
+
+}  // namespace
+
+UdpReceiver::UdpReceiver(const std::string& what, const std::string& host, int port,
+                         Handler handler)
+    : handler_(std::move(handler)) {
+  fd_ = bind_udp(what, host, port, port_);
+  // Room for a burst from a show controller while this thread is not running.
+  const int buffer = 1 << 20;
+  ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
+  thread_ = std::thread([this] { receive(); });
+}
+
+UdpReceiver::~UdpReceiver() {
+  running_.store(false);
+  if (thread_.joinable()) thread_.join();
+  ::close(fd_);
+}
+
+void UdpReceiver::receive() {
+  std::vector<std::uint8_t> buffer(kMaxDatagram);
+  while (running_.load()) {
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, kPollMs) <= 0) continue;
+    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+    if (n < 0) continue;
+    datagrams_.fetch_add(1);
+    const auto size = static_cast<std::size_t>(n);
+    handler_(size > buffer.size() ? std::span<const std::uint8_t>()
+                                  : std::span<const std::uint8_t>(buffer.data(), size));
+  }
+}
+
+}  // namespace animrt

@@ -1,0 +1,143 @@
+// The cue file: what it plays, and one clear error (file, line, key) for
+// each way it can be wrong, before anything moves.
+
+#include "animrt/runtime/cue_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "animrt/core/error.hpp"
+#include "animrt/runtime/robot_config.hpp"
+
+namespace animrt {
+namespace {
+
+const std::string kCueRoot = ANIMRT_SOURCE_DIR;
+
+RobotConfig animatronic() {
+  return load_robot_config(kCueRoot + "/configs/robots/animatronic.yaml");
+}
+
+// Writes a cue file beside the shipped shows, so their relative paths hold.
+std::string write_cues(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << "# " << name << "\n" << text;
+  return path;
+}
+
+std::string shows() { return kCueRoot + "/configs/shows/"; }
+
+// The InputError's text, or "" when the file loads.
+std::string load_error(const std::string& path) {
+  try {
+    load_cues(path, animatronic());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(CueFile, ShippedCuesLoadWithTheirStepsAndHandovers) {
+  const LoadedCues loaded = load_cues(kCueRoot + "/configs/cues/animatronic.yaml", animatronic());
+  ASSERT_EQ(loaded.cues.size(), 4u);
+  EXPECT_EQ(loaded.cues[static_cast<std::size_t>(loaded.idle)].name, "sway");
+  const Cue& greet = loaded.cues[static_cast<std::size_t>(find_cue(loaded.cues, "greet"))];
+  ASSERT_EQ(greet.steps.size(), 3u);
+  EXPECT_DOUBLE_EQ(greet.steps[0].duration_s, 1.5);
+  EXPECT_DOUBLE_EQ(greet.crossfade_s, 0.8);
+  EXPECT_EQ(greet.then, -1);  // back to the idle cue
+  const Cue& look = loaded.cues[static_cast<std::size_t>(find_cue(loaded.cues, "look_left"))];
+  EXPECT_EQ(look.steps[0].duration_s, kForever);
+  EXPECT_EQ(loaded.dmx_values[static_cast<std::size_t>(find_cue(loaded.cues, "hello"))], 2);
+}
+
+TEST(CueFile, EveryShippedCueFileLoadsForItsRobot) {
+  int files = 0;
+  for (const char* name : {"animatronic", "head"}) {
+    const RobotConfig robot = load_robot_config(kCueRoot + "/configs/robots/" + name + ".yaml");
+    const LoadedCues loaded = load_cues(kCueRoot + "/configs/cues/" + name + ".yaml", robot);
+    EXPECT_GE(loaded.cues.size(), 2u) << name;
+    ++files;
+  }
+  EXPECT_EQ(files, 2);
+}
+
+TEST(CueFile, ACueNamingAMissingShowNamesFileLineAndKey) {
+  const std::string path = write_cues("missing.yaml",
+                                      "idle: rest\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 0}}}\n"
+                                      "  talk: {play: {show: " +
+                                          shows() + "nothere.yaml}}\n");
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path + ":5"), std::string::npos) << error;
+  EXPECT_NE(error.find("cues.talk.play.show"), std::string::npos) << error;
+  EXPECT_NE(error.find("file not found"), std::string::npos) << error;
+}
+
+TEST(CueFile, CuesThatHandOverInALoopWithoutAnExitAreRefused) {
+  const std::string path =
+      write_cues("ring.yaml",
+                 "idle: rest\n"
+                 "cues:\n"
+                 "  rest: {play: {pose: {neck_pan: 0}}}\n"
+                 "  a: {play: {pose: {neck_pan: 10}, duration_s: 1}, then: b}\n"
+                 "  b: {play: {pose: {neck_pan: 20}, duration_s: 1}, then: a}\n");
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path + ":5"), std::string::npos) << error;
+  EXPECT_NE(error.find("cues.a.then"), std::string::npos) << error;
+  EXPECT_NE(error.find("loop without an exit (a -> b -> a)"), std::string::npos) << error;
+  // Through the idle cue it is no loop: a hands over to b, b to the idle cue.
+  const std::string fine =
+      write_cues("chain.yaml",
+                 "idle: rest\n"
+                 "cues:\n"
+                 "  rest: {play: {pose: {neck_pan: 0}}}\n"
+                 "  a: {play: {pose: {neck_pan: 10}, duration_s: 1}, then: b}\n"
+                 "  b: {play: {pose: {neck_pan: 20}, duration_s: 1}, then: rest}\n");
+  EXPECT_EQ(load_error(fine), "");
+}
+
+TEST(CueFile, UnknownKeysAndNamesAreRefusedWhereTheyAre) {
+  const std::string key = write_cues("key.yaml",
+                                     "idle: rest\n"
+                                     "cues:\n"
+                                     "  rest: {play: {pose: {neck_pan: 0}}, fade_s: 2}\n");
+  std::string error = load_error(key);
+  EXPECT_NE(error.find(key + ":4"), std::string::npos) << error;
+  EXPECT_NE(error.find("fade_s"), std::string::npos) << error;
+
+  const std::string idle = write_cues("idle.yaml",
+                                      "idle: sleep\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 0}}}\n");
+  error = load_error(idle);
+  EXPECT_NE(error.find(idle + ":2"), std::string::npos) << error;
+  EXPECT_NE(error.find("no cue named \"sleep\" (the cues: rest)"), std::string::npos) << error;
+
+  const std::string joint = write_cues("joint.yaml",
+                                       "idle: rest\n"
+                                       "cues:\n"
+                                       "  rest: {play: {pose: {tail: 0}}}\n");
+  error = load_error(joint);
+  EXPECT_NE(error.find("cues.rest.play.pose.tail"), std::string::npos) << error;
+}
+
+TEST(CueFile, AStepThatNeverEndsBeforeOthersIsRefused) {
+  const std::string path = write_cues("forever.yaml",
+                                      "idle: rest\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 0}}}\n"
+                                      "  stuck:\n"
+                                      "    play:\n"
+                                      "      - {pose: {neck_pan: 30}}\n"
+                                      "      - {pose: {neck_pan: 0}, duration_s: 1}\n");
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path + ":7"), std::string::npos) << error;
+  EXPECT_NE(error.find("never ends"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace animrt
