@@ -220,7 +220,8 @@ LoadedRobot load_robot(const std::string& path) {
 std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
                                                  const RobotConfig& config) {
   MotionCheck::Speeds speeds;
-  return make_source(motion, config, speeds);
+  std::vector<std::string> warnings;  // a cue's motions are checked when the cue file loads
+  return make_source(motion, config, speeds, warnings);
 }
 
 std::vector<std::string> device_guard_notes(const RobotConfig& config) {
