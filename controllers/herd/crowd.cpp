@@ -382,7 +382,13 @@ void CrowdGroup::make_slots(double radius) {
   }
   slot_taken_.assign(slots_.size(), false);
   frontier_.assign(slots_.size(), false);
-  if (!frontier_.empty()) frontier_[0] = true;
+  open_.clear();
+  open_.reserve(slots_.size());
+  taken_.reserve(slots_.size());
+  if (!frontier_.empty()) {
+    frontier_[0] = true;
+    open_.push_back(0);
+  }
   neighbours_.assign(slots_.size(), {});
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     for (std::size_t j = 0; j < slots_.size(); ++j) {
@@ -395,14 +401,36 @@ void CrowdGroup::make_slots(double radius) {
   assign_distance_ = params_.assign_distance_m > 0.0 ? params_.assign_distance_m : extent + 2 * s;
 }
 
+void CrowdGroup::take_slot(std::size_t slot) {
+  slot_taken_[slot] = true;
+  const auto at = std::find(open_.begin(), open_.end(), static_cast<int>(slot));
+  if (at != open_.end()) open_.erase(at);
+  taken_.push_back(static_cast<int>(slot));
+  for (const int n : neighbours_[slot]) {
+    const auto m = static_cast<std::size_t>(n);
+    if (frontier_[m]) continue;
+    frontier_[m] = true;
+    if (!slot_taken_[m]) open_.insert(std::lower_bound(open_.begin(), open_.end(), n), n);
+  }
+}
+
+void CrowdGroup::free_slot(std::size_t slot) {
+  slot_taken_[slot] = false;
+  const int s = static_cast<int>(slot);
+  const auto at = std::find(taken_.begin(), taken_.end(), s);
+  if (at != taken_.end()) taken_.erase(at);
+  const auto to = std::lower_bound(open_.begin(), open_.end(), s);
+  if (frontier_[slot] && (to == open_.end() || *to != s)) open_.insert(to, s);
+}
+
 bool CrowdGroup::reachable(Vec2 from, std::size_t slot) const {
   // The straight walk from `from` to the slot keeps clear of every taken
   // slot (but the slot's neighbours may be grazed at the very end).
   const Vec2 to = slots_[slot];
   const Vec2 d = to - from;
   const double len2 = norm2(d);
-  for (std::size_t s = 0; s < slots_.size(); ++s) {
-    if (!slot_taken_[s]) continue;
+  for (const int taken : taken_) {
+    const auto s = static_cast<std::size_t>(taken);
     const double u = len2 > 0.0 ? std::clamp(dot(slots_[s] - from, d) / len2, 0.0, 1.0) : 0.0;
     if (norm(from + d * u - slots_[s]) < 0.7 * spacing_) return false;
   }
@@ -430,8 +458,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     if (norm(p - target) > assign_distance_) continue;
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
-    for (std::size_t s = 0; s < slots_.size(); ++s) {
-      if (slot_taken_[s] || !frontier_[s]) continue;
+    for (const int open : open_) {
+      const auto s = static_cast<std::size_t>(open);
       const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
       if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
       if (cost < best_cost && reachable(p, s)) {
@@ -442,8 +470,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     if (best < 0) {
       // Nothing reachable in a straight line: the best edge slot anyway,
       // never the target itself, which a slot holder may be heading for.
-      for (std::size_t s = 0; s < slots_.size(); ++s) {
-        if (slot_taken_[s] || !frontier_[s]) continue;
+      for (const int open : open_) {
+        const auto s = static_cast<std::size_t>(open);
         const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
         if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
         if (cost < best_cost) {
@@ -459,8 +487,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     const int c = candidate_[k];
     if (c >= 0 && norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
       const auto b = static_cast<std::size_t>(c);
-      slot_taken_[b] = true;
-      for (int n : neighbours_[b]) frontier_[static_cast<std::size_t>(n)] = true;
+      take_slot(b);
       slot_of_[k] = c;
       state_[k] = State::kToSlot;
       for (std::size_t j = 0; j < members_.size(); ++j) {
@@ -521,7 +548,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
                norm(agents[static_cast<std::size_t>(members_[j])].position - p) < 1.5 * spacing_;
     }
     if (!beside) continue;
-    if (slot_of_[k] >= 0) slot_taken_[static_cast<std::size_t>(slot_of_[k])] = false;
+    if (slot_of_[k] >= 0) free_slot(static_cast<std::size_t>(slot_of_[k]));
     slot_of_[k] = -1;
     state_[k] = State::kArrived;
     crowd_.stop(members_[k]);

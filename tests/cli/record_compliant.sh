@@ -64,7 +64,7 @@ scan=$("$animrt" scan "$pty" --protocol dynamixel2 --baud 1000000 --ids 1-1 2>&1
 
 # A torque stronger than a hand: the hand is refused while record holds it.
 out=$(/usr/bin/python3 "$tmp/hand.py" "$tmp/ctl" "$animrt" record "$robot" --out "$tmp/strong.yaml" \
-  --joint lf_hip --compliant 40 --duration 1.5 --port "legs=$pty" 2>&1) || fail "record 40 %: $out"
+  --joint lf_hip --compliant 40 --duration 1 --port "legs=$pty" 2>&1) || fail "record 40 %: $out"
 grep -q "^hand 2348 error: torque is on" <<< "$out" || fail "a hand overpowered 40 %: $out"
 stop_sim
 

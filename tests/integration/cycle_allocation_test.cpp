@@ -21,6 +21,7 @@
 #include "animrt/bridge/modbus/modbus_bus.hpp"
 #include "animrt/sim/can/can_sim_bus.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
+#include "animrt/sim/mujoco/mujoco_leg_model.hpp"
 #include "support/alloc_counter.hpp"
 #include "support/files.hpp"
 #include "support/sim_rig.hpp"
@@ -173,6 +174,44 @@ TEST(CycleAllocation, TheWatchSeesTheIoThreadsAndNotTheSimulators) {
 TEST(CycleAllocation, DynamixelStartMotionStopWithTelemetry) {
   SimRig rig(kConfigsDir + "/robots/quadruped.yaml", short_ramps());
   expect_no_allocation(rig, 1.0, {});
+}
+
+// The horse walking its balanced seed: each cycle the gait reads the IMU,
+// poses the model's legs (forward kinematics, Jacobians) and stretches them.
+TEST(CycleAllocation, BalancedGaitWithItsImu) {
+  std::ifstream in(kConfigsDir + "/robots/horse.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("../gaits/horse_walk.yaml", kConfigsDir + "/gaits/horse_seed_balance.yaml");
+  replace("../models/horse.xml", kConfigsDir + "/models/horse.xml");
+  text += "imus:\n  - {name: trunk, protocol: bno08x_rvc, stale_timeout_s: 0.5}\n";
+  const std::string path = ::testing::TempDir() + "/horse_balanced.yaml";
+  std::ofstream(path) << text;
+  test::RigSettings settings = short_ramps();
+  settings.edit = [](RobotConfig& c) {
+    c.safety.start_ramp_s = 0.3;
+    c.safety.stop_ramp_s = 0.3;
+    // Servos as quick as the walk: no following-error fault without physics.
+    for (BusConfig& bus : c.buses) bus.sim.max_speed_rad_s = 100.0;
+  };
+  BalancedGaitSource* balanced = nullptr;
+  settings.edit_motion = [&balanced](LoadedRobot& robot) {
+    ASSERT_NE(robot.balanced, nullptr);
+    balanced = robot.balanced;
+    std::vector<std::string> names;
+    for (const JointSpec& joint : robot.config.joints) names.push_back(joint.name);
+    robot.balanced->attach(
+        std::make_unique<sim::MujocoLegModel>(robot.config.model, names, robot.config.model_where));
+  };
+  SimRig rig(path, settings);
+  expect_no_allocation(rig, 1.0, {});
+  // The reflex ran: the IMU's readings reached it (100 Hz over 1 s of motion).
+  ASSERT_NE(balanced, nullptr);
+  EXPECT_GT(balanced->readings(), 50u);
 }
 
 TEST(CycleAllocation, DynamixelDeviceDyingMidRun) {

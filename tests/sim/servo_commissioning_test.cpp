@@ -263,6 +263,40 @@ TEST(ServoCommissioning, AWeakCurrentBasedPositionHoldYieldsToAHand) {
   EXPECT_EQ(read_i32(line, 3, xreg::present_position), 2302);
 }
 
+TEST(ServoCommissioning, AFeetechUnderALowTorqueLimitYieldsToAHand) {
+  BusConfig config;
+  config.name = "arm";
+  config.protocol = "feetech_sts";
+  ActuatorBinding b;
+  b.joint = "wrist";
+  b.device_id = 1;
+  config.actuators.push_back(b);
+  ManualClock clock{0};
+  sim::FeetechSimBus sim(config, ft::Series::sts, clock, ServoStartup{});
+  sim.start();
+  test::PtyClient line(sim.endpoint());
+  auto write = [&line](std::uint8_t address, Bytes data) {  // STS: little-endian
+    Bytes p = {0xFF, 0xFF, 1, static_cast<std::uint8_t>(data.size() + 3), ft::inst::write, address};
+    p.insert(p.end(), data.begin(), data.end());
+    p.push_back(0);
+    p.back() = ft::checksum({p.data() + 2, p.size() - 3});
+    line.send(p);
+    EXPECT_EQ(line.read_raw(6).size(), 6u);  // its status packet
+  };
+  sim.hand_move(1, 2000);
+  write(ft::reg::sts_torque_limit, {100, 0});  // 10 % of full torque: weaker than a hand
+  write(ft::reg::torque_enable, {1});
+  sim.hand_move(1, 2300);  // held there against the servo's pull to 2000
+  clock.advance(1'000'000'000);
+  EXPECT_EQ(sim.servo_readout(1).ticks, 2300);
+  write(ft::reg::goal_position, {0xFE, 0x08});  // 2302: the hand lets go, the servo holds
+  clock.advance(1'000'000'000);
+  EXPECT_EQ(sim.servo_readout(1).ticks, 2302);
+  write(ft::reg::sts_torque_limit, {0xF4, 0x01});  // 50 %: stronger than a hand
+  EXPECT_THROW(sim.hand_move(1, 2100), std::logic_error);
+  EXPECT_EQ(sim.servo_readout(1).ticks, 2302);
+}
+
 TEST(ServoCommissioning, FeetechFactoryStartupIsId1At1Mbaud) {
   BusConfig config;
   config.name = "arm";

@@ -39,6 +39,7 @@ class ProbeSource final : public MotionSource {
     if (on_sample) on_sample(t);
     inner_->sample(t, targets);
   }
+  void sense(const Sensors& sensors) override { inner_->sense(sensors); }
   void control(const ShowCommand& command, double t) override { inner_->control(command, t); }
   ShowPosition show_position(double t) const override { return inner_->show_position(t); }
   void start(const MotionClock& clock) override { inner_->start(clock); }

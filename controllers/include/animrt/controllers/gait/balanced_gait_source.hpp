@@ -7,7 +7,8 @@
 // The legs are posed at the joints' measured positions when the cycle gives
 // them (as the fitness walk reads its physics), else at the curves' targets.
 // While the IMU is silent the reflex holds its last tilt and rate, so the
-// stretch does not jump; held cycles are counted. The legs come from the
+// stretch does not jump (the cycle counts the late readings, and faults a
+// stale IMU as it does a silent servo). The legs come from the
 // figure's model (attach()); without them the gait plays as its curves.
 
 #include <memory>
@@ -36,7 +37,7 @@ class BalancedGaitSource final : public MotionSource {
   void start(const MotionClock& clock) override { gait_->start(clock); }
   void stop() override { gait_->stop(); }
 
-  // Cycles sensed without an IMU reading after the first one (the reflex held).
+  // Cycles sensed with no IMU reading at all after the first one (held).
   std::uint64_t held_cycles() const { return held_; }
   // IMU readings the reflex took.
   std::uint64_t readings() const { return readings_; }

@@ -169,6 +169,8 @@ class CrowdGroup final : public GroupSteering {
   enum class State { kTravelling, kToSlot, kArrived };
   void make_slots(double radius);
   bool reachable(Vec2 from, std::size_t slot) const;
+  void take_slot(std::size_t slot);  // keeps open_ and taken_ with slot_taken_
+  void free_slot(std::size_t slot);
 
   Crowd& crowd_;
   std::vector<int> members_;
@@ -182,6 +184,8 @@ class CrowdGroup final : public GroupSteering {
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
   std::vector<bool> frontier_;  // free slots that may be taken next
+  std::vector<int> open_;       // free frontier slots, in index order
+  std::vector<int> taken_;      // taken slots
   std::vector<std::vector<int>> neighbours_;
   double assign_distance_ = 0.0;
   double spacing_ = 0.0;
