@@ -220,7 +220,7 @@ LoadedRobot load_robot(const std::string& path) {
 std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
                                                  const RobotConfig& config) {
   MotionCheck::Speeds speeds;
-  std::vector<std::string> warnings;  // a cue's motions are checked when the cue file loads
+  std::vector<std::string> warnings;  // not shown for a cue: its motion is refused or accepted
   return make_source(motion, config, speeds, warnings);
 }
 
