@@ -220,7 +220,9 @@ LoadedRobot load_robot(const std::string& path) {
 std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
                                                  const RobotConfig& config) {
   MotionCheck::Speeds speeds;
-  std::vector<std::string> warnings;  // not shown for a cue: its motion is refused or accepted
+  // A cue's motion is checked as a robot's is, but its warnings (a learned
+  // model never measured better than interpolation) are not reported yet.
+  std::vector<std::string> warnings;
   return make_source(motion, config, speeds, warnings);
 }
 
