@@ -147,10 +147,13 @@ void run_case(bool load, int triggers) {
   const CuePlayer& player = *owned;
   robot.motion = std::move(owned);
   Pending pending;
-  OscReceiver osc("127.0.0.1", 0, [&](const OscMessage& m) {
-    const int cue = find_cue(player.cues(), m.address.substr(5));
-    if (cue >= 0) requests.cue(cue);
-    return cue >= 0;
+  // The cue names are the receiver's own: its thread outlives the player.
+  std::vector<std::string> cues;
+  for (const Cue& cue : player.cues()) cues.push_back(cue.name);
+  OscReceiver osc("127.0.0.1", 0, [&requests, cues](const OscMessage& m) {
+    const auto found = std::find(cues.begin(), cues.end(), m.address.substr(5));
+    if (found != cues.end()) requests.cue(static_cast<int>(found - cues.begin()));
+    return found != cues.end();
   });
   SimulatedBackend simulated;
   FigureOptions options;
