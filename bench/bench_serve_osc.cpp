@@ -95,6 +95,46 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
 }
 
+struct Measured {
+  std::vector<double> latencies_ms;
+  int missed = 0;
+};
+
+// Sends the triggers, each once the last crossfade has ended, and waits for
+// each to reach the bus.
+void send_triggers(int port, int triggers, const CuePlayer& player, Pending& pending,
+                   const std::atomic<bool>& ended, Measured& measured) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::mt19937 random(7);
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // past the start ramp
+  const char* names[] = {"look_left", "hello"};
+  for (int i = 0; i < triggers && !ended.load(); ++i) {
+    const auto fade = std::chrono::duration<double>(player.last_crossfade_s());
+    std::this_thread::sleep_for(fade + std::chrono::microseconds(100000 + random() % 10000));
+    const std::vector<std::uint8_t> packet = osc_cue(names[i % 2]);
+    pending.latency_ns.store(-1);
+    pending.cue.store(find_cue(player.cues(), names[i % 2]));
+    pending.sent_ns.store(now_ns());
+    ::sendto(fd, packet.data(), packet.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    const std::int64_t give_up = now_ns() + 1000000000;
+    while (pending.latency_ns.load() < 0 && now_ns() < give_up) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    const std::int64_t l = pending.latency_ns.load();
+    pending.cue.store(-1);
+    if (l < 0) {
+      ++measured.missed;
+    } else {
+      measured.latencies_ms.push_back(static_cast<double>(l) * 1e-6);
+    }
+  }
+  ::close(fd);
+}
+
 void run_case(bool load, int triggers) {
   LoadedRobot robot = load_robot(kRoot + "/configs/robots/animatronic.yaml");
   // The simulated devices share a busy machine: a device silent for 0.1 s
@@ -107,10 +147,13 @@ void run_case(bool load, int triggers) {
   const CuePlayer& player = *owned;
   robot.motion = std::move(owned);
   Pending pending;
-  OscReceiver osc("127.0.0.1", 0, [&](const OscMessage& m) {
-    const int cue = find_cue(player.cues(), m.address.substr(5));
-    if (cue >= 0) requests.cue(cue);
-    return cue >= 0;
+  // The cue names are the receiver's own: its thread outlives the player.
+  std::vector<std::string> cues;
+  for (const Cue& cue : player.cues()) cues.push_back(cue.name);
+  OscReceiver osc("127.0.0.1", 0, [&requests, cues](const OscMessage& m) {
+    const auto found = std::find(cues.begin(), cues.end(), m.address.substr(5));
+    if (found != cues.end()) requests.cue(static_cast<int>(found - cues.begin()));
+    return found != cues.end();
   });
   SimulatedBackend simulated;
   FigureOptions options;
@@ -124,45 +167,16 @@ void run_case(bool load, int triggers) {
   run.controls = &controls;
   std::atomic<bool> spinning{load};
   std::vector<std::thread> spinners;
-  for (unsigned i = 0; load && i < 1; ++i) {
+  if (load) {
     spinners.emplace_back([&spinning] {
       volatile std::uint64_t x = 0;
       while (spinning.load(std::memory_order_relaxed)) x = x + 1;
     });
   }
-  std::vector<double> latencies;
-  int missed = 0;
+  Measured measured;
   std::atomic<bool> ended{false};  // a fault ends the run early
   std::thread sender([&] {
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_port = htons(static_cast<std::uint16_t>(osc.port()));
-    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    std::mt19937 random(7);
-    std::this_thread::sleep_for(std::chrono::seconds(3));  // past the start ramp
-    const char* names[] = {"look_left", "hello"};
-    for (int i = 0; i < triggers && !ended.load(); ++i) {
-      // Past the last crossfade, so the cue is not kept waiting for a blend slot.
-      const auto fade = std::chrono::duration<double>(player.last_crossfade_s());
-      std::this_thread::sleep_for(fade + std::chrono::microseconds(100000 + random() % 10000));
-      const std::vector<std::uint8_t> packet = osc_cue(names[i % 2]);
-      pending.latency_ns.store(-1);
-      pending.cue.store(find_cue(player.cues(), names[i % 2]));
-      pending.sent_ns.store(now_ns());
-      ::sendto(fd, packet.data(), packet.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
-      const std::int64_t give_up = now_ns() + 1000000000;
-      while (pending.latency_ns.load() < 0 && now_ns() < give_up) {
-        std::this_thread::sleep_for(std::chrono::microseconds(200));
-      }
-      const std::int64_t l = pending.latency_ns.load();
-      pending.cue.store(-1);
-      if (l < 0)
-        ++missed;
-      else
-        latencies.push_back(static_cast<double>(l) * 1e-6);
-    }
-    ::close(fd);
+    send_triggers(osc.port(), triggers, player, pending, ended, measured);
     controls.stop.store(true);
   });
   const RunSummary summary = figure.run(run);
@@ -173,8 +187,9 @@ void run_case(bool load, int triggers) {
   std::printf(
       "%-34s triggers %4zu (missed %d) | OSC send -> bus write p50 %6.2f p99 %6.2f max %6.2f "
       "ms | loop %3.0f Hz %s, overruns %llu, ended by %s\n",
-      load ? "added load (a spinning thread)" : "no added load", latencies.size(), missed,
-      percentile(latencies, 0.5), percentile(latencies, 0.99), percentile(latencies, 1.0),
+      load ? "added load (a spinning thread)" : "no added load", measured.latencies_ms.size(),
+      measured.missed, percentile(measured.latencies_ms, 0.5),
+      percentile(measured.latencies_ms, 0.99), percentile(measured.latencies_ms, 1.0),
       figure.config().rate_hz, summary.sched_fifo ? "SCHED_FIFO" : "SCHED_OTHER",
       static_cast<unsigned long long>(summary.overruns), to_string(summary.end_reason));
   if (summary.end_reason == EndReason::fault) std::printf("%s", format_summary(summary).c_str());

@@ -98,8 +98,8 @@ double CuePlayer::ease_in_time(const Cue& cue, const MotionSource& next) const {
   return fade;
 }
 
-void CuePlayer::push(int cue, int step) const {
-  const bool changes = count_ == 0 || layers_[count_ - 1].cue != cue;
+void CuePlayer::push(int cue, int step, bool asked) const {
+  const bool changes = asked || count_ == 0 || layers_[count_ - 1].cue != cue;
   const Cue& c = cues_[static_cast<std::size_t>(cue)];
   const double fade =
       count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source);
@@ -134,7 +134,7 @@ void CuePlayer::advance(double t) const {
   if (!begun_) {
     begun_ = true;
     last_t_ = t;
-    push(idle_, 0);
+    push(idle_, 0, false);
   }
   const double dt = std::max(0.0, t - last_t_);
   last_t_ = t;
@@ -154,7 +154,7 @@ void CuePlayer::advance(double t) const {
   compact();
   if (waiting_) {
     if (count_ < kMaxLayers) {
-      push(waiting_cue_, 0);
+      push(waiting_cue_, 0, true);
       waiting_ = false;
     } else {
       deferred_.fetch_add(1, std::memory_order_relaxed);
@@ -166,11 +166,11 @@ void CuePlayer::advance(double t) const {
   if (play_ - top.t0 < cue.steps[static_cast<std::size_t>(top.step)].duration_s) return;
   if (count_ >= kMaxLayers) return;  // the next step waits for a free slot
   if (static_cast<std::size_t>(top.step) + 1 < cue.steps.size()) {
-    push(top.cue, top.step + 1);
+    push(top.cue, top.step + 1, false);
   } else if (cue.loop || top.cue == idle_) {
-    push(top.cue, 0);
+    push(top.cue, 0, false);
   } else {
-    push(cue.then < 0 ? idle_ : cue.then, 0);
+    push(cue.then < 0 ? idle_ : cue.then, 0, false);
   }
 }
 

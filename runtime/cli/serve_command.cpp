@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -44,7 +45,8 @@ RunControls serve_controls;
 
 // What an OSC message asks: /cue/NAME, /stop, /pause (an argument 0
 // resumes), /resume. False for any other address.
-bool answer_osc(const OscMessage& message, const std::vector<Cue>& cues, CueRequests& requests) {
+bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
+                CueRequests& requests) {
   const std::string& address = message.address;
   if (address == "/stop") {
     serve_controls.stop.store(true);
@@ -60,9 +62,9 @@ bool answer_osc(const OscMessage& message, const std::vector<Cue>& cues, CueRequ
   }
   constexpr std::string_view kCue = "/cue/";
   if (address.rfind(kCue, 0) != 0) return false;
-  const int cue = find_cue(cues, address.substr(kCue.size()));
-  if (cue < 0) return false;
-  requests.cue(cue);
+  const auto found = std::find(cues.begin(), cues.end(), address.substr(kCue.size()));
+  if (found == cues.end()) return false;
+  requests.cue(static_cast<int>(found - cues.begin()));
   return true;
 }
 
@@ -111,10 +113,14 @@ void serve_dashboard(Figure& figure, const std::pair<std::string, int>& at, bool
 std::unique_ptr<OscReceiver> start_osc(const ServeArgs& args, const CuePlayer& playing,
                                        CueRequests& requests) {
   if (args.no_osc) return nullptr;
-  auto osc = std::make_unique<OscReceiver>(args.osc_bind, args.osc_port,
-                                           [&playing, &requests](const OscMessage& message) {
-                                             return answer_osc(message, playing.cues(), requests);
-                                           });
+  // The names are the receiver's own: its thread may outlive the player.
+  std::vector<std::string> names;
+  for (const Cue& cue : playing.cues()) names.push_back(cue.name);
+  auto osc = std::make_unique<OscReceiver>(
+      args.osc_bind, args.osc_port,
+      [names = std::move(names), &requests](const OscMessage& message) {
+        return answer_osc(message, names, requests);
+      });
   std::cout << "osc: listening on " << args.osc_bind << ':' << osc->port() << '\n' << std::flush;
   return osc;
 }

@@ -60,8 +60,11 @@ UdpReceiver::UdpReceiver(const std::string& what, const std::string& host, int p
     : handler_(std::move(handler)) {
   fd_ = bind_udp(what, host, port, port_);
   // Room for a burst from a show controller while this thread is not running.
+  // (SO_RCVBUFFORCE passes the system's cap where permitted; else the cap holds.)
   const int buffer = 1 << 20;
-  ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
+  if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &buffer, sizeof buffer) != 0) {
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
+  }
   thread_ = std::thread([this] { receive(); });
 }
 

@@ -69,7 +69,7 @@ def main():
             for i in range(int(words[1])):
                 sock.sendto(packets[i % len(packets)], target)
                 sent += 1
-                if i % 200 == 199:
+                if i % 50 == 49:
                     time.sleep(0.002)  # a desk's burst, not a flood past the socket's buffer
         elif words[0] == "sleep":
             time.sleep(float(words[1]))

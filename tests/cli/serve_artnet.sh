@@ -3,7 +3,7 @@
 # specification's ArtDmx layout: the cue file's DMX channel selects cues by
 # value, ArtDmx packets whose length disagrees with their header are counted
 # and dropped, other packets and universes are ignored, and SIGTERM stops the
-# figure with its ramp home.
+# figure with its ramp home. A bad cue file stops everything before it starts.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -11,6 +11,15 @@ tmp=$(mktemp -d)
 pid=""
 trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
+
+# A bad cue file: one line naming file, line and key, exit 2, nothing started.
+printf 'idle: rest\ncues:\n  rest: {play: {pose: {neck_pan: 0}}, dmx: 300}\n' > "$tmp/bad.yaml"
+"$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$tmp/bad.yaml" --lockstep \
+  > "$tmp/out.txt" 2> "$tmp/err.txt"
+code=$?
+[[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
+grep -q "^error: $tmp/bad.yaml:3:.*cues.rest.dmx" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
+grep -q "configure" "$tmp/err.txt" && fail "a device started for a bad cue file: $(cat "$tmp/err.txt")"
 
 "$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
   --backend sim --lockstep --no-realtime --no-osc --artnet-port 0 \

@@ -53,6 +53,7 @@ send /cue/nothere
 send /pause i:1
 send /resume
 burst 10000 /cue/greet /cue/look_left /cue/hello
+sleep 0.2
 bundle /cue/sway /stop"
 sent=$(/usr/bin/python3 "$here/osc_send.py" "$port" "$script") || fail "the sender failed"
 wait_exit

@@ -192,6 +192,10 @@ TEST(Crossfade, TakesTheCuesTimeWhenTheLimitsAllowIt) {
   EXPECT_NEAR(f.at(3.0), deg_to_rad(2.0), 1e-12);
   EXPECT_EQ(f.player->starts(1), 1u);
   EXPECT_EQ(f.player->current_cue(), 1);
+  f.requests.cue(1);  // asked for again: it starts again
+  f.at(3.01);
+  EXPECT_EQ(f.player->starts(1), 2u);
+  EXPECT_EQ(f.player->starts(0), 1u);
 }
 
 TEST(Crossfade, AFarCueEasesInOverLongerThanAsked) {

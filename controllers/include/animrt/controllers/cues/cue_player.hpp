@@ -61,7 +61,7 @@ class CuePlayer final : public MotionSource {
 
   // Read from any thread while it plays.
   int current_cue() const { return current_.load(std::memory_order_relaxed); }
-  std::uint64_t starts(int cue) const;  // how often each cue began
+  std::uint64_t starts(int cue) const;  // how often each cue began (asked for, or handed over)
   // Requests taken while every crossfade slot was busy, played when one freed.
   std::uint64_t deferred() const { return deferred_.load(std::memory_order_relaxed); }
   const std::vector<Cue>& cues() const { return cues_; }
@@ -81,7 +81,8 @@ class CuePlayer final : public MotionSource {
   static constexpr std::size_t kMaxLayers = 4;
 
   void advance(double t) const;
-  void push(int cue, int step) const;
+  // `asked`: a trigger's (a cue asked for again starts again, and counts).
+  void push(int cue, int step, bool asked) const;
   double ease_in_time(const Cue& cue, const MotionSource& next) const;
   void sample_layer(Layer& layer) const;
   void compact() const;
