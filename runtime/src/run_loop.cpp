@@ -30,6 +30,9 @@ void sleep_until_deadline(Nanos deadline) {
 }
 
 constexpr std::size_t kHealthColumns = 5;  // temperature, current, voltage, torque, error bits
+constexpr std::size_t kImuColumns = 7;     // attitude (w, x, y, z), angular rates (x, y, z)
+constexpr const char* kImuSuffixes[kImuColumns] = {
+    "_qw", "_qx", "_qy", "_qz", "_rate_x_rad_s", "_rate_y_rad_s", "_rate_z_rad_s"};
 
 std::vector<JointSlot> health_slots(const std::vector<std::unique_ptr<ActuatorBus>>& buses) {
   std::vector<JointSlot> slots;
@@ -69,7 +72,8 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
       clock_(run_clock(options, wall_)),
       period_(model.period),
       health_columns_(health_slots(buses)),
-      ring_(1 + 2 * model.joint_count() + kHealthColumns * health_columns_.size(),
+      ring_(1 + 2 * model.joint_count() + kHealthColumns * health_columns_.size() +
+                kImuColumns * model.imus.size(),
             kTelemetryCapacity),
       record_(ring_.width()),
       bus_hist_(buses.size()),
@@ -90,11 +94,14 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
         health_names_.push_back(joint + suffix);
       }
     }
+    for (const ImuModel& imu : model.imus) {
+      for (const char* suffix : kImuSuffixes) health_names_.push_back(imu.name + suffix);
+    }
     writer_.emplace(options.telemetry_path, model.joint_names, ring_, health_names_);
   }
   if (!options.record_path.empty()) {
     recorder_.emplace(options.record_path, model);
-    // More channels: recorder_->add(RecordChannel{...}) here, push() in record().
+    add_record_channels();
     recorder_->start();
     status_every_ = std::max<std::size_t>(1, static_cast<std::size_t>(model.rate_hz / 10.0));
   }
@@ -313,9 +320,67 @@ void RunLoop::record(const CycleOutputs& out) {
       record_[k++] = r.torque_nm;
       record_[k++] = r.has_error_bits ? static_cast<double>(r.error_bits) : HealthReading::kNone;
     }
+    for (const ImuIo& imu : imu_io_) {
+      for (double q : imu.reading.quat) record_[k++] = imu.valid ? q : HealthReading::kNone;
+      for (double w : imu.reading.rate_rad_s) record_[k++] = imu.valid ? w : HealthReading::kNone;
+    }
     ring_.push(record_);
   }
   if (recorder_) record_mcap(out);
+}
+
+// Device health (per device, for buses that read it) and every IMU's
+// reading, besides the recorder's own joint, event, loop and status channels.
+void RunLoop::add_record_channels() {
+  if (!health_columns_.empty()) {
+    health_seen_.assign(health_columns_.size(), 0);
+    health_channel_ = recorder_->add(
+        RecordChannel{"health",
+                      "animrt.DeviceHealth",
+                      {"temperature_c", "current_a", "voltage_v", "torque_nm", "error_bits"},
+                      true,
+                      kTelemetryCapacity});
+  }
+  if (!model_.imus.empty()) {
+    imu_channel_ = recorder_->add(RecordChannel{
+        "/imu",
+        "animrt.Imu",
+        {"imu", "qw", "qx", "qy", "qz", "rate_x_rad_s", "rate_y_rad_s", "rate_z_rad_s",
+         "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2", "measured_s"},
+        false,
+        kTelemetryCapacity});
+  }
+}
+
+void RunLoop::record_mcap_health() {
+  McapRecorder& r = *recorder_;
+  if (health_channel_ != static_cast<std::size_t>(-1)) {
+    for (std::size_t k = 0; k < health_columns_.size(); ++k) {
+      const JointSlot& slot = health_columns_[k];
+      const HealthReading& h = readings_[slot.bus][slot.device];
+      if (h.reads == health_seen_[k]) continue;  // only new readings
+      health_seen_[k] = h.reads;
+      const double rec[] = {
+          in_.t,
+          static_cast<double>(r.device_index(slot.bus, slot.device)),
+          h.temperature_c,
+          h.current_a,
+          h.voltage_v,
+          h.torque_nm,
+          h.has_error_bits ? static_cast<double>(h.error_bits) : HealthReading::kNone};
+      r.push(health_channel_, rec);
+    }
+  }
+  if (imu_channel_ == static_cast<std::size_t>(-1)) return;
+  for (std::size_t i = 0; i < imu_io_.size(); ++i) {
+    if (!imu_io_[i].valid) continue;
+    const ImuReading& m = imu_io_[i].reading;
+    const double rec[] = {
+        in_.t,           static_cast<double>(i), m.quat[0],       m.quat[1],       m.quat[2],
+        m.quat[3],       m.rate_rad_s[0],        m.rate_rad_s[1], m.rate_rad_s[2], m.accel_m_s2[0],
+        m.accel_m_s2[1], m.accel_m_s2[2],        m.time_s};
+    r.push(imu_channel_, rec);
+  }
 }
 
 void RunLoop::record_mcap(const CycleOutputs& out) {
@@ -326,6 +391,7 @@ void RunLoop::record_mcap(const CycleOutputs& out) {
     r.push_stop_request(in_.t);
   }
   for (const CycleEvent& e : out.events) r.push_event(e);
+  record_mcap_health();
   if (state_.cycles() % status_every_ != 0) return;
   for (std::size_t b = 0; b < buses_.size(); ++b) {
     for (std::size_t d = 0; d < view_[b].size(); ++d) {

@@ -101,6 +101,8 @@ class RunLoop {
   void post_writes(const CycleOutputs& out);
   void record(const CycleOutputs& out);
   void record_mcap(const CycleOutputs& out);
+  void record_mcap_health();
+  void add_record_channels();
   void pace(const Wake& woke);
   void mark_faults(std::size_t b);
   void update_view(std::size_t b);
@@ -117,13 +119,18 @@ class RunLoop {
   const Nanos period_;
 
   // Telemetry's health columns: per (bus, device) whose bus reads health,
-  // five values each after the joints' columns.
+  // five values each after the joints' columns; then per IMU its attitude
+  // (w, x, y, z) and angular rates.
   std::vector<JointSlot> health_columns_;
   std::vector<std::string> health_names_;
   TelemetryRing ring_;
   std::optional<TelemetryWriter> writer_;
   std::optional<McapRecorder> recorder_;
   std::size_t status_every_ = 1;  // cycles between two device status records
+  // The recording's health and IMU channels (npos: not recorded).
+  std::size_t health_channel_ = static_cast<std::size_t>(-1);
+  std::size_t imu_channel_ = static_cast<std::size_t>(-1);
+  std::vector<std::uint64_t> health_seen_;  // per health column: the reading last recorded
   bool stop_recorded_ = false;
   std::vector<double> record_;
   MicrosHistogram period_hist_, jitter_hist_, busy_hist_;

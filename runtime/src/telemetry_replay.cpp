@@ -122,11 +122,17 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   }
   for (std::size_t c = 1 + 2 * n; c < header.size(); ++c) {
     const std::string& h = header[c];
-    if (!ends_with(h, "_temp_c") && !ends_with(h, "_current_a") && !ends_with(h, "_voltage_v") &&
-        !ends_with(h, "_torque_nm") && !ends_with(h, "_error_bits")) {
+    bool known = false;
+    for (const char* suffix :
+         {"_temp_c", "_current_a", "_voltage_v", "_torque_nm", "_error_bits", "_qw", "_qx", "_qy",
+          "_qz", "_rate_x_rad_s", "_rate_y_rad_s", "_rate_z_rad_s"}) {
+      known = known || ends_with(h, suffix);
+    }
+    if (!known) {
       fail(0,
            "expected a device health column (<joint>_temp_c, _current_a, _voltage_v, _torque_nm or "
-           "_error_bits) as column " +
+           "_error_bits) or an IMU column (<imu>_qw, _qx, _qy, _qz, _rate_x_rad_s, _rate_y_rad_s, "
+           "_rate_z_rad_s) as column " +
                std::to_string(c + 1) + ", found " + quote(h));
     }
   }

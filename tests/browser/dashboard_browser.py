@@ -143,7 +143,7 @@ def robot_on_pty(root, pty, folder):
     # slack, so that only the frozen simulator is a fault, not a busy machine.
     text, n = re.subn(r"(?m)^(\s*watchdog_timeout_s:\s*)[\d.]+", r"\g<1>2.0", text)
     check(n == 1, f"expected one watchdog_timeout_s in {source}")
-    text, n = re.subn(r"(?m)^(\s*timeout_ms:\s*)\d+", r"\g<1>20", text)
+    text, n = re.subn(r"(?m)^([ \t]*)(timeout_ms:\s*)\d+", r"\g<1>\g<2>20\n\g<1>health: packed", text)
     check(n == 1, f"expected one timeout_ms in {source}")
     # Short ramps: a shorter test.
     for key, value in (("start_ramp_s", "1.0"), ("stop_ramp_s", "0.5")):
@@ -291,6 +291,17 @@ def run_test(args, tmp, page_holder):
 
         page.wait("the motion phase", lambda: page.text("#phase") == "motion", 15)
         step("joint names shown; in motion")
+        # Health read (health: packed): each device's trend plot draws its
+        # temperature and current over the last seconds.
+        page.wait("trend plots with points", lambda: page.js(
+            "const c = [...document.querySelectorAll('#device-table canvas.spark')];"
+            "return c.length === 12 && c.every((x) => Number(x.dataset.points) >= 3"
+            " && x.title.includes('temperature') && x.title.includes('current'));"), 10)
+        check(page.js(
+            "const c = document.querySelector('#device-table canvas.spark');"
+            "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+            "return d.some((v, i) => i % 4 === 3 && v > 0);"), "a trend plot is blank")
+        step("trend plots drawn")
         t0, v0 = page.text("#run-time"), joint_values(page)
         time.sleep(1.0)
         t1, v1 = page.text("#run-time"), joint_values(page)

@@ -79,8 +79,22 @@ TEST(Replay, ARecordingWithHealthColumnsLoads) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()).substr(bad.size()),
               ":1: expected a device health column (<joint>_temp_c, _current_a, _voltage_v, "
-              "_torque_nm or _error_bits) as column 4, found \"a_colour\"");
+              "_torque_nm or _error_bits) or an IMU column (<imu>_qw, _qx, _qy, _qz, "
+              "_rate_x_rad_s, _rate_y_rad_s, _rate_z_rad_s) as column 4, found \"a_colour\"");
   }
+}
+
+// A figure with an IMU writes seven columns per IMU after the health columns.
+TEST(Replay, ARecordingWithImuColumnsLoads) {
+  const TelemetryRecording rec = load_telemetry_csv(write_csv(
+      "imu",
+      "time_s,a_cmd_rad,a_meas_rad,trunk_qw,trunk_qx,trunk_qy,trunk_qz,trunk_rate_x_rad_s,"
+      "trunk_rate_y_rad_s,trunk_rate_z_rad_s\n"
+      "0,0.1,0.05,nan,nan,nan,nan,nan,nan,nan\n"
+      "0.1,0.2,0.15,1,0,0,0,0,0,0\n"));
+  EXPECT_EQ(rec.joints, (std::vector<std::string>{"a"}));
+  ASSERT_EQ(rec.rows(), 2u);
+  EXPECT_DOUBLE_EQ(rec.meas[1], 0.15);
 }
 
 TEST(Replay, SeekShowsTheRecordedRowAndControlsAreRefused) {

@@ -7,9 +7,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include "animrt/bridge/modbus/modbus_bus.hpp"
+#include "animrt/runtime/mcap_reader.hpp"
 #include "support/sim_rig.hpp"
 
 namespace animrt {
@@ -150,6 +155,73 @@ TEST(ModbusHealth, AWarningDoesNotStopTheRun) {
   ASSERT_NE(d, nullptr);
   EXPECT_EQ(d->health.warnings, 1u);
   EXPECT_GT(d->health.max_temperature_c, 60.0);
+}
+
+// The number after "key": in a JSON text (NaN when absent).
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? std::nan("")
+                                 : std::strtod(json.c_str() + at + key.size() + 3, nullptr);
+}
+
+// The drive's health and a trunk IMU (pushed into a roll) in the MCAP
+// recording and in the telemetry CSV.
+TEST(ModbusHealth, HealthAndTheImuAreRecorded) {
+  test::RigSettings settings = health(ModbusBusOptions::Health::packed, HealthLimits{}, {});
+  settings.edit = [edit = settings.edit](RobotConfig& c) {
+    edit(c);
+    ImuConfig imu;
+    imu.name = "trunk";
+    imu.protocol = "bno08x_rvc";
+    imu.stale_timeout_s = 0.5;
+    imu.sim_push = ImuConfig::Push{true, false, 0.2, 1.0, 0.3};  // roll to 0.3 rad
+    c.imus.push_back(imu);
+  };
+  test::SimRig rig(kAnimatronic, settings);
+  const std::string csv = ::testing::TempDir() + "/modbus_health_imu.csv";
+  RunOptions options = rig.options(1.5, csv);
+  options.record_path = ::testing::TempDir() + "/modbus_health_imu.mcap";
+  const RunSummary s = rig.run(options);
+  ASSERT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
+
+  const mcap::ReadFile file = mcap::read_file(options.record_path);
+  const mcap::ReadChannel* health_ch = file.channel("/devices/torso/torso_lean/health");
+  const mcap::ReadChannel* imu_ch = file.channel("/imu");
+  ASSERT_NE(health_ch, nullptr);
+  ASSERT_NE(imu_ch, nullptr);
+  EXPECT_EQ(health_ch->schema_name, "animrt.DeviceHealth");
+  std::size_t health_messages = 0, imu_messages = 0;
+  double last_temperature = 0.0, last_qx = 0.0;
+  for (const mcap::ReadMessage& m : file.messages) {
+    if (m.channel == health_ch->id) {
+      ++health_messages;
+      last_temperature = json_number(m.data, "temperature_c");
+    } else if (m.channel == imu_ch->id) {
+      ++imu_messages;
+      last_qx = json_number(m.data, "qx");
+    }
+  }
+  EXPECT_GE(health_messages + 2, s.cycles);
+  EXPECT_GE(imu_messages + 5, s.cycles);
+  EXPECT_NEAR(last_temperature, 36.0, 0.5);
+  EXPECT_NEAR(last_qx, std::sin(0.15), 0.01);  // rolled 0.3 rad
+
+  std::ifstream in(csv);
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line)) last = line;
+  EXPECT_NE(header.find(",torso_lean_temp_c,"), std::string::npos) << header;
+  const auto at = header.find(",trunk_qw,trunk_qx,trunk_qy,trunk_qz,trunk_rate_x_rad_s");
+  ASSERT_NE(at, std::string::npos) << header;
+  // The last row's trunk_qx: the field after as many commas as precede it.
+  const auto column = static_cast<std::size_t>(
+      std::count(header.begin(), header.begin() + static_cast<long>(at) + 1, ',') + 1);
+  std::size_t field = 0, pos = 0;
+  while (field < column && pos != std::string::npos) {
+    pos = last.find(',', pos) + 1;
+    ++field;
+  }
+  EXPECT_NEAR(std::strtod(last.c_str() + pos, nullptr), std::sin(0.15), 0.01) << last;
 }
 
 }  // namespace modbus_health_test

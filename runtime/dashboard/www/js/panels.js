@@ -126,6 +126,54 @@ const HEALTH = [
   ['error_bits', (v) => `0x${v.toString(16).padStart(2, '0')}`],
 ];
 
+// A device's temperature and current over the last TREND_S seconds, drawn
+// as two lines in one small canvas, each scaled to its own range.
+const TREND_S = 10;
+const TREND_LINES = [['temperature_c', '#ff7a7a', '°C'], ['current_a', '#7ab4ff', 'A']];
+
+class Trend {
+  constructor() {
+    this.canvas = el('canvas', { class: 'spark', width: 96, height: 24 });
+    this.points = [];  // [seconds, temperature, current]
+  }
+
+  add(d) {
+    const t = performance.now() / 1000;
+    if (!TREND_LINES.some(([k]) => isNum(d[k]))) return;
+    this.points.push([t, ...TREND_LINES.map(([k]) => (isNum(d[k]) ? d[k] : null))]);
+    while (this.points.length && this.points[0][0] < t - TREND_S) this.points.shift();
+    this.draw(t);
+  }
+
+  draw(now) {
+    const c = this.canvas;
+    const g = c.getContext('2d');
+    g.clearRect(0, 0, c.width, c.height);
+    const titles = [];
+    TREND_LINES.forEach(([key, colour, unit], i) => {
+      const values = this.points.map((p) => p[i + 1]).filter((v) => v !== null);
+      if (values.length < 2) return;
+      const lo = Math.min(...values), hi = Math.max(...values);
+      const span = hi - lo || 1;
+      g.strokeStyle = colour;
+      g.lineWidth = 1.5;
+      g.beginPath();
+      let started = false;
+      for (const p of this.points) {
+        if (p[i + 1] === null) continue;
+        const x = c.width * (1 - (now - p[0]) / TREND_S);
+        const y = c.height - 2 - (c.height - 4) * ((p[i + 1] - lo) / span);
+        if (started) g.lineTo(x, y); else g.moveTo(x, y);
+        started = true;
+      }
+      g.stroke();
+      titles.push(`${key.split('_')[0]} ${lo.toFixed(2)}–${hi.toFixed(2)} ${unit}`);
+    });
+    c.dataset.points = String(this.points.length);
+    c.title = titles.join(', ');
+  }
+}
+
 export class DeviceTable {
   constructor(table) {
     this.body = table.tBodies[0];
@@ -157,11 +205,13 @@ export class DeviceTable {
           cells[c] = el('td', { 'data-field': c, text: 'n/a' });
           tds.push(cells[c]);
         }
+        const trend = new Trend();
+        tds.push(el('td', { 'data-field': 'trend' }, trend.canvas));
         cells.fault = el('td', { class: 'fault', 'data-field': 'last_fault' });
         tds.push(cells.fault);
         const row = el('tr', { 'data-device': key }, ...tds);
         this.body.append(row);
-        r = { row, cells };
+        r = { row, cells, trend };
         this.rows.set(key, r);
       }
       const latest = typeof d.health === 'string' ? d.health : 'unknown';
@@ -181,6 +231,7 @@ export class DeviceTable {
         if (r.cells[c].textContent !== text) r.cells[c].textContent = text;
         r.cells[c].classList.toggle('nonzero', c === 'error_bits' && isNum(d[c]) && d[c] > 0);
       }
+      r.trend.add(d);
       let fault = typeof d.last_fault === 'string' && times.has(d.last_fault)
         ? faultText({ t_s: times.get(d.last_fault), text: d.last_fault })
         : faultText(d.last_fault);
