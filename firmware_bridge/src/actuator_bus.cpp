@@ -3,6 +3,8 @@
 #include <chrono>
 #include <thread>
 
+#include "animrt/core/error.hpp"
+
 namespace animrt {
 
 const char* to_string(DeviceHealth health) {
@@ -32,6 +34,14 @@ std::vector<bool> ping_until_answered(std::size_t devices,
     if (all) break;
   }
   return answered;
+}
+
+std::int64_t ActuatorBus::set_home(std::size_t device, std::int64_t ticks) {
+  (void)ticks;
+  const std::string joint =
+      device < config().actuators.size() ? config().actuators[device].joint : "?";
+  throw DeviceError("bus " + config().name + ": joint " + joint +
+                    ": its device cannot be homed by animrt on this bus");
 }
 
 }  // namespace animrt

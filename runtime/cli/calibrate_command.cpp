@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/runtime/yaml_value_editor.hpp"
@@ -271,10 +272,11 @@ std::vector<std::size_t> chosen_joints(const LimpFigure& figure, const Calibrate
 // The file's new values for one joint, written into `edit`. Returns the
 // report line.
 std::string write_joint(YamlValueEditor& edit, const std::string& name, const ActuatorBinding& a,
-                        const Seen& seen) {
-  const auto zero = static_cast<long long>(std::lround(seen.home_ticks));
-  const double lo = seen.direction * ticks_to_deg(a, seen.min_ticks - zero);
-  const double hi = seen.direction * ticks_to_deg(a, seen.max_ticks - zero);
+                        const Seen& seen, long long zero) {
+  // The range as seen from the home, whatever the home's ticks become.
+  const double home = seen.home_ticks;
+  const double lo = seen.direction * ticks_to_deg(a, seen.min_ticks - home);
+  const double hi = seen.direction * ticks_to_deg(a, seen.max_ticks - home);
   // Rounded inward: a limit is never past what the hand reached.
   const double min_deg = std::ceil(std::min(lo, hi) * 10.0 - 1e-9) / 10.0;
   const double max_deg = std::floor(std::max(lo, hi) * 10.0 + 1e-9) / 10.0;
@@ -285,6 +287,42 @@ std::string write_joint(YamlValueEditor& edit, const std::string& name, const Ac
   edit.set({"joints", name, "actuator", "direction"}, std::to_string(seen.direction));
   return fmt::format("{}: limits {} .. {} deg, home at {} ticks (0 deg), direction {}", name,
                      deg_text(min_deg), deg_text(max_deg), zero, seen.direction);
+}
+
+// A multi-turn joint (Dynamixel extended position mode): homed in the
+// servo itself, by its Homing Offset, so its zero_ticks stays as the file
+// gives it.
+bool is_multi_turn(const LimpFigure& figure, std::size_t j) {
+  return figure.protocol(j) == "dynamixel2" && dxl::device_options(*figure.binding(j)).multi_turn;
+}
+
+// The checks on what was seen, the home of a multi-turn joint set in its
+// servo, and the file's new values. Returns the report line.
+std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t j, Seen& seen,
+                         const CalibrateArgs& args) {
+  const std::string& name = figure.config().joints[j].name;
+  const ActuatorBinding& a = *figure.binding(j);
+  const double range = ticks_to_deg(a, seen.max_ticks - seen.min_ticks);
+  if (!(range >= args.min_range_deg)) {
+    throw std::runtime_error(fmt::format(
+        "{}: moved through only {:.1f} deg (at least {} deg needed): nothing was written; move "
+        "the joint through its whole range while it is recorded",
+        name, range, args.min_range_deg));
+  }
+  if (!is_multi_turn(figure, j)) {
+    if (!seen.within_one_turn()) {
+      throw std::runtime_error(fmt::format(
+          "{}: its range, {:.0f} .. {:.0f} ticks, crosses its servo's {:.0f} -> 0 seam, which a "
+          "servo in position mode cannot be driven across: nothing was written; turn the horn "
+          "on its spline so that the range lies within one turn",
+          name, seen.min_ticks, seen.max_ticks, seen.turn - 1));
+    }
+    return write_joint(edit, name, a, seen, std::lround(seen.home_ticks));
+  }
+  // The home where the joint rests now reads the file's zero_ticks.
+  const std::int64_t reads = figure.set_home(j, a.zero_ticks);
+  std::cout << fmt::format("{}: Homing Offset set: its home reads {} ticks\n", name, reads);
+  return write_joint(edit, name, a, seen, a.zero_ticks) + " (Homing Offset)";
 }
 
 // The edited file must load as a robot: checked on a copy beside it, so
@@ -330,6 +368,8 @@ int run_calibrate(const CalibrateArgs& args) {
     Seen seen;
     seen.direction = a.direction;
     seen.turn = ticks_per_turn(figure.protocol(j));
+    // A multi-turn servo counts on across its turns: nothing to unwrap.
+    if (is_multi_turn(figure, j)) seen.turn = std::numeric_limits<double>::infinity();
     const bool jogged = args.jog == 1 || (args.jog < 0 && !args.non_interactive &&
                                           ask_yes(name + ": check its direction by a small jog "
                                                          "under a weak torque?"));
@@ -352,21 +392,7 @@ int run_calibrate(const CalibrateArgs& args) {
       std::cout << "stopped: nothing was written\n";
       return kExitUsage;
     }
-    const double range = ticks_to_deg(a, seen.max_ticks - seen.min_ticks);
-    if (!(range >= args.min_range_deg)) {
-      throw std::runtime_error(fmt::format(
-          "{}: moved through only {:.1f} deg (at least {} deg needed): nothing was written; move "
-          "the joint through its whole range while it is recorded",
-          name, range, args.min_range_deg));
-    }
-    if (!seen.within_one_turn()) {
-      throw std::runtime_error(fmt::format(
-          "{}: its range, {:.0f} .. {:.0f} ticks, crosses its servo's {:.0f} -> 0 seam, which a "
-          "servo in position mode cannot be driven across: nothing was written; turn the horn "
-          "on its spline so that the range lies within one turn",
-          name, seen.min_ticks, seen.max_ticks, seen.turn - 1));
-    }
-    lines.push_back(write_joint(edit, name, a, seen));
+    lines.push_back(finish_joint(figure, edit, j, seen, args));
   }
   check_loads(args.robot, edit.text());
   replace_file_contents(args.robot, original, edit.text());

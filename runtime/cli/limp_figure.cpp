@@ -77,6 +77,17 @@ bool LimpFigure::hold_weakly(std::size_t joint, double share) {
   return false;
 }
 
+std::int64_t LimpFigure::set_home(std::size_t joint, std::int64_t ticks) {
+  for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
+    ActuatorBus& bus = figure_->bus(b);
+    const auto& actuators = bus.config().actuators;
+    for (std::size_t i = 0; i < actuators.size(); ++i) {
+      if (actuators[i].joint_index == static_cast<int>(joint)) return bus.set_home(i, ticks);
+    }
+  }
+  throw DeviceError("joint " + config().joints.at(joint).name + ": no bus drives it");
+}
+
 void LimpFigure::write(const std::vector<double>& joints) {
   for (std::size_t b = 0; b < figure_->bus_count(); ++b) {
     // Only buses with a joint held: a goal would switch a limp hobby servo's pulse on.

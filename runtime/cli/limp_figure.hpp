@@ -42,6 +42,10 @@ class LimpFigure {
   void write(const std::vector<double>& joints);
   // Torque off on every joint again.
   void let_go();
+  // Joint `j`'s device homed where it rests, so that its position there
+  // reads `ticks` (ActuatorBus::set_home); the position read back, in ticks.
+  // Throws DeviceError.
+  std::int64_t set_home(std::size_t joint, std::int64_t ticks);
 
   // The binding of joint `j` and its bus's protocol (null when no bus drives it).
   const ActuatorBinding* binding(std::size_t joint) const;

@@ -81,6 +81,7 @@ constexpr Item kItems[] = {
     {xreg_sim::backup_ready, 1, false},
 };
 
+constexpr std::uint8_t kPositionMode = 3;
 constexpr std::uint8_t kExtendedPositionMode = 4;
 constexpr std::uint8_t kCurrentBasedPositionMode = 5;
 // A hand overpowers a servo whose Goal Current is at most this share of its
@@ -236,11 +237,20 @@ std::int32_t DynamixelServo::motor_goal() const {
   if (!multi_turn(table_[xreg::operating_mode])) {
     goal = std::clamp(goal, reg32(xreg::min_position_limit), reg32(xreg::max_position_limit));
   }
-  return goal - reg32(xreg_sim::homing_offset);
+  return goal - reg32(xreg_sim::homing_offset) + turn_base_;
 }
 
 std::int32_t DynamixelServo::present_of(double motor_ticks) const {
-  return static_cast<std::int32_t>(std::lround(motor_ticks)) + reg32(xreg_sim::homing_offset);
+  return static_cast<std::int32_t>(std::lround(motor_ticks)) - turn_base_ +
+         reg32(xreg_sim::homing_offset);
+}
+
+void DynamixelServo::count_from_single_turn() {
+  const auto turn = static_cast<std::int64_t>(kXTicksPerRev);
+  const auto ticks = static_cast<std::int64_t>(std::lround(motor_.position));
+  // floor, also below zero: the count starts at the shaft's angle within its turn
+  const std::int64_t turns = ticks >= 0 ? ticks / turn : -((-ticks + turn - 1) / turn);
+  turn_base_ = static_cast<std::int32_t>(turns * turn);
 }
 
 std::int32_t DynamixelServo::reg32(std::uint16_t address) const {
@@ -486,7 +496,15 @@ StatusError DynamixelServo::write(std::uint16_t address, std::span<const std::ui
   std::array<std::uint16_t, xreg::table_size> targets;
   for (std::size_t i = 0; i < data.size(); ++i) targets[i] = resolve(address + i);
   const bool eeprom = eeprom_write(kDynamixelX, table_, address, data.size()) == EepromWrite::kept;
+  const std::uint8_t mode_before = table_[xreg::operating_mode];
+  const bool torque_before = torque_on();
   for (std::size_t i = 0; i < data.size(); ++i) table_[targets[i]] = data[i];
+  // Position control mode counts within one turn: entered, or torque on in
+  // it, the count starts again from the shaft's angle.
+  const bool position_mode = table_[xreg::operating_mode] == kPositionMode;
+  if (position_mode && (mode_before != kPositionMode || (!torque_before && torque_on()))) {
+    count_from_single_turn();
+  }
   if (eeprom) eeprom_.keep(table_);
   if (!torque_on() && physics_ == nullptr) motor_.velocity = 0;
   let_go_of_hand();
@@ -515,6 +533,8 @@ StatusError DynamixelServo::action() {
 
 void DynamixelServo::reboot(Nanos now) {
   advance(now);
+  // The encoder knows one turn: a power-up counts from the shaft's angle in it.
+  count_from_single_turn();
   shut_down_ = false;
   reset_ram();
   if (injected_error_ & table_[xreg_sim::shutdown]) latch_shutdown();
@@ -560,7 +580,7 @@ void DynamixelServo::let_go_of_hand() {
 bool DynamixelServo::hand_move(std::int32_t ticks, Nanos now) {
   advance(now);
   if (!yields_to_hand() || physics_ != nullptr) return false;
-  motor_.position = ticks - reg32(xreg_sim::homing_offset);
+  motor_.position = ticks - reg32(xreg_sim::homing_offset) + turn_base_;
   motor_.velocity = 0;
   // Against a weak torque the hand holds the joint until the servo's goal
   // comes to it; a limp joint simply stays.
@@ -628,7 +648,7 @@ Nanos DynamixelServo::take_answer_delay() const {
 
 double DynamixelServo::position_rad(Nanos now) const {
   const Motor m = motor_at(std::max(now, motor_time_));
-  const double present = m.position + reg32(xreg_sim::homing_offset);
+  const double present = m.position - turn_base_ + reg32(xreg_sim::homing_offset);
   return binding_.direction * (present - binding_.zero_ticks) / binding_.ticks_per_rad;
 }
 

@@ -232,6 +232,8 @@ void DynamixelBus::configure() {
                    ", the config says " + name(want);
   }
   if (!wrong_model.empty()) throw DeviceError(prefix() + wrong_model);
+  // Before the positions: entering position mode restarts a servo's count.
+  set_operating_modes();
 
   std::string unread;
   for (std::size_t i = 0; i < n; ++i) {
@@ -366,7 +368,8 @@ void DynamixelBus::choose_fast_read() {
 
 void DynamixelBus::write_position_limits(std::size_t device) {
   const ActuatorBinding& b = config_.actuators[device];
-  if (!b.has_limits()) return;
+  // Extended position mode does not use the position limits.
+  if (!b.has_limits() || dxl::device_options(b).multi_turn) return;
   // Inside the range X-series position mode accepts (0..4095); a joint
   // resting outside its limits would otherwise get a Data Limit Error.
   const auto span = positions_.limit_ticks(device, kXMaxTicks);

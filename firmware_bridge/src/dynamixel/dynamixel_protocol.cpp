@@ -18,6 +18,8 @@ namespace {
 constexpr int kMaxDeviceId = 252;
 constexpr std::int64_t kMinTicks = 0;
 constexpr std::int64_t kMaxTicks = 4095;
+// Extended position control (multi-turn): Goal Position +-256 turns.
+constexpr std::int64_t kMaxMultiTurnTicks = 1'048'575;
 constexpr double kMinTicksPerRev = 16.0;
 constexpr double kMaxTicksPerRev = 1e8;
 
@@ -27,8 +29,8 @@ constexpr double kWatchdogMaxMs = 127 * kWatchdogUnitMs;
 
 constexpr std::string_view kBusKeys[] = {
     "port", "baud", "timeout_ms", "fast_read", "model", "device_watchdog_ms", "health"};
-constexpr std::string_view kActuatorKeys[] = {"id",         "ticks_per_rev", "ticks_per_rad",
-                                              "zero_ticks", "direction",     "model"};
+constexpr std::string_view kActuatorKeys[] = {
+    "id", "ticks_per_rev", "ticks_per_rad", "zero_ticks", "direction", "model", "multi_turn"};
 
 std::uint16_t parse_model(const YamlNode& node) {
   if (node.is_scalar()) {
@@ -71,17 +73,20 @@ int parse_direction(const YamlNode& node) {
 // mapping is the one ActuatorBinding::to_ticks applies at run time.
 void check_ticks(const YamlNode& limit_node, double rad, const ActuatorBinding& b,
                  const std::string& scale) {
+  const bool multi_turn = dxl::device_options(b).multi_turn;
+  const std::int64_t lo = multi_turn ? -kMaxMultiTurnTicks : kMinTicks;
+  const std::int64_t hi = multi_turn ? kMaxMultiTurnTicks : kMaxTicks;
   // In double, so that absurd scales cannot overflow an integer.
   const double ticks = std::round(b.zero_ticks + b.direction * rad * b.ticks_per_rad);
-  if (ticks < static_cast<double>(kMinTicks) || ticks > static_cast<double>(kMaxTicks)) {
+  if (ticks < static_cast<double>(lo) || ticks > static_cast<double>(hi)) {
     std::ostringstream tick_text;  // whole numbers print plainly, absurd ones in e-notation
     tick_text.precision(12);
     tick_text << ticks;
     limit_node.fail(format_number(rad_to_deg(rad)) + " deg maps to tick " + tick_text.str() +
                     " (zero_ticks " + std::to_string(b.zero_ticks) + ", direction " +
-                    std::to_string(b.direction) + ", " + scale +
-                    "), outside the dynamixel2 position range " + std::to_string(kMinTicks) + ".." +
-                    std::to_string(kMaxTicks));
+                    std::to_string(b.direction) + ", " + scale + "), outside the dynamixel2 " +
+                    (multi_turn ? "extended (multi_turn) position range " : "position range ") +
+                    std::to_string(lo) + ".." + std::to_string(hi));
   }
 }
 
@@ -153,6 +158,7 @@ class Dynamixel2 final : public Protocol {
     dxl::DeviceOptions device;
     device.model_number = dxl::bus_options(bus).model_number;
     if (auto n = node.find("model")) device.model_number = parse_model(*n);
+    if (auto n = node.find("multi_turn")) device.multi_turn = n->as_bool();
     out.options = device;
 
     check_ticks(limits_node.at("min_deg"), joint.limits.min_position, out, scale);

@@ -90,6 +90,12 @@ class ActuatorBus {
     (void)share;
     return false;
   }
+  // Commissioning (calibrate): homes `device` where it rests, torque off,
+  // so that from now on, and after a power cycle, its present position
+  // there reads `ticks` (a Dynamixel's Homing Offset; a CiA 402 drive's
+  // homing). Returns the present position read back afterwards. Throws
+  // DeviceError naming the device, also when it cannot be homed this way.
+  virtual std::int64_t set_home(std::size_t device, std::int64_t ticks);
 
   // Whether read() fills DeviceStatus::reading (temperature, current,
   // voltage, error bits) as configured.

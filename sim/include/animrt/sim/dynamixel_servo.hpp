@@ -22,7 +22,10 @@
 // as 4, and Goal Current limits the torque, see the hand below; other
 // modes answer Data Range Error),
 // Homing Offset (Present and Goal Position are the motor's position plus
-// it), Moving Threshold,
+// it), the count of turns (Present Position counts on across turns in any
+// mode while torque is off; it starts again from the shaft's angle within
+// one turn, 0..4095, at power-up and Reboot, when Operating Mode becomes 3
+// and when torque comes on in mode 3), Moving Threshold,
 // Velocity Limit, Min/Max Position Limit, Shutdown, Torque Enable, LED, Status
 // Return Level, Registered Instruction, Hardware Error Status, Goal Position,
 // Realtime Tick, Moving, Present Velocity/Position/Input Voltage/Temperature.
@@ -255,6 +258,8 @@ class DynamixelServo {
   // plus the Homing Offset.
   std::int32_t motor_goal() const;  // Goal Position (within the limits in mode 3), motor ticks
   std::int32_t present_of(double motor_ticks) const;
+  // The turn count starts again from the shaft's angle within its turn.
+  void count_from_single_turn();
 
   ActuatorBinding binding_;
   double tau_s_;
@@ -262,6 +267,9 @@ class DynamixelServo {
   std::array<std::uint8_t, dxl::xreg::table_size> table_{};
   ServoEeprom eeprom_{kDynamixelX};
   Motor motor_;
+  // Motor ticks where the count of turns started (a multiple of a turn):
+  // Present Position = motor - turn_base_ + Homing Offset.
+  std::int32_t turn_base_ = 0;
   Nanos motor_time_;
   JointPhysics* physics_ = nullptr;
   int physics_joint_ = -1;

@@ -55,6 +55,8 @@ class DynamixelBus final : public ActuatorBus {
   // Decides the cycle's read: with `fast_read: auto`, Fast Sync Read when
   // every device's model and firmware (from its Ping answer) support it and
   // one Fast Sync Read of all of them succeeds; else Sync Read.
+  // Before reading the positions, puts each servo in the Operating Mode its
+  // joint needs (mode_warning()), torque off.
   // Then, for joints with limits, writes Min/Max Position Limit (52/48) from
   // them when the values read back differ (torque off first: EEPROM), so the
   // servo itself refuses goals outside the joint. A joint that rests outside
@@ -81,6 +83,12 @@ class DynamixelBus final : public ActuatorBus {
   // (Goal Current), goal = present position, torque on. False for a model
   // without current sensing (it reports load: XL430, XC430, ...).
   bool activate_compliant(std::size_t device, double share) override;
+  // A multi_turn joint's home: Homing Offset (EEPROM, torque off) set so
+  // that where the joint rests reads `ticks`, taken from the shaft's angle
+  // within its turn (a power-up counts from there), then Reboot, and the
+  // present position read back (DeviceError when it is not `ticks`).
+  // DeviceError for a joint that is not multi_turn.
+  std::int64_t set_home(std::size_t device, std::int64_t ticks) override;
 
   // One Sync Read / Sync Write. Counters: `transactions` counts instruction
   // packets that expected an answer from the device (Sync Write expects none).
@@ -121,6 +129,10 @@ class DynamixelBus final : public ActuatorBus {
   // The warning configure() printed about Bus Watchdogs that had fired;
   // empty when none had.
   const std::string& watchdog_warning() const { return watchdog_warning_; }
+  // The warning configure() printed about servos it found in another
+  // Operating Mode than their joints need (position, 3; extended position,
+  // 4, for `multi_turn`) and set right; empty when all were right.
+  const std::string& mode_warning() const { return mode_warning_; }
 
   // Whether the cycle's read is a Fast Sync Read (decided by configure()).
   bool fast_read_active() const { return fast_; }
@@ -140,6 +152,9 @@ class DynamixelBus final : public ActuatorBus {
   void transact_fast(std::size_t length, std::size_t count, std::size_t data_length);
   void choose_fast_read();
   void write_position_limits(std::size_t device);
+  std::uint8_t needed_mode(std::size_t device) const;
+  void set_operating_modes();
+  void reboot_and_wait(std::size_t device);
   void clear_bus_watchdogs();
   void rearm_after_silence();
   // Bus Watchdog 0, then its time, to every servo in two broadcast writes.
@@ -170,6 +185,7 @@ class DynamixelBus final : public ActuatorBus {
   std::string latency_warning_;
   std::string outside_warning_;
   std::string watchdog_warning_;
+  std::string mode_warning_;
   std::uint8_t watchdog_units_ = 0;  // Bus Watchdog set before the first cycle; 0: none
   std::chrono::nanoseconds watchdog_time_{0};
   bool armed_ = false;  // between arm_device_guard() and deactivate()

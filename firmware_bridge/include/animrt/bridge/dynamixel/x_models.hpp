@@ -61,6 +61,9 @@ struct BusOptions {
 };
 struct DeviceOptions {
   std::uint16_t model_number = 0;  // 0: no `model` given
+  // `multi_turn: true`: extended position control (Operating Mode 4), the
+  // home set by the servo's Homing Offset; else position control (3).
+  bool multi_turn = false;
 };
 
 // The options of a bus or device; defaults when none were stored.
