@@ -96,7 +96,8 @@ std::string deg_text(double deg) {
 }
 
 bool protocol_with_ticks(const std::string& protocol) {
-  return protocol == "dynamixel2" || protocol == "feetech_sts" || protocol == "feetech_scs";
+  return protocol == "dynamixel2" || protocol == "feetech_sts" || protocol == "feetech_scs" ||
+         protocol == "cia402";
 }
 
 void sleep_until(timespec& next, long period_ns) {
@@ -252,10 +253,11 @@ std::vector<std::size_t> chosen_joints(const LimpFigure& figure, const Calibrate
       throw std::invalid_argument("--joint " + joints[j].name + ": not calibrated here (" +
                                   (protocol.empty() ? "no bus drives it" : "protocol " + protocol) +
                                   "); calibrate knows revolute joints on Dynamixel and Feetech "
-                                  "servos");
+                                  "servos and CiA 402 drives");
     } else {
       std::cout << joints[j].name << ": skipped (" << (protocol.empty() ? "no bus" : protocol)
-                << "; calibrate knows revolute joints on Dynamixel and Feetech servos)\n";
+                << "; calibrate knows revolute joints on Dynamixel and Feetech servos and CiA "
+                   "402 drives)\n";
     }
   }
   for (const std::string& name : args.joints) {
@@ -289,10 +291,11 @@ std::string write_joint(YamlValueEditor& edit, const std::string& name, const Ac
                      deg_text(min_deg), deg_text(max_deg), zero, seen.direction);
 }
 
-// A multi-turn joint (Dynamixel extended position mode): homed in the
-// servo itself, by its Homing Offset, so its zero_ticks stays as the file
-// gives it.
+// A multi-turn joint (Dynamixel extended position mode) or a CiA 402
+// drive's: homed in the device itself (Homing Offset; homing mode on the
+// current position), so its zero_ticks stays as the file gives it.
 bool is_multi_turn(const LimpFigure& figure, std::size_t j) {
+  if (figure.protocol(j) == "cia402") return true;
   return figure.protocol(j) == "dynamixel2" && dxl::device_options(*figure.binding(j)).multi_turn;
 }
 
@@ -321,8 +324,11 @@ std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t 
   }
   // The home where the joint rests now reads the file's zero_ticks.
   const std::int64_t reads = figure.set_home(j, a.zero_ticks);
-  std::cout << fmt::format("{}: Homing Offset set: its home reads {} ticks\n", name, reads);
-  return write_joint(edit, name, a, seen, a.zero_ticks) + " (Homing Offset)";
+  const bool drive = figure.protocol(j) == "cia402";
+  std::cout << fmt::format("{}: {}: its home reads {} ticks\n", name,
+                           drive ? "homed on its current position" : "Homing Offset set", reads);
+  return write_joint(edit, name, a, seen, a.zero_ticks) +
+         (drive ? " (homing method 37)" : " (Homing Offset)");
 }
 
 // The edited file must load as a robot: checked on a copy beside it, so

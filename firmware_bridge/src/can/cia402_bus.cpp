@@ -426,11 +426,11 @@ void Cia402Bus::map_health_tpdo(std::size_t i) {
   sdo_write(i, tpdo2_comm, 1, canopen::kTpdo2Base + node, 4);
 }
 
-std::string Cia402Bus::walk_to(State goal) {
+std::string Cia402Bus::walk_to(State goal, std::size_t only) {
   for (int step = 0; step < kStateMachineSteps; ++step) {
     bool all_there = true;
     for (std::size_t i = 0; i < book_.size(); ++i) {
-      if (book_[i].faulted) continue;
+      if (book_[i].faulted || (only != kAllDrives && i != only)) continue;
       if (drive_[i].state == goal) continue;
       all_there = false;
       send_rpdo(i, cia402::controlword_toward(drive_[i].state, goal, controlword_[i]),
@@ -441,7 +441,7 @@ std::string Cia402Bus::walk_to(State goal) {
   }
   std::string failed;
   for (std::size_t i = 0; i < book_.size(); ++i) {
-    if (book_[i].faulted || drive_[i].state == goal) continue;
+    if (book_[i].faulted || drive_[i].state == goal || (only != kAllDrives && i != only)) continue;
     std::string why = fault_text(i);
     failed += (failed.empty() ? "" : ", ") + describe(i) + " stays in " +
               cia402::to_string(drive_[i].state) + (why.empty() ? "" : " (" + why + ")");

@@ -99,6 +99,9 @@ void Cia402DriveNode::reset_application(Nanos now) {
       {obj::position_actual, 0, 4, Access::ro, false, true, 0},
       {obj::velocity_actual, 0, 4, Access::ro, false, true, 0},
       {obj::target_position, 0, 4, Access::rw, true, false, 0},
+      {obj::home_offset, 0, 4, Access::rw, false, false, 0},
+      {obj::homing_method, 0, 1, Access::rw, false, false,
+       static_cast<std::uint8_t>(cia402::kHomingHere)},
       {obj::motor_rated_current, 0, 4, Access::rw, false, false, kRatedCurrentMa},
       {obj::current_actual, 0, 2, Access::ro, false, true, 0},
       {obj::dc_link_voltage, 0, 4, Access::ro, false, true, 0},
@@ -107,8 +110,20 @@ void Cia402DriveNode::reset_application(Nanos now) {
   state_ = State::switch_on_disabled;  // transitions 0 and 1 are immediate here
   last_controlword_ = 0;
   motor_.hold(now);
-  find(obj::target_position, 0)->value =
-      static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(motor_.position(now))));
+  find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
+  homing_attained_ = false;
+}
+
+std::int32_t Cia402DriveNode::counts(Nanos now) const {
+  return static_cast<std::int32_t>(std::lround(motor_.position(now))) + position_offset_;
+}
+
+void Cia402DriveNode::start_homing(Nanos now) {
+  // 35/37: the present position is the home; it reads the home offset.
+  const auto offset = static_cast<std::int32_t>(find(obj::home_offset, 0)->value);
+  position_offset_ = offset - static_cast<std::int32_t>(std::lround(motor_.position(now)));
+  find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
+  homing_attained_ = true;
 }
 
 void Cia402DriveNode::reset_communication() {
@@ -169,11 +184,17 @@ std::uint16_t Cia402DriveNode::statusword(Nanos now) const {
       state_ == State::operation_enabled || state_ == State::quick_stop_active) {
     sw |= 0x0010;  // voltage enabled
   }
+  if (homing_mode()) {
+    // Not started (or interrupted): target reached alone; done: attained too.
+    sw |= cia402::kSwTargetReached;
+    if (homing_attained_) sw |= cia402::kSwHomingAttained;
+    return sw;
+  }
   if (state_ == State::operation_enabled) {
     sw |= 0x1000;  // CSP: following the target
     const auto target = static_cast<std::int32_t>(
         const_cast<Cia402DriveNode*>(this)->find(obj::target_position, 0)->value);
-    if (std::abs(static_cast<double>(target) - motor_.position(now)) <= kTargetWindow) sw |= 0x0400;
+    if (std::abs(static_cast<double>(target) - counts(now)) <= kTargetWindow) sw |= 0x0400;
   } else {
     sw |= 0x0400;
   }
@@ -185,8 +206,7 @@ std::uint32_t Cia402DriveNode::read_value(const Entry& e, Nanos now) const {
     case obj::statusword:
       return statusword(now);
     case obj::position_actual:
-      return static_cast<std::uint32_t>(
-          static_cast<std::int32_t>(std::lround(motor_.position(now))));
+      return static_cast<std::uint32_t>(counts(now));
     case obj::velocity_actual:
       return static_cast<std::uint32_t>(
           static_cast<std::int32_t>(std::lround(motor_.velocity(now))));
@@ -205,9 +225,7 @@ std::uint32_t Cia402DriveNode::read_value(const Entry& e, Nanos now) const {
   }
 }
 
-double Cia402DriveNode::joint_position(Nanos now) const {
-  return binding_.to_rad(static_cast<std::int32_t>(std::lround(motor_.position(now))));
-}
+double Cia402DriveNode::joint_position(Nanos now) const { return binding_.to_rad(counts(now)); }
 
 std::uint32_t Cia402DriveNode::cob_id(const Pdo& pdo) const {
   return const_cast<Cia402DriveNode*>(this)->find(pdo.comm, 1)->value;
@@ -258,17 +276,29 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
     if (index == pdo.comm && sub == 2 && value > 240 && value < 254) return ac::value_range;
   }
   switch (index) {
-    case obj::modes_of_operation:
-      if (static_cast<std::int8_t>(value) != cia402::kModeCsp) return ac::value_range;
+    case obj::modes_of_operation: {
+      const auto mode = static_cast<std::int8_t>(value);
+      if (mode != cia402::kModeCsp && mode != cia402::kModeHoming) return ac::value_range;
+      homing_attained_ = false;
+      find(obj::modes_of_operation_display, 0)->value = value & 0xFF;
       break;
+    }
+    case obj::homing_method: {
+      const auto method = static_cast<std::int8_t>(value);
+      if (method != cia402::kHomingHere && method != cia402::kHomingHereOld) {
+        return ac::value_range;
+      }
+      break;
+    }
     case obj::controlword:
       e->value = value & 0xFFFF;
       controlword(static_cast<std::uint16_t>(value), now, out);
       return 0;
     case obj::target_position:
       e->value = value;
-      if (state_ == State::operation_enabled && !health_.blocked()) {
-        motor_.set_goal(static_cast<double>(static_cast<std::int32_t>(value)), now);
+      if (state_ == State::operation_enabled && !health_.blocked() && !homing_mode()) {
+        motor_.set_goal(static_cast<double>(static_cast<std::int32_t>(value) - position_offset_),
+                        now);
       }
       return 0;
     case obj::heartbeat_time:
@@ -297,8 +327,14 @@ void Cia402DriveNode::enter_state(State state, Nanos now) {
   state_ = state;
   if (state_ == State::operation_enabled) {
     // Take over at the present position: the target was set to it beforehand.
-    motor_.set_goal(
-        static_cast<double>(static_cast<std::int32_t>(find(obj::target_position, 0)->value)), now);
+    if (homing_mode()) {
+      motor_.hold(now);  // homing on the current position moves nothing
+    } else {
+      motor_.set_goal(
+          static_cast<double>(static_cast<std::int32_t>(find(obj::target_position, 0)->value) -
+                              position_offset_),
+          now);
+    }
   } else {
     motor_.hold(now);
   }
@@ -306,7 +342,10 @@ void Cia402DriveNode::enter_state(State state, Nanos now) {
 
 void Cia402DriveNode::controlword(std::uint16_t value, Nanos now, FrameList& out) {
   const cia402::Command command = cia402::decode_controlword(value, last_controlword_);
+  const bool start =
+      (value & cia402::kCwHomingStart) != 0 && (last_controlword_ & cia402::kCwHomingStart) == 0;
   last_controlword_ = value;
+  if (start && state_ == State::operation_enabled && homing_mode()) start_homing(now);
   if (command == cia402::Command::fault_reset && state_ == State::fault) {
     if (condition_ != 0) return;  // the cause is still there: stays in fault
     find(obj::error_register, 0)->value = 0;

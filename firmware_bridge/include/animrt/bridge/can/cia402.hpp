@@ -33,10 +33,22 @@ inline constexpr std::uint16_t motor_rated_current = 0x6075;         // u32, mA
 inline constexpr std::uint16_t current_actual = 0x6078;   // i16, per mille of rated current
 inline constexpr std::uint16_t dc_link_voltage = 0x6079;  // u32, mV
 inline constexpr std::uint16_t target_position = 0x607A;  // i32
+inline constexpr std::uint16_t home_offset = 0x607C;      // i32: the position the home reads
+inline constexpr std::uint16_t homing_method = 0x6098;    // i8
 }  // namespace obj
 
-inline constexpr std::uint32_t kDeviceProfile = 402;      // low word of 1000h
-inline constexpr std::int8_t kModeCsp = 8;                // cyclic synchronous position
+inline constexpr std::uint32_t kDeviceProfile = 402;  // low word of 1000h
+inline constexpr std::int8_t kModeCsp = 8;            // cyclic synchronous position
+inline constexpr std::int8_t kModeHoming = 6;
+// Homing on the current position: 37 in today's profile, 35 in older ones.
+inline constexpr std::int8_t kHomingHere = 37;
+inline constexpr std::int8_t kHomingHereOld = 35;
+// Homing mode: controlword bit 4 starts it (rising edge); statusword bits
+// 10 (target reached), 12 (homing attained), 13 (homing error).
+inline constexpr std::uint16_t kCwHomingStart = 0x0010;
+inline constexpr std::uint16_t kSwTargetReached = 0x0400;
+inline constexpr std::uint16_t kSwHomingAttained = 0x1000;
+inline constexpr std::uint16_t kSwHomingError = 0x2000;
 inline constexpr std::uint32_t kPdoInvalid = 0x80000000;  // COB-ID bit 31
 
 enum class State : std::uint8_t {

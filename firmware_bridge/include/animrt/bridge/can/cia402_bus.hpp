@@ -79,6 +79,16 @@ class Cia402Bus final : public ActuatorBus {
   // its current actual value (6078h, scaled by 6075h) and DC link voltage
   // (6079h).
   bool reads_health() const override { return options_.health; }
+  // Commissioning, with the bus configured and not running: homing mode
+  // (6060h = 6) with homing method 37 (35 where the drive knows only the
+  // older number), home offset (607Ch) = `ticks`: drive `device` alone is
+  // enabled, a rising controlword bit 4 starts the homing, which on the
+  // current position moves nothing and makes the position actual read
+  // `ticks`; statusword bits 12 and 10 (homing attained, target reached)
+  // end it, bit 13 (homing error) fails it. Then the drive is disabled
+  // again, back in cyclic synchronous position mode, and its position read
+  // back (DeviceError when it is not `ticks`).
+  std::int64_t set_home(std::size_t device, std::int64_t ticks) override;
 
   // What the runtime knows about each drive.
   struct DriveReport {
@@ -119,9 +129,12 @@ class Cia402Bus final : public ActuatorBus {
   void produce_heartbeat();
   // Writes 1016h:01 = 0 on every drive (errors ignored) and stops producing.
   void clear_device_guard();
-  // Runs SYNC cycles until every non-faulted drive is in `goal` (or steps
-  // run out); returns the drives that did not get there.
-  std::string walk_to(cia402::State goal);
+  // Runs SYNC cycles until every non-faulted drive (or drive `only`) is in
+  // `goal` (or steps run out); returns the drives that did not get there.
+  static constexpr std::size_t kAllDrives = static_cast<std::size_t>(-1);
+  std::string walk_to(cia402::State goal, std::size_t only = kAllDrives);
+  // set_home()'s steps with the drive in homing mode, operational: "" or why it failed.
+  std::string run_homing(std::size_t device);
   int slot_of(canid_t cob, canid_t base) const;
   std::string prefix() const { return book_.prefix(); }
   std::string describe(std::size_t device) const { return book_.describe(device); }

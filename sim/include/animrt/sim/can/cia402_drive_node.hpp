@@ -9,8 +9,15 @@
 //   register, 1017h heartbeat producer time, 1018h identity, RPDO1 (1400h,
 //   1600h) and TPDO1 (1800h, 1A00h) communication and mapping, 603Fh error
 //   code, 6040h controlword, 6041h statusword, 6060h/6061h modes of
-//   operation (8, cyclic synchronous position, only), 6064h position actual,
-//   606Ch velocity actual, 607Ah target position.
+//   operation (8, cyclic synchronous position, and 6, homing), 6064h
+//   position actual, 606Ch velocity actual, 607Ah target position, 607Ch
+//   home offset, 6098h homing method (35 and 37, homing on the current
+//   position; no switches are modelled, so 17-30 answer value range).
+// - Homing mode (6): in Operation Enabled a rising controlword bit 4 starts
+//   it; methods 35/37 make the position actual read the home offset where
+//   the motor is, without moving, and set statusword bits 12 (homing
+//   attained) and 10 (target reached). The offset is the drive's own
+//   (absolute encoder): kept across NMT resets and reboots.
 // - Expedited SDO upload and download with the CiA 301 abort codes (object
 //   or sub-index missing, read-only, write-only, length mismatch, value
 //   range, mapping rules); segmented transfers are answered with an abort.
@@ -134,6 +141,16 @@ class Cia402DriveNode final : public CanNode {
   cia402::State state_ = cia402::State::switch_on_disabled;
   std::uint16_t last_controlword_ = 0;
   LagMotor motor_;  // counts
+  // What homing added: position actual = motor + position_offset_.
+  std::int32_t position_offset_ = 0;
+  bool homing_attained_ = false;
+  std::int32_t counts(Nanos now) const;
+  bool homing_mode() const {
+    return static_cast<std::int8_t>(const_cast<Cia402DriveNode*>(this)
+                                        ->find(cia402::obj::modes_of_operation, 0)
+                                        ->value) == cia402::kModeHoming;
+  }
+  void start_homing(Nanos now);
   ServoHealthModel health_;
   std::uint8_t condition_ = 0;  // injected fault condition (0: none)
   bool boot_pending_ = true;
