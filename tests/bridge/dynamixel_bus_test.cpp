@@ -52,6 +52,7 @@ struct FakeServo {
   std::uint8_t torque = 0;
   std::uint32_t max_limit = 0, min_limit = 0;  // registers 48 and 52
   std::uint8_t hardware_error = 0;             // register 70; nonzero sets the alert bit
+  std::uint8_t mode = 3;                       // register 11, Operating Mode: position
   Fault fault = Fault::none;
   int booting_pings = 0;  // pings it ignores before it answers (still booting)
 };
@@ -158,6 +159,7 @@ class FakeDevices {
           if (address == dxl::xreg::torque_enable) s.torque = p[2];
           if (address == dxl::xreg::max_position_limit) s.max_limit = dxl::get_u32(&p[2]);
           if (address == dxl::xreg::min_position_limit) s.min_limit = dxl::get_u32(&p[2]);
+          if (address == dxl::xreg::operating_mode) s.mode = p[2];
           answer(packet.id, {});
         }
         break;
@@ -191,6 +193,7 @@ class FakeDevices {
     }
     if (address == dxl::xreg::hardware_error_status && length == 1) data[0] = s.hardware_error;
     if (address == dxl::xreg::torque_enable && length == 1) data[0] = s.torque;
+    if (address == dxl::xreg::operating_mode && length == 1) data[0] = s.mode;
     if (address == dxl::xreg::max_position_limit && length == 4)
       dxl::put_u32(data.data(), s.max_limit);
     if (address == dxl::xreg::min_position_limit && length == 4)
@@ -317,23 +320,78 @@ class DynamixelBusTest : public ::testing::Test {
 TEST_F(DynamixelBusTest, ConfigurePingsAndReadsEveryDevice) {
   bus_.configure();
   const auto log = fake_.log();
-  ASSERT_EQ(log.size(), 9u);
+  ASSERT_EQ(log.size(), 12u);
   for (std::uint8_t id = 1; id <= 3; ++id) {
     EXPECT_EQ(log[id - 1].instruction, dxl::inst::ping);
     EXPECT_EQ(log[id - 1].id, id);
+    // Operating Mode: read, and (position mode already) left alone.
     EXPECT_EQ(log[id + 2].instruction, dxl::inst::read);
     EXPECT_EQ(log[id + 2].id, id);
-    EXPECT_EQ(log[id + 2].params, (std::vector<std::uint8_t>{132, 0, 4, 0}));
-    // Bus Watchdog: read, and (reading 0 here) left alone.
+    EXPECT_EQ(log[id + 2].params, (std::vector<std::uint8_t>{11, 0, 1, 0}));
     EXPECT_EQ(log[id + 5].instruction, dxl::inst::read);
     EXPECT_EQ(log[id + 5].id, id);
-    EXPECT_EQ(log[id + 5].params, (std::vector<std::uint8_t>{98, 0, 1, 0}));
+    EXPECT_EQ(log[id + 5].params, (std::vector<std::uint8_t>{132, 0, 4, 0}));
+    // Bus Watchdog: read, and (reading 0 here) left alone.
+    EXPECT_EQ(log[id + 8].instruction, dxl::inst::read);
+    EXPECT_EQ(log[id + 8].id, id);
+    EXPECT_EQ(log[id + 8].params, (std::vector<std::uint8_t>{98, 0, 1, 0}));
   }
   for (std::size_t i = 0; i < 3; ++i) {
     expect_ok(i);
     EXPECT_EQ(status(i).device_id, static_cast<int>(i) + 1);
-    EXPECT_EQ(status(i).transactions, 3u);  // the lifecycle's transactions count too
+    EXPECT_EQ(status(i).transactions, 4u);  // the lifecycle's transactions count too
   }
+  EXPECT_EQ(bus_.mode_warning(), "");
+}
+
+// A process killed while it held a joint compliantly leaves its servo in
+// current-based position mode (EEPROM): configure writes position mode
+// back, torque off first, before it reads any position, and says so; a
+// multi_turn joint's servo goes to extended position mode and gets no
+// position limits (that mode does not use them).
+TEST_F(DynamixelBusTest, ConfigurePutsEachServoInTheModeItsJointNeeds) {
+  auto config = make_config(fake_.port());
+  config.actuators[0].min_position = -0.5;
+  config.actuators[0].max_position = 0.25;
+  config.actuators[2].min_position = -0.5;
+  config.actuators[2].max_position = 0.25;
+  dxl::DeviceOptions multi;
+  multi.multi_turn = true;
+  config.actuators[2].options = multi;
+  DynamixelBus bus(config, open_serial(fake_.port(), 1'000'000));
+  fake_.edit([](auto& s) {
+    s[1].mode = 5;
+    s[1].torque = 1;
+  });
+  bus.configure();
+  EXPECT_EQ(fake_.servo(1).mode, 3);
+  EXPECT_EQ(fake_.servo(2).mode, 3);
+  EXPECT_EQ(fake_.servo(3).mode, 4);
+  const auto log = fake_.log();
+  std::vector<std::uint16_t> to_1, to_3;
+  for (const auto& r : log) {
+    if (r.instruction == dxl::inst::write && r.id == 1) to_1.push_back(r.address());
+    if (r.instruction == dxl::inst::write && r.id == 3) to_3.push_back(r.address());
+  }
+  ASSERT_GE(to_1.size(), 2u);
+  EXPECT_EQ(to_1[0], dxl::xreg::torque_enable);
+  EXPECT_EQ(to_1[1], dxl::xreg::operating_mode);
+  EXPECT_EQ(to_3,
+            (std::vector<std::uint16_t>{dxl::xreg::torque_enable, dxl::xreg::operating_mode}));
+  // The mode is set before the position is read (entering position mode
+  // restarts a servo's count of turns).
+  std::size_t mode_write = log.size(), position_read = log.size();
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (log[k].id != 1) continue;
+    if (log[k].instruction == dxl::inst::write && log[k].address() == dxl::xreg::operating_mode)
+      mode_write = std::min(mode_write, k);
+    if (log[k].instruction == dxl::inst::read && log[k].address() == dxl::xreg::present_position)
+      position_read = std::min(position_read, k);
+  }
+  EXPECT_LT(mode_write, position_read);
+  EXPECT_EQ(bus.mode_warning(),
+            "id 1 (lf_hip) was in Operating Mode 5 (current-based position), set to 3 (position); "
+            "id 3 (lf_ankle) was in Operating Mode 3 (position), set to 4 (extended position)");
 }
 
 TEST_F(DynamixelBusTest, FirstReadHasConfiguredPositionsEvenIfNobodyAnswers) {
@@ -410,7 +468,7 @@ TEST(DynamixelBus, ConfigureReportsARejectedPositionRead) {
   DynamixelBus bus(make_config(fake.port()), open_serial(fake.port(), 1'000'000));
   EXPECT_EQ(error_of([&] { bus.configure(); }),
             "bus legs (" + fake.port() +
-                "): cannot read present position of id 2 (lf_knee): status error 0x04 (data "
+                "): cannot read Operating Mode of id 2 (lf_knee): status error 0x04 (data "
                 "range error)");
 }
 

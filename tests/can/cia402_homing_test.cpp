@@ -48,8 +48,12 @@ struct Rig {
     b.device_id = kNode;
     b.ticks_per_rad = 65536 / 6.283185307179586;
     b.zero_ticks = kHome;  // the robot file's zero: where homing puts the home
+    // The drive powers up reading near 0 counts, wherever the joint is.
+    BusConfig drive_side = config;
+    drive_side.actuators.push_back(b);
+    drive_side.actuators[0].zero_ticks = 0;
     config.actuators.push_back(b);
-    sim = std::make_unique<sim::CanSimBus>(config, clock, sim::CanSimAttach::in_process);
+    sim = std::make_unique<sim::CanSimBus>(drive_side, clock, sim::CanSimAttach::in_process);
     sim->start();
     sniffer = VirtualCanBus::named(name)->attach();
     bus = std::make_unique<Cia402Bus>(config, open_can(config.port));

@@ -234,6 +234,37 @@ TEST(ServoCommissioning, ExtendedPositionModeTurnsPastOneTurn) {
             static_cast<std::uint8_t>(dxl::StatusError::data_limit));
 }
 
+// Present Position = the count of the shaft's ticks + Homing Offset; the
+// count goes on across turns and starts again from the shaft's angle within
+// its turn at a Reboot, a power cycle, entering position mode and torque on
+// in it (X-series manual, Present Position and Homing Offset).
+TEST(ServoCommissioning, TheCountOfTurnsStartsAgainWithinOneTurn) {
+  ManualClock clock{0};
+  sim::DynamixelSimBus sim(dynamixel_bus({3}), clock);
+  sim.start();
+  test::PtyClient line(sim.endpoint());
+  EXPECT_EQ(line.transact(test::write(3, xreg::operating_mode, {4})).error, 0);
+  sim.hand_move(3, 9000);  // two turns and 808 ticks, torque off
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 9000);
+  // Homing Offset (20) moves what it reads, not the shaft.
+  EXPECT_EQ(line.transact(test::write_u32(3, 20, static_cast<std::uint32_t>(-100))).error, 0);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 8900);
+  EXPECT_EQ(line.transact(test::packet(3, dxl::inst::reboot, {})).id, 3);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 808 - 100);
+  sim.hand_move(3, 708 + 4096 * 3);  // turned three more turns, then power cycled
+  sim.set_device_plugged(0, false);
+  sim.set_device_plugged(0, true);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 708);
+  // Torque off in mode 4 and back: the count goes on.
+  sim.hand_move(3, 708 - 4096);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {1})).error, 0);
+  EXPECT_EQ(line.transact(test::write(3, xreg::torque_enable, {0})).error, 0);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 708 - 4096);
+  // Position control mode counts within one turn from its start.
+  EXPECT_EQ(line.transact(test::write(3, xreg::operating_mode, {3})).error, 0);
+  EXPECT_EQ(read_i32(line, 3, xreg::present_position), 708);
+}
+
 TEST(ServoCommissioning, AWeakCurrentBasedPositionHoldYieldsToAHand) {
   ManualClock clock{0};
   sim::DynamixelSimBus sim(dynamixel_bus({3}), clock);
