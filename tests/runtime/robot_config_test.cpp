@@ -295,7 +295,8 @@ joints:
 )"),
             at("7:14: joints.j1.limits.min: unknown key (expected one of: min_deg, max_deg, "
                "velocity_dps, acceleration_dps2)"));
-  EXPECT_EQ(error_of(R"(name: t
+  EXPECT_EQ(
+      error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
   b: {protocol: dynamixel2, port: /dev/ttyUSB0}
@@ -304,8 +305,8 @@ joints:
     limits: {min_deg: -10, max_deg: 10, velocity_dps: 100, acceleration_dps2: 1000}
     actuator: {bus: b, id: 1, inverted: true}
 )"),
-            at("8:31: joints.j1.actuator.inverted: unknown key (expected one of: bus, id, "
-               "ticks_per_rev, ticks_per_rad, zero_ticks, direction, model, health_limits)"));
+      at("8:31: joints.j1.actuator.inverted: unknown key (expected one of: bus, id, "
+         "ticks_per_rev, ticks_per_rad, zero_ticks, direction, model, multi_turn, health_limits)"));
   EXPECT_EQ(error_of(R"(name: t
 loop: {rate_hz: 100}
 buses:
@@ -685,6 +686,23 @@ TEST_F(RobotConfigTest, LimitsOutsideTheServoRange) {
 }
 
 // --------------------------------------------------------------- actuator
+
+TEST_F(RobotConfigTest, AMultiTurnJointSpansTurnsAndTheKeyIsABoolean) {
+  // 200 deg: past one turn, within extended position mode's +-256 turns.
+  const std::string limits =
+      "    limits: {min_deg: -10, max_deg: 200, velocity_dps: 100, acceleration_dps2: 1000}\n";
+  EXPECT_EQ(error_of(std::string(kLimitsHead) + limits +
+                     "    actuator: {bus: b, id: 1, multi_turn: true}\n"),
+            at("1:1: motion: required key is missing"));  // the joint is valid
+  EXPECT_EQ(error_of(std::string(kLimitsHead) + limits +
+                     "    actuator: {bus: b, id: 1, multi_turn: yes}\n"),
+            at("8:43: joints.j1.actuator.multi_turn: expected true or false, found \"yes\""));
+  EXPECT_EQ(error_of(std::string(kLimitsHead) + limits +
+                     "    actuator: {bus: b, id: 1, multi_turn: true, ticks_per_rev: 16000000}\n"),
+            at("7:37: joints.j1.limits.max_deg: 200 deg maps to tick 8890937 (zero_ticks 2048, "
+               "direction 1, 1.6e+07 ticks/rev), outside the dynamixel2 extended (multi_turn) "
+               "position range -1048575..1048575"));
+}
 
 TEST_F(RobotConfigTest, DirectionMustBePlusOrMinusOne) {
   EXPECT_EQ(error_of(std::string(kLimitsHead) +
