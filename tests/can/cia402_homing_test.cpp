@@ -4,7 +4,9 @@
 // controlword bit 4 starts it, the position actual then reads the home
 // offset without the drive moving, the drive ends disabled and back in
 // cyclic synchronous position mode, and the home survives a reset of the
-// node and plays as the run's zero.
+// node and plays as the run's zero. While the figure is limp (disabled,
+// pre-operational) the bus still reads the position, as calibrate follows
+// a joint moved by hand.
 
 #include <gtest/gtest.h>
 
@@ -86,6 +88,11 @@ TEST(Cia402Homing, HomesOnTheCurrentPositionWithoutMoving) {
   rig.drain();
   const std::int32_t before = rig.position();
   ASSERT_GT(std::abs(before - kHome), 1000);  // the home is somewhere else until homed
+  // Limp, its position is still read (by SDO: no PDOs while disabled).
+  std::vector<double> limp(1, 99.0);
+  rig.bus->read(limp);  // configure's reading
+  rig.bus->read(limp);
+  EXPECT_NEAR(limp[0], rig.config.actuators[0].to_rad(before), 1e-6);
 
   EXPECT_EQ(rig.bus->set_home(0, kHome), kHome);
   const std::vector<can_frame> frames = rig.drain();
@@ -110,6 +117,9 @@ TEST(Cia402Homing, HomesOnTheCurrentPositionWithoutMoving) {
   EXPECT_EQ(rig.position(), kHome);
   rig.clock.set(3000 * kMs);
   EXPECT_EQ(rig.position(), kHome);
+  rig.bus->read(limp);  // the home is the joint's zero
+  EXPECT_NEAR(limp[0], 0.0, 1e-6);
+  EXPECT_EQ(rig.bus->devices()[0].health, DeviceHealth::ok);
   // Disabled and back in cyclic synchronous position mode.
   EXPECT_EQ(rig.bus->sdo_read(0, cia402::obj::modes_of_operation, 0),
             static_cast<std::uint32_t>(cia402::kModeCsp));

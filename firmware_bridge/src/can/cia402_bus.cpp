@@ -524,10 +524,29 @@ void Cia402Bus::clear_device_guard() {
 
 void Cia402Bus::read(std::span<double> positions) {
   const std::size_t n = std::min(positions.size(), book_.size());
-  if (!fresh_) sync_cycle();
+  if (!fresh_ && !running_) {
+    read_limp();
+  } else if (!fresh_) {
+    sync_cycle();
+  }
   fresh_ = false;
   for (std::size_t i = 0; i < n; ++i) {
     positions[i] = config_.actuators[i].to_rad(actual_counts_[i]);
+  }
+}
+
+void Cia402Bus::read_limp() {
+  // Disabled and pre-operational (commissioning: a joint moved by hand):
+  // no PDOs, so the position actual by SDO, a device that fails counted.
+  for (std::size_t i = 0; i < book_.size(); ++i) {
+    if (book_[i].faulted) continue;
+    book_.asked(i);
+    try {
+      actual_counts_[i] = static_cast<std::int32_t>(sdo_read(i, cia402::obj::position_actual, 0));
+      book_.answered(i);
+    } catch (const DeviceError&) {
+      book_.timed_out(i);
+    }
   }
 }
 

@@ -71,6 +71,9 @@ class Cia402Bus final : public ActuatorBus {
   // host's heartbeats from every read on (device_watchdog_ms; none if off).
   void arm_device_guard() override;
   void deactivate() override;
+  // Between activate() and deactivate(): one SYNC and the drives' TPDOs.
+  // Otherwise (a limp figure being commissioned; drives disabled and
+  // pre-operational) each drive's position actual by SDO, which allocates.
   void read(std::span<double> positions) override;
   void write(std::span<const double> positions) override;
   std::span<DeviceStatus> devices() override { return book_.devices(); }
@@ -121,6 +124,7 @@ class Cia402Bus final : public ActuatorBus {
                              std::uint8_t sub, const std::string& what, canopen::SdoKind expected);
   // Sends SYNC and collects TPDOs of the drives in expect_ (one deadline).
   void sync_cycle();
+  void read_limp();
   void handle(const can_frame& frame);
   void supervise();
   void send_rpdo(std::size_t device, std::uint16_t controlword, std::int32_t target);
