@@ -37,8 +37,10 @@ inline constexpr std::uint16_t home_offset = 0x607C;      // i32: the position t
 inline constexpr std::uint16_t homing_method = 0x6098;    // i8
 }  // namespace obj
 
-inline constexpr std::uint32_t kDeviceProfile = 402;  // low word of 1000h
-inline constexpr std::int8_t kModeCsp = 8;            // cyclic synchronous position
+inline constexpr std::uint32_t kDeviceProfile = 402;      // low word of 1000h
+inline constexpr std::int8_t kModeCsp = 8;                // cyclic synchronous position
+inline constexpr std::uint32_t kPdoInvalid = 0x80000000;  // COB-ID bit 31
+
 inline constexpr std::int8_t kModeHoming = 6;
 // Homing on the current position: 37 in today's profile, 35 in older ones.
 inline constexpr std::int8_t kHomingHere = 37;
@@ -49,7 +51,6 @@ inline constexpr std::uint16_t kCwHomingStart = 0x0010;
 inline constexpr std::uint16_t kSwTargetReached = 0x0400;
 inline constexpr std::uint16_t kSwHomingAttained = 0x1000;
 inline constexpr std::uint16_t kSwHomingError = 0x2000;
-inline constexpr std::uint32_t kPdoInvalid = 0x80000000;  // COB-ID bit 31
 
 enum class State : std::uint8_t {
   not_ready_to_switch_on,

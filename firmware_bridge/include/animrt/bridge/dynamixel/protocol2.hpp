@@ -59,14 +59,13 @@ inline constexpr std::uint8_t kCurrentBasedPositionMode = 5;
 
 // X-series control table (the addresses the runtime and simulator use).
 namespace xreg {
-inline constexpr std::uint16_t model_number = 0;       // 2 bytes
-inline constexpr std::uint16_t firmware_version = 6;   // 1
-inline constexpr std::uint16_t id = 7;                 // 1
-inline constexpr std::uint16_t baud_rate = 8;          // 1
-inline constexpr std::uint16_t return_delay_time = 9;  // 1, unit 2 us
-inline constexpr std::uint16_t operating_mode = 11;    // 1, 3 = position
-// 4, signed, EEPROM: Present Position = the motor's count + Homing Offset.
-inline constexpr std::uint16_t homing_offset = 20;
+inline constexpr std::uint16_t model_number = 0;            // 2 bytes
+inline constexpr std::uint16_t firmware_version = 6;        // 1
+inline constexpr std::uint16_t id = 7;                      // 1
+inline constexpr std::uint16_t baud_rate = 8;               // 1
+inline constexpr std::uint16_t return_delay_time = 9;       // 1, unit 2 us
+inline constexpr std::uint16_t operating_mode = 11;         // 1, 3 = position
+inline constexpr std::uint16_t homing_offset = 20;          // 4, signed: added to the count
 inline constexpr std::uint16_t current_limit = 38;          // 2, unit as Present Current
 inline constexpr std::uint16_t velocity_limit = 44;         // 4, unit 0.229 rpm
 inline constexpr std::uint16_t max_position_limit = 48;     // 4
