@@ -41,8 +41,8 @@ HeadAxisMap parse_axis(const YamlNode& n) {
 
 HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robot_path) {
   node.allow_only({"type", "model", "audio", "capture", "live", "playback", "repeat", "pause_s",
-                   "audio_device", "decoder_lag_s", "max_gap_s", "block_s", "noise_deg", "axes",
-                   "jaw"});
+                   "audio_device", "decoder_lag_s", "max_gap_s", "smoothing", "block_s",
+                   "noise_deg", "axes", "jaw"});
   HeadMotionConfig c;
   c.where = node.location();
   c.model = resolve_file(node.at("model"), robot_path);
@@ -73,6 +73,11 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
   c.audio_device = node.get_string("audio_device", "none");
   if (auto p = node.find("decoder_lag_s")) c.decoder_lag_s = p->as_double_in(0.0, 5.0);
   if (auto p = node.find("max_gap_s")) c.max_gap_s = p->as_double_in(0.0, 5.0);
+  if (auto p = node.find("smoothing")) {
+    const std::string v = p->as_string();
+    if (v != "squad" && v != "causal") p->fail("expected squad or causal, found " + p->describe());
+    c.causal = v == "causal";
+  }
   if (auto p = node.find("block_s")) c.block_s = p->as_double_in(0.001, 0.5);
   if (auto p = node.find("noise_deg")) c.noise_deg = p->as_double_in(0.0, 10.0);
   const YamlNode axes = node.at("axes");

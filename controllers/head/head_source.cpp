@@ -49,6 +49,7 @@ class HeadSource final : public MotionSource {
     so.input_rate = audio_.sample_rate;
     so.decoder_lag_s = c.decoder_lag_s;
     so.max_gap_s = c.max_gap_s;
+    so.causal = c.causal;
     stream_options_ = so;
     block_ = std::max<std::size_t>(1, static_cast<std::size_t>(c.block_s * audio_.sample_rate));
     jaw_window_ = std::max<std::size_t>(

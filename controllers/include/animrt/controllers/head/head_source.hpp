@@ -31,6 +31,7 @@
 //     pause_s: 1.0
 //     audio_device: none             # ALSA playback: none, auto or a device name
 //     decoder_lag_s: 0.2
+//     smoothing: squad               # or causal: live head within ~0.14 s (docs/head.md)
 //     axes:
 //       yaw:   {joint: neck_yaw, sign: 1, scale: 1.0, offset_deg: 0}
 //       pitch: {joint: neck_pitch, sign: 1}
@@ -75,6 +76,7 @@ struct HeadMotionConfig {
   std::string audio_device = "none";
   double decoder_lag_s = 0.2;
   double max_gap_s = 0.15;
+  bool causal = false;  // smoothing: causal (no SQUAD look-ahead), for live sound
   double block_s = 0.01;
   std::optional<double> noise_deg;
   HeadAxisMap yaw, pitch, roll;
