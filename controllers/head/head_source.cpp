@@ -112,6 +112,8 @@ class HeadSource final : public MotionSource {
       std::uint64_t idx = static_cast<std::uint64_t>(audio_t * rate_);
       if (config_.precomputed) {
         idx = config_.repeat ? idx % written : std::min<std::uint64_t>(idx, written - 1);
+      } else if (live_) {
+        idx = written - 1;  // live: the newest final pose, whatever the motion's time
       } else {
         idx =
             std::min<std::uint64_t>(idx, written - 1);  // the stream is late: hold the newest pose

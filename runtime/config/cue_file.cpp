@@ -1,9 +1,12 @@
 #include "animrt/runtime/cue_file.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include "animrt/controllers/cues/pose_source.hpp"
+#include "animrt/controllers/head/audio.hpp"
+#include "animrt/controllers/head/head_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -67,13 +70,33 @@ std::unique_ptr<MotionSource> load_file_motion(const YamlNode& file, const std::
   return load_motion_source(motion, robot);
 }
 
-// One step: a gait, a show, a pose, or several of them layered in that order
-// (later ones win on the joints they drive), and how long it plays: a show
-// that does not loop for its length, everything else until the next cue.
+// Speech-driven head motion (the keys of a robot file's head motion, paths
+// relative to the cue file). A sound file is analysed at load, so the cue
+// plays it from its start each time it is asked for; live sound (capture,
+// or live: true) is heard from the run's start, and the cue joins it. Plays
+// for the sound's length when it does not repeat, else until the next cue.
+std::unique_ptr<MotionSource> make_head(const YamlNode& node, const std::string& cue_path,
+                                        const RobotConfig& robot, double& duration_s) {
+  auto config = std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, cue_path));
+  const bool file = config->capture.empty() && !config->live;
+  config->precomputed = file;
+  if (file && !config->repeat) duration_s = head::load_audio(config->audio).duration_s();
+  MotionConfig motion;
+  motion.type = "head";
+  motion.head = config;
+  motion.where = node.location();
+  motion.key = node.path();
+  return load_motion_source(motion, robot);
+}
+
+// One step: a gait, a show, a pose, a head, or several of them layered in
+// that order (later ones win on the joints they drive), and how long it
+// plays: a show that does not loop for its length, a head for its sound's,
+// everything else until the next cue.
 CueStep make_step(const YamlNode& node, const std::string& cue_path, const RobotConfig& robot) {
-  node.allow_only({"gait", "show", "pose", "duration_s"});
-  if (!node.has("show") && !node.has("gait") && !node.has("pose")) {
-    node.fail("expected a gait, a show or a pose (or several, layered), found none");
+  node.allow_only({"gait", "show", "pose", "head", "duration_s"});
+  if (!node.has("show") && !node.has("gait") && !node.has("pose") && !node.has("head")) {
+    node.fail("expected a gait, a show, a pose or a head (or several, layered), found none");
   }
   CueStep step;
   std::vector<std::unique_ptr<MotionSource>> layers;
@@ -83,6 +106,12 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
     layers.push_back(load_file_motion(*show, "show", cue_path, robot));
     const ShowFile file = load_show_file(resolve(*show, cue_path));
     if (!file.loop) step.duration_s = file.duration_s;
+  }
+  if (auto head = node.find("head")) {
+    double length = kForever;
+    layers.push_back(make_head(*head, cue_path, robot, length));
+    if (length != kForever)  // the speech ends the step (or the longer of it and a show)
+      step.duration_s = step.duration_s == kForever ? length : std::max(step.duration_s, length);
   }
   if (auto pose = node.find("pose")) layers.push_back(make_pose(*pose, robot));
   step.source =

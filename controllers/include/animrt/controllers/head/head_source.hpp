@@ -14,8 +14,10 @@
 //     less than one cycle. The file's sound (ALSA playback) is not delayed.
 //   - Live sound (`capture`, or `live: true` for a file played as if it were
 //     captured) cannot be looked ahead: the jaw shows the energy up to the
-//     newest block that has arrived, the head the pose of audio time
-//     t - latency_s (the synthesizer's worst case plus one block).
+//     newest block that has arrived, the head the newest final pose (at
+//     most the synthesizer's worst case plus one block behind the sound),
+//     whatever the motion's time t: a cue that restarts it joins the sound
+//     as it is.
 // A file's blocks "arrive" on the run's clock (MotionSource::start): in a
 // lockstep run on the simulated time, and sample(t) waits for the blocks due
 // by then, so the head moves the same however fast the machine runs.
