@@ -46,6 +46,7 @@ std::int64_t now_ns() {
 struct Pending {
   std::atomic<std::int64_t> onset_ns{-1};  // the burst's first sample, or -1
   std::vector<double> latencies_ms;        // the bus thread's, read after the run
+  double writer_late_ms = 0;               // the stand-in's worst write after its period's end
 };
 
 // Stamps the first write whose jaw goal (the bus's 4th servo) leaves closed.
@@ -110,6 +111,8 @@ void feed(const std::string& fifo, double seconds, Pending& pending,
     const std::int64_t due = t0 + (n + kPeriod) * 1000000000 / kRate;
     for (std::int64_t w; (w = due - now_ns()) > 0;)
       std::this_thread::sleep_for(std::chrono::nanoseconds(w));
+    pending.writer_late_ms =
+        std::max(pending.writer_late_ms, static_cast<double>(now_ns() - due) * 1e-6);
     if (::write(fd, period.data(), period.size() * 2) < 0) break;
   }
   ::close(fd);
@@ -156,8 +159,9 @@ int main(int argc, char** argv) {
   };
   std::printf(
       "jaw, live sound (FIFO at the sample clock, 10 ms blocks): %zu bursts | first sample -> bus "
-      "write p50 %.2f p99 %.2f max %.2f ms | loop %.0f Hz %s, overruns %llu, ended by %s\n",
-      v.size(), pct(0.5), pct(0.99), pct(1.0), figure.config().rate_hz,
+      "write p50 %.2f p99 %.2f max %.2f ms (the stand-in wrote up to %.2f ms late) | loop %.0f Hz "
+      "%s, overruns %llu, ended by %s\n",
+      v.size(), pct(0.5), pct(0.99), pct(1.0), pending.writer_late_ms, figure.config().rate_hz,
       summary.sched_fifo ? "SCHED_FIFO" : "SCHED_OTHER",
       static_cast<unsigned long long>(summary.overruns), to_string(summary.end_reason));
   return 0;

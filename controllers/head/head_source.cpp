@@ -224,11 +224,49 @@ class HeadSource final : public MotionSource {
                        std::memory_order_release);
   }
 
+  // Reader thread (live input): each block's energy for the jaw, then the
+  // block into a ring for the synthesizer; a synthesizer that has fallen a
+  // ring behind loses blocks (counted) rather than hold the jaw up.
+  void read_live(AudioInput& input) {
+    std::vector<float> block(block_);
+    while (!stop_.load()) {
+      if (!input.read(block)) break;
+      publish_energy(block);
+      const std::uint64_t w = captured_written_.load(std::memory_order_relaxed);
+      if (w - captured_read_.load(std::memory_order_acquire) >= kCapturedBlocks) {
+        captured_lost_.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      std::copy(block.begin(), block.end(),
+                captured_.begin() + static_cast<std::ptrdiff_t>((w % kCapturedBlocks) * block_));
+      captured_written_.store(w + 1, std::memory_order_release);
+    }
+    input_ended_.store(true, std::memory_order_release);
+  }
+
+  // Synthesizer side of the ring: the next captured block; false when the
+  // input has ended (or the run stops) and the ring is empty.
+  bool take_captured(std::span<float> block) {
+    for (;;) {
+      const std::uint64_t r = captured_read_.load(std::memory_order_relaxed);
+      if (captured_written_.load(std::memory_order_acquire) > r) {
+        const auto from =
+            captured_.begin() + static_cast<std::ptrdiff_t>((r % kCapturedBlocks) * block_);
+        std::copy(from, from + static_cast<std::ptrdiff_t>(block_), block.begin());
+        captured_read_.store(r + 1, std::memory_order_release);
+        return true;
+      }
+      if (stop_.load() || input_ended_.load(std::memory_order_acquire)) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+
   // Opens the live input, or ALSA playback of a file; false when a device
   // cannot be opened (the head then stays at rest; the run still works).
   bool open_devices(std::unique_ptr<AudioInput>& input, std::unique_ptr<AlsaPlayback>& playback) {
     try {
-      if (!config_.capture.empty()) input = open_audio_input(config_.capture, audio_.sample_rate);
+      if (!config_.capture.empty())
+        input = open_audio_input(config_.capture, audio_.sample_rate, &stop_);
       if (config_.audio_device != "none" && config_.capture.empty()) {
         const std::string dev = config_.audio_device == "auto" ? "default" : config_.audio_device;
         if (config_.audio_device != "auto" || alsa_playback_available(dev))
@@ -256,6 +294,12 @@ class HeadSource final : public MotionSource {
     std::unique_ptr<AlsaPlayback> playback;
     if (!open_devices(input, playback)) return;
     recent_.assign(jaw_window_, 0.0f);
+    if (input) {
+      // The jaw's path: its own thread reads the device and publishes each
+      // block's energy at once, whatever the synthesizer below is doing.
+      captured_.assign(kCapturedBlocks * block_, 0.0f);
+      reader_ = std::thread([this, in = input.get()] { read_live(*in); });
+    }
     StreamingSynthesizer stream(model_, stream_options_);
     std::vector<StreamPose> out;
     std::uint64_t next = 0;
@@ -275,7 +319,7 @@ class HeadSource final : public MotionSource {
     const Nanos start = clock_.start;
     for (std::uint64_t j = 0; !ended && !stop_.load(); ++j) {
       if (input) {
-        ended = !input->read(block);
+        ended = !take_captured(block);
         if (!ended) feed(block);
         continue;
       }
@@ -285,6 +329,10 @@ class HeadSource final : public MotionSource {
       if (playback && stream_block(j, heard)) playback->write(heard);
       ended = !stream_block(j + lead_blocks_, block);
       if (!ended) feed(block);
+    }
+    if (reader_.joinable()) {
+      stop_.store(true);  // the input ended, or the run: the reader ends too
+      reader_.join();
     }
     if (!stop_.load()) {
       out.clear();
@@ -323,6 +371,12 @@ class HeadSource final : public MotionSource {
   std::atomic<Nanos> seen_{-1};
   std::atomic<bool> stop_{false};
   std::thread worker_;
+  // Live input: the reader thread and its ring of blocks for the synthesizer.
+  static constexpr std::uint64_t kCapturedBlocks = 256;
+  std::thread reader_;
+  std::vector<float> captured_;
+  std::atomic<std::uint64_t> captured_written_{0}, captured_read_{0}, captured_lost_{0};
+  std::atomic<bool> input_ended_{false};
 };
 
 Drive bind_joint(const std::string& name, const Location& where, const std::string& key,
