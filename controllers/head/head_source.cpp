@@ -304,7 +304,7 @@ class HeadSource final : public MotionSource {
     std::vector<StreamPose> out;
     std::uint64_t next = 0;
     auto feed = [&](std::span<const float> block) {
-      if (live_) publish_energy(block);
+      if (live_ && !input) publish_energy(block);  // a live input's reader publishes its own
       out.clear();
       stream.push(block, out);
       for (const StreamPose& p : out) store(static_cast<std::size_t>(next++), p);
@@ -330,10 +330,8 @@ class HeadSource final : public MotionSource {
       ended = !stream_block(j + lead_blocks_, block);
       if (!ended) feed(block);
     }
-    if (reader_.joinable()) {
-      stop_.store(true);  // the input ended, or the run: the reader ends too
-      reader_.join();
-    }
+    // The input ended (the reader has ended) or the run stops (it sees stop_).
+    if (reader_.joinable()) reader_.join();
     if (!stop_.load()) {
       out.clear();
       stream.finish(out);
