@@ -177,6 +177,7 @@ int serve(const ServeArgs& args) {
   LoadedRobot robot = load_robot(args.robot);
   // Every cue file and what it names is valid before any device starts.
   LoadedCues loaded = load_cues(args.cues, robot.config);
+  robot.warnings.insert(robot.warnings.end(), loaded.warnings.begin(), loaded.warnings.end());
   CueRequests requests;
   auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
                                             robot.config.joints, requests);
