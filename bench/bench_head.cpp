@@ -20,6 +20,39 @@ static long max_rss_kb() {
   return u.ru_maxrss;
 }
 
+// Streams `audio` in 10 ms blocks; prints speed and latency in audio time.
+static void stream_case(const char* name, const HeadModel& model, const Audio& audio,
+                        const StreamOptions& so) {
+  using clk = std::chrono::steady_clock;
+  StreamingSynthesizer s(model, so);
+  std::vector<StreamPose> out;
+  const std::size_t block = static_cast<std::size_t>(audio.sample_rate / 100);
+  double max_lag = 0, sum_lag = 0, max_block_ms = 0;
+  std::size_t n = 0;
+  const auto t0 = clk::now();
+  for (std::size_t i = 0; i < audio.samples.size(); i += block) {
+    const std::size_t before = out.size();
+    const auto b0 = clk::now();
+    s.push(
+        std::span<const float>(audio.samples.data() + i, std::min(block, audio.samples.size() - i)),
+        out);
+    max_block_ms =
+        std::max(max_block_ms, std::chrono::duration<double, std::milli>(clk::now() - b0).count());
+    for (std::size_t j = before; j < out.size(); ++j) {
+      const double lag = s.audio_time_s() - out[j].t;  // audio heard minus pose time
+      max_lag = std::max(max_lag, lag);
+      sum_lag += lag;
+      ++n;
+    }
+  }
+  s.finish(out);
+  const double stream_s = std::chrono::duration<double>(clk::now() - t0).count();
+  std::printf("%s:\n  %.3f s  real-time factor %.4f; worst block (10 ms of audio) %.2f ms\n", name,
+              stream_s, stream_s / 60.0, max_block_ms);
+  std::printf("  latency (audio pushed - pose time): mean %.3f s, max %.3f s, bound %.3f s\n",
+              sum_lag / static_cast<double>(n), max_lag, s.worst_case_latency_s());
+}
+
 int main() {
   const std::string src = ANIMRT_SOURCE_DIR;
   const long rss0 = max_rss_kb();
@@ -36,42 +69,27 @@ int main() {
   auto t0 = clk::now();
   const PoseTrack offline = synthesize(model, minute);
   const double offline_s = std::chrono::duration<double>(clk::now() - t0).count();
+  // At the model's own rate (24 kHz): the analysis without resampling.
+  const Audio minute24 = resample(minute, model.features.sample_rate);
+  t0 = clk::now();
+  const PoseTrack offline24 = synthesize(model, minute24);
+  const double offline24_s = std::chrono::duration<double>(clk::now() - t0).count();
   const long rss_offline = max_rss_kb();
 
-  StreamOptions so;
-  so.input_rate = minute.sample_rate;
-  StreamingSynthesizer s(model, so);
-  std::vector<StreamPose> out;
-  const std::size_t block = static_cast<std::size_t>(minute.sample_rate / 100);  // 10 ms blocks
-  double max_lag = 0, sum_lag = 0, max_block_ms = 0;
-  std::size_t n = 0;
-  t0 = clk::now();
-  for (std::size_t i = 0; i < minute.samples.size(); i += block) {
-    const std::size_t before = out.size();
-    const auto b0 = clk::now();
-    s.push(std::span<const float>(minute.samples.data() + i,
-                                  std::min(block, minute.samples.size() - i)),
-           out);
-    max_block_ms =
-        std::max(max_block_ms, std::chrono::duration<double, std::milli>(clk::now() - b0).count());
-    for (std::size_t j = before; j < out.size(); ++j) {
-      const double lag = s.audio_time_s() - out[j].t;  // audio heard minus pose time
-      max_lag = std::max(max_lag, lag);
-      sum_lag += lag;
-      ++n;
-    }
-  }
-  s.finish(out);
-  const double stream_s = std::chrono::duration<double>(clk::now() - t0).count();
   std::printf("head synthesis, 60 s of speech, model K=%d S=%d M=%d %s\n", model.clusters(),
               model.states, model.mixtures, topology_name(model.topology));
   std::printf("offline:   %.3f s  real-time factor %.4f (%.0fx faster than real time), %zu poses\n",
               offline_s, offline_s / 60.0, 60.0 / offline_s, offline.size());
-  std::printf("streaming: %.3f s  real-time factor %.4f; worst block (10 ms of audio) %.2f ms\n",
-              stream_s, stream_s / 60.0, max_block_ms);
-  std::printf(
-      "streaming latency (audio pushed - pose time): mean %.3f s, max %.3f s, bound %.3f s\n",
-      sum_lag / static_cast<double>(n), max_lag, s.worst_case_latency_s());
+  std::printf("offline, 24 kHz input: %.3f s  (%.0fx faster than real time), %zu poses\n",
+              offline24_s, 60.0 / offline24_s, offline24.size());
+  StreamOptions squad;
+  squad.input_rate = minute.sample_rate;
+  stream_case("streaming (SQUAD, decoder lag 0.2 s, gap fill 0.15 s)", model, minute, squad);
+  StreamOptions live = squad;
+  live.causal = true;
+  live.decoder_lag_s = 0.07;
+  live.max_gap_s = 0.0;
+  stream_case("streaming (causal, decoder lag 0.07 s, no gap fill)", model, minute, live);
   std::printf("memory (max RSS): start %ld KiB, +model %ld KiB, +60 s offline synthesis %ld KiB\n",
               rss0, rss_model - rss0, rss_offline - rss_model);
   return 0;

@@ -18,7 +18,8 @@ int open_quietly(snd_pcm_t** pcm, const std::string& device, snd_pcm_stream_t st
   return err;
 }
 
-snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream) {
+snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream,
+                    unsigned latency_us) {
   snd_pcm_t* pcm = nullptr;
   const char* what = stream == SND_PCM_STREAM_PLAYBACK ? "playback" : "capture";
   int err = open_quietly(&pcm, device, stream, 0);
@@ -27,7 +28,7 @@ snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream
                       snd_strerror(err));
   }
   err = snd_pcm_set_params(pcm, SND_PCM_FORMAT_FLOAT_LE, SND_PCM_ACCESS_RW_INTERLEAVED, 1,
-                           static_cast<unsigned>(rate), 1, 50000);
+                           static_cast<unsigned>(rate), 1, latency_us);
   if (err < 0) {
     snd_pcm_close(pcm);
     throw DeviceError("ALSA " + std::string(what) + " device " + quote(device) + ": " +
@@ -39,7 +40,7 @@ snd_pcm_t* open_pcm(const std::string& device, int rate, snd_pcm_stream_t stream
 }  // namespace
 
 AlsaPlayback::AlsaPlayback(const std::string& device, int rate)
-    : pcm_(open_pcm(device, rate, SND_PCM_STREAM_PLAYBACK)) {}
+    : pcm_(open_pcm(device, rate, SND_PCM_STREAM_PLAYBACK, 50000)) {}
 AlsaPlayback::~AlsaPlayback() {
   auto* pcm = static_cast<snd_pcm_t*>(pcm_);
   snd_pcm_drain(pcm);
@@ -58,8 +59,9 @@ void AlsaPlayback::write(std::span<const float> samples) {
   }
 }
 
+// A short capture buffer (periods of a few ms): the jaw waits for each period.
 AlsaCapture::AlsaCapture(const std::string& device, int rate)
-    : pcm_(open_pcm(device, rate, SND_PCM_STREAM_CAPTURE)) {}
+    : pcm_(open_pcm(device, rate, SND_PCM_STREAM_CAPTURE, 20000)) {}
 AlsaCapture::~AlsaCapture() { snd_pcm_close(static_cast<snd_pcm_t*>(pcm_)); }
 void AlsaCapture::read(std::span<float> out) {
   auto* pcm = static_cast<snd_pcm_t*>(pcm_);

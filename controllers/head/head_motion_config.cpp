@@ -40,9 +40,9 @@ HeadAxisMap parse_axis(const YamlNode& n) {
 }  // namespace
 
 HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robot_path) {
-  node.allow_only({"type", "model", "audio", "capture", "playback", "repeat", "pause_s",
-                   "audio_device", "decoder_lag_s", "max_gap_s", "block_s", "noise_deg", "axes",
-                   "jaw"});
+  node.allow_only({"type", "model", "audio", "capture", "live", "playback", "repeat", "pause_s",
+                   "audio_device", "decoder_lag_s", "max_gap_s", "smoothing", "block_s",
+                   "noise_deg", "axes", "jaw"});
   HeadMotionConfig c;
   c.where = node.location();
   c.model = resolve_file(node.at("model"), robot_path);
@@ -57,18 +57,27 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
     c.capture = capture->as_string();
     if (c.capture.empty()) capture->fail("expected an ALSA device name, found \"\"");
   }
+  if (auto l = node.find("live")) {
+    c.live = l->as_bool();
+    if (capture) l->fail("live applies to an audio file (capture is always live)");
+  }
   if (auto p = node.find("playback")) {
     const std::string v = p->as_string();
     if (v != "realtime" && v != "precomputed")
       p->fail("expected realtime or precomputed, found " + p->describe());
     c.precomputed = v == "precomputed";
-    if (c.precomputed && capture) p->fail("live capture cannot be precomputed");
+    if (c.precomputed && (capture || c.live)) p->fail("live input cannot be precomputed");
   }
   c.repeat = node.get_bool("repeat", true);
   if (auto p = node.find("pause_s")) c.pause_s = p->as_double_in(0.0, 60.0);
   c.audio_device = node.get_string("audio_device", "none");
   if (auto p = node.find("decoder_lag_s")) c.decoder_lag_s = p->as_double_in(0.0, 5.0);
   if (auto p = node.find("max_gap_s")) c.max_gap_s = p->as_double_in(0.0, 5.0);
+  if (auto p = node.find("smoothing")) {
+    const std::string v = p->as_string();
+    if (v != "squad" && v != "causal") p->fail("expected squad or causal, found " + p->describe());
+    c.causal = v == "causal";
+  }
   if (auto p = node.find("block_s")) c.block_s = p->as_double_in(0.001, 0.5);
   if (auto p = node.find("noise_deg")) c.noise_deg = p->as_double_in(0.0, 10.0);
   const YamlNode axes = node.at("axes");
@@ -77,7 +86,7 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
   if (auto a = axes.find("pitch")) c.pitch = parse_axis(*a);
   if (auto a = axes.find("roll")) c.roll = parse_axis(*a);
   if (auto j = node.find("jaw")) {
-    j->allow_only({"joint", "closed_deg", "open_deg", "energy_floor", "energy_full"});
+    j->allow_only({"joint", "closed_deg", "open_deg", "energy_floor", "energy_full", "window_s"});
     c.jaw.where = j->location();
     c.jaw.joint = j->at("joint").as_string();
     if (auto d = j->find("closed_deg")) c.jaw.closed_deg = d->as_double_in(-360.0, 360.0);
@@ -87,6 +96,7 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
       c.jaw.energy_full = e->as_double_in(0.0, 1.0);
       if (c.jaw.energy_full <= c.jaw.energy_floor) e->fail("must be above energy_floor");
     }
+    if (auto w = j->find("window_s")) c.jaw.window_s = w->as_double_in(0.001, 0.2);
   }
   return c;
 }

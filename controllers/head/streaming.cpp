@@ -122,7 +122,54 @@ struct StreamingSynthesizer::Impl {
     }
   }
 
+  // Causal smoothing: every output sample whose frame is committed, moved
+  // towards the newest cluster's pose by two one-pole slerps.
+  Eigen::Quaterniond lp1 = Eigen::Quaterniond::Identity(), lp2 = Eigen::Quaterniond::Identity();
+  bool primed = false;
+
+  void on_cluster_causal(int cluster, std::vector<StreamPose>& out) {
+    const long frame = committed++;
+    const double orate = model.smoothing.output_rate_hz;
+    const double alpha = 1.0 - std::exp(-1.0 / (orate * options.causal_time_constant_s));
+    const Eigen::Vector3d m = model.cluster_pose(cluster);
+    Eigen::Quaterniond q = euler_to_quat({m(0), m(1), m(2)});
+    if (!primed) lp1 = lp2 = q;
+    primed = true;
+    while (std::max(0L, std::lround((static_cast<double>(next_out) / orate - t0) * fr)) <= frame) {
+      if (lp1.dot(q) < 0) q.coeffs() = -q.coeffs();
+      lp1 = slerp(lp1, q, alpha);
+      if (lp2.dot(lp1) < 0) lp2.coeffs() = -lp2.coeffs();
+      lp2 = slerp(lp2, lp1, alpha);
+      out.push_back(make_pose(lp2));
+    }
+  }
+
+  StreamPose make_pose(const Eigen::Quaterniond& q) {
+    StreamPose p;
+    p.t = static_cast<double>(next_out) / model.smoothing.output_rate_hz;
+    p.pose = quat_to_euler(q);
+    const SmoothingOptions& so = model.smoothing;
+    const auto idx = static_cast<std::uint64_t>(next_out);
+    p.pose.yaw += pose_noise(so.seed, idx, 0, so.noise_deg);
+    p.pose.pitch += pose_noise(so.seed, idx, 1, so.noise_deg);
+    p.pose.roll += pose_noise(so.seed, idx, 2, so.noise_deg);
+    const long ef = std::clamp<long>(std::lround((p.t - t0) * fr), energy_offset,
+                                     energy_offset + static_cast<long>(energies.size()) - 1);
+    p.energy = energies.empty() ? 0.0 : energies[static_cast<std::size_t>(ef - energy_offset)];
+    ++next_out;
+    // Energies older than the output are no longer needed.
+    while (energies.size() > 1 && energy_offset < ef - 2) {
+      energies.pop_front();
+      ++energy_offset;
+    }
+    return p;
+  }
+
   void on_cluster(int cluster, std::vector<StreamPose>& out) {
+    if (options.causal) {
+      on_cluster_causal(cluster, out);
+      return;
+    }
     const long frame = committed++;
     // Key k sits at time k / key_rate: the frame nearest to it.
     const double kr = model.smoothing.key_rate_hz;
@@ -163,24 +210,7 @@ struct StreamingSynthesizer::Impl {
         const Eigen::Quaterniond s2 = squad_inner(key(k), key(k + 1), key(k + 2));
         q = squad(key(k), s1, s2, key(k + 1), u - static_cast<double>(k));
       }
-      StreamPose p;
-      p.t = t;
-      p.pose = quat_to_euler(q);
-      const SmoothingOptions& so = model.smoothing;
-      const auto idx = static_cast<std::uint64_t>(next_out);
-      p.pose.yaw += pose_noise(so.seed, idx, 0, so.noise_deg);
-      p.pose.pitch += pose_noise(so.seed, idx, 1, so.noise_deg);
-      p.pose.roll += pose_noise(so.seed, idx, 2, so.noise_deg);
-      const long ef = std::clamp<long>(std::lround((t - t0) * fr), energy_offset,
-                                       energy_offset + static_cast<long>(energies.size()) - 1);
-      p.energy = energies.empty() ? 0.0 : energies[static_cast<std::size_t>(ef - energy_offset)];
-      out.push_back(p);
-      ++next_out;
-      // Energies older than the output are no longer needed.
-      while (energies.size() > 1 && energy_offset < ef - 2) {
-        energies.pop_front();
-        ++energy_offset;
-      }
+      out.push_back(make_pose(q));
     }
   }
 
@@ -259,7 +289,7 @@ void StreamingSynthesizer::finish(std::vector<StreamPose>& out) {
   std::vector<int> rest;
   m.decoder.finish(rest);
   for (int c : rest) m.on_cluster(c, out);
-  m.emit(out, true);
+  if (!m.options.causal) m.emit(out, true);
 }
 
 double StreamingSynthesizer::audio_time_s() const {
@@ -272,7 +302,8 @@ double StreamingSynthesizer::worst_case_latency_s() const {
   // The sinc resampler (when the input rate differs) delays by a few ms.
   return (m.src != nullptr ? 0.01 : 0.0) + f.window_s / 2 + m.options.max_gap_s +
          2.0 * f.delta_window / f.frame_rate_hz + m.options.decoder_lag_s +
-         2.0 / m.model.smoothing.key_rate_hz;
+         // Causal: an output sample shows the nearest frame, up to a frame later.
+         (m.options.causal ? 1.0 / f.frame_rate_hz : 2.0 / m.model.smoothing.key_rate_hz);
 }
 
 }  // namespace animrt::head

@@ -50,6 +50,7 @@
 #include "sim_command.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
+#include "summary_file.hpp"
 #include "view_command.hpp"
 
 namespace {
@@ -118,41 +119,6 @@ CLI::Validator duration_validator() {
       },
       "SECONDS");
 }
-
-// --summary-json's file: opened before anything moves (a summary that
-// cannot be written is found then), written once at the end, every failure
-// (a full disk, /dev/full, a close that fails) kept with its errno.
-struct SummaryFile {
-  int fd = -1;
-  int error = 0;
-  ~SummaryFile() {
-    if (fd >= 0) ::close(fd);
-  }
-  bool is_open() const { return fd >= 0; }
-  bool open(const std::string& path) {
-    fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) error = errno;
-    return fd >= 0;
-  }
-  bool write(const std::string& text) {
-    std::size_t done = 0;
-    while (done < text.size()) {
-      const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-      if (n > 0) {
-        done += static_cast<std::size_t>(n);
-      } else if (n < 0 && errno == EINTR) {
-        continue;
-      } else {
-        error = n < 0 ? errno : EIO;
-        return false;
-      }
-    }
-    const int closed = ::close(fd);
-    fd = -1;
-    if (closed != 0) error = errno;
-    return closed == 0;
-  }
-};
 
 struct RunArgs {
   std::string config;
@@ -246,7 +212,7 @@ int cmd_run(const RunArgs& args) {
   }
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
-  SummaryFile summary_out;
+  animrt::cli::SummaryFile summary_out;
   if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
     spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
                   std::strerror(summary_out.error));

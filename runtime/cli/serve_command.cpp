@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -13,12 +14,14 @@
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/osc_receiver.hpp"
 #include "animrt/runtime/robot_loader.hpp"
+#include "animrt/runtime/run_summary.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
+#include "summary_file.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -38,6 +41,7 @@ struct ServeArgs {
   bool no_artnet = false;
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
+  std::string summary_json;  // empty = none
 };
 
 // Written by the signal handlers, OSC's /stop and the dashboard; read by the cycle.
@@ -88,6 +92,20 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
               << " frames of the cue universe, " << artnet->malformed() << " malformed, "
               << artnet->ignored() << " ignored\n";
   }
+}
+
+// --summary-json: the run's summary and the cues' counts.
+std::string cue_summary_json(const RunSummary& summary, const CuePlayer& player,
+                             const CueRequests& requests) {
+  nlohmann::json j = to_json(summary);
+  nlohmann::json started = nlohmann::json::object();
+  for (std::size_t c = 0; c < player.cues().size(); ++c)
+    started[player.cues()[c].name] = player.starts(static_cast<int>(c));
+  j["cues_started"] = started;
+  j["cue_requests"] = {{"posted", requests.posted()},
+                       {"taken", requests.taken()},
+                       {"cycles_waited", player.deferred()}};
+  return j.dump(2) + '\n';
 }
 
 // --dashboard: the run's page, which also asks for cues and pauses them.
@@ -150,9 +168,16 @@ int serve(const ServeArgs& args) {
   }
   const DashboardAddress address = check_dashboard_address(args.dashboard, args.dashboard_remote);
   if (!address.ok) return kExitUsage;
+  SummaryFile summary_out;  // opened before anything moves
+  if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
+    spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
+                  std::strerror(summary_out.error));
+    return kExitUsage;
+  }
   LoadedRobot robot = load_robot(args.robot);
   // Every cue file and what it names is valid before any device starts.
   LoadedCues loaded = load_cues(args.cues, robot.config);
+  robot.warnings.insert(robot.warnings.end(), loaded.warnings.begin(), loaded.warnings.end());
   CueRequests requests;
   auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
                                             robot.config.joints, requests);
@@ -180,10 +205,18 @@ int serve(const ServeArgs& args) {
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
+  const bool summary_written =
+      !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, requests));
   std::cout << format_summary(summary);
   print_cue_report(playing, requests, osc.get(), artnet.get());
+  int code = summary.exit_code();
+  if (!summary_written) {
+    std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "
+              << std::strerror(summary_out.error) << '\n';
+    if (code == kExitOk) code = kExitRecordLost;
+  }
   std::cout << std::flush;
-  return summary.exit_code();
+  return code;
 }
 
 }  // namespace
@@ -215,6 +248,8 @@ void add_serve_command(CLI::App& app) {
                   "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
+  cmd->add_option("--summary-json", args->summary_json,
+                  "write the run's summary and the cues' counts as JSON");
   set_subcommand_body(cmd, [args]() -> int {
     try {
       return serve(*args);

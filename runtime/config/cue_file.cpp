@@ -1,9 +1,12 @@
 #include "animrt/runtime/cue_file.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include "animrt/controllers/cues/pose_source.hpp"
+#include "animrt/controllers/head/audio.hpp"
+#include "animrt/controllers/head/head_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -56,33 +59,73 @@ std::unique_ptr<MotionSource> make_pose(const YamlNode& node, const RobotConfig&
   return make_pose_source(std::move(pose));
 }
 
+// A motion, its warnings kept with the cue file's line and key.
+std::unique_ptr<MotionSource> load_warned(const MotionConfig& motion, const RobotConfig& robot,
+                                          std::vector<std::string>& warnings) {
+  std::vector<std::string> own;
+  auto source = load_motion_source(motion, robot, own);
+  for (const std::string& w : own)
+    warnings.push_back(motion.where.file + ":" + std::to_string(motion.where.line) + ": " +
+                       motion.key + ": " + w);
+  return source;
+}
+
 std::unique_ptr<MotionSource> load_file_motion(const YamlNode& file, const std::string& type,
                                                const std::string& cue_path,
-                                               const RobotConfig& robot) {
+                                               const RobotConfig& robot,
+                                               std::vector<std::string>& warnings) {
   MotionConfig motion;
   motion.type = type;
   motion.file = resolve(file, cue_path);
   motion.where = file.location();
   motion.key = file.path();
-  return load_motion_source(motion, robot);
+  return load_warned(motion, robot, warnings);
 }
 
-// One step: a gait, a show, a pose, or several of them layered in that order
-// (later ones win on the joints they drive), and how long it plays: a show
-// that does not loop for its length, everything else until the next cue.
-CueStep make_step(const YamlNode& node, const std::string& cue_path, const RobotConfig& robot) {
-  node.allow_only({"gait", "show", "pose", "duration_s"});
-  if (!node.has("show") && !node.has("gait") && !node.has("pose")) {
-    node.fail("expected a gait, a show or a pose (or several, layered), found none");
+// Speech-driven head motion (the keys of a robot file's head motion, paths
+// relative to the cue file). A sound file is analysed at load, so the cue
+// plays it from its start each time it is asked for; live sound (capture,
+// or live: true) is heard from the run's start, and the cue joins it. Plays
+// for the sound's length when it does not repeat, else until the next cue.
+std::unique_ptr<MotionSource> make_head(const YamlNode& node, const std::string& cue_path,
+                                        const RobotConfig& robot, double& duration_s,
+                                        std::vector<std::string>& warnings) {
+  auto config = std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, cue_path));
+  const bool file = config->capture.empty() && !config->live;
+  config->precomputed = file;
+  if (file && !config->repeat) duration_s = head::load_audio(config->audio).duration_s();
+  MotionConfig motion;
+  motion.type = "head";
+  motion.head = config;
+  motion.where = node.location();
+  motion.key = node.path();
+  return load_warned(motion, robot, warnings);
+}
+
+// One step: a gait, a show, a pose, a head, or several of them layered in
+// that order (later ones win on the joints they drive), and how long it
+// plays: a show that does not loop for its length, a head for its sound's,
+// everything else until the next cue.
+CueStep make_step(const YamlNode& node, const std::string& cue_path, const RobotConfig& robot,
+                  std::vector<std::string>& warnings) {
+  node.allow_only({"gait", "show", "pose", "head", "duration_s"});
+  if (!node.has("show") && !node.has("gait") && !node.has("pose") && !node.has("head")) {
+    node.fail("expected a gait, a show, a pose or a head (or several, layered), found none");
   }
   CueStep step;
   std::vector<std::unique_ptr<MotionSource>> layers;
   if (auto gait = node.find("gait"))
-    layers.push_back(load_file_motion(*gait, "gait", cue_path, robot));
+    layers.push_back(load_file_motion(*gait, "gait", cue_path, robot, warnings));
   if (auto show = node.find("show")) {
-    layers.push_back(load_file_motion(*show, "show", cue_path, robot));
+    layers.push_back(load_file_motion(*show, "show", cue_path, robot, warnings));
     const ShowFile file = load_show_file(resolve(*show, cue_path));
     if (!file.loop) step.duration_s = file.duration_s;
+  }
+  if (auto head = node.find("head")) {
+    double length = kForever;
+    layers.push_back(make_head(*head, cue_path, robot, length, warnings));
+    if (length != kForever)  // the speech ends the step (or the longer of it and a show)
+      step.duration_s = step.duration_s == kForever ? length : std::max(step.duration_s, length);
   }
   if (auto pose = node.find("pose")) layers.push_back(make_pose(*pose, robot));
   step.source =
@@ -92,7 +135,8 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
 }
 
 Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
-             const std::string& cue_path, const RobotConfig& robot) {
+             const std::string& cue_path, const RobotConfig& robot,
+             std::vector<std::string>& warnings) {
   node.allow_only({"play", "crossfade_s", "loop", "then", "dmx"});
   Cue cue;
   cue.name = name;
@@ -101,7 +145,8 @@ Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
   const YamlNode play = node.at("play");
   std::vector<YamlNode> steps = play.is_sequence() ? play.items() : std::vector<YamlNode>{play};
   if (steps.empty()) play.fail("expected at least one step, found an empty list");
-  for (const YamlNode& step : steps) cue.steps.push_back(make_step(step, cue_path, robot));
+  for (const YamlNode& step : steps)
+    cue.steps.push_back(make_step(step, cue_path, robot, warnings));
   for (std::size_t s = 0; s + 1 < cue.steps.size(); ++s) {
     if (cue.steps[s].duration_s == kForever) {
       steps[s].fail(
@@ -175,7 +220,7 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
                                             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
                                             "0123456789_-") == std::string::npos;
     if (!plain) node.fail("a cue's name is letters, digits, _ and - (it is an OSC address)");
-    loaded.cues.push_back(make_cue(name, node, crossfade, path, robot));
+    loaded.cues.push_back(make_cue(name, node, crossfade, path, robot, loaded.warnings));
     drafts.push_back({node.find("then"), node.find("loop"), node});
     const auto dmx = node.find("dmx");
     loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);

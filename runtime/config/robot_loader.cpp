@@ -219,10 +219,14 @@ LoadedRobot load_robot(const std::string& path) {
 
 std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
                                                  const RobotConfig& config) {
-  MotionCheck::Speeds speeds;
-  // A cue's motion is checked as a robot's is, but its warnings (a learned
-  // model never measured better than interpolation) are not reported yet.
   std::vector<std::string> warnings;
+  return load_motion_source(motion, config, warnings);
+}
+
+std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
+                                                 const RobotConfig& config,
+                                                 std::vector<std::string>& warnings) {
+  MotionCheck::Speeds speeds;
   return make_source(motion, config, speeds, warnings);
 }
 

@@ -139,6 +139,53 @@ TEST(Streaming, FollowsOfflineSynthesisWithBoundedLag) {
       << d_stream / n << " vs " << d_offline / n;
 }
 
+// Live speech: causal smoothing, a short decoder lag and no gap fill put
+// every head pose on the output within 150 ms of audio (counted in samples
+// pushed), and the head still moves about as offline synthesis does.
+TEST(Streaming, CausalSmoothingFollowsLiveSpeechWithin150ms) {
+  const Trained& t = trained();
+  const auto utts = list_corpus(test::tiny_corpus());
+  const Audio audio = load_audio(utts[0].audio_path);
+  const PoseTrack offline = synthesize(t.model, audio);
+  StreamOptions so;
+  so.input_rate = audio.sample_rate;
+  so.causal = true;
+  so.decoder_lag_s = 0.07;
+  so.max_gap_s = 0.0;
+  StreamingSynthesizer s(t.model, so);
+  std::vector<StreamPose> out;
+  double worst = 0;
+  const std::size_t block = static_cast<std::size_t>(audio.sample_rate / 100);
+  for (std::size_t i = 0; i < audio.samples.size(); i += block) {
+    const std::size_t before = out.size();
+    s.push(
+        std::span<const float>(audio.samples.data() + i, std::min(block, audio.samples.size() - i)),
+        out);
+    for (std::size_t j = before; j < out.size(); ++j)
+      worst = std::max(worst, s.audio_time_s() - out[j].t);
+  }
+  s.finish(out);
+  EXPECT_LE(worst, 0.15);
+  EXPECT_LE(worst, s.worst_case_latency_s() + 0.011);
+  EXPECT_LE(s.worst_case_latency_s() + 0.01, 0.15);
+  ASSERT_NEAR(static_cast<double>(out.size()), static_cast<double>(offline.size()), 2.0);
+  const PoseTrack original = load_pose_file(utts[0].pose_path);
+  double d_stream = 0, d_offline = 0, spread = 0;
+  const std::size_t n = std::min(out.size(), offline.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_NEAR(out[i].t, offline.times[i], 1e-9);
+    const Euler o = original.at(out[i].t);
+    d_stream +=
+        std::hypot(out[i].pose.yaw - o.yaw, out[i].pose.pitch - o.pitch, out[i].pose.roll - o.roll);
+    const Euler& f = offline.poses[i];
+    d_offline += std::hypot(f.yaw - o.yaw, f.pitch - o.pitch, f.roll - o.roll);
+    spread = std::max(spread, std::abs(out[i].pose.pitch - out[0].pose.pitch));
+  }
+  EXPECT_LT(d_stream, 1.5 * d_offline + 1.0 * static_cast<double>(n))
+      << d_stream / n << " vs " << d_offline / n;
+  EXPECT_GT(spread, 1.0);  // the head moves, not only its +-0.5 deg noise
+}
+
 // ------------------------------------------------------------ model files
 
 TEST(ModelFile, RoundTripDecodesTheSame) {

@@ -30,6 +30,9 @@ struct LoadedCues {
   std::vector<int> dmx_values;
   int artnet_universe = 0;
   int artnet_channel = 0;
+  // What the cues' motions are warned of (a learned model never measured
+  // better than interpolation), one line each, naming the cue file's line.
+  std::vector<std::string> warnings;
 };
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot);

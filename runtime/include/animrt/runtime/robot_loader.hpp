@@ -38,6 +38,11 @@ LoadedRobot load_robot(const std::string& path);
 // Throws InputError.
 std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
                                                  const RobotConfig& config);
+// The same, keeping what the motion is warned of (a learned model never
+// measured better than interpolation) in `warnings`, one line each.
+std::unique_ptr<MotionSource> load_motion_source(const MotionConfig& motion,
+                                                 const RobotConfig& config,
+                                                 std::vector<std::string>& warnings);
 
 // One line per bus whose actuators nothing stops if animrt dies (kill -9, a
 // crash, a power cut), or whose guard must be set outside animrt:

@@ -4,30 +4,42 @@
 // Euler angles drive the neck joints (axis mapping, signs, scale, offsets,
 // clamped to the joint limits) and the speech energy opens the jaw.
 //
-// Timing: motion time t shows the pose of audio time t - latency_s, where
-// latency_s is the synthesizer's worst-case latency plus one block. When a
-// file is played, its sound is delayed by the same amount, so what is heard
-// and what moves stay in step; with live capture the head trails the voice
-// by latency_s. A file's blocks "arrive" on the run's clock
-// (MotionSource::start): in a lockstep run on the simulated time, and
-// sample(t) waits for the blocks due by then, so the head moves the same
-// however fast the machine runs.
+// Timing. The jaw and the head poses take two paths: the jaw follows the
+// speech energy (RMS over jaw.window_s, from the samples themselves), the
+// neck follows the slower HMM pipeline of the streaming synthesizer.
+//   - A sound file (`audio`) is known ahead: the worker feeds the
+//     synthesizer its worst-case latency ahead of the run's clock, so motion
+//     time t shows the head pose of audio time t, and the jaw opens with the
+//     energy of the samples up to t: it never leads the sound and lags it by
+//     less than one cycle. The file's sound (ALSA playback) is not delayed.
+//   - Live sound (`capture`, or `live: true` for a file played as if it were
+//     captured) cannot be looked ahead: the jaw shows the energy up to the
+//     newest block that has arrived, the head the newest final pose (at
+//     most the synthesizer's worst case plus one block behind the sound),
+//     whatever the motion's time t: a cue that restarts it joins the sound
+//     as it is.
+// A file's blocks "arrive" on the run's clock (MotionSource::start): in a
+// lockstep run on the simulated time, and sample(t) waits for the blocks due
+// by then, so the head moves the same however fast the machine runs.
 //
 // Robot file (motion section), see docs/head.md:
 //   motion:
 //     type: head
 //     model: ../head/model.txt
-//     audio: ../head/utterance.wav   # or  capture: default  (ALSA, live)
+//     audio: ../head/utterance.wav   # or  capture: default  (ALSA, live; or pipe:PATH)
+//     live: false                    # true: play the file as live input (no look-ahead)
 //     playback: realtime             # or precomputed (same stream, run at load)
 //     repeat: true
 //     pause_s: 1.0
 //     audio_device: none             # ALSA playback: none, auto or a device name
 //     decoder_lag_s: 0.2
+//     smoothing: squad               # or causal: live head within ~0.14 s (docs/head.md)
 //     axes:
 //       yaw:   {joint: neck_yaw, sign: 1, scale: 1.0, offset_deg: 0}
 //       pitch: {joint: neck_pitch, sign: 1}
 //       roll:  {joint: neck_roll, sign: 1}
-//     jaw: {joint: jaw, closed_deg: 0, open_deg: 20, energy_floor: 0.01, energy_full: 0.12}
+//     jaw: {joint: jaw, closed_deg: 0, open_deg: 20, energy_floor: 0.01, energy_full: 0.12,
+//           window_s: 0.02}
 
 #include <memory>
 #include <optional>
@@ -51,19 +63,22 @@ struct HeadJawMap {
   std::string joint;  // empty: no jaw
   double closed_deg = 0.0, open_deg = 20.0;
   double energy_floor = 0.01, energy_full = 0.12;  // RMS energy: closed below, fully open above
+  double window_s = 0.02;                          // the RMS window, ending at the newest sample
   Location where;
 };
 
 struct HeadMotionConfig {
   std::string model;    // resolved path
   std::string audio;    // resolved path, or empty with capture
-  std::string capture;  // ALSA capture device for live use, or empty
+  std::string capture;  // live input (audio_input.hpp: ALSA device or pipe:PATH), or empty
+  bool live = false;    // play `audio` as if captured live: no look-ahead
   bool precomputed = false;
   bool repeat = true;
   double pause_s = 1.0;
   std::string audio_device = "none";
   double decoder_lag_s = 0.2;
   double max_gap_s = 0.15;
+  bool causal = false;  // smoothing: causal (no SQUAD look-ahead), for live sound
   double block_s = 0.01;
   std::optional<double> noise_deg;
   HeadAxisMap yaw, pitch, roll;

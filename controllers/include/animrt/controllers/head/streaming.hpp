@@ -13,7 +13,8 @@
 //   fixed-lag Viterbi: frame t is committed when t + lag arrives
 //                                                  decoder_lag_s
 //   SQUAD: the segment between keys k and k+1 needs key k+2
-//                                                  <= 2 / key_rate_hz (333 ms)
+//                                                  <= 2 / key_rate_hz (333 ms;
+//                                                  none with causal smoothing)
 // worst_case_latency_s() adds these up; the bench measures the real figure.
 // Differences from offline synthesis: the F0 spline is local (through the
 // last voiced frames and the first after the gap) instead of global, and the
@@ -36,6 +37,14 @@ struct StreamOptions {
   int input_rate = 24000;      // rate of the pushed samples
   double decoder_lag_s = 0.2;  // fixed-lag Viterbi
   double max_gap_s = 0.15;     // longest unvoiced run filled by spline before holding
+  // Causal smoothing instead of SQUAD: each output sample moves towards the
+  // pose of the newest committed frame through two one-pole slerps of this
+  // time constant, so a pose waits for no later key (SQUAD waits up to
+  // 2 / key_rate_hz). With a short decoder lag and max_gap_s 0 the head
+  // follows live speech within 0.15 s
+  // (decoder_lag_s 0.07: the bound is 0.124 s plus the block).
+  bool causal = false;
+  double causal_time_constant_s = 0.06;
 };
 
 struct StreamPose {
