@@ -264,7 +264,9 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
     }
   }
   if (version >= 3) {
-    s.placement_nodes = r.bounded("placement nodes", 0, mesh ? 1000000 : 0);
+    // A piece has 3 vertices or more, so 3 numbers per piece take fewer
+    // nodes than there are vertices.
+    s.placement_nodes = r.bounded("placement nodes", 0, mesh ? s.vertex_count : 0);
   }
   if (mesh) {
     const std::uint32_t triangles = r.u32("header", "triangle count");
