@@ -12,10 +12,12 @@
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
 
+#include <cstdlib>
 #include <ctime>
 #include <numbers>
 
 #include "animrt/learn/seqnet/blas_kernels.hpp"
+#include "animrt/learn/seqnet/memory.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 #include "animrt/learn/seqnet/shapes.hpp"
 
@@ -76,6 +78,8 @@ BENCHMARK(BM_SeqTrainIteration)
 
 int main(int argc, char** argv) {
   restart_with_better_blas_kernels(argv);
+  // As animrt-seqnet does; ANIMRT_BENCH_GLIBC_FREE=1 leaves glibc's defaults.
+  if (std::getenv("ANIMRT_BENCH_GLIBC_FREE") == nullptr) keep_freed_memory();
   benchmark::AddCustomContext("blas_kernels", blas_kernels());
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -78,15 +78,15 @@ SeqNetInference::SeqNetInference(const ModelFile& model, const std::string& file
   const bool mesh = shape_.kind == ModelKind::mesh;
   const int d = shape_.input_dims();
   if (static_cast<int>(low_.size()) != d || static_cast<int>(high_.size()) != d) {
-    throw InputError(Location{file, 0, 0}, "mapping",
-                     std::to_string(low_.size()) + " dimensions, the shape has " +
-                         std::to_string(d));
+    throw InputError(
+        Location{file, 0, 0}, "mapping",
+        std::to_string(low_.size()) + " dimensions, the shape has " + std::to_string(d));
   }
   if (shape_.conv_layers < 1 || shape_.lstm_layers < 1 || d < 1) {
     throw InputError(Location{file, 0, 0}, "shape",
                      "no input dimension, no encoder layer or no LSTM layer");
   }
-  vertices_ = mesh ? shape_.vertex_count : 1;
+  vertices_ = mesh ? shape_.nodes() : 1;  // placement nodes have no neighbours
   if (mesh) {
     std::vector<std::set<int>> ring(static_cast<std::size_t>(vertices_));
     for (const auto& t : model.triangles) {
@@ -125,7 +125,8 @@ SeqNetInference::SeqNetInference(const ModelFile& model, const std::string& file
   };
   // Sequential modules number their children, the tanh layers included.
   for (int k = 0; k < shape_.conv_layers; ++k) {
-    encoder_.push_back(layer("encoder." + std::to_string(2 * k), k == 0 ? io : width, width, false));
+    encoder_.push_back(
+        layer("encoder." + std::to_string(2 * k), k == 0 ? io : width, width, false));
   }
   const int flat = width * vertices_;
   to_mu_ = p.matrix("to_mu.weight", shape_.latent, flat);
@@ -144,8 +145,7 @@ SeqNetInference::SeqNetInference(const ModelFile& model, const std::string& file
   from_hidden_bias_ = p.vector("from_hidden.bias", flat);
   for (int k = 0; k < shape_.conv_layers; ++k) {
     const bool last = k + 1 == shape_.conv_layers;
-    decoder_.push_back(
-        layer("decoder." + std::to_string(2 * k), width, last ? io : width, true));
+    decoder_.push_back(layer("decoder." + std::to_string(2 * k), width, last ? io : width, true));
   }
   p.check_all_used();
   mu_.resize(shape_.latent);
@@ -343,7 +343,8 @@ Completion SeqNetInference::complete(const FrameMatrix& keys, const std::vector<
                                 std::to_string(gaps.size()));
   }
   for (int g : gaps) {
-    if (g < 1) throw std::invalid_argument("a gap of " + std::to_string(g) + " frames (at least 1)");
+    if (g < 1)
+      throw std::invalid_argument("a gap of " + std::to_string(g) + " frames (at least 1)");
   }
   if (!(options.threshold > 0.0) || !std::isfinite(options.threshold)) {
     throw std::invalid_argument("threshold " + std::to_string(options.threshold) +

@@ -179,6 +179,7 @@ std::vector<std::uint8_t> model_file_bytes(const ModelFile& m) {
     w.f64(m.held_out_interpolation);
     w.i32(m.held_out_gap);
   }
+  if (m.version >= 3) w.i32(s.placement_nodes);
   if (s.kind == ModelKind::mesh) {
     w.u32(static_cast<std::uint32_t>(m.triangles.size()));
     for (Eigen::Index i = 0; i < m.rest.size(); ++i) w.f64(m.rest.data()[i]);
@@ -225,9 +226,9 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
   ModelFile m;
   const std::uint32_t version = r.u32("header", "version");
   m.version = version;
-  if (version != 1 && version != kModelFileVersion) {
+  if (version < 1 || version > kModelFileVersion) {
     detail::fail(file, "header",
-                 "version " + std::to_string(version) + ", this build reads versions 1 and " +
+                 "version " + std::to_string(version) + ", this build reads versions 1 to " +
                      std::to_string(kModelFileVersion));
   }
   const std::uint32_t kind = r.u32("header", "kind");
@@ -261,6 +262,11 @@ ModelFile parse_model_file(const std::vector<std::uint8_t>& bytes, const std::st
     if (!std::isfinite(m.held_out_completion) || !std::isfinite(m.held_out_interpolation)) {
       detail::fail(file, "header", "the held-out measurement is not finite");
     }
+  }
+  if (version >= 3) {
+    // A piece has 3 vertices or more, so 3 numbers per piece take fewer
+    // nodes than there are vertices.
+    s.placement_nodes = r.bounded("placement nodes", 0, mesh ? s.vertex_count : 0);
   }
   if (mesh) {
     const std::uint32_t triangles = r.u32("header", "triangle count");

@@ -162,7 +162,7 @@ int run_complete(const CompleteArgs& a) {
     }
     const MeshFrames keys = read_mesh_frames(a.keys, "--keys");
     const seqnet::FrameMatrix features =
-        seqnet::mesh_features(model, a.model, keys.frames, keys.triangles);
+        seqnet::mesh_features(model, a.model, keys.frames, keys.triangles, a.gap + 1.0);
     seqnet::SeqNetInference net(model, a.model);
     c = net.complete(features, std::vector<int>(keys.frames.size() - 1, a.gap), a.options);
     // Keys as read, the in-betweens reconstructed and placed between them.

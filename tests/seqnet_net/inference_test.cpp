@@ -20,12 +20,13 @@
 namespace animrt::seqnet {
 namespace {
 
-ModelFile random_mesh_model(int channels) {
+ModelFile random_mesh_model(int channels, int placement_nodes = 0) {
   torch::manual_seed(21);
   const MeshSequence bar = make_bar(4, 6, 4.0);  // caps: vertex degrees 3 to 6
   ModelFile m;
   m.shape.kind = ModelKind::mesh;
   m.shape.vertex_count = bar.vertex_count();
+  m.shape.placement_nodes = placement_nodes;
   m.shape.channels = channels;
   m.shape.latent = 7;
   m.shape.hidden = 10;
@@ -139,6 +140,12 @@ TEST(SeqInference, MeshModelEqualsTheTorchNetwork) { expect_same_chains(random_m
 
 TEST(SeqInference, MeshModelWithNineChannelsEqualsTheTorchNetwork) {
   expect_same_chains(random_mesh_model(9));
+}
+
+// The placement nodes run through both networks as vertices without
+// neighbours, and the dense layers mix them in.
+TEST(SeqInference, MeshModelWithPlacementNodesEqualsTheTorchNetwork) {
+  expect_same_chains(random_mesh_model(6, 2));
 }
 
 TEST(SeqInference, JointModelEqualsTheTorchNetwork) { expect_same_chains(random_joint_model()); }

@@ -102,6 +102,32 @@ TEST_F(ModelFileTest, SaveLoadRoundTripGivesIdenticalOutputs) {
   EXPECT_FALSE(torch::equal(out_a, c->run(given, 6, c->initial_state(3, -1.0), false).frames));
 }
 
+TEST_F(ModelFileTest, PlacementNodesRoundTripAndOlderFilesLoadWithoutThem) {
+  ModelFile m = mesh_model(0);
+  m.shape.placement_nodes = 2;
+  m.low.assign(static_cast<std::size_t>(m.shape.input_dims()), -1.0);
+  m.high.assign(static_cast<std::size_t>(m.shape.input_dims()), 2.0);
+  m.parameters = save_parameters(*SeqNet(m.shape, mesh_graph(m.shape.vertex_count, m.triangles)));
+  const std::string path = nettest::temp_path("placement.model");
+  write_model_file(path, m);
+  const ModelFile back = read_model_file(path);
+  EXPECT_EQ(back.version, 3U);
+  EXPECT_EQ(back.shape.placement_nodes, 2);
+  EXPECT_EQ(back.shape.input_dims(), 9 * (12 + 2));
+  EXPECT_NO_THROW(network_for(back, path));
+  // A version-2 file (an older build's) has no placement nodes: it loads
+  // with none and is written back byte for byte.
+  ModelFile old = mesh_model(0);
+  old.version = 2;
+  const std::string old_path = nettest::temp_path("version2.model");
+  write_model_file(old_path, old);
+  const ModelFile old_back = read_model_file(old_path);
+  EXPECT_EQ(old_back.version, 2U);
+  EXPECT_EQ(old_back.shape.placement_nodes, 0);
+  EXPECT_EQ(model_file_bytes(old_back), load_bytes(old_path));
+  EXPECT_NO_THROW(network_for(old_back, old_path));
+}
+
 TEST_F(ModelFileTest, JointModelRoundTripKeepsTheJointNames) {
   const ModelFile m = joint_model({"hip", "knee", "ankle"});
   const std::string path = nettest::temp_path("joints.model");
@@ -141,8 +167,9 @@ TEST_F(ModelFileTest, OtherMagicOrVersionIsRefused) {
   std::vector<std::uint8_t> b = load_bytes(path);
   b[8] = 9;  // version
   save_bytes(path, b);
-  EXPECT_NE(error_of([&] { read_model_file(path); }).find("version 9, this build reads versions 1 and 2"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { read_model_file(path); }).find("version 9, this build reads versions 1 to 3"),
+      std::string::npos);
   b[0] = 'X';
   save_bytes(path, b);
   EXPECT_NE(error_of([&] { read_model_file(path); }).find("not an animrt sequence model"),

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "animrt/controllers/seqnet/placement_nodes.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
@@ -15,8 +16,10 @@ Eigen::VectorXd column(const FeatureFrame& raw) {
   return Eigen::Map<const Eigen::VectorXd>(raw.data(), raw.size());
 }
 
-FeatureFrame frame_of(const Eigen::Ref<const Eigen::VectorXd>& c) {
-  return Eigen::Map<const FeatureFrame>(c.data(), kFeatureDims, c.size() / kFeatureDims);
+// The features of a model input column (the placement nodes after them left
+// out: errors here are measured up to a translation per piece).
+FeatureFrame frame_of(const Eigen::Ref<const Eigen::VectorXd>& c, int vertices) {
+  return Eigen::Map<const FeatureFrame>(c.data(), kFeatureDims, vertices);
 }
 
 // Mean per-vertex distance after removing each piece's mean offset, in the
@@ -48,6 +51,22 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
   const Reconstructor solver(data.rest, data.triangles);
   const Neighbourhood& ring = solver.neighbourhood();
   SeqNetInference net(model, model_path);
+  const int vertices = data.vertex_count();
+  const std::vector<Eigen::VectorXd> track =
+      model.shape.placement_nodes > 0 ? placement_track(data) : std::vector<Eigen::VectorXd>{};
+  if (model.shape.placement_nodes > 0 &&
+      (track.empty() || track.front().size() != 9 * model.shape.placement_nodes)) {
+    throw InputError(Location{model_path, 0, 0}, "placement",
+                     "the model has placement nodes the feature file does not fit (a version-1 "
+                     "file, or other pieces)");
+  }
+  // Frame f as the model's input: its features, then its placement nodes.
+  auto input = [&](int f) {
+    Eigen::VectorXd c(net.dims());
+    c.head(9 * vertices) = column(data.raw(f));
+    if (!track.empty()) c.tail(track.front().size()) = track[static_cast<std::size_t>(f)];
+    return c;
+  };
 
   // The true meshes of the held-out frames (up to a translation per piece).
   std::map<int, Positions> truth;
@@ -70,13 +89,13 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
     for (const Clip& p : e.pieces) {
       for (int s = p.first; s + u - 1 + longest < p.first + p.count; ++s) {
         FrameMatrix given(net.dims(), u);
-        for (int k = 0; k < u; ++k) given.col(k) = column(data.raw(s + k));
+        for (int k = 0; k < u; ++k) given.col(k) = input(s + k);
         const FrameMatrix all = net.generate(given, longest);
         const FeatureFrame last = data.raw(s + u - 1);
         const FeatureFrame before = u > 1 ? data.raw(s + u - 2) : last;
         for (GenerationRow& r : rows) {
           const int target = s + u - 1 + r.horizon;
-          const Positions learned = solver.solve(frame_of(all.col(u - 1 + r.horizon)));
+          const Positions learned = solver.solve(frame_of(all.col(u - 1 + r.horizon), vertices));
           const Positions extrapolated = solver.solve(lerp_features(before, last, 1.0 + r.horizon));
           r.learned += vertex_error(truth.at(target), learned, ring);
           r.extrapolated += vertex_error(truth.at(target), extrapolated, ring);
@@ -99,7 +118,7 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
     const int keys = (p.count - 1) / (o.gap + 1) + 1;
     if (keys < 2) continue;
     FrameMatrix key_frames(net.dims(), keys);
-    for (int k = 0; k < keys; ++k) key_frames.col(k) = column(data.raw(p.first + k * (o.gap + 1)));
+    for (int k = 0; k < keys; ++k) key_frames.col(k) = input(p.first + k * (o.gap + 1));
     const Completion done = net.complete(
         key_frames, std::vector<int>(static_cast<std::size_t>(keys - 1), o.gap), o.completion);
     for (int g = 0; g + 1 < keys; ++g) {
@@ -109,8 +128,8 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
       for (int t = 1; t <= o.gap; ++t) {
         const Positions& want = truth.at(k0 + t);
         const double s = static_cast<double>(t) / (o.gap + 1);
-        c.learned +=
-            vertex_error(want, solver.solve(frame_of(done.frames.col(g * (o.gap + 1) + t))), ring);
+        c.learned += vertex_error(
+            want, solver.solve(frame_of(done.frames.col(g * (o.gap + 1) + t), vertices)), ring);
         c.feature_linear +=
             vertex_error(want, solver.solve(lerp_features(data.raw(k0), data.raw(k1), s)), ring);
         c.vertex_linear += vertex_error(want, lerp_positions(truth.at(k0), truth.at(k1), s), ring);
@@ -133,7 +152,7 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
     for (const Clip& p : e.pieces) {
       for (int f = p.first; f < p.first + p.count; ++f) {
         FrameMatrix given(net.dims(), 1);
-        given.col(0) = column(data.raw(f));
+        given.col(0) = input(f);
         const Eigen::MatrixXf x = net.normalise(net.generate(given, o.change_frames));
         for (int t = 0; t < o.change_frames; ++t) {
           e.change_generated[static_cast<std::size_t>(t)] +=

@@ -6,11 +6,13 @@
 
 #include "../subcommand.hpp"
 #include "animrt/learn/seqnet/blas_kernels.hpp"
+#include "animrt/learn/seqnet/memory.hpp"
 #include "seq_net_commands.hpp"
 
 int main(int argc, char** argv) {
   // Before anything else: the BLAS kernels are fixed when it loads.
   animrt::seqnet::restart_with_better_blas_kernels(argv);
+  animrt::seqnet::keep_freed_memory();
   CLI::App app{"animrt-seqnet: train the sequence network"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "animrt-seqnet " ANIMRT_VERSION);

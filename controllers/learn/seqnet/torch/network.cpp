@@ -107,6 +107,9 @@ torch::Tensor MeshConvImpl::forward_vertices_first(const torch::Tensor& x) {
 
 SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
   const bool mesh = shape.kind == ModelKind::mesh;
+  // Placement nodes follow the vertices with no neighbours: the ring
+  // products leave them out, the dense layers mix them in.
+  if (mesh) graph.vertex_count = shape.nodes();
   const int width = mesh ? shape.channels : shape.dense_width;
   encoder = torch::nn::Sequential();
   decoder = torch::nn::Sequential();
@@ -118,7 +121,7 @@ SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
     }
     encoder->push_back(torch::nn::Tanh());
   }
-  const std::int64_t flat = mesh ? std::int64_t{shape.vertex_count} * width : width;
+  const std::int64_t flat = mesh ? std::int64_t{shape.nodes()} * width : width;
   encoder = register_module("encoder", encoder);
   to_mu = register_module("to_mu", torch::nn::Linear(flat, shape.latent));
   to_logvar = register_module("to_logvar", torch::nn::Linear(flat, shape.latent));
@@ -161,7 +164,7 @@ torch::Tensor SeqNetImpl::encoded(const torch::Tensor& x) {
   if (shape_.kind != ModelKind::mesh) return encoder->forward(x);
   // Vertices first through the convolutions, back to [B, V C] for the
   // dense layers.
-  torch::Tensor h = x.view({batch, shape_.vertex_count, 9}).transpose(0, 1).contiguous();
+  torch::Tensor h = x.view({batch, shape_.nodes(), 9}).transpose(0, 1).contiguous();
   return run_vertices_first(encoder, h).transpose(0, 1).reshape({batch, -1});
 }
 
@@ -178,7 +181,7 @@ torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
   const std::int64_t batch = dense.size(0);
   torch::Tensor h = torch::tanh(dense);
   if (shape_.kind != ModelKind::mesh) return decoder->forward(h);
-  h = h.view({batch, shape_.vertex_count, shape_.channels}).transpose(0, 1).contiguous();
+  h = h.view({batch, shape_.nodes(), shape_.channels}).transpose(0, 1).contiguous();
   return run_vertices_first(decoder, h).transpose(0, 1).reshape({batch, -1});
 }
 

@@ -14,6 +14,7 @@
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
+#include "animrt/controllers/seqnet/placement_nodes.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/blas_kernels.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
@@ -96,6 +97,31 @@ std::string held_out_line(const HeldOutCompletion& h, int iteration) {
   return line;
 }
 
+// The placement nodes' numbers (placement_nodes.hpp) after every frame's
+// features, each mapped from its range to [-0.95, 0.95] as the features
+// are. A feature file without placement (version 1) gets none.
+void append_placement(ModelFile& d, const SequenceFeatures& f,
+                      std::vector<std::vector<float>>& frames) {
+  const std::vector<Eigen::VectorXd> track = placement_track(f);
+  if (track.empty()) return;
+  const Eigen::Index n = track.front().size();
+  d.shape.placement_nodes = static_cast<int>(n / 9);
+  Eigen::VectorXd low = track.front(), high = track.front();
+  for (const Eigen::VectorXd& v : track) {
+    low = low.cwiseMin(v);
+    high = high.cwiseMax(v);
+  }
+  d.low.insert(d.low.end(), low.data(), low.data() + n);
+  d.high.insert(d.high.end(), high.data(), high.data() + n);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double span = high[i] - low[i];
+      frames[k].push_back(span > 0 ? static_cast<float>((track[k][i] - low[i]) / span * 1.9 - 0.95)
+                                   : 0.0F);
+    }
+  }
+}
+
 }  // namespace
 
 TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
@@ -112,7 +138,6 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
     }
     const SequenceFeatures f = read_feature_file(files.front());
     set.kind = ModelKind::mesh;
-    set.dims = 9 * f.vertex_count();
     ModelFile& d = set.description;
     d.shape.kind = ModelKind::mesh;
     d.shape.vertex_count = f.vertex_count();
@@ -124,6 +149,8 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
     for (const FeatureFrame& frame : f.frames) {
       frames.emplace_back(frame.data(), frame.data() + frame.size());
     }
+    append_placement(d, f, frames);
+    set.dims = d.shape.input_dims();
     const int n = static_cast<int>(frames.size());
     const auto block = held_out_block(n, held_out, seed, 0);
     std::vector<Clip> clips = f.clips;
@@ -243,6 +270,12 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
       check_model_mesh(checkpoint, o.resume, shape.vertex_count, set.description.triangles);
     } else {
       check_model_joints(checkpoint, o.resume, set.description.joint_names);
+    }
+    if (checkpoint.shape.placement_nodes != shape.placement_nodes) {
+      fail(o.resume, 0, 0, "shape",
+           "a checkpoint with " + std::to_string(checkpoint.shape.placement_nodes) +
+               " placement nodes, the data has " + std::to_string(shape.placement_nodes) +
+               " (a checkpoint of an older build): start a new training without --resume");
     }
     if (checkpoint.optimiser.empty()) {
       fail(o.resume, 0, 0, "optimiser", "a final model, not a checkpoint (no optimiser state)");

@@ -15,7 +15,8 @@
 namespace animrt::seqnet {
 
 constexpr char kModelFileMagic[8] = {'A', 'N', 'S', 'E', 'Q', 'N', 'N', '\n'};
-constexpr std::uint32_t kModelFileVersion = 2;  // 2 added the held-out measurement; 1 is still read
+// 2 added the held-out measurement, 3 the placement nodes; 1 and 2 are still read
+constexpr std::uint32_t kModelFileVersion = 3;
 
 enum class ModelKind : std::uint32_t { mesh = 1, joints = 2 };
 
@@ -35,8 +36,13 @@ struct NetShape {
   int window = 32;  // frames per training sequence
   int stride = 1;   // 2: every other frame (slow motion)
   double s0 = 0.1;  // forward chain's initial state; the backward chain takes -s0
+  // Mesh: nodes of 9 placement numbers after the vertices (placement_nodes.hpp);
+  // 0 for a model of an older build, which knows nothing of translation.
+  int placement_nodes = 0;
 
-  int input_dims() const { return kind == ModelKind::mesh ? 9 * vertex_count : joint_count; }
+  // Vertices and placement nodes: the rows the mesh layers run over.
+  int nodes() const { return vertex_count + placement_nodes; }
+  int input_dims() const { return kind == ModelKind::mesh ? 9 * nodes() : joint_count; }
 };
 
 // A named float array: a parameter, or a piece of optimiser state.
