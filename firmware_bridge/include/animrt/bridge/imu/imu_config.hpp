@@ -32,6 +32,9 @@ struct ImuConfig {
     double rate_rad_s = 0.0;
     double to_rad = 0.0;
   } sim_push;
+  // Simulated part only: it sends nothing from this time on (s; < 0: never),
+  // as a part whose cable came loose.
+  double sim_silent_at_s = -1.0;
   Location where;
 };
 
