@@ -1,7 +1,9 @@
 // Device health of the CiA 402 drive on the CAN quadruped, in lockstep:
 // with `health: on` a second TPDO carries the current actual value (per
 // mille of the rated current read at configure) and the DC link voltage
-// every SYNC; an undervoltage or a blocked joint faults the drive.
+// every SYNC; an undervoltage or a blocked joint faults the drive. A
+// drive's config may name the manufacturer object of its temperature, which
+// then travels in the same TPDO and meets the temperature limits.
 
 #include <gtest/gtest.h>
 
