@@ -65,7 +65,12 @@ std::vector<ImuConfig> parse_imus(const YamlNode& list, double rate_hz) {
       }
     }
     if (auto sim = item.find("sim")) {
-      sim->allow_only({"push_at_s", "push_axis", "push_rate_deg_s", "push_to_deg"});
+      sim->allow_only({"push_at_s", "push_axis", "push_rate_deg_s", "push_to_deg", "silent_at_s",
+                       "latency_ms"});
+      if (auto n = sim->find("silent_at_s")) imu.sim_silent_at_s = n->as_double_in(0.0, 1e6);
+      if (auto n = sim->find("latency_ms")) {
+        imu.sim_latency_s = n->as_double_in(1000.0 / imu.rate_hz, 200.0) / 1000.0;
+      }
       if (auto at = sim->find("push_at_s")) {
         imu.sim_push.on = true;
         imu.sim_push.at_s = at->as_double_in(0.0, 1e6);

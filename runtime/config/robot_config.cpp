@@ -172,7 +172,8 @@ SafetyConfig parse_safety(const YamlNode& node, double rate_hz) {
 // sim.health: the simulated servos' thermal, supply and current model.
 void parse_sim_health(const YamlNode& node, SimHealthSettings& h) {
   node.allow_only({"ambient_c", "thermal_tau_s", "heat_c_per_a2", "supply_v", "supply_ohm",
-                   "idle_current_a", "current_per_rad_s", "stall_current_a", "overload_s"});
+                   "idle_current_a", "current_per_rad_s", "stall_current_a", "overload_s",
+                   "trip_c"});
   if (auto n = node.find("ambient_c")) h.ambient_c = n->as_double_in(-40.0, 150.0);
   if (auto n = node.find("thermal_tau_s")) h.thermal_tau_s = n->as_double_in(0.001, 1e5);
   if (auto n = node.find("heat_c_per_a2")) h.heat_c_per_a2 = n->as_double_in(0.0, 1000.0);
@@ -182,6 +183,7 @@ void parse_sim_health(const YamlNode& node, SimHealthSettings& h) {
   if (auto n = node.find("current_per_rad_s")) h.current_per_rad_s = n->as_double_in(0.0, 100.0);
   if (auto n = node.find("stall_current_a")) h.stall_current_a = n->as_double_in(0.0, 100.0);
   if (auto n = node.find("overload_s")) h.overload_s = n->as_double_in(0.0, 3600.0);
+  if (auto n = node.find("trip_c")) h.trip_c = n->as_double_in(0.0, 250.0);
 }
 
 // sim.inject: health changes at a time, one key saying what.

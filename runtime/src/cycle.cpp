@@ -79,12 +79,21 @@ CycleState::CycleState(const RobotModel& model)
     out_.bus_commands.emplace_back(bus.joint.size(), 0.0);
   }
   imu_late_.assign(model.imus.size(), 0);
+  imu_track_.assign(model.imus.size(), ImuTrack{});
   imu_faulted_.assign(model.imus.size(), 0);
   out_.commands.assign(n, 0.0);
   out_.write.assign(buses, 0);
   // A cycle emits at most a few events per joint and device.
   out_.events.reserve(4 * n + 8);
   log_.reserve(kEventLogCapacity);
+}
+
+std::uint64_t CycleState::imu_missing(std::size_t i, double rate_hz) const {
+  const ImuTrack& track = imu_track_[i];
+  if (track.last < 0.0) return 0;
+  // Since the last reading: the reports whose successor is due by now.
+  const double silent = std::floor((imu_now_ - track.last) * rate_hz - 1e-6);
+  return track.missing + static_cast<std::uint64_t>(std::max(0.0, silent));
 }
 
 bool CycleState::joint_faulted(std::size_t j) const {
@@ -288,6 +297,7 @@ struct CycleStages {
   static bool watch_imus(const RobotModel& model, CycleState& s, const CycleInputs& in) {
     const double t = in.t;
     if (s.cycles_ == 0) s.imu_start_ = t;
+    s.imu_now_ = t;
     s.sensors_.imu = nullptr;
     bool fault = false;
     for (std::size_t i = 0; i < model.imus.size(); ++i) {
@@ -295,6 +305,15 @@ struct CycleStages {
       const bool valid = io && io->valid;
       const double age = valid ? t - io->reading.time_s : t - s.imu_start_;
       if (age > 1.0 / model.imus[i].rate_hz + model.dt + kTimeEps) ++s.imu_late_[i];
+      CycleState::ImuTrack& track = s.imu_track_[i];
+      if (valid && io->reading.time_s > track.last + kTimeEps) {
+        if (track.last >= 0.0) {
+          const double periods = (io->reading.time_s - track.last) * model.imus[i].rate_hz;
+          track.missing += static_cast<std::uint64_t>(std::max(0.0, std::round(periods) - 1.0));
+        }
+        track.last = io->reading.time_s;
+        ++track.readings;
+      }
       const bool stale = age > model.imus[i].stale_timeout_s + kTimeEps;
       if (stale && !s.imu_faulted_[i]) {
         s.imu_faulted_[i] = 1;

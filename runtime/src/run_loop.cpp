@@ -113,6 +113,7 @@ RunLoop::RunLoop(const RobotModel& model, std::vector<std::unique_ptr<ActuatorBu
   }
   in_.buses = io_;
   imu_io_.resize(model.imus.size());
+  imu_silent_.assign(model.imus.size(), 0);
   in_.imus = imu_io_;
   in_.motion_duration_s = options.duration_s;
   for (std::size_t b = 0; b < buses.size(); ++b) {
@@ -224,12 +225,15 @@ void RunLoop::take_imu(std::size_t i) {
   Mailbox<ImuReading>& box = *options_.imu_readings[i];
   ImuIo& io = imu_io_[i];
   const auto take = [&] {
-    if (!box.take(io.reading)) return;
+    if (!box.take(io.reading)) return false;
     io.valid = true;
     io.reading.time_s -= to_seconds(start_);  // on the run's clock -> since the run began
+    imu_silent_[i] = 0;
+    return true;
   };
   take();
-  if (!options_.lockstep_clock) return;
+  // A part that has fallen silent costs one wait, not one per cycle.
+  if (!options_.lockstep_clock || imu_silent_[i]) return;
   // A simulated part sends on whole multiples of its period on the clock;
   // a frame due before the run began may have been dropped as old by the
   // reader when it opened the line, so only later ones are waited for.
@@ -241,6 +245,7 @@ void RunLoop::take_imu(std::size_t i) {
     sleep_until_deadline(wall_.now() + 100'000);
     take();
   }
+  if (!io.valid || io.reading.time_s < due - 1e-9) imu_silent_[i] = 1;
 }
 
 void RunLoop::gather_inputs() {

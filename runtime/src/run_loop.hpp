@@ -143,6 +143,9 @@ class RunLoop {
   std::vector<std::uint64_t> io_seen_;
   // Controls taken from the mailboxes this cycle.
   std::vector<ImuIo> imu_io_;  // per IMU: the latest reading taken
+  // Lockstep, per IMU: its last wait gave up (a silent part); it is not
+  // waited for again until a frame arrives.
+  std::vector<std::uint8_t> imu_silent_;
   CycleInputs in_;
   MotionCommand steer_;
   ShowCommand show_;

@@ -187,6 +187,11 @@ std::string format_summary(const RunSummary& s) {
   }
   line("devices:");
   for (const auto& d : s.devices) line(device_line(d));
+  for (const auto& imu : s.imus) {
+    line(fmt::format("imu {}: {} readings, {} late cycles, {} missing reports{}", imu.name,
+                     imu.readings, imu.late_cycles, imu.missing_reports,
+                     imu.faulted ? " (FAULTED: silent past its stale_timeout_s)" : ""));
+  }
   if (s.physics) add_physics(out, *s.physics);
   add_telemetry(out, s);
   return out;
@@ -229,6 +234,14 @@ nlohmann::json to_json(const RunSummary& s) {
   }
   j["devices"] = nlohmann::json::array();
   for (const auto& d : s.devices) j["devices"].push_back(device_json(d));
+  j["imus"] = nlohmann::json::array();
+  for (const auto& imu : s.imus) {
+    j["imus"].push_back({{"name", imu.name},
+                         {"readings", imu.readings},
+                         {"late_cycles", imu.late_cycles},
+                         {"missing_reports", imu.missing_reports},
+                         {"faulted", imu.faulted}});
+  }
   j["telemetry"] = {{"file", s.telemetry_file},
                     {"records", s.telemetry_records},
                     {"dropped", s.telemetry_dropped},

@@ -44,7 +44,8 @@ std::string slowest_start(const RobotModel& m, std::span<const double> measured,
 }
 
 // "temperature 85 C (fault limit 75 C)", for a health event.
-std::string describe_health(const HealthLimits& lim, const CycleEvent& e) {
+std::string describe_health(const HealthLimits& lim, const CycleEvent& e,
+                            const std::string& error_text) {
   const bool fault = e.kind == EventKind::health_fault;
   switch (e.check) {
     case HealthCheck::temperature:
@@ -60,11 +61,22 @@ std::string describe_health(const HealthLimits& lim, const CycleEvent& e) {
           "stall: current {:.2f} A (limit {:g} A) for {:g} s while the joint did not follow",
           e.value, lim.stall_current_a, lim.stall_time_s);
     case HealthCheck::error_bits:
-      return fmt::format("device error bits 0x{:02X}", static_cast<unsigned>(e.value));
+      return fmt::format("device error bits 0x{:02X}{}", static_cast<unsigned>(e.value),
+                         error_text.empty() ? "" : " (" + error_text + ")");
     case HealthCheck::none:
       break;
   }
   return "health";
+}
+
+// describe_health with the device's own words for its error bits.
+std::string health_text(const RobotModel& m, const std::vector<std::unique_ptr<ActuatorBus>>& buses,
+                        const CycleEvent& e) {
+  const std::string words =
+      e.check == HealthCheck::error_bits
+          ? buses[e.bus]->error_words(e.device, static_cast<std::uint32_t>(e.value))
+          : std::string();
+  return describe_health(m.buses[e.bus].health_of(e.device), e, words);
 }
 
 std::string describe_event(const RobotModel& m,
@@ -104,8 +116,7 @@ std::string describe_event(const RobotModel& m,
       return fmt::format(
           "bus {} id {} ({}): {}; at t={:.3f} s; the device was switched off, "
           "other joints ramped to home",
-          bus.name, actuator.device_id, actuator.joint,
-          describe_health(m.buses[e.bus].health_of(e.device), e), e.t);
+          bus.name, actuator.device_id, actuator.joint, health_text(m, buses, e), e.t);
     }
     case EventKind::motion_fault:
       return fmt::format(
@@ -296,6 +307,11 @@ void Runner::Impl::report(const RunLoop& loop, const CycleState& state, const Ru
           DeviceReport{bus.name, bus.actuators[d].joint, devices[d], state.health_stats()[b][d]});
     }
   }
+  for (std::size_t i = 0; i < model.imus.size(); ++i) {
+    summary.imus.push_back(
+        ImuReport{model.imus[i].name, state.imu_readings(i), state.imu_late_cycles()[i],
+                  state.imu_missing(i, model.imus[i].rate_hz), state.imu_faulted()[i] != 0});
+  }
   report_events(state, summary);
   for (std::size_t j = 0; j < model.joint_count(); ++j) {
     summary.joints.push_back(JointReport{model.joint_names[j], state.rms_error(j),
@@ -339,9 +355,9 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
     } else if (e.kind == EventKind::health_warning) {
       const auto& bus = buses[e.bus]->config();
       const auto& actuator = bus.actuators[e.device];
-      summary.health_warnings.push_back(fmt::format(
-          "bus {} id {} ({}): {} at t={:.3f} s", bus.name, actuator.device_id, actuator.joint,
-          describe_health(model.buses[e.bus].health_of(e.device), e), e.t));
+      summary.health_warnings.push_back(fmt::format("bus {} id {} ({}): {} at t={:.3f} s", bus.name,
+                                                    actuator.device_id, actuator.joint,
+                                                    health_text(model, buses, e), e.t));
     } else if (std::string line = describe_event(model, buses, config.lag_notes, e);
                !line.empty()) {
       summary.faults.push_back(std::move(line));

@@ -2,7 +2,8 @@
 # The balance reflex on the runtime against the fitness walk, over neighbours
 # of the horse's balanced seed (docs/results/balance_runtime.md).
 #
-# Usage: ANIMRT=build/bin/animrt [START_RAMP_S=2] [TILT_DEG=] [MEASURE=1] \
+# Usage: ANIMRT=build/bin/animrt [START_RAMP_S=2] [TILT_DEG=] [MEASURE=1] [IMU_LATENCY_MS=] \
+#          [ONLY_REFLEX=0] \
 #          balance_runtime.sh OUT_DIR COUNT RNG_SEED [DURATION_S]
 # For each neighbour: `gait measure` (3 starts) with and without the reflex,
 # then `animrt run --physics --lockstep` of the horse with a simulated IMU on
@@ -12,6 +13,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 animrt=${ANIMRT:-$root/build/bin/animrt}
 out=$1 count=$2 seed=$3 duration=${4:-6}
 ramp=${START_RAMP_S:-2.0} tilt=${TILT_DEG:-} do_measure=${MEASURE:-1}
+latency=${IMU_LATENCY_MS:-} only_reflex=${ONLY_REFLEX:-0}
 python3 "$root/scripts/experiments/balance_neighbours.py" \
   "$root/configs/gaits/horse_seed_balance.yaml" "$out" "$count" "$seed"
 robot() {  # $1 gait file -> the horse robot with an IMU, on stdout
@@ -21,7 +23,9 @@ robot() {  # $1 gait file -> the horse robot with an IMU, on stdout
     -e "s#start_ramp_s: 2.0 #start_ramp_s: $ramp #" -e "s#^safety:\$#safety:$watch#" \
     -e "s#^model: ../models/horse.xml#model: $root/configs/models/horse.xml#" \
     "$root/configs/robots/horse.yaml"
-  printf "imus:\n  - {name: trunk, protocol: bno08x_rvc, stale_timeout_s: 0.5}\n"
+  local sim=""
+  [[ -n $latency ]] && sim=", sim: {latency_ms: $latency}"
+  printf "imus:\n  - {name: trunk, protocol: bno08x_rvc, stale_timeout_s: 0.5%s}\n" "$sim"
 }
 measure() {  # $1 gait -> "falls/starts"
   [[ $do_measure == 1 ]] || { echo "-"; return; }
@@ -43,5 +47,5 @@ echo "| neighbour | gait measure falls, reflex | without | runtime falls, reflex
 echo "|---|---|---|---|---|"
 for ((n = 0; n < count; ++n)); do
   echo "| n$n | $(measure "$out/n$n.yaml") | $(measure "$out/n${n}_plain.yaml") |" \
-    "$(run "$out/n$n.yaml") | $(run "$out/n${n}_plain.yaml") |"
+    "$(run "$out/n$n.yaml") | $([[ $only_reflex == 1 ]] && echo - || run "$out/n${n}_plain.yaml") |"
 done

@@ -77,8 +77,9 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
       // physics has got there by then at any loop rate from the part's up,
       // so a lockstep run reads the same frames whichever thread runs first.
       own_physics_->keep_torso_history();
-      trunk = [physics = own_physics_.get(), period = 1.0 / imu.rate_hz](double t) {
-        const sim::TorsoMotion torso = physics->torso_motion_at(t - period);
+      const double age = std::max(1.0 / imu.rate_hz, imu.sim_latency_s);
+      trunk = [physics = own_physics_.get(), age](double t) {
+        const sim::TorsoMotion torso = physics->torso_motion_at(t - age);
         return sim::TrunkState{torso.quat, torso.accel_m_s2};
       };
       source = "on the physics' torso";

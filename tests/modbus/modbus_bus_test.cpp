@@ -207,6 +207,57 @@ TEST_P(ModbusTransports, ADriveSwitchedOffForItsHealthHasItsEnableOff) {
   EXPECT_NEAR(r.sim->device_position(1), 0.0, 1e-3);  // the other drive carries on
 }
 
+// The drive's firmware trips by itself when its thermal model passes its
+// trip temperature: fault code 0x4310 and the output off, latched through a
+// cooling until the host resets it (enable off, then on) below the trip.
+TEST(ModbusBus, ADriveTripsOnOvertemperatureUntilAFaultResetOnceCooled) {
+  Rig r("modbus-tcp");
+  std::any_cast<ModbusBusOptions&>(r.config.buses[0].options).health =
+      ModbusBusOptions::Health::packed;
+  r.bus = std::make_unique<ModbusBus>(r.config.buses[0]);
+  ASSERT_DOUBLE_EQ(r.config.buses[0].sim.health.trip_c, 80.0);
+  r.bus->configure();
+  r.bus->activate();
+  const double lean = r.sim->device_position(2);
+  r.step({0.0, lean}, 5);
+  const auto code = [&] { return r.bus->devices()[1].reading.error_bits; };
+  EXPECT_EQ(code(), 0u);
+  using Kind = SimHealthInjection::Kind;
+  r.sim->inject_device_health(2, {2, 0.0, Kind::temperature, 79.0});
+  r.step({0.0, lean}, 2);
+  EXPECT_EQ(code(), 0u);  // below the trip
+  r.sim->inject_device_health(2, {2, 0.0, Kind::temperature, 85.0});
+  r.step({0.0, lean}, 2);
+  EXPECT_EQ(code(), 0x4310u);
+  EXPECT_EQ(r.bus->error_words(1, code()), "driver overtemperature");
+  // Its output is off: a new goal does not move it; the other drive follows.
+  const double held = r.sim->device_position(2);
+  EXPECT_NEAR(held, lean, 1e-3);
+  r.step({deg_to_rad(10), lean + deg_to_rad(10)}, 30);
+  EXPECT_EQ(r.sim->device_position(2), held);
+  EXPECT_NEAR(r.sim->device_position(1), deg_to_rad(10), 1e-3);
+  // Cooled, but not reset: still tripped.
+  r.sim->inject_device_health(2, {2, 0.0, Kind::temperature, 60.0});
+  r.step({deg_to_rad(10), lean + deg_to_rad(10)}, 30);
+  EXPECT_EQ(code(), 0x4310u);
+  EXPECT_EQ(r.sim->device_position(2), held);
+  // A reset while still hot (77 C: within 5 C of the trip) does not clear it.
+  r.sim->inject_device_health(2, {2, 0.0, Kind::temperature, 77.0});
+  r.bus->deactivate();
+  r.bus->activate();
+  r.step({deg_to_rad(10), lean + deg_to_rad(10)}, 30);
+  EXPECT_EQ(code(), 0x4310u);
+  EXPECT_EQ(r.sim->device_position(2), held);
+  // Cooled and reset: it follows again.
+  r.sim->inject_device_health(2, {2, 0.0, Kind::temperature, 60.0});
+  r.bus->deactivate();
+  r.bus->activate();
+  r.step({deg_to_rad(10), lean + deg_to_rad(10)}, 30);
+  EXPECT_EQ(code(), 0u);
+  EXPECT_NEAR(r.sim->device_position(2), lean + deg_to_rad(10), 1e-3);
+  r.bus->deactivate();
+}
+
 INSTANTIATE_TEST_SUITE_P(TcpAndRtu, ModbusTransports, ::testing::Values("modbus-tcp", "modbus-rtu"),
                          [](const auto& p) { return p.param == "modbus-tcp" ? "tcp" : "rtu"; });
 

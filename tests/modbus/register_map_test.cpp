@@ -130,7 +130,19 @@ TEST(RegisterMap, AHealthSectionNamesCurrentTemperatureVoltageAndFaultCode) {
                               "address: 7, type: uint16, "
                               "scale: 2}")),
             "map.yaml:14:58: health.fault_code.scale: unknown key (expected one of: table, "
-            "address, type)");
+            "address, type, codes)");
+  // The drive's own names for its fault codes, for the fault line.
+  const auto named = load_register_map_text(
+      replaced(text, "address: 7, type: uint16}",
+               "address: 7, type: uint16, codes: {0x4310: overtemperature, 17: overload}}"),
+      "map.yaml");
+  EXPECT_EQ(named->health.code_name(0x4310), "overtemperature");
+  EXPECT_EQ(named->health.code_name(17), "overload");
+  EXPECT_EQ(named->health.code_name(18), "");
+  EXPECT_EQ(error_of(replaced(text, "address: 7, type: uint16}",
+                              "address: 7, type: uint16, codes: {0x10000: x}}")),
+            "map.yaml:14:75: health.fault_code.codes.0x10000: expected a fault code 1..65535 "
+            "(decimal or 0x hex) as the key, found \"0x10000\"");
   EXPECT_EQ(error_of(kGood + "health: {}\n"),
             "map.yaml:11:9: health: expected at least one of current, temperature, voltage, "
             "fault_code");

@@ -187,7 +187,16 @@ TEST(CycleSensors, AStaleImuIsLateThenFaultedAndRampsHome) {
   // 30 and 40 ms into the glitch; no fault.
   EXPECT_EQ(rig.state.imu_late_cycles()[0], 2u);
   EXPECT_EQ(rig.first(EventKind::sensor_stale), nullptr);
+  // The reports of 1.01 to 1.04 s never came.
+  EXPECT_EQ(rig.state.imu_missing(0, 100.0), 4u);
+  const std::uint64_t readings = rig.state.imu_readings(0);
+  EXPECT_EQ(readings, static_cast<std::uint64_t>(rig.count) - 4u);
   rig.run(10.0);
+  // Every report after 1.5 s is missing, up to the last cycle's own.
+  const double last = (rig.count - 1) / kRate;
+  EXPECT_EQ(rig.state.imu_missing(0, 100.0),
+            4u + static_cast<std::uint64_t>(std::llround((last - 1.5) * 100.0)) - 1u);
+  EXPECT_EQ(rig.state.imu_readings(0), readings + 1u);  // the one at 1.5 s
   ASSERT_TRUE(rig.state.done());
   const CycleEvent* stale = rig.first(EventKind::sensor_stale);
   ASSERT_NE(stale, nullptr);

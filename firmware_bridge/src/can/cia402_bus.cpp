@@ -77,8 +77,10 @@ Cia402Bus::Cia402Bus(BusConfig config, std::unique_ptr<CanFrameTransport> transp
   min_rad_.resize(n);
   max_rad_.resize(n);
   rated_current_a_.assign(n, 0.0);
+  joint_options_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const ActuatorBinding& b = config_.actuators[i];
+    joint_options_[i] = options_of<Cia402JointOptions>(b.options);
     const double a = b.to_rad(std::numeric_limits<std::int32_t>::min() + 1);
     const double c = b.to_rad(std::numeric_limits<std::int32_t>::max() - 1);
     min_rad_[i] = std::min(a, c);
@@ -154,7 +156,9 @@ void Cia402Bus::handle(const can_frame& f) {
       slot = slot_of(cob, canopen::kTpdo2Base);
       if (slot < 0 || !options_.health) return;
       const auto device = static_cast<std::size_t>(slot);
-      if (f.len != 6) {
+      const Cia402JointOptions& o = joint_options_[device];
+      const int temperature_bytes = o.has_temperature ? o.temperature.bits / 8 : 0;
+      if (f.len != 6 + temperature_bytes) {
         book_.garbled(device);
         return;
       }
@@ -165,6 +169,10 @@ void Cia402Bus::handle(const can_frame& f) {
                         ? std::abs(per_mille) / 1000.0 * rated_current_a_[device]
                         : HealthReading::kNone;
       h.voltage_v = canopen::get_le(f.data + 2, 4) / 1000.0;
+      if (o.has_temperature) {
+        h.temperature_c = o.temperature.decode(
+            static_cast<std::uint32_t>(canopen::get_le(f.data + 6, temperature_bytes)));
+      }
       return;
     }
     case canopen::kHeartbeatBase: {
@@ -411,8 +419,9 @@ void Cia402Bus::configure() {
   fresh_ = true;
 }
 
-// TPDO2: current actual + DC link voltage on every SYNC, scaled by the
-// motor's rated current read once here.
+// TPDO2: current actual + DC link voltage (+ the temperature object the
+// device's config names) on every SYNC, the current scaled by the motor's
+// rated current read once here.
 void Cia402Bus::map_health_tpdo(std::size_t i) {
   using namespace cia402::obj;
   const auto node = static_cast<std::uint32_t>(config_.actuators[i].device_id);
@@ -421,7 +430,13 @@ void Cia402Bus::map_health_tpdo(std::size_t i) {
   sdo_write(i, tpdo2_map, 0, 0, 1);
   sdo_write(i, tpdo2_map, 1, canopen::mapping(current_actual, 0, 16), 4);
   sdo_write(i, tpdo2_map, 2, canopen::mapping(dc_link_voltage, 0, 32), 4);
-  sdo_write(i, tpdo2_map, 0, 2, 1);
+  const Cia402JointOptions& o = joint_options_[i];
+  if (o.has_temperature) {
+    const Cia402Temperature& t = o.temperature;
+    sdo_write(i, tpdo2_map, 3,
+              canopen::mapping(t.index, t.subindex, static_cast<std::uint8_t>(t.bits)), 4);
+  }
+  sdo_write(i, tpdo2_map, 0, o.has_temperature ? 3 : 2, 1);
   sdo_write(i, tpdo2_comm, 2, 1, 1);
   sdo_write(i, tpdo2_comm, 1, canopen::kTpdo2Base + node, 4);
 }

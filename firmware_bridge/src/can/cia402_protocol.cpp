@@ -27,7 +27,54 @@ constexpr std::string_view kCia402BusKeys[] = {"interface",
 // The consumer time of 1016h is 16 bits of milliseconds.
 constexpr int kMaxConsumerMs = 65535;
 constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
-                                                    "direction"};
+                                                    "direction", "temperature"};
+
+// "0x2022:0x01" (or decimal parts): a manufacturer object, 2000h to 5FFFh.
+Cia402Temperature read_temperature(const YamlNode& node, const BusConfig& bus) {
+  if (!node.is_map()) node.fail("expected a map {object, type, scale}, found " + node.describe());
+  node.allow_only({"object", "type", "scale"});
+  if (!options_of<Cia402BusOptions>(bus.options).health)
+    node.fail("needs the bus's health: true (the temperature travels in the health TPDO)");
+  Cia402Temperature t;
+  const YamlNode object = node.at("object");
+  const std::string text = object.as_string();
+  const auto colon = text.find(':');
+  long index = -1, sub = -1;
+  try {
+    std::size_t used = 0, used_sub = 0;
+    if (colon != std::string::npos) {
+      index = std::stol(text.substr(0, colon), &used, 0);
+      sub = std::stol(text.substr(colon + 1), &used_sub, 0);
+      if (used != colon || used_sub != text.size() - colon - 1) index = -1;
+    }
+  } catch (...) {
+    index = -1;
+  }
+  if (index < 0x2000 || index > 0x5FFF || sub < 0 || sub > 255)
+    object.fail(
+        "expected a manufacturer object INDEX:SUBINDEX from 0x2000 to 0x5FFF, e.g. "
+        "\"0x2022:0x01\", found " +
+        object.describe());
+  t.index = static_cast<std::uint16_t>(index);
+  t.subindex = static_cast<std::uint8_t>(sub);
+  const YamlNode type = node.at("type");
+  const std::string ty = type.as_string();
+  if (ty == "int8" || ty == "uint8" || ty == "int16" || ty == "uint16") {
+    t.bits = ty.find("16") != std::string::npos ? 16 : 8;
+    t.is_signed = ty[0] == 'i';
+  } else {
+    type.fail(
+        "expected int8, uint8, int16 or uint16 (TPDO2 holds 16 bits beside the current "
+        "and voltage), found " +
+        type.describe());
+  }
+  if (auto n = node.find("scale")) {
+    t.scale = n->as_double();
+    if (!(std::isfinite(t.scale) && t.scale != 0.0))
+      n->fail("expected a non-zero number (deg C per count), found " + n->describe());
+  }
+  return t;
+}
 
 class Cia402 final : public Protocol {
  public:
@@ -102,6 +149,12 @@ class Cia402 final : public Protocol {
           std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()));
     }
     if (auto n = node.find("direction")) out.direction = can_config::read_direction(*n);
+    Cia402JointOptions joint_options;
+    if (auto n = node.find("temperature")) {
+      joint_options.has_temperature = true;
+      joint_options.temperature = read_temperature(*n, bus);
+    }
+    out.options = joint_options;
     const auto check = [&](const char* key, double rad) {
       const double counts = std::round(out.zero_ticks + out.direction * rad * out.ticks_per_rad);
       if (counts < std::numeric_limits<std::int32_t>::min() ||

@@ -36,7 +36,7 @@ Register parse_register(const YamlNode& node, bool input_allowed, bool scaled) {
   if (scaled) {
     node.allow_only({"table", "address", "type", "word_order", "scale", "offset"});
   } else {
-    node.allow_only({"table", "address", "type"});
+    node.allow_only({"table", "address", "type", "codes"});
   }
   Register r;
   r.where = node.location();
@@ -120,6 +120,25 @@ void parse_status(const YamlNode& status, RegisterMap& map, std::vector<Named>& 
       {"status", map.status.table, map.status.address, map.status.end(), map.status.where});
 }
 
+// fault_code.codes: {CODE: name}, codes decimal or 0x hexadecimal.
+void parse_codes(const YamlNode& codes, std::vector<FaultCode>& out) {
+  if (!codes.is_map()) codes.fail("expected a map of code: name, found " + codes.describe());
+  for (const auto& [key, value] : codes.entries()) {
+    long code = -1;
+    try {
+      std::size_t used_chars = 0;
+      code = std::stol(key, &used_chars, 0);
+      if (used_chars != key.size()) code = -1;
+    } catch (...) {
+      code = -1;
+    }
+    if (code <= 0 || code > 65535)
+      value.fail("expected a fault code 1..65535 (decimal or 0x hex) as the key, found " +
+                 quote(key));
+    out.push_back(FaultCode{static_cast<std::uint16_t>(code), value.as_string()});
+  }
+}
+
 // The registers the drive reports its health in.
 void parse_health(const YamlNode& health, RegisterMap& map, std::vector<Named>& used) {
   if (!health.is_map()) health.fail("expected a map, found " + health.describe());
@@ -129,7 +148,10 @@ void parse_health(const YamlNode& health, RegisterMap& map, std::vector<Named>& 
   if (auto n = health.find("current")) h.current = parse_register(*n, true, true);
   if (auto n = health.find("temperature")) h.temperature = parse_register(*n, true, true);
   if (auto n = health.find("voltage")) h.voltage = parse_register(*n, true, true);
-  if (auto n = health.find("fault_code")) h.fault_code = parse_register(*n, true, false);
+  if (auto n = health.find("fault_code")) {
+    h.fault_code = parse_register(*n, true, false);
+    if (auto codes = n->find("codes")) parse_codes(*codes, h.codes);
+  }
   if (!h.any()) health.fail("expected at least one of current, temperature, voltage, fault_code");
   static constexpr const char* kKeys[] = {"health.current", "health.temperature", "health.voltage",
                                           "health.fault_code"};
@@ -306,6 +328,13 @@ std::string RegisterMap::fault_text(std::uint16_t value) const {
     if (value & (1u << f.bit)) out += (out.empty() ? "" : ", ") + f.name;
   }
   return out;
+}
+
+std::string HealthRegisters::code_name(std::uint32_t code) const {
+  for (const FaultCode& c : codes) {
+    if (c.code == code) return c.name;
+  }
+  return {};
 }
 
 std::vector<const Register*> HealthRegisters::list() const {

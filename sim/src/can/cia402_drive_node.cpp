@@ -106,6 +106,14 @@ void Cia402DriveNode::reset_application(Nanos now) {
       {obj::current_actual, 0, 2, Access::ro, false, true, 0},
       {obj::dc_link_voltage, 0, 4, Access::ro, false, true, 0},
   };
+  // The manufacturer object the drive reports its temperature in, if the
+  // device's config names one (CiA 402 defines none).
+  const auto joint = options_of<Cia402JointOptions>(binding_.options);
+  if (joint.has_temperature) {
+    const Cia402Temperature& t = joint.temperature;
+    od_.push_back(
+        {t.index, t.subindex, static_cast<std::uint8_t>(t.bits / 8), Access::ro, false, true, 0});
+  }
   reset_communication();
   state_ = State::switch_on_disabled;  // transitions 0 and 1 are immediate here
   last_controlword_ = 0;
@@ -221,8 +229,20 @@ std::uint32_t Cia402DriveNode::read_value(const Entry& e, Nanos now) const {
     case obj::dc_link_voltage:
       return static_cast<std::uint32_t>(std::lround(std::max(0.0, health_.voltage_v()) * 1000.0));
     default:
-      return e.value;
+      return e.index >= 0x2000 && e.index < 0x6000 ? manufacturer_value(e) : e.value;
   }
+}
+
+std::uint32_t Cia402DriveNode::manufacturer_value(const Entry& e) const {
+  const auto joint = options_of<Cia402JointOptions>(binding_.options);
+  const Cia402Temperature& t = joint.temperature;
+  if (!joint.has_temperature || e.index != t.index || e.sub != t.subindex) return e.value;
+  const double top = t.bits == 8 ? 255.0 : 65535.0;
+  const double lo = t.is_signed ? -(top + 1.0) / 2.0 : 0.0;
+  const double hi = t.is_signed ? (top - 1.0) / 2.0 : top;
+  const double raw = std::clamp(std::round(health_.temperature_c() / t.scale), lo, hi);
+  return static_cast<std::uint32_t>(static_cast<std::int32_t>(raw)) &
+         static_cast<std::uint32_t>(top);
 }
 
 double Cia402DriveNode::joint_position(Nanos now) const { return binding_.to_rad(counts(now)); }

@@ -58,6 +58,10 @@ void RvcSimImu::serve() {
       ::ppoll(&p, 1, &tick, nullptr);
       continue;
     }
+    if (config_.sim_silent_at_s >= 0.0 && to_seconds(due - start_) >= config_.sim_silent_at_s) {
+      due += period;  // a silent part: its frames never come
+      continue;
+    }
     const TrunkState s = trunk_(to_seconds(due - start_));
     // The part's own attitude: the trunk's turned by the mounting; its
     // acceleration in the part's axes.

@@ -26,6 +26,11 @@ namespace animrt::sim {
 namespace {
 
 constexpr Nanos kStep = 1'000'000;  // motor integration step: 1 ms
+// The fault code of the drive's own overtemperature trip: the CiA 402 code
+// for excess drive temperature, which many Modbus drives report too.
+constexpr std::uint16_t kOvertemperatureCode = 0x4310;
+// A trip is cleared by a fault reset only this far below the trip.
+constexpr double kTripHysteresisC = 5.0;
 
 void sleep_us(int us) {
   if (us <= 0) return;
@@ -51,7 +56,11 @@ struct ModbusSimBus::Drive {
   bool responding = true;
   std::uint16_t faults = 0;
   std::uint16_t fault_code = 0;  // the health section's fault code (injected)
+  // The firmware's own overtemperature trip: output off, latched until a
+  // fault reset (the enable written off, then on) once the drive cooled.
+  bool tripped = false;
   bool enabled = false;
+  bool commanded = false;  // the enable as last written
   Nanos time = 0;
   // The communication timeout: the register (if a map names one), the time
   // it allows (0: off) and when the drive last heard a request.
@@ -203,7 +212,7 @@ void ModbusSimBus::advance(Drive& d, Nanos now) {
   const double vmax = config_.sim.max_speed_rad_s;
   const auto integrate = [&](Nanos until) {
     for (; d.time + kStep <= until; d.time += kStep) {
-      const bool on = d.enabled && !d.faults && !d.fault_code;
+      const bool on = d.enabled && !d.faults && !d.fault_code && !d.tripped;
       const double dt = to_seconds(kStep);
       for (Joint& j : d.joints) {
         // A blocked joint stays where it is and draws its stall current.
@@ -213,6 +222,7 @@ void ModbusSimBus::advance(Drive& d, Nanos now) {
         j.position += v * dt;
         j.health.advance(d.time + kStep, v, on);
         d.fault_code = static_cast<std::uint16_t>(d.fault_code | j.health.injected_bits());
+        if (j.health.temperature_c() > config_.sim.health.trip_c) d.tripped = true;
       }
     }
   };
@@ -221,6 +231,7 @@ void ModbusSimBus::advance(Drive& d, Nanos now) {
   if (d.guard > 0 && d.enabled && now - d.last_request > d.guard) {
     integrate(d.last_request + d.guard);
     d.enabled = false;
+    d.commanded = false;
     for (const Joint& j : d.joints) {
       const modbus::Enable& e = j.options.map->enable;
       if (!e.configured) continue;
@@ -268,7 +279,7 @@ void ModbusSimBus::publish_health(Drive& d, Joint& j) {
   put(h.current, j.health.current_a());
   put(h.temperature, j.health.temperature_c());
   put(h.voltage, j.health.voltage_v());
-  put(h.fault_code, d.fault_code);
+  put(h.fault_code, d.fault_code ? d.fault_code : d.tripped ? kOvertemperatureCode : 0);
 }
 
 void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
@@ -339,6 +350,14 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
       enabled = enabled && v == m.enable.on;
     }
   }
+  // A fault reset: the enable switched on again, once every motor cooled.
+  if (any_enable && enabled && !d->commanded && d->tripped) {
+    bool cool = true;
+    for (const Joint& j : d->joints)
+      cool = cool && j.health.temperature_c() <= config_.sim.health.trip_c - kTripHysteresisC;
+    if (cool) d->tripped = false;
+  }
+  d->commanded = any_enable && enabled;
   d->enabled = !any_enable || enabled;
   if (d->watchdog != nullptr) {
     const std::uint16_t counts =

@@ -100,6 +100,11 @@ class ActuatorBus {
   // Whether read() fills DeviceStatus::reading (temperature, current,
   // voltage, error bits) as configured.
   virtual bool reads_health() const { return false; }
+  // The device's own name for the error bits or fault code its health
+  // reading carries (a drive's "driver overtemperature"); "" for none.
+  virtual std::string error_words(std::size_t /*device*/, std::uint32_t /*bits*/) const {
+    return {};
+  }
 
   // Per device status, indexed like config().actuators; written by this bus
   // alone (see DeviceStatus).

@@ -161,6 +161,11 @@ class CycleState {
   // period (late),
   // and whether it went stale past its timeout (faulted).
   std::span<const std::uint64_t> imu_late_cycles() const { return imu_late_; }
+  // Per IMU: new readings taken, and reports due that never came (gaps
+  // between readings, and the silence since the last one), one per report
+  // period of the part.
+  std::uint64_t imu_readings(std::size_t i) const { return imu_track_[i].readings; }
+  std::uint64_t imu_missing(std::size_t i, double rate_hz) const;
   std::span<const std::uint8_t> imu_faulted() const { return imu_faulted_; }
   // The trunk's largest |roll| or |pitch| seen (rad; 0 without an IMU).
   double max_tilt() const { return max_tilt_; }
@@ -214,6 +219,13 @@ class CycleState {
   // Sensors: per IMU, late cycles and the fault record; the trunk's reading
   // handed to the motion, and the tilt watch.
   std::vector<std::uint64_t> imu_late_;
+  struct ImuTrack {
+    double last = -1.0;  // the newest reading's time (s), -1 before the first
+    std::uint64_t readings = 0;
+    std::uint64_t missing = 0;  // in gaps between readings
+  };
+  std::vector<ImuTrack> imu_track_;
+  double imu_now_ = 0.0;  // the latest cycle's time
   std::vector<std::uint8_t> imu_faulted_;
   double imu_start_ = 0.0;
   ImuReading trunk_;

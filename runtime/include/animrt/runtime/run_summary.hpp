@@ -40,6 +40,17 @@ struct BusReport {
   std::uint64_t late_cycles = 0;
 };
 
+// An IMU over the run: the readings the cycle took, the cycles that went
+// on with an older one than due (late), the reports that never came
+// (missing), and whether its silence faulted it.
+struct ImuReport {
+  std::string name;
+  std::uint64_t readings = 0;
+  std::uint64_t late_cycles = 0;
+  std::uint64_t missing_reports = 0;
+  bool faulted = false;
+};
+
 // What the physics behind simulated servos saw (`animrt run --physics`).
 struct PhysicsReport {
   std::string model;
@@ -79,6 +90,7 @@ struct RunSummary {
   std::vector<BusReport> buses;
   std::vector<JointReport> joints;
   std::vector<DeviceReport> devices;
+  std::vector<ImuReport> imus;
   bool sched_fifo = false;
   int sched_priority = 0;
   std::string sched_note;

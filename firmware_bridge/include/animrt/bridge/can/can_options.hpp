@@ -6,6 +6,7 @@
 #include <linux/can.h>
 
 #include <any>
+#include <cstdint>
 #include <string>
 
 #include "animrt/bridge/bus_config.hpp"
@@ -64,6 +65,32 @@ struct Cia402BusOptions {
   // Error Code (603Fh) mapped into TPDO1 after statusword and position
   // actual (8 bytes, the same frame each SYNC): bus key `health`.
   bool health = false;
+};
+
+// A drive's temperature in a manufacturer object (CiA 402 defines none):
+// actuator key `temperature: {object: "0x2022:0x01", type: int16, scale: 0.1}`,
+// mapped at configure into TPDO2 after the current and DC link voltage
+// (so 8 or 16 bits: the PDO holds 64).
+struct Cia402Temperature {
+  std::uint16_t index = 0;
+  std::uint8_t subindex = 0;
+  int bits = 16;
+  bool is_signed = true;
+  double scale = 1.0;  // deg C per count
+
+  double decode(std::uint32_t raw) const {
+    const std::uint32_t mask = bits == 8 ? 0xFFu : 0xFFFFu;
+    raw &= mask;
+    const double v = is_signed && (raw & (mask ^ (mask >> 1)))
+                         ? static_cast<double>(raw) - static_cast<double>(mask) - 1.0
+                         : static_cast<double>(raw);
+    return v * scale;
+  }
+};
+
+struct Cia402JointOptions {
+  bool has_temperature = false;
+  Cia402Temperature temperature;
 };
 
 // Options of a bus / binding of the given type; a default when absent.

@@ -160,7 +160,8 @@ class Cia402Bus final : public ActuatorBus {
   std::vector<int> slot_of_node_;          // node id -> device index
   std::vector<double> min_rad_, max_rad_;  // goals that stay inside int32 counts
   std::vector<double> rated_current_a_;    // 6075h, for 6078h (health)
-  bool running_ = false;                   // between activate() and deactivate(): OE expected
+  std::vector<Cia402JointOptions> joint_options_;  // a temperature object, if named
+  bool running_ = false;  // between activate() and deactivate(): OE expected
   bool fresh_ = false;
   bool producing_ = false;  // host heartbeats between arm_device_guard() and deactivate()
   Nanos host_heartbeat_ns_ = 0;

@@ -32,6 +32,12 @@ struct ImuConfig {
     double rate_rad_s = 0.0;
     double to_rad = 0.0;
   } sim_push;
+  // Simulated part only: it sends nothing from this time on (s; < 0: never),
+  // as a part whose cable came loose.
+  double sim_silent_at_s = -1.0;
+  // Simulated part on the physics only: how old the torso it reports is
+  // (s; at least one report period, so a lockstep run is deterministic).
+  double sim_latency_s = 0.0;  // 0: one report period
   Location where;
 };
 

@@ -104,6 +104,9 @@ class ModbusBus final : public ActuatorBus {
   // Marks the device faulted; its enable goes off in the next read().
   void switch_off(std::size_t device) override;
   bool reads_health() const override { return options_.health != ModbusBusOptions::Health::off; }
+  std::string error_words(std::size_t device, std::uint32_t code) const override {
+    return joints_[device].map->health.code_name(code);
+  }
 
   std::uint64_t reconnects() const { return reconnects_; }
   bool connected() const { return connected_; }

@@ -69,12 +69,21 @@ struct Watchdog {
 // bus with `health` on: each register optional; current (A), temperature
 // (deg C) and supply voltage (V) scaled like goal and present, the fault
 // code unscaled (0: no fault; any other value is the drive's own fault).
+struct FaultCode {
+  std::uint16_t code = 0;
+  std::string name;
+};
+
 struct HealthRegisters {
   std::optional<Register> current;
   std::optional<Register> temperature;
   std::optional<Register> voltage;
   std::optional<Register> fault_code;
+  std::vector<FaultCode> codes;  // fault_code.codes: names of the drive's codes
   Location where;
+
+  // The name the map gives `code`, or "" when it names none.
+  std::string code_name(std::uint32_t code) const;
 
   bool any() const { return current || temperature || voltage || fault_code; }
   // Those given, for planning reads and overlap checks.

@@ -112,6 +112,9 @@ class Cia402DriveNode final : public CanNode {
   Entry* find(std::uint16_t index, std::uint8_t sub);
   bool index_exists(std::uint16_t index) const;
   std::uint32_t read_value(const Entry& e, Nanos now) const;
+  // A manufacturer object: the temperature object the config names, served
+  // from the health model; any other keeps its stored value.
+  std::uint32_t manufacturer_value(const Entry& e) const;
   // Checks and performs a write (SDO or PDO); returns an abort code or 0.
   std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size,
                       bool from_pdo, Nanos now, FrameList& out);

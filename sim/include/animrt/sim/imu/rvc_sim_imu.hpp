@@ -5,6 +5,7 @@
 // The attitude comes from a provider: the physics' torso, a level figure,
 // or the robot file's scripted push (ImuConfig::sim_push). The part's
 // mounting is applied, so the host must take it out as with a real part.
+// From ImuConfig::sim_silent_at_s on it sends nothing (a loose cable).
 
 #include <array>
 #include <atomic>

@@ -11,8 +11,11 @@
 // supply from the servos' health model (sim.health, sim.inject: a thermal
 // model driven by the current, a supply that sags with it, a joint that can
 // be blocked); an injected hardware_error is the fault code, and a drive
-// with a fault code stops its motors, as with status fault bits. Any standard
-// Modbus master can talk to it (mbpoll, pymodbus).
+// with a fault code stops its motors, as with status fault bits. Its firmware
+// trips by itself above sim.health.trip_c: fault code 0x4310 and the output
+// off (the motors coast where they are), latched until a fault reset (the
+// enable written off, then on) once every motor is 5 deg C below the trip.
+// Any standard Modbus master can talk to it (mbpoll, pymodbus).
 //
 // TCP: every connection has its own receive buffer, so a client that sends
 // half a request stalls nobody else; it is closed after 1 s incomplete.
