@@ -32,19 +32,24 @@ GroupMetrics run_flock_scene(const std::string& name, std::uint64_t seed) {
   return g;
 }
 
-// The goal: the Unity-sample flock walks at least 60 % of its leader's
-// speed and its centre stays within 3 m of the leader. Not met: it stood
-// (0.0004 m/s against the leader's 0.11, 6.6 m behind) when each step
-// began from the figures' walked velocity; with the boids' own velocity it
-// walks 0.013-0.024 m/s (seeds 1-5), 4.3-6.7 m behind. The figures close
-// on the leader's start in the first 20 s and lock there nose to a
-// neighbour: a figure that turns only while it walks cannot turn out of
-// such a knot. Run with --gtest_also_run_disabled_tests.
-TEST(HerdFlockFollow, DISABLED_GoalUnityFlockKeepsUpWithItsLeader) {
+// The Unity-sample flock stood (0.0004 m/s against its leader's 0.11, 6.6 m
+// behind): each step began from the figures' walked velocity, and figures
+// knotted nose to a neighbour could not turn out of the knot.
+TEST(HerdFlockFollow, UnityFlockWalksWithItsLeader) {
   const GroupMetrics g = run_flock_scene("unity.yaml", 1);
   EXPECT_FALSE(g.standing);
   EXPECT_GE(g.speed_mean_mps, 0.6 * g.leader_speed_mean_mps);
-  EXPECT_LT(g.leader_distance_mean_m, 3.0);
+}
+
+// The goal: as above, and the flock's centre within 3 m of its leader. Not
+// met: 3.09 m (seed 1; 2.1-3.4 m over seeds 1-5). Run with
+// --gtest_also_run_disabled_tests.
+TEST(HerdFlockFollow, DISABLED_GoalUnityFlockKeepsUpWithItsLeader) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const GroupMetrics g = run_flock_scene("unity.yaml", seed);
+    EXPECT_GE(g.speed_mean_mps, 0.6 * g.leader_speed_mean_mps) << "seed " << seed;
+    EXPECT_LT(g.leader_distance_mean_m, 3.0) << "seed " << seed;
+  }
 }
 
 }  // namespace
