@@ -483,6 +483,10 @@ void validate_steering(const GaitFile& gait) {
     if (!mapped) fail("yaw_joints", "yaw joint '" + elide(y) + "' is not one of the gait's joints");
   }
   if (!in(s.swing_offset, -5.0, 0.9)) fail("swing_offset", "expected a number from -5 to 0.9");
+  if (!in(s.spot_swing_offset, -5.0, 0.9))
+    fail("spot_swing_offset", "expected a number from -5 to 0.9");
+  if (s.spot_track_width_m != 0.0 && !in(s.spot_track_width_m, kMinTrackWidthM, kMaxTrackWidthM))
+    fail("spot_track_width_m", range(kMinTrackWidthM, kMaxTrackWidthM));
   for (const auto& c : s.lift_curves) {
     bool defined = false;
     for (const auto& gc : gait.curves) defined = defined || gc.name == c;
@@ -731,7 +735,7 @@ std::string format_gait_file(const GaitFile& gait) {
     if (s.swing_offset != 0.0) out += "  swing_offset: " + shortest_exact(s.swing_offset) + "\n";
     if (s.fixed_cadence) out += "  fixed_cadence: true\n";
     if (s.turn_on_the_spot) out += "  turn_on_the_spot: true\n";
-    if (s.spot_track_width_m != s.track_width_m)
+    if (s.spot_track_width_m > 0.0 && s.spot_track_width_m != s.track_width_m)
       out += "  spot_track_width_m: " + shortest_exact(s.spot_track_width_m) + "\n";
     if (s.spot_swing_offset != s.swing_offset)
       out += "  spot_swing_offset: " + shortest_exact(s.spot_swing_offset) + "\n";
