@@ -45,7 +45,9 @@ WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* 
   if (steering.turn_on_the_spot && !all.empty() && all.front().speed == 0.0) {
     // Turns on the spot, from standing (0, 0) outward on either side until
     // the first unusable one.
-    std::vector<CalibrationPoint> spot = all.front().points;
+    std::vector<CalibrationPoint> spot;  // standing itself (turn 0) is no turn
+    for (const CalibrationPoint& p : all.front().points)
+      if (p.commanded.turn_rad_s != 0.0) spot.push_back(p);
     std::sort(spot.begin(), spot.end(), [](const auto& a, const auto& b) {
       return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
     });

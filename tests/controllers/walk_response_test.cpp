@@ -250,6 +250,7 @@ TEST(WalkResponse, TurnsOnTheSpotOnlyWhereTheSpeedZeroRowsAreUsable) {
   cal.points.push_back(point(0.0, -0.1, -0.005, -0.095));
   cal.points.push_back(point(0.0, 0.1, 0.004, 0.105));
   cal.points.push_back(point(0.0, 0.2, 0.006, 0.19));
+  cal.points.push_back(point(0.0, 0.0, 0.0, 0.0));  // standing: no turn, ignored
   // Without turn_on_the_spot the rows are ignored: speed 0 stands.
   EXPECT_EQ(WalkResponse(s, &cal).spot_turn(), 0.0);
   EXPECT_EQ(WalkResponse(s, &cal).achieved({0.0, 0.1}), (MotionCommand{0.0, 0.0}));
