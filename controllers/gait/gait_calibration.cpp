@@ -67,8 +67,11 @@ bool calibration_usable(const CalibrationPoint& p, double tolerance) {
   const double w = p.commanded.turn_rad_s;
   const double turn_allowed =
       std::max(tolerance * std::abs(w), deg_to_rad(kCalibrationTurnFloorDps));
-  return !p.fell && v > 0.0 && std::isfinite(p.achieved.speed_m_s) &&
-         std::abs(p.achieved.speed_m_s - v) <= tolerance * v &&
+  // A turn on the spot must stay on the spot, and turn the way it was told.
+  const bool on_the_spot = v == 0.0 && w != 0.0;
+  const double speed_allowed = on_the_spot ? kCalibrationSpotDriftMps : tolerance * v;
+  return !p.fell && (v > 0.0 || on_the_spot) && std::isfinite(p.achieved.speed_m_s) &&
+         std::abs(p.achieved.speed_m_s - v) <= speed_allowed &&
          std::isfinite(p.achieved.turn_rad_s) &&
          std::abs(p.achieved.turn_rad_s - w) <= turn_allowed;
 }

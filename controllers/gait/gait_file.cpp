@@ -324,7 +324,8 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
   if (!node) return;
   node->allow_only({"min_froude", "max_froude", "max_turn_dps", "max_acceleration_m_s2",
                     "hip_height_m", "track_width_m", "sides", "yaw_joints", "lift_curves",
-                    "swing_offset", "fixed_cadence"});
+                    "swing_offset", "fixed_cadence", "turn_on_the_spot", "spot_track_width_m",
+                    "spot_swing_offset"});
   GaitSteering s;
   s.where = node->location();
   const YamlNode min_fr = node->at("min_froude");
@@ -378,6 +379,13 @@ void read_steering(const YamlNode& root, GaitFile& gait) {
   }
   if (const auto off = node->find("swing_offset")) s.swing_offset = off->as_double_in(-5.0, 0.9);
   if (const auto fixed = node->find("fixed_cadence")) s.fixed_cadence = fixed->as_bool();
+  if (const auto spot = node->find("turn_on_the_spot")) s.turn_on_the_spot = spot->as_bool();
+  s.spot_swing_offset = s.swing_offset;
+  if (const auto off = node->find("spot_swing_offset"))
+    s.spot_swing_offset = off->as_double_in(-5.0, 0.9);
+  s.spot_track_width_m = s.track_width_m;
+  if (const auto w = node->find("spot_track_width_m"))
+    s.spot_track_width_m = positive_in(*w, kMinTrackWidthM, kMaxTrackWidthM);
   if (const auto lift = node->find("lift_curves")) {
     s.lift_curves = read_names(*lift);
     const auto items = lift->items();
@@ -475,6 +483,10 @@ void validate_steering(const GaitFile& gait) {
     if (!mapped) fail("yaw_joints", "yaw joint '" + elide(y) + "' is not one of the gait's joints");
   }
   if (!in(s.swing_offset, -5.0, 0.9)) fail("swing_offset", "expected a number from -5 to 0.9");
+  if (!in(s.spot_swing_offset, -5.0, 0.9))
+    fail("spot_swing_offset", "expected a number from -5 to 0.9");
+  if (s.spot_track_width_m != 0.0 && !in(s.spot_track_width_m, kMinTrackWidthM, kMaxTrackWidthM))
+    fail("spot_track_width_m", range(kMinTrackWidthM, kMaxTrackWidthM));
   for (const auto& c : s.lift_curves) {
     bool defined = false;
     for (const auto& gc : gait.curves) defined = defined || gc.name == c;
@@ -550,7 +562,9 @@ bool operator==(const GaitSteering& a, const GaitSteering& b) {
          a.max_acceleration_m_s2 == b.max_acceleration_m_s2 && a.hip_height_m == b.hip_height_m &&
          a.track_width_m == b.track_width_m && a.left == b.left && a.right == b.right &&
          a.yaw_joints == b.yaw_joints && a.lift_curves == b.lift_curves &&
-         a.swing_offset == b.swing_offset && a.fixed_cadence == b.fixed_cadence;
+         a.swing_offset == b.swing_offset && a.fixed_cadence == b.fixed_cadence &&
+         a.turn_on_the_spot == b.turn_on_the_spot && a.spot_track_width_m == b.spot_track_width_m &&
+         a.spot_swing_offset == b.spot_swing_offset;
 }
 
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
@@ -720,6 +734,11 @@ std::string format_gait_file(const GaitFile& gait) {
     if (!s.lift_curves.empty()) out += "  lift_curves: " + names_text(s.lift_curves) + "\n";
     if (s.swing_offset != 0.0) out += "  swing_offset: " + shortest_exact(s.swing_offset) + "\n";
     if (s.fixed_cadence) out += "  fixed_cadence: true\n";
+    if (s.turn_on_the_spot) out += "  turn_on_the_spot: true\n";
+    if (s.spot_track_width_m > 0.0 && s.spot_track_width_m != s.track_width_m)
+      out += "  spot_track_width_m: " + shortest_exact(s.spot_track_width_m) + "\n";
+    if (s.spot_swing_offset != s.swing_offset)
+      out += "  spot_swing_offset: " + shortest_exact(s.spot_swing_offset) + "\n";
   }
   if (gait.balance) {
     out += "balance: {tilt_m: " + shortest_exact(gait.balance->tilt_m) +

@@ -62,20 +62,23 @@ void SteeredGaitSource::steer(const MotionCommand& command) {
   target_speed_ = (std::isfinite(v) && v >= min_speed_) ? std::min(v, max_speed_) : 0.0;
   const double w = std::isfinite(command.turn_rad_s) ? command.turn_rad_s : 0.0;
   target_turn_ = std::clamp(w, -steering_.max_turn_rad_s, steering_.max_turn_rad_s);
+  // Under the slowest walk a turn is a turn on the spot, where the gait can.
+  target_spot_ = target_speed_ == 0.0 && target_turn_ != 0.0 && steering_.turn_on_the_spot;
 }
 
 MotionCommand SteeredGaitSource::current() const {
   if (!started_) return {0.0, 0.0};
-  return {speed_ * smoothstep(blend_), turn_};
+  return {speed_ * smoothstep(blend_) * (1.0 - smoothstep(spot_)), turn_};
 }
 
 void SteeredGaitSource::reset(double t) const {
-  const bool walking = target_speed_ > 0.0;
+  const bool walking = target_speed_ > 0.0 || target_spot_;
   started_ = true;
   phase_ = 0.0;
-  speed_ = walking ? target_speed_ : min_speed_;
+  speed_ = target_speed_ > 0.0 ? target_speed_ : min_speed_;
   turn_ = walking ? target_turn_ : 0.0;
   blend_ = walking ? 1.0 : 0.0;
+  spot_ = target_spot_ ? 1.0 : 0.0;
   // As if it had walked at this command since t = 0 (the unsteered gait's
   // phase at a constant speed).
   phase_ = frequency_at(speed_) * blend_ * t;
@@ -89,10 +92,12 @@ void SteeredGaitSource::advance(double t) const {
   }
   const double dt = t - last_t_;
   last_t_ = t;
-  const bool walking = target_speed_ > 0.0;
-  speed_ = step_toward(speed_, walking ? target_speed_ : min_speed_,
+  const bool walking = target_speed_ > 0.0 || target_spot_;
+  speed_ = step_toward(speed_, target_speed_ > 0.0 ? target_speed_ : min_speed_,
                        steering_.max_acceleration_m_s2 * dt);
   blend_ = std::clamp(blend_ + (walking ? dt : -dt) / blend_time_s_, 0.0, 1.0);
+  // Into and out of the turn on the spot over a stride, as walk and stand.
+  spot_ = std::clamp(spot_ + (target_spot_ ? dt : -dt) / blend_time_s_, 0.0, 1.0);
   turn_ = step_toward(turn_, walking ? target_turn_ : 0.0,
                       steering_.max_turn_rad_s * dt / blend_time_s_);
   phase_ += frequency_at(speed_) * smoothstep(blend_) * dt;
@@ -101,17 +106,29 @@ void SteeredGaitSource::advance(double t) const {
 void SteeredGaitSource::sample(double t, std::span<double> targets) const {
   advance(t);
   const double s = smoothstep(blend_);
+  const double spot = smoothstep(spot_);
   const double a0 = steering_.swing_offset;
   const double amplitude = s * (a0 + (1.0 - a0) * length_ratio_at(speed_));
   const double half_track = 0.5 * steering_.track_width_m;
   // Positive turn is to the left: the left side is inside.
-  const double left = std::max(0.0, (speed_ - turn_ * half_track) / speed_);
-  const double right = std::max(0.0, (speed_ + turn_ * half_track) / speed_);
+  double left = amplitude * std::max(0.0, (speed_ - turn_ * half_track) / speed_);
+  double right = amplitude * std::max(0.0, (speed_ + turn_ * half_track) / speed_);
+  // On the spot each side swings as for walking -+turn x half the spot
+  // track (the inner side backward), about the swing that walks nowhere.
+  const double spot_half_track =
+      0.5 *
+      (steering_.spot_track_width_m > 0.0 ? steering_.spot_track_width_m : steering_.track_width_m);
+  const double b0 = steering_.spot_swing_offset;
+  const double per_speed = (1.0 - a0) * length_ratio_at(min_speed_) / min_speed_;
+  left += spot * (s * (b0 - per_speed * turn_ * spot_half_track) - left);
+  right += spot * (s * (b0 + per_speed * turn_ * spot_half_track) - right);
   // A yaw angle d turns the walk at about v tan(d) / wheelbase: the same turn
-  // rate at a faster walk needs a smaller angle.
-  const double yaw = steering_.max_turn_rad_s > 0.0
-                         ? s * (turn_ / steering_.max_turn_rad_s) * (min_speed_ / speed_)
-                         : 0.0;
+  // rate at a faster walk needs a smaller angle. On the spot the yaw joints
+  // rest: steered legs that step in place drift the figure.
+  const double yaw =
+      steering_.max_turn_rad_s > 0.0
+          ? s * (1.0 - spot) * (turn_ / steering_.max_turn_rad_s) * (min_speed_ / speed_)
+          : 0.0;
   for (const Drive& d : drives_) {
     if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
     const auto c = static_cast<std::size_t>(d.curve);
@@ -121,8 +138,8 @@ void SteeredGaitSource::sample(double t, std::span<double> targets) const {
       deg = d.gain * yaw * value + d.offset_deg;
     } else {
       double scale = d.lift ? s : amplitude;
-      if (!d.lift && d.side == kLeft) scale *= left;
-      if (!d.lift && d.side == kRight) scale *= right;
+      if (!d.lift && d.side == kLeft) scale = left;
+      if (!d.lift && d.side == kRight) scale = right;
       deg = d.gain * (means_[c] + scale * (value - means_[c])) + d.offset_deg;
     }
     targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);

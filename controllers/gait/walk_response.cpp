@@ -42,6 +42,26 @@ WalkResponse::WalkResponse(const GaitSteering& steering, const GaitCalibration* 
   }
   std::sort(all.begin(), all.end(),
             [](const Level& a, const Level& b) { return a.speed < b.speed; });
+  if (steering.turn_on_the_spot && !all.empty() && all.front().speed == 0.0) {
+    // Turns on the spot, from standing (0, 0) outward on either side until
+    // the first unusable one.
+    std::vector<CalibrationPoint> spot;  // standing itself (turn 0) is no turn
+    for (const CalibrationPoint& p : all.front().points)
+      if (p.commanded.turn_rad_s != 0.0) spot.push_back(p);
+    std::sort(spot.begin(), spot.end(), [](const auto& a, const auto& b) {
+      return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
+    });
+    const auto zero = std::partition_point(
+        spot.begin(), spot.end(), [](const auto& p) { return p.commanded.turn_rad_s < 0.0; });
+    auto lo = zero, hi = zero;
+    while (lo != spot.begin() && (lo - 1)->usable) --lo;
+    while (hi != spot.end() && hi->usable && hi->commanded.turn_rad_s > 0.0) ++hi;
+    CalibrationPoint stand;
+    stand.usable = true;
+    spot_.points.assign(lo, zero);
+    spot_.points.push_back(stand);
+    spot_.points.insert(spot_.points.end(), zero, hi);
+  }
   for (Level& l : all) {
     std::sort(l.points.begin(), l.points.end(), [](const auto& a, const auto& b) {
       return a.commanded.turn_rad_s < b.commanded.turn_rad_s;
@@ -106,6 +126,19 @@ double WalkResponse::max_speed() const {
 
 double WalkResponse::max_acceleration() const { return steering_.max_acceleration_m_s2; }
 
+double WalkResponse::spot_turn() const {
+  if (!steering_.turn_on_the_spot) return 0.0;
+  if (!calibrated_) return steering_.max_turn_rad_s;
+  return spot_.points.empty() ? 0.0 : level_max_turn(spot_);
+}
+
+MotionCommand WalkResponse::spot_achieved(double turn) const {
+  const double limit = spot_turn();
+  const double w = std::clamp(std::isfinite(turn) ? turn : 0.0, -limit, limit);
+  if (!calibrated_ || w == 0.0) return {0.0, w};
+  return level_achieved(spot_, w);
+}
+
 double WalkResponse::level_max_turn(const Level& level) const {
   // Either way: the smaller of the fastest usable left and right turns.
   double left = 0.0, right = 0.0;
@@ -151,6 +184,8 @@ MotionCommand WalkResponse::level_achieved(const Level& level, double turn) cons
 }
 
 MotionCommand WalkResponse::achieved(const MotionCommand& commanded) const {
+  if (commanded.speed_m_s == 0.0 && commanded.turn_rad_s != 0.0 && spot_turn() > 0.0)
+    return spot_achieved(commanded.turn_rad_s);
   const MotionCommand c = clamp(commanded);
   if (c.speed_m_s <= 0.0 || !calibrated_) return c;
   const double v = c.speed_m_s;

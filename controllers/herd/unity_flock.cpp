@@ -37,6 +37,19 @@ UnityFlock::UnityFlock(std::vector<int> members, const UnityFlockParams& params,
   grid_.reserve(std::max(herd_capacity, herd_size_needed(members_)));
   push_.assign(members_.size(), Vec2{});
   next_renewal_.assign(members_.size(), -std::numeric_limits<double>::infinity());
+  velocity_.assign(members_.size(), Vec2{});
+  slot_of_.assign(herd_size_needed(members_), -1);
+  for (std::size_t k = 0; k < members_.size(); ++k)
+    slot_of_[static_cast<std::size_t>(members_[k])] = static_cast<int>(k);
+}
+
+Vec2 UnityFlock::boid_direction(int j, const Agent& b) const {
+  const auto u = static_cast<std::size_t>(j);
+  if (started_ && u < slot_of_.size() && slot_of_[u] >= 0) {
+    const Vec2 v = velocity_[static_cast<std::size_t>(slot_of_[u])];
+    if (norm2(v) > 0.0) return normalized(v);
+  }
+  return motion_direction(b);
 }
 
 void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
@@ -58,8 +71,11 @@ void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
     const Agent& a = agents[static_cast<std::size_t>(i)];
     const Vec2 pos = a.position;
 
-    Vec2 v = a.velocity();
-    if (norm(v) < p.min_speed) v = motion_direction(a) * p.min_speed;
+    // The boid's own velocity, as the text's boid keeps it: a figure that
+    // stands (blocked, or asked for less than its slowest walk) does not
+    // reset it, so the flock's pull builds up until the figure walks again.
+    Vec2 v = started_ ? velocity_[k] : a.velocity();
+    if (norm(v) < p.min_speed) v = boid_direction(i, a) * p.min_speed;
 
     // Separation from every agent, alignment with the own group's, inside
     // follow_radius.
@@ -71,7 +87,7 @@ void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
       if (d < p.avoidance_radius && d > 0.0)
         avg_vel += (pos - b.position) * ((1.0 - d / p.avoidance_radius) * p.avoidance_force / d);
       if (b.group == a.group)
-        avg_vel += motion_direction(b) * (d / p.follow_radius * p.follow_velocity);
+        avg_vel += boid_direction(j, b) * (d / p.follow_radius * p.follow_velocity);
     };
     if (use_grid) {
       grid_.for_each_near(i, p.follow_radius, neighbour);
@@ -106,6 +122,8 @@ void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
     }
     desired[static_cast<std::size_t>(i)] = out;
   }
+  for (std::size_t k = 0; k < n; ++k) velocity_[k] = desired[static_cast<std::size_t>(members_[k])];
+  started_ = true;
   leader_.step(dt);
 }
 

@@ -66,6 +66,32 @@ void explain_turns(const GaitCalibration& cal, const GaitSteering& st, int turns
   std::printf("\n");
 }
 
+// One point of the table: the gait walked from standing at `command` on the
+// model, measured after `ramp_s` plus the warm-up strides. Prints its row.
+CalibrationPoint measure_point(const sim::MujocoModel& model, const GaitFile& gait,
+                               const std::vector<JointSpec>& specs, const MotionCommand& command,
+                               double stride_s, double ramp_s, std::uint64_t seed,
+                               double tolerance) {
+  sim::WalkTrial trial;
+  trial.settle_s = kSettleS;
+  trial.warmup_s = ramp_s + kWarmupStrides * stride_s;
+  trial.measure_s = kMeasureStrides * stride_s;
+  trial.seed = seed;
+  auto source = make_gait_source(gait, specs);
+  const sim::WalkTrace trace = sim::walk_command(model, *source, command, trial);
+  CalibrationPoint p;
+  p.commanded = command;
+  p.achieved = trace.achieved;
+  p.fell = trace.fell;
+  p.usable = calibration_usable(p, tolerance);
+  const double v = command.speed_m_s, w = command.turn_rad_s;
+  std::printf(
+      "%10.4f %9.2f | %10.4f %9.2f %7.1f %9.2f  %s\n", v, rad_to_deg(w), p.achieved.speed_m_s,
+      rad_to_deg(p.achieved.turn_rad_s), v > 0.0 ? 100.0 * (p.achieved.speed_m_s - v) / v : 0.0,
+      rad_to_deg(p.achieved.turn_rad_s - w), p.fell ? "FELL" : (p.usable ? "usable" : "off"));
+  return p;
+}
+
 int run_calibrate(const CalibrateArgs& a) {
   std::string gait_path = a.gait;
   if (gait_path.empty()) {
@@ -102,26 +128,17 @@ int run_calibrate(const CalibrateArgs& a) {
     const double stride_s = 1.0 / (st.fixed_cadence ? gait.stride_frequency()
                                                     : froude_stride_frequency(fr, st.hip_height_m));
     const double ramp_s = v / st.max_acceleration_m_s2 + stride_s;
+    // A gait that turns on the spot gets the speed-0 rows too, once, at
+    // the slowest walk's cadence.
+    const bool spot_rows = i == 0 && st.turn_on_the_spot;
     for (int k = -a.turns; k <= a.turns; ++k) {
       const double sign = k < 0 ? -1.0 : 1.0;
       const double w = a.turns == 0 ? 0.0 : sign * st.max_turn_rad_s * std::abs(k) / a.turns;
-      sim::WalkTrial trial;
-      trial.settle_s = kSettleS;
-      trial.warmup_s = ramp_s + kWarmupStrides * stride_s;
-      trial.measure_s = kMeasureStrides * stride_s;
-      trial.seed = a.seed;
-      auto source = make_gait_source(gait, specs);
-      const sim::WalkTrace trace = sim::walk_command(model, *source, {v, w}, trial);
-      CalibrationPoint p;
-      p.commanded = {v, w};
-      p.achieved = trace.achieved;
-      p.fell = trace.fell;
-      p.usable = calibration_usable(p, cal.tolerance);
-      cal.points.push_back(p);
-      std::printf("%10.4f %9.2f | %10.4f %9.2f %7.1f %9.2f  %s\n", v, rad_to_deg(w),
-                  p.achieved.speed_m_s, rad_to_deg(p.achieved.turn_rad_s),
-                  100.0 * (p.achieved.speed_m_s - v) / v, rad_to_deg(p.achieved.turn_rad_s - w),
-                  p.fell ? "FELL" : (p.usable ? "usable" : "off"));
+      if (spot_rows && k != 0)
+        cal.points.push_back(
+            measure_point(model, gait, specs, {0.0, w}, stride_s, stride_s, a.seed, cal.tolerance));
+      cal.points.push_back(
+          measure_point(model, gait, specs, {v, w}, stride_s, ramp_s, a.seed, cal.tolerance));
     }
   }
   // Standing first, then by speed and turn, so the table reads in order.

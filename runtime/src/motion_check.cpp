@@ -177,9 +177,12 @@ std::vector<SteeringStep> steering_check_plan(const GaitSteering& s) {
   // Long enough to reach any command from any other and walk two strides.
   const double stride_s = 1.0 / froude_stride_frequency(s.min_froude, s.hip_height_m);
   const double hold = 2.0 * stride_s + (hi / s.max_acceleration_m_s2) + stride_s;
-  const MotionCommand commands[] = {{hi, 0.0}, {hi, w},    {hi, -w},   {lo, 0.0}, {lo, w},
-                                    {lo, -w},  {0.0, 0.0}, {mid, 0.0}, {mid, w},  {hi, -w},
-                                    {lo, w},   {0.0, 0.0}, {hi, 0.0}};
+  std::vector<MotionCommand> commands = {{hi, 0.0}, {hi, w},    {hi, -w},   {lo, 0.0}, {lo, w},
+                                         {lo, -w},  {0.0, 0.0}, {mid, 0.0}, {mid, w},  {hi, -w},
+                                         {lo, w},   {0.0, 0.0}, {hi, 0.0}};
+  // Turns on the spot, both ways, and into and out of walking.
+  if (s.turn_on_the_spot)
+    commands.insert(commands.end(), {{0.0, w}, {lo, -w}, {0.0, -w}, {0.0, w}, {0.0, 0.0}});
   std::vector<SteeringStep> plan;
   double t = 0.0;
   for (const MotionCommand& c : commands) {

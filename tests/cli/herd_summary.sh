@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# animrt herd's summary reports only what it measured: the Unity scene's
-# flock, which stands while its leader walks, is reported as standing with
+# animrt herd's summary reports only what it measured: a Unity flock that
+# stands while its leader walks is reported as standing with
 # no order (text and JSON, with both speeds); a one-figure crowd that cannot
 # reach its goal in time has no pair distance, neighbour or time to goal.
 set -uo pipefail
@@ -10,7 +10,24 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-out=$("$animrt" herd "$root/configs/herd/unity.yaml" --summary-json "$tmp/u.json" --quiet 2>&1) ||
+# A flock whose boids feel no pull (every force 0) stands while its
+# leader walks.
+cat > "$tmp/standing.yaml" <<YAML
+bounds_m: [-20, -20, 20, 20]
+duration_s: 100
+figures:
+  pony: {gait: $root/configs/gaits/pony.yaml, radius_m: 0.25}
+groups:
+  - name: flock
+    kind: unity
+    figure: pony
+    count: 30
+    spawn_m: [-6, -6, 6, 6]
+    leader: {wander_m: [-12, -12, 12, 12], speed_mps: 0.11, reach_m: 1.0, max_turn_dps: 6}
+    params: {min_speed: 0.0, random_force: 0.0, to_origin_force: 0.0, gravity: 0.0,
+             avoidance_force: 0.0, follow_velocity: 0.0}
+YAML
+out=$("$animrt" herd "$tmp/standing.yaml" --summary-json "$tmp/u.json" --quiet 2>&1) ||
   fail "herd failed: $out"
 [[ $out == *"flock (unity, 30 figures): 0 collisions, standing, speed "*"(leader 0.1100 m/s)"* ]] ||
   fail "unity summary: $out"

@@ -102,6 +102,31 @@ TEST(GaitSteeringFile, RoundTripsThroughTheWriter) {
   EXPECT_FALSE(other == g);
 }
 
+TEST(GaitSteeringFile, TurnOnTheSpotAndItsTrackAndOffset) {
+  const GaitFile plain = parse_gait_file(steering(kGood + "  swing_offset: -0.4\n"), "g.yaml");
+  EXPECT_FALSE(plain.steering->turn_on_the_spot);
+  EXPECT_EQ(plain.steering->spot_track_width_m, plain.steering->track_width_m);
+  EXPECT_EQ(plain.steering->spot_swing_offset, -0.4);  // the walk's, unless given
+  const std::string extra =
+      "  turn_on_the_spot: true\n"    // 18
+      "  spot_track_width_m: 0.8\n"   // 19
+      "  spot_swing_offset: -0.2\n";  // 20
+  const GaitFile g = parse_gait_file(steering(kGood + extra), "g.yaml");
+  EXPECT_TRUE(g.steering->turn_on_the_spot);
+  EXPECT_EQ(g.steering->spot_track_width_m, 0.8);
+  EXPECT_EQ(g.steering->spot_swing_offset, -0.2);
+  EXPECT_EQ(parse_gait_file(format_gait_file(g), "back.yaml"), g);
+  GaitFile other = g;
+  other.steering->turn_on_the_spot = false;
+  EXPECT_FALSE(other == g);
+  const std::string flag = gait_file_error(steering(kGood + "  turn_on_the_spot: 3\n"));
+  EXPECT_NE(flag.find("g.yaml:18:21: steering.turn_on_the_spot"), std::string::npos) << flag;
+  const std::string track = gait_file_error(steering(kGood + "  spot_track_width_m: 0\n"));
+  EXPECT_NE(track.find("g.yaml:18:23: steering.spot_track_width_m"), std::string::npos) << track;
+  const std::string off = gait_file_error(steering(kGood + "  spot_swing_offset: 2\n"));
+  EXPECT_NE(off.find("g.yaml:18:22: steering.spot_swing_offset"), std::string::npos) << off;
+}
+
 TEST(GaitSteeringFile, LiftCurvesSwingOffsetAndFixedCadence) {
   const GaitFile plain = parse_gait_file(steering(kGood), "g.yaml");
   EXPECT_TRUE(plain.steering->lift_curves.empty());
@@ -132,6 +157,9 @@ TEST(GaitSteeringFile, LiftCurvesSwingOffsetAndFixedCadence) {
   const std::string cadence = gait_file_error(steering(kGood + "  fixed_cadence: 2\n"));
   EXPECT_NE(cadence.find("g.yaml:18:18: steering.fixed_cadence"), std::string::npos) << cadence;
   GaitFile bad = g;
+  bad.steering->spot_swing_offset = 1.0;
+  EXPECT_THROW(validate_gait(bad), InputError);
+  bad = g;
   bad.steering->lift_curves = {"nope"};
   EXPECT_THROW(validate_gait(bad), InputError);
   bad = g;

@@ -384,6 +384,42 @@ TEST(SteeredGait, SwingOffsetShiftsTheSwingForASpeed) {
   EXPECT_NEAR(s.hi[0] - s.lo[0], 2.0 * kSwingDeg * (-0.5 + 1.5 * v / native), 0.1);
 }
 
+// Speed 0 with a turn: standing, unless the gait turns on the spot; then
+// the legs step in place, the sides swinging against each other about the
+// spot swing offset as for -+turn x half the spot track, the yaw joints at
+// rest.
+TEST(SteeredGait, TurnOnTheSpotStepsInPlaceWithTheSidesAgainstEachOther) {
+  const std::string steering = "  fixed_cadence: true\n  swing_offset: -0.5\n  yaw_joints: [yaw]\n";
+  const std::string yaw = "\n  yaw: {curve: hip, limb: lf}";
+  ExtendedRig stands("", yaw, {"yaw"}, steering);
+  const double w = 0.3;
+  const auto still = stands.under({0.0, w});
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_LT(still.hi[j] - still.lo[j], 1e-9) << j;
+  ExtendedRig rig("", yaw, {"yaw"},
+                  steering +
+                      "  turn_on_the_spot: true\n  spot_track_width_m: 0.4\n"
+                      "  spot_swing_offset: -0.2\n");
+  const auto s = rig.under({0.0, w});
+  const double native = dynamic_cast<SteeredGaitSource&>(*rig.source).native_speed_m_s();
+  // Fixed cadence: (1 - swing_offset) x (v / native) for a side walking v.
+  const double differential = 1.5 * w * 0.2 / native;
+  const double left = -0.2 - differential, right = -0.2 + differential;
+  ASSERT_GT(right, 0.0);  // the outer side swings forward, the inner back
+  EXPECT_NEAR(s.hi[0] - s.lo[0], 2.0 * kSwingDeg * std::abs(left), 0.1);   // lf
+  EXPECT_NEAR(s.hi[2] - s.lo[2], 2.0 * kSwingDeg * std::abs(left), 0.1);   // lh
+  EXPECT_NEAR(s.hi[1] - s.lo[1], 2.0 * kSwingDeg * std::abs(right), 0.1);  // rf
+  EXPECT_NEAR(s.hi[3] - s.lo[3], 2.0 * kSwingDeg * std::abs(right), 0.1);  // rh
+  EXPECT_LT(s.hi[4] - s.lo[4], 1e-9);                                      // the yaw joint rests
+  const MotionCommand now = dynamic_cast<SteeredGaitSource&>(*rig.source).current();
+  EXPECT_EQ(now.speed_m_s, 0.0);
+  EXPECT_NEAR(now.turn_rad_s, w, 1e-12);
+  // Back to walking straight: the ordinary swing on both sides.
+  const double v = rig.st().max_speed_m_s();
+  const auto walk = rig.under({v, 0.0});
+  EXPECT_NEAR(walk.hi[0] - walk.lo[0], 2.0 * kSwingDeg * (-0.5 + 1.5 * v / native), 0.1);
+  EXPECT_NEAR(walk.hi[1] - walk.lo[1], walk.hi[0] - walk.lo[0], 1e-6);
+}
+
 TEST(SteeredGait, SteerAndSampleDoNotAllocate) {
   Rig rig;
   rig.source->sample(0.0, rig.targets);

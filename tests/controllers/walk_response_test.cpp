@@ -236,6 +236,40 @@ TEST(WalkResponse, NeverCommandsAnUnusableTurn) {
   EXPECT_GT(turning, 0);  // it does turn where it can
 }
 
+// Speed-0 rows of a gait that turns on the spot: usable when it stays on
+// the spot and turns as told; the herd turns only as fast as the usable
+// rows reach from standing on both sides.
+TEST(WalkResponse, TurnsOnTheSpotOnlyWhereTheSpeedZeroRowsAreUsable) {
+  EXPECT_TRUE(calibration_usable(point(0.0, 0.1, 0.005, 0.095), 0.15));
+  EXPECT_FALSE(calibration_usable(point(0.0, 0.1, 0.02, 0.1), 0.15));  // walks off
+  EXPECT_FALSE(calibration_usable(point(0.0, 0.1, 0.0, -0.1), 0.15));  // wrong way
+  EXPECT_FALSE(calibration_usable(point(0.0, 0.0, 0.0, 0.0), 0.15));   // standing is no turn
+  GaitSteering s = steering();
+  GaitCalibration cal = table();
+  cal.points.push_back(point(0.0, -0.2, 0.0, -0.1));  // turns half as fast: unusable
+  cal.points.push_back(point(0.0, -0.1, -0.005, -0.095));
+  cal.points.push_back(point(0.0, 0.1, 0.004, 0.105));
+  cal.points.push_back(point(0.0, 0.2, 0.006, 0.19));
+  cal.points.push_back(point(0.0, 0.0, 0.0, 0.0));  // standing: no turn, ignored
+  // Without turn_on_the_spot the rows are ignored: speed 0 stands.
+  EXPECT_EQ(WalkResponse(s, &cal).spot_turn(), 0.0);
+  EXPECT_EQ(WalkResponse(s, &cal).achieved({0.0, 0.1}), (MotionCommand{0.0, 0.0}));
+  s.turn_on_the_spot = true;
+  const WalkResponse r(s, &cal);
+  EXPECT_DOUBLE_EQ(r.spot_turn(), 0.1);  // 0.2 to the left, 0.1 to the right
+  const MotionCommand left = r.achieved({0.0, 0.1});
+  EXPECT_DOUBLE_EQ(left.turn_rad_s, 0.105);
+  EXPECT_DOUBLE_EQ(left.speed_m_s, 0.004);
+  EXPECT_NEAR(r.achieved({0.0, -0.05}).turn_rad_s, -0.0475, 1e-12);  // halfway from standing
+  EXPECT_DOUBLE_EQ(r.achieved({0.0, -0.3}).turn_rad_s, -0.095);      // within spot_turn()
+  // The walking table is unchanged by them.
+  EXPECT_EQ(r.min_speed(), 0.1);
+  EXPECT_EQ(r.achieved({0.1, 0.0}), (MotionCommand{0.1, 0.0}));
+  // Uncalibrated, it turns on the spot as told, within the fastest turn.
+  EXPECT_EQ(WalkResponse(s).spot_turn(), 0.4);
+  EXPECT_EQ(WalkResponse(s).achieved({0.0, -0.3}), (MotionCommand{0.0, -0.3}));
+}
+
 TEST(WalkResponse, LoadsTheGaitAndItsCalibration) {
   const std::string gait =
       "name: w\nstride_frequency_hz: 1\ncurves: {c: \"sin(2*PI*t)\"}\nlimbs: {l: 0, r: 0.5}\n"

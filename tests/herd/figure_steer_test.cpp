@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+#include <string>
+
 #include "animrt/controllers/gait/walk_response.hpp"
 #include "animrt/controllers/herd/figure.hpp"
 
@@ -72,6 +76,44 @@ TEST(FigureSteer, AFigureThatCannotTurnStandsRatherThanWalkAwayFromItsWay) {
   // A figure that turns walks on while it turns toward a way behind it.
   const Figure turning = calibrated_figure();
   EXPECT_GT(steer_figure(turning, a, Vec2{-0.15, 0.02}, 0.1).speed_m_s, 0.0);
+}
+
+// The calibrated pony nose to a wall 5 cm ahead of its front, its way
+// behind it: it turns round on the spot, no faster than its table's turn on
+// the spot achieves and in the time that turn takes, and never closes on
+// the wall. A figure that turns only while it walks walked into it.
+TEST(FigureSteer, AFigureFacingAWallTurnsRoundOnTheSpot) {
+  const Figure pony{
+      "pony", 0.25,
+      load_walk_response(std::string(ANIMRT_SOURCE_DIR) + "/configs/gaits/pony.yaml")};
+  const WalkResponse& walk = pony.walk;
+  ASSERT_GT(walk.spot_turn(), 0.0);
+  const double left = walk.achieved({0.0, walk.spot_turn()}).turn_rad_s;
+  const double right = -walk.achieved({0.0, -walk.spot_turn()}).turn_rad_s;
+  const double fastest = std::max(left, right), slowest = std::min(left, right);
+  ASSERT_GT(slowest, 0.0);
+  Agent a;
+  a.heading = 0.02;  // facing the wall at x = 0.3, a hair to the left
+  const Vec2 away{-0.1, 0.0};
+  const double dt = 0.1;
+  double t = 0.0, spot_s = 0.0, nearest_wall = 0.3;
+  while (std::cos(a.heading) > -0.95 && t < 120.0) {
+    const MotionCommand c = steer_figure(pony, a, away, dt);
+    walk_figure(pony, c, dt, a);
+    if (c.speed_m_s == 0.0) {
+      EXPECT_LE(std::abs(a.turn), fastest + 1e-9) << "t " << t;
+      spot_s += dt;
+    }
+    nearest_wall = std::min(nearest_wall, 0.3 - a.position.x);
+    t += dt;
+  }
+  // On the spot until its way is no longer behind it (heading pi/2), at
+  // its calibrated rate; then it walks off, turning the rest of the way.
+  const double angle = std::numbers::pi / 2 - 0.02;
+  EXPECT_LT(std::cos(a.heading), -0.95);
+  EXPECT_GE(spot_s, angle / fastest - dt);
+  EXPECT_LE(spot_s, angle / slowest + dt);
+  EXPECT_GE(nearest_wall, 0.3 - 1e-9) << "walked toward the wall";
 }
 
 }  // namespace

@@ -41,35 +41,33 @@ int arrivals(const HerdMetrics& m) {
 
 // Three of the eight stood for good, nose to the gap's corner with a
 // neighbour behind: a plan stalled to a step too short to walk was not seen
-// as stalled. Now one more arrives; the other two still stand there, as a
-// figure that cannot turn on the spot does (the goal below, not met).
-TEST(HerdNarrowGap, GateSeed4MoreArrive) {
+// as stalled (one more arrived once it was), and a figure that turns only
+// while it walks could not turn out of the corner. It turns on the spot now.
+TEST(HerdNarrowGap, GateSeed4AllArrive) {
   const HerdMetrics m = run_scene("gate.yaml", 4);
   EXPECT_EQ(m.collisions, 0);
-  EXPECT_GE(arrivals(m), 6);
+  EXPECT_EQ(arrivals(m), 8);
 }
 
-TEST(HerdNarrowGap, DISABLED_GoalGateSeed4AllArrive) {
-  EXPECT_EQ(arrivals(run_scene("gate.yaml", 4)), 8);
-}
-
-// The teams take turns at the gap: without that, none of the 24 arrives.
-TEST(HerdNarrowGap, CounterflowSeed2AllArrive) {
-  const HerdMetrics m = run_scene("counterflow.yaml", 2);
+// The teams take turns at the gap: without that, none of the 24 arrived
+// on any seed. Seed 4 still knotted six red figures at the mouth, each with
+// another ahead of it (2 of 24 arrived); turning on the spot, they leave.
+TEST(HerdNarrowGap, CounterflowSeed4KnotResolves) {
+  const HerdMetrics m = run_scene("counterflow.yaml", 4);
   EXPECT_EQ(m.collisions, 0);
   EXPECT_EQ(arrivals(m), 24);
   for (const GroupMetrics& g : m.groups) EXPECT_LT(g.time_ratio_max, 3.0) << g.name;
 }
 
-// The goal: every seed, everyone within 3x the straight-line time. Not met
-// (seeds 1, 3, 4, 5 leave 1-22 of 24 in knots at the mouth that a figure
-// unable to turn on the spot cannot leave); run with
-// --gtest_also_run_disabled_tests.
+// The goal: every seed, everyone within 3x the straight-line time. Met
+// since figures turn on the spot (worst 2.40, seed 4), but five 700 s runs
+// are too long for the suite; run with --gtest_also_run_disabled_tests.
 TEST(HerdNarrowGap, DISABLED_GoalCounterflowEverySeed) {
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     const HerdMetrics m = run_scene("counterflow.yaml", seed);
     EXPECT_EQ(m.collisions, 0);
     EXPECT_EQ(arrivals(m), 24) << "seed " << seed;
+    for (const GroupMetrics& g : m.groups) EXPECT_LT(g.time_ratio_max, 3.0) << g.name;
   }
 }
 

@@ -49,10 +49,12 @@ TEST(UnityFlock, SeparationPushesApartAcrossGroupsInsideTheRadius) {
   EXPECT_NEAR(d[0].x, -0.1, 1e-12);
   EXPECT_NEAR(d[0].y, -0.05, 1e-12);
   EXPECT_GT(d[1].x, 0.0);
-  // Beyond the avoidance radius nothing pushes.
+  // Beyond the avoidance radius nothing pushes (a new flock: this one's
+  // boids now have a velocity of their own).
   a[1].position = {1.5, 0};
   a[2].position = {0, -1.2};
-  f.steer(0, 0.1, a, d);
+  UnityFlock g({0, 1}, p, still_leader({0, 0}), 1);
+  g.steer(0, 0.1, a, d);
   EXPECT_EQ(d[0], Vec2{});
 }
 
@@ -71,7 +73,8 @@ TEST(UnityFlock, AlignmentFollowsOwnGroupNeighboursOnly) {
   // A standing neighbour aligns along its heading.
   a[1].speed = 0.0;
   a[1].heading = 0.0;
-  f.steer(0, 0.1, a, d);
+  UnityFlock f2({0, 1}, p, still_leader({0, 0}), 1);
+  f2.steer(0, 0.1, a, d);
   EXPECT_NEAR(d[0].x, 0.075, 1e-12);
   EXPECT_NEAR(d[0].y, 0.0, 1e-12);
   // Behaviour: walking figures with headings apart come to share one.
@@ -123,6 +126,25 @@ TEST(UnityFlock, OriginPushClosesOnTheLeader) {
   for (const Agent& x : a) EXPECT_LT(norm(x.position - Vec2{5, 3}), 1.0);
 }
 
+// The boid keeps its own velocity, as the text's does: while its figure
+// stands (its slowest walk is faster than one step's pull), the pull builds
+// up step by step until it asks for a walk. Started from the figure's
+// walked velocity each step, it asked for one step's pull forever.
+TEST(UnityFlock, AStandingFiguresBoidBuildsUpItsVelocity) {
+  UnityFlockParams p = no_rules();
+  p.to_origin_force = 0.05;
+  p.turn_speed = 0.6;
+  std::vector<Agent> a{agent({0, 0}, 0.0), agent({0, 5}, 0.0)};
+  std::vector<Vec2> d(2);
+  UnityFlock f({0, 1}, p, still_leader({2, 0}), 1);
+  f.steer(0, 0.1, a, d);
+  EXPECT_NEAR(d[0].x, 0.1 * 0.05 * 2.0, 1e-12);              // one step's pull from standing
+  for (int s = 1; s < 50; ++s) f.steer(s * 0.1, 0.1, a, d);  // the figures stand
+  // v' = F - v: after 5 s, (1 - 0.9^50) of F = 0.05 * 2 m/s.
+  EXPECT_NEAR(d[0].x, 0.1 * (1.0 - std::pow(0.9, 50)), 1e-9);
+  EXPECT_GT(norm(d[0]), 0.086);  // faster than the pony's slowest walk
+}
+
 TEST(UnityFlock, MinSpeedAndTurnLimitHold) {
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> u(-5, 5);
@@ -133,15 +155,17 @@ TEST(UnityFlock, MinSpeedAndTurnLimitHold) {
   for (int i = 0; i < 40; ++i) a.push_back(agent({u(rng), u(rng)}, u(rng), i % 3 ? 0.1 : 0.0));
   std::vector<Vec2> d(a.size());
   UnityFlock f(iota(40), p, still_leader({0, 0}), 1);
+  std::vector<Vec2> last(a.size());
   for (int s = 0; s < 20; ++s) {
     f.steer(s * 0.1, 0.1, a, d);
     for (std::size_t i = 0; i < a.size(); ++i) {
       EXPECT_GE(norm(d[i]), 0.05 - 1e-12);
-      // Turned from the walked direction (the heading when standing) by at
-      // most turn_speed * dt.
-      const Vec2 from = heading_vector(a[i].heading);
+      // Turned from the boid's velocity (at the first step the walked
+      // direction, the heading when standing) by at most turn_speed * dt.
+      const Vec2 from = s == 0 ? heading_vector(a[i].heading) : last[i];
       EXPECT_LE(std::abs(std::atan2(cross(from, d[i]), dot(from, d[i]))), 0.06 + 1e-9);
     }
+    last = d;
   }
 }
 
@@ -152,17 +176,20 @@ TEST(UnityFlock, RandomPushIsRenewedAtRandomIntervals) {
   std::vector<Agent> a{agent({0, 0}), agent({9, 9})};
   std::vector<Vec2> d(2);
   UnityFlock f({0, 1}, p, still_leader({0, 0}), 1);
-  Vec2 last{-1, -1};
+  Vec2 last{-1, -1}, velocity;
   int changes = 0, longest = 0, run = 0;
   for (int s = 0; s < 1000; ++s) {
     f.steer(s * 0.01, 0.01, a, d);
-    ASSERT_LE(norm(d[0]), 0.01 + 1e-12);  // a unit-disc point * force * dt
-    if (!(d[0] == last)) {
+    // The boid's velocity decays by dt and takes the push * dt.
+    const Vec2 push = d[0] - velocity * (1.0 - 0.01);
+    velocity = d[0];
+    ASSERT_LE(norm(push), 0.01 + 1e-12);  // a unit-disc point * force * dt
+    if (norm(push - last) > 1e-9) {
       ++changes;
       run = 0;
     }
     longest = std::max(longest, ++run);
-    last = d[0];
+    last = push;
   }
   EXPECT_GE(changes, 10 / 0.75 - 1);
   EXPECT_LE(changes, 10 / 0.25 + 1);

@@ -37,6 +37,19 @@ struct GaitSteering {
   // length alone follows the speed, lambda = v / f) instead of the Froude
   // f(Fr): for a figure whose walk only works at one cadence.
   bool fixed_cadence = false;
+  // A command of speed 0 and a turn steps in place while the body yaws: the
+  // two sides swing against each other as they would walking +-turn x half
+  // spot_track_width_m, about spot_swing_offset (the swing that walks
+  // nowhere), the yaw joints at rest, at the slowest walk's cadence. false:
+  // a speed under the slowest walk stands, whatever the turn.
+  bool turn_on_the_spot = false;
+  // Feet that slip turn the body less than the track says: the track the
+  // sides' swing is computed for on the spot (in a file it defaults to
+  // track_width_m; 0 here means track_width_m).
+  double spot_track_width_m = 0.0;
+  // The swing fraction at which stepping in place stays in place (in a
+  // file it defaults to swing_offset).
+  double spot_swing_offset = 0.0;
   Location where;  // of the `steering` key; ignored by ==
 
   double min_speed_m_s() const;

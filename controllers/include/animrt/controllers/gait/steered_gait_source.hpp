@@ -12,7 +12,11 @@
 // the steering acceleration, turn rate and walk/stand blend over one stride
 // at the slowest speed, and the phase is integrated, so no command makes a
 // joint jump. A command below the slowest speed stands: the swing blends
-// to 0 (the standing pose is the curve means) and the phase stops.
+// to 0 (the standing pose is the curve means) and the phase stops; with
+// `turn_on_the_spot`, one with a turn steps in place at the slowest
+// walk's cadence instead, each side swinging as for -+turn x half the spot
+// track about the spot swing offset (the swing that walks nowhere), the
+// yaw joints at rest, blended in and out over a stride.
 
 #include <memory>
 #include <vector>
@@ -72,6 +76,7 @@ class SteeredGaitSource final : public MotionSource {
 
   double target_speed_ = 0.0;  // 0 or within [min_speed_, max_speed_]
   double target_turn_ = 0.0;   // within +-max turn
+  bool target_spot_ = false;   // speed 0 with a turn: turn on the spot
 
   // Integrated playback state. sample() is const in the interface but is
   // called once per cycle with non-decreasing t, so it advances this state
@@ -84,6 +89,7 @@ class SteeredGaitSource final : public MotionSource {
   mutable double speed_ = 0.0;  // walking speed, within [min_speed_, max_speed_]
   mutable double turn_ = 0.0;   // rad/s
   mutable double blend_ = 0.0;  // 0 standing .. 1 walking (linear; smoothed when applied)
+  mutable double spot_ = 0.0;   // 0 walking .. 1 turning on the spot (linear, smoothed)
 };
 
 }  // namespace animrt

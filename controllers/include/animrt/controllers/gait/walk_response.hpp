@@ -42,9 +42,14 @@ bool operator==(const GaitCalibration& a, const GaitCalibration& b);
 // miss by this much, without being judged unusable.
 inline constexpr double kCalibrationTurnFloorDps = 1.0;
 
+// The most a turn on the spot may drift along the heading, m/s: 1 cm/s, a
+// tenth of a pony's walk (10 cm while it turns round in 10 s).
+inline constexpr double kCalibrationSpotDriftMps = 0.01;
+
 // Whether a measured point counts as usable under `tolerance`: no fall, the
-// achieved speed within tolerance x commanded of the commanded speed, and the
-// achieved turn rate within max(tolerance x |commanded turn|,
+// achieved speed within tolerance x commanded of the commanded speed (a turn
+// on the spot, speed 0: within kCalibrationSpotDriftMps of standing), and
+// the achieved turn rate within max(tolerance x |commanded turn|,
 // kCalibrationTurnFloorDps) of the commanded turn rate.
 bool calibration_usable(const CalibrationPoint& point, double tolerance);
 
@@ -83,9 +88,15 @@ class WalkResponse {
   // Fastest usable turn rate at `speed` (rad/s, either way).
   double max_turn(double speed) const;
   double max_acceleration() const;
+  // Fastest turn on the spot either way (rad/s; speed 0): the steering's
+  // max turn when `turn_on_the_spot` is set and there is no calibration,
+  // with one the fastest its usable speed-0 rows reach from either side
+  // without crossing an unusable one; 0 when the figure cannot.
+  double spot_turn() const;
 
   // What the figure walks when given `commanded` (clamped to the usable
-  // range first).
+  // range first; a speed of 0 with a turn turns on the spot within
+  // spot_turn(), interpolating the speed-0 rows when calibrated).
   MotionCommand achieved(const MotionCommand& commanded) const;
   // The usable command whose achieved motion comes closest to `wanted`.
   MotionCommand command_for(const MotionCommand& wanted) const;
@@ -99,10 +110,12 @@ class WalkResponse {
   double level_max_turn(const Level& level) const;
   MotionCommand level_achieved(const Level& level, double turn) const;
   MotionCommand clamp(const MotionCommand& command) const;
+  MotionCommand spot_achieved(double turn) const;
 
   GaitSteering steering_;
   bool calibrated_ = false;
   std::vector<Level> levels_;  // by commanded speed
+  Level spot_;                 // usable speed-0 rows reached from standing, by turn
   struct Node {
     MotionCommand commanded, achieved;
   };

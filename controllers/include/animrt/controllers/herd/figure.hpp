@@ -1,6 +1,7 @@
 #pragma once
-// A walking figure in the herd: it cannot slide sideways or turn on the
-// spot; it walks forward at a speed and turns at a rate its gait can do.
+// A walking figure in the herd: it cannot slide sideways; it walks forward
+// at a speed and turns at a rate its gait can do, and turns on the spot
+// (speed 0) only where its gait can (WalkResponse::spot_turn).
 // steer_figure() turns a group's desired ground velocity into that command,
 // and walk_figure() moves the agent by what the gait achieves.
 
@@ -24,7 +25,8 @@ inline constexpr double kHeadingTimeConstant_s = 0.3;
 // The command given to `figure` for walking `agent` toward `desired` (m/s on
 // the ground) over the next `dt`: forward speed from the part of `desired`
 // along the heading, a turn toward it, both within what the gait can walk
-// and its acceleration, as command_for() of the walk response chooses.
+// and its acceleration, as command_for() of the walk response chooses; for
+// a velocity behind it, a turn on the spot when the gait has one.
 MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desired, double dt);
 
 // Moves `agent` for `dt` by what `figure` achieves under `command`:

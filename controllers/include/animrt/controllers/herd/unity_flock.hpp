@@ -2,14 +2,16 @@
 // The first flocking variant: the boid of Unity's old Tropical Paradise
 // sample, following a wandering controller point (the "origin").
 //
-// Per step and member, from the figures as they walk:
-//   v       the walked velocity, raised to min_speed (along the heading when
-//           the figure stands);
+// Per step and member, from where the figures stand:
+//   v       the boid's own velocity (the desired velocity it gave in the
+//           previous step; the figure's walked velocity at the first step),
+//           raised to min_speed (along the heading when it is zero);
 //   avg     over every agent within follow_radius (d < follow_radius):
 //           separation (any group) closer than avoidance_radius,
 //             (1 - d/avoidance_radius) * avoidance_force along the way apart,
 //           alignment (own group only),
-//             the neighbour's unit velocity * d/follow_radius * follow_velocity,
+//             the neighbour's unit boid velocity (its walked one for an
+//             agent of another flock) * d/follow_radius * follow_velocity,
 //           divided by the number of other members of the group;
 //   to_avg  toward the mean position of the other members (cohesion);
 //   origin  toward the leader, |origin| = d/to_origin_range * to_origin_force;
@@ -18,7 +20,11 @@
 //   wanted  = v - v*dt + (push + origin + avg + unit(to_avg)*gravity) * dt;
 // and the desired velocity is v turned toward wanted by at most
 // turn_speed*dt (its length moved toward |wanted| by at most
-// max_length_delta), never slower than min_speed.
+// max_length_delta), never slower than min_speed. The figure is asked for
+// that velocity and walks what its gait can of it; the boid's velocity is
+// not reset to the figure's, as a figure that stands (its slowest walk is
+// faster than the pull on it, or a neighbour blocks it) would otherwise
+// give the rules nothing to build on and the flock would stay standing.
 //
 // Units: metres, seconds; the forces are accelerations (m/s^2), the speeds
 // m/s, turn_speed rad/s. The defaults are the text's, for birds in a Unity
@@ -81,6 +87,13 @@ class UnityFlock : public GroupSteering {
   SpatialGrid grid_;
   std::vector<Vec2> push_;            // per member
   std::vector<double> next_renewal_;  // per member, s
+  std::vector<Vec2> velocity_;        // per member: the boid's own velocity, m/s
+  std::vector<int> slot_of_;          // agent index -> member slot, -1 for none
+  bool started_ = false;              // velocity_ holds a step's output
+
+  // Unit direction of agent j's boid velocity when it is a member of this
+  // flock that has one; else the way its figure moves.
+  Vec2 boid_direction(int j, const Agent& b) const;
 };
 
 }  // namespace animrt::herd
