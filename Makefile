@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench clean
+.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb clean
 
 deps:
 	@scripts/install-deps.sh
@@ -56,6 +56,11 @@ test-fuzz: fuzz-build
 # QEMU, on a real 8250 UART and on SocketCAN (vcan0); results in $(BUILD)/hil.
 test-hil: build
 	tests/hil/run $(BUILD)
+
+# Debian packages from the release build: animrt (what a figure runs, its
+# service and data) and animrt-tools (the offline tools), in $(BUILD)/deb.
+deb: build
+	packaging/build-debs $(BUILD) $(BUILD)/deb
 
 bench: build
 	scripts/run-benchmarks.sh $(BUILD)

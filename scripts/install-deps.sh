@@ -25,6 +25,9 @@ packages=(
   # view and charts served from Debian, and the headless-browser test.
   libcpp-httplib-dev libjs-three libjs-chart.js
   chromium chromium-driver python3-selenium
+  # A figure's computer: the service's readiness and watchdog (sd_notify),
+  # the Debian packages (make deb) and their checks.
+  libsystemd-dev systemd dpkg-dev fakeroot lintian
 )
 # npm for the MCAP test's reader (below): Debian's, unless a Node.js with npm
 # is installed already (Debian's npm package conflicts with other Node builds).
