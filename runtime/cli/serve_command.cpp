@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "animrt/core/error.hpp"
@@ -17,6 +18,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
+#include "service_notify.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -178,8 +180,13 @@ int serve(const ServeArgs& args) {
   options.request_realtime = !args.no_realtime;
   options.controls = &serve_controls;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  // Under systemd: ready after the start ramp, the watchdog fed by the loop's cycles.
+  RunHeartbeat heartbeat;
+  options.heartbeat = &heartbeat;
+  std::optional<ServiceNotifier> notifier(std::in_place, heartbeat);
   start_fault_injection();
   const RunSummary summary = figure.run(options);
+  notifier.reset();
   std::cout << format_summary(summary);
   print_cue_report(playing, requests, osc.get(), artnet.get());
   std::cout << std::flush;
