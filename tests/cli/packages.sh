@@ -14,7 +14,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-deb=$(DEB_PACKAGES=animrt DEB_COMPRESS=gzip "$root/packaging/build-debs" "$build" "$tmp/deb" 2>&1) ||
+deb=$(DEB_PACKAGES=animrt DEB_COMPRESS=gzip DEB_COMPRESS_LEVEL=1 "$root/packaging/build-debs" "$build" "$tmp/deb" 2>&1) ||
   fail "build-debs: $deb"
 [[ -f $deb ]] || fail "build-debs made no package: $deb"
 
