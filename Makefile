@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench clean
+.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb cross-arm64 clean
 
 deps:
 	@scripts/install-deps.sh
@@ -56,6 +56,22 @@ test-fuzz: fuzz-build
 # QEMU, on a real 8250 UART and on SocketCAN (vcan0); results in $(BUILD)/hil.
 test-hil: build
 	tests/hil/run $(BUILD)
+
+# Debian packages from the release build: animrt (what a figure runs, its
+# service and data) and animrt-tools (the offline tools), in $(BUILD)/deb.
+deb: build
+	packaging/build-debs $(BUILD) $(BUILD)/deb
+
+# The loop's library and its unit tests cross-compiled for arm64 (Debian's
+# cross toolchain and arm64 libraries), run under qemu-user. Not part of
+# `make test` (docs/deployment.md: what it costs).
+CROSS_BUILD ?= build-arm64
+cross-arm64: deps
+	cmake -S . -B $(CROSS_BUILD) -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DANIMRT_WERROR=ON -DANIMRT_LOOP_ONLY=ON \
+	  -DANIMRT_TESTS=OFF -DANIMRT_BENCH=OFF
+	cmake --build $(CROSS_BUILD) -j $(JOBS)
+	ctest --test-dir $(CROSS_BUILD) --output-on-failure
 
 bench: build
 	scripts/run-benchmarks.sh $(BUILD)

@@ -25,6 +25,12 @@ packages=(
   # view and charts served from Debian, and the headless-browser test.
   libcpp-httplib-dev libjs-three libjs-chart.js
   chromium chromium-driver python3-selenium
+  # A figure's computer: the service's readiness and watchdog (sd_notify),
+  # the Debian packages (make deb) and their checks (systemd-analyze, lintian),
+  # the arm64 cross toolchain and emulator (make cross-arm64; its arm64 -dev
+  # libraries are not installed here: libyaml-cpp-dev:arm64 replaces the
+  # host's libyaml-cpp-dev, docs/deployment.md).
+  libsystemd-dev systemd dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static
 )
 # npm for the MCAP test's reader (below): Debian's, unless a Node.js with npm
 # is installed already (Debian's npm package conflicts with other Node builds).

@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
+#include <sys/sysinfo.h>
 #include <sys/utsname.h>
 #include <unistd.h>
 
@@ -138,24 +139,33 @@ void check_limits(std::vector<Check>& out) {
   const bool root = ::geteuid() == 0;
   rlimit rt{};
   ::getrlimit(RLIMIT_RTPRIO, &rt);
+  const std::string rtprio =
+      rt.rlim_cur == RLIM_INFINITY ? "unlimited" : std::to_string(rt.rlim_cur);
+  // What this process got, as a service's LimitRTPRIO= sets it.
   if (root || rt.rlim_cur == RLIM_INFINITY || rt.rlim_cur >= 80) {
     out.push_back({Status::ok, "rtprio limit",
-                   root ? std::string("root") : "rtprio " + std::to_string(rt.rlim_cur), ""});
+                   "rtprio " + rtprio + (root ? " (root: any priority)" : ""), ""});
   } else {
     out.push_back({Status::warn, "rtprio limit",
                    "rtprio " + std::to_string(rt.rlim_cur) + " (the loop asks for 80)",
-                   "add '@realtime - rtprio 95' to /etc/security/limits.d/animrt.conf and this "
-                   "user to group realtime, then log in again"});
+                   "the animrt package's /etc/security/limits.d/animrt.conf gives group animrt "
+                   "rtprio 95: sudo usermod -aG animrt $USER, then log in again; under "
+                   "systemd, LimitRTPRIO=95"});
   }
   rlimit mem{};
   ::getrlimit(RLIMIT_MEMLOCK, &mem);
+  const std::string memlock = mem.rlim_cur == RLIM_INFINITY
+                                  ? std::string("unlimited")
+                                  : std::to_string(mem.rlim_cur / 1024) + " KiB";
   if (root || mem.rlim_cur == RLIM_INFINITY) {
-    out.push_back({Status::ok, "memlock limit", root ? "root" : "unlimited", ""});
+    out.push_back({Status::ok, "memlock limit",
+                   "memlock " + memlock + (root ? " (root: no limit)" : ""), ""});
   } else {
     out.push_back({Status::warn, "memlock limit",
                    "memlock " + std::to_string(mem.rlim_cur / 1024) + " KiB",
-                   "add '@realtime - memlock unlimited' to "
-                   "/etc/security/limits.d/animrt.conf, then log in again"});
+                   "the animrt package's limits.d file gives group animrt memlock unlimited: "
+                   "sudo usermod -aG animrt $USER, then log in again; under systemd, "
+                   "LimitMEMLOCK=infinity"});
   }
 }
 
@@ -204,6 +214,68 @@ void check_kernel(const Host& host, std::vector<Check>& out) {
                        "): worst-case latency is milliseconds under load",
                    "install a real-time kernel (Debian: linux-image-rt-amd64 or "
                    "linux-image-rt-arm64) and boot it"});
+  }
+}
+
+// "0-3,6": the CPUs of a set as the kernel writes lists (isolcpus, taskset).
+std::string cpu_list(const cpu_set_t& set) {
+  std::string list;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (!CPU_ISSET(cpu, &set)) continue;
+    int last = cpu;
+    while (last + 1 < CPU_SETSIZE && CPU_ISSET(last + 1, &set)) ++last;
+    list += (list.empty() ? "" : ",") + std::to_string(cpu);
+    if (last > cpu) list += "-" + std::to_string(last);
+    cpu = last;
+  }
+  return list;
+}
+
+// "1,3-4" back into a set (what /sys/devices/system/cpu/isolated holds).
+cpu_set_t parse_cpu_list(const std::string& text) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t end = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, end - at);
+    const std::size_t dash = item.find('-');
+    const int first = std::atoi(item.c_str());
+    const int last = dash == std::string::npos ? first : std::atoi(item.c_str() + dash + 1);
+    for (int cpu = std::max(first, 0); cpu <= last && cpu < CPU_SETSIZE; ++cpu) CPU_SET(cpu, &set);
+    at = end + 1;
+  }
+  return set;
+}
+
+// Which CPU the process runs on and may run on (the loop's threads inherit
+// it), against the CPUs the kernel keeps free of other work (isolcpus=).
+void check_cpu(const Host& host, std::vector<Check>& out) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ::sched_getaffinity(0, sizeof allowed, &allowed);
+  const std::string isolated_text = first_line(host.at("/sys/devices/system/cpu/isolated"));
+  const cpu_set_t isolated = parse_cpu_list(isolated_text);
+  cpu_set_t outside;
+  CPU_ZERO(&outside);
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed) && !CPU_ISSET(cpu, &isolated)) CPU_SET(cpu, &outside);
+  }
+  const std::string detail = "runs on CPU " + std::to_string(::sched_getcpu()) + ", may run on " +
+                             cpu_list(allowed) + " of " + std::to_string(::get_nprocs_conf());
+  if (CPU_COUNT(&isolated) == 0) {
+    out.push_back({Status::ok, "CPU",
+                   detail + "; no CPU isolated (isolcpus=) for the loop, which shares them", ""});
+  } else if (CPU_COUNT(&outside) == 0) {
+    out.push_back({Status::ok, "CPU", detail + ", isolated " + cpu_list(isolated), ""});
+  } else {
+    const std::string pin = cpu_list(isolated);
+    out.push_back({Status::warn, "CPU",
+                   detail + ": isolated " + pin + " but the loop may run outside it",
+                   "pin it there: under systemd, CPUAffinity=" + pin +
+                       " (systemctl edit animrt); "
+                       "from a shell, taskset -c " +
+                       pin + " animrt ..."});
   }
 }
 
@@ -286,6 +358,7 @@ int run_doctor() {
   check_limits(checks);
   check_realtime(checks);
   check_kernel(host, checks);
+  check_cpu(host, checks);
   check_governor(host, checks);
   check_can(host, checks);
   int fails = 0;
@@ -307,7 +380,8 @@ int run_doctor() {
 void add_doctor_command(CLI::App& app) {
   using namespace doctor_cmd;
   auto* cmd = app.add_subcommand(
-      "doctor", "Check this host for a figure: adapters, latency, permissions, real time, CAN");
+      "doctor",
+      "Check this host for a figure: adapters, latency, permissions, real time, CPUs, CAN");
   set_subcommand_body(cmd, [] { return run_doctor(); });
 }
 

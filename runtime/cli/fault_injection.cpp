@@ -1,6 +1,9 @@
 #include "fault_injection.hpp"
 
+#include <pthread.h>
+#include <signal.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -20,9 +23,29 @@ double seconds_of(const char* name) {
   return std::isfinite(seconds) && seconds >= 0.0 ? seconds : -1.0;
 }
 
+// The stalled thread waits in its signal handler until the process ends.
+void stall_here(int) {
+  for (;;) ::pause();
+}
+
+void stall_loop_after(double seconds) {
+  struct sigaction action {};
+  action.sa_handler = stall_here;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGRTMIN, &action, nullptr);
+  const pthread_t loop = ::pthread_self();
+  std::thread([seconds, loop] {
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+    ::pthread_kill(loop, SIGRTMIN);
+  }).detach();
+}
+
 }  // namespace
 
 void start_fault_injection() {
+  if (const double seconds = seconds_of("ANIMRT_TEST_STALL_LOOP_AFTER_S"); seconds >= 0.0) {
+    stall_loop_after(seconds);
+  }
   if (const double seconds = seconds_of("ANIMRT_TEST_UNCAUGHT_EXCEPTION_AFTER_S"); seconds >= 0.0) {
     std::thread([seconds] {
       std::this_thread::sleep_for(std::chrono::duration<double>(seconds));

@@ -6,6 +6,10 @@
 //     bug in a helper thread would.
 //   ANIMRT_TEST_BAD_WRITE_AFTER_S=SECONDS: a thread writes to a page it may
 //     not write then: a real SIGSEGV, raised by the fault, not sent.
+//   ANIMRT_TEST_STALL_LOOP_AFTER_S=SECONDS: the thread that called
+//     start_fault_injection (the loop's) stops there for good, as a loop
+//     stuck in a driver call would, while every other thread runs on.
+//     Called just before the run, on the thread that runs the loop.
 
 namespace animrt::cli {
 

@@ -23,34 +23,28 @@
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
-#include "animrt/runtime/embodied_herd.hpp"
 #include "animrt/runtime/emergency_stop.hpp"
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_leg_model.hpp"
-#include "animrt/sim/mujoco/mujoco_physics.hpp"
 #include "animrt/sim/simulated_backend.hpp"
 #include "calibrate_command.hpp"
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "doctor_command.hpp"
-#include "evolve_command.hpp"
 #include "fault_injection.hpp"
-#include "gait_command.hpp"
-#include "head_command.hpp"
-#include "herd_command.hpp"
 #include "record_command.hpp"
+#include "run_herd.hpp"
 #include "scan_command.hpp"
-#include "seq_command.hpp"
-#include "seq_corpus_command.hpp"
 #include "serve_command.hpp"
 #include "servo_command.hpp"
 #include "sim_command.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "summary_file.hpp"
+#include "tools_exec.hpp"
 #include "view_command.hpp"
 
 namespace {
@@ -157,25 +151,6 @@ bool run_args_go_together(const RunArgs& args) {
   return true;
 }
 
-// --herd: the herd that steers the figure as one of its agents (null without),
-// seeing the walk the physics measures when there is physics.
-std::unique_ptr<animrt::EmbodiedHerd> join_herd(const RunArgs& args, const animrt::Figure& figure,
-                                                const animrt::SimulatedBackend& simulated) {
-  if (args.herd.empty()) return nullptr;
-  const animrt::sim::MujocoJointPhysics* physics = simulated.mujoco_physics();
-  animrt::EmbodiedHerd::MeasuredTrack measured;
-  if (physics) {
-    measured = [physics] {
-      const animrt::sim::TorsoPose p = physics->torso_pose();
-      return animrt::EmbodiedHerd::Track{p.x_m, p.y_m, p.yaw_rad};
-    };
-  }
-  auto herd = std::make_unique<animrt::EmbodiedHerd>(args.herd, args.agent, figure.clock(),
-                                                     g_controls, std::move(measured));
-  spdlog::info("herd: {} steers the robot as agent {}", args.herd, args.agent);
-  return herd;
-}
-
 // --dashboard: where and how it serves; the figure adds what it knows.
 animrt::DashboardSetup dashboard_setup(const RunArgs& args, const std::pair<std::string, int>& at,
                                        const animrt::Figure& figure,
@@ -200,6 +175,7 @@ int cmd_run(const RunArgs& args) {
   if (!address.ok) return kExitUsage;
   const std::pair<std::string, int> dashboard_at =
       address.at.value_or(std::pair<std::string, int>{});
+  animrt::cli::run_herd_here(args.herd);
   animrt::LoadedRobot robot = animrt::load_robot(args.config);
   attach_legs(robot);
   // The figure the dashboard draws: the robot file's model, or else the physics model.
@@ -234,7 +210,8 @@ int cmd_run(const RunArgs& args) {
   figure_options.warn = [](const std::string& line) { spdlog::warn("{}", line); };
   animrt::Figure figure(std::move(robot), backend, figure_options);
 
-  std::unique_ptr<animrt::EmbodiedHerd> herd = join_herd(args, figure, simulated);
+  std::unique_ptr<animrt::cli::RunHerd> herd =
+      animrt::cli::join_run_herd(args.herd, args.agent, figure, simulated, g_controls);
 
   animrt::RunOptions options = figure.run_options();
   options.duration_s = args.duration;
@@ -320,6 +297,7 @@ int main(int argc, char** argv) {
   // fails with EPIPE instead of killing the process (a dashboard whose
   // browser closed; run and sim take SIGPIPE as a stop below).
   animrt::install_fatal_error_handlers();
+  animrt::cli::remember_argv(argv);
   signal(SIGPIPE, SIG_IGN);
 
   CLI::App app{"animrt: real-time motion for animatronic figures"};
@@ -335,10 +313,7 @@ int main(int argc, char** argv) {
   auto* run = add_run_subcommand(app, run_args);
 
   animrt::cli::add_sim_command(app);
-  animrt::cli::add_evolve_command(app);
-  animrt::cli::add_gait_command(app);
-  animrt::cli::add_head_command(app);
-  animrt::cli::add_herd_command(app);
+  animrt::cli::add_tool_commands(app);
   animrt::cli::add_view_command(app);
   animrt::cli::add_scan_command(app);
   animrt::cli::add_servo_command(app);
@@ -346,11 +321,6 @@ int main(int argc, char** argv) {
   animrt::cli::add_record_command(app);
   animrt::cli::add_doctor_command(app);
   animrt::cli::add_serve_command(app);
-  auto* seq = app.add_subcommand(
-      "seq", "Mesh sequences: generated corpus, deformation features, the sequence network");
-  seq->require_subcommand(1);
-  animrt::cli::add_seq_corpus_command(*seq);
-  animrt::cli::add_seq_command(*seq);
   animrt::cli::hide_empty_defaults(app);
   try {
     app.parse(argc, argv);

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "animrt/core/error.hpp"
@@ -19,6 +20,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
+#include "service_notify.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "summary_file.hpp"
@@ -203,8 +205,13 @@ int serve(const ServeArgs& args) {
   options.request_realtime = !args.no_realtime;
   options.controls = &serve_controls;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  // Under systemd: ready after the start ramp, the watchdog fed by the loop's cycles.
+  RunHeartbeat heartbeat;
+  options.heartbeat = &heartbeat;
+  std::optional<ServiceNotifier> notifier(std::in_place, heartbeat);
   start_fault_injection();
   const RunSummary summary = figure.run(options);
+  notifier.reset();
   const bool summary_written =
       !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, requests));
   std::cout << format_summary(summary);

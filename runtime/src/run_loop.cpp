@@ -141,6 +141,7 @@ bool RunLoop::run() {
     gather_inputs();
     const CycleOutputs& out = step(model_, motion_, state_, in_);
     publish(out);
+    if (options_.heartbeat) options_.heartbeat->beat(state_.phase());
     notify(out);
     if (out.torque_off_now) return true;
     post_writes(out);
@@ -153,6 +154,7 @@ bool RunLoop::run() {
 void RunLoop::finish() {
   for (auto& w : workers_) w->stop();
   if (options_.monitor) options_.monitor->publish_ended();
+  if (options_.heartbeat) options_.heartbeat->end();
   for (std::size_t b = 0; b < buses_.size(); ++b) {
     count_io(b);
     mark_faults(b);

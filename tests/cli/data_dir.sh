@@ -18,9 +18,11 @@ cd "$tmp" || fail "cannot enter $tmp"
 out=$(corpus "$animrt" "$tmp/corpus") || fail "seq corpus from $tmp: $out"
 [[ $out == "wrote 2 sequences "* ]] || fail "unexpected output: $out"
 
-# Installed: PREFIX/bin/animrt and the data in PREFIX/share/animrt.
+# Installed: PREFIX/bin/animrt (and animrt-tools, which answers seq) and
+# the data in PREFIX/share/animrt.
 mkdir -p "$tmp/prefix/bin" "$tmp/prefix/share" "$tmp/elsewhere"
 cp "$animrt" "$tmp/prefix/bin/animrt"
+cp "$(dirname "$animrt")/animrt-tools" "$tmp/prefix/bin/animrt-tools"
 ln -s "$root/configs" "$tmp/prefix/share/animrt"
 cd "$tmp/elsewhere" || fail "cannot enter $tmp/elsewhere"
 out=$(corpus "$tmp/prefix/bin/animrt" "$tmp/installed") || fail "installed seq corpus: $out"

@@ -3,7 +3,9 @@
 # (a fix under each WARN and FAIL) and the exit code says whether one
 # failed; on a host made up under ANIMRT_DOCTOR_ROOT, a slow FTDI latency
 # timer, a power-saving governor and a CAN interface that is down are found
-# with their fixes, and bringing the interface up clears the failure.
+# with their fixes, and bringing the interface up clears the failure; an
+# isolated CPU the process may run outside of is a warning with the
+# affinity to set, and a process pinned to it is OK.
 set -uo pipefail
 animrt=$1
 tmp=$(mktemp -d)
@@ -34,7 +36,7 @@ out=$("$animrt" doctor 2>&1)
 code=$?
 check_structure "$out"
 for name in "serial adapter" "latency timer" dialout "rtprio limit" "memlock limit" SCHED_FIFO \
-  mlockall kernel "CPU governor" CAN; do
+  mlockall kernel CPU "CPU governor" CAN; do
   grep -q "^[OKWARNFIL ]\{4\}  $name" <<< "$out" || fail "no $name check: $out"
 done
 if grep -q "^FAIL" <<< "$out"; then want=3; else want=0; fi
@@ -80,4 +82,19 @@ out=$(ANIMRT_DOCTOR_ROOT=$host "$animrt" doctor 2>&1)
 code=$?
 [[ $code -eq 0 ]] || fail "can0 up, still exit $code: $out"
 grep -q "^OK    CAN: can0 up, bitrate 500000" <<< "$out" || fail "can0 up: $out"
+grep -q "^OK    CPU: runs on CPU [0-9]*, may run on .*no CPU isolated" <<< "$out" ||
+  fail "no isolated CPU: $out"
+
+if [[ $(nproc) -ge 2 ]]; then
+  last=$(($(nproc) - 1))
+  echo "$last" > "$host/sys/devices/system/cpu/isolated"
+  out=$(ANIMRT_DOCTOR_ROOT=$host "$animrt" doctor 2>&1)
+  check_structure "$out"
+  grep -q "^WARN  CPU: .*isolated $last but the loop may run outside it" <<< "$out" ||
+    fail "isolated CPU not used: $out"
+  grep -q "fix: pin it there: under systemd, CPUAffinity=$last " <<< "$out" || fail "no fix: $out"
+  out=$(ANIMRT_DOCTOR_ROOT=$host taskset -c "$last" "$animrt" doctor 2>&1)
+  grep -q "^OK    CPU: runs on CPU $last, may run on $last of [0-9]*, isolated $last$" <<< "$out" ||
+    fail "pinned to the isolated CPU: $out"
+fi
 echo "doctor: ok"

@@ -196,6 +196,18 @@ TEST(Runner, AnExceptionInTheLoopStillSwitchesEveryBusOff) {
   EXPECT_EQ(rig.bus_b->deactivations, 1);
 }
 
+TEST(Runner, TheHeartbeatCountsEveryCycleAndEndsWithTheRun) {
+  Rig rig;
+  RunHeartbeat heartbeat;
+  RunOptions o = lockstep(rig, 0.5);
+  o.heartbeat = &heartbeat;
+  const RunSummary summary = rig.runner->run(o);
+  EXPECT_GT(summary.cycles, 0u);
+  EXPECT_EQ(heartbeat.cycles(), summary.cycles);
+  EXPECT_TRUE(heartbeat.moved());
+  EXPECT_EQ(heartbeat.stage(), RunHeartbeat::Stage::ended);
+}
+
 TEST(Runner, ABusThatFailsToActivateIsSwitchedOffWithTheOnesBeforeIt) {
   Rig rig;
   rig.bus_b->throw_on_activate = true;

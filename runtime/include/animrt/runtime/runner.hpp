@@ -23,6 +23,7 @@
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/runtime/robot_model.hpp"
 #include "animrt/runtime/run_controls.hpp"
+#include "animrt/runtime/run_heartbeat.hpp"
 #include "animrt/runtime/run_monitor.hpp"
 #include "animrt/runtime/run_summary.hpp"
 
@@ -56,6 +57,9 @@ struct RunOptions {
   // Readers of the run (a dashboard): the cycle publishes its state, timing
   // and events here, lock-free. Built on this runner's model().
   RunMonitor* monitor = nullptr;
+  // The loop's pulse for a supervisor (a service manager's watchdog): beaten
+  // after every cycle, ended after the last; none when null.
+  RunHeartbeat* heartbeat = nullptr;
   // Threads outside the runner that its buses wait on (simulated devices'):
   // in a real-time run, called before configure with the priority just below
   // the bus I/O threads'; returns why, for each thread that could not have it
