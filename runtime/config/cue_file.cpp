@@ -152,6 +152,75 @@ void link_cue(std::vector<Cue>& cues, std::size_t c, int idle, const CueDraft& d
   }
 }
 
+// A joint's DMX channels: `channel` (coarse), `fine` (optional) and the
+// `range` (degrees, or metres) that level 0 and full map to.
+DmxJoint make_dmx_joint(const std::string& name, const YamlNode& node, const RobotConfig& robot,
+                        std::vector<bool>& used) {
+  node.allow_only({"channel", "fine", "range"});
+  DmxJoint dmx;
+  dmx.joint = -1;
+  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+    if (robot.joints[j].name == name) dmx.joint = static_cast<int>(j);
+  }
+  if (dmx.joint < 0) node.fail("no joint " + quote(name) + " in robot " + robot.name);
+  auto channel = [&used](const YamlNode& at) {
+    const int c = static_cast<int>(at.as_int_in(1, 512));
+    if (used[static_cast<std::size_t>(c)])
+      at.fail("channel " + std::to_string(c) + " is used twice");
+    used[static_cast<std::size_t>(c)] = true;
+    return c;
+  };
+  dmx.coarse = channel(node.at("channel"));
+  if (auto fine = node.find("fine")) dmx.fine = channel(*fine);
+  const JointSpec& joint = robot.joints[static_cast<std::size_t>(dmx.joint)];
+  dmx.min = joint.limits.min_position;
+  dmx.max = joint.limits.max_position;
+  if (auto range = node.find("range")) {
+    const std::vector<YamlNode> ends = range->items();
+    if (!range->is_sequence() || ends.size() != 2) {
+      range->fail("expected [at level 0, at full], found " + range->describe());
+    }
+    const bool metres = joint.type == JointType::prismatic;
+    const double lo = metres ? joint.limits.min_position : rad_to_deg(joint.limits.min_position);
+    const double hi = metres ? joint.limits.max_position : rad_to_deg(joint.limits.max_position);
+    dmx.min = ends[0].as_double_in(lo, hi);
+    dmx.max = ends[1].as_double_in(lo, hi);
+    if (!metres) {
+      dmx.min = deg_to_rad(dmx.min);
+      dmx.max = deg_to_rad(dmx.max);
+    }
+  }
+  return dmx;
+}
+
+// `artnet:` or `sacn:`: the universe, the cue channel, joints.
+DmxSection make_dmx_section(const YamlNode& node, int lowest, int highest,
+                            const std::vector<int>& dmx_values, const RobotConfig& robot) {
+  node.allow_only({"universe", "channel", "joints", "hold_s"});
+  DmxSection section;
+  section.present = true;
+  section.universe = static_cast<int>(node.at("universe").as_int_in(lowest, highest));
+  std::vector<bool> used(513, false);
+  if (auto channel = node.find("channel")) {
+    section.channel = static_cast<int>(channel->as_int_in(1, 512));
+    used[static_cast<std::size_t>(section.channel)] = true;
+    bool any = false;
+    for (int value : dmx_values) any = any || value != 0;
+    if (!any) channel->fail("no cue has a dmx value, so this channel would ask for none");
+  }
+  if (auto joints = node.find("joints")) {
+    if (!joints->is_map()) joints->fail("expected a map of joints, found " + joints->describe());
+    for (const auto& [name, entry] : joints->entries()) {
+      section.joints.push_back(make_dmx_joint(name, entry, robot, used));
+    }
+  }
+  if (section.channel == 0 && section.joints.empty()) {
+    node.fail("expected a channel that selects cues, or joints it drives, found neither");
+  }
+  if (auto hold = node.find("hold_s")) section.hold_s = hold->as_double_in(0.0, 3600.0);
+  return section;
+}
+
 }  // namespace
 
 int find_cue(const std::vector<Cue>& cues, const std::string& name) {
@@ -163,7 +232,7 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"idle", "crossfade_s", "cues", "artnet"});
+  root.allow_only({"idle", "crossfade_s", "cues", "artnet", "sacn"});
   const double crossfade =
       root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
   LoadedCues loaded;
@@ -199,12 +268,12 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
     }
   }
   if (auto artnet = root.find("artnet")) {
-    artnet->allow_only({"universe", "channel"});
-    loaded.artnet_universe = static_cast<int>(artnet->at("universe").as_int_in(0, 32767));
-    loaded.artnet_channel = static_cast<int>(artnet->at("channel").as_int_in(1, 512));
-    bool any = false;
-    for (int value : loaded.dmx_values) any = any || value != 0;
-    if (!any) artnet->fail("no cue has a dmx value, so Art-Net would ask for none");
+    loaded.artnet = make_dmx_section(*artnet, 0, 32767, loaded.dmx_values, robot);
+    loaded.artnet_universe = loaded.artnet.universe;
+    loaded.artnet_channel = loaded.artnet.channel;
+  }
+  if (auto sacn = root.find("sacn")) {
+    loaded.sacn = make_dmx_section(*sacn, 1, 63999, loaded.dmx_values, robot);
   }
   return loaded;
 }

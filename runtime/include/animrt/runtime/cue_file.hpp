@@ -4,6 +4,8 @@
 //   idle: rest                      # the cue played at the start and between cues
 //   crossfade_s: 1.0                # default crossfade into every cue
 //   artnet: {universe: 0, channel: 1}   # a DMX channel's value (a cue's dmx) asks for it
+//   sacn: {universe: 1, channel: 1,     # the same over sACN (E1.31)
+//          joints: {neck_pan: {channel: 2, fine: 3, range: [-45, 45]}}, hold_s: 2}
 //   cues:
 //     rest:  {play: {gait: ../shows/neck_idle_gait.yaml}}
 //     hello: {play: {show: ../shows/hello.yaml}, crossfade_s: 0.5}
@@ -18,9 +20,20 @@
 #include <vector>
 
 #include "animrt/controllers/cues/cue_player.hpp"
+#include "animrt/controllers/cues/dmx_joints.hpp"
 #include "animrt/runtime/robot_config.hpp"
 
 namespace animrt {
+
+// A DMX input (Art-Net or sACN): a universe, the channel whose value selects
+// a cue (0: none), and the channels that drive joints.
+struct DmxSection {
+  bool present = false;
+  int universe = 0;
+  int channel = 0;
+  std::vector<DmxJoint> joints;
+  double hold_s = 2.0;  // a lost stream's joints hold this long, then ease back
+};
 
 struct LoadedCues {
   std::vector<Cue> cues;
@@ -30,6 +43,8 @@ struct LoadedCues {
   std::vector<int> dmx_values;
   int artnet_universe = 0;
   int artnet_channel = 0;
+  DmxSection artnet;  // the same, and its joints
+  DmxSection sacn;
 };
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot);
