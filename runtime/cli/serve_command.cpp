@@ -17,6 +17,7 @@
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "serve_dmx.hpp"
+#include "serve_triggers.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -34,6 +35,7 @@ struct ServeArgs {
   int osc_port = 9000;
   bool no_osc = false;
   DmxArgs dmx;            // Art-Net and sACN
+  TriggerArgs triggers;   // LTC and MIDI
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
 };
@@ -68,7 +70,7 @@ bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
 
 // What was played and what the triggers sent, after the run's summary.
 void print_cue_report(const CuePlayer& player, const CueRequests& requests, const OscReceiver* osc,
-                      const ServeDmx& dmx) {
+                      const ServeDmx& dmx, const ServeTriggers& triggers) {
   std::cout << "cues started:";
   for (std::size_t c = 0; c < player.cues().size(); ++c) {
     std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
@@ -82,6 +84,7 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
               << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
   }
   dmx.report(std::cout);
+  triggers.report(std::cout);
 }
 
 // --dashboard: the run's page, which also asks for cues and pauses them.
@@ -138,6 +141,7 @@ int serve(const ServeArgs& args) {
   robot.steering.reset();
   const std::unique_ptr<OscReceiver> osc = start_osc(args, playing, requests);
   const ServeDmx dmx(args.dmx, loaded, requests, robot.motion, robot.config.joints);
+  ServeTriggers triggers(args.triggers, loaded, requests);
 
   HardwareBackend hardware;
   SimulatedBackend simulated(SimulatedBackend::Settings{});
@@ -155,10 +159,11 @@ int serve(const ServeArgs& args) {
   options.request_realtime = !args.no_realtime;
   options.controls = &serve_controls;
   options.log = [](const std::string& message) { spdlog::info("{}", message); };
+  options.on_motion_start = [&triggers](Nanos) { triggers.begin(); };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
   std::cout << format_summary(summary);
-  print_cue_report(playing, requests, osc.get(), dmx);
+  print_cue_report(playing, requests, osc.get(), dmx, triggers);
   std::cout << std::flush;
   return summary.exit_code();
 }
@@ -184,6 +189,7 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::Range(0, 65535));
   cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
   add_dmx_options(cmd, args->dmx);
+  add_trigger_options(cmd, args->triggers);
   cmd->add_option("--dashboard", args->dashboard,
                   "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,

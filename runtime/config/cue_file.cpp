@@ -7,6 +7,7 @@
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
+#include "animrt/runtime/ltc_chase.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 
 namespace animrt {
@@ -93,7 +94,7 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
 
 Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
              const std::string& cue_path, const RobotConfig& robot) {
-  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx"});
+  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx", "timecode", "midi"});
   Cue cue;
   cue.name = name;
   cue.crossfade_s = crossfade;
@@ -150,6 +151,27 @@ void link_cue(std::vector<Cue>& cues, std::size_t c, int idle, const CueDraft& d
   if (cue.loop && forever) {
     draft.loop_node->fail("the cue's last step never ends, so it never loops; drop loop");
   }
+}
+
+// A cue's MIDI trigger: {note: N} or {program: N}, and an optional channel.
+void read_midi_binding(const YamlNode& node, LoadedCues& loaded) {
+  node.allow_only({"note", "program", "channel"});
+  if (node.has("note") == node.has("program")) node.fail("expected a note or a program, not both");
+  MidiBinding binding;
+  binding.cue = static_cast<int>(loaded.cues.size() - 1);
+  binding.program = node.has("program");
+  const YamlNode number = node.at(binding.program ? "program" : "note");
+  binding.number = static_cast<int>(number.as_int_in(0, 127));
+  if (auto channel = node.find("channel"))
+    binding.channel = static_cast<int>(channel->as_int_in(1, 16));
+  for (const MidiBinding& other : loaded.midi) {
+    if (other.program == binding.program && other.number == binding.number &&
+        (other.channel == 0 || binding.channel == 0 || other.channel == binding.channel)) {
+      number.fail("cue " + loaded.cues[static_cast<std::size_t>(other.cue)].name +
+                  " answers this MIDI message too");
+    }
+  }
+  loaded.midi.push_back(binding);
 }
 
 // A joint's DMX channels: `channel` (coarse), `fine` (optional) and the
@@ -232,10 +254,22 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"idle", "crossfade_s", "cues", "artnet", "sacn"});
+  LoadedCues loaded;
+  root.allow_only({"idle", "crossfade_s", "cues", "artnet", "sacn", "ltc"});
+  if (auto ltc = root.find("ltc")) {
+    ltc->allow_only({"fps", "freewheel_s"});
+    loaded.ltc = true;
+    if (auto fps = ltc->find("fps")) {
+      loaded.ltc_fps = fps->as_double();
+      if (loaded.ltc_fps != 24.0 && loaded.ltc_fps != 25.0 && loaded.ltc_fps != 29.97 &&
+          loaded.ltc_fps != 30.0) {
+        fps->fail("expected 24, 25, 29.97 or 30 frames per second, found " + fps->as_string());
+      }
+    }
+    if (auto f = ltc->find("freewheel_s")) loaded.ltc_freewheel_s = f->as_double_in(0.0, 60.0);
+  }
   const double crossfade =
       root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
-  LoadedCues loaded;
   std::vector<CueDraft> drafts;
   const YamlNode list = root.at("cues");
   if (!list.is_map()) list.fail("expected a map of cue names to cues, found " + list.describe());
@@ -248,6 +282,16 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
     drafts.push_back({node.find("then"), node.find("loop"), node});
     const auto dmx = node.find("dmx");
     loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);
+    if (auto tc = node.find("timecode")) {
+      const auto start = parse_timecode(tc->as_string(), loaded.ltc_fps);
+      if (!start) {
+        tc->fail("expected a timecode HH:MM:SS:FF (frames below the ltc: fps), found " +
+                 quote(tc->as_string()));
+      }
+      if (!loaded.ltc) tc->fail("a timecode start needs an `ltc:` section (its frame rate)");
+      loaded.timecode_cues.push_back({*start, static_cast<int>(loaded.cues.size() - 1)});
+    }
+    if (auto midi = node.find("midi")) read_midi_binding(*midi, loaded);
   }
   if (loaded.cues.empty()) list.fail("expected at least one cue, found none");
   const YamlNode idle = root.at("idle");

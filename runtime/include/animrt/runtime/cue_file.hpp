@@ -6,9 +6,11 @@
 //   artnet: {universe: 0, channel: 1}   # a DMX channel's value (a cue's dmx) asks for it
 //   sacn: {universe: 1, channel: 1,     # the same over sACN (E1.31)
 //          joints: {neck_pan: {channel: 2, fine: 3, range: [-45, 45]}}, hold_s: 2}
+//   ltc: {fps: 25, freewheel_s: 1}      # cues with a `timecode` start chase LTC
 //   cues:
 //     rest:  {play: {gait: ../shows/neck_idle_gait.yaml}}
-//     hello: {play: {show: ../shows/hello.yaml}, crossfade_s: 0.5}
+//     hello: {play: {show: ../shows/hello.yaml}, crossfade_s: 0.5,
+//             timecode: "00:01:00:00", midi: {note: 60, channel: 1}}
 //     look:  {play: [{pose: {neck_pan: 40}, duration_s: 2}, {show: ../shows/hello.yaml}],
 //             then: rest}
 //
@@ -21,6 +23,8 @@
 
 #include "animrt/controllers/cues/cue_player.hpp"
 #include "animrt/controllers/cues/dmx_joints.hpp"
+#include "animrt/runtime/ltc_chase.hpp"
+#include "animrt/runtime/midi_input.hpp"
 #include "animrt/runtime/robot_config.hpp"
 
 namespace animrt {
@@ -45,6 +49,14 @@ struct LoadedCues {
   int artnet_channel = 0;
   DmxSection artnet;  // the same, and its joints
   DmxSection sacn;
+  // LTC timecode: cues bound to a start, the frame rate, how long a dropout
+  // freewheels.
+  bool ltc = false;
+  double ltc_fps = 25.0;
+  double ltc_freewheel_s = 1.0;
+  std::vector<TimecodeCue> timecode_cues;
+  // MIDI: the notes and programs that ask for cues.
+  std::vector<MidiBinding> midi;
 };
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot);
