@@ -92,10 +92,11 @@ def frame(cue=2):
     art.sendto(artdmx([0, 0, 0, 0, 255, 0]), ("127.0.0.1", artnet_port))
 assert wait_for("neck_pan", 30.0, 6.0, frame), "neck_pan never reached 30 (%.1f)" % measured("neck_pan")
 assert wait_for("neck_tilt", 25.0, 2.0, frame), "neck_tilt never reached 25 (%.1f)" % measured("neck_tilt")
-# Not output: a late sequence number, a lower priority, preview data, another universe.
-sacn.unicast(data_packet(7, [3, 0, 0], seq[0] - 1))
+# Not output: a late sequence number, a lower priority, preview data, another
+# universe. (The desk's own packets by the group's socket, so in order.)
+sacn.multicast(7, data_packet(7, [3, 0, 0], seq[0] - 1))
 sacn.unicast(data_packet(7, [3, 0, 0], 1, priority=50, cid=b"\x22" * 16))
-sacn.unicast(data_packet(7, [3, 0, 0], seq[0] + 1, options=0x80))
+sacn.multicast(7, data_packet(7, [3, 0, 0], seq[0] + 1, options=0x80))
 sacn.unicast(data_packet(8, [3, 0, 0], 1))
 # Malformed: a count that disagrees, a cut packet, a wrong identifier, priority 201.
 sacn.unicast(data_packet(7, [3, 0, 0], seq[0] + 2, count=10))
