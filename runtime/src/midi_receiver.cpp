@@ -1,6 +1,7 @@
 #include <alsa/asoundlib.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -64,6 +65,13 @@ MidiReceiver::MidiReceiver(const std::string& input, std::vector<MidiBinding> bi
   fd_ = ::open(input.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) fd_ = ::open(input.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) throw DeviceError("MIDI: cannot open " + input + ": " + std::strerror(errno));
+  // A terminal (a serial MIDI interface, a pty) passes bytes as they come,
+  // untranslated, only in raw mode.
+  termios tio{};
+  if (::isatty(fd_) && ::tcgetattr(fd_, &tio) == 0) {
+    ::cfmakeraw(&tio);
+    ::tcsetattr(fd_, TCSANOW, &tio);
+  }
   where_ = input;
   thread_ = std::thread([this] { read_stream(); });
 }

@@ -69,4 +69,5 @@ grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$
 grep -qE "^midi: 6 messages, 3 triggers, 2 unbound, 2 malformed, 0 from unknown ports$" <<<"$out" ||
   fail "$(grep '^midi' <<<"$out")"
 grep -qE "^cues started: rest 1 a 1 b 1 c 1$" <<<"$out" || fail "$(grep '^cues started' <<<"$out")"
+
 echo "ok: serve over MIDI"

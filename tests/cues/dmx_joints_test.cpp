@@ -13,7 +13,7 @@
 namespace animrt {
 namespace {
 
-std::vector<JointSpec> two_joints() {
+std::vector<JointSpec> dmx_two_joints() {
   std::vector<JointSpec> joints(2);
   for (JointSpec& j : joints) {
     j.limits.min_position = -1.0;
@@ -42,7 +42,7 @@ TEST(DmxJoints, LevelsMapOntoTheRangeInEightAndSixteenBits) {
 TEST(DmxJoints, ALostStreamHoldsThenEasesBackToTheCuesWithoutAStep) {
   DmxJointInputs inputs({{1, 1, 0, -1.0, 1.0}});
   // The cues drive joint 0 only: joint 1 goes home without DMX.
-  DmxJointSource source(make_pose_source({{0, 0.3}}), inputs, two_joints(), 0.5);
+  DmxJointSource source(make_pose_source({{0, 0.3}}), inputs, dmx_two_joints(), 0.5);
   ASSERT_EQ(source.driven_joints().size(), 2u);
   std::vector<double> targets(2, 0.0);
   const double dt = 0.01;

@@ -9,15 +9,15 @@
 namespace animrt {
 namespace {
 
-constexpr double kFrame = 1.0 / 25;
+constexpr double kLtcFrame = 1.0 / 25;
 
 // Frames from timecode `tc` at input time `at`, `count` of them, advancing
 // after each; the cues asked for, in order.
-std::vector<int> play(LtcChase& chase, double tc, double at, int count) {
+std::vector<int> ltc_play(LtcChase& chase, double tc, double at, int count) {
   std::vector<int> asked;
   for (int i = 0; i < count; ++i) {
-    chase.frame(tc + i * kFrame, at + (i + 1) * kFrame);
-    const int cue = chase.advance(at + (i + 1) * kFrame);
+    chase.frame(tc + i * kLtcFrame, at + (i + 1) * kLtcFrame);
+    const int cue = chase.advance(at + (i + 1) * kLtcFrame);
     if (cue >= 0) asked.push_back(cue);
   }
   return asked;
@@ -25,20 +25,20 @@ std::vector<int> play(LtcChase& chase, double tc, double at, int count) {
 
 TEST(LtcChase, CuesComeAsTheTimecodeCrossesThemAndAJumpReSyncs) {
   LtcChase chase(25, 0.5, {{0.4, 1}, {599.0, 2}, {600.8, 3}, {1200.0, 4}});
-  EXPECT_EQ(play(chase, 0.0, 0.0, 25), std::vector<int>{1});
+  EXPECT_EQ(ltc_play(chase, 0.0, 0.0, 25), std::vector<int>{1});
   EXPECT_NEAR(*chase.timecode(), 1.0, 1e-9);
   // Cued to ten minutes: the cue that should be playing there.
-  EXPECT_EQ(play(chase, 600.0, 1.0, 15), std::vector<int>{2});
+  EXPECT_EQ(ltc_play(chase, 600.0, 1.0, 15), std::vector<int>{2});
   EXPECT_EQ(chase.jumps(), 1u);
   // Silence: freewheels through 600.8 (cue 3), then frames where expected.
   std::vector<int> asked;
   for (int i = 1; i <= 10; ++i) {
-    const int cue = chase.advance(1.6 + i * kFrame);
+    const int cue = chase.advance(1.6 + i * kLtcFrame);
     if (cue >= 0) asked.push_back(cue);
   }
   EXPECT_EQ(asked, std::vector<int>{3});
   EXPECT_EQ(chase.dropouts(), 1u);
-  EXPECT_TRUE(play(chase, 601.0, 2.0, 10).empty());
+  EXPECT_TRUE(ltc_play(chase, 601.0, 2.0, 10).empty());
   EXPECT_EQ(chase.jumps(), 1u);
   // The signal ends: a dropout, and after freewheel_s the timecode is lost.
   EXPECT_EQ(chase.advance(2.4 + 0.3), -1);
@@ -48,7 +48,7 @@ TEST(LtcChase, CuesComeAsTheTimecodeCrossesThemAndAJumpReSyncs) {
   EXPECT_EQ(chase.dropouts(), 2u);
   EXPECT_EQ(chase.losses(), 1u);
   // A lock regained at a new time re-syncs without counting a jump.
-  EXPECT_EQ(play(chase, 1300.0, 5.0, 3), std::vector<int>{4});
+  EXPECT_EQ(ltc_play(chase, 1300.0, 5.0, 3), std::vector<int>{4});
   EXPECT_EQ(chase.jumps(), 1u);
   EXPECT_EQ(chase.frames(), 53u);
 }

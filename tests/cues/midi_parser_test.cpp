@@ -9,7 +9,7 @@
 namespace animrt {
 namespace {
 
-std::vector<MidiMessage> parse(MidiParser& parser, std::vector<std::uint8_t> bytes) {
+std::vector<MidiMessage> midi_parse(MidiParser& parser, std::vector<std::uint8_t> bytes) {
   std::vector<MidiMessage> out;
   for (std::uint8_t b : bytes) {
     MidiMessage m;
@@ -21,8 +21,8 @@ std::vector<MidiMessage> parse(MidiParser& parser, std::vector<std::uint8_t> byt
 TEST(MidiParser, RunningStatusRealTimeAndSysEx) {
   MidiParser parser;
   const auto messages =
-      parse(parser, {0x40, 0x90, 60, 0xF8, 100,  62, 0xFA, 0, 0xF0, 1, 2,    3,  0xF7,
-                     64,   0xC3, 5,  6,    0xF2, 1,  2,    7, 0xB0, 7, 0xFE, 100});
+      midi_parse(parser, {0x40, 0x90, 60, 0xF8, 100,  62, 0xFA, 0, 0xF0, 1, 2,    3,  0xF7,
+                          64,   0xC3, 5,  6,    0xF2, 1,  2,    7, 0xB0, 7, 0xFE, 100});
   ASSERT_EQ(messages.size(), 5u);
   EXPECT_EQ(messages[0].status, 0x90);
   EXPECT_EQ(messages[0].data1, 60);
