@@ -44,7 +44,7 @@ cues:
   d: {play: {pose: {eye_pan: 7}}, timecode: "00:20:00:00"}
 YAML
 "$animrt" serve "$robot" --cues "$tmp/cues.yaml" --backend sim --no-realtime --no-osc \
-  --ltc "$tmp/ltc.wav" --duration 4 > "$tmp/out.txt" 2> "$tmp/err.txt"
+  --ltc "$tmp/ltc.wav" --duration 3.2 > "$tmp/out.txt" 2> "$tmp/err.txt"
 code=$?
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out $(cat "$tmp/err.txt")"
