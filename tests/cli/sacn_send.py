@@ -22,7 +22,7 @@ def data_packet(universe, slots, sequence, priority=100, cid=b"\x11" * 16, optio
 
 
 class Sender:
-    def __init__(self, port, multicast_universe=None):
+    def __init__(self, port):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF,
                              socket.inet_aton("127.0.0.1"))
