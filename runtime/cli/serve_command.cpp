@@ -10,7 +10,6 @@
 #include <string>
 
 #include "animrt/core/error.hpp"
-#include "animrt/runtime/artnet_receiver.hpp"
 #include "animrt/runtime/cue_file.hpp"
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/osc_receiver.hpp"
@@ -21,6 +20,8 @@
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "service_notify.hpp"
+#include "serve_dmx.hpp"
+#include "serve_triggers.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "summary_file.hpp"
@@ -38,9 +39,8 @@ struct ServeArgs {
   std::string osc_bind = "127.0.0.1";
   int osc_port = 9000;
   bool no_osc = false;
-  std::string artnet_bind = "127.0.0.1";
-  int artnet_port = kArtNetPort;
-  bool no_artnet = false;
+  DmxArgs dmx;            // Art-Net and sACN
+  TriggerArgs triggers;   // LTC and MIDI
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
   std::string summary_json;  // empty = none
@@ -76,7 +76,7 @@ bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
 
 // What was played and what the triggers sent, after the run's summary.
 void print_cue_report(const CuePlayer& player, const CueRequests& requests, const OscReceiver* osc,
-                      const ArtNetReceiver* artnet) {
+                      const ServeDmx& dmx, const ServeTriggers& triggers) {
   std::cout << "cues started:";
   for (std::size_t c = 0; c < player.cues().size(); ++c) {
     std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
@@ -89,11 +89,8 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
     std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
               << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
   }
-  if (artnet) {
-    std::cout << "artnet: " << artnet->packets() << " packets, " << artnet->frames()
-              << " frames of the cue universe, " << artnet->malformed() << " malformed, "
-              << artnet->ignored() << " ignored\n";
-  }
+  dmx.report(std::cout);
+  triggers.report(std::cout);
 }
 
 // --summary-json: the run's summary and the cues' counts.
@@ -145,23 +142,6 @@ std::unique_ptr<OscReceiver> start_osc(const ServeArgs& args, const CuePlayer& p
   return osc;
 }
 
-std::unique_ptr<ArtNetReceiver> start_artnet(const ServeArgs& args, const LoadedCues& loaded,
-                                             CueRequests& requests) {
-  if (args.no_artnet || loaded.artnet_channel == 0) return nullptr;
-  auto artnet = std::make_unique<ArtNetReceiver>(
-      args.artnet_bind, args.artnet_port, loaded.artnet_universe, loaded.artnet_channel,
-      [&requests, values = loaded.dmx_values](int value) {
-        for (std::size_t c = 0; c < values.size(); ++c) {
-          if (values[c] == value) requests.cue(static_cast<int>(c));
-        }
-      });
-  std::cout << "artnet: listening on " << args.artnet_bind << ':' << artnet->port()
-            << " for universe " << loaded.artnet_universe << ", channel " << loaded.artnet_channel
-            << '\n'
-            << std::flush;
-  return artnet;
-}
-
 int serve(const ServeArgs& args) {
   install_stop_signals(serve_controls);
   if (args.lockstep && args.backend != "sim") {
@@ -187,7 +167,8 @@ int serve(const ServeArgs& args) {
   robot.motion = std::move(player);
   robot.steering.reset();
   const std::unique_ptr<OscReceiver> osc = start_osc(args, playing, requests);
-  const std::unique_ptr<ArtNetReceiver> artnet = start_artnet(args, loaded, requests);
+  const ServeDmx dmx(args.dmx, loaded, requests, robot.motion, robot.config.joints);
+  ServeTriggers triggers(args.triggers, loaded, requests);
 
   HardwareBackend hardware;
   SimulatedBackend simulated(SimulatedBackend::Settings{});
@@ -209,13 +190,14 @@ int serve(const ServeArgs& args) {
   RunHeartbeat heartbeat;
   options.heartbeat = &heartbeat;
   std::optional<ServiceNotifier> notifier(std::in_place, heartbeat);
+  options.on_motion_start = [&triggers](Nanos) { triggers.begin(); };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
   notifier.reset();
   const bool summary_written =
       !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, requests));
   std::cout << format_summary(summary);
-  print_cue_report(playing, requests, osc.get(), artnet.get());
+  print_cue_report(playing, requests, osc.get(), dmx, triggers);
   int code = summary.exit_code();
   if (!summary_written) {
     std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "
@@ -246,11 +228,8 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--osc-port", args->osc_port, "UDP port for OSC (0: a free one, printed)")
       ->check(CLI::Range(0, 65535));
   cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
-  cmd->add_option("--artnet-bind", args->artnet_bind,
-                  "address Art-Net listens on (loopback unless another is given)");
-  cmd->add_option("--artnet-port", args->artnet_port, "UDP port for Art-Net (0: a free one)")
-      ->check(CLI::Range(0, 65535));
-  cmd->add_flag("--no-artnet", args->no_artnet, "take no Art-Net triggers");
+  add_dmx_options(cmd, args->dmx);
+  add_trigger_options(cmd, args->triggers);
   cmd->add_option("--dashboard", args->dashboard,
                   "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,

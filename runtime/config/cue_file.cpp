@@ -10,6 +10,7 @@
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
+#include "animrt/runtime/ltc_chase.hpp"
 #include "animrt/runtime/robot_loader.hpp"
 
 namespace animrt {
@@ -137,7 +138,7 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
 Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
              const std::string& cue_path, const RobotConfig& robot,
              std::vector<std::string>& warnings) {
-  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx"});
+  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx", "timecode", "midi"});
   Cue cue;
   cue.name = name;
   cue.crossfade_s = crossfade;
@@ -197,6 +198,96 @@ void link_cue(std::vector<Cue>& cues, std::size_t c, int idle, const CueDraft& d
   }
 }
 
+// A cue's MIDI trigger: {note: N} or {program: N}, and an optional channel.
+void read_midi_binding(const YamlNode& node, LoadedCues& loaded) {
+  node.allow_only({"note", "program", "channel"});
+  if (node.has("note") == node.has("program")) node.fail("expected a note or a program, not both");
+  MidiBinding binding;
+  binding.cue = static_cast<int>(loaded.cues.size() - 1);
+  binding.program = node.has("program");
+  const YamlNode number = node.at(binding.program ? "program" : "note");
+  binding.number = static_cast<int>(number.as_int_in(0, 127));
+  if (auto channel = node.find("channel"))
+    binding.channel = static_cast<int>(channel->as_int_in(1, 16));
+  for (const MidiBinding& other : loaded.midi) {
+    if (other.program == binding.program && other.number == binding.number &&
+        (other.channel == 0 || binding.channel == 0 || other.channel == binding.channel)) {
+      number.fail("cue " + loaded.cues[static_cast<std::size_t>(other.cue)].name +
+                  " answers this MIDI message too");
+    }
+  }
+  loaded.midi.push_back(binding);
+}
+
+// A joint's DMX channels: `channel` (coarse), `fine` (optional) and the
+// `range` (degrees, or metres) that level 0 and full map to.
+DmxJoint make_dmx_joint(const std::string& name, const YamlNode& node, const RobotConfig& robot,
+                        std::vector<bool>& used) {
+  node.allow_only({"channel", "fine", "range"});
+  DmxJoint dmx;
+  dmx.joint = -1;
+  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+    if (robot.joints[j].name == name) dmx.joint = static_cast<int>(j);
+  }
+  if (dmx.joint < 0) node.fail("no joint " + quote(name) + " in robot " + robot.name);
+  auto channel = [&used](const YamlNode& at) {
+    const int c = static_cast<int>(at.as_int_in(1, 512));
+    if (used[static_cast<std::size_t>(c)])
+      at.fail("channel " + std::to_string(c) + " is used twice");
+    used[static_cast<std::size_t>(c)] = true;
+    return c;
+  };
+  dmx.coarse = channel(node.at("channel"));
+  if (auto fine = node.find("fine")) dmx.fine = channel(*fine);
+  const JointSpec& joint = robot.joints[static_cast<std::size_t>(dmx.joint)];
+  dmx.min = joint.limits.min_position;
+  dmx.max = joint.limits.max_position;
+  if (auto range = node.find("range")) {
+    const std::vector<YamlNode> ends = range->items();
+    if (!range->is_sequence() || ends.size() != 2) {
+      range->fail("expected [at level 0, at full], found " + range->describe());
+    }
+    const bool metres = joint.type == JointType::prismatic;
+    const double lo = metres ? joint.limits.min_position : rad_to_deg(joint.limits.min_position);
+    const double hi = metres ? joint.limits.max_position : rad_to_deg(joint.limits.max_position);
+    dmx.min = ends[0].as_double_in(lo, hi);
+    dmx.max = ends[1].as_double_in(lo, hi);
+    if (!metres) {
+      dmx.min = deg_to_rad(dmx.min);
+      dmx.max = deg_to_rad(dmx.max);
+    }
+  }
+  return dmx;
+}
+
+// `artnet:` or `sacn:`: the universe, the cue channel, joints.
+DmxSection make_dmx_section(const YamlNode& node, int lowest, int highest,
+                            const std::vector<int>& dmx_values, const RobotConfig& robot) {
+  node.allow_only({"universe", "channel", "joints", "hold_s"});
+  DmxSection section;
+  section.present = true;
+  section.universe = static_cast<int>(node.at("universe").as_int_in(lowest, highest));
+  std::vector<bool> used(513, false);
+  if (auto channel = node.find("channel")) {
+    section.channel = static_cast<int>(channel->as_int_in(1, 512));
+    used[static_cast<std::size_t>(section.channel)] = true;
+    bool any = false;
+    for (int value : dmx_values) any = any || value != 0;
+    if (!any) channel->fail("no cue has a dmx value, so this channel would ask for none");
+  }
+  if (auto joints = node.find("joints")) {
+    if (!joints->is_map()) joints->fail("expected a map of joints, found " + joints->describe());
+    for (const auto& [name, entry] : joints->entries()) {
+      section.joints.push_back(make_dmx_joint(name, entry, robot, used));
+    }
+  }
+  if (section.channel == 0 && section.joints.empty()) {
+    node.fail("expected a channel that selects cues, or joints it drives, found neither");
+  }
+  if (auto hold = node.find("hold_s")) section.hold_s = hold->as_double_in(0.0, 3600.0);
+  return section;
+}
+
 }  // namespace
 
 int find_cue(const std::vector<Cue>& cues, const std::string& name) {
@@ -208,10 +299,22 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
-  root.allow_only({"idle", "crossfade_s", "cues", "artnet"});
+  LoadedCues loaded;
+  root.allow_only({"idle", "crossfade_s", "cues", "artnet", "sacn", "ltc"});
+  if (auto ltc = root.find("ltc")) {
+    ltc->allow_only({"fps", "freewheel_s"});
+    loaded.ltc = true;
+    if (auto fps = ltc->find("fps")) {
+      loaded.ltc_fps = fps->as_double();
+      if (loaded.ltc_fps != 24.0 && loaded.ltc_fps != 25.0 && loaded.ltc_fps != 29.97 &&
+          loaded.ltc_fps != 30.0) {
+        fps->fail("expected 24, 25, 29.97 or 30 frames per second, found " + fps->as_string());
+      }
+    }
+    if (auto f = ltc->find("freewheel_s")) loaded.ltc_freewheel_s = f->as_double_in(0.0, 60.0);
+  }
   const double crossfade =
       root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
-  LoadedCues loaded;
   std::vector<CueDraft> drafts;
   const YamlNode list = root.at("cues");
   if (!list.is_map()) list.fail("expected a map of cue names to cues, found " + list.describe());
@@ -224,6 +327,16 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
     drafts.push_back({node.find("then"), node.find("loop"), node});
     const auto dmx = node.find("dmx");
     loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);
+    if (auto tc = node.find("timecode")) {
+      const auto start = parse_timecode(tc->as_string(), loaded.ltc_fps);
+      if (!start) {
+        tc->fail("expected a timecode HH:MM:SS:FF (frames below the ltc: fps), found " +
+                 quote(tc->as_string()));
+      }
+      if (!loaded.ltc) tc->fail("a timecode start needs an `ltc:` section (its frame rate)");
+      loaded.timecode_cues.push_back({*start, static_cast<int>(loaded.cues.size() - 1)});
+    }
+    if (auto midi = node.find("midi")) read_midi_binding(*midi, loaded);
   }
   if (loaded.cues.empty()) list.fail("expected at least one cue, found none");
   const YamlNode idle = root.at("idle");
@@ -244,12 +357,12 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
     }
   }
   if (auto artnet = root.find("artnet")) {
-    artnet->allow_only({"universe", "channel"});
-    loaded.artnet_universe = static_cast<int>(artnet->at("universe").as_int_in(0, 32767));
-    loaded.artnet_channel = static_cast<int>(artnet->at("channel").as_int_in(1, 512));
-    bool any = false;
-    for (int value : loaded.dmx_values) any = any || value != 0;
-    if (!any) artnet->fail("no cue has a dmx value, so Art-Net would ask for none");
+    loaded.artnet = make_dmx_section(*artnet, 0, 32767, loaded.dmx_values, robot);
+    loaded.artnet_universe = loaded.artnet.universe;
+    loaded.artnet_channel = loaded.artnet.channel;
+  }
+  if (auto sacn = root.find("sacn")) {
+    loaded.sacn = make_dmx_section(*sacn, 1, 63999, loaded.dmx_values, robot);
   }
   return loaded;
 }

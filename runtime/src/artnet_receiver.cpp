@@ -28,10 +28,11 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
 }
 
 ArtNetReceiver::ArtNetReceiver(const std::string& host, int port, int universe, int channel,
-                               Handler handler)
+                               Handler handler, FrameHandler frames)
     : universe_(universe),
       channel_(channel),
       handler_(std::move(handler)),
+      frame_handler_(std::move(frames)),
       udp_("Art-Net", host, port,
            [this](std::span<const std::uint8_t> datagram) { take(datagram); }) {}
 
@@ -47,8 +48,9 @@ void ArtNetReceiver::take(std::span<const std::uint8_t> datagram) {
     return;
   }
   frames_.fetch_add(1);
+  if (frame_handler_) frame_handler_(dmx.data);
   // A frame too short to hold the channel leaves it as it was.
-  if (static_cast<std::size_t>(channel_) > dmx.data.size()) return;
+  if (channel_ == 0 || static_cast<std::size_t>(channel_) > dmx.data.size()) return;
   const int value = dmx.data[static_cast<std::size_t>(channel_ - 1)];
   if (value == last_) return;
   last_ = value;

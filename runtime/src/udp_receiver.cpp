@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <netdb.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -17,7 +18,8 @@ namespace {
 constexpr int kPollMs = 100;
 constexpr std::size_t kMaxDatagram = 65536;
 
-int bind_udp(const std::string& what, const std::string& host, int port, int& bound_port) {
+int bind_udp(const std::string& what, const std::string& host, int port, bool reuse,
+             int& bound_port) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_DGRAM;
@@ -33,6 +35,8 @@ int bind_udp(const std::string& what, const std::string& host, int port, int& bo
   int error = 0;
   for (addrinfo* a = found; a != nullptr && fd < 0; a = a->ai_next) {
     fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    const int on = 1;
+    if (fd >= 0 && reuse) ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
     if (fd >= 0 && ::bind(fd, a->ai_addr, a->ai_addrlen) != 0) {
       error = errno;
       ::close(fd);
@@ -53,12 +57,34 @@ int bind_udp(const std::string& what, const std::string& host, int port, int& bo
   return fd;
 }
 
+void join_group(const std::string& what, int fd, const UdpOptions& options) {
+  ip_mreq request{};
+  std::string problem;
+  if (::inet_pton(AF_INET, options.group.c_str(), &request.imr_multiaddr) != 1 ||
+      ::inet_pton(AF_INET, options.interface.c_str(), &request.imr_interface) != 1) {
+    problem = "multicast needs IPv4 addresses";
+  } else if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &request, sizeof request) != 0) {
+    problem = std::strerror(errno);
+  }
+  if (problem.empty()) return;
+  ::close(fd);
+  throw std::runtime_error(what + ": cannot join multicast group " + options.group +
+                           " on the interface of " + options.interface + ": " + problem);
+}
+
 }  // namespace
 
 UdpReceiver::UdpReceiver(const std::string& what, const std::string& host, int port,
-                         Handler handler)
+                         Handler handler, const UdpOptions& options)
     : handler_(std::move(handler)) {
-  fd_ = bind_udp(what, host, port, port_);
+  fd_ = bind_udp(what, host, port, options.reuse_address, port_);
+  if (!options.group.empty()) {
+    join_group(what, fd_, options);
+  } else {
+    // A socket bound to a wildcard address takes no group another socket joined.
+    const int off = 0;
+    ::setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_ALL, &off, sizeof off);
+  }
   // Room for a burst from a show controller while this thread is not running.
   // (SO_RCVBUFFORCE passes the system's cap where permitted; else the cap holds.)
   const int buffer = 1 << 20;

@@ -34,9 +34,13 @@ class ArtNetReceiver {
  public:
   // Called with the channel's new value when it changes.
   using Handler = std::function<void(int value)>;
+  // Called with every ArtDmx frame of the universe (all its channels).
+  using FrameHandler = std::function<void(std::span<const std::uint8_t> data)>;
 
-  // Listens at `host`:`port` for `universe`, channel `channel` (1-512).
-  ArtNetReceiver(const std::string& host, int port, int universe, int channel, Handler handler);
+  // Listens at `host`:`port` for `universe`, channel `channel` (1-512; 0:
+  // no cue channel, frames only).
+  ArtNetReceiver(const std::string& host, int port, int universe, int channel, Handler handler,
+                 FrameHandler frames = {});
 
   int port() const { return udp_.port(); }
   std::uint64_t packets() const { return udp_.datagrams(); }
@@ -50,6 +54,7 @@ class ArtNetReceiver {
   int universe_;
   int channel_;
   Handler handler_;
+  FrameHandler frame_handler_;
   int last_ = 0;  // the receiving thread's: the channel's value in the last frame
   std::atomic<std::uint64_t> frames_{0}, malformed_{0}, ignored_{0};
   UdpReceiver udp_;  // last: its thread stops before the rest goes

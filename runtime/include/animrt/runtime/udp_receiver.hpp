@@ -12,6 +12,12 @@
 
 namespace animrt {
 
+struct UdpOptions {
+  bool reuse_address = false;  // share the port with another socket (unicast and multicast)
+  std::string group;           // a multicast group to join, empty: none
+  std::string interface;       // the address of the interface to join it on
+};
+
 class UdpReceiver {
  public:
   // A datagram longer than the largest UDP payload comes as an empty span.
@@ -19,7 +25,8 @@ class UdpReceiver {
 
   // Binds UDP `host`:`port` (port 0: a free one). Throws std::runtime_error
   // naming `what` and the address when it cannot.
-  UdpReceiver(const std::string& what, const std::string& host, int port, Handler handler);
+  UdpReceiver(const std::string& what, const std::string& host, int port, Handler handler,
+              const UdpOptions& options = {});
   ~UdpReceiver();
   UdpReceiver(const UdpReceiver&) = delete;
   UdpReceiver& operator=(const UdpReceiver&) = delete;

@@ -1,0 +1,99 @@
+#include "animrt/runtime/ltc_chase.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace animrt {
+namespace {
+
+constexpr double kJumpFrames = 1.5;
+constexpr double kDropoutFrames = 2.5;
+
+}  // namespace
+
+LtcChase::LtcChase(double fps, double freewheel_s, std::vector<TimecodeCue> cues)
+    : frame_s_(1.0 / fps), freewheel_s_(freewheel_s), cues_(std::move(cues)) {
+  std::stable_sort(cues_.begin(), cues_.end(), [](const TimecodeCue& a, const TimecodeCue& b) {
+    return a.start_s < b.start_s;
+  });
+}
+
+void LtcChase::frame(double timecode_s, double end_s) {
+  ++frames_;
+  // The frame's timecode is its start's; at its end the next frame begins.
+  const double at_end = timecode_s + frame_s_;
+  if (locked_) {
+    const double expected = anchor_tc_ + (end_s - anchor_at_);
+    if (std::abs(at_end - expected) > kJumpFrames * frame_s_) {
+      ++jumps_;
+      resync_ = true;
+    }
+  } else {
+    resync_ = true;  // first lock, or lock regained after a loss
+  }
+  locked_ = true;
+  anchor_tc_ = at_end;
+  anchor_at_ = end_s;
+}
+
+int LtcChase::advance(double now_s) {
+  if (!locked_) {
+    position_.reset();
+    return -1;
+  }
+  // (A late frame from before a silence does not end the dropout.)
+  const double silent = now_s - anchor_at_;
+  if (silent <= kDropoutFrames * frame_s_) {
+    in_dropout_ = false;
+  } else if (!in_dropout_) {
+    in_dropout_ = true;
+    ++dropouts_;
+  }
+  if (silent > freewheel_s_) {
+    locked_ = false;
+    ++losses_;
+    position_.reset();
+    return -1;
+  }
+  const double now_tc = anchor_tc_ + silent;
+  int cue = -1;
+  if (resync_ || !position_) {
+    cue = playing_at(now_tc);
+    resync_ = false;
+  } else {
+    cue = due(*position_, now_tc);
+  }
+  position_ = now_tc;
+  return cue;
+}
+
+int LtcChase::due(double from, double to) const {
+  int cue = -1;
+  for (const TimecodeCue& c : cues_) {
+    if (c.start_s > from && c.start_s <= to) cue = c.cue;
+  }
+  return cue;
+}
+
+int LtcChase::playing_at(double t) const {
+  int cue = -1;
+  for (const TimecodeCue& c : cues_) {
+    if (c.start_s <= t) cue = c.cue;
+  }
+  return cue;
+}
+
+std::optional<double> parse_timecode(const std::string& text, double fps) {
+  int h = 0, m = 0, s = 0, f = 0;
+  char sep = 0;
+  int used = 0;
+  if (std::sscanf(text.c_str(), "%2d:%2d:%2d%c%2d%n", &h, &m, &s, &sep, &f, &used) != 5 ||
+      used != static_cast<int>(text.size()) || (sep != ':' && sep != ';') || h > 23 || m > 59 ||
+      s > 59 || f >= std::ceil(fps) || h < 0 || m < 0 || s < 0 || f < 0) {
+    return std::nullopt;
+  }
+  return h * 3600.0 + m * 60.0 + s + f / fps;
+}
+
+}  // namespace animrt
