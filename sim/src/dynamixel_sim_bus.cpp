@@ -96,6 +96,7 @@ DynamixelSimBus::DynamixelSimBus(const BusConfig& config, const Clock& clock, Jo
   answers_.bytes.reserve(most);
   answers_.list.reserve(firmware_.size() + 1);
   due_.reserve(firmware_.size() + 1);
+  if (lockstep_) line_ = std::make_shared<LockstepLine>();
   // Joined last: a bus whose pty could not be opened never holds the others up.
   if (lockstep_ && physics_ != nullptr) party_ = physics_->join_lockstep();
 }
@@ -121,6 +122,7 @@ void DynamixelSimBus::start() {
   while (::read(wake_[0], drain, sizeof(drain)) > 0) {
   }
   stop_ = false;
+  if (line_) line_->device_serving(true);
   thread_ = std::thread([this] { serve(); });
 }
 
@@ -131,6 +133,7 @@ void DynamixelSimBus::stop() {
   const std::uint8_t wake = 1;
   [[maybe_unused]] const ssize_t n = ::write(wake_[1], &wake, 1);
   thread_.join();
+  if (line_) line_->device_serving(false);
 }
 
 void DynamixelSimBus::serve() {
@@ -150,7 +153,8 @@ void DynamixelSimBus::serve() {
                  // receive timeout does.
                  dropped_partial_ += decoder_.buffered();
                  decoder_.reset();
-               }});
+               }},
+              line_.get());
 }
 
 void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
@@ -216,7 +220,9 @@ Nanos DynamixelSimBus::wire_ns(std::size_t bytes) const {
 }
 
 void DynamixelSimBus::send(std::span<const std::uint8_t> bytes) {
-  dropped_bytes_ += bytes.size() - line::write_all(master_, wake_[0], bytes);
+  const std::size_t written = line::write_all(master_, wake_[0], bytes);
+  if (line_) line_->device_wrote(written);
+  dropped_bytes_ += bytes.size() - written;
 }
 
 void DynamixelSimBus::set_device_responding(int device_id, bool responding) {

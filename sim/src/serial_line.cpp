@@ -83,7 +83,7 @@ std::size_t write_all(int fd, int wake_fd, std::span<const std::uint8_t> bytes) 
 }
 
 void serve(int master_fd, int wake_fd, const std::atomic<bool>& stop,
-           std::span<std::uint8_t> buffer, const LineHandlers& handlers) {
+           std::span<std::uint8_t> buffer, const LineHandlers& handlers, LockstepLine* lockstep) {
   const MonotonicClock wall;
   Nanos last_byte = 0;
   while (!stop.load()) {
@@ -105,6 +105,7 @@ void serve(int master_fd, int wake_fd, const std::atomic<bool>& stop,
       if (n > 0) {
         last_byte = wall.now();
         handlers.on_bytes(buffer.first(static_cast<std::size_t>(n)), last_byte);
+        if (lockstep != nullptr) lockstep->device_took(static_cast<std::size_t>(n));
         continue;
       }
       if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;

@@ -16,6 +16,7 @@ std::vector<std::unique_ptr<SimulatedBus>> start_simulated_devices(std::vector<B
     auto sim = make_simulated_bus(bus, clock, physics, startup);
     sim->start();
     bus.port = sim->endpoint();
+    bus.lockstep_line = sim->lockstep_line();
     simulated.push_back(std::move(sim));
   }
   return simulated;
@@ -53,7 +54,11 @@ void SimulatedBackend::check(const RobotConfig& config, bool lockstep) const {
 }
 
 void SimulatedBackend::adjust(RobotConfig& config, bool lockstep) const {
-  if (lockstep) widen_timeouts_for_lockstep(config.buses);
+  if (!lockstep) return;
+  widen_timeouts_for_lockstep(config.buses);
+  // Nor does the wire take simulated time: its emulation (real time, for
+  // real-time runs) would only make a lockstep run slower, never different.
+  for (BusConfig& bus : config.buses) bus.sim.wire_time = false;
 }
 
 std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Clock& clock) {

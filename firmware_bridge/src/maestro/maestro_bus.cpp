@@ -98,14 +98,16 @@ void MaestroBus::send(std::size_t length) {
 
 std::size_t MaestroBus::receive(std::size_t want, std::chrono::microseconds timeout) {
   const auto deadline = steady_clock::now() + timeout;
+  // A lockstep line (lockstep_line.hpp) says when nothing more will come.
+  const bool line = transport_->follows_line();
   std::size_t got = 0;
   while (got < want) {
     const auto now = steady_clock::now();
-    if (now >= deadline) break;
-    const std::size_t n =
-        transport_->read({rx_.data() + got, want - got},
-                         std::chrono::ceil<std::chrono::microseconds>(deadline - now));
-    if (n == 0 && transport_->failure() != nullptr) break;  // line gone: nothing will come
+    if (!line && now >= deadline) break;
+    const std::size_t n = transport_->read(
+        {rx_.data() + got, want - got},
+        line ? timeout : std::chrono::ceil<std::chrono::microseconds>(deadline - now));
+    if (n == 0 && (line || transport_->failure() != nullptr)) break;  // nothing will come
     got += n;
   }
   return got;

@@ -25,6 +25,8 @@ class FdTransport : public ByteTransport {
   int failure_errno() const override { return failure_errno_; }
   std::uint64_t write_failures() const override { return write_failures_; }
   const std::string& port() const override { return port_; }
+  void follow(std::shared_ptr<LockstepLine> line) override { line_ = std::move(line); }
+  bool follows_line() const override { return line_ != nullptr; }
 
  protected:
   // `fd` must be non-blocking; the derived class owns and closes it.
@@ -34,6 +36,12 @@ class FdTransport : public ByteTransport {
  private:
   // Marks the line failed (first reason kept); no allocation.
   void line_gone(const char* how, int error);
+  // Reads queued bytes away until the lockstep line's device side has
+  // nothing unread, or the deadline.
+  void discard_lockstep(std::int64_t deadline_ns);
+  bool write_all(std::span<const std::uint8_t> bytes, std::size_t& done);
+  // `n` bytes read (> 0): counted on the lockstep line; returns n.
+  std::size_t took(long n);
 
   std::string port_;
   int fd_ = -1;
@@ -41,6 +49,7 @@ class FdTransport : public ByteTransport {
   const char* failure_ = nullptr;
   int failure_errno_ = 0;
   std::uint64_t write_failures_ = 0;
+  std::shared_ptr<LockstepLine> line_;  // lockstep runs on simulated devices only
 };
 
 // "cannot open serial port PORT: REASON", with a hint for the usual causes.

@@ -39,7 +39,9 @@ std::unique_ptr<ByteTransport> open_serial(const std::string& port, int baud) {
 
 std::unique_ptr<ByteTransport> open_bus_serial(const BusConfig& bus) {
   try {
-    return open_serial(bus.port, bus.baud);
+    std::unique_ptr<ByteTransport> line = open_serial(bus.port, bus.baud);
+    if (bus.lockstep_line) line->follow(bus.lockstep_line);
+    return line;
   } catch (const DeviceError& e) {
     throw DeviceError("bus " + bus.name + ": " + e.what());
   }

@@ -24,6 +24,7 @@ FeetechSimBus::FeetechSimBus(const BusConfig& config, ft::Series series, const C
   line::set_line_baud(pty_.master(), config_.baud);  // until a host sets its own
   answers_.bytes.reserve((board_.size() + 1) * ft::kMaxPacket);
   answers_.list.reserve(board_.size() + 1);
+  if (lockstep_) line_ = std::make_shared<LockstepLine>();
 }
 
 FeetechSimBus::~FeetechSimBus() {
@@ -37,6 +38,7 @@ void FeetechSimBus::start() {
   if (thread_.joinable()) return;
   wake_.drain();
   stop_ = false;
+  if (line_) line_->device_serving(true);
   thread_ = std::thread([this] { serve(); });
 }
 
@@ -45,6 +47,7 @@ void FeetechSimBus::stop() {
   stop_ = true;
   wake_.wake();
   thread_.join();
+  if (line_) line_->device_serving(false);
 }
 
 void FeetechSimBus::serve() {
@@ -58,7 +61,8 @@ void FeetechSimBus::serve() {
                [this] {
                  dropped_partial_ += decoder_.buffered();  // a servo's receive timeout
                  decoder_.reset();
-               }});
+               }},
+              line_.get());
 }
 
 void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
@@ -89,7 +93,8 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
 Nanos FeetechSimBus::wire_ns(std::size_t bytes) const { return line::wire_ns(bytes, config_.baud); }
 
 void FeetechSimBus::send(std::span<const std::uint8_t> bytes) {
-  line::write_all(pty_.master(), wake_.read_fd(), bytes);
+  const std::size_t written = line::write_all(pty_.master(), wake_.read_fd(), bytes);
+  if (line_) line_->device_wrote(written);
 }
 
 FeetechServo& FeetechSimBus::servo(int device_id) {

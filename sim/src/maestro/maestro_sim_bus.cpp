@@ -35,6 +35,7 @@ MaestroSimBus::MaestroSimBus(const BusConfig& config, const Clock& clock)
     boards_.back().set_serial_timeout(static_cast<Nanos>(options.serial_timeout_ms * 1e6));
   }
   answers_.reserve(4096);
+  if (lockstep_) line_ = std::make_shared<LockstepLine>();
 }
 
 MaestroSimBus::~MaestroSimBus() { stop(); }
@@ -45,6 +46,7 @@ void MaestroSimBus::start() {
   if (thread_.joinable()) return;
   wake_.drain();
   stop_ = false;
+  if (line_) line_->device_serving(true);
   thread_ = std::thread([this] { serve(); });
 }
 
@@ -53,6 +55,7 @@ void MaestroSimBus::stop() {
   stop_ = true;
   wake_.wake();
   thread_.join();
+  if (line_) line_->device_serving(false);
 }
 
 void MaestroSimBus::serve() {
@@ -68,6 +71,7 @@ void MaestroSimBus::serve() {
       const ssize_t n = ::read(pty_.master(), buffer.data(), buffer.size());
       if (n > 0) {
         process(buffer.data(), static_cast<std::size_t>(n));
+        if (line_) line_->device_took(static_cast<std::size_t>(n));
         continue;
       }
       if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
@@ -111,6 +115,7 @@ void MaestroSimBus::process(const std::uint8_t* bytes, std::size_t n) {
     const ssize_t w = ::write(pty_.master(), answers_.data() + done, answers_.size() - done);
     if (w > 0) {
       done += static_cast<std::size_t>(w);
+      if (line_) line_->device_wrote(static_cast<std::size_t>(w));
     } else if (w < 0 && errno == EAGAIN) {
       pollfd fd{pty_.master(), POLLOUT, 0};
       if (::poll(&fd, 1, 200) <= 0) break;  // the client stopped reading

@@ -5,6 +5,7 @@
 #include <any>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@
 #include "animrt/core/error.hpp"
 
 namespace animrt {
+
+class LockstepLine;
 
 // How a joint maps to one device on a bus.
 struct ActuatorBinding {
@@ -102,6 +105,9 @@ struct BusConfig {
   // The loop period (s) the bus will run at, known before its keys are read
   // (defaults such as device_watchdog_ms depend on it); 0 when not known.
   double loop_period_s = 0.0;
+  // Set by simulated devices on a lockstep clock (lockstep_line.hpp); the
+  // bus's transport follows it. Empty on hardware.
+  std::shared_ptr<LockstepLine> lockstep_line;
 };
 
 }  // namespace animrt

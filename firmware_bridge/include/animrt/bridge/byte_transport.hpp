@@ -11,6 +11,8 @@
 
 namespace animrt {
 
+class LockstepLine;
+
 class ByteTransport {
  public:
   virtual ~ByteTransport() = default;
@@ -36,6 +38,14 @@ class ByteTransport {
   // Writes that did not complete (stalled or failed), since opening.
   virtual std::uint64_t write_failures() const = 0;
   virtual const std::string& port() const = 0;
+  // In a lockstep run on simulated devices the transport follows the line
+  // (lockstep_line.hpp): a read then waits, whatever its timeout, until
+  // bytes come or the line has settled (a guard stops it on a hung device
+  // side), so a read that returns nothing means the answer is missing.
+  // Hardware has no such line; a transport that follows none waits its
+  // timeouts.
+  virtual void follow(std::shared_ptr<LockstepLine> line) { (void)line; }
+  virtual bool follows_line() const { return false; }
 
   static constexpr std::size_t kMaxDiscard = 4096;
 };

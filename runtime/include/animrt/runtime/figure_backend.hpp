@@ -30,7 +30,8 @@ class FigureBackend {
     (void)lockstep;
   }
   // Adjusts the bus configs to the backend before anything starts (a
-  // simulated device answers in no simulated time: lockstep timeouts widen).
+  // simulated device answers in no simulated time: lockstep timeouts widen,
+  // and the wire is not emulated).
   virtual void adjust(RobotConfig& config, bool lockstep) const {
     (void)config;
     (void)lockstep;

@@ -85,6 +85,7 @@ class DynamixelSimBus final : public SimulatedBus {
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
+  std::shared_ptr<LockstepLine> lockstep_line() const override { return line_; }
   // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
   void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
   void hand_move(int device_id, std::int32_t ticks) override;
@@ -120,7 +121,8 @@ class DynamixelSimBus final : public SimulatedBus {
   // Serving thread only.
   bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
-  Nanos last_time_ = 0;  // when the previous packet took effect
+  std::shared_ptr<LockstepLine> line_;  // lockstep only
+  Nanos last_time_ = 0;                 // when the previous packet took effect
   dxl::Decoder decoder_;
   Answers answers_;
   Nanos bus_free_ = 0;      // wire time: when the emulated line is idle again

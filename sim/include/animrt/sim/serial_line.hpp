@@ -13,6 +13,7 @@
 #include <functional>
 #include <span>
 
+#include "animrt/bridge/lockstep_line.hpp"
 #include "animrt/bridge/serial_servo/servo_link.hpp"
 #include "animrt/core/clock.hpp"
 
@@ -39,14 +40,17 @@ std::size_t write_all(int fd, int wake_fd, std::span<const std::uint8_t> bytes);
 
 // The thread's loop, until `stop` or `wake_fd` is readable: each read's
 // bytes go to on_bytes(bytes, arrival); while partial() says a packet is
-// half received, kPacketSilenceMs of silence calls on_silence().
+// half received, kPacketSilenceMs of silence calls on_silence(). On a
+// lockstep line (if given), each read's bytes are taken once on_bytes has
+// answered them.
 struct LineHandlers {
   std::function<void(std::span<const std::uint8_t>, Nanos)> on_bytes;
   std::function<bool()> partial;
   std::function<void()> on_silence;
 };
 void serve(int master_fd, int wake_fd, const std::atomic<bool>& stop,
-           std::span<std::uint8_t> buffer, const LineHandlers& handlers);
+           std::span<std::uint8_t> buffer, const LineHandlers& handlers,
+           LockstepLine* lockstep = nullptr);
 
 // Counts of what the firmware could not take as a packet (read by other
 // threads for statistics).

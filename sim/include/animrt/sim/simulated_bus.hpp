@@ -10,6 +10,7 @@
 #include <string>
 
 #include "animrt/bridge/bus_config.hpp"
+#include "animrt/bridge/lockstep_line.hpp"
 #include "animrt/core/clock.hpp"
 
 namespace animrt {
@@ -51,6 +52,10 @@ class SimulatedBus {
     (void)change;
     throw std::logic_error("simulated bus " + endpoint() + ": device health is not modelled");
   }
+  // On a lockstep clock: the line the host's transport follows, so that it
+  // knows when the devices have answered all they will (lockstep_line.hpp);
+  // nullptr on the wall clock, and where the devices keep no such line.
+  virtual std::shared_ptr<LockstepLine> lockstep_line() const { return nullptr; }
   // Position of a device in radians (through its binding), for tests.
   virtual double device_position(int device_id) const = 0;
 

@@ -18,7 +18,9 @@
 //   next, so N healthy servos never time out a read because N answers take
 //   longer than one; a silent servo costs one timeout. Past the wait the
 //   core looks once more without waiting: an answer queued while this
-//   thread was not running is not a timeout;
+//   thread was not running is not a timeout. On a lockstep line to
+//   simulated devices (lockstep_line.hpp) an answer is missing once the
+//   devices have settled without it, whatever the wall clock says;
 // - the status book (StatusBook): every counter and health change;
 // - ping rounds at configure (ping_until_answered) and the one error that
 //   lists every device that stayed silent or answered garbage.
@@ -401,11 +403,14 @@ class Link {
   std::size_t read_raw(std::span<std::uint8_t> buffer, std::size_t got, AnswerClock& clock,
                        Done&& done) {
     bool late = false;
+    const bool line = transport_->follows_line();
     for (;;) {
       if (done(std::span<const std::uint8_t>(buffer.data(), got)) || got == buffer.size()) break;
       const auto now = Clock::now();
       std::chrono::microseconds wait{0};
-      if (now < clock.deadline()) {
+      if (line) {
+        wait = timeout_;  // the line, not the wall clock, says when nothing more comes
+      } else if (now < clock.deadline()) {
         wait = std::chrono::ceil<std::chrono::microseconds>(clock.deadline() - now);
       } else if (late) {
         break;
@@ -414,7 +419,7 @@ class Link {
       }
       const std::size_t n = transport_->read(buffer.subspan(got), wait);
       got += n;
-      if (n == 0 && (wait.count() == 0 || transport_->failure() != nullptr)) break;
+      if (n == 0 && (line || wait.count() == 0 || transport_->failure() != nullptr)) break;
     }
     return got;
   }
@@ -436,7 +441,12 @@ class Link {
       }
       const auto now = Clock::now();
       std::chrono::microseconds wait{0};
-      if (now < deadline) {
+      const bool line = transport_->follows_line();
+      if (line) {
+        // A lockstep line: a read returns nothing only once the simulated
+        // devices have settled without this answer (lockstep_line.hpp).
+        wait = timeout_;
+      } else if (now < deadline) {
         wait = std::chrono::ceil<std::chrono::microseconds>(deadline - now);
       } else if (late_look_done_) {
         return Frame::need_more;
@@ -448,7 +458,7 @@ class Link {
       rx_begin_ = 0;
       rx_end_ = transport_->read(rx_, wait);
       // A failed line answers nothing, at once: no point waiting.
-      if (rx_end_ == 0 && (wait.count() == 0 || transport_->failure() != nullptr)) {
+      if (rx_end_ == 0 && (line || wait.count() == 0 || transport_->failure() != nullptr)) {
         return Frame::need_more;
       }
     }

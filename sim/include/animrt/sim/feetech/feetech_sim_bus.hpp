@@ -63,6 +63,7 @@ class FeetechSimBus final : public SimulatedBus {
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
+  std::shared_ptr<LockstepLine> lockstep_line() const override { return line_; }
   void hand_move(int device_id, std::int32_t ticks) override;
   ServoReadout servo_readout(int device_id) const override;
   void set_device_plugged(std::size_t index, bool plugged) override;
@@ -90,6 +91,7 @@ class FeetechSimBus final : public SimulatedBus {
 
   bool any_baud_ = false;  // ServoStartup::any_baud
   bool lockstep_ = false;
+  std::shared_ptr<LockstepLine> line_;  // lockstep only
   Nanos last_time_ = 0;
   ft::Decoder decoder_;
   FeetechAnswers answers_;

@@ -47,6 +47,7 @@ class MaestroSimBus final : public SimulatedBus {
   // `error_bits` are Maestro error register bits (low byte).
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
   double device_position(int device_id) const override;
+  std::shared_ptr<LockstepLine> lockstep_line() const override { return line_; }
 
   MaestroSimStats stats() const;
   // Output pulse (quarter-us) of a channel, for tests.
@@ -67,6 +68,7 @@ class MaestroSimBus final : public SimulatedBus {
   PtyPair pty_;
   WakePipe wake_;
   bool lockstep_;
+  std::shared_ptr<LockstepLine> line_;  // lockstep only
   Nanos last_time_;
   mutable std::mutex mutex_;  // guards boards_
   std::vector<MaestroBoard> boards_;
