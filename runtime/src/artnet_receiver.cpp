@@ -30,9 +30,7 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
 ArtNetReceiver::ArtNetReceiver(const std::string& host, int port, int universe, int channel,
                                Handler handler, FrameHandler frames)
     : universe_(universe),
-      channel_(channel),
-      handler_(std::move(handler)),
-      frame_handler_(std::move(frames)),
+      watch_(channel, std::move(handler), std::move(frames)),
       udp_("Art-Net", host, port,
            [this](std::span<const std::uint8_t> datagram) { take(datagram); }) {}
 
@@ -47,14 +45,7 @@ void ArtNetReceiver::take(std::span<const std::uint8_t> datagram) {
     ignored_.fetch_add(1);
     return;
   }
-  frames_.fetch_add(1);
-  if (frame_handler_) frame_handler_(dmx.data);
-  // A frame too short to hold the channel leaves it as it was.
-  if (channel_ == 0 || static_cast<std::size_t>(channel_) > dmx.data.size()) return;
-  const int value = dmx.data[static_cast<std::size_t>(channel_ - 1)];
-  if (value == last_) return;
-  last_ = value;
-  handler_(value);
+  watch_.take(dmx.data);
 }
 
 }  // namespace animrt

@@ -104,10 +104,7 @@ std::string SacnReceiver::group(int universe) {
 
 SacnReceiver::SacnReceiver(const std::string& host, int port, bool multicast, int universe,
                            int channel, Handler handler, FrameHandler frames)
-    : universe_(universe),
-      channel_(channel),
-      handler_(std::move(handler)),
-      frame_handler_(std::move(frames)) {
+    : universe_(universe), watch_(channel, std::move(handler), std::move(frames)) {
   auto take = [this](std::span<const std::uint8_t> datagram) { this->take(datagram); };
   UdpOptions shared;
   shared.reuse_address = multicast;
@@ -141,14 +138,7 @@ void SacnReceiver::take(std::span<const std::uint8_t> datagram) {
     if (verdict != SacnSources::Verdict::out_of_sequence) ignored_.fetch_add(1);
     return;
   }
-  frames_.fetch_add(1);
-  if (frame_handler_) frame_handler_(dmx.data);
-  // A frame too short to hold the channel leaves it as it was.
-  if (channel_ == 0 || static_cast<std::size_t>(channel_) > dmx.data.size()) return;
-  const int value = dmx.data[static_cast<std::size_t>(channel_ - 1)];
-  if (value == last_) return;
-  last_ = value;
-  handler_(value);
+  watch_.take(dmx.data);
 }
 
 }  // namespace animrt

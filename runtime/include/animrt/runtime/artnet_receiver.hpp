@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 
+#include "animrt/runtime/dmx_channel_watch.hpp"
 #include "animrt/runtime/udp_receiver.hpp"
 
 namespace animrt {
@@ -32,10 +33,8 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out);
 
 class ArtNetReceiver {
  public:
-  // Called with the channel's new value when it changes.
-  using Handler = std::function<void(int value)>;
-  // Called with every ArtDmx frame of the universe (all its channels).
-  using FrameHandler = std::function<void(std::span<const std::uint8_t> data)>;
+  using Handler = DmxChannelWatch::Handler;
+  using FrameHandler = DmxChannelWatch::FrameHandler;
 
   // Listens at `host`:`port` for `universe`, channel `channel` (1-512; 0:
   // no cue channel, frames only).
@@ -44,7 +43,7 @@ class ArtNetReceiver {
 
   int port() const { return udp_.port(); }
   std::uint64_t packets() const { return udp_.datagrams(); }
-  std::uint64_t frames() const { return frames_.load(); }  // ArtDmx of our universe
+  std::uint64_t frames() const { return watch_.frames(); }  // ArtDmx of our universe
   std::uint64_t malformed() const { return malformed_.load(); }
   std::uint64_t ignored() const { return ignored_.load(); }
 
@@ -52,11 +51,8 @@ class ArtNetReceiver {
   void take(std::span<const std::uint8_t> datagram);
 
   int universe_;
-  int channel_;
-  Handler handler_;
-  FrameHandler frame_handler_;
-  int last_ = 0;  // the receiving thread's: the channel's value in the last frame
-  std::atomic<std::uint64_t> frames_{0}, malformed_{0}, ignored_{0};
+  DmxChannelWatch watch_;
+  std::atomic<std::uint64_t> malformed_{0}, ignored_{0};
   UdpReceiver udp_;  // last: its thread stops before the rest goes
 };
 

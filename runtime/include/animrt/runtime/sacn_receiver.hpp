@@ -18,6 +18,7 @@
 #include <span>
 #include <string>
 
+#include "animrt/runtime/dmx_channel_watch.hpp"
 #include "animrt/runtime/udp_receiver.hpp"
 
 namespace animrt {
@@ -71,10 +72,8 @@ class SacnSources {
 
 class SacnReceiver {
  public:
-  // Called with the channel's new value when it changes.
-  using Handler = std::function<void(int value)>;
-  // Called with every frame output for the universe (all its channels).
-  using FrameHandler = std::function<void(std::span<const std::uint8_t> data)>;
+  using Handler = DmxChannelWatch::Handler;
+  using FrameHandler = DmxChannelWatch::FrameHandler;
 
   // Listens at `host`:`port` for `universe` (1-63999); with `multicast`,
   // also joins 239.255.hi.lo on the interface that has address `host`.
@@ -86,7 +85,7 @@ class SacnReceiver {
   std::uint64_t packets() const {
     return unicast_->datagrams() + (multicast_ ? multicast_->datagrams() : 0);
   }
-  std::uint64_t frames() const { return frames_.load(); }  // output for our universe
+  std::uint64_t frames() const { return watch_.frames(); }  // output for our universe
   std::uint64_t malformed() const { return malformed_.load(); }
   std::uint64_t out_of_sequence() const { return out_of_sequence_.load(); }
   std::uint64_t ignored() const { return ignored_.load(); }  // other kinds, universes, priorities
@@ -97,15 +96,12 @@ class SacnReceiver {
   void take(std::span<const std::uint8_t> datagram);
 
   int universe_;
-  int channel_;
-  Handler handler_;
-  FrameHandler frame_handler_;
+  DmxChannelWatch watch_;
   // Both sockets' threads take packets (never the cycle's: a lock is fine).
   std::mutex arbitration_;
   SacnSources sources_;
-  int last_ = 0;
   std::chrono::steady_clock::time_point epoch_ = std::chrono::steady_clock::now();
-  std::atomic<std::uint64_t> frames_{0}, malformed_{0}, out_of_sequence_{0}, ignored_{0};
+  std::atomic<std::uint64_t> malformed_{0}, out_of_sequence_{0}, ignored_{0};
   std::unique_ptr<UdpReceiver> unicast_;  // last: their threads stop before the rest goes
   std::unique_ptr<UdpReceiver> multicast_;
 };
