@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "animrt/core/joint.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
 
 namespace animrt::sim {
@@ -102,6 +104,10 @@ void Cia402DriveNode::reset_application(Nanos now) {
       {obj::home_offset, 0, 4, Access::rw, false, false, 0},
       {obj::homing_method, 0, 1, Access::rw, false, false,
        static_cast<std::uint8_t>(cia402::kHomingHere)},
+      {obj::homing_speeds, 0, 1, Access::ro, false, false, 2},
+      {obj::homing_speeds, 1, 4, Access::rw, false, false, 0},
+      {obj::homing_speeds, 2, 4, Access::rw, false, false, 0},
+      {obj::homing_accel, 0, 4, Access::rw, false, false, 0},
       {obj::motor_rated_current, 0, 4, Access::rw, false, false, kRatedCurrentMa},
       {obj::current_actual, 0, 2, Access::ro, false, true, 0},
       {obj::dc_link_voltage, 0, 4, Access::ro, false, true, 0},
@@ -120,18 +126,66 @@ void Cia402DriveNode::reset_application(Nanos now) {
   motor_.hold(now);
   find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
   homing_attained_ = false;
+  homing_error_ = false;
+  search_.reset();
 }
 
 std::int32_t Cia402DriveNode::counts(Nanos now) const {
   return static_cast<std::int32_t>(std::lround(motor_.position(now))) + position_offset_;
 }
 
+HomingSearch::Switches Cia402DriveNode::switches() const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  HomingSearch::Switches out{kInf, -kInf, -kInf, kInf};  // none fitted: never active
+  const double per_deg = binding_.ticks_per_rad * deg_to_rad(1.0);
+  for (const SimDriveSwitches& s : settings_.switches) {
+    if (s.device_id != binding_.device_id) continue;
+    if (s.has_home) {
+      out.home_from = s.home_from_deg * per_deg;
+      out.home_to = s.home_to_deg * per_deg;
+    }
+    out.negative_limit = s.negative_limit_deg * per_deg;
+    out.positive_limit = s.positive_limit_deg * per_deg;
+  }
+  return out;
+}
+
 void Cia402DriveNode::start_homing(Nanos now) {
+  homing_attained_ = false;
+  homing_error_ = false;
+  const auto method = static_cast<std::int8_t>(find(obj::homing_method, 0)->value);
+  if (HomingSearch::is_switch_method(method)) {
+    search_.emplace(method, switches(), motor_.position(now), find(obj::homing_speeds, 1)->value,
+                    find(obj::homing_speeds, 2)->value, now);
+    return;
+  }
   // 35/37: the present position is the home; it reads the home offset.
   const auto offset = static_cast<std::int32_t>(find(obj::home_offset, 0)->value);
   position_offset_ = offset - static_cast<std::int32_t>(std::lround(motor_.position(now)));
   find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
   homing_attained_ = true;
+}
+
+void Cia402DriveNode::advance_search(Nanos now) {
+  if (!search_) return;
+  search_->advance(now);
+  motor_.hold(now);
+  motor_.offset(search_->position() - motor_.position(now));
+  if (search_->phase() == HomingSearch::Phase::searching) return;
+  if (search_->phase() == HomingSearch::Phase::attained) {
+    const auto offset = static_cast<std::int32_t>(find(obj::home_offset, 0)->value);
+    position_offset_ = offset - static_cast<std::int32_t>(std::lround(search_->position()));
+    find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
+    homing_attained_ = true;
+  } else {
+    homing_error_ = true;
+  }
+  search_.reset();
+}
+
+void Cia402DriveNode::stop_search(Nanos now) {
+  advance_search(now);
+  search_.reset();
 }
 
 void Cia402DriveNode::reset_communication() {
@@ -193,9 +247,12 @@ std::uint16_t Cia402DriveNode::statusword(Nanos now) const {
     sw |= 0x0010;  // voltage enabled
   }
   if (homing_mode()) {
-    // Not started (or interrupted): target reached alone; done: attained too.
+    // Searching: bits 10, 12, 13 clear. Not started (or interrupted):
+    // target reached alone; done: attained too; failed: homing error.
+    if (search_) return sw;
     sw |= cia402::kSwTargetReached;
     if (homing_attained_) sw |= cia402::kSwHomingAttained;
+    if (homing_error_) sw |= cia402::kSwHomingError;
     return sw;
   }
   if (state_ == State::operation_enabled) {
@@ -300,12 +357,15 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
       const auto mode = static_cast<std::int8_t>(value);
       if (mode != cia402::kModeCsp && mode != cia402::kModeHoming) return ac::value_range;
       homing_attained_ = false;
+      homing_error_ = false;
+      stop_search(now);
       find(obj::modes_of_operation_display, 0)->value = value & 0xFF;
       break;
     }
     case obj::homing_method: {
       const auto method = static_cast<std::int8_t>(value);
-      if (method != cia402::kHomingHere && method != cia402::kHomingHereOld) {
+      if (method != cia402::kHomingHere && method != cia402::kHomingHereOld &&
+          !HomingSearch::is_switch_method(method)) {
         return ac::value_range;
       }
       break;
@@ -344,6 +404,7 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
 // ---- state machine -----------------------------------------------------------
 
 void Cia402DriveNode::enter_state(State state, Nanos now) {
+  if (state != State::operation_enabled) stop_search(now);
   state_ = state;
   if (state_ == State::operation_enabled) {
     // Take over at the present position: the target was set to it beforehand.
@@ -364,8 +425,11 @@ void Cia402DriveNode::controlword(std::uint16_t value, Nanos now, FrameList& out
   const cia402::Command command = cia402::decode_controlword(value, last_controlword_);
   const bool start =
       (value & cia402::kCwHomingStart) != 0 && (last_controlword_ & cia402::kCwHomingStart) == 0;
+  const bool halt =
+      (value & cia402::kCwHomingStart) == 0 && (last_controlword_ & cia402::kCwHomingStart) != 0;
   last_controlword_ = value;
   if (start && state_ == State::operation_enabled && homing_mode()) start_homing(now);
+  if (halt) stop_search(now);  // interrupted: stops where it has got to
   if (command == cia402::Command::fault_reset && state_ == State::fault) {
     if (condition_ != 0) return;  // the cause is still there: stays in fault
     find(obj::error_register, 0)->value = 0;
@@ -624,6 +688,7 @@ void Cia402DriveNode::handle(const can_frame& f, Nanos now, FrameList& out) {
   if (!responding()) return;
   if ((f.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0) return;
   poll(now, out);
+  advance_search(now);
   const canid_t id = f.can_id & CAN_SFF_MASK;
   if (id == canopen::kNmtId) {
     handle_nmt(f, now, out);
