@@ -19,6 +19,10 @@ constexpr std::int32_t kTargetWindow = 20;  // counts: "target reached"
 constexpr std::uint16_t kEmcyRpdoLength = 0x8210;
 constexpr std::uint16_t kEmcyHeartbeat = 0x8130;    // life guard or heartbeat error
 constexpr std::uint8_t kCommunicationError = 0x10;  // error register bit 4
+// The drive's own overtemperature trip (sim.health.trip_c), as the injected
+// overheating condition; a fault reset clears it this far below the trip.
+constexpr std::uint8_t kOverheating = 0x04;
+constexpr double kTripHysteresisC = 5.0;
 
 // Error register (1001h) bits for an EMCY code's class.
 std::uint8_t error_register_for(std::uint16_t code) {
@@ -431,6 +435,7 @@ void Cia402DriveNode::controlword(std::uint16_t value, Nanos now, FrameList& out
   if (start && state_ == State::operation_enabled && homing_mode()) start_homing(now);
   if (halt) stop_search(now);  // interrupted: stops where it has got to
   if (command == cia402::Command::fault_reset && state_ == State::fault) {
+    advance_health(now, out);     // cooled enough since the trip?
     if (condition_ != 0) return;  // the cause is still there: stays in fault
     find(obj::error_register, 0)->value = 0;
     find(obj::error_code, 0)->value = 0;
@@ -461,6 +466,7 @@ void Cia402DriveNode::set_fault(std::uint8_t bits, Nanos now, FrameList& out) {
 
 void Cia402DriveNode::reboot(Nanos now, FrameList& out) {
   condition_ = 0;
+  overheated_ = false;
   reset_application(now);
   boot(out);
 }
@@ -662,6 +668,19 @@ void Cia402DriveNode::advance_health(Nanos now, FrameList& out) {
   health_.advance(now, speed, state_ == State::operation_enabled);
   if (health_.blocked() && !was_blocked) motor_.hold(now);
   if (health_.injected_bits() != 0 && condition_ == 0) set_fault(health_.injected_bits(), now, out);
+  check_trip(now, out);
+}
+
+void Cia402DriveNode::check_trip(Nanos now, FrameList& out) {
+  const double t = health_.temperature_c();
+  const double trip = settings_.health.trip_c;
+  if (!overheated_ && condition_ == 0 && t > trip) {
+    overheated_ = true;
+    set_fault(kOverheating, now, out);  // EMCY 4310h; output off, so it cools
+  } else if (overheated_ && t <= trip - kTripHysteresisC) {
+    overheated_ = false;
+    if (condition_ == kOverheating) condition_ = 0;  // a fault reset may clear it now
+  }
 }
 
 void Cia402DriveNode::inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) {
@@ -682,6 +701,7 @@ void Cia402DriveNode::inject_health(const SimHealthInjection& change, Nanos now,
       set_fault(static_cast<std::uint8_t>(change.value), now, out);
       break;
   }
+  check_trip(now, out);
 }
 
 void Cia402DriveNode::handle(const can_frame& f, Nanos now, FrameList& out) {

@@ -69,8 +69,8 @@ struct SimHealthSettings {
   double current_per_rad_s = 0.1;  // added per rad/s of motion
   double stall_current_a = 1.4;    // drawn while the joint is blocked with torque on
   double overload_s = 1.0;         // stalled this long: the Overload error
-  // Simulated Modbus drives: their firmware's own overtemperature trip; the
-  // output goes off until a fault reset below trip_c - 5 deg C.
+  // Simulated Modbus and CiA 402 drives: their firmware's own overtemperature
+  // trip; the output goes off until a fault reset below trip_c - 5 deg C.
   double trip_c = 80.0;
   std::vector<SimHealthInjection> inject{};
 };

@@ -53,7 +53,10 @@
 //   health model (current driven by the motion or a stall, a supply that
 //   sags with it), mappable into TPDO2 (1801h, 1A01h; COB-ID 280h + node,
 //   invalid by default). The profile has no temperature object, so none is
-//   reported; an injected hardware error is a fault with its EMCY.
+//   reported; an injected hardware error is a fault with its EMCY. Above
+//   sim.health.trip_c the drive trips by itself, as drive firmware does:
+//   Fault, EMCY 4310h (excess temperature, drive), output off; a fault
+//   reset clears it only once it has cooled 5 deg C below the trip.
 
 #include <array>
 #include <cstdint>
@@ -136,6 +139,8 @@ class Cia402DriveNode final : public CanNode {
   void send_tpdo(const Pdo& pdo, Nanos now, FrameList& out);
   // The health model on to `now`; an injected fault condition faults the drive.
   void advance_health(Nanos now, FrameList& out);
+  // The drive's own trip above sim.health.trip_c, and its end once cooled.
+  void check_trip(Nanos now, FrameList& out);
   void controlword(std::uint16_t value, Nanos now, FrameList& out);
   void enter_state(cia402::State state, Nanos now);
   void emit_emcy(std::uint16_t code, FrameList& out);
@@ -171,6 +176,7 @@ class Cia402DriveNode final : public CanNode {
   bool homing_error_ = false;
   ServoHealthModel health_;
   std::uint8_t condition_ = 0;  // injected fault condition (0: none)
+  bool overheated_ = false;     // tripped on its own temperature, not yet cooled
   bool boot_pending_ = true;
   Nanos next_heartbeat_ = 0;
   // Heartbeat consumer: watching since the first heartbeat, and its time.
