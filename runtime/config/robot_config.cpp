@@ -297,7 +297,12 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   node.allow_only(keys);
 
   protocol->read_bus(node, bus);
-  if (auto n = node.find("sim")) bus.sim = parse_sim(*n);
+  if (auto n = node.find("sim")) {
+    bus.sim = parse_sim(*n);
+    if (!bus.sim.switches.empty() && bus.protocol != "cia402") {
+      n->at("switches").fail("switches are simulated on cia402 drives only (for their homing)");
+    }
+  }
   if (auto n = node.find("health_limits")) bus.health_limits = parse_health_limits(*n, rate_hz);
   return bus;
 }

@@ -92,6 +92,22 @@ TEST(Cia402HomingConfig, MistakesNameFileLineAndKey) {
             std::string::npos)
       << error_of("{method: 37, speed_dps: 3}");
   EXPECT_NE(error_of("{method: 19, speed: 3}").find("speed"), std::string::npos);
+  // Switches belong to a CiA 402 drive's bus.
+  try {
+    std::string robot =
+        "name: t\nloop: {rate_hz: 100}\nbuses:\n  b:\n    protocol: dynamixel2\n"
+        "    port: /dev/ttyUSB0\n    sim: {switches: [{id: 1}]}\n";
+    const std::string path = ::testing::TempDir() + "/switches_on_servos.yaml";
+    std::ofstream(path) << robot;
+    load_robot_config(path);
+    ADD_FAILURE() << "switches taken on a Dynamixel bus";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "switches_on_servos.yaml:7:21: buses.b.sim.switches: switches are simulated "
+                  "on cia402 drives only"),
+              std::string::npos)
+        << e.what();
+  }
   const std::string backwards =
       error_of("{method: 37}", "[{id: 32, home_from_deg: 10, home_to_deg: 5}]");
   EXPECT_NE(backwards.find("hip_drive.sim.switches[0].home_to_deg: expected more than "
