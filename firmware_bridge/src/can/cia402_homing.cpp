@@ -61,6 +61,10 @@ std::string Cia402Bus::run_homing(std::size_t device) {
     if (k == 0) continue;
     if (sw & kSwHomingError) {
       failure = "homing error (statusword " + hex16(sw) + ")";
+      if (homing.on_switches()) {
+        failure += ": method " + std::to_string(homing.method) +
+                   " met a limit switch it does not use, or did not find its switch";
+      }
       break;
     }
     if ((sw & done) == done) {
