@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/dynamixel/x_models.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
@@ -37,6 +38,7 @@ struct CalibrateArgs {
   int jog = -1;  // --jog 1, --no-jog 0; -1: asked (interactive), none (non-interactive)
   double jog_deg = 5.0;
   double jog_percent = 10.0;
+  bool yes = false;  // moves agreed beforehand (a homing search on switches)
 };
 
 // What one joint's calibration saw, in the servo's own ticks (so that the
@@ -299,6 +301,32 @@ bool is_multi_turn(const LimpFigure& figure, std::size_t j) {
   return figure.protocol(j) == "dynamixel2" && dxl::device_options(*figure.binding(j)).multi_turn;
 }
 
+// The homing method of a CiA 402 joint that searches its switches (17-30), or 0.
+int switch_homing_method(const LimpFigure& figure, std::size_t j) {
+  if (figure.protocol(j) != "cia402") return 0;
+  const Cia402Homing h = options_of<Cia402JointOptions>(figure.binding(j)->options).homing;
+  return h.on_switches() ? h.method : 0;
+}
+
+// A drive homed on its switches moves, so only once the user agreed (asked,
+// or --yes); then its switch's edge reads the file's zero_ticks, before the
+// range is followed, so the range is seen from that home.
+void home_on_switches(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
+  const std::string& name = figure.config().joints[j].name;
+  const int method = switch_homing_method(figure, j);
+  const std::string what = fmt::format(
+      "{}: homing method {} moves the joint until its drive finds its switch", name, method);
+  const bool agreed = args.yes || (!args.non_interactive && ask_yes(what + "; start it?"));
+  if (!agreed) {
+    throw std::runtime_error(what + ": not agreed (" +
+                             (args.non_interactive ? "--yes agrees beforehand" : "answered no") +
+                             "); nothing was written");
+  }
+  std::cout << what << std::endl;
+  const std::int64_t reads = figure.set_home(j, figure.binding(j)->zero_ticks);
+  std::cout << fmt::format("{}: homed on its switch: its home reads {} ticks\n", name, reads);
+}
+
 // The checks on what was seen, the home of a multi-turn joint set in its
 // servo, and the file's new values. Returns the report line.
 std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t j, Seen& seen,
@@ -321,6 +349,11 @@ std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t 
           name, seen.min_ticks, seen.max_ticks, seen.turn - 1));
     }
     return write_joint(edit, name, a, seen, std::lround(seen.home_ticks));
+  }
+  if (const int method = switch_homing_method(figure, j)) {
+    seen.home_ticks = static_cast<double>(a.zero_ticks);  // homed before the range was seen
+    return write_joint(edit, name, a, seen, a.zero_ticks) +
+           fmt::format(" (homing method {}: 0 deg at the switch)", method);
   }
   // The home where the joint rests now reads the file's zero_ticks.
   const std::int64_t reads = figure.set_home(j, a.zero_ticks);
@@ -376,6 +409,7 @@ int run_calibrate(const CalibrateArgs& args) {
     seen.turn = ticks_per_turn(figure.protocol(j));
     // A multi-turn servo counts on across its turns: nothing to unwrap.
     if (is_multi_turn(figure, j)) seen.turn = std::numeric_limits<double>::infinity();
+    if (switch_homing_method(figure, j) != 0) home_on_switches(figure, j, args);
     const bool jogged = args.jog == 1 || (args.jog < 0 && !args.non_interactive &&
                                           ask_yes(name + ": check its direction by a small jog "
                                                          "under a weak torque?"));
@@ -437,6 +471,9 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--jog-percent", args.jog_percent,
                   "the jog's torque: this share of the servo's current limit (default 10)")
       ->check(CLI::Range(1.0, 50.0));
+  cmd->add_flag("--yes", args.yes,
+                "agree beforehand to the moves calibrate would ask about: the homing search of "
+                "a CiA 402 drive on its switches (a joint with homing method 17-30)");
   cmd->add_option("--min-range-deg", args.min_range_deg,
                   "refuse a joint moved through less than this (default 2)")
       ->check(CLI::Range(0.0, 360.0));

@@ -343,7 +343,16 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--joint", args.joints, "record only this joint (repeatable)");
   cmd->add_flag("--audio", args.audio,
                 "record the microphone beside the motion as the show's sound track (SHOW.wav)");
-  cmd->add_option("--audio-device", args.audio_device, "ALSA capture device (default: default)");
+  cmd->add_option("--audio-device", args.audio_device,
+                  "the capture for --audio: an ALSA device or pipe:PATH (default: default)");
+  cmd->add_option_function<std::string>(
+      "--sound",
+      [](const std::string& capture) {
+        args.audio = true;
+        args.audio_device = capture;
+      },
+      "CAPTURE: record the sound track from this capture (an ALSA device, or pipe:PATH: "
+      "s16le mono at 48 kHz from a FIFO, as a head's capture key) into SHOW.wav");
   cmd->add_option(
          "--compliant", args.compliant_percent,
          "PERCENT: hold the figure by a weak torque, this share of each servo's current "

@@ -135,12 +135,18 @@ int put_draft_joints(std::ostream& y, std::ostream& keys, const commission::Scan
     const std::string name = "id" + std::to_string(d.id);
     y << "  " << name << ":   # " << d.model;
     if (d.position) y << ", at " << *d.position << " ticks when scanned";
+    if (d.multi_turn) {
+      y << "\n    # multi_turn: found in extended position mode (Operating Mode 4):\n"
+        << "    # it counts +-256 turns and its limit registers bound nothing; set the\n"
+        << "    # limits to what the joint allows. `animrt calibrate` sets its home.";
+    }
     y << "\n    limits: {min_deg: " << fixed1(min_deg) << ", max_deg: " << fixed1(max_deg)
       << ", velocity_dps: 60, acceleration_dps2: 300}\n"
       << "    home_deg: 0\n"
       << "    actuator: {bus: bus0, id: " << d.id;
     if (protocol != "feetech_scs") y << ", ticks_per_rev: " << static_cast<long>(tpr);
-    y << ", zero_ticks: " << zero << ", direction: 1}\n";
+    y << ", zero_ticks: " << zero << ", direction: 1" << (d.multi_turn ? ", multi_turn: true" : "")
+      << "}\n";
     keys << "  " << name << ":\n    keys:\n      - [0.0, 0]\n      - [1.0, 0]\n";
     ++joints;
   }

@@ -8,24 +8,26 @@
 #include <stdexcept>
 #include <vector>
 
-#include "animrt/controllers/head/alsa_audio.hpp"
+#include "animrt/controllers/head/audio_input.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt::cli {
 
 struct SoundTrackRecorder::Impl {
-  head::AlsaCapture capture;
+  std::atomic<bool> stop{false};  // before the capture, which watches it
+  std::unique_ptr<head::AudioInput> capture;
   int rate;
   std::string path;
   SNDFILE* file = nullptr;
   std::thread thread;
-  std::atomic<bool> stop{false};
   double first_sample_s = 0.0;
   std::exception_ptr failure;
   bool finished = false;
 
   Impl(const std::string& device, int sample_rate, std::string out)
-      : capture(device, sample_rate), rate(sample_rate), path(std::move(out)) {
+      : capture(head::open_audio_input(device, sample_rate, &stop)),
+        rate(sample_rate),
+        path(std::move(out)) {
     SF_INFO info{};
     info.samplerate = rate;
     info.channels = 1;
@@ -35,6 +37,10 @@ struct SoundTrackRecorder::Impl {
       throw std::runtime_error("cannot write the sound track " + quote_path(path) + ": " +
                                sf_strerror(nullptr));
     }
+    // Samples in 16-bit units, so the captured 16-bit samples are written
+    // exactly (a full-scale 1.0 clips to 32767).
+    sf_command(file, SFC_SET_NORM_FLOAT, nullptr, SF_FALSE);
+    sf_command(file, SFC_SET_CLIPPING, nullptr, SF_TRUE);
   }
 
   void run() {
@@ -43,7 +49,8 @@ struct SoundTrackRecorder::Impl {
       bool first = true;
       double frames = 0.0;
       while (!stop.load()) {
-        capture.read(block);
+        if (!capture->read(block)) break;  // the pipe's writer closed it: the track ends
+        for (float& v : block) v *= 32768.0f;
         timespec now{};
         clock_gettime(CLOCK_MONOTONIC, &now);
         const double now_s = static_cast<double>(now.tv_sec) + now.tv_nsec * 1e-9;

@@ -12,9 +12,11 @@ namespace animrt::cli {
 
 class SoundTrackRecorder {
  public:
-  // Opens the ALSA capture device and the file (DeviceError, or
-  // std::runtime_error for a file that cannot be written); nothing runs yet.
-  SoundTrackRecorder(const std::string& device, int sample_rate, std::string path);
+  // Opens the capture (an ALSA device, or pipe:PATH as a head's `capture`
+  // key takes it: s16le mono at `sample_rate`) and the file (DeviceError,
+  // or std::runtime_error for a file that cannot be written); nothing runs
+  // yet. A pipe whose writer closes it ends the track there.
+  SoundTrackRecorder(const std::string& capture, int sample_rate, std::string path);
   ~SoundTrackRecorder();  // stops; a file not finished by finish() is removed
   SoundTrackRecorder(const SoundTrackRecorder&) = delete;
   SoundTrackRecorder& operator=(const SoundTrackRecorder&) = delete;

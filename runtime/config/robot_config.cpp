@@ -221,10 +221,39 @@ SimHealthInjection parse_injection(const YamlNode& node) {
   return i;
 }
 
+// sim.switches: a simulated CiA 402 drive's home and limit switches.
+SimDriveSwitches parse_switches(const YamlNode& node) {
+  node.allow_only(
+      {"id", "home_from_deg", "home_to_deg", "negative_limit_deg", "positive_limit_deg"});
+  SimDriveSwitches s;
+  s.device_id = static_cast<int>(node.at("id").as_int_in(1, 127));
+  constexpr double kTravel = 1e6;
+  if (auto n = node.find("home_from_deg")) s.home_from_deg = n->as_double_in(-kTravel, kTravel);
+  if (auto n = node.find("home_to_deg")) {
+    s.home_to_deg = n->as_double_in(-kTravel, kTravel);
+    if (!(s.home_to_deg > s.home_from_deg))
+      n->fail("expected more than home_from_deg, found " + n->describe());
+  }
+  s.has_home = node.find("home_from_deg") || node.find("home_to_deg");
+  if (auto n = node.find("negative_limit_deg")) {
+    s.negative_limit_deg = n->as_double_in(-kTravel, kTravel);
+  }
+  if (auto n = node.find("positive_limit_deg")) {
+    s.positive_limit_deg = n->as_double_in(-kTravel, kTravel);
+    if (!(s.positive_limit_deg > s.negative_limit_deg))
+      n->fail("expected more than negative_limit_deg, found " + n->describe());
+  }
+  return s;
+}
+
 SimBusSettings parse_sim(const YamlNode& node) {
   node.allow_only({"time_constant_s", "max_speed_dps", "wire_time", "return_delay_us",
-                   "firmware_version", "health", "inject"});
+                   "firmware_version", "health", "inject", "switches"});
   SimBusSettings sim;
+  if (auto n = node.find("switches")) {
+    if (!n->is_sequence()) n->fail("expected a list of drives' switches, found " + n->describe());
+    for (const YamlNode& item : n->items()) sim.switches.push_back(parse_switches(item));
+  }
   if (auto n = node.find("health")) parse_sim_health(*n, sim.health);
   if (auto n = node.find("inject")) {
     if (!n->is_sequence()) n->fail("expected a list of injections, found " + n->describe());
@@ -268,7 +297,12 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   node.allow_only(keys);
 
   protocol->read_bus(node, bus);
-  if (auto n = node.find("sim")) bus.sim = parse_sim(*n);
+  if (auto n = node.find("sim")) {
+    bus.sim = parse_sim(*n);
+    if (!bus.sim.switches.empty() && bus.protocol != "cia402") {
+      n->at("switches").fail("switches are simulated on cia402 drives only (for their homing)");
+    }
+  }
   if (auto n = node.find("health_limits")) bus.health_limits = parse_health_limits(*n, rate_hz);
   return bus;
 }

@@ -66,8 +66,15 @@ out=$(servo21 set-mode extended-position) && [[ $out == *"operating mode extende
 out=$(servo21 set-limits 1000 3000) && [[ $out == *"position limits 1000..3000 ticks (read back)"* ]] \
   || fail "set-limits: $out"
 out=$(servo21 reboot) && [[ $out == *"rebooted, answers again"* ]] || fail "reboot: $out"
-scan > "$tmp/scan3.txt" 2>&1
+scan --write-robot "$tmp/draft3.yaml" > "$tmp/scan3.txt" 2>&1
 grep -q "  21  .*operating mode extended-position" "$tmp/scan3.txt" || fail "mode lost: $(cat "$tmp/scan3.txt")"
+# The draft keeps it multi-turn (and only it), with the comment why.
+grep -A7 "^  id21:" "$tmp/draft3.yaml" | grep -q "actuator: {.*, multi_turn: true}" \
+  && grep -A7 "^  id21:" "$tmp/draft3.yaml" | grep -q "# multi_turn: found in extended position mode" \
+  && [[ $(grep -c "multi_turn: true" "$tmp/draft3.yaml") == 1 ]] || fail "draft: $(cat "$tmp/draft3.yaml")"
+grep -q "multi_turn" "$tmp/draft.yaml" && fail "multi_turn in the first draft"
+"$animrt" validate "$tmp/draft3.yaml" > "$tmp/validate3.txt" 2>&1 \
+  || fail "multi-turn draft does not validate: $(cat "$tmp/validate3.txt")"
 out=$(servo21 factory-reset --yes) && [[ $out == *"factory reset (id and baud rate kept)"* ]] \
   || fail "factory reset: $out"
 scan > "$tmp/scan4.txt" 2>&1

@@ -273,7 +273,7 @@ buses:
 )"),
             at("7:11: buses.b.sim.max_speed_rad_s: unknown key (expected one of: "
                "time_constant_s, max_speed_dps, wire_time, return_delay_us, "
-               "firmware_version, health, inject)"));
+               "firmware_version, health, inject, switches)"));
   EXPECT_EQ(
       error_of(R"(name: t
 loop: {rate_hz: 100}

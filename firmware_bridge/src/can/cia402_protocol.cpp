@@ -26,8 +26,51 @@ constexpr std::string_view kCia402BusKeys[] = {"interface",
 
 // The consumer time of 1016h is 16 bits of milliseconds.
 constexpr int kMaxConsumerMs = 65535;
-constexpr std::string_view kCia402ActuatorKeys[] = {"node_id", "counts_per_rev", "zero_counts",
-                                                    "direction", "temperature"};
+constexpr std::string_view kCia402ActuatorKeys[] = {"node_id",   "counts_per_rev", "zero_counts",
+                                                    "direction", "temperature",    "homing"};
+
+// deg/s (or deg/s^2) as the drive's counts, which 6099h/609Ah hold as u32.
+std::uint32_t counts_of(const YamlNode& n, double counts_per_deg) {
+  const double v = n.as_double();
+  const double counts = std::round(v * counts_per_deg);
+  if (!(v > 0.0) || !(counts >= 1.0 && counts <= 4294967295.0)) {
+    n.fail("expected a number above 0 that is at least one count and fits 32 bits (" +
+           format_number(1.0 / counts_per_deg) + " to " +
+           format_number(4294967295.0 / counts_per_deg) + "), found " + n.describe());
+  }
+  return static_cast<std::uint32_t>(counts);
+}
+
+// `homing: {method, speed_dps, zero_speed_dps, acceleration_dps2, timeout_s}`.
+Cia402Homing read_homing(const YamlNode& node, double counts_per_rev) {
+  if (!node.is_map())
+    node.fail("expected a map {method, speed_dps, ...}, found " + node.describe());
+  node.allow_only({"method", "speed_dps", "zero_speed_dps", "acceleration_dps2", "timeout_s"});
+  Cia402Homing h;
+  const YamlNode method = node.at("method");
+  const std::int64_t m = method.as_int();
+  if (!((m >= 17 && m <= 30) || m == 35 || m == 37)) {
+    method.fail(
+        "expected a homing method of CiA 402: 17-30 (limit or home switches, no index pulse) "
+        "or 35/37 (the present position), found " +
+        method.describe());
+  }
+  h.method = static_cast<std::int8_t>(m);
+  const double per_deg = counts_per_rev / 360.0;
+  if (!h.on_switches()) {
+    for (const char* key : {"speed_dps", "zero_speed_dps", "acceleration_dps2", "timeout_s"}) {
+      if (auto n = node.find(key))
+        n->fail("method " + std::to_string(m) + " homes where the drive rests and moves nothing");
+    }
+    return h;
+  }
+  h.switch_speed = counts_of(node.at("speed_dps"), per_deg);
+  h.zero_speed = h.switch_speed;
+  if (auto n = node.find("zero_speed_dps")) h.zero_speed = counts_of(*n, per_deg);
+  if (auto n = node.find("acceleration_dps2")) h.acceleration = counts_of(*n, per_deg);
+  if (auto n = node.find("timeout_s")) h.timeout_s = n->as_double_in(0.1, 3600.0);
+  return h;
+}
 
 // "0x2022:0x01" (or decimal parts): a manufacturer object, 2000h to 5FFFh.
 Cia402Temperature read_temperature(const YamlNode& node, const BusConfig& bus) {
@@ -154,6 +197,7 @@ class Cia402 final : public Protocol {
       joint_options.has_temperature = true;
       joint_options.temperature = read_temperature(*n, bus);
     }
+    if (auto n = node.find("homing")) joint_options.homing = read_homing(*n, counts_per_rev);
     out.options = joint_options;
     const auto check = [&](const char* key, double rad) {
       const double counts = std::round(out.zero_ticks + out.direction * rad * out.ticks_per_rad);

@@ -51,6 +51,7 @@ void read_dxl_details(ByteTransport& line, int baud, const ScanLimits& limits, F
   d.ticks_per_rev = 4096.0;
   const std::uint8_t mode = t[x::operating_mode];
   if (mode != 3) d.note = "operating mode " + dxl_detail::mode_name(mode);
+  d.multi_turn = mode == dxl::kExtendedPositionMode;
   if (t[x::hardware_error_status] != 0) {
     if (!d.note.empty()) d.note += "; ";
     d.note += "hardware error status " + std::to_string(t[x::hardware_error_status]);

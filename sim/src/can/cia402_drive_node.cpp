@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "animrt/core/joint.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"  // initial_offset_rad
 
 namespace animrt::sim {
@@ -17,6 +19,10 @@ constexpr std::int32_t kTargetWindow = 20;  // counts: "target reached"
 constexpr std::uint16_t kEmcyRpdoLength = 0x8210;
 constexpr std::uint16_t kEmcyHeartbeat = 0x8130;    // life guard or heartbeat error
 constexpr std::uint8_t kCommunicationError = 0x10;  // error register bit 4
+// The drive's own overtemperature trip (sim.health.trip_c), as the injected
+// overheating condition; a fault reset clears it this far below the trip.
+constexpr std::uint8_t kOverheating = 0x04;
+constexpr double kTripHysteresisC = 5.0;
 
 // Error register (1001h) bits for an EMCY code's class.
 std::uint8_t error_register_for(std::uint16_t code) {
@@ -102,6 +108,10 @@ void Cia402DriveNode::reset_application(Nanos now) {
       {obj::home_offset, 0, 4, Access::rw, false, false, 0},
       {obj::homing_method, 0, 1, Access::rw, false, false,
        static_cast<std::uint8_t>(cia402::kHomingHere)},
+      {obj::homing_speeds, 0, 1, Access::ro, false, false, 2},
+      {obj::homing_speeds, 1, 4, Access::rw, false, false, 0},
+      {obj::homing_speeds, 2, 4, Access::rw, false, false, 0},
+      {obj::homing_accel, 0, 4, Access::rw, false, false, 0},
       {obj::motor_rated_current, 0, 4, Access::rw, false, false, kRatedCurrentMa},
       {obj::current_actual, 0, 2, Access::ro, false, true, 0},
       {obj::dc_link_voltage, 0, 4, Access::ro, false, true, 0},
@@ -120,18 +130,66 @@ void Cia402DriveNode::reset_application(Nanos now) {
   motor_.hold(now);
   find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
   homing_attained_ = false;
+  homing_error_ = false;
+  search_.reset();
 }
 
 std::int32_t Cia402DriveNode::counts(Nanos now) const {
   return static_cast<std::int32_t>(std::lround(motor_.position(now))) + position_offset_;
 }
 
+HomingSearch::Switches Cia402DriveNode::switches() const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  HomingSearch::Switches out{kInf, -kInf, -kInf, kInf};  // none fitted: never active
+  const double per_deg = binding_.ticks_per_rad * deg_to_rad(1.0);
+  for (const SimDriveSwitches& s : settings_.switches) {
+    if (s.device_id != binding_.device_id) continue;
+    if (s.has_home) {
+      out.home_from = s.home_from_deg * per_deg;
+      out.home_to = s.home_to_deg * per_deg;
+    }
+    out.negative_limit = s.negative_limit_deg * per_deg;
+    out.positive_limit = s.positive_limit_deg * per_deg;
+  }
+  return out;
+}
+
 void Cia402DriveNode::start_homing(Nanos now) {
+  homing_attained_ = false;
+  homing_error_ = false;
+  const auto method = static_cast<std::int8_t>(find(obj::homing_method, 0)->value);
+  if (HomingSearch::is_switch_method(method)) {
+    search_.emplace(method, switches(), motor_.position(now), find(obj::homing_speeds, 1)->value,
+                    find(obj::homing_speeds, 2)->value, now);
+    return;
+  }
   // 35/37: the present position is the home; it reads the home offset.
   const auto offset = static_cast<std::int32_t>(find(obj::home_offset, 0)->value);
   position_offset_ = offset - static_cast<std::int32_t>(std::lround(motor_.position(now)));
   find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
   homing_attained_ = true;
+}
+
+void Cia402DriveNode::advance_search(Nanos now) {
+  if (!search_) return;
+  search_->advance(now);
+  motor_.hold(now);
+  motor_.offset(search_->position() - motor_.position(now));
+  if (search_->phase() == HomingSearch::Phase::searching) return;
+  if (search_->phase() == HomingSearch::Phase::attained) {
+    const auto offset = static_cast<std::int32_t>(find(obj::home_offset, 0)->value);
+    position_offset_ = offset - static_cast<std::int32_t>(std::lround(search_->position()));
+    find(obj::target_position, 0)->value = static_cast<std::uint32_t>(counts(now));
+    homing_attained_ = true;
+  } else {
+    homing_error_ = true;
+  }
+  search_.reset();
+}
+
+void Cia402DriveNode::stop_search(Nanos now) {
+  advance_search(now);
+  search_.reset();
 }
 
 void Cia402DriveNode::reset_communication() {
@@ -193,9 +251,12 @@ std::uint16_t Cia402DriveNode::statusword(Nanos now) const {
     sw |= 0x0010;  // voltage enabled
   }
   if (homing_mode()) {
-    // Not started (or interrupted): target reached alone; done: attained too.
+    // Searching: bits 10, 12, 13 clear. Not started (or interrupted):
+    // target reached alone; done: attained too; failed: homing error.
+    if (search_) return sw;
     sw |= cia402::kSwTargetReached;
     if (homing_attained_) sw |= cia402::kSwHomingAttained;
+    if (homing_error_) sw |= cia402::kSwHomingError;
     return sw;
   }
   if (state_ == State::operation_enabled) {
@@ -300,12 +361,15 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
       const auto mode = static_cast<std::int8_t>(value);
       if (mode != cia402::kModeCsp && mode != cia402::kModeHoming) return ac::value_range;
       homing_attained_ = false;
+      homing_error_ = false;
+      stop_search(now);
       find(obj::modes_of_operation_display, 0)->value = value & 0xFF;
       break;
     }
     case obj::homing_method: {
       const auto method = static_cast<std::int8_t>(value);
-      if (method != cia402::kHomingHere && method != cia402::kHomingHereOld) {
+      if (method != cia402::kHomingHere && method != cia402::kHomingHereOld &&
+          !HomingSearch::is_switch_method(method)) {
         return ac::value_range;
       }
       break;
@@ -344,6 +408,7 @@ std::uint32_t Cia402DriveNode::write(std::uint16_t index, std::uint8_t sub, std:
 // ---- state machine -----------------------------------------------------------
 
 void Cia402DriveNode::enter_state(State state, Nanos now) {
+  if (state != State::operation_enabled) stop_search(now);
   state_ = state;
   if (state_ == State::operation_enabled) {
     // Take over at the present position: the target was set to it beforehand.
@@ -364,9 +429,13 @@ void Cia402DriveNode::controlword(std::uint16_t value, Nanos now, FrameList& out
   const cia402::Command command = cia402::decode_controlword(value, last_controlword_);
   const bool start =
       (value & cia402::kCwHomingStart) != 0 && (last_controlword_ & cia402::kCwHomingStart) == 0;
+  const bool halt =
+      (value & cia402::kCwHomingStart) == 0 && (last_controlword_ & cia402::kCwHomingStart) != 0;
   last_controlword_ = value;
   if (start && state_ == State::operation_enabled && homing_mode()) start_homing(now);
+  if (halt) stop_search(now);  // interrupted: stops where it has got to
   if (command == cia402::Command::fault_reset && state_ == State::fault) {
+    advance_health(now, out);     // cooled enough since the trip?
     if (condition_ != 0) return;  // the cause is still there: stays in fault
     find(obj::error_register, 0)->value = 0;
     find(obj::error_code, 0)->value = 0;
@@ -397,6 +466,7 @@ void Cia402DriveNode::set_fault(std::uint8_t bits, Nanos now, FrameList& out) {
 
 void Cia402DriveNode::reboot(Nanos now, FrameList& out) {
   condition_ = 0;
+  overheated_ = false;
   reset_application(now);
   boot(out);
 }
@@ -598,6 +668,19 @@ void Cia402DriveNode::advance_health(Nanos now, FrameList& out) {
   health_.advance(now, speed, state_ == State::operation_enabled);
   if (health_.blocked() && !was_blocked) motor_.hold(now);
   if (health_.injected_bits() != 0 && condition_ == 0) set_fault(health_.injected_bits(), now, out);
+  check_trip(now, out);
+}
+
+void Cia402DriveNode::check_trip(Nanos now, FrameList& out) {
+  const double t = health_.temperature_c();
+  const double trip = settings_.health.trip_c;
+  if (!overheated_ && condition_ == 0 && t > trip) {
+    overheated_ = true;
+    set_fault(kOverheating, now, out);  // EMCY 4310h; output off, so it cools
+  } else if (overheated_ && t <= trip - kTripHysteresisC) {
+    overheated_ = false;
+    if (condition_ == kOverheating) condition_ = 0;  // a fault reset may clear it now
+  }
 }
 
 void Cia402DriveNode::inject_health(const SimHealthInjection& change, Nanos now, FrameList& out) {
@@ -618,12 +701,14 @@ void Cia402DriveNode::inject_health(const SimHealthInjection& change, Nanos now,
       set_fault(static_cast<std::uint8_t>(change.value), now, out);
       break;
   }
+  check_trip(now, out);
 }
 
 void Cia402DriveNode::handle(const can_frame& f, Nanos now, FrameList& out) {
   if (!responding()) return;
   if ((f.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0) return;
   poll(now, out);
+  advance_search(now);
   const canid_t id = f.can_id & CAN_SFF_MASK;
   if (id == canopen::kNmtId) {
     handle_nmt(f, now, out);

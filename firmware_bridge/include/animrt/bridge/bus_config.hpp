@@ -69,10 +69,24 @@ struct SimHealthSettings {
   double current_per_rad_s = 0.1;  // added per rad/s of motion
   double stall_current_a = 1.4;    // drawn while the joint is blocked with torque on
   double overload_s = 1.0;         // stalled this long: the Overload error
-  // Simulated Modbus drives: their firmware's own overtemperature trip; the
-  // output goes off until a fault reset below trip_c - 5 deg C.
+  // Simulated Modbus and CiA 402 drives: their firmware's own overtemperature
+  // trip; the output goes off until a fault reset below trip_c - 5 deg C.
   double trip_c = 80.0;
   std::vector<SimHealthInjection> inject{};
+};
+
+// A simulated CiA 402 drive's switch inputs (sim.switches), in degrees of
+// the drive's encoder as it reads before any homing (counts / counts_per_rev
+// * 360): a home switch active from home_from_deg to home_to_deg (either
+// end open: to the end of travel), a negative limit switch active at and
+// below negative_limit_deg, a positive one at and above positive_limit_deg.
+struct SimDriveSwitches {
+  int device_id = 0;
+  double home_from_deg = -std::numeric_limits<double>::infinity();
+  double home_to_deg = std::numeric_limits<double>::infinity();
+  bool has_home = false;
+  double negative_limit_deg = -std::numeric_limits<double>::infinity();
+  double positive_limit_deg = std::numeric_limits<double>::infinity();
 };
 
 // Simulated-device settings of a bus (used only with --backend sim).
@@ -83,6 +97,7 @@ struct SimBusSettings {
   int return_delay_us = 0;        // device's delay before answering
   int firmware_version = 0;       // Dynamixel: firmware the servos report (0: the default, 38)
   SimHealthSettings health{};
+  std::vector<SimDriveSwitches> switches{};
 };
 
 struct BusConfig {

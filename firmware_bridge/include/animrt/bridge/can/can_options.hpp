@@ -88,9 +88,23 @@ struct Cia402Temperature {
   }
 };
 
+// How calibrate homes a drive: actuator key `homing: {method, speed_dps,
+// zero_speed_dps, acceleration_dps2, timeout_s}`. Methods 35/37 home on the
+// present position and move nothing; 17-30 search a limit or home switch at
+// 6099h:01 (then creep at 6099h:02) with 609Ah, in counts per second.
+struct Cia402Homing {
+  std::int8_t method = 37;
+  std::uint32_t switch_speed = 0;  // 6099h:01, counts/s
+  std::uint32_t zero_speed = 0;    // 6099h:02, counts/s
+  std::uint32_t acceleration = 0;  // 609Ah, counts/s^2; 0: the drive's own
+  double timeout_s = 30.0;         // the host gives up (and halts the search)
+  bool on_switches() const { return method >= 17 && method <= 30; }
+};
+
 struct Cia402JointOptions {
   bool has_temperature = false;
   Cia402Temperature temperature;
+  Cia402Homing homing;
 };
 
 // Options of a bus / binding of the given type; a default when absent.

@@ -35,6 +35,8 @@ inline constexpr std::uint16_t dc_link_voltage = 0x6079;  // u32, mV
 inline constexpr std::uint16_t target_position = 0x607A;  // i32
 inline constexpr std::uint16_t home_offset = 0x607C;      // i32: the position the home reads
 inline constexpr std::uint16_t homing_method = 0x6098;    // i8
+inline constexpr std::uint16_t homing_speeds = 0x6099;    // u32 :01 switch, :02 zero
+inline constexpr std::uint16_t homing_accel = 0x609A;     // u32
 }  // namespace obj
 
 inline constexpr std::uint32_t kDeviceProfile = 402;      // low word of 1000h

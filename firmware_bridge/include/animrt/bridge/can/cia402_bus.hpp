@@ -84,13 +84,15 @@ class Cia402Bus final : public ActuatorBus {
   bool reads_health() const override { return options_.health; }
   // Commissioning, with the bus configured and not running: homing mode
   // (6060h = 6) with homing method 37 (35 where the drive knows only the
-  // older number), home offset (607Ch) = `ticks`: drive `device` alone is
-  // enabled, a rising controlword bit 4 starts the homing, which on the
-  // current position moves nothing and makes the position actual read
-  // `ticks`; statusword bits 12 and 10 (homing attained, target reached)
-  // end it, bit 13 (homing error) fails it. Then the drive is disabled
-  // again, back in cyclic synchronous position mode, and its position read
-  // back (DeviceError when it is not `ticks`).
+  // older number) or the joint's `homing` method, home offset (607Ch) =
+  // `ticks`: drive `device` alone is enabled, a rising controlword bit 4
+  // starts the homing, which on the current position moves nothing and
+  // makes the position actual read `ticks` (a switch method, 17-30, first
+  // moves the joint to its switch's edge, watched until its timeout_s);
+  // statusword bits 12 and 10 (homing attained, target reached) end it,
+  // bit 13 (homing error) fails it. Then the drive is disabled again, back
+  // in cyclic synchronous position mode, and its position read back
+  // (DeviceError when it is not `ticks`).
   std::int64_t set_home(std::size_t device, std::int64_t ticks) override;
 
   // What the runtime knows about each drive.
@@ -139,6 +141,9 @@ class Cia402Bus final : public ActuatorBus {
   std::string walk_to(cia402::State goal, std::size_t only = kAllDrives);
   // set_home()'s steps with the drive in homing mode, operational: "" or why it failed.
   std::string run_homing(std::size_t device);
+  // 6098h (37, or 35 for the older profile, or the joint's `homing` method)
+  // and, for a switch search, its speeds (6099h) and acceleration (609Ah).
+  void write_homing_method(std::size_t device);
   int slot_of(canid_t cob, canid_t base) const;
   std::string prefix() const { return book_.prefix(); }
   std::string describe(std::size_t device) const { return book_.describe(device); }

@@ -26,6 +26,7 @@ struct FoundDevice {
   std::optional<std::int64_t> min_limit;
   std::optional<std::int64_t> max_limit;
   std::optional<double> ticks_per_rev;  // of `position`, where it is an angle
+  bool multi_turn = false;              // a Dynamixel in extended position mode (4)
   std::string note;                     // what else the user should know (errors, a failed read)
 };
 

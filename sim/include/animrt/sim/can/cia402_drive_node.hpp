@@ -12,12 +12,18 @@
 //   operation (8, cyclic synchronous position, and 6, homing), 6064h
 //   position actual, 606Ch velocity actual, 607Ah target position, 607Ch
 //   home offset, 6098h homing method (35 and 37, homing on the current
-//   position; no switches are modelled, so 17-30 answer value range).
+//   position; 17-30, on switches), 6099h homing speeds, 609Ah homing
+//   acceleration.
 // - Homing mode (6): in Operation Enabled a rising controlword bit 4 starts
 //   it; methods 35/37 make the position actual read the home offset where
 //   the motor is, without moving, and set statusword bits 12 (homing
-//   attained) and 10 (target reached). The offset is the drive's own
-//   (absolute encoder): kept across NMT resets and reboots.
+//   attained) and 10 (target reached). Methods 17-30 first search the
+//   switches of sim.switches (HomingSearch: statusword bits 10, 12, 13
+//   clear while it moves), then the edge found reads the home offset;
+//   a limit switch the method does not use sets bit 13 (homing error) and
+//   the drive stops there. Bit 4 falling interrupts a search (bit 10 alone).
+//   The offset is the drive's own (absolute encoder): kept across NMT
+//   resets and reboots.
 // - Expedited SDO upload and download with the CiA 301 abort codes (object
 //   or sub-index missing, read-only, write-only, length mismatch, value
 //   range, mapping rules); segmented transfers are answered with an abort.
@@ -47,10 +53,14 @@
 //   health model (current driven by the motion or a stall, a supply that
 //   sags with it), mappable into TPDO2 (1801h, 1A01h; COB-ID 280h + node,
 //   invalid by default). The profile has no temperature object, so none is
-//   reported; an injected hardware error is a fault with its EMCY.
+//   reported; an injected hardware error is a fault with its EMCY. Above
+//   sim.health.trip_c the drive trips by itself, as drive firmware does:
+//   Fault, EMCY 4310h (excess temperature, drive), output off; a fault
+//   reset clears it only once it has cooled 5 deg C below the trip.
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
@@ -58,6 +68,7 @@
 #include "animrt/bridge/can/canopen.hpp"
 #include "animrt/bridge/can/cia402.hpp"
 #include "animrt/sim/can/can_node.hpp"
+#include "animrt/sim/can/homing_search.hpp"
 #include "animrt/sim/can/motor_model.hpp"
 #include "animrt/sim/servo_health_model.hpp"
 
@@ -128,6 +139,8 @@ class Cia402DriveNode final : public CanNode {
   void send_tpdo(const Pdo& pdo, Nanos now, FrameList& out);
   // The health model on to `now`; an injected fault condition faults the drive.
   void advance_health(Nanos now, FrameList& out);
+  // The drive's own trip above sim.health.trip_c, and its end once cooled.
+  void check_trip(Nanos now, FrameList& out);
   void controlword(std::uint16_t value, Nanos now, FrameList& out);
   void enter_state(cia402::State state, Nanos now);
   void emit_emcy(std::uint16_t code, FrameList& out);
@@ -154,8 +167,16 @@ class Cia402DriveNode final : public CanNode {
                                         ->value) == cia402::kModeHoming;
   }
   void start_homing(Nanos now);
+  // A switch search on to `now`: the motor where it has got to, the home
+  // offset taken at the edge found.
+  void advance_search(Nanos now);
+  void stop_search(Nanos now);
+  HomingSearch::Switches switches() const;
+  std::optional<HomingSearch> search_;
+  bool homing_error_ = false;
   ServoHealthModel health_;
   std::uint8_t condition_ = 0;  // injected fault condition (0: none)
+  bool overheated_ = false;     // tripped on its own temperature, not yet cooled
   bool boot_pending_ = true;
   Nanos next_heartbeat_ = 0;
   // Heartbeat consumer: watching since the first heartbeat, and its time.
