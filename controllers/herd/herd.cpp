@@ -201,9 +201,12 @@ void Herd::step() {
     });
     if (blocked) {
       ++contact_stops_;
-      // It stands, and turns on the spot out of the way where it can (in
-      // place: the drift of a turn on the spot is ignored here).
-      commands_[i] = turn_clear(figure, agents_[i], desired_[i], toward);
+      // It stands; a flock's figure turns on the spot out of the way where
+      // it can (in place: the drift of such a turn is ignored here). A
+      // crowd plans around its neighbours and unsticks by its own rule.
+      const bool flock =
+          scene_.groups[static_cast<std::size_t>(agents_[i].group)].kind != GroupKind::crowd;
+      commands_[i] = flock ? turn_clear(figure, agents_[i], desired_[i], toward) : MotionCommand{};
       const Vec2 at = agents_[i].position;
       walk_figure(figure, commands_[i], dt, agents_[i]);
       agents_[i].position = at;
