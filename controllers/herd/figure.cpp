@@ -49,6 +49,19 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
   return walk.command_for(want);
 }
 
+MotionCommand turn_clear(const Figure& figure, const Agent& agent, Vec2 desired, Vec2 toward) {
+  const double spot = figure.walk.spot_turn();
+  if (!(spot > 0.0) || norm2(toward) <= 0.0 || norm2(desired) <= 0.0) return {};
+  const Vec2 n = normalized(toward);
+  Vec2 way = desired;
+  const double closing = dot(way, n);
+  if (closing > 0.0) way -= n * closing;
+  if (norm(way) < 0.1 * norm(desired)) way = Vec2{n.y, -n.x};
+  const Vec2 h = heading_vector(agent.heading);
+  const double error = std::atan2(cross(h, way), dot(h, way));
+  return {0.0, std::clamp(error / kHeadingTimeConstant_s, -spot, spot)};
+}
+
 void walk_figure(const Figure& figure, const MotionCommand& command, double dt, Agent& agent) {
   const MotionCommand done = figure.walk.achieved(command);
   const double mid = agent.heading + 0.5 * done.turn_rad_s * dt;

@@ -188,17 +188,29 @@ void Herd::step() {
     // Figures are solid: the last guard, whatever the steering asked, is a
     // figure that stops rather than step into another.
     bool blocked = false;
+    Vec2 toward;  // unit vectors to the figures it would step into
     grid_.for_each_near(static_cast<int>(i), reach, [&](int j, double) {
       const Agent& other = agents_[static_cast<std::size_t>(j)];
       const double contact = next.radius + other.radius;
       const double before = norm(agents_[i].position - other.position);
       const double after = norm(next.position - other.position);
-      if (after < contact && after < before) blocked = true;
+      if (after < contact && after < before) {
+        blocked = true;
+        if (before > 0.0) toward += (other.position - agents_[i].position) / before;
+      }
     });
     if (blocked) {
       ++contact_stops_;
+      // It stands; a flock's figure turns on the spot out of the way where
+      // it can (in place: the drift of such a turn is ignored here). A
+      // crowd plans around its neighbours and unsticks by its own rule.
+      const bool flock =
+          scene_.groups[static_cast<std::size_t>(agents_[i].group)].kind != GroupKind::crowd;
+      commands_[i] = flock ? turn_clear(figure, agents_[i], desired_[i], toward) : MotionCommand{};
+      const Vec2 at = agents_[i].position;
+      walk_figure(figure, commands_[i], dt, agents_[i]);
+      agents_[i].position = at;
       agents_[i].speed = 0.0;
-      agents_[i].turn = 0.0;
       continue;
     }
     agents_[i] = next;

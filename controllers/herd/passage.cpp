@@ -63,7 +63,29 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
                           const std::vector<bool>& active) {
   held_.assign(agents.size(), 0);
   hold_.resize(agents.size());
+  queued_.resize(agents.size(), 0);
+  queue_at_.resize(agents.size());
   for (Passage& p : passages_) update_one(t, p, agents, target, active);
+  // A figure keeps its place in a queue only while it stays queued.
+  for (char& q : queued_) q = q == 2 ? 1 : 0;
+}
+
+int PassageRules::single_file(const Passage& p, std::span<const Agent> agents) const {
+  if (p.owner == 0 || p.half_width >= 2.0 * avoid_radius_) return -1;
+  const Vec2 mouth = p.centre - p.axis * (p.owner * p.half_length);
+  int next = -1;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    if (dir_of_[i] != p.owner) continue;
+    const double s = dot(agents[i].position - p.centre, p.axis) * p.owner;
+    if (s >= -p.half_length) continue;  // in the passage already
+    const double d = norm(agents[i].position - mouth);
+    if (d < best) {
+      best = d;
+      next = static_cast<int>(i);
+    }
+  }
+  return next;
 }
 
 void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agents,
@@ -112,6 +134,7 @@ void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agent
     p.waiting_since = -1.0;
     p.closing = false;
   }
+  const int next = single_file(p, agents);
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const int dir = dir_of[i];
     if (dir == 0 || held_[i]) continue;
@@ -123,7 +146,19 @@ void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agent
     // a stream, touching, they could not turn out of its way.
     const bool near = s >= -(hl + params_.close_m);
     const bool wait = (dir != p.owner && !inside) || (dir == p.owner && p.closing && !near);
-    if (!wait) continue;
+    if (!wait) {
+      // One lane: the owner's figures near the mouth stand where they are
+      // and go in one at a time, nearest first; several pressing into it
+      // from a wide front lock there.
+      if (next < 0 || static_cast<int>(i) == next || dir != p.owner || s >= -hl ||
+          norm(agents[i].position - (p.centre - u * (dir * hl))) > params_.queue_m)
+        continue;
+      held_[i] = 1;
+      if (!queued_[i]) queue_at_[i] = agents[i].position;
+      queued_[i] = 2;
+      hold_[i] = queue_at_[i];
+      continue;
+    }
     // Beside the mouth on the figure's right, clear of the way out of the
     // passage (figures coming out keep to their own right, the other side).
     const Vec2 way = u * dir, right{way.y, -way.x};

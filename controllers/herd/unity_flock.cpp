@@ -65,6 +65,9 @@ void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
   for (const int i : members_) sum_pos += agents[static_cast<std::size_t>(i)].position;
   const double others = static_cast<double>(n > 0 ? n - 1 : 0);
   const Vec2 leader_pos = leader_.position();
+  // The text's boids are children of the controller: its move this step
+  // carries them, and their own velocity is on top of it.
+  const Vec2 carried = leader_.velocity();
 
   for (std::size_t k = 0; k < n; ++k) {
     const int i = members_[k];
@@ -122,7 +125,11 @@ void UnityFlock::steer(double t, double dt, std::span<const Agent> agents,
     }
     desired[static_cast<std::size_t>(i)] = out;
   }
-  for (std::size_t k = 0; k < n; ++k) velocity_[k] = desired[static_cast<std::size_t>(members_[k])];
+  for (std::size_t k = 0; k < n; ++k) {
+    Vec2& d = desired[static_cast<std::size_t>(members_[k])];
+    velocity_[k] = d;
+    d += carried;
+  }
   started_ = true;
   leader_.step(dt);
 }

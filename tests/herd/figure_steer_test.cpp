@@ -116,5 +116,31 @@ TEST(FigureSteer, AFigureFacingAWallTurnsRoundOnTheSpot) {
   EXPECT_GE(nearest_wall, 0.3 - 1e-9) << "walked toward the wall";
 }
 
+// Stopped by the contact guard nose to a neighbour, with its way ahead: a
+// figure that turns on the spot turns there, toward its way less the part
+// that closes on the neighbour, or to the right when its way is straight
+// into it; one that cannot stands.
+TEST(FigureSteer, AFigureStoppedNoseToANeighbourTurnsOutOfItsWay) {
+  const Figure pony{
+      "pony", 0.25,
+      load_walk_response(std::string(ANIMRT_SOURCE_DIR) + "/configs/gaits/pony.yaml")};
+  const double spot = pony.walk.spot_turn();
+  ASSERT_GT(spot, 0.0);
+  Agent a;  // heading +x, the neighbour 0.5 m ahead
+  const Vec2 toward{1.0, 0.0};
+  MotionCommand c = turn_clear(pony, a, Vec2{0.1, 0.03}, toward);
+  EXPECT_EQ(c.speed_m_s, 0.0);
+  EXPECT_NEAR(c.turn_rad_s, spot, 1e-12);  // left, where its way leans
+  c = turn_clear(pony, a, Vec2{0.1, 0.0}, toward);
+  EXPECT_NEAR(c.turn_rad_s, -spot, 1e-12);  // straight into it: to the right
+  // Its way already clear of the neighbour (along its side): it stands.
+  a.heading = std::numbers::pi / 2;
+  c = turn_clear(pony, a, Vec2{0.0, 0.1}, toward);
+  EXPECT_NEAR(c.turn_rad_s, 0.0, 1e-12);
+  const MotionCommand none = turn_clear(calibrated_figure(), a, Vec2{0.1, 0.0}, toward);
+  EXPECT_EQ(none.speed_m_s, 0.0);
+  EXPECT_EQ(none.turn_rad_s, 0.0);
+}
+
 }  // namespace
 }  // namespace animrt::herd

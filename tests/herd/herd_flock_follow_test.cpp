@@ -34,19 +34,15 @@ GroupMetrics run_flock_scene(const std::string& name, std::uint64_t seed) {
 
 // The Unity-sample flock stood (0.0004 m/s against its leader's 0.11, 6.6 m
 // behind): each step began from the figures' walked velocity, and figures
-// knotted nose to a neighbour could not turn out of the knot.
-TEST(HerdFlockFollow, UnityFlockWalksWithItsLeader) {
-  const GroupMetrics g = run_flock_scene("unity.yaml", 1);
-  EXPECT_FALSE(g.standing);
-  EXPECT_GE(g.speed_mean_mps, 0.6 * g.leader_speed_mean_mps);
-}
-
-// The goal: as above, and the flock's centre within 3 m of its leader. Not
-// met: 3.09 m (seed 1; 2.1-3.4 m over seeds 1-5). Run with
-// --gtest_also_run_disabled_tests.
-TEST(HerdFlockFollow, DISABLED_GoalUnityFlockKeepsUpWithItsLeader) {
+// knotted nose to a neighbour could not turn out of the knot. It walks at
+// 60 % of its leader's speed or more, its centre within 3 m of its leader
+// on every seed: the boids are carried by their leader's move, as the
+// text's are children of the controller, and a figure the contact guard
+// stops turns on the spot out of the way (before: 2.1-3.4 m).
+TEST(HerdFlockFollow, GoalUnityFlockKeepsUpWithItsLeader) {
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     const GroupMetrics g = run_flock_scene("unity.yaml", seed);
+    EXPECT_FALSE(g.standing) << "seed " << seed;
     EXPECT_GE(g.speed_mean_mps, 0.6 * g.leader_speed_mean_mps) << "seed " << seed;
     EXPECT_LT(g.leader_distance_mean_m, 3.0) << "seed " << seed;
   }

@@ -29,6 +29,13 @@ inline constexpr double kHeadingTimeConstant_s = 0.3;
 // a velocity behind it, a turn on the spot when the gait has one.
 MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desired, double dt);
 
+// The command for a figure the contact guard stopped, `toward` the sum of
+// unit vectors to the figures it would have stepped into: a turn on the
+// spot (when its gait has one) toward `desired` less the part that closes
+// on them, or to the right of them when nothing else is left. Standing
+// nose to a neighbour with its way ahead, it would otherwise never leave.
+MotionCommand turn_clear(const Figure& figure, const Agent& agent, Vec2 desired, Vec2 toward);
+
 // Moves `agent` for `dt` by what `figure` achieves under `command`:
 // heading and position integrated at the midpoint heading.
 void walk_figure(const Figure& figure, const MotionCommand& command, double dt, Agent& agent);

@@ -24,6 +24,9 @@ struct PassageParams {
   double close_m = 2.5;
   double clear_m = 1.5;
   double max_hold_s = 60.0;  // the other way waits at most this long for a turn
+  // At a passage one figure wide, the owner's figures this near its mouth
+  // queue there and go in one at a time.
+  double queue_m = 1.5;
 };
 
 struct Passage {
@@ -57,6 +60,10 @@ class PassageRules {
   void update_one(double t, Passage& p, std::span<const Agent> agents, std::span<const Vec2> target,
                   const std::vector<bool>& active);
 
+  // In a passage one figure wide, the owner's figure outside it that is
+  // nearest its mouth (the next to go in); -1 for a wider one.
+  int single_file(const Passage& p, std::span<const Agent> agents) const;
+
   std::vector<Passage> passages_;
   double avoid_radius_;
   PassageParams params_;
@@ -64,6 +71,10 @@ class PassageRules {
   std::vector<Vec2> hold_;
   // Per agent: its direction (+1, -1) while it asks for the passage at hand, else 0.
   std::vector<signed char> dir_of_;
+  // Per agent: queued at a one-lane mouth (1 since the last update, 2 this
+  // one), and where it stands in the queue.
+  std::vector<char> queued_;
+  std::vector<Vec2> queue_at_;
 };
 
 }  // namespace animrt::herd

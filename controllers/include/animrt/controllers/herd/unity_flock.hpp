@@ -18,10 +18,12 @@
 //   push    a point of the unit disc * random_force, renewed after a random
 //           interval uniform in [0.5, 1.5] / random_freq;
 //   wanted  = v - v*dt + (push + origin + avg + unit(to_avg)*gravity) * dt;
-// and the desired velocity is v turned toward wanted by at most
+// and the boid's new velocity is v turned toward wanted by at most
 // turn_speed*dt (its length moved toward |wanted| by at most
-// max_length_delta), never slower than min_speed. The figure is asked for
-// that velocity and walks what its gait can of it; the boid's velocity is
+// max_length_delta), never slower than min_speed. The text's boids are
+// children of the controller, so the leader's move carries them: the
+// figure is asked for the boid's velocity plus the leader's, and walks
+// what its gait can of it; the boid's velocity is
 // not reset to the figure's, as a figure that stands (its slowest walk is
 // faster than the pull on it, or a neighbour blocks it) would otherwise
 // give the rules nothing to build on and the flock would stay standing.
