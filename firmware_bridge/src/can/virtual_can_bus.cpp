@@ -63,12 +63,13 @@ class VirtualCanEndpoint final : public LockstepCanPort {
 
   bool receive(can_frame& frame, std::chrono::microseconds timeout) override {
     VirtualCanBus::Queue& q = *queue_;
+    const auto start = std::chrono::steady_clock::now();
     std::unique_lock lock(bus_->mutex_);
     // Following lockstep devices, they say when nothing more will come; the
     // wall clock only guards against a hung device thread.
     const bool follow = !q.lockstep_device && bus_->lockstep_devices_ > 0;
     if (follow) timeout = std::max<std::chrono::microseconds>(timeout, LockstepLine::kGuard);
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    const auto deadline = start + timeout;
     for (;;) {
       q.errors.rx_overflows = q.overflows;
       while (q.size > 0) {
