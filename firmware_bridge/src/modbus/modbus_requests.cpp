@@ -48,11 +48,15 @@ int exchange(modbus_t* ctx, LockstepLine& line, const std::uint8_t* req, int len
 // exception), the length.
 bool answer_ok(const std::uint8_t* req, const std::uint8_t* rsp, int rc, int want) {
   if (rc < 0) return false;
+  if (rc < 3) {
+    errno = EMBBADDATA;
+    return false;
+  }
   if (rsp[0] != req[0]) {
     errno = EMBBADSLAVE;
     return false;
   }
-  if (rsp[1] == (req[1] | 0x80) && rc >= 3) {
+  if (rsp[1] == (req[1] | 0x80)) {
     errno = MODBUS_ENOBASE + rsp[2];
     return false;
   }
@@ -87,7 +91,7 @@ int read_registers(modbus_t* ctx, LockstepLine* line, int slave, bool input, int
                                                          : MODBUS_FC_READ_HOLDING_REGISTERS)};
   put16(req + 2, address);
   put16(req + 4, count);
-  std::uint8_t rsp[MODBUS_RTU_MAX_ADU_LENGTH];
+  std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
   const int rc = exchange(ctx, *line, req, sizeof req, rsp);
   // Slave, function, byte count, the registers, CRC.
   if (!answer_ok(req, rsp, rc, 3 + 2 * count + 2)) return -1;
@@ -112,7 +116,7 @@ int write_registers(modbus_t* ctx, LockstepLine* line, int slave, int address, i
   put16(req + 4, count);
   req[6] = static_cast<std::uint8_t>(2 * count);
   for (int i = 0; i < count; ++i) put16(req + 7 + 2 * i, src[i]);
-  std::uint8_t rsp[MODBUS_RTU_MAX_ADU_LENGTH];
+  std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
   const int rc = exchange(ctx, *line, req, 7 + 2 * count, rsp);
   // Slave, function, address, quantity, CRC.
   if (!answer_ok(req, rsp, rc, 8)) return -1;
@@ -135,7 +139,7 @@ int write_single(modbus_t* ctx, LockstepLine* line, int slave, bool coil, int ad
                                                         : MODBUS_FC_WRITE_SINGLE_REGISTER)};
   put16(req + 2, address);
   put16(req + 4, word);
-  std::uint8_t rsp[MODBUS_RTU_MAX_ADU_LENGTH];
+  std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
   const int rc = exchange(ctx, *line, req, sizeof req, rsp);
   // The request echoed, and the CRC.
   if (!answer_ok(req, rsp, rc, 8)) return -1;
