@@ -141,6 +141,54 @@ TEST(QuadrupedCanLockstep, EmcyBecomesTheDevicesFaultReport) {
   EXPECT_GE(d.status.hardware_errors, 1u);
 }
 
+// The drive's thread runs late (a loaded machine) while the host, which
+// waits for no answer from a faulted drive, goes on: the drive still takes
+// every host heartbeat at the time it was sent, so its guard does not fire
+// and its own fault stays the one reported.
+TEST(QuadrupedCanLockstep, ALateDriveThreadAfterItsEmcyMissesNoHostHeartbeat) {
+  Rig rig;
+  bool done = false;
+  rig.probe->on_sample = [&](double t) {
+    if (!done && t >= 0.3) {
+      rig.sims[2]->set_device_hardware_error(32, 0x20);  // overload
+      rig.sims[2]->set_device_answer_delay(32, 100'000'000, 3);
+      done = true;
+    }
+  };
+  const RunSummary s = rig.run(1.0);
+  EXPECT_EQ(s.exit_code(), 4);
+  EXPECT_EQ(rig.drive->fault_text(0).substr(0, 46),
+            "EMCY 0x2310 (current), error register 0x03; st");
+  EXPECT_FALSE(rig.can(2).device_guard_fired(32));
+  EXPECT_EQ(rig.drive->drive(0).emcy_count, 1u);
+}
+
+// The drive's answers from 0.3 s on leave later than the lockstep bus
+// timeout (its thread ran late), two of them; `late_s` 0: on time.
+RunSummary run_with_a_late_drive(double late_s, const std::string& csv) {
+  Rig rig;
+  bool delayed = false;
+  rig.probe->on_sample = [&](double t) {
+    if (t >= 0.3 && !delayed && late_s > 0) {
+      rig.sims[2]->set_device_answer_delay(32, from_seconds(late_s), 2);
+      delayed = true;
+    }
+  };
+  return rig.run(0.6, csv);
+}
+
+TEST(QuadrupedCanLockstep, AnAnswerLaterOnTheWallClockThanTheBusTimeoutChangesNothing) {
+  const std::string on_time = ::testing::TempDir() + "/can_on_time.csv";
+  const std::string late = ::testing::TempDir() + "/can_late.csv";
+  const RunSummary a = run_with_a_late_drive(0.0, on_time);
+  const RunSummary b = run_with_a_late_drive(kLockstepMinTimeoutS + 0.15, late);
+  EXPECT_EQ(b.end_reason, EndReason::duration);
+  EXPECT_EQ(test::lockstep_problems(a), "");
+  EXPECT_EQ(test::lockstep_problems(b), "");
+  EXPECT_EQ(a.cycles, b.cycles);
+  EXPECT_EQ(test::first_difference(on_time, late), "");
+}
+
 TEST(QuadrupedCanLockstep, SilentDriveTimesOutThroughTheHeartbeatConsumer) {
   Rig rig;
   bool done = false;

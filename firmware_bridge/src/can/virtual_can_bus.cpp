@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
 
+#include "animrt/bridge/lockstep_line.hpp"
 #include "animrt/core/error.hpp"
 
 namespace animrt {
@@ -27,9 +29,16 @@ struct VirtualCanBus::Queue {
   CanErrorCounters errors;  // written by the endpoint's thread only
   bool bus_off = false;
   std::uint64_t overflows = 0;  // written under the bus lock
+  // A lockstep device's queue (the rest under the bus lock, see the header).
+  bool lockstep_device = false;
+  bool serving = false;
+  std::uint64_t taken = 0;    // frames its receive() returned or consumed
+  std::uint64_t handled = 0;  // of those, served
+  Nanos polled_at = std::numeric_limits<Nanos>::min();
+  bool poke = false;  // its receive() returns at once: poll at the clock's time
 };
 
-class VirtualCanEndpoint final : public CanFrameTransport {
+class VirtualCanEndpoint final : public LockstepCanPort {
  public:
   VirtualCanEndpoint(std::shared_ptr<VirtualCanBus> bus, std::unique_ptr<VirtualCanBus::Queue> q)
       : bus_(std::move(bus)),
@@ -53,24 +62,48 @@ class VirtualCanEndpoint final : public CanFrameTransport {
   }
 
   bool receive(can_frame& frame, std::chrono::microseconds timeout) override {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    VirtualCanBus::Queue& q = *queue_;
+    const auto start = std::chrono::steady_clock::now();
     std::unique_lock lock(bus_->mutex_);
+    // Following lockstep devices, they say when nothing more will come; the
+    // wall clock only guards against a hung device thread.
+    const bool follow = !q.lockstep_device && bus_->lockstep_devices_ > 0;
+    if (follow) timeout = std::max<std::chrono::microseconds>(timeout, LockstepLine::kGuard);
+    const auto deadline = start + timeout;
     for (;;) {
-      queue_->errors.rx_overflows = queue_->overflows;
-      while (queue_->size > 0) {
-        frame = queue_->frames[queue_->head];
-        queue_->head = (queue_->head + 1) % VirtualCanBus::kQueueFrames;
-        --queue_->size;
+      q.errors.rx_overflows = q.overflows;
+      while (q.size > 0) {
+        frame = q.frames[q.head];
+        q.head = (q.head + 1) % VirtualCanBus::kQueueFrames;
+        --q.size;
+        if (q.lockstep_device) ++q.taken;
         if ((frame.can_id & CAN_ERR_FLAG) == 0) return true;
-        const int change = count_error_frame(frame, queue_->errors);
-        if (change > 0) queue_->bus_off = true;
-        if (change < 0) queue_->bus_off = false;
+        const int change = count_error_frame(frame, q.errors);
+        if (change > 0) q.bus_off = true;
+        if (change < 0) q.bus_off = false;
       }
-      if (queue_->ready.wait_until(lock, deadline) == std::cv_status::timeout &&
-          queue_->size == 0) {
+      if (q.poke) {
+        q.poke = false;
+        return false;
+      }
+      if (follow && bus_->settled_locked()) return false;
+      if (q.ready.wait_until(lock, deadline) == std::cv_status::timeout && q.size == 0) {
         return false;
       }
     }
+  }
+
+  void serving(bool on) override {
+    std::lock_guard lock(bus_->mutex_);
+    queue_->serving = on;
+    bus_->wake_followers_locked();
+  }
+
+  void served(Nanos now) override {
+    std::lock_guard lock(bus_->mutex_);
+    queue_->handled = queue_->taken;
+    queue_->polled_at = std::max(queue_->polled_at, now);
+    bus_->wake_followers_locked();
   }
 
   const CanErrorCounters& errors() const override { return queue_->errors; }
@@ -105,9 +138,45 @@ std::unique_ptr<CanFrameTransport> VirtualCanBus::attach() {
   return std::make_unique<VirtualCanEndpoint>(shared_from_this(), std::move(queue));
 }
 
+std::unique_ptr<LockstepCanPort> VirtualCanBus::attach_lockstep_device() {
+  auto queue = std::make_unique<Queue>();
+  queue->lockstep_device = true;
+  {
+    std::lock_guard lock(mutex_);
+    queues_.push_back(queue.get());
+    ++lockstep_devices_;
+  }
+  return std::make_unique<VirtualCanEndpoint>(shared_from_this(), std::move(queue));
+}
+
 void VirtualCanBus::detach(Queue* queue) {
   std::lock_guard lock(mutex_);
   queues_.erase(std::remove(queues_.begin(), queues_.end(), queue), queues_.end());
+  if (queue->lockstep_device) {
+    --lockstep_devices_;
+    wake_followers_locked();
+  }
+}
+
+bool VirtualCanBus::settled_locked() {
+  const Nanos now = now_locked();
+  bool settled = true;
+  for (Queue* q : queues_) {
+    if (!q->lockstep_device || !q->serving) continue;
+    if (q->size == 0 && q->handled == q->taken && q->polled_at >= now) continue;
+    settled = false;
+    if (q->size == 0 && !q->poke) {
+      q->poke = true;  // idle, but not polled at this time yet
+      q->ready.notify_one();
+    }
+  }
+  return settled;
+}
+
+void VirtualCanBus::wake_followers_locked() {
+  for (Queue* q : queues_) {
+    if (!q->lockstep_device) q->ready.notify_all();
+  }
 }
 
 void VirtualCanBus::set_clock(const Clock* clock) {
@@ -115,14 +184,14 @@ void VirtualCanBus::set_clock(const Clock* clock) {
   clock_ = clock;
 }
 
-Nanos VirtualCanBus::now() const {
-  const Clock* clock = nullptr;
-  {
-    std::lock_guard lock(mutex_);
-    clock = clock_;
-  }
-  if (clock) return clock->now();
+Nanos VirtualCanBus::now_locked() const {
+  if (clock_) return clock_->now();
   return MonotonicClock().now();
+}
+
+Nanos VirtualCanBus::now() const {
+  std::lock_guard lock(mutex_);
+  return now_locked();
 }
 
 void VirtualCanBus::deliver_locked(const Queue* sender, const can_frame& frame, bool error) {

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "animrt/core/error.hpp"
+#include "modbus_requests.hpp"
 
 namespace animrt {
 namespace {
@@ -37,6 +38,12 @@ std::string exception_name(int code) {
     default:
       return "exception " + std::to_string(code);
   }
+}
+
+// Simulated RTU drives on a lockstep clock say when they have answered all
+// they will (modbus_requests.hpp); TCP and hardware have no such line.
+LockstepLine* line_of(const BusConfig& config, const ModbusBusOptions& options) {
+  return options.tcp ? nullptr : config.lockstep_line.get();
 }
 
 }  // namespace
@@ -283,9 +290,9 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
     if (!connected_) return false;
     modbus_set_slave(ctx_, slave.id);
     ++requests_;
-    const int rc = r.table == modbus::Table::holding
-                       ? modbus_read_registers(ctx_, r.begin, r.count, r.words.data())
-                       : modbus_read_input_registers(ctx_, r.begin, r.count, r.words.data());
+    const int rc = modbus_requests::read_registers(ctx_, line_of(config_, options_), slave.id,
+                                                   r.table == modbus::Table::input, r.begin,
+                                                   r.count, r.words.data());
     if (rc != r.count) {
       const int error = rc < 0 ? errno : EMBMDATA;
       if (count) {
@@ -358,9 +365,9 @@ void ModbusBus::read_health_round_robin() {
       if (!connected_) return;
       modbus_set_slave(ctx_, s.id);
       ++requests_;
-      const int rc = r.table == modbus::Table::holding
-                         ? modbus_read_registers(ctx_, r.begin, r.count, r.words.data())
-                         : modbus_read_input_registers(ctx_, r.begin, r.count, r.words.data());
+      const int rc = modbus_requests::read_registers(ctx_, line_of(config_, options_), s.id,
+                                                     r.table == modbus::Table::input, r.begin,
+                                                     r.count, r.words.data());
       if (rc != r.count) {
         for (std::size_t d : s.devices) kept_health_[d] = book_[d].health;
         fail_slave(s, rc < 0 ? errno : EMBMDATA);
@@ -393,7 +400,8 @@ bool ModbusBus::write_slave(Slave& slave) {
     if (!connected_) return false;
     modbus_set_slave(ctx_, slave.id);
     ++requests_;
-    if (modbus_write_registers(ctx_, w.begin, w.count, w.words.data()) != w.count) {
+    if (modbus_requests::write_registers(ctx_, line_of(config_, options_), slave.id, w.begin,
+                                         w.count, w.words.data()) != w.count) {
       fail_slave(slave, errno);
       return false;
     }
@@ -407,8 +415,8 @@ bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
     if (!e.configured) continue;
     modbus_set_slave(ctx_, slave.id);
     const std::uint16_t value = on ? e.on : e.off;
-    const int rc = e.coil ? modbus_write_bit(ctx_, e.address, value)
-                          : modbus_write_register(ctx_, e.address, value);
+    const int rc = modbus_requests::write_single(ctx_, line_of(config_, options_), slave.id, e.coil,
+                                                 e.address, value);
     if (rc != 1) {
       *error = errno;
       return false;
@@ -422,7 +430,9 @@ bool ModbusBus::set_watchdog(Slave& slave, bool on, int* error) {
     const modbus::Watchdog& w = joints_[d].map->watchdog;
     if (!w.configured || joints_[d].watchdog_counts == 0) continue;
     modbus_set_slave(ctx_, slave.id);
-    if (modbus_write_register(ctx_, w.address, on ? joints_[d].watchdog_counts : 0) != 1) {
+    const auto counts = static_cast<std::uint16_t>(on ? joints_[d].watchdog_counts : 0);
+    if (modbus_requests::write_single(ctx_, line_of(config_, options_), slave.id, false, w.address,
+                                      counts) != 1) {
       *error = errno;
       return false;
     }
@@ -541,8 +551,8 @@ void ModbusBus::switch_off_pending() {
       if (!e.configured || !connected_) continue;
       modbus_set_slave(ctx_, s.id);
       ++requests_;
-      const int rc = e.coil ? modbus_write_bit(ctx_, e.address, e.off)
-                            : modbus_write_register(ctx_, e.address, e.off);
+      const int rc = modbus_requests::write_single(ctx_, line_of(config_, options_), s.id, e.coil,
+                                                   e.address, e.off);
       if (rc != 1 && classify(errno) == Failure::connection && options_.tcp) disconnect();
     }
   }

@@ -27,6 +27,12 @@ bool LockstepLine::settled() const {
   return host_read_ >= device_wrote_.load(std::memory_order_acquire);
 }
 
+bool LockstepLine::device_caught_up() const {
+  return !serving_.load(std::memory_order_acquire) ||
+         device_took_.load(std::memory_order_acquire) ==
+             host_wrote_.load(std::memory_order_acquire);
+}
+
 std::uint64_t LockstepLine::unread() const {
   const std::uint64_t wrote = device_wrote_.load(std::memory_order_acquire);
   return wrote > host_read_ ? wrote - host_read_ : 0;

@@ -1,7 +1,9 @@
 #include "animrt/sim/can/can_sim_bus.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/bridge/can/socketcan.hpp"
@@ -51,7 +53,14 @@ CanSimBus::CanSimBus(const BusConfig& config, const Clock& clock, CanSimAttach a
                                  : config_.port;
     virtual_bus_ = VirtualCanBus::named(name);
     virtual_bus_->set_clock(&clock_);
-    transport_ = virtual_bus_->attach();
+    if (dynamic_cast<const ManualClock*>(&clock_) != nullptr) {
+      // Lockstep: the host's reads wait for these devices, not the wall clock.
+      auto port = virtual_bus_->attach_lockstep_device();
+      lockstep_port_ = port.get();
+      transport_ = std::move(port);
+    } else {
+      transport_ = virtual_bus_->attach();
+    }
     endpoint_ = std::string(kVirtualCanPrefix) + name;
   } else {
     transport_ = open_socketcan(config_.port);
@@ -80,29 +89,63 @@ void CanSimBus::flush(FrameList& out) {
 void CanSimBus::start() {
   if (thread_.joinable()) return;
   stop_ = false;
+  if (lockstep_port_) lockstep_port_->serving(true);
   thread_ = std::thread([this] { serve(); });
 }
 
 void CanSimBus::stop() {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
+  if (lockstep_port_) lockstep_port_->serving(false);
 }
 
 void CanSimBus::serve() {
   can_frame frame;
   while (!stop_.load()) {
     const bool got = transport_->receive(frame, kPollInterval);
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     const Nanos now = clock_.now();
+    Nanos late = 0;
     if (got) {
       ++frames_handled_;
-      for (CanNode* n : listeners_[frame.can_id & CAN_SFF_MASK]) n->handle(frame, now, out_);
+      for (CanNode* n : listeners_[frame.can_id & CAN_SFF_MASK]) {
+        const std::size_t before = out_.size();
+        n->handle(frame, now, out_);
+        late = std::max(late, lateness(*n, before));
+      }
     }
     // Time-driven behaviour (heartbeats, the guards against a dead host)
     // must not wait for a quiet bus.
-    for (const auto& n : nodes_) n->poll(now, out_);
+    for (const auto& n : nodes_) {
+      const std::size_t before = out_.size();
+      n->poll(now, out_);
+      late = std::max(late, lateness(*n, before));
+    }
+    if (late > 0) {
+      lock.unlock();
+      std::this_thread::sleep_for(std::chrono::nanoseconds(late));
+      lock.lock();
+    }
     flush(out_);
+    if (lockstep_port_) lockstep_port_->served(now);
   }
+}
+
+Nanos CanSimBus::lateness(const CanNode& node, std::size_t out_before) {
+  if (delays_.empty() || out_.size() == out_before) return 0;
+  for (Delay& d : delays_) {
+    if (d.device_id != node.device_id() || d.answers == 0) continue;
+    if (d.answers > 0) --d.answers;
+    return d.ns;
+  }
+  return 0;
+}
+
+void CanSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int answers) {
+  std::lock_guard lock(mutex_);
+  node(device_id);  // std::out_of_range for a device not on this bus
+  std::erase_if(delays_, [&](const Delay& d) { return d.device_id == device_id; });
+  if (delay_ns > 0 && answers != 0) delays_.push_back({device_id, delay_ns, answers});
 }
 
 CanNode& CanSimBus::node(int device_id) const {

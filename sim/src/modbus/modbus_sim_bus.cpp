@@ -165,6 +165,8 @@ ModbusSimBus::ModbusSimBus(const BusConfig& config, const Clock& clock)
     endpoint_ = pty_->path();
     ctx_ = modbus_new_rtu("/dev/null", std::max(config_.baud, 300), 'N', 8, 1);
     if (ctx_) modbus_set_socket(ctx_, pty_->master());
+    if (dynamic_cast<const ManualClock*>(&clock_) != nullptr)
+      line_ = std::make_shared<LockstepLine>();
   }
   if (ctx_ == nullptr)
     throw DeviceError("simulated bus '" + elide(config_.name) + "': libmodbus context");
@@ -187,6 +189,7 @@ void ModbusSimBus::start() {
   if (thread_.joinable()) return;
   wake_->drain();
   stop_ = false;
+  if (line_) line_->device_serving(true);
   thread_ = std::thread([this] { tcp_ ? serve_tcp() : serve_rtu(); });
 }
 
@@ -195,6 +198,7 @@ void ModbusSimBus::stop() {
   stop_ = true;
   wake_->wake();
   thread_.join();
+  if (line_) line_->device_serving(false);
   for (int fd : clients_) ::close(fd);
   clients_.clear();
   client_rx_.clear();
@@ -327,14 +331,14 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
   const int delay = config_.sim.return_delay_us;
   if (bad_value) {
     sleep_us(delay);
-    modbus_reply_exception(ctx_, req, MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE);
+    wrote(modbus_reply_exception(ctx_, req, MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE));
     ++exceptions_;
     return;
   }
   if (!tcp_) modbus_set_slave(ctx_, d->slave);
   sleep_us(delay);
   // libmodbus answers exceptions 2 (illegal address) and 3 (bad quantity) itself.
-  modbus_reply(ctx_, req, length, d->mapping);
+  wrote(modbus_reply(ctx_, req, length, d->mapping));
   // Read back what was written: goals and enables.
   bool enabled = true, any_enable = false;
   for (Joint& j : d->joints) {
@@ -500,7 +504,13 @@ void ModbusSimBus::serve_rtu() {
       dropped_ += have;
       have = 0;
     }
+    // Every byte read is handled: answered, or kept for the rest of its frame.
+    if (line_) line_->device_took(static_cast<std::size_t>(n));
   }
+}
+
+void ModbusSimBus::wrote(int bytes) {
+  if (line_ && bytes > 0) line_->device_wrote(static_cast<std::size_t>(bytes));
 }
 
 void ModbusSimBus::set_device_responding(int device_id, bool responding) {

@@ -13,7 +13,10 @@
 // the host through an eventfd each time it has taken a batch. The host's
 // wall-clock wait is then only a guard (kGuard) against a device side that
 // hangs. Hardware, and simulated devices on the wall clock, have no such
-// line: their transports wait their timeouts.
+// line: their transports wait their timeouts. Modbus RTU requests follow the
+// same line (firmware_bridge/src/modbus/modbus_requests.hpp); the virtual
+// CAN bus, many endpoints to many, counts frames itself
+// (VirtualCanBus::attach_lockstep_device).
 
 #include <atomic>
 #include <chrono>
@@ -38,6 +41,9 @@ class LockstepLine {
   void host_read(std::size_t bytes) { host_read_ += bytes; }
   // Nothing more will come until the host writes again.
   bool settled() const;
+  // The device side has taken (and answered) every byte the host wrote, or
+  // does not serve; its answers may still be unread (unread()).
+  bool device_caught_up() const;
   // Bytes the device side wrote that the host has not read yet (in flight
   // in the pty, or queued); what a discard must read away.
   std::uint64_t unread() const;

@@ -4,7 +4,9 @@
 // - in-process (the default): attached to the virtual bus named after the
 //   bus's interface; endpoint() is "virtual:IFACE", which make_bus opens. The
 //   virtual bus reports the simulation's clock, so lockstep runs are
-//   deterministic.
+//   deterministic; on a lockstep clock the host's reads wait until these
+//   devices have served every frame at the clock's time
+//   (VirtualCanBus::attach_lockstep_device), never on the wall clock.
 // - SocketCAN (`animrt sim`, see set_can_sim_attach): attached to the real
 //   interface (e.g. vcan0 in the HIL guest); endpoint() is the interface, and
 //   any SocketCAN client (the runtime, candump, python-can) talks to them.
@@ -48,6 +50,10 @@ class CanSimBus final : public SimulatedBus {
   std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   void set_device_responding(int device_id, bool responding) override;
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
+  // The device's next `answers` batches of frames (every one while answers
+  // < 0), answers or heartbeats, leave `delay_ns` of real time late: the
+  // devices' thread ran late, as on a loaded machine.
+  void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
   // The device's health model (CiA 402 drives, MIT motors), at once.
   void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
@@ -63,6 +69,8 @@ class CanSimBus final : public SimulatedBus {
 
  private:
   void serve();
+  // How late (real time) the frames `node` just added to out_ leave.
+  Nanos lateness(const CanNode& node, std::size_t out_before);
   CanNode& node(int device_id) const;
   void flush(FrameList& out);
 
@@ -71,10 +79,17 @@ class CanSimBus final : public SimulatedBus {
   std::string endpoint_;
   std::shared_ptr<VirtualCanBus> virtual_bus_;
   std::unique_ptr<CanFrameTransport> transport_;
-  mutable std::mutex mutex_;  // guards nodes_ and the transport's send side
+  LockstepCanPort* lockstep_port_ = nullptr;  // transport_ on a lockstep clock
+  mutable std::mutex mutex_;                  // guards nodes_ and the transport's send side
   std::vector<std::unique_ptr<CanNode>> nodes_;
   std::vector<std::vector<CanNode*>> listeners_;  // per CAN id (11 bits)
   FrameList out_;                                 // serving thread only
+  struct Delay {
+    int device_id;
+    Nanos ns;
+    int answers;  // < 0: every one
+  };
+  std::vector<Delay> delays_;  // guarded by mutex_
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> frames_handled_{0};

@@ -76,12 +76,15 @@ class ModbusSimBus final : public SimulatedBus {
   // joint of the slave), at once.
   void inject_device_health(int device_id, const SimHealthInjection& change) override;
   double device_position(int device_id) const override;
+  // RTU on a lockstep clock: the line the host's requests follow.
+  std::shared_ptr<LockstepLine> lockstep_line() const override { return line_; }
 
   // TCP: closes every open client connection (the server keeps listening).
   void drop_connections();
   ModbusSimStats stats() const;
 
  private:
+  void wrote(int bytes);  // an answer's bytes, for the lockstep line
   struct Joint;
   struct Drive;
   void serve_tcp();
@@ -100,6 +103,7 @@ class ModbusSimBus final : public SimulatedBus {
   std::string endpoint_;
   int listen_fd_ = -1;
   std::unique_ptr<PtyPair> pty_;
+  std::shared_ptr<LockstepLine> line_;  // RTU on a lockstep clock only
   std::unique_ptr<WakePipe> wake_;
   _modbus* ctx_ = nullptr;
   std::vector<std::unique_ptr<Drive>> drives_;
