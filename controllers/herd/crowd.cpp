@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "animrt/controllers/herd/cell_index.hpp"
 #include "animrt/controllers/herd/passage.hpp"
 
 namespace animrt::herd {
@@ -33,7 +34,7 @@ double unit(std::mt19937_64& rng) {
 }  // namespace
 
 Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
-    : world_(world), params_(params) {
+    : world_(world), params_(params), grid_rows_(std::make_unique<CellIndex>()) {
   if (static_cast<int>(agents.size()) > params_.max_agents) {
     throw std::invalid_argument("crowd: more agents than max_agents");
   }
@@ -171,6 +172,16 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
   if (passages_) apply_passages(t, agents);
+  // The crowd registers every agent in its grid as it stands now (all of
+  // them are active there, so grid ids are agent indices).
+  grid_rows_->begin(crowd_->getGrid()->getCellSize());
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
+    const float r = ag->params.radius;
+    grid_rows_->add(static_cast<int>(i), ag->npos[0] - r, ag->npos[2] - r, ag->npos[0] + r,
+                    ag->npos[2] + r);
+  }
+  grid_rows_->finish();
   crowd_->update(static_cast<float>(dt), nullptr);
   dt_ = dt;
 }
@@ -276,6 +287,17 @@ Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
   return v;
 }
 
+int Crowd::near_agents(Vec2 p, double range, std::span<unsigned short> out) const {
+  const auto c = NavWorld::to_recast(p);
+  const float r = static_cast<float>(range);
+  if (grid_rows_->query(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.size(), near_scratch_)) {
+    std::copy(near_scratch_.begin(), near_scratch_.end(), out.begin());
+    return static_cast<int>(near_scratch_.size());
+  }
+  return crowd_->getGrid()->queryItems(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.data(),
+                                       static_cast<int>(out.size()));
+}
+
 Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
   const double speed = norm(v);
   if (params_.keep_right_rad <= 0.0 || speed <= 0.0) return v;
@@ -286,11 +308,7 @@ Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
   const double lane = 2.0 * (a.radius + params_.avoidance_margin_m);
   // Agents near the figure, from the crowd's own grid (built at its last update).
   std::array<unsigned short, 64> near{};
-  const auto p = NavWorld::to_recast(a.position);
-  const int n = crowd_->getGrid()->queryItems(
-      p[0] - static_cast<float>(range), p[2] - static_cast<float>(range),
-      p[0] + static_cast<float>(range), p[2] + static_cast<float>(range), near.data(),
-      static_cast<int>(near.size()));
+  const int n = near_agents(a.position, range, near);
   double urge = 0.0;  // 0..1: how hard to keep right
   for (int k = 0; k < n; ++k) {
     const int j = near[static_cast<std::size_t>(k)];
