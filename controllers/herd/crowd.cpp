@@ -84,6 +84,19 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
     const int idx = crowd_->addAgent(p.data(), &ap);
     if (idx != static_cast<int>(i)) throw std::runtime_error("crowd: could not add an agent");
   }
+  // A member's plan reads the agents in its grid query (the cell span of
+  // its query range) and, through the collision pushes of the crowd's four
+  // passes, the neighbours of its neighbours three links away, each
+  // chosen by its own grid query; keep-right reads a wider square.
+  const double r = rmax + params_.avoidance_margin_m;
+  const double hop = params_.query_range_radii * r;
+  const double cell = crowd_->getGrid()->getCellSize();
+  const double box = std::sqrt(2.0) * (hop + r + cell);
+  const double ahead = std::sqrt(2.0) * (params_.keep_right_range_m + r + cell);
+  reach_m_ = std::max(3 * hop + box, ahead) + 1.0;
+  member_at_.reserve(agents.size());
+  members_near_.reserve(agents.size());
+  in_update_.reserve(agents.size());
 }
 
 Crowd::~Crowd() { dtFreeCrowd(crowd_); }
@@ -172,18 +185,38 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
   if (passages_) apply_passages(t, agents);
-  // The crowd registers every agent in its grid as it stands now (all of
-  // them are active there, so grid ids are agent indices).
+  select_participants();
+  // The crowd registers each agent of its update in its grid as it stands now.
   grid_rows_->begin(crowd_->getGrid()->getCellSize());
-  for (std::size_t i = 0; i < agents.size(); ++i) {
-    const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
+  for (const int i : in_update_) {
+    const dtCrowdAgent* ag = crowd_->getAgent(i);
     const float r = ag->params.radius;
-    grid_rows_->add(static_cast<int>(i), ag->npos[0] - r, ag->npos[2] - r, ag->npos[0] + r,
-                    ag->npos[2] + r);
+    grid_rows_->add(i, ag->npos[0] - r, ag->npos[2] - r, ag->npos[0] + r, ag->npos[2] + r);
   }
   grid_rows_->finish();
   crowd_->update(static_cast<float>(dt), nullptr);
   dt_ = dt;
+}
+
+void Crowd::select_participants() {
+  // Passive agents farther than reach_m_ from every member leave the
+  // crowd's update: nothing of theirs reaches a member's plan, and Detour
+  // spends as much on a passive agent's neighbours and move as on a
+  // member's. They are still synced every step, so they rejoin in place.
+  member_at_.clear();
+  for (std::size_t i = 0; i < active_.size(); ++i) {
+    if (active_[i]) member_at_.push_back(synced_[i]);
+  }
+  if (!member_at_.empty()) members_near_.build(std::span<const Vec2>(member_at_), reach_m_);
+  in_update_.clear();
+  for (std::size_t i = 0; i < active_.size(); ++i) {
+    bool take = active_[i];
+    if (!take && !member_at_.empty()) {
+      members_near_.for_each_within(synced_[i], reach_m_, [&](int, double) { take = true; });
+    }
+    crowd_->getEditableAgent(static_cast<int>(i))->active = take;
+    if (take) in_update_.push_back(static_cast<int>(i));
+  }
 }
 
 bool Crowd::retarget(int i, Vec2 target) {
@@ -294,8 +327,14 @@ int Crowd::near_agents(Vec2 p, double range, std::span<unsigned short> out) cons
     std::copy(near_scratch_.begin(), near_scratch_.end(), out.begin());
     return static_cast<int>(near_scratch_.size());
   }
-  return crowd_->getGrid()->queryItems(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.data(),
-                                       static_cast<int>(out.size()));
+  // The grid's own ids count the agents of the update in order.
+  const int n = crowd_->getGrid()->queryItems(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.data(),
+                                              static_cast<int>(out.size()));
+  for (int k = 0; k < n; ++k) {
+    const auto id = out[static_cast<std::size_t>(k)];
+    out[static_cast<std::size_t>(k)] = static_cast<unsigned short>(in_update_[id]);
+  }
+  return n;
 }
 
 Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {

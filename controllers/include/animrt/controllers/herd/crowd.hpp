@@ -17,6 +17,7 @@
 
 #include "animrt/controllers/herd/agent.hpp"
 #include "animrt/controllers/herd/nav_world.hpp"
+#include "animrt/controllers/herd/spatial_grid.hpp"
 
 class dtCrowd;
 
@@ -116,6 +117,8 @@ class Crowd {
   // there, or where it meets one already standing.
   Vec2 passage_wait(int i, Vec2 v, std::span<const Agent> agents) const;
   void apply_passages(double t, std::span<const Agent> agents);
+  // Which agents take part in the crowd's update (see crowd.cpp).
+  void select_participants();
 
   NavWorld& world_;
   CrowdParams params_;
@@ -127,7 +130,11 @@ class Crowd {
   std::unique_ptr<PassageRules> passages_;
   std::unique_ptr<CellIndex> grid_rows_;  // the proximity grid's items at the last update
   mutable std::vector<int> near_scratch_;
-  std::vector<bool> asking_;  // active members with a target
+  double reach_m_ = 0.0;  // a passive agent this far from every member cannot matter to one
+  SpatialGrid members_near_;
+  std::vector<Vec2> member_at_;
+  std::vector<int> in_update_;  // the agents in the crowd's update, in its order
+  std::vector<bool> asking_;    // active members with a target
   std::vector<char> was_held_;
   std::vector<Vec2> hold_at_;  // where each held member waits
   double dt_ = 0.0;
