@@ -87,7 +87,8 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   // A member's plan reads the agents in its grid query (the cell span of
   // its query range) and, through the collision pushes of the crowd's four
   // passes, the neighbours of its neighbours three links away, each
-  // chosen by its own grid query; keep-right reads a wider square.
+  // chosen by its own grid query; keep-right reads a wider square. A rule
+  // that reads the crowd's agents farther out must widen this reach.
   const double r = rmax + params_.avoidance_margin_m;
   const double hop = params_.query_range_radii * r;
   const double cell = crowd_->getGrid()->getCellSize();
@@ -200,9 +201,9 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
 
 void Crowd::select_participants() {
   // Passive agents farther than reach_m_ from every member leave the
-  // crowd's update: nothing of theirs reaches a member's plan, and Detour
-  // spends as much on a passive agent's neighbours and move as on a
-  // member's. They are still synced every step, so they rejoin in place.
+  // crowd's update: nothing of theirs reaches a member's plan, yet Detour
+  // gives each a neighbour query, a move along the mesh and the collision
+  // passes. They are still synced every step, so they rejoin in place.
   member_at_.clear();
   for (std::size_t i = 0; i < active_.size(); ++i) {
     if (active_[i]) member_at_.push_back(synced_[i]);
