@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "animrt/controllers/herd/cell_index.hpp"
 #include "animrt/controllers/herd/passage.hpp"
 
 namespace animrt::herd {
@@ -33,7 +34,7 @@ double unit(std::mt19937_64& rng) {
 }  // namespace
 
 Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
-    : world_(world), params_(params) {
+    : world_(world), params_(params), grid_rows_(std::make_unique<CellIndex>()) {
   if (static_cast<int>(agents.size()) > params_.max_agents) {
     throw std::invalid_argument("crowd: more agents than max_agents");
   }
@@ -83,6 +84,20 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
     const int idx = crowd_->addAgent(p.data(), &ap);
     if (idx != static_cast<int>(i)) throw std::runtime_error("crowd: could not add an agent");
   }
+  // A member's plan reads the agents in its grid query (the cell span of
+  // its query range) and, through the collision pushes of the crowd's four
+  // passes, the neighbours of its neighbours three links away, each
+  // chosen by its own grid query; keep-right reads a wider square. A rule
+  // that reads the crowd's agents farther out must widen this reach.
+  const double r = rmax + params_.avoidance_margin_m;
+  const double hop = params_.query_range_radii * r;
+  const double cell = crowd_->getGrid()->getCellSize();
+  const double box = std::sqrt(2.0) * (hop + r + cell);
+  const double ahead = std::sqrt(2.0) * (params_.keep_right_range_m + r + cell);
+  reach_m_ = std::max(3 * hop + box, ahead) + 1.0;
+  member_at_.reserve(agents.size());
+  members_near_.reserve(agents.size());
+  in_update_.reserve(agents.size());
 }
 
 Crowd::~Crowd() { dtFreeCrowd(crowd_); }
@@ -171,8 +186,38 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
   if (passages_) apply_passages(t, agents);
+  select_participants();
+  // The crowd registers each agent of its update in its grid as it stands now.
+  grid_rows_->begin(crowd_->getGrid()->getCellSize());
+  for (const int i : in_update_) {
+    const dtCrowdAgent* ag = crowd_->getAgent(i);
+    const float r = ag->params.radius;
+    grid_rows_->add(i, ag->npos[0] - r, ag->npos[2] - r, ag->npos[0] + r, ag->npos[2] + r);
+  }
+  grid_rows_->finish();
   crowd_->update(static_cast<float>(dt), nullptr);
   dt_ = dt;
+}
+
+void Crowd::select_participants() {
+  // Passive agents farther than reach_m_ from every member leave the
+  // crowd's update: nothing of theirs reaches a member's plan, yet Detour
+  // gives each a neighbour query, a move along the mesh and the collision
+  // passes. They are still synced every step, so they rejoin in place.
+  member_at_.clear();
+  for (std::size_t i = 0; i < active_.size(); ++i) {
+    if (active_[i]) member_at_.push_back(synced_[i]);
+  }
+  if (!member_at_.empty()) members_near_.build(std::span<const Vec2>(member_at_), reach_m_);
+  in_update_.clear();
+  for (std::size_t i = 0; i < active_.size(); ++i) {
+    bool take = active_[i];
+    if (!take && !member_at_.empty()) {
+      members_near_.for_each_within(synced_[i], reach_m_, [&](int, double) { take = true; });
+    }
+    crowd_->getEditableAgent(static_cast<int>(i))->active = take;
+    if (take) in_update_.push_back(static_cast<int>(i));
+  }
 }
 
 bool Crowd::retarget(int i, Vec2 target) {
@@ -276,6 +321,23 @@ Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
   return v;
 }
 
+int Crowd::near_agents(Vec2 p, double range, std::span<unsigned short> out) const {
+  const auto c = NavWorld::to_recast(p);
+  const float r = static_cast<float>(range);
+  if (grid_rows_->query(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.size(), near_scratch_)) {
+    std::copy(near_scratch_.begin(), near_scratch_.end(), out.begin());
+    return static_cast<int>(near_scratch_.size());
+  }
+  // The grid's own ids count the agents of the update in order.
+  const int n = crowd_->getGrid()->queryItems(c[0] - r, c[2] - r, c[0] + r, c[2] + r, out.data(),
+                                              static_cast<int>(out.size()));
+  for (int k = 0; k < n; ++k) {
+    const auto id = out[static_cast<std::size_t>(k)];
+    out[static_cast<std::size_t>(k)] = static_cast<unsigned short>(in_update_[id]);
+  }
+  return n;
+}
+
 Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
   const double speed = norm(v);
   if (params_.keep_right_rad <= 0.0 || speed <= 0.0) return v;
@@ -286,11 +348,7 @@ Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
   const double lane = 2.0 * (a.radius + params_.avoidance_margin_m);
   // Agents near the figure, from the crowd's own grid (built at its last update).
   std::array<unsigned short, 64> near{};
-  const auto p = NavWorld::to_recast(a.position);
-  const int n = crowd_->getGrid()->queryItems(
-      p[0] - static_cast<float>(range), p[2] - static_cast<float>(range),
-      p[0] + static_cast<float>(range), p[2] + static_cast<float>(range), near.data(),
-      static_cast<int>(near.size()));
+  const int n = near_agents(a.position, range, near);
   double urge = 0.0;  // 0..1: how hard to keep right
   for (int k = 0; k < n; ++k) {
     const int j = near[static_cast<std::size_t>(k)];

@@ -1,5 +1,6 @@
 // Figures of other groups (a flock, the embodied robot) are passive crowd
 // agents: crowd members walk around them.
+#include <DetourCrowd.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,6 +32,30 @@ TEST(CrowdPassive, MembersWalkAroundFiguresOfOtherGroups) {
   }
   EXPECT_TRUE(g.arrived(0));
   EXPECT_GT(closest, agents[0].radius + agents[1].radius);
+}
+
+// A passive figure far from every member costs the crowd's update
+// nothing: it sits out until it comes near one, then takes part again.
+TEST(CrowdPassive, FarFiguresSitOutTheCrowdUpdateUntilTheyComeNear) {
+  NavWorldConfig c;
+  c.bounds = {-40, -5, 40, 5};
+  NavWorld w(c);
+  std::vector<Agent> agents(3);
+  agents[0].position = {-30, 0};
+  agents[1].position = {-28, 2};  // near the member
+  agents[2].position = {30, 0};   // 60 m away
+  agents[1].group = agents[2].group = 1;
+  Crowd crowd(w, agents);
+  CrowdGroup g(crowd, agents, {0}, {{-25, 0}, 0.3, 0.3, 1});
+  std::vector<Vec2> desired(3);
+  g.steer(0.0, 0.1, agents, desired);
+  EXPECT_TRUE(crowd.native()->getAgent(0)->active);
+  EXPECT_TRUE(crowd.native()->getAgent(1)->active);
+  EXPECT_FALSE(crowd.native()->getAgent(2)->active);
+  agents[2].position = {-29, -2};
+  g.steer(0.1, 0.1, agents, desired);
+  EXPECT_TRUE(crowd.native()->getAgent(2)->active);
+  EXPECT_NEAR(crowd.native()->getAgent(2)->npos[0], -29.0f, 1e-4f);
 }
 
 }  // namespace

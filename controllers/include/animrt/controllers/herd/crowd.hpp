@@ -17,6 +17,7 @@
 
 #include "animrt/controllers/herd/agent.hpp"
 #include "animrt/controllers/herd/nav_world.hpp"
+#include "animrt/controllers/herd/spatial_grid.hpp"
 
 class dtCrowd;
 
@@ -78,6 +79,7 @@ struct CrowdParams {
 
 class CrowdGroup;
 class PassageRules;
+class CellIndex;
 
 class Crowd {
  public:
@@ -108,10 +110,15 @@ class Crowd {
   Vec2 planned_velocity(int i, bool unstick) const;
   Vec2 safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const;
   Vec2 keep_right(int i, Vec2 v, std::span<const Agent> agents) const;
+  // The agents the crowd's proximity grid holds in the square of half-side
+  // `range` around p, as its query returns them (at most out.size()).
+  int near_agents(Vec2 p, double range, std::span<unsigned short> out) const;
   // A member the passage rules hold walks to its waiting place and stands
   // there, or where it meets one already standing.
   Vec2 passage_wait(int i, Vec2 v, std::span<const Agent> agents) const;
   void apply_passages(double t, std::span<const Agent> agents);
+  // Which agents take part in the crowd's update (see crowd.cpp).
+  void select_participants();
 
   NavWorld& world_;
   CrowdParams params_;
@@ -121,7 +128,13 @@ class Crowd {
   std::vector<Vec2> target_;
   std::vector<Vec2> synced_;  // each agent's position before the last crowd update
   std::unique_ptr<PassageRules> passages_;
-  std::vector<bool> asking_;  // active members with a target
+  std::unique_ptr<CellIndex> grid_rows_;  // the proximity grid's items at the last update
+  mutable std::vector<int> near_scratch_;
+  double reach_m_ = 0.0;  // a passive agent this far from every member cannot matter to one
+  SpatialGrid members_near_;
+  std::vector<Vec2> member_at_;
+  std::vector<int> in_update_;  // the agents in the crowd's update, in its order
+  std::vector<bool> asking_;    // active members with a target
   std::vector<char> was_held_;
   std::vector<Vec2> hold_at_;  // where each held member waits
   double dt_ = 0.0;
