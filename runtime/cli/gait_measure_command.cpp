@@ -25,6 +25,7 @@ struct MeasureArgs {
   double settle_s = 0.5;
   int warmup_cycles = 1;
   int measure_cycles = 3;
+  double balance_delay_ms = 0.0;
 };
 
 struct Stat {
@@ -55,6 +56,7 @@ int run_measure(const MeasureArgs& a) {
   settings.warmup_cycles = a.warmup_cycles;
   settings.measure_cycles = a.measure_cycles;
   settings.perturb_rad = a.perturb_deg * M_PI / 180.0;
+  settings.balance_delay_s = a.balance_delay_ms / 1000.0;
 
   std::printf("walking %s on %s: %d starts, %.2f Hz, hip height %.3f m\n", a.gait.c_str(),
               a.physics.c_str(), a.seeds, f, h);
@@ -62,6 +64,9 @@ int run_measure(const MeasureArgs& a) {
     std::printf(
         "balance reflex: tilt_m %g, tilt_rate_m_s %g (legs on the ground stretch up to %g m)\n",
         gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
+    if (a.balance_delay_ms > 0.0) {
+      std::printf("balance reflex reads the trunk's attitude %g ms late\n", a.balance_delay_ms);
+    }
   }
   std::printf("%5s %6s %9s %9s %8s %9s %10s\n", "start", "fell", "fall s", "m/s", "stride m",
               "duty", "J/cycle");
@@ -115,6 +120,10 @@ void add_gait_measure_command(CLI::App& gait) {
       ->check(CLI::Range(0, 100));
   cmd->add_option("--measure-cycles", args->measure_cycles, "stride cycles measured")
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--balance-delay-ms", args->balance_delay_ms,
+                  "the balance reflex reads the trunk's attitude this late (a robustness "
+                  "measure; the fitness reads it at once)")
+      ->check(CLI::Range(0.0, 200.0));
   set_subcommand_body(cmd, [args] { return run_measure(*args); });
 }
 

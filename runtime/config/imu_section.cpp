@@ -69,7 +69,9 @@ std::vector<ImuConfig> parse_imus(const YamlNode& list, double rate_hz) {
                        "latency_ms"});
       if (auto n = sim->find("silent_at_s")) imu.sim_silent_at_s = n->as_double_in(0.0, 1e6);
       if (auto n = sim->find("latency_ms")) {
-        imu.sim_latency_s = n->as_double_in(1000.0 / imu.rate_hz, 200.0) / 1000.0;
+        // A real part's frame is younger than its report period; a lockstep
+        // physics reaches a time only a loop period after the clock does.
+        imu.sim_latency_s = n->as_double_in(1000.0 / rate_hz, 200.0) / 1000.0;
       }
       if (auto at = sim->find("push_at_s")) {
         imu.sim_push.on = true;

@@ -349,13 +349,14 @@ void RunLoop::add_record_channels() {
                       kTelemetryCapacity});
   }
   if (!model_.imus.empty()) {
-    imu_channel_ = recorder_->add(RecordChannel{
-        "/imu",
-        "animrt.Imu",
-        {"imu", "qw", "qx", "qy", "qz", "rate_x_rad_s", "rate_y_rad_s", "rate_z_rad_s",
-         "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2", "measured_s"},
-        false,
-        kTelemetryCapacity});
+    imu_channel_ = recorder_->add(
+        RecordChannel{"/imu",
+                      "animrt.Imu",
+                      {"imu", "qw", "qx", "qy", "qz", "rate_x_rad_s", "rate_y_rad_s",
+                       "rate_z_rad_s", "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2", "measured_s",
+                       "late_cycles", "missing_reports"},
+                      false,
+                      kTelemetryCapacity});
   }
 }
 
@@ -382,10 +383,18 @@ void RunLoop::record_mcap_health() {
   for (std::size_t i = 0; i < imu_io_.size(); ++i) {
     if (!imu_io_[i].valid) continue;
     const ImuReading& m = imu_io_[i].reading;
-    const double rec[] = {
-        in_.t,           static_cast<double>(i), m.quat[0],       m.quat[1],       m.quat[2],
-        m.quat[3],       m.rate_rad_s[0],        m.rate_rad_s[1], m.rate_rad_s[2], m.accel_m_s2[0],
-        m.accel_m_s2[1], m.accel_m_s2[2],        m.time_s};
+    // The cycle's counts so far: cycles the reading was late, reports the
+    // part did not send (a recording shows when an IMU faltered).
+    const double late = static_cast<double>(state_.imu_late_cycles()[i]);
+    const double missing = static_cast<double>(state_.imu_missing(i, model_.imus[i].rate_hz));
+    const double rec[] = {in_.t,           static_cast<double>(i),
+                          m.quat[0],       m.quat[1],
+                          m.quat[2],       m.quat[3],
+                          m.rate_rad_s[0], m.rate_rad_s[1],
+                          m.rate_rad_s[2], m.accel_m_s2[0],
+                          m.accel_m_s2[1], m.accel_m_s2[2],
+                          m.time_s,        late,
+                          missing};
     r.push(imu_channel_, rec);
   }
 }

@@ -3,11 +3,12 @@
 # of the horse's balanced seed (docs/results/balance_runtime.md).
 #
 # Usage: ANIMRT=build/bin/animrt [START_RAMP_S=2] [TILT_DEG=] [MEASURE=1] [IMU_LATENCY_MS=] \
-#          [ONLY_REFLEX=0] \
+#          [ONLY_REFLEX=0] [BALANCE='{tilt_m: 0.3, tilt_rate_m_s: 0.1}'] \
 #          balance_runtime.sh OUT_DIR COUNT RNG_SEED [DURATION_S]
 # For each neighbour: `gait measure` (3 starts) with and without the reflex,
 # then `animrt run --physics --lockstep` of the horse with a simulated IMU on
 # the physics' torso, with and without it. Prints one table row a neighbour.
+# BALANCE replaces the neighbours' reflex gains (the seed's by default).
 set -uo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 animrt=${ANIMRT:-$root/build/bin/animrt}
@@ -16,6 +17,11 @@ ramp=${START_RAMP_S:-2.0} tilt=${TILT_DEG:-} do_measure=${MEASURE:-1}
 latency=${IMU_LATENCY_MS:-} only_reflex=${ONLY_REFLEX:-0}
 python3 "$root/scripts/experiments/balance_neighbours.py" \
   "$root/configs/gaits/horse_seed_balance.yaml" "$out" "$count" "$seed"
+if [[ -n ${BALANCE:-} ]]; then
+  for g in "$out"/n[0-9]*.yaml; do
+    [[ $g == *_plain.yaml ]] || sed -i "s/^balance:.*/balance: $BALANCE/" "$g"
+  done
+fi
 robot() {  # $1 gait file -> the horse robot with an IMU, on stdout
   local watch=""
   [[ -n $tilt ]] && watch="\\n  tilt_limit_deg: $tilt\\n  tilt_time_s: 0.1\\n  on_tilt: hold"

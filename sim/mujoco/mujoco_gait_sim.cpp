@@ -35,14 +35,24 @@ int root_qpos(const mjModel* m, int torso) {
 // actuator targets by the same apply_balance() the runtime plays.
 class LegBalance {
  public:
-  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains)
-      : mm_(mm), reflex_(gains), legs_(mm, d), scratch_(2 * legs_.max_leg_joints(), 0.0) {}
+  // The reflex reads the tilt `delay_steps` physics steps old.
+  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains, long delay_steps)
+      : mm_(mm),
+        reflex_(gains),
+        legs_(mm, d),
+        scratch_(2 * legs_.max_leg_joints(), 0.0),
+        tilts_(static_cast<std::size_t>(delay_steps) + 1) {}
 
   // Adds the reflex to the actuator targets already in d->ctrl.
   void apply(mjData* d, double dt) {
     const double* r = d->xmat + 9 * mm_.torso_body;
-    // World z of the trunk's forward and left axes.
-    reflex_.update(TrunkTilt{r[6], r[7]}, dt);
+    // World z of the trunk's forward and left axes; until the delay has
+    // passed, the first tilt (the figure stood still before).
+    const TrunkTilt now{r[6], r[7]};
+    if (steps_ == 0) std::fill(tilts_.begin(), tilts_.end(), now);
+    tilts_[steps_ % tilts_.size()] = now;
+    ++steps_;
+    reflex_.update(tilts_[steps_ % tilts_.size()], dt);
     legs_.pose({}, {});
     apply_balance(reflex_, legs_,
                   std::span<double>(d->ctrl, static_cast<std::size_t>(mm_.model->nu)), scratch_);
@@ -53,6 +63,8 @@ class LegBalance {
   BalanceReflex reflex_;
   MujocoLegModel legs_;
   std::vector<double> scratch_;
+  std::vector<TrunkTilt> tilts_;  // ring: the newest at (steps_ - 1), the one read at steps_
+  std::size_t steps_ = 0;
 };
 
 }  // namespace
@@ -144,7 +156,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   const long blend = std::max(1L, std::min(warmup, steps_for(1.0 / f)));
   const double standing_z = d->xpos[3 * mm.torso_body + 2];
   std::optional<LegBalance> balance;
-  if (gait.balance) balance.emplace(mm, d, *gait.balance);
+  if (gait.balance) balance.emplace(mm, d, *gait.balance, steps_for(settings.balance_delay_s));
 
   const std::size_t feet = mm.foot_geoms.size();
   std::vector<int> foot_of(static_cast<std::size_t>(m->ngeom), -1);

@@ -78,11 +78,12 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
     sim::TrunkProvider trunk = sim::scripted_trunk(imu.sim_push);
     std::string source = imu.sim_push.on ? "pushed over by the robot file's script" : "level";
     if (own_physics_) {
-      // A frame reports the torso one report period before it is sent: the
-      // physics has got there by then at any loop rate from the part's up,
-      // so a lockstep run reads the same frames whichever thread runs first.
+      // A frame reports the torso one report period before it is sent, or as
+      // long before as `latency_ms` says (at least a loop period): the
+      // physics has got there by then, so a lockstep run reads the same
+      // frames whichever thread runs first.
       own_physics_->keep_torso_history();
-      const double age = std::max(1.0 / imu.rate_hz, imu.sim_latency_s);
+      const double age = imu.sim_latency_s > 0.0 ? imu.sim_latency_s : 1.0 / imu.rate_hz;
       trunk = [physics = own_physics_.get(), age](double t) {
         const sim::TorsoMotion torso = physics->torso_motion_at(t - age);
         return sim::TrunkState{torso.quat, torso.accel_m_s2};

@@ -25,6 +25,19 @@ out=$("$animrt" gait measure "$gait" --physics "$tmp/weak.xml" --starts 2 2>&1) 
   fail "measure on the weak model failed: $out"
 [[ $out == *"falls: 2 of 2"* ]] || fail "a model that cannot stand did not fall: $out"
 
+# The balance reflex fed the attitude late (a robustness measure): without
+# the flag, or at 0 ms, the walk is the fitness walk; 60 ms late it is another.
+horse=$root/configs/models/horse.xml
+seed=$root/configs/gaits/horse_seed_balance.yaml
+walks() { grep -E '^ +1 ' <<< "$1"; }
+one=(--physics "$horse" --starts 1 --measure-cycles 1)
+now=$("$animrt" gait measure "$seed" "${one[@]}" 2>&1) || fail "horse: $now"
+zero=$("$animrt" gait measure "$seed" "${one[@]}" --balance-delay-ms 0 2>&1) || fail "0 ms: $zero"
+late=$("$animrt" gait measure "$seed" "${one[@]}" --balance-delay-ms 60 2>&1) || fail "60 ms: $late"
+[[ $(walks "$now") == "$(walks "$zero")" ]] || fail "0 ms late is not the fitness walk: $zero"
+[[ $late == *"reads the trunk's attitude 60 ms late"* ]] || fail "the delay is not said: $late"
+[[ $(walks "$now") != "$(walks "$late")" ]] || fail "60 ms late walked the same: $late"
+
 out=$("$animrt" gait measure "$tmp/missing.yaml" --physics "$model" 2>&1)
 code=$?
 [[ $code -eq 2 && $out == *"missing.yaml"* ]] || fail "missing gait (exit $code): $out"

@@ -224,5 +224,43 @@ TEST(ModbusHealth, HealthAndTheImuAreRecorded) {
   EXPECT_NEAR(std::strtod(last.c_str() + pos, nullptr), std::sin(0.15), 0.01) << last;
 }
 
+// An IMU that falls silent mid-run: each /imu message carries the cycle's
+// late cycles and missing reports so far, so the recording shows when the
+// part faltered, up to the summary's counts at the end.
+TEST(ModbusHealth, ALateImuIsCountedInTheRecording) {
+  test::RigSettings settings = health(ModbusBusOptions::Health::packed, HealthLimits{}, {});
+  settings.edit = [edit = settings.edit](RobotConfig& c) {
+    edit(c);
+    ImuConfig imu;
+    imu.name = "trunk";
+    imu.protocol = "bno08x_rvc";
+    imu.stale_timeout_s = 5.0;  // late, not stale: the run goes on
+    imu.sim_silent_at_s = 0.6;
+    c.imus.push_back(imu);
+  };
+  test::SimRig rig(kAnimatronic, settings);
+  RunOptions options = rig.options(1.2, "");
+  options.record_path = ::testing::TempDir() + "/modbus_health_late_imu.mcap";
+  const RunSummary s = rig.run(options);
+  ASSERT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
+  ASSERT_EQ(s.imus.size(), 1u);
+
+  const mcap::ReadFile file = mcap::read_file(options.record_path);
+  const mcap::ReadChannel* imu_ch = file.channel("/imu");
+  ASSERT_NE(imu_ch, nullptr);
+  double first_late = -1.0, last_late = -1.0, last_missing = -1.0;
+  for (const mcap::ReadMessage& m : file.messages) {
+    if (m.channel != imu_ch->id) continue;
+    if (first_late < 0.0) first_late = json_number(m.data, "late_cycles");
+    last_late = json_number(m.data, "late_cycles");
+    last_missing = json_number(m.data, "missing_reports");
+  }
+  EXPECT_LE(first_late, 1.0);     // the part was on time at first
+  EXPECT_GE(last_late, 40.0);     // 0.6 s silent at 100 Hz: ~55 late cycles
+  EXPECT_GE(last_missing, 40.0);  // and ~55 reports not sent
+  EXPECT_LE(last_late, static_cast<double>(s.imus[0].late_cycles));
+  EXPECT_LE(last_missing, static_cast<double>(s.imus[0].missing_reports));
+}
+
 }  // namespace modbus_health_test
 }  // namespace animrt

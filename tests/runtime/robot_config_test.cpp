@@ -1228,6 +1228,20 @@ TEST_F(RobotConfigImu, BadImusAreNamedWhereTheyAre) {
             std::string::npos);
 }
 
+TEST_F(RobotConfigImu, ASimulatedPartsLatencyMayBeAsShortAsALoopPeriod) {
+  // A real part sends a frame when its fusion has computed it, not a report
+  // period later; the simulated one can report no fresher than a lockstep
+  // physics that is a loop period behind the clock.
+  std::string text = with("imus:\n  - {name: trunk, protocol: bno08x_rvc, sim: {latency_ms: 5}}\n");
+  text.replace(text.find("rate_hz: 100"), 12, "rate_hz: 200");
+  const RobotConfig c = load(text);
+  ASSERT_EQ(c.imus.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.imus[0].sim_latency_s, 0.005);
+  text.replace(text.find("latency_ms: 5"), 13, "latency_ms: 4");
+  EXPECT_NE(error_of(text).find("imus[0].sim.latency_ms: expected"), std::string::npos)
+      << error_of(text);
+}
+
 TEST_F(RobotConfigImu, ATiltWatchWithoutAnImuIsRefused) {
   EXPECT_NE(error_of(with("safety: {tilt_limit_deg: 45}\n"))
                 .find("safety.tilt_limit_deg: the tilt watch needs an IMU"),

@@ -24,6 +24,10 @@ struct WalkSettings {
   // gait is rather than replaying one exact start.
   std::uint64_t perturb_seed = 0;
   double perturb_rad = 0.0;
+  // The balance reflex reads the trunk's attitude this long ago (s), as a
+  // runtime whose IMU reports late does. A measure of how the law stands a
+  // delay, not the fitness (which reads the attitude of the step: 0).
+  double balance_delay_s = 0.0;
 };
 
 struct GaitMeasures {

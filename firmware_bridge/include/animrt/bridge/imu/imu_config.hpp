@@ -36,7 +36,7 @@ struct ImuConfig {
   // as a part whose cable came loose.
   double sim_silent_at_s = -1.0;
   // Simulated part on the physics only: how old the torso it reports is
-  // (s; at least one report period, so a lockstep run is deterministic).
+  // (s; at least one loop period, so a lockstep run is deterministic).
   double sim_latency_s = 0.0;  // 0: one report period
   Location where;
 };
