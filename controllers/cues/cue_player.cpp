@@ -77,11 +77,11 @@ void CuePlayer::sample_layer(Layer& layer) const {
 // The crossfade's length: the cue's, or longer where the gap between the
 // present targets and the next motion's start (in position, and in velocity)
 // would ask a joint for more than its share of its limits.
-double CuePlayer::ease_in_time(const Cue& cue, const MotionSource& next) const {
+double CuePlayer::ease_in_time(const Cue& cue, const MotionSource& next, double at_s) const {
   std::vector<double>& at0 = layers_[count_].pose;  // the slot the layer will take
   for (std::size_t j = 0; j < joints_.size(); ++j) at0[j] = scratch_[j] = joints_[j].home;
-  next.sample(0.0, at0);
-  next.sample(kVelocityStepS, scratch_);
+  next.sample(at_s, at0);
+  next.sample(at_s + kVelocityStepS, scratch_);
   double fade = cue.crossfade_s;
   for (int index : driven_) {
     const auto j = static_cast<std::size_t>(index);
@@ -98,19 +98,36 @@ double CuePlayer::ease_in_time(const Cue& cue, const MotionSource& next) const {
   return fade;
 }
 
-void CuePlayer::push(int cue, int step, bool asked) const {
+void CuePlayer::locate(int cue, double at_s, int& step, double& within) const {
+  const Cue& c = cues_[static_cast<std::size_t>(cue)];
+  double total = 0.0;
+  for (const CueStep& s : c.steps) total += s.duration_s;
+  // A looping cue that always ends: its passes repeat.
+  if (c.loop && std::isfinite(total) && total > 0.0) at_s = std::fmod(at_s, total);
+  step = 0;
+  within = at_s > 0.0 ? at_s : 0.0;
+  while (static_cast<std::size_t>(step) + 1 < c.steps.size() &&
+         within >= c.steps[static_cast<std::size_t>(step)].duration_s) {
+    within -= c.steps[static_cast<std::size_t>(step)].duration_s;
+    ++step;
+  }
+  // Past a cue that ends: its last step's end (it hands over at once).
+  within = std::min(within, c.steps[static_cast<std::size_t>(step)].duration_s);
+}
+
+void CuePlayer::push(int cue, int step, bool asked, double at_s) const {
   const bool changes = asked || count_ == 0 || layers_[count_ - 1].cue != cue;
   const Cue& c = cues_[static_cast<std::size_t>(cue)];
   const double fade =
-      count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source);
+      count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source, at_s);
   Layer& layer = layers_[count_];
   layer.cue = cue;
   layer.step = step;
-  layer.t0 = play_;
+  layer.t0 = play_ - at_s;
   layer.fade_start = play_;
   layer.fade_s = fade;
   ++count_;
-  if (step == 0 && changes) starts_[static_cast<std::size_t>(cue)].fetch_add(1);
+  if ((step == 0 || asked) && changes) starts_[static_cast<std::size_t>(cue)].fetch_add(1);
   current_.store(cue, std::memory_order_relaxed);
   last_fade_.store(fade, std::memory_order_relaxed);
 }
@@ -146,15 +163,22 @@ void CuePlayer::advance(double t) const {
   rate_phase_ =
       goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
   play_ += smootherstep(rate_phase_) * dt;
+  // A cue waiting to start at a time into it (a timecode) goes on running.
+  if (waiting_ && waiting_at_ > 0.0) waiting_at_ += smootherstep(rate_phase_) * dt;
   int asked = 0;
-  if (requests_.take(asked) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {
+  double at = 0.0;
+  if (requests_.take(asked, at) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {
     waiting_ = true;
     waiting_cue_ = asked;
+    waiting_at_ = at;
   }
   compact();
   if (waiting_) {
     if (count_ < kMaxLayers) {
-      push(waiting_cue_, 0, true);
+      int step = 0;
+      double within = 0.0;
+      locate(waiting_cue_, waiting_at_, step, within);
+      push(waiting_cue_, step, true, within);
       waiting_ = false;
     } else {
       deferred_.fetch_add(1, std::memory_order_relaxed);

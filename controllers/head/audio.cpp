@@ -15,6 +15,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
+#include "polyphase.hpp"
 
 namespace animrt::head {
 namespace {
@@ -209,16 +210,20 @@ Audio load_audio(const std::string& path, int target_rate) {
   return audio;
 }
 
-Audio resample(const Audio& in, int target_rate) {
+Audio resample(const Audio& in, int target_rate, ResampleQuality quality) {
   if (target_rate <= 0) throw std::invalid_argument("resample: target rate must be positive");
   if (in.sample_rate == target_rate || in.samples.empty()) {
     Audio out = in;
     out.sample_rate = target_rate;
     return out;
   }
-  const double ratio = static_cast<double>(target_rate) / in.sample_rate;
   Audio out;
   out.sample_rate = target_rate;
+  if (quality == ResampleQuality::fast &&
+      resample_polyphase(in.samples, in.sample_rate, target_rate, out.samples)) {
+    return out;
+  }
+  const double ratio = static_cast<double>(target_rate) / in.sample_rate;
   out.samples.resize(static_cast<std::size_t>(static_cast<double>(in.samples.size()) * ratio) + 16);
   SRC_DATA data{};
   data.data_in = in.samples.data();
@@ -226,7 +231,8 @@ Audio resample(const Audio& in, int target_rate) {
   data.data_out = out.samples.data();
   data.output_frames = static_cast<long>(out.samples.size());
   data.src_ratio = ratio;
-  const int err = src_simple(&data, SRC_SINC_MEDIUM_QUALITY, 1);
+  const int err = src_simple(
+      &data, quality == ResampleQuality::fast ? SRC_SINC_FASTEST : SRC_SINC_MEDIUM_QUALITY, 1);
   if (err != 0) throw std::runtime_error(std::string("libsamplerate: ") + src_strerror(err));
   out.samples.resize(static_cast<std::size_t>(data.output_frames_gen));
   return out;

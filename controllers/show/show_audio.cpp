@@ -50,14 +50,17 @@ void ShowAudioSchedule::render(std::span<const float> track, std::int64_t first_
 }
 
 ShowAudioPlayer::ShowAudioPlayer(const ShowFile& show, AudioTrack track,
-                                 std::unique_ptr<AudioSink> sink, const Clock& clock)
+                                 std::unique_ptr<AudioSink> sink, const Clock& clock,
+                                 bool own_thread)
     : track_(std::move(track)),
       schedule_(show.audio, show.loop, show.duration_s, track_.rate,
                 static_cast<std::int64_t>(track_.samples.size())),
       sink_(std::move(sink)),
       clock_(clock),
-      playhead_(show.duration_s, show.loop) {
-  thread_ = std::thread([this] { run(); });
+      playhead_(show.duration_s, show.loop),
+      buffer_(static_cast<std::size_t>(std::max(1, track_.rate / 100))),  // 10 ms per write
+      show_file_(show.file) {
+  if (own_thread) thread_ = std::thread([this] { run(); });
 }
 
 ShowAudioPlayer::~ShowAudioPlayer() {
@@ -74,55 +77,70 @@ bool ShowAudioPlayer::control(const ShowCommand& command, double t) {
 }
 
 void ShowAudioPlayer::run() {
-  const int rate = schedule_.rate();
-  const std::int64_t block = std::max(1, rate / 100);  // 10 ms per write
-  std::vector<float> buffer(static_cast<std::size_t>(block));
-  std::int64_t next = -1;  // show frame of the next block; -1: not in step yet
   while (!quit_.load(std::memory_order_acquire)) {
-    const Nanos origin = origin_.load(std::memory_order_acquire);
-    if (origin == kNotStarted || stopped_.load(std::memory_order_acquire)) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-      continue;
-    }
-    std::int64_t queued = sink_->queued_frames();
-    // The show's commands since the last block: what is queued belongs to
-    // the transport before them, so it goes.
-    bool moved = false;
-    for (std::uint64_t tail = tail_.load(std::memory_order_relaxed);
-         tail != head_.load(std::memory_order_acquire); ++tail) {
-      const TimedCommand c = commands_[tail % kCommands];
-      tail_.store(tail + 1, std::memory_order_release);
-      const bool was_paused = playhead_.paused();
-      const double was_at = playhead_.time(c.t);
-      playhead_.control(c.command, c.t);
-      // A play while playing (the dashboard sends the whole transport) moves nothing.
-      moved = moved || playhead_.paused() != was_paused ||
-              std::abs(playhead_.time(c.t) - was_at) > 1e-9;
-    }
-    if (moved) {
-      sink_->flush();
-      queued = 0;
-      next = -1;
-    }
-    if (playhead_.paused()) {
-      std::fill(buffer.begin(), buffer.end(), 0.0f);
-      sink_->write(buffer);
-      next = -1;
-      continue;
-    }
-    // The show frame that will be heard when the next written frame plays:
-    // the show's time now, plus what the output still holds.
-    const double motion_t = static_cast<double>(clock_.now() - origin) * 1e-9;
-    const std::int64_t heard =
-        static_cast<std::int64_t>(std::floor(playhead_.time(motion_t) * rate)) + queued;
-    // Continuous blocks while in step; a jump when more than 20 ms apart (the
-    // start, a stall of this thread, or drift between the clocks).
-    if (next < 0 || std::llabs(heard - next) > rate / 50) next = heard;
-    schedule_.render(track_.samples, next, buffer);
-    sink_->write(buffer);
-    next += block;
-    played_.fetch_add(block, std::memory_order_acq_rel);
+    if (!pump()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
+}
+
+bool ShowAudioPlayer::take_commands(bool& seeked) {
+  bool moved = false;
+  seeked = false;
+  for (std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+       tail != head_.load(std::memory_order_acquire); ++tail) {
+    const TimedCommand c = commands_[tail % kCommands];
+    tail_.store(tail + 1, std::memory_order_release);
+    const bool was_paused = playhead_.paused();
+    const double was_at = playhead_.time(c.t);
+    playhead_.control(c.command, c.t);
+    seeked = seeked || c.command.seeks != seeks_;
+    seeks_ = c.command.seeks;
+    // A play while playing (the dashboard sends the whole transport) moves nothing.
+    moved =
+        moved || playhead_.paused() != was_paused || std::abs(playhead_.time(c.t) - was_at) > 1e-9;
+  }
+  return moved;
+}
+
+// The sound runs on the output's clock: blocks follow each other without a
+// gap, and where the output is heard is published for the motion to follow.
+// The sound is placed (from the playhead, plus the drift so far) only at the
+// start, after the transport moved, or when it is heard far from where it
+// should be (this thread or the output stalled).
+bool ShowAudioPlayer::pump() {
+  const Nanos origin = origin_.load(std::memory_order_acquire);
+  if (origin == kNotStarted || stopped_.load(std::memory_order_acquire)) return false;
+  const int rate = schedule_.rate();
+  std::int64_t queued = sink_->queued_frames();
+  const Nanos stamp = clock_.now();
+  bool seeked = false;
+  if (take_commands(seeked)) {
+    // What is queued belongs to the transport before the commands: it goes.
+    sink_->flush();
+    queued = 0;
+    next_ = -1;
+    if (seeked) drift_s_ = 0.0;  // the motion's seek forgets its drift too
+  }
+  const std::uint64_t taken = tail_.load(std::memory_order_relaxed);
+  const double at = playhead_.time(to_seconds(stamp - origin));
+  if (playhead_.paused()) {
+    sound_.publish({at, stamp, false, taken});
+    std::fill(buffer_.begin(), buffer_.end(), 0.0f);
+    sink_->write(buffer_);
+    next_ = -1;
+    return true;
+  }
+  const double due = at + drift_s_;  // where the sound should be heard now
+  if (next_ >= 0 && std::abs(static_cast<double>(next_ - queued) / rate - due) > kStallS)
+    next_ = -1;
+  if (next_ < 0) next_ = std::llround(due * rate) + queued;
+  const double heard = static_cast<double>(next_ - queued) / rate;
+  drift_s_ = heard - at;
+  sound_.publish({heard, stamp, true, taken});
+  schedule_.render(track_.samples, next_, buffer_);
+  sink_->write(buffer_);
+  next_ += static_cast<std::int64_t>(buffer_.size());
+  played_.fetch_add(static_cast<std::int64_t>(buffer_.size()), std::memory_order_acq_rel);
+  return true;
 }
 
 std::vector<std::unique_ptr<ShowAudioPlayer>> open_show_audio(

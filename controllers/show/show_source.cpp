@@ -7,6 +7,7 @@
 #include "animrt/controllers/seqnet/inference.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/controllers/show/show_playhead.hpp"
+#include "animrt/controllers/show/sound_clock.hpp"
 #include "animrt/core/yaml_doc.hpp"
 
 namespace animrt {
@@ -20,18 +21,31 @@ class ShowSource final : public MotionSource {
     std::vector<double> slope;  // rad/s at each key (cubic tangents)
   };
 
-  ShowSource(std::vector<Track> tracks, bool loop, double duration)
-      : tracks_(std::move(tracks)), loop_(loop), duration_(duration), playhead_(duration, loop) {
+  ShowSource(std::vector<Track> tracks, bool loop, double duration, std::string file)
+      : tracks_(std::move(tracks)),
+        loop_(loop),
+        duration_(duration),
+        file_(std::move(file)),
+        playhead_(duration, loop) {
     for (const Track& t : tracks_) driven_.push_back(t.joint);
   }
 
   std::span<const int> driven_joints() const override { return driven_; }
 
-  void control(const ShowCommand& command, double t) override { playhead_.control(command, t); }
+  void control(const ShowCommand& command, double t) override {
+    playhead_.control(command, t);
+    ++commands_;
+  }
 
   ShowPosition show_position(double t) const override { return playhead_.position(t); }
 
+  void follow_sound(const std::string& show_file, const SoundClock& clock) override {
+    if (show_file == file_) sound_ = &clock;
+  }
+  void start(const MotionClock& clock) override { start_ = clock.start; }
+
   void sample(double t, std::span<double> targets) const override {
+    follow(t);
     t = playhead_.time(t);
     if (loop_) {
       t = std::fmod(t, duration_);
@@ -95,11 +109,36 @@ class ShowSource final : public MotionSource {
     return v0;
   }
 
+  // With a sound track playing, the show's time is the sound's: the gap
+  // between the sound's time (interpolated from the player's newest reading
+  // to this cycle) and the playhead's becomes a small change of speed. The
+  // loop's clock alone where no sound is followed: none plays, it is
+  // paused, stale, or has not yet taken the show's latest command.
+  void follow(double t) const {
+    if (sound_ == nullptr) return;
+    const double dt = t - last_t_;
+    if (!(dt > 0.0)) return;  // the same cycle again, or the first
+    last_t_ = t;
+    const Nanos now = start_ + from_seconds(t);
+    SoundClock::Reading r;
+    const bool valid = !playhead_.paused() && sound_->read(r) && r.playing &&
+                       r.commands == commands_ &&
+                       std::abs(to_seconds(now - r.stamp)) < SoundFollower::kStaleS;
+    const double gap = valid ? r.show_s + to_seconds(now - r.stamp) - playhead_.time(t) : 0.0;
+    playhead_.nudge(follower_.correction(gap, dt, valid));
+  }
+
   std::vector<Track> tracks_;
   bool loop_;
   double duration_;
+  std::string file_;
   std::vector<int> driven_;
-  ShowPlayhead playhead_;
+  mutable ShowPlayhead playhead_;  // nudged by the sound in sample()
+  const SoundClock* sound_ = nullptr;
+  Nanos start_ = 0;
+  std::uint64_t commands_ = 0;  // show commands taken, as the sound's player counts them
+  mutable SoundFollower follower_;
+  mutable double last_t_ = 0.0;
 };
 
 // Slopes for cubic segments: the slope between the neighbours of each key
@@ -218,6 +257,9 @@ class LayeredSource final : public MotionSource {
   void start(const MotionClock& clock) override {
     for (const auto& l : layers_) l->start(clock);
   }
+  void follow_sound(const std::string& show_file, const SoundClock& clock) override {
+    for (const auto& l : layers_) l->follow_sound(show_file, clock);
+  }
   void stop() override {
     for (const auto& l : layers_) l->stop();
   }
@@ -281,7 +323,7 @@ std::unique_ptr<MotionSource> make_show_source(const ShowFile& show,
   }
   if (show.has_learned) complete_learned(show, joints, tracks);
   for (ShowSource::Track& t : tracks) t.slope = slopes(t.keys, show.loop, show.duration_s);
-  return std::make_unique<ShowSource>(std::move(tracks), show.loop, show.duration_s);
+  return std::make_unique<ShowSource>(std::move(tracks), show.loop, show.duration_s, show.file);
 }
 
 std::unique_ptr<MotionSource> load_show_source(const std::string& path,

@@ -20,8 +20,10 @@ ServeTriggers::ServeTriggers(const TriggerArgs& args, const LoadedCues& loaded,
     if (loaded.timecode_cues.empty()) {
       throw std::invalid_argument("--ltc: the cue file binds no cue to a timecode start");
     }
+    // A cue is asked for at the time into it that the timecode is at.
+    auto at = [&requests](int cue, double at_s) { requests.cue(cue, at_s); };
     ltc_ = std::make_unique<LtcReceiver>(args.ltc, loaded.ltc_fps, loaded.ltc_freewheel_s,
-                                         loaded.timecode_cues, ask);
+                                         loaded.timecode_cues, at);
     std::cout << "ltc: reading " << args.ltc << " at " << loaded.ltc_fps << " fps\n" << std::flush;
   }
   if (!args.midi.empty()) {

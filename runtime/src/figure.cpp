@@ -76,8 +76,6 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
     }
     throw DeviceError(bus_failures(failed, config_.buses.size()));
   }
-  runner_ =
-      std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
   if (options.audio_sink) {
     std::vector<std::string> shows;
     collect_shows(config_.motion, shows);
@@ -85,7 +83,12 @@ Figure::Figure(LoadedRobot robot, FigureBackend& backend, const FigureOptions& o
       if (options.warn) options.warn(line);
     };
     audio_ = open_show_audio(shows, lockstep_, options.audio_sink, wall_clock_, warn);
+    // A show with its sound playing runs on the sound output's clock.
+    for (auto& player : audio_)
+      robot.motion->follow_sound(player->show_file(), player->sound_clock());
   }
+  runner_ =
+      std::make_unique<Runner>(std::move(robot.config), std::move(buses), std::move(robot.motion));
 }
 
 Figure::~Figure() {

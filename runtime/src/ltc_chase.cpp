@@ -57,31 +57,33 @@ int LtcChase::advance(double now_s) {
     return -1;
   }
   const double now_tc = anchor_tc_ + silent;
-  int cue = -1;
+  int entry = -1;
   if (resync_ || !position_) {
-    cue = playing_at(now_tc);
+    entry = playing_at(now_tc);
     resync_ = false;
   } else {
-    cue = due(*position_, now_tc);
+    entry = due(*position_, now_tc);
   }
   position_ = now_tc;
-  return cue;
+  if (entry < 0) return -1;
+  offset_ = now_tc - cues_[static_cast<std::size_t>(entry)].start_s;
+  return cues_[static_cast<std::size_t>(entry)].cue;
 }
 
 int LtcChase::due(double from, double to) const {
-  int cue = -1;
-  for (const TimecodeCue& c : cues_) {
-    if (c.start_s > from && c.start_s <= to) cue = c.cue;
+  int entry = -1;
+  for (std::size_t i = 0; i < cues_.size(); ++i) {
+    if (cues_[i].start_s > from && cues_[i].start_s <= to) entry = static_cast<int>(i);
   }
-  return cue;
+  return entry;
 }
 
 int LtcChase::playing_at(double t) const {
-  int cue = -1;
-  for (const TimecodeCue& c : cues_) {
-    if (c.start_s <= t) cue = c.cue;
+  int entry = -1;
+  for (std::size_t i = 0; i < cues_.size(); ++i) {
+    if (cues_[i].start_s <= t) entry = static_cast<int>(i);
   }
-  return cue;
+  return entry;
 }
 
 std::optional<double> parse_timecode(const std::string& text, double fps) {

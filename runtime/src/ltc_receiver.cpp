@@ -112,7 +112,7 @@ void LtcReceiver::decode(const float* samples, std::size_t count) {
   losses_.store(chase_.losses());
   if (cue >= 0) {
     asked_.fetch_add(1);
-    handler_(cue);
+    handler_(cue, chase_.cue_offset());
   }
 }
 

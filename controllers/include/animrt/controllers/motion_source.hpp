@@ -14,6 +14,8 @@
 
 namespace animrt {
 
+class SoundClock;  // controllers/show/sound_clock.hpp
+
 // What a steered source is told while it plays: a herd's or a dashboard's
 // command for a walking figure. Sources that cannot be steered ignore it.
 struct MotionCommand {
@@ -99,6 +101,11 @@ class MotionSource {
   // clock's time is done, as the run waits for a lockstep bus. A source
   // plays in one run.
   virtual void start(const MotionClock& /*clock*/) {}
+
+  // The sound track of the show file `show_file` plays on `clock`: a source
+  // that plays that show follows the sound's time from now on (called before
+  // the run, outside the cycle). Others ignore it.
+  virtual void follow_sound(const std::string& /*show_file*/, const SoundClock& /*clock*/) {}
 
   // The run is over (called outside the cycle, on every way out of the run):
   // the clock handed to start() is read no more, it may be gone.

@@ -5,7 +5,8 @@
 // - locks on the first frame, and follows the frames as they come;
 // - re-syncs when a frame disagrees with the running time by more than a
 //   frame and a half (a jump: the timecode source was cued elsewhere), and
-//   asks for the cue that should be playing at the new time;
+//   asks for the cue that should be playing at the new time, at the time
+//   into it that the timecode says;
 // - freewheels through a dropout (no frame for more than two and a half
 //   frame periods, counted) on the audio clock, for up to `freewheel_s`;
 //   after that the timecode is lost until frames come again.
@@ -32,6 +33,8 @@ class LtcChase {
   // The input has reached time `now_s`: the cue to ask for now, or -1. Call
   // after the frames decoded up to `now_s`.
   int advance(double now_s);
+  // The time into the cue the last advance() asked for, at `now_s` (s).
+  double cue_offset() const { return offset_; }
 
   // The chased timecode at the last advance(), empty when not locked.
   std::optional<double> timecode() const { return position_; }
@@ -41,6 +44,7 @@ class LtcChase {
   std::uint64_t losses() const { return losses_; }
 
  private:
+  // Indices into cues_, or -1.
   int due(double from, double to) const;  // the last cue starting in (from, to]
   int playing_at(double t) const;         // the last cue starting at or before t
 
@@ -53,6 +57,7 @@ class LtcChase {
   double anchor_tc_ = 0.0;  // timecode at input time anchor_at_
   double anchor_at_ = 0.0;
   std::optional<double> position_;
+  double offset_ = 0.0;
   std::uint64_t frames_ = 0, jumps_ = 0, dropouts_ = 0, losses_ = 0;
 };
 

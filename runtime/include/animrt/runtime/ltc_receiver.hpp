@@ -20,7 +20,8 @@ namespace animrt {
 
 class LtcReceiver {
  public:
-  using Handler = std::function<void(int cue)>;
+  // The cue to ask for, and the time into it the timecode is at.
+  using Handler = std::function<void(int cue, double at_s)>;
 
   // Opens the input (throws InputError for a bad file, DeviceError for a
   // device that cannot be opened) and starts reading.

@@ -8,7 +8,9 @@
 // velocity or acceleration step of its own; a crossfade that would ask a
 // joint for more than a share of its velocity or acceleration limit (a cue
 // that starts far from the present pose) is lengthened until it does not.
-// Joints a step does not drive go to their home pose.
+// Joints a step does not drive go to their home pose. A cue asked for at a
+// time into it (a timecode that jumped into its middle) starts at that
+// time, through the same crossfade.
 //
 // The player is a motion source: everything it plays is built and allocated
 // before the run, and sample() only reads requests and blends.
@@ -81,9 +83,12 @@ class CuePlayer final : public MotionSource {
   static constexpr std::size_t kMaxLayers = 4;
 
   void advance(double t) const;
-  // `asked`: a trigger's (a cue asked for again starts again, and counts).
-  void push(int cue, int step, bool asked) const;
-  double ease_in_time(const Cue& cue, const MotionSource& next) const;
+  // `asked`: a trigger's (a cue asked for again starts again, and counts);
+  // `at_s`: the time into the step it starts at.
+  void push(int cue, int step, bool asked, double at_s = 0.0) const;
+  // The step of `cue` and the time into it at `at_s` into the cue.
+  void locate(int cue, double at_s, int& step, double& within) const;
+  double ease_in_time(const Cue& cue, const MotionSource& next, double at_s) const;
   void sample_layer(Layer& layer) const;
   void compact() const;
   double weight(const Layer& layer) const;
@@ -107,6 +112,7 @@ class CuePlayer final : public MotionSource {
   mutable double rate_phase_ = 1.0;  // 1 playing, 0 paused, between: easing
   mutable bool waiting_ = false;     // a request waits for a free slot
   mutable int waiting_cue_ = 0;
+  mutable double waiting_at_ = 0.0;  // its time into the cue
   mutable std::vector<double> out_, prev_out_, scratch_;
   mutable double last_dt_ = 0.0;  // motion time between prev_out_ and out_
   mutable double step_dt_ = 0.0;  // this call's

@@ -28,9 +28,14 @@ struct Audio {
 // samples.
 Audio load_audio(const std::string& path, int target_rate = 0);
 
-// Resamples with libsamplerate (band-limited sinc). Returns `in` unchanged
-// when the rates match.
-Audio resample(const Audio& in, int target_rate);
+// `fast`: a polyphase windowed-sinc filter for the rational ratio (what the
+// analysis uses; its features are tested to stay within a tolerance of
+// `medium`'s), libsamplerate's fastest sinc converter for ratios too
+// irregular for a table; `medium`: libsamplerate's medium-quality sinc.
+enum class ResampleQuality { fast, medium };
+
+// Resamples with libsamplerate. Returns `in` unchanged when the rates match.
+Audio resample(const Audio& in, int target_rate, ResampleQuality quality = ResampleQuality::fast);
 
 // Writes 16-bit PCM WAV. Throws std::runtime_error when the file cannot be
 // written.

@@ -5,6 +5,8 @@
 // thread that feeds ALSA from that schedule once the show has started, and
 // follows the show's transport (a dashboard's pause, seek and play): it keeps
 // a ShowPlayhead that gets the show's commands at the same motion times.
+// The sound runs on the output's clock, never re-placed for drift: where it
+// is heard is published (SoundClock) and the show's motion follows it.
 //
 // Show frame f is show time f / rate. Track frame (f - offset) sounds at show
 // frame f: silence before the offset and after the track's end. A looping
@@ -23,6 +25,7 @@
 
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/controllers/show/show_playhead.hpp"
+#include "animrt/controllers/show/sound_clock.hpp"
 #include "animrt/core/clock.hpp"
 
 namespace animrt {
@@ -74,9 +77,10 @@ class ShowAudioPlayer {
  public:
   // The sink is opened by the caller (so a missing sound card is reported
   // before the run starts); `clock` is the clock of the origin given to
-  // start() (CLOCK_MONOTONIC in a real-time run).
+  // start() (CLOCK_MONOTONIC in a real-time run). Without `own_thread` the
+  // caller calls pump() itself (a test on a simulated clock).
   ShowAudioPlayer(const ShowFile& show, AudioTrack track, std::unique_ptr<AudioSink> sink,
-                  const Clock& clock);
+                  const Clock& clock, bool own_thread = true);
   ~ShowAudioPlayer();
   ShowAudioPlayer(const ShowAudioPlayer&) = delete;
   ShowAudioPlayer& operator=(const ShowAudioPlayer&) = delete;
@@ -96,8 +100,21 @@ class ShowAudioPlayer {
   // Show frames written to the sink so far (for tests and the report).
   std::int64_t frames_played() const { return played_.load(std::memory_order_acquire); }
 
+  // The show time the sink is heard at, for the show's motion to follow
+  // (MotionSource::follow_sound).
+  const SoundClock& sound_clock() const { return sound_; }
+  const std::string& show_file() const { return show_file_; }
+
+  // One block: the commands taken, where the sound is heard now published,
+  // the next block written (the sink may block). False before start() and
+  // after stop() (nothing written). The player's thread loops on it.
+  bool pump();
+
  private:
   void run();
+  // Takes the commands queued; true when the transport moved (`seeked`:
+  // by a seek).
+  bool take_commands(bool& seeked);
 
   AudioTrack track_;
   ShowAudioSchedule schedule_;
@@ -112,6 +129,9 @@ class ShowAudioPlayer {
   // producer, one consumer; a slot is the producer's until `head_` passes
   // it, then the consumer's until `tail_` does).
   static constexpr std::size_t kCommands = 64;
+  // A sound heard this far from where it should be has stalled (not
+  // drifted: the motion follows drift within milliseconds): placed again.
+  static constexpr double kStallS = 0.05;
   struct TimedCommand {
     ShowCommand command;
     double t = 0.0;
@@ -119,6 +139,15 @@ class ShowAudioPlayer {
   std::array<TimedCommand, kCommands> commands_{};
   std::atomic<std::uint64_t> head_{0}, tail_{0};
   ShowPlayhead playhead_;  // the player thread's
+  // The pump's: the show frame of the next block (-1: to be placed), and the
+  // sound's time minus the playhead's (the output's clock drifting from the
+  // loop's), which the sound keeps when it is placed again.
+  std::int64_t next_ = -1;
+  double drift_s_ = 0.0;
+  std::uint32_t seeks_ = 0;
+  std::vector<float> buffer_;
+  std::string show_file_;
+  SoundClock sound_;
   std::thread thread_;
 };
 

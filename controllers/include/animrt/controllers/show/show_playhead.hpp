@@ -24,6 +24,15 @@ class ShowPlayhead {
   // go on counting): held while paused, else t moved by the seeks and
   // pauses so far.
   double time(double t) const { return paused_ ? held_ : t + offset_; }
+  // Moves the show's time by ds, as if it had run that much faster (a
+  // sound track's clock pulling it along). A seek forgets the nudges.
+  void nudge(double ds) {
+    if (paused_) {
+      held_ += ds;
+    } else {
+      offset_ += ds;
+    }
+  }
   bool paused() const { return paused_; }
   // Within [0, duration], wrapped for a looping show; playing: not paused
   // and not past a non-looping show's end.
