@@ -212,7 +212,8 @@ torch::Tensor run_vertices_first(torch::nn::Sequential& layers, torch::Tensor h)
   const auto children = layers->children();
   for (std::size_t k = 0; k < children.size(); ++k) {
     if (auto* conv = children[k]->as<MeshConvImpl>()) {
-      const bool squash = k + 1 < children.size() && !children[k + 1]->as<MeshConvImpl>();
+      const bool squash =
+          k + 1 < children.size() && children[k + 1]->as<torch::nn::TanhImpl>() != nullptr;
       h = conv->forward_fused(h, squash);
       if (squash) ++k;
     } else {
