@@ -41,6 +41,9 @@ class MeshConvImpl : public torch::nn::Module {
   torch::Tensor forward(const torch::Tensor& x);
   // The same on [V, B, C] (vertices first, contiguous), as the network runs it.
   torch::Tensor forward_vertices_first(const torch::Tensor& x);
+  // The same, then tanh when `squash`, as one autograd node (one iteration
+  // of training records far fewer operations).
+  torch::Tensor forward_fused(const torch::Tensor& x, bool squash);
   // The neighbour mean (or its adjoint) alone, on [B, V, C] and on [V, B, C].
   torch::Tensor ring(const torch::Tensor& x) const;
   torch::Tensor ring_vertices_first(const torch::Tensor& x) const;
