@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb cross-arm64 clean
+.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install test-boot cross-arm64 clean
 
 deps:
 	@scripts/install-deps.sh
@@ -61,6 +61,20 @@ test-hil: build
 # service and data) and animrt-tools (the offline tools), in $(BUILD)/deb.
 deb: build
 	packaging/build-debs $(BUILD) $(BUILD)/deb
+
+# The packages installed by apt into a fresh Debian 12 root (mmdebstrap; the
+# root is cached in $(BUILD)/install/cache, the first run fetches it from
+# Debian's archive) and checked there: the service user, the files, the
+# unit, every shipped robot file validated from the installed paths. Needs
+# root. Not part of `make test` (docs/results/packaging.md: what it costs).
+test-install: deb
+	packaging/test-install $(BUILD)
+
+# That installed system booted with systemd under QEMU (TCG): the service
+# plays a figure on the host's simulated servos, a shutdown ramps it home
+# and turns torque off. Results in $(BUILD)/hil-boot.
+test-boot: deb
+	tests/hil/boot $(BUILD)
 
 # The loop's library and its unit tests cross-compiled for arm64 (Debian's
 # cross toolchain and arm64 libraries), run under qemu-user. Not part of

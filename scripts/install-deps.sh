@@ -31,6 +31,11 @@ packages=(
   # libraries are not installed here: libyaml-cpp-dev:arm64 replaces the
   # host's libyaml-cpp-dev, docs/deployment.md).
   libsystemd-dev systemd dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static
+  # The packages installed into a fresh Debian 12 root (make test-install:
+  # mmdebstrap, fetching from Debian's archive) and that root booted with
+  # systemd (make test-boot: an ext4 image written by mkfs.ext4 -d, read
+  # back by debugfs; depmod for the guest's modules).
+  mmdebstrap e2fsprogs kmod
 )
 # npm for the MCAP test's reader (below): Debian's, unless a Node.js with npm
 # is installed already (Debian's npm package conflicts with other Node builds).
