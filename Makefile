@@ -77,11 +77,14 @@ test-boot: deb
 	tests/hil/boot $(BUILD)
 
 # The loop's library and its unit tests cross-compiled for arm64 (Debian's
-# cross toolchain and arm64 libraries), run under qemu-user. Not part of
-# `make test` (docs/deployment.md: what it costs).
+# cross toolchain, a sysroot of Debian's arm64 -dev packages extracted into
+# $(CROSS_BUILD)/sysroot: fetched once from Debian's archive), run under
+# qemu-user. Not part of `make test` (docs/deployment.md: what it costs).
 CROSS_BUILD ?= build-arm64
 cross-arm64: deps
+	packaging/arm64-sysroot $(CROSS_BUILD)/sysroot
 	cmake -S . -B $(CROSS_BUILD) -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake \
+	  -DANIMRT_ARM64_SYSROOT=$(abspath $(CROSS_BUILD))/sysroot \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DANIMRT_WERROR=ON -DANIMRT_LOOP_ONLY=ON \
 	  -DANIMRT_TESTS=OFF -DANIMRT_BENCH=OFF
 	cmake --build $(CROSS_BUILD) -j $(JOBS)
