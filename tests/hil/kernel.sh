@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Sourced by the HIL scripts: Debian's kernel package for the guest, fetched
 # with apt-get download into OUT/kernel once and unpacked there (never
 # installed on this host). Sets kernel_pkg, kver, vmlinuz and kroot (the
