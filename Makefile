@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb cross-arm64 clean
+.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install test-boot cross-arm64 clean
 
 deps:
 	@scripts/install-deps.sh
@@ -62,12 +62,29 @@ test-hil: build
 deb: build
 	packaging/build-debs $(BUILD) $(BUILD)/deb
 
+# The packages installed by apt into a fresh Debian 12 root (mmdebstrap; the
+# root is cached in $(BUILD)/install/cache, the first run fetches it from
+# Debian's archive) and checked there: the service user, the files, the
+# unit, every shipped robot file validated from the installed paths. Needs
+# root. Not part of `make test` (docs/results/packaging.md: what it costs).
+test-install: deb
+	packaging/test-install $(BUILD)
+
+# That installed system booted with systemd under QEMU (TCG): the service
+# plays a figure on the host's simulated servos, a shutdown ramps it home
+# and turns torque off. Results in $(BUILD)/hil-boot.
+test-boot: deb
+	tests/hil/boot $(BUILD)
+
 # The loop's library and its unit tests cross-compiled for arm64 (Debian's
-# cross toolchain and arm64 libraries), run under qemu-user. Not part of
-# `make test` (docs/deployment.md: what it costs).
+# cross toolchain, a sysroot of Debian's arm64 -dev packages extracted into
+# $(CROSS_BUILD)/sysroot: fetched once from Debian's archive), run under
+# qemu-user. Not part of `make test` (docs/deployment.md: what it costs).
 CROSS_BUILD ?= build-arm64
 cross-arm64: deps
+	packaging/arm64-sysroot $(CROSS_BUILD)/sysroot
 	cmake -S . -B $(CROSS_BUILD) -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake \
+	  -DANIMRT_ARM64_SYSROOT=$(abspath $(CROSS_BUILD))/sysroot \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DANIMRT_WERROR=ON -DANIMRT_LOOP_ONLY=ON \
 	  -DANIMRT_TESTS=OFF -DANIMRT_BENCH=OFF
 	cmake --build $(CROSS_BUILD) -j $(JOBS)
