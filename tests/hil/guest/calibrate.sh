@@ -39,9 +39,27 @@ cal_position() {
   kill $d 2>/dev/null; wait $d 2>/dev/null
   f=$(grep -m1 '#43646000' /tmp/cal_sdo.log | sed 's/.*#43646000//')
   [ ${#f} = 8 ] || return
-  v=$((0x${f:6:2}${f:4:2}${f:2:2}${f:0:2}))
+  v=$((0x$(echo "$f" | sed 's/\(..\)\(..\)\(..\)\(..\)/\4\3\2\1/')))
   [ $v -ge 2147483648 ] && v=$((v - 4294967296))
   echo $v
+}
+
+# The drive's statusword in its TPDO (1A8h) while it was in homing mode
+# (6060h = 6 to 6060h = 8 by SDO, 628h), from a candump log: "attained"
+# once bits 12 and 10 were set with bit 13 clear; "search" before it if
+# it had moved first (bits 10, 12, 13 clear: searching).
+cal_homing() {
+  awk 'function hex(s,   i, v) {
+         for (i = 1; i <= length(s); i++) v = v * 16 + index("0123456789ABCDEF", substr(s, i, 1)) - 1
+         return v }
+       { split($3, f, "#") }
+       f[1] == "628" && substr(f[2], 1, 10) == "2F60600006" { homing = 1; next }
+       f[1] == "628" && substr(f[2], 1, 10) == "2F60600008" { homing = 0; next }
+       homing && f[1] == "1A8" && !done {
+         sw = hex(substr(f[2], 3, 2) substr(f[2], 1, 2))
+         if (and(sw, 0x3400) == 0) search = 1
+         if (and(sw, 0x3400) == 0x1400) { done = 1; printf "%s%s", search ? "search " : "", "attained" }
+       }' $1
 }
 
 # NAME ROBOT EXPECTED_LINE HAND_COUNTS...: calibrate with the hand moving the joint.
@@ -49,6 +67,8 @@ cal_run() {
   name=$1 robot=$2 expect=$3
   shift 3
   : > /tmp/${name}_out.txt
+  candump -L vcan0,1A8:7FF,628:7FF > /tmp/${name}.log 2>/dev/null &
+  cal_dump=$!
   animrt calibrate $robot --non-interactive --yes --seconds-per-joint 4 \
     > /tmp/${name}_out.txt 2>&1 &
   c=$!
@@ -60,6 +80,7 @@ cal_run() {
   grep -q '^axis: move it through its whole range' /tmp/${name}_out.txt && cal_hand "$@"
   wait $c
   rc=$?
+  kill $cal_dump 2>/dev/null; wait $cal_dump 2>/dev/null
   if [ $rc = 0 ] && grep -q "$expect" /tmp/${name}_out.txt &&
     grep -q '1 joint calibrated' /tmp/${name}_out.txt; then
     pass "$name ($(grep -m1 'its home reads' /tmp/${name}_out.txt))"
@@ -102,10 +123,11 @@ cal_run calibrate_cia402_method37 /tmp/cal37.yaml \
   'axis: homed on its current position: its home reads 1000 ticks' -2000 3000 500
 cal_file calibrate_cia402_method37_file /tmp/cal37.yaml -25 25 /tmp/cal37_before.yaml
 p=$(cal_position)
-if [ -n "$p" ] && [ $p -ge 980 ] && [ $p -le 1020 ]; then
-  pass "calibrate_cia402_method37_drive_homed (position actual $p at the home)"
+h=$(cal_homing /tmp/calibrate_cia402_method37.log)
+if [ "$h" = attained ] && [ -n "$p" ] && [ $p -ge 980 ] && [ $p -le 1020 ]; then
+  pass "calibrate_cia402_method37_drive_homed (statusword: homing attained on the spot; position actual $p at the home)"
 else
-  fail calibrate_cia402_method37_drive_homed "position actual '$p' at the home, expected 1000"
+  fail calibrate_cia402_method37_drive_homed "statusword in homing mode: '$h' (expected attained on the spot); position actual '$p' at the home (expected 1000)"
 fi
 # Method 19: the search ends at the switch's edge (25 deg of the encoder),
 # which then reads 1000; the hand then -15, +20, +5 deg from there.
@@ -114,4 +136,10 @@ cp /tmp/cal19.yaml /tmp/cal19_before.yaml
 cal_run calibrate_cia402_method19 /tmp/cal19.yaml \
   'axis: homed on its switch: its home reads 1000 ticks' -500 3000 1500
 cal_file calibrate_cia402_method19_file /tmp/cal19.yaml -15 20 /tmp/cal19_before.yaml
+h=$(cal_homing /tmp/calibrate_cia402_method19.log)
+if [ "$h" = "search attained" ]; then
+  pass "calibrate_cia402_method19_drive_homed (statusword: searching, then homing attained)"
+else
+  fail calibrate_cia402_method19_drive_homed "statusword in homing mode: '$h' (expected a search, then attained)"
+fi
 kill $cal_sim 2>/dev/null; wait $cal_sim 2>/dev/null
