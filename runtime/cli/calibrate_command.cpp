@@ -273,10 +273,15 @@ std::vector<std::size_t> chosen_joints(const LimpFigure& figure, const Calibrate
   return out;
 }
 
+// The key of the home's count in the joint's actuator map.
+const char* zero_key(const LimpFigure& figure, std::size_t j) {
+  return figure.protocol(j) == "cia402" ? "zero_counts" : "zero_ticks";
+}
+
 // The file's new values for one joint, written into `edit`. Returns the
 // report line.
 std::string write_joint(YamlValueEditor& edit, const std::string& name, const ActuatorBinding& a,
-                        const Seen& seen, long long zero) {
+                        const Seen& seen, long long zero, const char* zero_key = "zero_ticks") {
   // The range as seen from the home, whatever the home's ticks become.
   const double home = seen.home_ticks;
   const double lo = seen.direction * ticks_to_deg(a, seen.min_ticks - home);
@@ -287,7 +292,7 @@ std::string write_joint(YamlValueEditor& edit, const std::string& name, const Ac
   edit.set({"joints", name, "limits", "min_deg"}, deg_text(min_deg));
   edit.set({"joints", name, "limits", "max_deg"}, deg_text(max_deg));
   edit.set({"joints", name, "home_deg"}, "0");
-  edit.set({"joints", name, "actuator", "zero_ticks"}, std::to_string(zero));
+  edit.set({"joints", name, "actuator", zero_key}, std::to_string(zero));
   edit.set({"joints", name, "actuator", "direction"}, std::to_string(seen.direction));
   return fmt::format("{}: limits {} .. {} deg, home at {} ticks (0 deg), direction {}", name,
                      deg_text(min_deg), deg_text(max_deg), zero, seen.direction);
@@ -352,7 +357,7 @@ std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t 
   }
   if (const int method = switch_homing_method(figure, j)) {
     seen.home_ticks = static_cast<double>(a.zero_ticks);  // homed before the range was seen
-    return write_joint(edit, name, a, seen, a.zero_ticks) +
+    return write_joint(edit, name, a, seen, a.zero_ticks, zero_key(figure, j)) +
            fmt::format(" (homing method {}: 0 deg at the switch)", method);
   }
   // The home where the joint rests now reads the file's zero_ticks.
@@ -360,7 +365,7 @@ std::string finish_joint(LimpFigure& figure, YamlValueEditor& edit, std::size_t 
   const bool drive = figure.protocol(j) == "cia402";
   std::cout << fmt::format("{}: {}: its home reads {} ticks\n", name,
                            drive ? "homed on its current position" : "Homing Offset set", reads);
-  return write_joint(edit, name, a, seen, a.zero_ticks) +
+  return write_joint(edit, name, a, seen, a.zero_ticks, zero_key(figure, j)) +
          (drive ? " (homing method 37)" : " (Homing Offset)");
 }
 

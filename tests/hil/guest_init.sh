@@ -190,13 +190,18 @@ check sdo_device_type '5A0#4300100092010200'
 check heartbeat_operational '720#05'
 check tpdo '1A0#.*'
 
+# -- CAN: animrt calibrate homes a CiA 402 drive (methods 37 and 19) ----------
+. /hil/calibrate.sh
+
 echo DONE >> $R
 # -- results to the host --------------------------------------------------------
 stty -F /dev/ttyS3 raw -echo 2>/dev/null
 {
   for f in results.txt vcan0.log serial_summary.json serial_run.txt modbus_summary.json \
            modbus_run.txt can_summary.json can_run.txt can_sim.txt can_missing_run.txt \
-           can_kill.log can_kill_run.txt; do
+           can_kill.log can_kill_run.txt cal_sim.txt calibrate_cia402_method37_out.txt \
+           cal37.yaml calibrate_cia402_method37.log calibrate_cia402_method19_out.txt cal19.yaml \
+           calibrate_cia402_method19.log; do
     [ -f /tmp/$f ] || continue
     echo "=== BEGIN $f ==="
     cat /tmp/$f
