@@ -546,12 +546,25 @@ struct CycleStages {
     }
   }
 
-  // A joint that can move and has not been measured near its stop pose
-  // this cycle (a late bus's joint has no measurement to judge).
-  static bool off_stop_pose(const RobotModel& model, const CycleState& s, std::size_t j) {
-    if (s.joint_faulted(j)) return false;
+  // A joint that can move and was measured away from its stop pose this
+  // cycle. A faulted joint is held, and one whose device did not answer
+  // this cycle has no measurement: neither is waited for (the watchdogs
+  // judge a silent device).
+  static bool off_stop_pose(const RobotModel& model, const CycleState& s, std::size_t j, double t) {
+    const JointSlot slot = s.slots_[j];
+    if (s.joint_faulted(j) || !s.active_[j] || s.last_ok_[slot.bus][slot.device] != t) {
+      return false;
+    }
     const double tolerance = model.prismatic[j] ? kArrivedM : kArrivedRad;
-    return !s.active_[j] || !(std::abs(s.measured_[j] - s.ramp_to_[j]) <= tolerance);
+    return !(std::abs(s.measured_[j] - s.ramp_to_[j]) <= tolerance);
+  }
+
+  // How long after its start a stop waits for the joints: the settling
+  // time after the ramp, ending a cycle before the stop deadline would cut
+  // torque without the warning.
+  static double settle_limit(const RobotModel& model, const CycleState& s) {
+    return std::min(s.ramp_.duration() + kStopSettleTime,
+                    std::max(s.ramp_.duration(), model.safety.stop_deadline_s - model.dt));
   }
 
   // The run is done once the stop ramp has ended, the command is at rest and
@@ -565,7 +578,7 @@ struct CycleStages {
     for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
     bool arrived = fastest < kSettledVelocity;
     for (std::size_t j = 0; arrived && j < s.slots_.size(); ++j) {
-      arrived = !off_stop_pose(model, s, j);
+      arrived = !off_stop_pose(model, s, j, t);
     }
     if (!arrived) {
       s.arrived_since_ = -1.0;
@@ -574,9 +587,9 @@ struct CycleStages {
     }
     if (arrived && t - s.arrived_since_ >= kArrivedHold - kTimeEps) {
       s.phase_ = Phase::done;
-    } else if (t - s.phase_start_ >= s.ramp_.duration() + kStopSettleTime - kTimeEps) {
+    } else if (t - s.phase_start_ >= settle_limit(model, s) - kTimeEps) {
       for (std::size_t j = 0; j < s.slots_.size(); ++j) {
-        if (!off_stop_pose(model, s, j)) continue;
+        if (!off_stop_pose(model, s, j, t)) continue;
         s.emit(CycleEvent{EventKind::stop_unreached, t, static_cast<int>(j), s.slots_[j].bus,
                           s.slots_[j].device, DeviceHealth::ok, s.measured_[j] - s.ramp_to_[j]});
       }

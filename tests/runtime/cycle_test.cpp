@@ -465,6 +465,28 @@ TEST(Cycle, AJointThatNeverArrivesEndsTheStopABoundedTimeAfterTheRampAndIsNamed)
   EXPECT_FALSE(bench.has(EventKind::stop_deadline));
 }
 
+TEST(Cycle, TheWaitForAJointEndsBeforeTheStopDeadlineWouldCutTorque) {
+  RobotModel model = two_bus_model();
+  model.safety.start_ramp_s = 1.0;
+  model.safety.stop_ramp_s = 1.0;
+  model.safety.stop_deadline_s = 2.0;  // under the ramp and the whole wait
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double) { return 0.4; };
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  SlowServos servos(bench);
+  servos.floor[0][0] = 0.1;
+  while (!bench.state.done() && bench.count < 2000) servos.cycle();
+  const CycleEvent* ended = bench.first(EventKind::motion_ended);
+  const CycleEvent* unreached = bench.first(EventKind::stop_unreached);
+  ASSERT_NE(ended, nullptr);
+  ASSERT_NE(unreached, nullptr);
+  EXPECT_EQ(unreached->joint, 0);
+  EXPECT_LT(unreached->t - ended->t, 2.0);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+  EXPECT_FALSE(bench.state.end().torque_cut);
+}
+
 TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {
   Bench bench(two_bus_model());
   bench.begin();

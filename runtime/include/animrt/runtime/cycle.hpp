@@ -31,7 +31,8 @@ namespace animrt {
 
 enum class Phase { start_ramp, motion, stop_ramp, done };
 
-// How long after its ramp a stop waits for the joints to arrive (s).
+// How long after its ramp a stop waits for the joints to arrive (s), at
+// most, and never up to the stop deadline.
 inline constexpr double kStopSettleTime = 2.0;
 
 // One bus's results for this cycle.
