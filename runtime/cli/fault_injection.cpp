@@ -66,4 +66,10 @@ void start_fault_injection() {
   }
 }
 
+void slow_exit_for_test() {
+  if (const double seconds = seconds_of("ANIMRT_TEST_SLOW_EXIT_S"); seconds >= 0.0) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  }
+}
+
 }  // namespace animrt::cli

@@ -10,9 +10,12 @@
 //     start_fault_injection (the loop's) stops there for good, as a loop
 //     stuck in a driver call would, while every other thread runs on.
 //     Called just before the run, on the thread that runs the loop.
+//   ANIMRT_TEST_SLOW_EXIT_S=SECONDS: `animrt serve` waits that long after
+//     the run, before its summary, as a loaded machine's slow exit would.
 
 namespace animrt::cli {
 
 void start_fault_injection();
+void slow_exit_for_test();
 
 }  // namespace animrt::cli

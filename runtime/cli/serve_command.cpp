@@ -19,9 +19,9 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
-#include "service_notify.hpp"
 #include "serve_dmx.hpp"
 #include "serve_triggers.hpp"
+#include "service_notify.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "summary_file.hpp"
@@ -193,7 +193,7 @@ int serve(const ServeArgs& args) {
   options.on_motion_start = [&triggers](Nanos) { triggers.begin(); };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
-  notifier.reset();
+  slow_exit_for_test();
   const bool summary_written =
       !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, requests));
   std::cout << format_summary(summary);
@@ -205,6 +205,9 @@ int serve(const ServeArgs& args) {
     if (code == kExitOk) code = kExitRecordLost;
   }
   std::cout << std::flush;
+  // The watchdog is fed up to here: the figure was released, and writing
+  // the summary may take seconds on a loaded machine.
+  notifier.reset();
   return code;
 }
 

@@ -161,6 +161,7 @@ void RunLoop::finish() {
     update_view(b);
   }
   activation_.release();
+  if (options_.heartbeat) options_.heartbeat->released();
   if (writer_) writer_->finish();
   if (recorder_) recorder_->finish();
 }

@@ -4,7 +4,8 @@
 # watchdog pings of the ramp's cycles), WATCHDOG=1 while the loop completes
 # cycles, none once the loop stalls (a stuck loop, however alive the rest
 # of the process), and STOPPING=1 when SIGTERM starts the stop ramp, which
-# then ends the service with exit 0.
+# then ends the service with exit 0, the watchdog fed until the exit once
+# the figure is released.
 set -uo pipefail
 animrt=$1
 root=$(realpath "$2")
@@ -36,6 +37,16 @@ stopping=$(at "$tmp/term.txt" STOPPING=1)
 [[ -n $sent && -n $stopping ]] || fail "no STOPPING=1 after SIGTERM: $log"
 grep -q " exit 0$" "$tmp/term.txt" || fail "SIGTERM did not end the service with exit 0: $log"
 [[ $(grep -c "READY=1\|STOPPING=1" "$tmp/term.txt") == 2 ]] || fail "sent twice: $log"
+
+# A clean stop whose exit is slow (the summary written on a loaded machine):
+# the figure is released, and the watchdog is fed until the process exits.
+ANIMRT_TEST_SLOW_EXIT_S=1.5 notify "$tmp/slow.txt" 200000 30 --term-after-ready 0.3 -- "${serve[@]}"
+log=$(cat "$tmp/slow.txt")
+grep -q " exit 0$" "$tmp/slow.txt" || fail "slow exit: not ended with exit 0: $log"
+exited=$(at "$tmp/slow.txt" exit)
+last=$(awk '$2 == "WATCHDOG=1" { t = $1 } END { print t }' "$tmp/slow.txt")
+awk -v t="$last" -v e="$exited" 'BEGIN { exit !(t != "" && e - t < 0.75) }' ||
+  fail "slow exit: no watchdog ping in the last 0.75 s before the exit: $log"
 
 # The loop stalls 2.5 s after the run began: the pings stop, the process lives on.
 ANIMRT_TEST_STALL_LOOP_AFTER_S=2.5 notify "$tmp/stall.txt" 200000 6 -- "${serve[@]}"

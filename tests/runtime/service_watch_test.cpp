@@ -50,6 +50,21 @@ TEST(ServiceWatch, StoppingOnceWhenTheStopRampBegins) {
   EXPECT_TRUE(watch.stopping());
 }
 
+TEST(ServiceWatch, OnceTheActuatorsAreReleasedTheWatchdogIsFedUntilTheProcessExits) {
+  RunHeartbeat beat;
+  ServiceWatch watch(true);
+  beat.beat(Phase::motion);
+  beat.beat(Phase::stop_ramp);
+  watch.look(beat);
+  beat.end();
+  // The loop has ended, the actuators not yet released: no ping.
+  EXPECT_EQ(watch.look(beat), Messages{});
+  beat.released();
+  // No more cycles: only the summary is left to write, however long it takes.
+  EXPECT_EQ(watch.look(beat), Messages{"WATCHDOG=1"});
+  EXPECT_EQ(watch.look(beat), Messages{"WATCHDOG=1"});
+}
+
 TEST(ServiceWatch, AStopDuringTheStartRampIsNeverReady) {
   RunHeartbeat beat;
   ServiceWatch watch(false);

@@ -28,17 +28,22 @@ class RunHeartbeat {
   }
   // After the last cycle, whatever ended the run.
   void end() { stage_.store(Stage::ended, std::memory_order_release); }
+  // After end(), once every actuator was released (torque off): whatever
+  // the process does until it exits cannot move the figure.
+  void released() { safe_.store(true, std::memory_order_release); }
 
   // --- the reader's side ---
   std::uint64_t cycles() const { return cycles_.load(std::memory_order_acquire); }
   Stage stage() const { return stage_.load(std::memory_order_acquire); }
   // The start ramp has ended and the motion has played.
   bool moved() const { return moved_.load(std::memory_order_acquire); }
+  bool safe() const { return safe_.load(std::memory_order_acquire); }
 
  private:
   std::atomic<std::uint64_t> cycles_{0};
   std::atomic<Stage> stage_{Stage::bring_up};
   std::atomic<bool> moved_{false};
+  std::atomic<bool> safe_{false};
 };
 
 }  // namespace animrt

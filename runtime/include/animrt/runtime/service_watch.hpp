@@ -2,8 +2,9 @@
 // What a service manager (systemd's sd_notify protocol) is told about a
 // run, decided from the loop's heartbeat by a thread beside the loop:
 // READY=1 once the start ramp has ended and the motion plays, WATCHDOG=1
-// only when cycles completed since the last look, STOPPING=1 once the stop
-// ramp has begun (or the run ended). The caller sends the messages.
+// only when cycles completed since the last look (or, after the loop, once
+// the actuators were released, until the process exits), STOPPING=1 once
+// the stop ramp has begun (or the run ended). The caller sends the messages.
 
 #include <cstdint>
 #include <string>
