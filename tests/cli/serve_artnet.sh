@@ -7,10 +7,7 @@
 set -uo pipefail
 animrt=$1
 root=$2
-tmp=$(mktemp -d)
-pid=""
-trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 
 # A bad cue file: one line naming file, line and key, exit 2, nothing started.
 printf 'idle: rest\ncues:\n  rest: {play: {pose: {neck_pan: 0}}, dmx: 300}\n' > "$tmp/bad.yaml"
@@ -21,16 +18,8 @@ code=$?
 grep -q "^error: $tmp/bad.yaml:3:.*cues.rest.dmx" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
 grep -q "configure" "$tmp/err.txt" && fail "a device started for a bad cue file: $(cat "$tmp/err.txt")"
 
-"$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
-  --backend sim --lockstep --no-realtime --no-osc --artnet-port 0 \
-  > "$tmp/out.txt" 2> "$tmp/err.txt" &
-pid=$!
-for _ in $(seq 150); do
-  grep -q "activate: torque on" "$tmp/err.txt" && break
-  sleep 0.1
-done
-grep -q "activate: torque on" "$tmp/err.txt" || fail "serve did not start: $(cat "$tmp/err.txt")"
-line=$(head -n 1 "$tmp/out.txt")
+start_serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
+  --backend sim --lockstep --no-realtime --no-osc --artnet-port 0
 [[ $line =~ ^artnet:\ listening\ on\ 127\.0\.0\.1:([0-9]+)\ for\ universe\ 0,\ channel\ 1$ ]] ||
   fail "no Art-Net line: '$line'"
 /usr/bin/python3 - "${BASH_REMATCH[1]}" <<'PY' || fail "the sender failed"
@@ -64,13 +53,7 @@ send(artdmx([4, 0]))            # greet
 time.sleep(0.5)
 PY
 kill -TERM $pid
-for _ in $(seq 300); do
-  kill -0 $pid 2>/dev/null || break
-  sleep 0.1
-done
-wait $pid
-code=$?
-pid=""
+wait_exit
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "ended by stop request" <<<"$out" || fail "SIGTERM did not stop: $out"

@@ -5,21 +5,10 @@
 set -uo pipefail
 animrt=$1
 root=$2
-tmp=$(mktemp -d)
-pid=""
-trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 
-"$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
-  --backend sim --lockstep --no-realtime --no-osc --no-artnet --dashboard 127.0.0.1:0 \
-  > "$tmp/out.txt" 2> "$tmp/err.txt" &
-pid=$!
-for _ in $(seq 150); do
-  grep -q "activate: torque on" "$tmp/err.txt" && break
-  sleep 0.1
-done
-grep -q "activate: torque on" "$tmp/err.txt" || fail "serve did not start: $(cat "$tmp/err.txt")"
-line=$(head -n 1 "$tmp/out.txt")
+start_serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
+  --backend sim --lockstep --no-realtime --no-osc --no-artnet --dashboard 127.0.0.1:0
 [[ $line =~ ^dashboard:\ (http://127\.0\.0\.1:[0-9]+)/\?token=([0-9a-f]{32})$ ]] ||
   fail "no dashboard line: '$line'"
 /usr/bin/python3 - "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" <<'PY' || fail "the dashboard's answers"
@@ -41,13 +30,7 @@ assert post("/api/cue", {"pause": "yes"}) == 400
 time.sleep(0.5)
 assert post("/api/stop", {}) == 200
 PY
-for _ in $(seq 300); do
-  kill -0 $pid 2>/dev/null || break
-  sleep 0.1
-done
-wait $pid
-code=$?
-pid=""
+wait_exit
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "ended by stop request" <<<"$out" || fail "not stopped: $out"

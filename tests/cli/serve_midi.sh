@@ -9,10 +9,7 @@
 set -uo pipefail
 animrt=$1
 root=$2
-tmp=$(mktemp -d)
-pid=""
-trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 robot="$root/configs/robots/animatronic.yaml"
 
 printf 'idle: rest\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, midi: {note: 60}}\n  a: {play: {pose: {eye_pan: 1}}, midi: {note: 60, channel: 2}}\n' \
@@ -32,14 +29,8 @@ cues:
   c: {play: {pose: {eye_pan: 5}}, midi: {program: 7, channel: 10}}
 YAML
 mkfifo "$tmp/midi"
-"$animrt" serve "$robot" --cues "$tmp/cues.yaml" --backend sim --lockstep --no-realtime --no-osc \
-  --midi "$tmp/midi" > "$tmp/out.txt" 2> "$tmp/err.txt" &
-pid=$!
-for _ in $(seq 150); do
-  grep -q "activate: torque on" "$tmp/err.txt" && break
-  sleep 0.1
-done
-grep -q "activate: torque on" "$tmp/err.txt" || fail "serve did not start: $(cat "$tmp/err.txt")"
+start_serve "$robot" --cues "$tmp/cues.yaml" --backend sim --lockstep --no-realtime --no-osc \
+  --midi "$tmp/midi"
 grep -q "^midi: reading $tmp/midi$" "$tmp/out.txt" || fail "no MIDI line: $(cat "$tmp/out.txt")"
 /usr/bin/python3 - "$tmp/midi" <<'PY' || fail "the MIDI writer"
 import os, sys, time
@@ -56,13 +47,7 @@ send(0xFE, 0xC9, 7)                     # active sensing, program 7 on channel 1
 send(0xC0, 7)                           # program 7 on channel 1: unbound
 PY
 kill -TERM $pid
-for _ in $(seq 300); do
-  kill -0 $pid 2>/dev/null || break
-  sleep 0.1
-done
-wait $pid
-code=$?
-pid=""
+wait_exit
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"

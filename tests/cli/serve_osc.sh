@@ -8,38 +8,23 @@ set -uo pipefail
 animrt=$1
 root=$2
 here=$(dirname "$0")
-tmp=$(mktemp -d)
-pid=""
-trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 
 # Serves until stopped; sets `port` to OSC's once the motion is under way.
-start_serve() {
-  "$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
-    --backend sim --lockstep --no-realtime --osc-port 0 --no-artnet > "$tmp/out.txt" 2> "$tmp/err.txt" &
-  pid=$!
-  for _ in $(seq 150); do
-    grep -q "activate: torque on" "$tmp/err.txt" && break
-    sleep 0.1
-  done
-  grep -q "activate: torque on" "$tmp/err.txt" || fail "serve did not start: $(cat "$tmp/out.txt" "$tmp/err.txt")"
-  line=$(head -n 1 "$tmp/out.txt")
+start_osc() {
+  start_serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
+    --backend sim --lockstep --no-realtime --osc-port 0 --no-artnet
   [[ $line =~ ^osc:\ listening\ on\ 127\.0\.0\.1:([0-9]+)$ ]] || fail "no OSC line: '$line'"
   port=${BASH_REMATCH[1]}
 }
 
-wait_exit() {
-  for _ in $(seq 300); do
-    kill -0 $pid 2>/dev/null || break
-    sleep 0.1
-  done
+wait_ended() {
+  poll_exit
   kill -0 $pid 2>/dev/null && fail "serve did not end: $(tail -5 "$tmp/err.txt")"
-  wait $pid
-  code=$?
-  pid=""
+  reap
 }
 
-start_serve
+start_osc
 # Malformed: no padding, an unknown type tag, an argument missing, an address
 # without '/', a bundle element longer than the bundle.
 script="send /cue/hello
@@ -56,7 +41,7 @@ burst 10000 /cue/greet /cue/look_left /cue/hello
 sleep 0.2
 bundle /cue/sway /stop"
 sent=$(/usr/bin/python3 "$here/osc_send.py" "$port" "$script") || fail "the sender failed"
-wait_exit
+wait_ended
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code, expected 0: $out $(cat "$tmp/err.txt")"
 grep -q "ended by stop request" <<<"$out" || fail "not stopped by /stop: $out"
@@ -71,10 +56,10 @@ grep -qE "^cues started: sway [1-9][0-9]* hello [1-9]" <<<"$out" ||
 grep -E "^(cues|cue requests|osc:)" <<<"$out"
 
 # A stop signal: the terminal hung up.
-start_serve
+start_osc
 sleep 0.5
 kill -HUP $pid
-wait_exit
+wait_ended
 [[ $code == 0 ]] || fail "SIGHUP: exit $code, expected 0: $(cat "$tmp/out.txt")"
 grep -q "ended by stop request" "$tmp/out.txt" || fail "SIGHUP: $(head -3 "$tmp/out.txt")"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "SIGHUP: $(cat "$tmp/err.txt")"

@@ -10,10 +10,7 @@
 set -uo pipefail
 animrt=$1
 root=$2
-tmp=$(mktemp -d)
-pid=""
-trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 robot="$root/configs/robots/animatronic.yaml"
 
 bad() {  # a cue file body, the key its error names
@@ -49,14 +46,9 @@ cues:
   left: {play: {pose: {eye_pan: 10}}, dmx: 2}
   right: {play: {pose: {eye_pan: -10}}, dmx: 3}
 YAML
-"$animrt" serve "$robot" --cues "$tmp/cues.yaml" --backend sim --no-realtime --no-osc \
-  --artnet-port 0 --sacn-port 0 --sacn-multicast --dashboard 127.0.0.1:0 \
-  > "$tmp/out.txt" 2> "$tmp/err.txt" &
-pid=$!
-for _ in $(seq 150); do
-  grep -q "^dashboard:" "$tmp/out.txt" && break
-  sleep 0.1
-done
+serve_in_background "$robot" --cues "$tmp/cues.yaml" --backend sim --no-realtime --no-osc \
+  --artnet-port 0 --sacn-port 0 --sacn-multicast --dashboard 127.0.0.1:0
+await_line "^dashboard:" "$tmp/out.txt"
 artnet=$(sed -n 's/^artnet: listening on 127\.0\.0\.1:\([0-9]*\) for universe 0, 1 joint(s)$/\1/p' "$tmp/out.txt")
 sacn=$(sed -n 's/^sacn: listening on 127\.0\.0\.1:\([0-9]*\) for universe 7, channel 1, 1 joint(s)$/\1/p' "$tmp/out.txt")
 url=$(sed -n 's|^dashboard: \(http://127\.0\.0\.1:[0-9]*\)/.*|\1|p' "$tmp/out.txt")
@@ -111,13 +103,7 @@ assert wait_for("neck_pan", 0.0, 8.0), "neck_pan never eased home (%.1f)" % meas
 assert wait_for("neck_tilt", 0.0, 2.0), "neck_tilt never eased home (%.1f)" % measured("neck_tilt")
 PY
 kill -TERM $pid
-for _ in $(seq 300); do
-  kill -0 $pid 2>/dev/null || break
-  sleep 0.1
-done
-wait $pid
-code=$?
-pid=""
+wait_exit
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"

@@ -10,8 +10,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "animrt/bridge/can/can_options.hpp"
 #include "animrt/runtime/robot_config.hpp"
@@ -23,9 +25,12 @@ namespace cia402_health_test {
 const std::string kRobot = std::string(ANIMRT_SOURCE_DIR) + "/configs/robots/quadruped_can.yaml";
 constexpr std::size_t kDrive = 2;
 
-test::RigSettings health_on(const HealthLimits& limits, std::vector<SimHealthInjection> inject) {
+// The drive with health on, these limits and injected faults; `more` edits
+// the drive's bus further.
+test::RigSettings health_on(const HealthLimits& limits, std::vector<SimHealthInjection> inject,
+                            std::function<void(BusConfig&)> more = nullptr) {
   test::RigSettings settings;
-  settings.edit = [limits, inject](RobotConfig& c) {
+  settings.edit = [limits, inject, more](RobotConfig& c) {
     c.safety.start_ramp_s = 0.3;
     c.safety.stop_ramp_s = 0.3;
     Cia402BusOptions o = options_of<Cia402BusOptions>(c.buses[kDrive].options);
@@ -33,18 +38,34 @@ test::RigSettings health_on(const HealthLimits& limits, std::vector<SimHealthInj
     c.buses[kDrive].options = o;
     c.buses[kDrive].health_limits = limits;
     c.buses[kDrive].sim.health.inject = inject;
+    if (more) more(c.buses[kDrive]);
   };
   return settings;
+}
+
+// A run that one fault of the rh_hip drive (node 32) ended, `what` in it.
+void expect_drive_fault(const RunSummary& s, const std::string& what) {
+  EXPECT_EQ(s.exit_code(), 4);
+  ASSERT_EQ(s.faults.size(), 1u);
+  EXPECT_NE(s.faults[0].find("32 (rh_hip)"), std::string::npos) << s.faults[0];
+  EXPECT_NE(s.faults[0].find(what), std::string::npos) << s.faults[0];
+}
+
+// The devices of the drive's bus.
+std::vector<DeviceReport> drive_devices(const test::SimRig& rig, const RunSummary& s) {
+  std::vector<DeviceReport> out;
+  for (const auto& d : s.devices) {
+    if (d.bus == rig.config().buses[kDrive].name) out.push_back(d);
+  }
+  return out;
 }
 
 TEST(Cia402Health, ASecondTpdoCarriesCurrentAndSupply) {
   test::SimRig rig(kRobot, health_on(HealthLimits{}, {}));
   const RunSummary s = rig.run(1.0);
   EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
-  int drives = 0;
-  for (const auto& d : s.devices) {
-    if (d.bus != rig.config().buses[kDrive].name) continue;
-    ++drives;
+  const std::vector<DeviceReport> drives = drive_devices(rig, s);
+  for (const auto& d : drives) {
     EXPECT_GT(d.health.readings, 50u) << d.joint;
     // The drive's 12 V supply sagging with its current; per mille of 2 A.
     EXPECT_NEAR(d.health.min_voltage_v, 12.0, 0.1) << d.joint;
@@ -52,7 +73,7 @@ TEST(Cia402Health, ASecondTpdoCarriesCurrentAndSupply) {
     EXPECT_LT(d.health.peak_current_a, 1.0) << d.joint;
     EXPECT_TRUE(std::isnan(d.health.max_temperature_c)) << d.joint;  // not in the profile
   }
-  EXPECT_EQ(drives, 1);
+  EXPECT_EQ(drives.size(), 1u);
 }
 
 TEST(Cia402Health, AnUndervoltageFaultsTheDrive) {
@@ -61,12 +82,7 @@ TEST(Cia402Health, AnUndervoltageFaultsTheDrive) {
   limits.voltage_fault_v = 10;
   SimHealthInjection sag{32, 0.5, SimHealthInjection::Kind::supply, 9.0};
   test::SimRig rig(kRobot, health_on(limits, {sag}));
-  const RunSummary s = rig.run(3.0);
-  EXPECT_EQ(s.exit_code(), 4);
-  ASSERT_EQ(s.faults.size(), 1u);
-  EXPECT_NE(s.faults[0].find("32 (rh_hip)"), std::string::npos) << s.faults[0];
-  EXPECT_NE(s.faults[0].find("undervoltage: supply 9.0 V (fault limit 10 V)"), std::string::npos)
-      << s.faults[0];
+  expect_drive_fault(rig.run(3.0), "undervoltage: supply 9.0 V (fault limit 10 V)");
 }
 
 TEST(Cia402Health, ABlockedDriveIsAStall) {
@@ -76,34 +92,30 @@ TEST(Cia402Health, ABlockedDriveIsAStall) {
   limits.stall_error_rad = 0.01;
   SimHealthInjection block{32, 0.5, SimHealthInjection::Kind::blocked, 1.0};
   test::SimRig rig(kRobot, health_on(limits, {block}));
-  const RunSummary s = rig.run(3.0);
-  EXPECT_EQ(s.exit_code(), 4);
-  ASSERT_EQ(s.faults.size(), 1u);
-  EXPECT_NE(s.faults[0].find("32 (rh_hip)"), std::string::npos) << s.faults[0];
-  EXPECT_NE(s.faults[0].find("stall: current 1.40 A"), std::string::npos) << s.faults[0];
+  expect_drive_fault(rig.run(3.0), "stall: current 1.40 A");
 }
 
 // CiA 402 has no temperature object; a drive's config names its
 // manufacturer object, mapped into the health TPDO at configure.
+void name_temperature(BusConfig& drive, const Cia402Temperature& temperature) {
+  Cia402JointOptions o;
+  o.has_temperature = true;
+  o.temperature = temperature;
+  drive.actuators[0].options = o;
+}
+
 test::RigSettings with_temperature(const HealthLimits& limits,
                                    std::vector<SimHealthInjection> inject) {
-  test::RigSettings settings = health_on(limits, std::move(inject));
-  settings.edit = [edit = settings.edit](RobotConfig& c) {
-    edit(c);
-    Cia402JointOptions o;
-    o.has_temperature = true;
-    o.temperature = Cia402Temperature{0x2022, 0x01, 16, true, 0.1};
-    c.buses[kDrive].actuators[0].options = o;
-  };
-  return settings;
+  return health_on(limits, std::move(inject), [](BusConfig& drive) {
+    name_temperature(drive, Cia402Temperature{0x2022, 0x01, 16, true, 0.1});
+  });
 }
 
 TEST(Cia402Health, ANamedTemperatureObjectTravelsInTheHealthTpdo) {
   test::SimRig rig(kRobot, with_temperature(HealthLimits{}, {}));
   const RunSummary s = rig.run(1.0);
   EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
-  for (const auto& d : s.devices) {
-    if (d.bus != rig.config().buses[kDrive].name) continue;
+  for (const auto& d : drive_devices(rig, s)) {
     EXPECT_GT(d.health.readings, 50u) << d.joint;
     // The simulated drive at rest: ambient 36 C, in 0.1 C counts.
     EXPECT_NEAR(d.health.min_temperature_c, 36.0, 0.15) << d.joint;
@@ -118,32 +130,17 @@ TEST(Cia402Health, AnOverheatFaultsTheDriveNamingItsTemperature) {
   limits.temperature_fault_c = 70;
   SimHealthInjection heat{32, 0.5, SimHealthInjection::Kind::temperature, 75.0};
   test::SimRig rig(kRobot, with_temperature(limits, {heat}));
-  const RunSummary s = rig.run(3.0);
-  EXPECT_EQ(s.exit_code(), 4);
-  ASSERT_EQ(s.faults.size(), 1u);
-  EXPECT_NE(s.faults[0].find("32 (rh_hip)"), std::string::npos) << s.faults[0];
-  EXPECT_NE(s.faults[0].find("temperature 75 C (fault limit 70 C)"), std::string::npos)
-      << s.faults[0];
+  expect_drive_fault(rig.run(3.0), "temperature 75 C (fault limit 70 C)");
 }
 
 TEST(Cia402Health, AnEightBitTemperatureInWholeDegrees) {
-  test::RigSettings settings = health_on(HealthLimits{}, {});
-  settings.edit = [edit = settings.edit](RobotConfig& c) {
-    edit(c);
-    Cia402JointOptions o;
-    o.has_temperature = true;
-    o.temperature = Cia402Temperature{0x3000, 0x00, 8, false, 1.0};
-    c.buses[kDrive].actuators[0].options = o;
-    c.buses[kDrive].sim.health.ambient_c = 41.4;
-  };
-  test::SimRig rig(kRobot, settings);
+  test::SimRig rig(kRobot, health_on(HealthLimits{}, {}, [](BusConfig& drive) {
+                     name_temperature(drive, Cia402Temperature{0x3000, 0x00, 8, false, 1.0});
+                     drive.sim.health.ambient_c = 41.4;
+                   }));
   const RunSummary s = rig.run(0.5);
   EXPECT_EQ(s.exit_code(), 0) << (s.faults.empty() ? "" : s.faults[0]);
-  for (const auto& d : s.devices) {
-    if (d.bus == rig.config().buses[kDrive].name) {
-      EXPECT_EQ(d.health.max_temperature_c, 41.0);
-    }
-  }
+  for (const auto& d : drive_devices(rig, s)) EXPECT_EQ(d.health.max_temperature_c, 41.0);
 }
 
 // The robot file's key: its place in the TPDO, and one located error.
