@@ -6,7 +6,8 @@
 // The simulated drive is on the in-process virtual bus, its clock advanced
 // by the test. The host's death is what a kill leaves: no further frame, no
 // deactivate; its thread is frozen inside the bus until the drive has been
-// looked at, from the wire, by a client written here.
+// looked at, from the wire, by a client written here. A homing that ends
+// normally leaves the consumer off, so the host's later silence is no error.
 
 #include <gtest/gtest.h>
 
