@@ -191,10 +191,12 @@ TEST(Cia402HomingGuard, AHostThatDiesMidSearchLeavesTheDriveFaultedAndStopped) {
   host_link.die();
   pacing = false;
   pacer.join();
-  // Frames the host sent before it died are taken while the clock stands.
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
   const Nanos died = clock.now();
   EXPECT_TRUE(moving) << "the search did not start";
+  // Answered after every frame the host sent (the drive takes them in
+  // order), all taken while the clock stands: still searching, enabled.
+  const auto alive = static_cast<std::uint16_t>(wire.upload(cia402::obj::statusword, 0));
+  EXPECT_EQ(cia402::decode_statusword(alive), cia402::State::operation_enabled);
   EXPECT_FALSE(wire.heartbeat_emcy);
 
   // Just past the consumer time since the host's last heartbeat.
