@@ -483,19 +483,27 @@ void Cia402Bus::activate() {
 }
 
 void Cia402Bus::arm_device_guard() {
+  try {
+    arm_guard(kAllDrives);
+  } catch (const DeviceError&) {
+    deactivate();
+    throw;
+  }
+}
+
+void Cia402Bus::arm_guard(std::size_t only) {
   if (options_.device_watchdog_ms <= 0) return;
   // A drive starts watching at the first heartbeat after the consumer is
   // set, sent at once; from then on every read produces them.
   try {
     for (std::size_t i = 0; i < book_.size(); ++i) {
-      if (book_[i].faulted) continue;
+      if (book_[i].faulted || (only != kAllDrives && i != only)) continue;
       sdo_write(i, cia402::obj::abort_connection_option, 0,
                 static_cast<std::uint16_t>(options_.abort_connection), 2);
       sdo_write(i, cia402::obj::heartbeat_consumer, 1,
                 consumer_entry(options_.host_node_id, options_.device_watchdog_ms), 4);
     }
   } catch (const DeviceError& e) {
-    deactivate();
     throw DeviceError(std::string(e.what()) +
                       " (the drive's guard against a dead host; device_watchdog_ms: off "
                       "runs without it)");
@@ -522,9 +530,10 @@ void Cia402Bus::deactivate() {
   producing_ = false;
 }
 
-void Cia402Bus::clear_device_guard() {
+void Cia402Bus::clear_device_guard(std::size_t only) {
   if (options_.device_watchdog_ms <= 0) return;
   for (std::size_t i = 0; i < book_.size(); ++i) {
+    if (only != kAllDrives && i != only) continue;
     try {
       sdo_write(i, cia402::obj::heartbeat_consumer, 1, 0, 4);
     } catch (const DeviceError&) {

@@ -116,11 +116,15 @@ std::int64_t Cia402Bus::set_home(std::size_t device, std::int64_t ticks) {
   nmt(canopen::NmtCommand::start, device);
   std::string failure;
   try {
+    // Enabled, the drive watches the host as in a run: a host that dies
+    // mid-search stops it within device_watchdog_ms, not at its switches.
+    arm_guard(device);
     failure = run_homing(device);
   } catch (const DeviceError& e) {
     failure = e.what();
   }
   walk_to(State::switch_on_disabled, device);
+  clear_device_guard(device);
   nmt(canopen::NmtCommand::enter_pre_operational, device);
   sdo_write(device, obj::modes_of_operation, 0, static_cast<std::uint8_t>(kModeCsp), 1);
   if (!failure.empty()) {

@@ -92,7 +92,9 @@ class Cia402Bus final : public ActuatorBus {
   // statusword bits 12 and 10 (homing attained, target reached) end it,
   // bit 13 (homing error) fails it. Then the drive is disabled again, back
   // in cyclic synchronous position mode, and its position read back
-  // (DeviceError when it is not `ticks`).
+  // (DeviceError when it is not `ticks`). While it is enabled the drive
+  // watches the host's heartbeat as in a run (arm_device_guard(), this
+  // drive only; cleared once it is disabled).
   std::int64_t set_home(std::size_t device, std::int64_t ticks) override;
 
   // What the runtime knows about each drive.
@@ -133,11 +135,15 @@ class Cia402Bus final : public ActuatorBus {
   void map_health_tpdo(std::size_t device);
   // The host's heartbeat, when one is due (guard armed).
   void produce_heartbeat();
-  // Writes 1016h:01 = 0 on every drive (errors ignored) and stops producing.
-  void clear_device_guard();
+  static constexpr std::size_t kAllDrives = static_cast<std::size_t>(-1);
+  // arm_device_guard() for every non-faulted drive or drive `only` alone;
+  // throws DeviceError naming the write that failed (nothing deactivated).
+  void arm_guard(std::size_t only);
+  // Writes 1016h:01 = 0 on every drive or drive `only` (errors ignored) and
+  // stops producing.
+  void clear_device_guard(std::size_t only = kAllDrives);
   // Runs SYNC cycles until every non-faulted drive (or drive `only`) is in
   // `goal` (or steps run out); returns the drives that did not get there.
-  static constexpr std::size_t kAllDrives = static_cast<std::size_t>(-1);
   std::string walk_to(cia402::State goal, std::size_t only = kAllDrives);
   // set_home()'s steps with the drive in homing mode, operational: "" or why it failed.
   std::string run_homing(std::size_t device);
