@@ -62,7 +62,7 @@ test-hil: build
 deb: build
 	packaging/build-debs $(BUILD) $(BUILD)/deb
 
-# The packages installed by apt into a fresh Debian 12 root (mmdebstrap; the
+# The packages installed with dpkg into a fresh Debian 12 root (mmdebstrap; the
 # root is cached in $(BUILD)/install/cache, the first run fetches it from
 # Debian's archive) and checked there: the service user, the files, the
 # unit, every shipped robot file validated from the installed paths. Needs
