@@ -1,5 +1,6 @@
 #include "animrt/runtime/robot_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -305,6 +306,30 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   }
   if (auto n = node.find("health_limits")) bus.health_limits = parse_health_limits(*n, rate_hz);
   return bus;
+}
+
+// sim.switches of a drive the bus does not have would simulate nothing: the
+// id is almost always a typo. After the joints, which bind the drives.
+void check_switch_ids(const YamlNode& buses, const RobotConfig& config) {
+  for (const BusConfig& bus : config.buses) {
+    const auto sim = buses.at(bus.name).find("sim");
+    const auto switches = sim ? sim->find("switches") : std::nullopt;
+    if (!switches) continue;
+    std::string ids;
+    for (const ActuatorBinding& a : bus.actuators) {
+      ids += (ids.empty() ? "" : ", ") + std::to_string(a.device_id);
+    }
+    for (const YamlNode& item : switches->items()) {
+      const YamlNode id = item.at("id");
+      const auto n = id.as_int();
+      const bool bound = std::any_of(bus.actuators.begin(), bus.actuators.end(),
+                                     [&](const ActuatorBinding& a) { return a.device_id == n; });
+      if (!bound) {
+        id.fail("no drive on bus " + bus.name + " has id " + std::to_string(n) +
+                " (its drives: " + ids + ")");
+      }
+    }
+  }
 }
 
 std::vector<BusConfig> parse_buses(const YamlNode& node, double rate_hz) {
@@ -614,6 +639,7 @@ RobotConfig load_robot_config(const std::string& path) {
   config.buses = parse_buses(buses, config.rate_hz);
   check_bus_timeouts(buses, config, safety);
   parse_joints(root.at("joints"), config);
+  check_switch_ids(buses, config);
   check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and
   // opening its port would fail or grab a line for nothing.

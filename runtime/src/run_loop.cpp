@@ -285,7 +285,7 @@ void RunLoop::publish(const CycleOutputs& out) {
         io_[b].fresh ? std::span<const DeviceStatus>(view_[b]) : std::span<const DeviceStatus>();
   }
   monitor->publish(in_.t, state_, out.commands, monitor_devices_, summary_.overruns,
-                   summary_.skipped_cycles, in_.steer);
+                   summary_.skipped_cycles, in_.steer, in_.imus);
   for (const CycleEvent& e : out.events) monitor->push_event(e);
 }
 

@@ -26,6 +26,8 @@ enum Header : std::size_t {
 };
 constexpr std::size_t kJointWords = 4;    // cmd, meas, vel, manual pose
 constexpr std::size_t kDeviceWords = 14;  // id, health, faulted, 6 counters, 5 health values
+// valid, quaternion (4), rates (3), time, late cycles, missing reports, faulted
+constexpr std::size_t kImuWords = 12;
 constexpr std::size_t kTimingCapacity = 1 << 13;  // cycles (40 s at 200 Hz unread)
 constexpr std::size_t kEventCapacity = 256;
 constexpr std::size_t kEventWidth = 8;
@@ -68,13 +70,15 @@ RunMonitor::RunMonitor(const RobotModel& model)
     : model_(model),
       joints_(model.joint_count()),
       buses_(model.buses.size()),
+      imus_(model.imus.size()),
       timing_(4, kTimingCapacity),
       events_(kEventWidth, kEventCapacity) {
   for (const BusModel& bus : model.buses) {
     device_offset_.push_back(devices_);
     devices_ += bus.joint.size();
   }
-  word_count_ = kHeaderWords + kJointWords * joints_ + buses_ + kDeviceWords * devices_;
+  imu_words_ = kHeaderWords + kJointWords * joints_ + buses_ + kDeviceWords * devices_;
+  word_count_ = imu_words_ + kImuWords * imus_;
   words_ = std::make_unique<std::atomic<std::uint64_t>[]>(word_count_);
   for (std::size_t i = 0; i < word_count_; ++i) words_[i].store(0, std::memory_order_relaxed);
   store_u(kPhase, static_cast<std::uint64_t>(RunPhaseView::configure));
@@ -100,8 +104,8 @@ void RunMonitor::end_write() {
 
 void RunMonitor::publish(double t, const CycleState& state, std::span<const double> commands,
                          std::span<const std::span<const DeviceStatus>> devices,
-                         std::uint64_t overruns, std::uint64_t skipped,
-                         const MotionCommand* steer) {
+                         std::uint64_t overruns, std::uint64_t skipped, const MotionCommand* steer,
+                         std::span<const ImuIo> imus) {
   if (steer) {
     steered_ = true;
     steer_ = *steer;
@@ -159,7 +163,24 @@ void RunMonitor::publish(double t, const CycleState& state, std::span<const doub
                                              : HealthReading::kNone);
     }
   }
+  publish_imus(state, imus);
   end_write();
+}
+
+void RunMonitor::publish_imus(const CycleState& state, std::span<const ImuIo> imus) {
+  const auto late = state.imu_late_cycles();
+  const auto faulted = state.imu_faulted();
+  for (std::size_t i = 0; i < imus_ && i < imus.size(); ++i) {
+    const std::size_t w = imu_words_ + kImuWords * i;
+    const ImuReading& r = imus[i].reading;
+    store_u(w, imus[i].valid ? 1 : 0);
+    for (std::size_t k = 0; k < 4; ++k) store(w + 1 + k, r.quat[k]);
+    for (std::size_t k = 0; k < 3; ++k) store(w + 5 + k, r.rate_rad_s[k]);
+    store(w + 8, r.time_s);
+    store_u(w + 9, i < late.size() ? late[i] : 0);
+    store_u(w + 10, state.imu_missing(i, model_.imus[i].rate_hz));
+    store_u(w + 11, i < faulted.size() ? faulted[i] : 0);
+  }
 }
 
 void RunMonitor::publish_ended() {
@@ -266,6 +287,18 @@ void RunMonitor::read(RunView& view) const {
     const double bits = as_double(w[i + 12]);
     s.reading.has_error_bits = !std::isnan(bits);
     s.reading.error_bits = s.reading.has_error_bits ? static_cast<std::uint32_t>(bits) : 0;
+  }
+  view.imus.resize(imus_);
+  for (std::size_t i = 0; i < imus_; ++i) {
+    const std::size_t k = imu_words_ + kImuWords * i;
+    ImuView& imu = view.imus[i];
+    imu.valid = w[k] != 0;
+    for (std::size_t c = 0; c < 4; ++c) imu.reading.quat[c] = as_double(w[k + 1 + c]);
+    for (std::size_t c = 0; c < 3; ++c) imu.reading.rate_rad_s[c] = as_double(w[k + 5 + c]);
+    imu.reading.time_s = as_double(w[k + 8]);
+    imu.late_cycles = w[k + 9];
+    imu.missing_reports = w[k + 10];
+    imu.faulted = w[k + 11] != 0;
   }
 }
 

@@ -4,9 +4,10 @@
 One browser visits, in turn:
 
 - a show: `animrt run configs/robots/animatronic.yaml` (a show layered over
-  a gait) on simulated devices. Pause holds the playhead (it stops
-  advancing), a seek from the seek bar jumps it there, play lets it advance
-  again;
+  a gait) on simulated devices, with a simulated trunk IMU pushed into a
+  roll. Pause holds the playhead (it stops advancing), a seek from the seek
+  bar jumps it there, play lets it advance again; the IMU panel shows the
+  roll, counts and a trend of roll and pitch against the tilt limit;
 - a replay: `animrt view` of a short recorded quadruped run. With the
   replay paused, the time slider moves the run's time, the joint values and
   the figure;
@@ -65,7 +66,7 @@ def num(page, script):
     return float(value) if value not in (None, "") else None
 
 
-def relaxed_robot(root, name, folder):
+def relaxed_robot(root, name, folder, extra=""):
     """A copy of configs/robots/NAME.yaml for a busy machine: every file it
     names made absolute, generous bus timeouts and watchdog (the browser
     shares the CPU with the simulated devices; only the page is under test
@@ -80,12 +81,43 @@ def relaxed_robot(root, name, folder):
     text = re.sub(r"(?m)^(\s*(?:start|stop)_ramp_s:\s*)[\d.]+", r"\g<1>0.5", text)
     path = os.path.join(folder, name + "_relaxed.yaml")
     with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+        f.write(text + extra)
     return path
 
 
+# A simulated trunk IMU rolled to 8 degrees soon after the start, under a
+# tilt watch at 40 degrees; stale only after 2 s (the machine is busy).
+PUSHED_IMU = """
+imus:
+  - name: trunk
+    protocol: bno08x_rvc
+    stale_timeout_s: 2.0
+    sim: {push_at_s: 0.2, push_axis: roll, push_rate_deg_s: 40, push_to_deg: 8}
+"""
+
+
+def check_imu_panel(page):
+    check(page.js("return !document.getElementById('panel-imus').hidden;"), "no IMU panel for a robot with an IMU")
+    check("40.0" in (page.text("#panel-imus .tilt-limit") or ""),
+          f"the tilt limit shown: {page.text('#panel-imus .tilt-limit')}")
+    roll = "return document.querySelector('#imu-table tr[data-imu=trunk] td[data-field=roll_deg]').dataset.value;"
+    page.wait("the trunk's roll at 8 degrees", lambda: abs(float(page.js(roll) or 0) - 8.0) < 0.5, 10)
+    for field in ("pitch_deg", "rates", "age", "late_cycles", "missing_reports"):
+        text = page.text(f"#imu-table tr[data-imu=trunk] td[data-field={field}]")
+        check(text not in (None, "", "–"), f"the IMU's {field} shows {text!r}")
+    points = "return Number(document.querySelector('#imu-table tr[data-imu=trunk] canvas').dataset.points || 0);"
+    page.wait("the attitude trend drawn", lambda: page.js(points) >= 2, 5)
+    step(f"IMU panel: roll {page.js(roll)} deg, trend of {page.js(points)} points")
+
+
 def show_page(args, page, tmp):
-    run = Process([args.animrt, "run", relaxed_robot(args.root, "animatronic", tmp),
+    robot = relaxed_robot(args.root, "animatronic", tmp, PUSHED_IMU)
+    with open(robot, encoding="utf-8") as f:
+        text = f.read()
+    text = re.sub(r"(?m)^safety:\n", "safety:\n  tilt_limit_deg: 40\n", text, count=1)
+    with open(robot, "w", encoding="utf-8") as f:
+        f.write(text)
+    run = Process([args.animrt, "run", robot,
                    "--duration", "120", "--no-realtime", "--no-audio",
                    "--dashboard", "127.0.0.1:0"], "animrt run (show)", nice=-5)
     try:
@@ -94,6 +126,7 @@ def show_page(args, page, tmp):
         open_page(page, url)
         check(page.js("return !document.getElementById('show').hidden;"), "no show controls for a show")
         page.wait("the motion phase", lambda: page.text("#phase") == "motion", 20)
+        check_imu_panel(page)
         page.wait("the show controls enabled",
                   lambda: page.js("return !document.getElementById('btn-show-play').disabled;"), 5)
         position = "return document.getElementById('show-seek').value;"

@@ -116,5 +116,30 @@ TEST(Cia402HomingConfig, MistakesNameFileLineAndKey) {
       << backwards;
 }
 
+// A switch entry for a drive the bus does not have simulates nothing: one
+// error at its id, naming the bus and the drives it has.
+TEST(Cia402HomingConfig, SwitchesOfADriveTheBusLacksAreRefused) {
+  const std::string path =
+      robot_with("{method: 37}", "[{id: 32, home_from_deg: 10}, {id: 33, home_from_deg: 10}]");
+  std::ifstream in(path);
+  int line = 0;
+  for (std::string text; std::getline(in, text);) {
+    ++line;
+    if (text.find("switches:") != std::string::npos) break;
+  }
+  try {
+    load_robot_config(path);
+    ADD_FAILURE() << "switches of drive 33 taken";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cia402_homing.yaml:" + std::to_string(line) + ":"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("hip_drive.sim.switches[1].id: no drive on bus hip_drive has id 33 "
+                        "(its drives: 32)"),
+              std::string::npos)
+        << what;
+  }
+}
+
 }  // namespace
 }  // namespace animrt::cia402_homing_config_test

@@ -9,6 +9,10 @@
 #                                is on; sets $line (the first line of output)
 #   wait_exit                    waits up to 30 s for the serve to end, then
 #                                reaps it (poll_exit, reap); sets $code
+#   bad_cues TEXT LINE KEY       serves the animatronic with the cue file TEXT
+#                                and expects it refused: exit 2, one error
+#                                naming the file, LINE (a grep pattern) and
+#                                KEY, and no device started
 
 tmp=$(mktemp -d)
 pid=""
@@ -51,4 +55,14 @@ reap() {
 wait_exit() {
   poll_exit
   reap
+}
+
+bad_cues() {
+  printf '%s\n' "$1" > "$tmp/bad.yaml"
+  "$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$tmp/bad.yaml" --lockstep \
+    > "$tmp/out.txt" 2> "$tmp/err.txt"
+  code=$?
+  [[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
+  grep -q "^error: $tmp/bad.yaml:$2:.*$3" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
+  grep -q "configure" "$tmp/err.txt" && fail "a device started for a bad cue file: $(cat "$tmp/err.txt")"
 }

@@ -9,14 +9,7 @@ animrt=$1
 root=$2
 source "$root/tests/cli/serve.bash"
 
-# A bad cue file: one line naming file, line and key, exit 2, nothing started.
-printf 'idle: rest\ncues:\n  rest: {play: {pose: {neck_pan: 0}}, dmx: 300}\n' > "$tmp/bad.yaml"
-"$animrt" serve "$root/configs/robots/animatronic.yaml" --cues "$tmp/bad.yaml" --lockstep \
-  > "$tmp/out.txt" 2> "$tmp/err.txt"
-code=$?
-[[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
-grep -q "^error: $tmp/bad.yaml:3:.*cues.rest.dmx" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
-grep -q "configure" "$tmp/err.txt" && fail "a device started for a bad cue file: $(cat "$tmp/err.txt")"
+bad_cues $'idle: rest\ncues:\n  rest: {play: {pose: {neck_pan: 0}}, dmx: 300}' 3 cues.rest.dmx
 
 start_serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/animatronic.yaml" \
   --backend sim --lockstep --no-realtime --no-osc --artnet-port 0

@@ -10,17 +10,11 @@
 set -uo pipefail
 animrt=$1
 root=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$root/tests/cli/serve.bash"
 robot="$root/configs/robots/animatronic.yaml"
 
-printf 'idle: rest\nltc: {fps: 25}\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, timecode: "00:00:00:25"}\n' \
-  > "$tmp/bad.yaml"
-"$animrt" serve "$robot" --cues "$tmp/bad.yaml" --lockstep > "$tmp/out.txt" 2> "$tmp/err.txt"
-code=$?
-[[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
-grep -q "^error: $tmp/bad.yaml:4:.*cues.rest.timecode" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
+bad_cues $'idle: rest\nltc: {fps: 25}\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, timecode: "00:00:00:25"}' \
+  4 cues.rest.timecode
 
 PYTHONPATH="$root/tests/cli" /usr/bin/python3 - "$tmp/ltc.wav" <<'PY' || fail "the LTC writer"
 import sys

@@ -12,12 +12,8 @@ root=$2
 source "$root/tests/cli/serve.bash"
 robot="$root/configs/robots/animatronic.yaml"
 
-printf 'idle: rest\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, midi: {note: 60}}\n  a: {play: {pose: {eye_pan: 1}}, midi: {note: 60, channel: 2}}\n' \
-  > "$tmp/bad.yaml"
-"$animrt" serve "$robot" --cues "$tmp/bad.yaml" --lockstep > "$tmp/out.txt" 2> "$tmp/err.txt"
-code=$?
-[[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
-grep -q "^error: $tmp/bad.yaml:4:.*cues.a.midi.note" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
+bad_cues $'idle: rest\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, midi: {note: 60}}\n  a: {play: {pose: {eye_pan: 1}}, midi: {note: 60, channel: 2}}' \
+  4 cues.a.midi.note
 
 cat > "$tmp/cues.yaml" <<YAML
 idle: rest

@@ -13,28 +13,20 @@ root=$2
 source "$root/tests/cli/serve.bash"
 robot="$root/configs/robots/animatronic.yaml"
 
-bad() {  # a cue file body, the key its error names
-  printf '%s\n' "$1" > "$tmp/bad.yaml"
-  "$animrt" serve "$robot" --cues "$tmp/bad.yaml" --lockstep > "$tmp/out.txt" 2> "$tmp/err.txt"
-  code=$?
-  [[ $code == 2 ]] || fail "bad cue file: exit $code, expected 2: $(cat "$tmp/err.txt")"
-  grep -q "^error: $tmp/bad.yaml:[0-9]*:.*$2" "$tmp/err.txt" || fail "bad cue file: $(cat "$tmp/err.txt")"
-  grep -q "configure" "$tmp/err.txt" && fail "a device started for a bad cue file"
-}
 cues='cues:
   rest: {play: {pose: {eye_pan: 0}}, dmx: 1}'
-bad "idle: rest
+bad_cues "idle: rest
 sacn: {universe: 0, channel: 1}
-$cues" "sacn.universe"
-bad "idle: rest
+$cues" 2 "sacn.universe"
+bad_cues "idle: rest
 sacn: {universe: 1, joints: {neck_pan: {channel: 4, fine: 4}}}
-$cues" "sacn.joints.neck_pan.fine"
-bad "idle: rest
+$cues" 2 "sacn.joints.neck_pan.fine"
+bad_cues "idle: rest
 artnet: {universe: 0, joints: {neck_pan: {channel: 4, range: [-90, 0]}}}
-$cues" "artnet.joints.neck_pan.range"
-bad "idle: rest
+$cues" 2 "artnet.joints.neck_pan.range"
+bad_cues "idle: rest
 sacn: {universe: 1, joints: {nose: {channel: 4}}}
-$cues" "sacn.joints.nose"
+$cues" 2 "sacn.joints.nose"
 
 cat > "$tmp/cues.yaml" <<YAML
 idle: rest

@@ -40,8 +40,9 @@ class DashboardRun {
  public:
   explicit DashboardRun(double duration_s, bool steerable = true,
                         const std::function<void(test::SimRig&)>& before = {},
-                        const std::string& robot_file = kQuadruped)
-      : rig_(robot_file) {
+                        const std::string& robot_file = kQuadruped,
+                        const test::RigSettings& settings = {})
+      : rig_(robot_file, settings) {
     if (before) before(rig_);
     monitor_ = std::make_unique<RunMonitor>(rig_.runner().model());
     DashboardSetup setup;
@@ -174,6 +175,60 @@ TEST(Dashboard, InfoAndStateShowEveryJointAndDevice) {
   std::uint64_t histogram = 0;
   for (const json& c : state["loop"]["jitter_hist"]["counts"]) histogram += c.get<std::uint64_t>();
   EXPECT_GT(histogram, 100u);
+}
+
+// A trunk IMU pushed into a 0.3 rad roll (no physics: the simulated part
+// reports the scripted attitude).
+test::RigSettings with_pushed_imu() {
+  test::RigSettings settings;
+  settings.edit = [](RobotConfig& c) {
+    ImuConfig imu;
+    imu.name = "trunk";
+    imu.protocol = "bno08x_rvc";
+    imu.stale_timeout_s = 0.5;
+    imu.sim_push = ImuConfig::Push{true, false, 0.1, 2.0, 0.3};
+    c.imus.push_back(imu);
+    c.safety.tilt_limit_rad = 1.0;  // not reached
+  };
+  return settings;
+}
+
+TEST(Dashboard, TheImuSectionShowsItsAttitudeRatesAndCounts) {
+  DashboardRun run(0.0, true, {}, kQuadruped, with_pushed_imu());
+  const json info = run.get("/api/info");
+  ASSERT_EQ(info["imus"].size(), 1u);
+  EXPECT_EQ(info["imus"][0]["name"], "trunk");
+  EXPECT_DOUBLE_EQ(info["imus"][0]["rate_hz"].get<double>(), 100.0);
+  EXPECT_NEAR(info["tilt_limit_deg"].get<double>(), 57.2958, 1e-3);
+
+  const json state = run.wait_state([](const json& s) {
+    const json& imus = s["imus"];
+    return in_motion(s) && imus.size() == 1 && imus[0]["roll_deg"].is_number() &&
+           imus[0]["roll_deg"].get<double>() > 17.0;
+  });
+  const json& imu = state["imus"][0];
+  EXPECT_EQ(imu["name"], "trunk");
+  EXPECT_NEAR(imu["roll_deg"].get<double>(), 17.19, 0.2);  // 0.3 rad
+  EXPECT_NEAR(imu["pitch_deg"].get<double>(), 0.0, 0.2);
+  EXPECT_NEAR(imu["yaw_deg"].get<double>(), 0.0, 0.2);
+  ASSERT_EQ(imu["rate_dps"].size(), 3u);
+  EXPECT_TRUE(imu["age_s"].is_number());
+  EXPECT_NE(imu["health"], "waiting");
+  EXPECT_NE(imu["health"], "stale");
+  EXPECT_TRUE(imu["late_cycles"].is_number_unsigned());
+  EXPECT_TRUE(imu["missing_reports"].is_number_unsigned());
+}
+
+// A run without IMUs has an empty section and no tilt limit.
+TEST(Dashboard, ARunWithoutAnImuHasNoImuRows) {
+  DashboardRun run(0.0);
+  const json info = run.get("/api/info");
+  ASSERT_TRUE(info["imus"].is_array());
+  EXPECT_TRUE(info["imus"].empty());
+  EXPECT_TRUE(info["tilt_limit_deg"].is_null());
+  const json state = run.wait_state(in_motion);
+  ASSERT_TRUE(state["imus"].is_array());
+  EXPECT_TRUE(state["imus"].empty());
 }
 
 TEST(Dashboard, TheStreamDeliversStatesWithIncreasingTimes) {
@@ -419,10 +474,12 @@ TEST(Dashboard, AStreamClientThatNeverReadsDoesNotHoldUpTheLoop) {
 }
 
 // Publishing to the dashboard and taking its controls adds no allocation to
-// the run's threads, with a client streaming and manual targets arriving.
+// the run's threads, with a client streaming, manual targets arriving and an
+// IMU published.
 TEST(Dashboard, TheCycleStillDoesNotAllocate) {
-  test::RigSettings settings;
-  settings.edit = [](RobotConfig& c) {
+  test::RigSettings settings = with_pushed_imu();
+  settings.edit = [edit = settings.edit](RobotConfig& c) {
+    edit(c);
     c.safety.start_ramp_s = 0.3;
     c.safety.stop_ramp_s = 0.3;
   };

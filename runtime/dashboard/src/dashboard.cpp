@@ -13,9 +13,11 @@
 #include <condition_variable>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <stdexcept>
 #include <thread>
 
+#include "animrt/core/imu.hpp"
 #include "animrt/runtime/loop_stats.hpp"
 #include "dashboard_core.hpp"
 
@@ -59,6 +61,38 @@ struct LoopStats {
 
 // A health value, or null when the device does not report it.
 json health_number(double v) { return std::isnan(v) ? json() : json(v); }
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+// An IMU's row: attitude and rates in degrees, the reading's age and the
+// cycle's counts. Health as the cycle judges it: waiting (no reading yet),
+// ok, late (older than one report and one loop period) or stale (silent
+// past its stale timeout: faulted).
+json imu_json(const ImuModel& model, const ImuView& v, double now_s, double dt) {
+  const ImuReading& r = v.reading;
+  const double age = now_s - r.time_s;
+  const char* health = !v.valid                                ? "waiting"
+                       : v.faulted                             ? "stale"
+                       : age > 1.0 / model.rate_hz + dt + 1e-9 ? "late"
+                                                               : "ok";
+  json row = {{"name", model.name},
+              {"health", health},
+              {"late_cycles", v.late_cycles},
+              {"missing_reports", v.missing_reports},
+              {"roll_deg", nullptr},
+              {"pitch_deg", nullptr},
+              {"yaw_deg", nullptr},
+              {"rate_dps", nullptr},
+              {"age_s", nullptr}};
+  if (!v.valid) return row;
+  row["roll_deg"] = roll_of(r.quat) * kDegPerRad;
+  row["pitch_deg"] = pitch_of(r.quat) * kDegPerRad;
+  row["yaw_deg"] = yaw_of(r.quat) * kDegPerRad;
+  row["rate_dps"] = {r.rate_rad_s[0] * kDegPerRad, r.rate_rad_s[1] * kDegPerRad,
+                     r.rate_rad_s[2] * kDegPerRad};
+  row["age_s"] = nullable(age);
+  return row;
+}
 
 json timing_json(const MicrosHistogram& h) {
   return {{"p50", h.quantile(0.5) * 1e3}, {"p99", h.quantile(0.99) * 1e3}, {"max", h.max() * 1e3}};
@@ -205,12 +239,33 @@ struct DashboardServer::Impl {
                 {"rate_hz", model.rate_hz},
                 {"joints", joints},
                 {"buses", buses},
+                {"imus", imus_info_json()},
+                {"tilt_limit_deg", model.safety.tilt_limit_rad > 0.0
+                                       ? json(model.safety.tilt_limit_rad * kDegPerRad)
+                                       : json(nullptr)},
                 {"motion", motion},
                 {"model", figure},
                 {"replay", setup.replay},
                 {"replay_range_s",
                  setup.replay ? json{setup.replay_start_s, setup.replay_end_s} : json(nullptr)}}
         .dump();
+  }
+
+  json imus_info_json() const {
+    json imus = json::array();
+    for (const ImuModel& imu : model.imus) {
+      imus.push_back(
+          {{"name", imu.name}, {"rate_hz", imu.rate_hz}, {"stale_timeout_s", imu.stale_timeout_s}});
+    }
+    return imus;
+  }
+
+  json imus_json() const {
+    json imus = json::array();
+    for (std::size_t i = 0; i < model.imus.size() && i < view.imus.size(); ++i) {
+      imus.push_back(imu_json(model.imus[i], view.imus[i], view.t_s, model.dt));
+    }
+    return imus;
   }
 
   json poses_json(const std::vector<BodyPose>& poses) const {
@@ -233,6 +288,7 @@ struct DashboardServer::Impl {
                   {"joints", joints},
                   {"loop", loop_json()},
                   {"devices", devices},
+                  {"imus", imus_json()},
                   {"faults", fault_log},
                   {"motion", motion_json()},
                   {"manual", {{"on", view.manual}, {"positions", manual_positions}}}};

@@ -5,6 +5,7 @@ import { JitterHistogram, JointCharts, JointHistory } from './charts.js';
 import { makeControls } from './controls.js';
 import { startEvolve } from './evolve.js';
 import { startHerd } from './herd.js';
+import { ImuPanel } from './imu.js';
 import { DeviceTable, JointList, showFaults, showInfo, showLoop, showMotion, showPhase } from './panels.js';
 import { FigureView } from './view3d.js';
 
@@ -62,6 +63,7 @@ async function start() {
   const jitter = new JitterHistogram(document.getElementById('chart-jitter'));
   if (!charts.available) showPageError('Chart.js did not load (/lib/chart.umd.js): no charts.');
   const devices = new DeviceTable(document.getElementById('device-table'));
+  const imus = new ImuPanel(document.getElementById('panel-imus'), info);
   const controls = makeControls(info);
 
   let last = null;
@@ -87,6 +89,7 @@ async function start() {
       history.add(state.t_s, state.joints);
       showLoop(state.loop);
       devices.update(state.devices, state.faults);
+      imus.update(state.imus);
       showFaults(state.faults);
       controls.refresh(state);
       if (figure) figure.update(state.bodies);

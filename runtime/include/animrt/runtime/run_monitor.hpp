@@ -25,6 +25,15 @@ namespace animrt {
 enum class RunPhaseView : std::uint8_t { configure, start_ramp, motion, stop_ramp, ended };
 const char* to_string(RunPhaseView phase);
 
+// One IMU as the cycle last saw it (per RobotModel::imus).
+struct ImuView {
+  bool valid = false;  // a reading has arrived
+  ImuReading reading;  // attitude, angular rates and the time the part measured them
+  std::uint64_t late_cycles = 0;
+  std::uint64_t missing_reports = 0;
+  bool faulted = false;  // silent past its stale timeout
+};
+
 // The reader's copy of the latest published state.
 struct RunView {
   bool published = false;  // the run has published at least once
@@ -41,6 +50,7 @@ struct RunView {
   std::vector<double> cmd, meas, vel, manual_pose;  // per joint
   std::vector<std::uint64_t> late;                  // per bus
   std::vector<DeviceStatus> devices;                // per device, bus after bus
+  std::vector<ImuView> imus;                        // per IMU
 };
 
 // One cycle's timing, as the reader drains it.
@@ -61,10 +71,11 @@ class RunMonitor {
   // --- writer side (the cycle): never blocks, locks or allocates ----------
   // Publishes the cycle's state. `devices` is per bus: the statuses of a bus
   // whose I/O thread is idle (fresh this cycle), or an empty span to keep
-  // that bus's last published statuses.
+  // that bus's last published statuses. `imus` is the cycle's IMU inputs
+  // (empty: the IMUs' words stay as they are).
   void publish(double t, const CycleState& state, std::span<const double> commands,
                std::span<const std::span<const DeviceStatus>> devices, std::uint64_t overruns,
-               std::uint64_t skipped, const MotionCommand* steer);
+               std::uint64_t skipped, const MotionCommand* steer, std::span<const ImuIo> imus = {});
   // The run is over (after the last cycle).
   void publish_ended();
   // A recorded sample (a replay): time, phase and per joint command,
@@ -91,9 +102,11 @@ class RunMonitor {
   }
   void begin_write();
   void end_write();
+  void publish_imus(const CycleState& state, std::span<const ImuIo> imus);
 
   RobotModel model_;
-  std::size_t joints_ = 0, buses_ = 0, devices_ = 0;
+  std::size_t joints_ = 0, buses_ = 0, devices_ = 0, imus_ = 0;
+  std::size_t imu_words_ = 0;               // the first IMU word
   std::vector<std::size_t> device_offset_;  // per bus: first device word block
   std::size_t word_count_ = 0;
   std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
