@@ -100,15 +100,16 @@ imus:
 
 
 def check_imu_panel(page):
-    check(page.js("return !document.getElementById('panel-imus').hidden;"), "no IMU panel for a robot with an IMU")
+    check(page.js("const p = document.getElementById('panel-imus'); return !!p && !p.hidden;"),
+          "no IMU panel for a robot with an IMU")
     check("40.0" in (page.text("#panel-imus .tilt-limit") or ""),
           f"the tilt limit shown: {page.text('#panel-imus .tilt-limit')}")
-    roll = "return document.querySelector('#imu-table tr[data-imu=trunk] td[data-field=roll_deg]').dataset.value;"
+    roll = "return document.querySelector('#imu-table tr[data-imu=trunk] td[data-field=roll_deg]')?.dataset.value;"
     page.wait("the trunk's roll at 8 degrees", lambda: abs(float(page.js(roll) or 0) - 8.0) < 0.5, 10)
     for field in ("pitch_deg", "rates", "age", "late_cycles", "missing_reports"):
         text = page.text(f"#imu-table tr[data-imu=trunk] td[data-field={field}]")
         check(text not in (None, "", "–"), f"the IMU's {field} shows {text!r}")
-    points = "return Number(document.querySelector('#imu-table tr[data-imu=trunk] canvas').dataset.points || 0);"
+    points = "return Number(document.querySelector('#imu-table tr[data-imu=trunk] canvas')?.dataset.points || 0);"
     page.wait("the attitude trend drawn", lambda: page.js(points) >= 2, 5)
     step(f"IMU panel: roll {page.js(roll)} deg, trend of {page.js(points)} points")
 
