@@ -91,8 +91,7 @@ void PitchEnergyTracker::push(std::span<const float> samples, std::vector<RawFra
   while (i < samples.size()) {
     // Up to the end of the hop block and of the ring at once, not sample
     // by sample: the same values land in the same places.
-    const std::size_t n =
-        std::min({samples.size() - i, hop - m.fill, m.ring.size() - m.ring_pos});
+    const std::size_t n = std::min({samples.size() - i, hop - m.fill, m.ring.size() - m.ring_pos});
     std::copy_n(samples.data() + i, n, m.in->data + m.fill);
     std::copy_n(samples.data() + i, n, m.ring.data() + m.ring_pos);
     i += n;
