@@ -1,11 +1,20 @@
 // Head motion: synthesis speed (real-time factor), streaming latency and
 // memory, for the bundled model and a minute of speech (the bundled
 // utterance repeated).
+//
+// `bench_head offline` runs only the offline path (model and file reading,
+// analysis at 22.05 and 24 kHz, decoding, smoothing) and prints the
+// process's CPU time per second of audio, so `/usr/bin/time` and `perf`
+// see that path alone on a loaded machine where wall time misleads.
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <string>
 
 #include "animrt/controllers/head/model.hpp"
@@ -53,17 +62,58 @@ static void stream_case(const char* name, const HeadModel& model, const Audio& a
               sum_lag / static_cast<double>(n), max_lag, s.worst_case_latency_s());
 }
 
-int main() {
-  const std::string src = ANIMRT_SOURCE_DIR;
-  const long rss0 = max_rss_kb();
-  const HeadModel model = load_model(src + "/configs/head/model.txt");
-  const long rss_model = max_rss_kb();
-  const Audio one = load_audio(src + "/configs/head/utterance.wav");
+// User plus system CPU of this (single-threaded) process, in seconds.
+static double cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// The bundled utterance repeated to one minute.
+static Audio one_minute(const Audio& one) {
   Audio minute;
   minute.sample_rate = one.sample_rate;
   while (minute.duration_s() < 60.0)
     minute.samples.insert(minute.samples.end(), one.samples.begin(), one.samples.end());
   minute.samples.resize(static_cast<std::size_t>(60.0 * minute.sample_rate));
+  return minute;
+}
+
+// The offline path alone, `rounds` times, timed by CPU.
+static int offline_only(const std::string& src, int rounds) {
+  const double c0 = cpu_s();
+  const HeadModel model = load_model(src + "/configs/head/model.txt");
+  const Audio minute = one_minute(load_audio(src + "/configs/head/utterance.wav"));
+  const double c_load = cpu_s();
+  const Audio minute24 = resample(minute, model.features.sample_rate);
+  double at22 = 0, at24 = 0;
+  std::size_t poses = 0;
+  for (int r = 0; r < rounds; ++r) {
+    double c = cpu_s();
+    poses += synthesize(model, minute).size();
+    at22 += cpu_s() - c;
+    c = cpu_s();
+    poses += synthesize(model, minute24).size();
+    at24 += cpu_s() - c;
+  }
+  std::printf("offline only, %d rounds of 60 s at %d Hz and at %d Hz (%zu poses)\n", rounds,
+              minute.sample_rate, minute24.sample_rate, poses);
+  std::printf("  model and file reading: %.3f s CPU\n", c_load - c0);
+  std::printf("  %d Hz: %.4f s CPU per 60 s (%.0fx real time)\n", minute.sample_rate, at22 / rounds,
+              60.0 * rounds / at22);
+  std::printf("  %d Hz: %.4f s CPU per 60 s (%.0fx real time)\n", minute24.sample_rate,
+              at24 / rounds, 60.0 * rounds / at24);
+  return 0;
+}
+
+int main(int argc, char** argv) {
+  const std::string src = ANIMRT_SOURCE_DIR;
+  if (argc > 1 && std::strcmp(argv[1], "offline") == 0)
+    return offline_only(src, argc > 2 ? std::max(1, std::atoi(argv[2])) : 5);
+  const long rss0 = max_rss_kb();
+  const HeadModel model = load_model(src + "/configs/head/model.txt");
+  const long rss_model = max_rss_kb();
+  const Audio minute = one_minute(load_audio(src + "/configs/head/utterance.wav"));
 
   using clk = std::chrono::steady_clock;
   auto t0 = clk::now();

@@ -2,6 +2,9 @@
 
 #include "animrt/controllers/head/decoder.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace animrt::head {
@@ -23,9 +26,26 @@ NetworkDecoder::NetworkDecoder(const std::vector<Hmm>& hmms, const Bigram& bigra
   exit_score_.resize(k_);
   entry_score_.resize(k_);
   entry_from_.resize(static_cast<std::size_t>(k_));
+  exit_from_.resize(static_cast<std::size_t>(k_));
+  dim_ = hmms.front().dim();
+  for (const Hmm& h : hmms) {
+    for (const GaussianMixture& g : h.states) {
+      comp_begin_.push_back(static_cast<int>(comp_log_weight_.size()));
+      for (Eigen::Index c = 0; c < g.means.rows(); ++c) {
+        for (int d = 0; d < dim_; ++d) {
+          comp_mean_.push_back(g.means(c, d));
+          comp_var_.push_back(g.variances(c, d));
+        }
+        comp_log_weight_.push_back(g.log_weights(c));
+        // The same expression as GaussianMixture::component_log_densities,
+        // so the sum (and every score) is the same to the last bit.
+        comp_log_var_sum_.push_back(g.variances.row(c).array().log().sum());
+      }
+    }
+  }
+  comp_begin_.push_back(static_cast<int>(comp_log_weight_.size()));
   if (lag_ >= 0)
-    back_.assign(static_cast<std::size_t>(lag_) + 1,
-                 std::vector<int>(static_cast<std::size_t>(n_)));
+    back_.assign((static_cast<std::size_t>(lag_) + 1) * static_cast<std::size_t>(n_), 0);
   reset();
 }
 
@@ -36,45 +56,62 @@ void NetworkDecoder::reset() {
 }
 
 int NetworkDecoder::trace(long from_frame, int state, long to_frame) const {
-  const std::size_t ring = back_.size();
+  const auto n = static_cast<std::size_t>(n_);
+  const std::size_t ring = back_.size() / n;
   for (long t = from_frame; t > to_frame; --t) {
     const std::size_t slot =
         lag_ >= 0 ? static_cast<std::size_t>(t) % ring : static_cast<std::size_t>(t);
-    state = back_[slot][static_cast<std::size_t>(state)];
+    state = back_[slot * n + static_cast<std::size_t>(state)];
   }
   return state;
 }
 
-bool NetworkDecoder::push(const Eigen::Ref<const Eigen::VectorXd>& obs, int& cluster) {
-  for (int k = 0; k < k_; ++k) {
-    const Hmm& h = hmms_[static_cast<std::size_t>(k)];
-    for (int s = 0; s < h.num_states(); ++s) {
-      const GaussianMixture& g = h.states[static_cast<std::size_t>(s)];
-      g.component_log_densities(obs, comp_);
-      const double m = comp_.maxCoeff();
-      log_b_(offset_[static_cast<std::size_t>(k)] + s) =
-          m == kLogZero ? kLogZero : m + std::log((comp_.array() - m).exp().sum());
+// log b_i(obs) of every network state: GaussianMixture::component_log_densities
+// and the log-sum-exp over the components, in the same order of operations,
+// on the flattened components with their log variance sums computed once.
+void NetworkDecoder::emission_log_probs(const Eigen::Ref<const Eigen::VectorXd>& obs) {
+  const double dim_term = static_cast<double>(obs.size()) * std::log(2.0 * std::numbers::pi);
+  for (int i = 0; i < n_; ++i) {
+    const int first = comp_begin_[static_cast<std::size_t>(i)];
+    const int end = comp_begin_[static_cast<std::size_t>(i) + 1];
+    comp_.resize(end - first);
+    for (int c = first; c < end; ++c) {
+      const double* mean =
+          &comp_mean_[static_cast<std::size_t>(c) * static_cast<std::size_t>(dim_)];
+      const double* var = &comp_var_[static_cast<std::size_t>(c) * static_cast<std::size_t>(dim_)];
+      double maha = 0.0;
+      for (int d = 0; d < dim_; ++d) {
+        const double diff = obs(d) - mean[d];
+        maha += diff * diff / var[d];
+      }
+      comp_(c - first) = comp_log_weight_[static_cast<std::size_t>(c)] -
+                         0.5 * (maha + comp_log_var_sum_[static_cast<std::size_t>(c)] + dim_term);
     }
+    const double m = comp_.maxCoeff();
+    log_b_(i) = m == kLogZero ? kLogZero : m + std::log((comp_.array() - m).exp().sum());
   }
-  std::vector<int>* back = nullptr;
-  if (lag_ >= 0) {
-    back = &back_[static_cast<std::size_t>(frames_) % back_.size()];
-  } else {
-    back_.emplace_back(static_cast<std::size_t>(n_));
-    back = &back_.back();
-  }
+}
+
+bool NetworkDecoder::push(const Eigen::Ref<const Eigen::VectorXd>& obs, int& cluster) {
+  emission_log_probs(obs);
+  const auto n = static_cast<std::size_t>(n_);
+  if (lag_ < 0) back_.resize(back_.size() + n);
+  const std::size_t slot =
+      lag_ >= 0 ? static_cast<std::size_t>(frames_) % (back_.size() / n) : back_.size() / n - 1;
+  int* back = &back_[slot * n];
   if (frames_ == 0) {
     for (int k = 0; k < k_; ++k) {
       const Hmm& h = hmms_[static_cast<std::size_t>(k)];
       for (int s = 0; s < h.num_states(); ++s) {
         const int i = offset_[static_cast<std::size_t>(k)] + s;
         delta_(i) = options_.lm_scale * bigram_.log_initial(k) + h.log_pi(s) + log_b_(i);
-        (*back)[static_cast<std::size_t>(i)] = -1;
+        back[i] = -1;
       }
     }
   } else {
     // Best exit of every model, then the best way into every model.
-    std::vector<int> exit_from(static_cast<std::size_t>(k_), -1);
+    std::vector<int>& exit_from = exit_from_;
+    std::fill(exit_from.begin(), exit_from.end(), -1);
     for (int k = 0; k < k_; ++k) {
       const Hmm& h = hmms_[static_cast<std::size_t>(k)];
       double best = kLogZero;
@@ -115,7 +152,7 @@ bool NetworkDecoder::push(const Eigen::Ref<const Eigen::VectorXd>& obs, int& clu
           }
         }
         next_(o + j) = best + log_b_(o + j);
-        (*back)[static_cast<std::size_t>(o + j)] = arg;
+        back[o + j] = arg;
       }
     }
     delta_.swap(next_);

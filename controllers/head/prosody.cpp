@@ -86,12 +86,20 @@ PitchEnergyTracker::~PitchEnergyTracker() {
 
 void PitchEnergyTracker::push(std::span<const float> samples, std::vector<RawFrame>& frames) {
   Impl& m = *impl_;
-  for (float s : samples) {
-    m.in->data[m.fill++] = s;
-    m.ring[m.ring_pos] = s;
-    m.ring_pos = (m.ring_pos + 1) % m.ring.size();
-    ++m.total;
-    if (m.fill < static_cast<std::size_t>(m.hop)) continue;
+  const auto hop = static_cast<std::size_t>(m.hop);
+  std::size_t i = 0;
+  while (i < samples.size()) {
+    // Up to the end of the hop block and of the ring at once, not sample
+    // by sample: the same values land in the same places.
+    const std::size_t n = std::min({samples.size() - i, hop - m.fill, m.ring.size() - m.ring_pos});
+    std::copy_n(samples.data() + i, n, m.in->data + m.fill);
+    std::copy_n(samples.data() + i, n, m.ring.data() + m.ring_pos);
+    i += n;
+    m.fill += n;
+    m.total += n;
+    m.ring_pos += n;
+    if (m.ring_pos == m.ring.size()) m.ring_pos = 0;
+    if (m.fill < hop) continue;
     m.fill = 0;
     aubio_pitch_do(m.pitch, m.in, m.out);
     // Until a whole window has arrived the analysis sees leading zeros.

@@ -38,6 +38,7 @@ class NetworkDecoder {
 
  private:
   int trace(long from_frame, int from_state, long to_frame) const;
+  void emission_log_probs(const Eigen::Ref<const Eigen::VectorXd>& obs);
   const std::vector<Hmm>& hmms_;
   const Bigram& bigram_;
   DecodeOptions options_;
@@ -46,10 +47,18 @@ class NetworkDecoder {
   std::vector<int> offset_;        // first network index of cluster k
   std::vector<int> owner_;         // cluster of network index
   Eigen::VectorXd delta_, next_, log_b_, comp_, exit_score_, entry_score_;
-  std::vector<int> entry_from_;         // best predecessor network index per entered cluster
-  std::vector<std::vector<int>> back_;  // ring (or growing) of backpointers per frame
-  long frames_ = 0;                     // frames pushed
-  long committed_ = 0;                  // frames committed
+  std::vector<int> entry_from_;  // best predecessor network index per entered cluster
+  std::vector<int> exit_from_;   // best exit state per cluster
+  // The mixtures' components flattened in network order (state i owns
+  // components comp_begin_[i] .. comp_begin_[i + 1] - 1), each with its
+  // log variance sum, which depends on the model alone.
+  std::vector<int> comp_begin_;
+  std::vector<double> comp_mean_, comp_var_, comp_log_weight_, comp_log_var_sum_;
+  int dim_ = 0;
+  // Backpointers, n_ per frame: a ring of lag + 1 frames, or every frame.
+  std::vector<int> back_;
+  long frames_ = 0;     // frames pushed
+  long committed_ = 0;  // frames committed
 };
 
 // Offline: the cluster of every row of `obs`.
