@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <filesystem>
 
 #include "animrt/controllers/cues/cue_player.hpp"
 #include "animrt/controllers/show/show_audio.hpp"
@@ -11,7 +12,10 @@ namespace animrt::cli {
 
 void add_sound_options(CLI::App* cmd, SoundArgs& args) {
   cmd->add_flag("--no-audio", args.no_audio, "do not play the cues' sound tracks");
-  cmd->add_option("--audio-device", args.device, "ALSA playback device for the cues' sound tracks")
+  cmd->add_option("--audio-device", args.device,
+                  "where the cues' sound tracks play: an ALSA device, or file:FOLDER (each "
+                  "show's track as FOLDER/SHOW.s16: raw s16le mono at the track's rate, written "
+                  "in real time as a sound card would play it)")
       ->capture_default_str();
 }
 
@@ -25,11 +29,20 @@ ServeSound::ServeSound(const SoundArgs& args, bool lockstep, CuePlayer& cues) {
         shows.push_back(step.show_file);
     }
   }
-  const std::string device = args.device;
-  players_ = open_show_audio(
-      shows, lockstep, [device](int rate) { return open_alsa_sink(device, rate); }, clock_,
-      [](const std::string& line) { spdlog::warn("{}", line); });
-  for (auto& player : players_) cues.play_sound(player->show_file(), *player);
+  const auto warn = [](const std::string& line) { spdlog::warn("{}", line); };
+  // One show at a time, so that a folder output knows whose file it opens.
+  for (const std::string& show : shows) {
+    const auto open_sink = [&args, &show](int rate) {
+      constexpr std::string_view kFolder = "file:";
+      if (args.device.rfind(kFolder, 0) != 0) return open_alsa_sink(args.device, rate);
+      const std::filesystem::path folder = args.device.substr(kFolder.size());
+      return open_file_sink((folder / std::filesystem::path(show).stem()).string() + ".s16", rate);
+    };
+    for (auto& player : open_show_audio({show}, lockstep, open_sink, clock_, warn)) {
+      cues.play_sound(player->show_file(), *player);
+      players_.push_back(std::move(player));
+    }
+  }
 }
 
 ServeSound::~ServeSound() = default;
