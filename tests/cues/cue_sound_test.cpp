@@ -23,6 +23,7 @@
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/runtime/cue_file.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace animrt::cue_sound_test {
 namespace {
@@ -100,6 +101,7 @@ struct Rig {
   CueRequests requests;
   std::unique_ptr<CuePlayer> cues;
   std::vector<double> pose = std::vector<double>(1, 0.0);
+  long allocations = 0;  // by sample()
 
   Rig() {
     const ShowFile show = talk_show();
@@ -128,7 +130,9 @@ struct Rig {
     if (k > 0) {
       while (out->queued_frames() <= capacity - block) ASSERT_TRUE(sound->pump());
     }
-    cues->sample(t, pose);
+    const test::AllocationCounter counter;
+    cues->sample(t, pose);  // the cycle's part: it tells the sound, never allocating
+    allocations += counter.count();
     if (k == 0) {  // as the run does: started after the cycle that sampled t = 0
       cues->start(MotionClock{&clock, t0, true});
       sound->start(t0);
@@ -172,6 +176,7 @@ TEST(CueSound, ACuePlaysItsSoundItsMotionOnTheSoundsClockAndASwitchCutsIt) {
   EXPECT_LT(max_step, 0.01 * (1.0 + SoundFollower::kMaxRate) + 1e-9);
   EXPECT_EQ(rig.cues->sound_commands_lost(), 0u);
   EXPECT_EQ(rig.cues->starts(1), 1u);
+  EXPECT_EQ(rig.allocations, 0);
 }
 
 TEST(CueSound, APauseHoldsTheSoundWhereTheMotionRestsAndResumesInStep) {
@@ -196,8 +201,8 @@ TEST(CueSound, APauseHoldsTheSoundWhereTheMotionRestsAndResumesInStep) {
     }
     if (k >= 1100) max_gap = std::max(max_gap, std::abs(rig.motion_s() - heard));
   }
-  std::cout << "pause: motion held at " << held_motion << " s; gap while easing "
-            << ramp_gap * 1e3 << " ms, after " << max_gap * 1e3 << " ms\n";
+  std::cout << "pause: motion held at " << held_motion << " s; gap while easing " << ramp_gap * 1e3
+            << " ms, after " << max_gap * 1e3 << " ms\n";
   EXPECT_GT(held_motion, 5.0);
   EXPECT_LT(ramp_gap, 0.045);  // the figure's mouth never leads it by more (ITU-R BT.1359)
   EXPECT_LT(max_gap, 0.01);
