@@ -85,8 +85,8 @@ class CuePlayer final : public MotionSource {
   double last_crossfade_s() const { return last_fade_.load(std::memory_order_relaxed); }
 
   // The steps that play `show_file` sound through `player` (before the run,
-  // outside the cycle; its origin is the motion's start). Each player starts
-  // paused; the player tells it when to play, from the cycle.
+  // outside the cycle; the player's origin is the motion's start). It is
+  // told from the cycle when to play, and is silent until its step is taken.
   void play_sound(const std::string& show_file, ShowAudioPlayer& player);
   // Sound commands the players could not take (they had fallen behind).
   std::uint64_t sound_commands_lost() const { return sound_lost_.load(std::memory_order_relaxed); }
