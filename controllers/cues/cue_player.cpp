@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "animrt/controllers/show/show_audio.hpp"
+
 namespace animrt {
 namespace {
 
@@ -51,7 +53,20 @@ std::uint64_t CuePlayer::starts(int cue) const {
   return starts_[static_cast<std::size_t>(cue)].load(std::memory_order_relaxed);
 }
 
+void CuePlayer::play_sound(const std::string& show_file, ShowAudioPlayer& player) {
+  const int index = static_cast<int>(sounds_.size());
+  Sound sound;
+  sound.player = &player;
+  sounds_.push_back(sound);
+  for (Cue& cue : cues_) {
+    for (CueStep& step : cue.steps) {
+      if (step.show_file == show_file) step.sound = index;
+    }
+  }
+}
+
 void CuePlayer::start(const MotionClock& clock) {
+  clock_start_ = clock.start;
   for (Cue& cue : cues_) {
     for (CueStep& step : cue.steps) step.source->start(clock);
   }
@@ -130,6 +145,56 @@ void CuePlayer::push(int cue, int step, bool asked, double at_s) const {
   if ((step == 0 || asked) && changes) starts_[static_cast<std::size_t>(cue)].fetch_add(1);
   current_.store(cue, std::memory_order_relaxed);
   last_fade_.store(fade, std::memory_order_relaxed);
+  switch_sound(c.steps[static_cast<std::size_t>(step)].sound, at_s);
+}
+
+// A command to a sound's player, at this cycle's motion time.
+void CuePlayer::send_sound(int sound, bool playing, bool seek, double at_s) const {
+  Sound& s = sounds_[static_cast<std::size_t>(sound)];
+  if (seek) {
+    ++s.seeks;
+    s.follower.reset();  // a new start owes nothing to the last one's drift
+  }
+  s.playing = playing;
+  if (s.player->control(ShowCommand{playing, s.seeks, at_s}, last_t_)) {
+    ++s.sent;
+  } else {
+    sound_lost_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+// The newest step's sound starts from the time into it; the one before is cut.
+void CuePlayer::switch_sound(int sound, double at_s) const {
+  if (sounding_ >= 0 && sounding_ != sound) send_sound(sounding_, false, false, 0.0);
+  sounding_ = sound;
+  if (sound >= 0) send_sound(sound, !sound_held_, true, at_s);
+}
+
+// The motion eases to a halt over kPauseRampS, covering half of it in play
+// time: the sound stops halfway, where the motion comes to rest, and plays
+// again halfway through the easing back, so the two never part by more
+// than the easing's lag (about 40 ms).
+void CuePlayer::pause_sound() const {
+  const bool held = rate_phase_ < 0.5;
+  if (held == sound_held_) return;
+  sound_held_ = held;
+  if (sounding_ >= 0) send_sound(sounding_, !held, false, 0.0);
+}
+
+// The newest step runs on its sound's clock while the sound plays at full
+// speed: the gap between the time heard and the step's own time becomes a
+// small change of the step's speed (as a show's under `animrt run`).
+void CuePlayer::chase_sound() const {
+  if (sounding_ < 0 || count_ == 0) return;
+  Sound& s = sounds_[static_cast<std::size_t>(sounding_)];
+  Layer& top = layers_[count_ - 1];
+  const Nanos now = clock_start_ + from_seconds(last_t_);
+  SoundClock::Reading r;
+  const bool valid = s.playing && rate_phase_ >= 1.0 && s.player->sound_clock().read(r) &&
+                     r.playing && r.commands == s.sent &&
+                     std::abs(to_seconds(now - r.stamp)) < SoundFollower::kStaleS;
+  const double gap = valid ? r.show_s + to_seconds(now - r.stamp) - (play_ - top.t0) : 0.0;
+  top.t0 -= s.follower.correction(gap, step_dt_, valid);
 }
 
 // Layers under one fully faded in are no longer seen: dropped (their pose
@@ -151,6 +216,9 @@ void CuePlayer::advance(double t) const {
   if (!begun_) {
     begun_ = true;
     last_t_ = t;
+    // Every sound is silent until its step is taken.
+    for (std::size_t s = 0; s < sounds_.size(); ++s)
+      send_sound(static_cast<int>(s), false, false, 0.0);
     push(idle_, 0, false);
   }
   const double dt = std::max(0.0, t - last_t_);
@@ -163,6 +231,7 @@ void CuePlayer::advance(double t) const {
   rate_phase_ =
       goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
   play_ += smootherstep(rate_phase_) * dt;
+  pause_sound();
   // A cue waiting to start at a time into it (a timecode) goes on running.
   if (waiting_ && waiting_at_ > 0.0) waiting_at_ += smootherstep(rate_phase_) * dt;
   int asked = 0;
@@ -200,6 +269,7 @@ void CuePlayer::advance(double t) const {
 
 void CuePlayer::sample(double t, std::span<double> targets) const {
   advance(t);
+  chase_sound();
   for (std::size_t i = 0; i < count_; ++i) sample_layer(layers_[i]);
   std::swap(prev_out_, out_);
   std::copy(layers_[0].pose.begin(), layers_[0].pose.end(), out_.begin());

@@ -20,6 +20,7 @@
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "serve_dmx.hpp"
+#include "serve_sound.hpp"
 #include "serve_triggers.hpp"
 #include "service_notify.hpp"
 #include "stop_signals.hpp"
@@ -41,6 +42,7 @@ struct ServeArgs {
   bool no_osc = false;
   DmxArgs dmx;            // Art-Net and sACN
   TriggerArgs triggers;   // LTC and MIDI
+  SoundArgs sound;        // the cues' sound tracks
   std::string dashboard;  // HOST:PORT, empty = none
   bool dashboard_remote = false;
   std::string summary_json;  // empty = none
@@ -85,6 +87,10 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
             << "cue requests: " << requests.posted() << " posted, " << requests.taken()
             << " taken by the cycle (the rest replaced by a newer one first), " << player.deferred()
             << " cycles waited for a crossfade to end\n";
+  if (player.sound_commands_lost() > 0) {
+    std::cout << "sound: " << player.sound_commands_lost()
+              << " commands lost (a player had fallen behind)\n";
+  }
   if (osc) {
     std::cout << "osc: " << osc->packets() << " packets, " << osc->messages() << " messages, "
               << osc->malformed() << " malformed, " << osc->unknown() << " unknown addresses\n";
@@ -164,6 +170,8 @@ int serve(const ServeArgs& args) {
   auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
                                             robot.config.joints, requests);
   const CuePlayer& playing = *player;
+  // Declared before the figure: the players outlive the cue player that tells them.
+  ServeSound sound(args.sound, args.lockstep, *player);
   robot.motion = std::move(player);
   robot.steering.reset();
   const std::unique_ptr<OscReceiver> osc = start_osc(args, playing, requests);
@@ -190,7 +198,11 @@ int serve(const ServeArgs& args) {
   RunHeartbeat heartbeat;
   options.heartbeat = &heartbeat;
   std::optional<ServiceNotifier> notifier(std::in_place, heartbeat);
-  options.on_motion_start = [&triggers](Nanos) { triggers.begin(); };
+  options.on_motion_start = [&triggers, &sound](Nanos t0) {
+    sound.start(t0);
+    triggers.begin();
+  };
+  options.on_motion_end = [&sound] { sound.stop(); };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
   slow_exit_for_test();
@@ -233,6 +245,7 @@ void add_serve_command(CLI::App& app) {
   cmd->add_flag("--no-osc", args->no_osc, "take no OSC triggers");
   add_dmx_options(cmd, args->dmx);
   add_trigger_options(cmd, args->triggers);
+  add_sound_options(cmd, args->sound);
   cmd->add_option("--dashboard", args->dashboard,
                   "serve the dashboard at HOST:PORT (as run's; POST /api/cue asks for a cue)");
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,

@@ -121,6 +121,7 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
     layers.push_back(load_file_motion(*show, "show", cue_path, robot, warnings));
     const ShowFile file = load_show_file(resolve(*show, cue_path));
     if (!file.loop) step.duration_s = file.duration_s;
+    if (file.has_audio) step.show_file = file.file;
   }
   if (auto head = node.find("head")) {
     double length = kForever;

@@ -14,6 +14,15 @@
 //
 // The player is a motion source: everything it plays is built and allocated
 // before the run, and sample() only reads requests and blends.
+//
+// A step whose show has a sound track plays it (play_sound). The sound
+// belongs to the newest cue alone: it starts when its step is taken (at the
+// time into it the step starts at) and is cut when another step or cue is
+// taken, while the motions crossfade (a voice does not talk over itself). A
+// pause holds the sound where the motion comes to rest: halfway through the
+// pause's easing, and it resumes halfway through the easing back. While it
+// plays, the step's motion runs on the sound's clock (SoundFollower), as a
+// show does under `animrt run`.
 
 #include <array>
 #include <atomic>
@@ -25,15 +34,20 @@
 
 #include "animrt/controllers/cues/cue_requests.hpp"
 #include "animrt/controllers/motion_source.hpp"
+#include "animrt/controllers/show/sound_clock.hpp"
 #include "animrt/core/joint.hpp"
 
 namespace animrt {
 
 inline constexpr double kForever = std::numeric_limits<double>::infinity();
 
+class ShowAudioPlayer;  // controllers/show/show_audio.hpp
+
 struct CueStep {
   std::unique_ptr<MotionSource> source;
   double duration_s = kForever;  // kForever: until another cue is asked for
+  std::string show_file = {};    // the show it plays, whose sound track it has (empty: none)
+  int sound = -1;                // the player's: its sound track, -1 none
 };
 
 struct Cue {
@@ -70,6 +84,13 @@ class CuePlayer final : public MotionSource {
   // The crossfade time of the newest change (after any lengthening).
   double last_crossfade_s() const { return last_fade_.load(std::memory_order_relaxed); }
 
+  // The steps that play `show_file` sound through `player` (before the run,
+  // outside the cycle; the player's origin is the motion's start). It is
+  // told from the cycle when to play, and is silent until its step is taken.
+  void play_sound(const std::string& show_file, ShowAudioPlayer& player);
+  // Sound commands the players could not take (they had fallen behind).
+  std::uint64_t sound_commands_lost() const { return sound_lost_.load(std::memory_order_relaxed); }
+
  private:
   // One motion being blended in; the newest is on top.
   struct Layer {
@@ -92,6 +113,11 @@ class CuePlayer final : public MotionSource {
   void sample_layer(Layer& layer) const;
   void compact() const;
   double weight(const Layer& layer) const;
+  // The sound: the newest step's starts, the one before is cut; a pause holds it.
+  void switch_sound(int sound, double at_s) const;
+  void send_sound(int sound, bool playing, bool seek, double at_s) const;
+  void pause_sound() const;
+  void chase_sound() const;
 
   std::vector<Cue> cues_;
   int idle_;
@@ -116,6 +142,19 @@ class CuePlayer final : public MotionSource {
   mutable std::vector<double> out_, prev_out_, scratch_;
   mutable double last_dt_ = 0.0;  // motion time between prev_out_ and out_
   mutable double step_dt_ = 0.0;  // this call's
+
+  struct Sound {
+    ShowAudioPlayer* player = nullptr;
+    std::uint64_t sent = 0;  // commands handed over
+    std::uint32_t seeks = 0;
+    bool playing = false;
+    SoundFollower follower;
+  };
+  mutable std::vector<Sound> sounds_;
+  mutable int sounding_ = -1;        // the sound of the newest step, -1 none
+  mutable bool sound_held_ = false;  // held by a pause
+  Nanos clock_start_ = 0;            // the motion's t = 0 on the run's clock
+  mutable std::atomic<std::uint64_t> sound_lost_{0};
 };
 
 }  // namespace animrt

@@ -72,6 +72,10 @@ class AudioSink {
 // Throws DeviceError with ALSA's reason (no sound card, busy, ...); ALSA's
 // own diagnostics are kept off stderr, so the caller reports it once.
 std::unique_ptr<AudioSink> open_alsa_sink(const std::string& device, int rate);
+// A stand-in for a sound card: writes what it would play to `path` as raw
+// s16le mono at `rate`, in real time (controllers/show/file_sink.cpp).
+// Throws DeviceError naming the file when it cannot be written.
+std::unique_ptr<AudioSink> open_file_sink(const std::string& path, int rate);
 
 class ShowAudioPlayer {
  public:
