@@ -390,11 +390,15 @@ Completion SeqNetInference::complete(const FrameMatrix& keys, const std::vector<
     }
     best.gap = n;
     best.merged = best.difference < options.threshold;
-    // Forward frames before the merge frame, the mean of the pair at it,
-    // backward frames after it.
+    // Blended: each chain weighted by its nearness to its own key. Handed
+    // over: forward frames before the merge frame, the mean of the pair at
+    // it, backward frames after it.
     out.col(at) = normal_keys.col(col);
     for (int t = 1; t <= n; ++t) {
-      if (t < best.frame) {
+      if (options.blend) {
+        const float s = static_cast<float>(t) / static_cast<float>(n + 1);
+        out.col(at + t) = (1.0F - s) * best_forward.col(t) + s * best_backward.col(n + 1 - t);
+      } else if (t < best.frame) {
         out.col(at + t) = best_forward.col(t);
       } else if (t == best.frame) {
         out.col(at + t) = 0.5F * (best_forward.col(t) + best_backward.col(n + 1 - t));

@@ -280,6 +280,9 @@ void add_seq_model_commands(CLI::App& seq) {
   complete->add_option("--retries", c->options.retries, "runs with random initial states")
       ->check(CLI::Range(0, 100000));
   complete->add_option("--seed", c->options.seed, "seed of the random initial states");
+  complete->add_flag("!--hand-over", c->options.blend,
+                     "forward frames up to where the chains meet, backward frames after (the "
+                     "paper) instead of blending the chains");
   set_subcommand_body(complete, [c] { return run_complete(*c); });
 
   auto ev = std::make_shared<EvaluateArgs>();

@@ -52,7 +52,9 @@ TEST(SeqCompletion, ChainsMergeWhereTheyMeet) {
   keys << 0.4, 0.0, 0.4;
   // Gap 1: 0.4 + 0.1 t meets 0.0 + 0.1 (10 - t) at t = 3. Gap 2: 0.1 t
   // meets 0.4 + 0.1 (10 - t) at t = 7.
-  const Completion c = net.complete(keys, {9, 9});
+  CompletionOptions handed_over;
+  handed_over.blend = false;
+  const Completion c = net.complete(keys, {9, 9}, handed_over);
   ASSERT_EQ(c.frames.cols(), 21);
   ASSERT_EQ(c.gaps.size(), 2U);
   EXPECT_TRUE(c.gaps[0].merged);
@@ -65,6 +67,49 @@ TEST(SeqCompletion, ChainsMergeWhereTheyMeet) {
   for (int t = 0; t <= 10; ++t) EXPECT_NEAR(c.frames(0, t), first[t], 1e-6) << t;
   const double second[] = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.6, 0.5, 0.4};
   for (int t = 0; t <= 10; ++t) EXPECT_NEAR(c.frames(0, 10 + t), second[t], 1e-6) << t;
+}
+
+TEST(SeqCompletion, BlendedChainsWeighEachByItsNearnessToItsKey) {
+  SeqNetInference net(constant_step_model(0.1F), "m.model");
+  FrameMatrix keys(1, 2);
+  keys << 0.4, 0.0;
+  // Frame t of 9: (1 - t / 10) (0.4 + 0.1 t) + t / 10 (0.1 (10 - t)).
+  const Completion c = net.complete(keys, {9});
+  EXPECT_EQ(c.gaps[0].frame, 3);  // where they meet is still reported
+  for (int t = 1; t <= 9; ++t) {
+    const double s = t / 10.0;
+    EXPECT_NEAR(c.frames(0, t), (1 - s) * (0.4 + 0.1 * t) + s * 0.1 * (10 - t), 1e-6) << t;
+  }
+}
+
+// An untrained network whose output layer starts at zero (as training
+// starts it) completes every gap as linear interpolation of its keys, so
+// training starts from interpolation, not below it.
+TEST(SeqCompletion, UntrainedNetworkWithZeroOutputInterpolatesLinearly) {
+  ModelFile m = joint_model(3, 5);
+  SeqNet zeroed(m.shape, MeshGraph{});
+  zeroed->zero_output_layer();
+  m.parameters = save_parameters(*zeroed);
+  SeqNetInference net(m, "m.model");
+  FrameMatrix keys(3, 3);
+  keys << 0.5, -0.5, 0.9, 0.2, 0.3, -0.1, -0.4, 0.6, 0.0;
+  const Completion c = net.complete(keys, {6, 3});
+  ASSERT_EQ(c.frames.cols(), 12);
+  for (int t = 1; t <= 6; ++t) {
+    const double s = t / 7.0;
+    const Eigen::VectorXd line = (1 - s) * keys.col(0) + s * keys.col(1);
+    EXPECT_LT((c.frames.col(t) - line).cwiseAbs().maxCoeff(), 1e-6) << t;
+  }
+  for (int t = 1; t <= 3; ++t) {
+    const Eigen::VectorXd line = (1 - t / 4.0) * keys.col(1) + t / 4.0 * keys.col(2);
+    EXPECT_LT((c.frames.col(7 + t) - line).cwiseAbs().maxCoeff(), 1e-6) << t;
+  }
+  // The network's other layers are untouched: not every parameter is zero.
+  double sum = 0;
+  for (const NamedArray& a : m.parameters) {
+    for (float v : a.values) sum += std::abs(v);
+  }
+  EXPECT_GT(sum, 1.0);
 }
 
 TEST(SeqCompletion, AGapThatDoesNotMeetIsRetriedAndReported) {

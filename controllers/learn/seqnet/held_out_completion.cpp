@@ -18,14 +18,15 @@ struct Sums {
   int frames = 0, gaps = 0;
 };
 
-void measure_segment(SeqNetInference& net, const Eigen::MatrixXf& truth, int gap, Sums& sums) {
+void measure_segment(SeqNetInference& net, const Eigen::MatrixXf& truth, int gap, bool blend,
+                     Sums& sums) {
   const int keys = (static_cast<int>(truth.cols()) - 1) / (gap + 1) + 1;
   if (keys < 2) return;
   Eigen::MatrixXf key_frames(truth.rows(), keys);
   for (int k = 0; k < keys; ++k) key_frames.col(k) = truth.col(k * (gap + 1));
   const Completion c = net.complete(net.denormalise(key_frames),
                                     std::vector<int>(static_cast<std::size_t>(keys - 1), gap),
-                                    {.threshold = 0.05, .retries = 0, .seed = 1});
+                                    {.threshold = 0.05, .retries = 0, .seed = 1, .blend = blend});
   const Eigen::MatrixXf done = net.normalise(c.frames);
   for (int k = 0; k + 1 < keys; ++k) {
     for (int t = 1; t <= gap; ++t) {
@@ -43,7 +44,7 @@ void measure_segment(SeqNetInference& net, const Eigen::MatrixXf& truth, int gap
 }  // namespace
 
 HeldOutCompletion measure_held_out_completion(const ModelFile& model, const TrainingSet& set,
-                                              int max_gap) {
+                                              int max_gap, bool blend) {
   HeldOutCompletion out;
   int longest = 0;
   for (const Segment& s : set.segments) {
@@ -54,7 +55,7 @@ HeldOutCompletion measure_held_out_completion(const ModelFile& model, const Trai
   SeqNetInference net(model, "the model in training");
   Sums sums;
   for (const Segment& s : set.segments) {
-    if (s.held_out) measure_segment(net, segment_frames(s, set.dims), out.gap, sums);
+    if (s.held_out) measure_segment(net, segment_frames(s, set.dims), out.gap, blend, sums);
   }
   if (sums.frames == 0) return out;
   out.gaps = sums.gaps;

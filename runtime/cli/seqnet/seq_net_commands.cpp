@@ -63,6 +63,14 @@ void add_seq_net_commands(CLI::App& app) {
       ->add_option("--held-out-every", train_args->held_out_every,
                    "iterations between held-out completion lines (0: only at the end)")
       ->check(CLI::NonNegativeNumber);
+  train->add_option("--held-out-clip", train_args->held_out_clips,
+                    "hold out this clip whole (feature file clip, or joint CSV) instead of a "
+                    "block of every file; repeatable");
+  train->add_option("--zero-output", train_args->zero_output,
+                    "start the decoder's last layer at zero (false: random, as the paper)");
+  train->add_flag("!--hand-over", train_args->blend,
+                  "held-out completion hands over between the chains (the paper) instead of "
+                  "blending them");
   train->add_option("--latent", train_args->latent, "latent size")->check(CLI::Range(1, 4096));
   train->add_option("--hidden", train_args->hidden, "LSTM hidden units")
       ->check(CLI::Range(1, 4096));

@@ -204,6 +204,11 @@ SeqNetImpl::SeqNetImpl(const NetShape& shape, MeshGraph graph) : shape_(shape) {
   decoder = register_module("decoder", decoder);
 }
 
+void SeqNetImpl::zero_output_layer() {
+  torch::NoGradGuard no_grad;
+  for (auto& p : decoder->children().back()->parameters()) p.zero_();
+}
+
 namespace {
 
 // A Sequential of mesh convolutions and tanh on [V, B, C]; a convolution

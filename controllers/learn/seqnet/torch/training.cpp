@@ -54,6 +54,20 @@ void add_clip(TrainingSet& set, int dataset, const std::vector<std::vector<float
   }
 }
 
+bool listed(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void check_clip_names(const std::vector<std::string>& wanted, const std::vector<std::string>& have,
+                      const std::string& file) {
+  for (const std::string& w : wanted) {
+    if (listed(have, w)) continue;
+    std::string known;
+    for (const std::string& h : have) known += (known.empty() ? "" : ", ") + h;
+    fail(file, 0, 0, "--held-out-clip", "no clip named '" + w + "' (the clips: " + known + ")");
+  }
+}
+
 std::string duration(double seconds) {
   const auto s = static_cast<long>(std::lround(std::max(0.0, seconds)));
   char buf[32];
@@ -125,7 +139,7 @@ void append_placement(ModelFile& d, const SequenceFeatures& f,
 }  // namespace
 
 TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
-                              double held_out) {
+                              double held_out, const std::vector<std::string>& held_out_clips) {
   if (files.empty()) throw InputError(Location{}, "DATA", "no data files given");
   TrainingSet set;
   set.sources = files;
@@ -152,15 +166,23 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
     append_placement(d, f, frames);
     set.dims = d.shape.input_dims();
     const int n = static_cast<int>(frames.size());
-    const auto block = held_out_block(n, held_out, seed, 0);
     std::vector<Clip> clips = f.clips;
     if (clips.empty()) clips.push_back(Clip{"all", 0, n, 0.0});
-    for (const Clip& c : clips) add_clip(set, 0, frames, c.first, c.count, block);
+    std::vector<std::string> names;
+    for (const Clip& c : clips) names.push_back(c.name);
+    check_clip_names(held_out_clips, names, files.front());
+    const auto block =
+        held_out_clips.empty() ? held_out_block(n, held_out, seed, 0) : std::pair<int, int>{0, 0};
+    for (const Clip& c : clips) {
+      add_clip(set, 0, frames, c.first, c.count,
+               listed(held_out_clips, c.name) ? std::pair<int, int>{c.first, c.count} : block);
+    }
     return set;
   }
   set.kind = ModelKind::joints;
   std::vector<std::vector<std::vector<double>>> per_file;
   std::vector<std::string> joints;
+  check_clip_names(held_out_clips, files, files.front());
   for (std::size_t k = 0; k < files.size(); ++k) {
     JointCsv t = read_joint_csv(files[k]);
     if (k == 0) {
@@ -200,8 +222,10 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
       frames.push_back(std::move(v));
     }
     const int n = static_cast<int>(frames.size());
-    add_clip(set, static_cast<int>(k), frames, 0, n,
-             held_out_block(n, held_out, seed, static_cast<int>(k)));
+    const auto block = held_out_clips.empty()
+                           ? held_out_block(n, held_out, seed, static_cast<int>(k))
+                           : std::pair<int, int>{0, listed(held_out_clips, files[k]) ? n : 0};
+    add_clip(set, static_cast<int>(k), frames, 0, n, block);
   }
   return set;
 }
@@ -263,7 +287,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
   const bool resuming = !o.resume.empty();
   if (resuming) checkpoint = read_model_file(o.resume);
   const std::uint64_t seed = resuming ? checkpoint.seed : o.seed;
-  TrainingSet set = load_training_set(o.data, seed, o.held_out);
+  TrainingSet set = load_training_set(o.data, seed, o.held_out, o.held_out_clips);
   NetShape shape = set.description.shape;
   if (resuming) {
     if (set.kind == ModelKind::mesh) {
@@ -315,6 +339,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
   if (shape.kind == ModelKind::mesh)
     graph = mesh_graph(shape.vertex_count, set.description.triangles);
   SeqNet net(shape, graph);
+  if (o.zero_output) net->zero_output_layer();  // a resume loads over it
   const std::vector<std::string> names = parameter_names(*net);
   Adam adam(net->parameters(), o.learning_rate);
   std::vector<LossRecord> history;
@@ -397,7 +422,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
 
   auto measure = [&] {
     measured = HeldOutCompletion{};
-    measured = measure_held_out_completion(model_file(false), set);
+    measured = measure_held_out_completion(model_file(false), set, 9, o.blend);
     progress << held_out_line(measured, iteration) << std::endl;
   };
 

@@ -40,6 +40,12 @@ struct CompletionOptions {
   // Tries with random initial states after the first (which uses s0).
   int retries = 20;
   std::uint64_t seed = 1;
+  // true: each in-between frame is the two chains weighted by its distance
+  // from their keys, (1 - s) forward + s backward with s = t / (gap + 1), so
+  // chains that change nothing give linear interpolation of the keys. false:
+  // the paper's hand-over (forward frames up to where the chains are
+  // closest, backward frames after it).
+  bool blend = true;
 };
 
 // How one gap between two keys was filled.

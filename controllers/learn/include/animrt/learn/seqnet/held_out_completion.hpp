@@ -21,8 +21,9 @@ struct HeldOutCompletion {
 
 // Keys every gap + 1 frames from each held-out segment's first frame, gap
 // the largest up to `max_gap` that fits the longest held-out segment; every
-// gap completed once (no retries, the plain states).
+// gap completed once (no retries, the plain states), the chains blended or
+// handed over (CompletionOptions::blend).
 HeldOutCompletion measure_held_out_completion(const ModelFile& model, const TrainingSet& set,
-                                              int max_gap = 9);
+                                              int max_gap = 9, bool blend = true);
 
 }  // namespace animrt::seqnet

@@ -91,6 +91,13 @@ class SeqNetImpl : public torch::nn::Module {
   // keep each step's input and output gradient instead; after backward,
   // finish_gradients forms each weight's gradient in one product over all
   // steps (the same sum as autograd's, without one full-size matrix per step).
+  // Sets the decoder's last layer to zero, weights and bias: every frame's
+  // change is zero until training moves it, so an untrained network holds
+  // its given frame and completes a gap as linear interpolation of the keys
+  // (CompletionOptions::blend). The layer's weight gradients are not zero
+  // (its input is not), so it learns from the first step.
+  void zero_output_layer();
+
   void collect_dense_gradients(bool on);
   void finish_gradients();
 

@@ -35,8 +35,12 @@ struct TrainingSet {
 // CSVs with the same joints. Each file is a dataset: one contiguous block
 // of `held_out` of its frames, placed by the seed, is held out. Throws
 // InputError for bad files (naming file, line, column).
+// With `held_out_clips` (clip names of a feature file, or joint CSV paths)
+// those clips are held out whole instead of the block, e.g. the walks of
+// another seed; a name that is no clip of the data throws InputError.
 TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
-                              double held_out = 0.2);
+                              double held_out = 0.2,
+                              const std::vector<std::string>& held_out_clips = {});
 
 struct TrainOptions {
   std::vector<std::string> data;
@@ -56,6 +60,11 @@ struct TrainOptions {
   // keeps it.
   int held_out_every = 100;
   double held_out = 0.2;
+  std::vector<std::string> held_out_clips;  // held out whole instead (load_training_set)
+  // The decoder's last layer starts at zero (SeqNetImpl::zero_output_layer).
+  bool zero_output = true;
+  // The held-out completion blends the chains (CompletionOptions::blend).
+  bool blend = true;
   // Network size (paper values by default).
   int latent = 128;
   int hidden = 128;
