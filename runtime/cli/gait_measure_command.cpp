@@ -29,6 +29,7 @@ struct MeasureArgs {
   int warmup_cycles = 1;
   int measure_cycles = 3;
   double balance_delay_ms = 0.0;
+  double balance_period_ms = 0.0;
   std::string robot;  // play through this robot file's joint limits and loop rate
 };
 
@@ -79,6 +80,7 @@ int run_measure(const MeasureArgs& a) {
   settings.measure_cycles = a.measure_cycles;
   settings.perturb_rad = a.perturb_deg * M_PI / 180.0;
   settings.balance_delay_s = a.balance_delay_ms / 1000.0;
+  settings.balance_period_s = a.balance_period_ms / 1000.0;
   if (!a.robot.empty()) limit_as_robot(a.robot, simulator->info(), settings);
 
   std::printf("walking %s on %s: %d starts, %.2f Hz, hip height %.3f m\n", a.gait.c_str(),
@@ -93,6 +95,9 @@ int run_measure(const MeasureArgs& a) {
         gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
     if (a.balance_delay_ms > 0.0) {
       std::printf("balance reflex reads the trunk's attitude %g ms late\n", a.balance_delay_ms);
+    }
+    if (a.balance_period_ms > 0.0) {
+      std::printf("balance reflex reads the trunk's attitude every %g ms\n", a.balance_period_ms);
     }
   }
   std::printf("%5s %6s %9s %9s %8s %9s %10s\n", "start", "fell", "fall s", "m/s", "stride m",
@@ -150,6 +155,10 @@ void add_gait_measure_command(CLI::App& gait) {
   cmd->add_option("--balance-delay-ms", args->balance_delay_ms,
                   "the balance reflex reads the trunk's attitude this late (a robustness "
                   "measure; the fitness reads it at once)")
+      ->check(CLI::Range(0.0, 200.0));
+  cmd->add_option("--balance-period-ms", args->balance_period_ms,
+                  "the balance reflex reads the trunk's attitude once every this long, as from "
+                  "an IMU reporting at that rate (a measure; the fitness reads it every step)")
       ->check(CLI::Range(0.0, 200.0));
   cmd->add_option("--robot", args->robot,
                   "play the targets through this robot file's joint velocity, acceleration and "

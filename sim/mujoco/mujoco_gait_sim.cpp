@@ -37,9 +37,12 @@ int root_qpos(const mjModel* m, int torso) {
 // actuator targets by the same apply_balance() the runtime plays.
 class LegBalance {
  public:
-  // The reflex reads the tilt `delay_steps` physics steps old.
-  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains, long delay_steps)
+  // The reflex reads the tilt `delay_steps` physics steps old, once every
+  // `period_steps` steps (an IMU's reports), and holds it between.
+  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains, long delay_steps,
+             long period_steps)
       : mm_(mm),
+        period_(static_cast<std::size_t>(std::max(1L, period_steps))),
         reflex_(gains),
         legs_(mm, d),
         scratch_(2 * legs_.max_leg_joints(), 0.0),
@@ -54,7 +57,9 @@ class LegBalance {
     if (steps_ == 0) std::fill(tilts_.begin(), tilts_.end(), now);
     tilts_[steps_ % tilts_.size()] = now;
     ++steps_;
-    reflex_.update(tilts_[steps_ % tilts_.size()], dt);
+    if ((steps_ - 1) % period_ == 0) {
+      reflex_.update(tilts_[steps_ % tilts_.size()], dt * static_cast<double>(period_));
+    }
     legs_.pose({}, {});
     apply_balance(reflex_, legs_,
                   std::span<double>(d->ctrl, static_cast<std::size_t>(mm_.model->nu)), scratch_);
@@ -62,6 +67,7 @@ class LegBalance {
 
  private:
   const MujocoModel& mm_;
+  std::size_t period_;
   BalanceReflex reflex_;
   MujocoLegModel legs_;
   std::vector<double> scratch_;
@@ -189,7 +195,9 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   const long blend = std::max(1L, std::min(warmup, steps_for(1.0 / f)));
   const double standing_z = d->xpos[3 * mm.torso_body + 2];
   std::optional<LegBalance> balance;
-  if (gait.balance) balance.emplace(mm, d, *gait.balance, steps_for(settings.balance_delay_s));
+  if (gait.balance)
+    balance.emplace(mm, d, *gait.balance, steps_for(settings.balance_delay_s),
+                    steps_for(settings.balance_period_s));
   std::optional<LimitedTargets> limited;
   if (!settings.joint_limits.empty()) {
     if (settings.joint_limits.size() != static_cast<std::size_t>(m->nu) ||

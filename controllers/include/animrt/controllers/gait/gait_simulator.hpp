@@ -29,6 +29,10 @@ struct WalkSettings {
   // runtime whose IMU reports late does. A measure of how the law stands a
   // delay, not the fitness (which reads the attitude of the step: 0).
   double balance_delay_s = 0.0;
+  // The reflex reads the attitude once every this long (s), as from an IMU
+  // reporting at that rate, and holds tilt and rate between; up to a
+  // physics step: every step (the fitness). A measure, like the delay.
+  double balance_period_s = 0.0;
   // Nonempty (one per actuated joint, ModelInfo::joints' order): the walk
   // plays its targets (gait and reflex) through the runtime's safety filter
   // with these limits, stepped every `limits_period_s` (the robot's loop
