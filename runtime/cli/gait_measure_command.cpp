@@ -2,6 +2,7 @@
 // MuJoCo model the way the evolver does, from several perturbed starts, and
 // prints what it achieved beside the Froude predictions (docs/evolve.md).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -9,7 +10,9 @@
 #include <vector>
 
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/core/error.hpp"
 #include "animrt/learn/evolve/fitness.hpp"
+#include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "gait_command.hpp"
 #include "subcommand.hpp"
@@ -26,6 +29,8 @@ struct MeasureArgs {
   int warmup_cycles = 1;
   int measure_cycles = 3;
   double balance_delay_ms = 0.0;
+  double balance_period_ms = 0.0;
+  std::string robot;  // play through this robot file's joint limits and loop rate
 };
 
 struct Stat {
@@ -44,6 +49,24 @@ struct Stat {
   }
 };
 
+// The robot file's limits, one per model joint (by name), and its loop period:
+// the walk plays its targets through the runtime's safety filter with them.
+void limit_as_robot(const std::string& path, const evolve::ModelInfo& model,
+                    evolve::WalkSettings& settings) {
+  const RobotConfig robot = load_robot_config(path);
+  settings.joint_limits.clear();
+  for (const std::string& name : model.joints) {
+    const auto it = std::find_if(robot.joints.begin(), robot.joints.end(),
+                                 [&](const JointSpec& j) { return j.name == name; });
+    if (it == robot.joints.end()) {
+      throw InputError(Location{path, 0, 0}, "joints",
+                       "no joint " + quote(name) + " of the model (--robot needs them all)");
+    }
+    settings.joint_limits.push_back(it->limits);
+  }
+  settings.limits_period_s = 1.0 / robot.rate_hz;
+}
+
 int run_measure(const MeasureArgs& a) {
   const GaitFile gait = load_gait_file(a.gait);
   sim::MujocoGaitSimulatorFactory factory(a.physics);
@@ -57,15 +80,24 @@ int run_measure(const MeasureArgs& a) {
   settings.measure_cycles = a.measure_cycles;
   settings.perturb_rad = a.perturb_deg * M_PI / 180.0;
   settings.balance_delay_s = a.balance_delay_ms / 1000.0;
+  settings.balance_period_s = a.balance_period_ms / 1000.0;
+  if (!a.robot.empty()) limit_as_robot(a.robot, simulator->info(), settings);
 
   std::printf("walking %s on %s: %d starts, %.2f Hz, hip height %.3f m\n", a.gait.c_str(),
               a.physics.c_str(), a.seeds, f, h);
+  if (!a.robot.empty()) {
+    std::printf("targets played through %s's joint limits at %g Hz\n", a.robot.c_str(),
+                1.0 / settings.limits_period_s);
+  }
   if (gait.balance) {
     std::printf(
         "balance reflex: tilt_m %g, tilt_rate_m_s %g (legs on the ground stretch up to %g m)\n",
         gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
     if (a.balance_delay_ms > 0.0) {
       std::printf("balance reflex reads the trunk's attitude %g ms late\n", a.balance_delay_ms);
+    }
+    if (a.balance_period_ms > 0.0) {
+      std::printf("balance reflex reads the trunk's attitude every %g ms\n", a.balance_period_ms);
     }
   }
   std::printf("%5s %6s %9s %9s %8s %9s %10s\n", "start", "fell", "fall s", "m/s", "stride m",
@@ -124,6 +156,15 @@ void add_gait_measure_command(CLI::App& gait) {
                   "the balance reflex reads the trunk's attitude this late (a robustness "
                   "measure; the fitness reads it at once)")
       ->check(CLI::Range(0.0, 200.0));
+  cmd->add_option("--balance-period-ms", args->balance_period_ms,
+                  "the balance reflex reads the trunk's attitude once every this long, as from "
+                  "an IMU reporting at that rate (a measure; the fitness reads it every step)")
+      ->check(CLI::Range(0.0, 200.0));
+  cmd->add_option("--robot", args->robot,
+                  "play the targets through this robot file's joint velocity, acceleration and "
+                  "position limits at its loop rate, as `animrt run` does (its joints named as "
+                  "the model's)")
+      ->check(CLI::ExistingFile);
   set_subcommand_body(cmd, [args] { return run_measure(*args); });
 }
 

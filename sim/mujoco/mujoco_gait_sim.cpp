@@ -6,11 +6,13 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "animrt/controllers/gait/balance_reflex.hpp"
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
+#include "animrt/core/safety_filter.hpp"
 #include "animrt/sim/mujoco/mujoco_leg_model.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
@@ -35,9 +37,12 @@ int root_qpos(const mjModel* m, int torso) {
 // actuator targets by the same apply_balance() the runtime plays.
 class LegBalance {
  public:
-  // The reflex reads the tilt `delay_steps` physics steps old.
-  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains, long delay_steps)
+  // The reflex reads the tilt `delay_steps` physics steps old, once every
+  // `period_steps` steps (an IMU's reports), and holds it between.
+  LegBalance(const MujocoModel& mm, const mjData* d, const GaitBalance& gains, long delay_steps,
+             long period_steps)
       : mm_(mm),
+        period_(static_cast<std::size_t>(std::max(1L, period_steps))),
         reflex_(gains),
         legs_(mm, d),
         scratch_(2 * legs_.max_leg_joints(), 0.0),
@@ -52,7 +57,9 @@ class LegBalance {
     if (steps_ == 0) std::fill(tilts_.begin(), tilts_.end(), now);
     tilts_[steps_ % tilts_.size()] = now;
     ++steps_;
-    reflex_.update(tilts_[steps_ % tilts_.size()], dt);
+    if ((steps_ - 1) % period_ == 0) {
+      reflex_.update(tilts_[steps_ % tilts_.size()], dt * static_cast<double>(period_));
+    }
     legs_.pose({}, {});
     apply_balance(reflex_, legs_,
                   std::span<double>(d->ctrl, static_cast<std::size_t>(mm_.model->nu)), scratch_);
@@ -60,11 +67,43 @@ class LegBalance {
 
  private:
   const MujocoModel& mm_;
+  std::size_t period_;
   BalanceReflex reflex_;
   MujocoLegModel legs_;
   std::vector<double> scratch_;
   std::vector<TrunkTilt> tilts_;  // ring: the newest at (steps_ - 1), the one read at steps_
   std::size_t steps_ = 0;
+};
+
+// The runtime's safety filter between the walk's targets and the actuators
+// (WalkSettings::joint_limits): stepped once a loop period from the standing
+// pose at rest, its command held between steps as a servo holds its goal.
+class LimitedTargets {
+ public:
+  LimitedTargets(const std::vector<JointLimits>& limits, double period, const double* standing)
+      : filter_(limits, period),
+        period_(period),
+        targets_(limits.size(), 0.0),
+        commands_(standing, standing + limits.size()) {
+    filter_.reset(commands_);
+  }
+
+  // `ctrl` holds this step's targets; it leaves with the filter's command.
+  void apply(double t, double* ctrl) {
+    if (t + 1e-9 >= next_s_) {
+      std::copy(ctrl, ctrl + targets_.size(), targets_.begin());
+      filter_.step(targets_, commands_);
+      next_s_ += period_;
+    }
+    std::copy(commands_.begin(), commands_.end(), ctrl);
+  }
+
+ private:
+  SafetyFilter filter_;
+  double period_;
+  double next_s_ = 0.0;
+  std::vector<double> targets_;
+  std::vector<double> commands_;
 };
 
 }  // namespace
@@ -156,7 +195,17 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   const long blend = std::max(1L, std::min(warmup, steps_for(1.0 / f)));
   const double standing_z = d->xpos[3 * mm.torso_body + 2];
   std::optional<LegBalance> balance;
-  if (gait.balance) balance.emplace(mm, d, *gait.balance, steps_for(settings.balance_delay_s));
+  if (gait.balance)
+    balance.emplace(mm, d, *gait.balance, steps_for(settings.balance_delay_s),
+                    steps_for(settings.balance_period_s));
+  std::optional<LimitedTargets> limited;
+  if (!settings.joint_limits.empty()) {
+    if (settings.joint_limits.size() != static_cast<std::size_t>(m->nu) ||
+        !(settings.limits_period_s > 0.0)) {
+      throw std::invalid_argument("walk: one joint limit per actuator and a period > 0 needed");
+    }
+    limited.emplace(settings.joint_limits, settings.limits_period_s, d->ctrl);
+  }
 
   const std::size_t feet = mm.foot_geoms.size();
   std::vector<int> foot_of(static_cast<std::size_t>(m->ngeom), -1);
@@ -189,6 +238,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
       }
       if (balance) balance->apply(d, dt);
     }
+    if (limited) limited->apply(static_cast<double>(step) * dt, d->ctrl);
     mj_step(m, d);
     ++out.steps;
     if (has_fallen(mm, d, standing_z)) {

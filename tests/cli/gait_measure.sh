@@ -37,6 +37,23 @@ late=$("$animrt" gait measure "$seed" "${one[@]}" --balance-delay-ms 60 2>&1) ||
 [[ $(walks "$now") == "$(walks "$zero")" ]] || fail "0 ms late is not the fitness walk: $zero"
 [[ $late == *"reads the trunk's attitude 60 ms late"* ]] || fail "the delay is not said: $late"
 [[ $(walks "$now") != "$(walks "$late")" ]] || fail "60 ms late walked the same: $late"
+# Read once a physics step (2 ms) it is the fitness walk; once every 10 ms another.
+step=$("$animrt" gait measure "$seed" "${one[@]}" --balance-period-ms 2 2>&1) || fail "2 ms: $step"
+slow=$("$animrt" gait measure "$seed" "${one[@]}" --balance-period-ms 10 2>&1) || fail "10: $slow"
+[[ $(walks "$now") == "$(walks "$step")" ]] || fail "every step is not the fitness walk: $step"
+[[ $(walks "$now") != "$(walks "$slow")" ]] || fail "every 10 ms walked the same: $slow"
+
+# Through the robot file's joint limits at its loop rate: another walk, and
+# a robot without one of the model's joints is refused naming file and joint.
+robot=$root/configs/robots/horse.yaml
+played=$("$animrt" gait measure "$seed" "${one[@]}" --robot "$robot" 2>&1) || fail "robot: $played"
+[[ $played == *"joint limits at 200 Hz"* ]] || fail "the limits are not said: $played"
+[[ $(walks "$now") != "$(walks "$played")" ]] || fail "the limits changed nothing: $played"
+sed -e 's/^  lf_elbow:/  lf_elbow_renamed:/' -e "s#\.\./#$root/configs/#g" "$robot" > "$tmp/robot.yaml"
+out=$("$animrt" gait measure "$seed" "${one[@]}" --robot "$tmp/robot.yaml" 2>&1)
+code=$?
+[[ $code -eq 2 && $out == *"robot.yaml"* && $out == *'"lf_elbow"'* ]] ||
+  fail "a robot without a model joint (exit $code): $out"
 
 out=$("$animrt" gait measure "$tmp/missing.yaml" --physics "$model" 2>&1)
 code=$?

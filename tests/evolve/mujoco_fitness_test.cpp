@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/core/joint.hpp"
 #include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/learn/evolve/phenotype.hpp"
 #include "animrt/learn/evolve/random.hpp"
@@ -197,6 +199,41 @@ TEST(MujocoGaitSimulator, TheBalanceReflexKeepsMoreNeighboursOfTheHorseSeedOnThe
   std::cout << "of " << kNeighbours << " neighbours, " << walked_plain
             << " walk without the reflex, " << walked_balanced << " with it\n";
   EXPECT_GE(walked_balanced, walked_plain + kNeighbours / 6);
+}
+
+// WalkSettings::joint_limits: the walk plays its targets through the
+// runtime's safety filter. The horse robot's own limits (1000 deg/s,
+// 30,000 deg/s^2 at 200 Hz) let the seed walk; a velocity limit of 5 deg/s
+// leaves it standing, and an acceleration limit of 20 deg/s^2 (its swings
+// need thousands) lets its legs lag until it falls. A walk that ignores the
+// limits walks at full speed in all three.
+TEST(MujocoGaitSimulator, AWalkThroughJointLimitsPlaysOnlyWhatTheyAllow) {
+  sim::MujocoGaitSimulatorFactory factory(kSourceRoot + "/configs/models/horse.xml");
+  auto sim = factory.make();
+  const GaitFile seed = load_gait_file(kSourceRoot + "/configs/gaits/horse_seed.yaml");
+  const auto limited = [&](double velocity_dps, double acceleration_dps2) {
+    WalkSettings w;
+    const JointLimits l{-kPi, kPi, deg_to_rad(velocity_dps), deg_to_rad(acceleration_dps2)};
+    w.joint_limits.assign(sim->info().joints.size(), l);
+    w.limits_period_s = 0.005;
+    return sim->walk(seed, w);
+  };
+  const GaitMeasures free = sim->walk(seed, WalkSettings{});
+  const GaitMeasures robot = limited(1000.0, 30000.0);
+  const GaitMeasures slow = limited(5.0, 30000.0);
+  const GaitMeasures sluggish = limited(1000.0, 20.0);
+  std::cout << "speed: free " << free.speed << ", robot's limits " << robot.speed << ", 5 deg/s "
+            << slow.speed << (slow.fell ? " (fell)" : "") << ", 20 deg/s^2 " << sluggish.speed
+            << (sluggish.fell ? " (fell)" : "") << "\n";
+  ASSERT_FALSE(free.fell);
+  EXPECT_FALSE(robot.fell);
+  EXPECT_GT(robot.speed, 0.5 * free.speed);
+  EXPECT_FALSE(slow.fell);
+  EXPECT_LT(std::abs(slow.speed), 0.05 * free.speed);
+  EXPECT_TRUE(sluggish.fell || std::abs(sluggish.speed) < 0.2 * free.speed);
+  WalkSettings wrong;
+  wrong.joint_limits.assign(sim->info().joints.size() - 1, JointLimits{-1.0, 1.0, 1.0, 1.0});
+  EXPECT_THROW(sim->walk(seed, wrong), std::invalid_argument);
 }
 
 // The horse model with actuators too weak to carry it (every force limit

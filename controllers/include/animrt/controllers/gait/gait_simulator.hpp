@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "animrt/controllers/gait/gait_file.hpp"
+#include "animrt/core/joint.hpp"
 
 namespace animrt::evolve {
 
@@ -28,6 +29,18 @@ struct WalkSettings {
   // runtime whose IMU reports late does. A measure of how the law stands a
   // delay, not the fitness (which reads the attitude of the step: 0).
   double balance_delay_s = 0.0;
+  // The reflex reads the attitude once every this long (s), as from an IMU
+  // reporting at that rate, and holds tilt and rate between; up to a
+  // physics step: every step (the fitness). A measure, like the delay.
+  double balance_period_s = 0.0;
+  // Nonempty (one per actuated joint, ModelInfo::joints' order): the walk
+  // plays its targets (gait and reflex) through the runtime's safety filter
+  // with these limits, stepped every `limits_period_s` (the robot's loop
+  // period; the actuators hold a command between steps, as a servo holds its
+  // goal), so a gait is scored as the runtime plays it. Empty: the targets
+  // reach the actuators every physics step as they are (the fitness).
+  std::vector<JointLimits> joint_limits;
+  double limits_period_s = 0.005;
 };
 
 struct GaitMeasures {

@@ -1,4 +1,4 @@
-#include "animrt/runtime/safety_filter.hpp"
+#include "animrt/core/safety_filter.hpp"
 
 #include <algorithm>
 #include <cmath>
