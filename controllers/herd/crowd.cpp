@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "animrt/controllers/herd/cell_index.hpp"
+#include "animrt/controllers/herd/knot.hpp"
 #include "animrt/controllers/herd/passage.hpp"
 
 namespace animrt::herd {
@@ -58,6 +59,18 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   asking_.assign(agents.size(), false);
   was_held_.assign(agents.size(), 0);
   hold_at_.assign(agents.size(), Vec2{});
+  travelling_.assign(agents.size(), 0);
+  backing_.assign(agents.size(), 0);
+  eligible_.assign(agents.size(), 0);
+  if (params_.knot_still_s > 0.0) {
+    KnotParams kp;
+    kp.still_s = params_.knot_still_s;
+    kp.progress_m = params_.knot_progress_m;
+    kp.link_m = params_.knot_link_m;
+    kp.back_off_m = params_.knot_back_off_m;
+    kp.back_off_s = params_.knot_back_off_s;
+    knots_ = std::make_unique<KnotRules>(agents.size(), kp);
+  }
   if (params_.passage_width_radii > 0.0) {
     PassageParams pp;
     pp.max_width_radii = params_.passage_width_radii;
@@ -163,11 +176,7 @@ void Crowd::sync(int i, const Agent& a) {
     ag->state = DT_CROWDAGENT_STATE_WALKING;
     dtVcopy(ag->npos, nearest);
     if (active_[static_cast<std::size_t>(i)] && has_target_[static_cast<std::size_t>(i)]) {
-      if (was_held_[static_cast<std::size_t>(i)]) {
-        retarget(i, hold_at_[static_cast<std::size_t>(i)]);
-      } else {
-        request_target(i, target_[static_cast<std::size_t>(i)]);
-      }
+      request_current(i);
     }
   }
   const auto v = NavWorld::to_recast(a.velocity());
@@ -186,6 +195,7 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
   if (passages_) apply_passages(t, agents);
+  if (knots_) apply_knots(t, agents);
   select_participants();
   // The crowd registers each agent of its update in its grid as it stands now.
   grid_rows_->begin(crowd_->getGrid()->getCellSize());
@@ -220,6 +230,34 @@ void Crowd::select_participants() {
   }
 }
 
+long Crowd::knots() const { return knots_ ? knots_->knots() : 0; }
+
+bool Crowd::request_current(int i) {
+  const auto k = static_cast<std::size_t>(i);
+  if (backing_[k]) return retarget(i, knots_->back_off_point(i));
+  if (was_held_[k]) return retarget(i, hold_at_[k]);
+  return request_target(i, target_[k]);
+}
+
+void Crowd::apply_knots(double t, std::span<const Agent> agents) {
+  // Only members whose plan asks them to walk (at half their top speed or
+  // more, before avoidance): one that the plan stands (no way open, as at
+  // a closed gate) waits, and is no knot.
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
+    const bool asks = dtVlen(ag->dvel) >= 0.5f * ag->params.maxSpeed;
+    eligible_[i] = travelling_[i] && active_[i] && has_target_[i] && !was_held_[i] && asks ? 1 : 0;
+  }
+  knots_->update(t, agents, target_, eligible_);
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const int k = static_cast<int>(i);
+    const char backing = knots_->backing_off(k) && active_[i] && has_target_[i] ? 1 : 0;
+    if (backing == backing_[i]) continue;
+    backing_[i] = backing;
+    request_current(k);
+  }
+}
+
 bool Crowd::retarget(int i, Vec2 target) {
   const auto p = NavWorld::to_recast(target);
   const float ext[3] = {1.0f, 2.0f, 1.0f};
@@ -235,7 +273,9 @@ void Crowd::apply_passages(double t, std::span<const Agent> agents) {
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const int k = static_cast<int>(i);
     const char held = passages_->held(k) ? 1 : 0;
-    if (held && (!was_held_[i] || norm(passages_->hold_point(k) - hold_at_[i]) > 1e-9)) {
+    if (backing_[i]) {  // backing off out of a knot first; the knot rules send it on after
+      if (held) hold_at_[i] = passages_->hold_point(k);
+    } else if (held && (!was_held_[i] || norm(passages_->hold_point(k) - hold_at_[i]) > 1e-9)) {
       retarget(k, passages_->hold_point(k));
       hold_at_[i] = passages_->hold_point(k);
     } else if (!held && was_held_[i] && has_target_[i]) {
@@ -247,7 +287,7 @@ void Crowd::apply_passages(double t, std::span<const Agent> agents) {
 
 Vec2 Crowd::passage_wait(int i, Vec2 v, std::span<const Agent> agents) const {
   const auto k = static_cast<std::size_t>(i);
-  if (!passages_ || !was_held_[k]) return v;
+  if (!passages_ || !was_held_[k] || backing_[k]) return v;
   const Agent& a = agents[k];
   const double here = norm(a.position - hold_at_[k]);
   if (here < kWaitRadius) return {};
@@ -610,6 +650,11 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     slot_of_[k] = -1;
     state_[k] = State::kArrived;
     crowd_.stop(members_[k]);
+  }
+  for (std::size_t k = 0; k < members_.size(); ++k) {
+    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
+    crowd_.set_travelling(members_[k],
+                          state_[k] == State::kTravelling && norm(p - target) > assign_distance_);
   }
   crowd_.step(t, dt, agents);
   for (std::size_t k = 0; k < members_.size(); ++k) {

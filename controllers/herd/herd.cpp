@@ -237,6 +237,7 @@ void Herd::record_metrics() {
   }
   recorder_->sample(t_, agents_, leaders_scratch_, arrived_scratch_, max_speed_scratch_);
   recorder_->set_contact_stops(contact_stops_);
+  recorder_->set_knots(crowd_ ? crowd_->knots() : 0);
 }
 
 }  // namespace animrt::herd

@@ -225,8 +225,8 @@ std::string format_metrics(const HerdMetrics& m) {
                                ? fmt::format("min pair distance {:.3f} m (clearance {:.3f} m)",
                                              m.min_pair_distance_m, m.min_clearance_m)
                                : std::string("min pair distance n/a");
-  std::string s = fmt::format("herd: {:.1f} s, {} collisions, {}, {} contact stops\n", m.duration_s,
-                              m.collisions, pair, m.contact_stops);
+  std::string s = fmt::format("herd: {:.1f} s, {} collisions, {}, {} contact stops, {} knots\n",
+                              m.duration_s, m.collisions, pair, m.contact_stops, m.knots);
   for (const GroupMetrics& g : m.groups) {
     s += fmt::format("  {} ({}, {} figures): {} collisions, {}, speed {:.4f} m/s mean", g.name,
                      g.kind, g.agents, g.collisions, format_order(g), g.speed_mean_mps);

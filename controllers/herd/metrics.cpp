@@ -186,6 +186,7 @@ HerdMetrics MetricsRecorder::finish() const {
   m.steps = steps_;
   m.collisions = collisions_;
   m.contact_stops = contact_stops_;
+  m.knots = knots_;
   m.has_pair = min_pair_ < 1e299;
   m.min_pair_distance_m = m.has_pair ? min_pair_ : 0.0;
   m.min_clearance_m = m.has_pair ? min_clearance_ : 0.0;

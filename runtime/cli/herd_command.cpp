@@ -56,6 +56,7 @@ nlohmann::json to_json(const herd::HerdMetrics& m, double wall_s) {
   j["min_pair_distance_m"] = measured(m.has_pair, m.min_pair_distance_m);
   j["min_clearance_m"] = measured(m.has_pair, m.min_clearance_m);
   j["contact_stops"] = m.contact_stops;
+  j["knots"] = m.knots;
   for (const herd::GroupMetrics& g : m.groups) {
     nlohmann::json k;
     k["name"] = g.name;

@@ -35,6 +35,7 @@ out=$("$animrt" herd "$tmp/standing.yaml" --summary-json "$tmp/u.json" --quiet 2
 [[ $out != *"order"* ]] || fail "a standing flock printed an order: $out"
 /usr/bin/python3 - "$tmp/u.json" <<'PY' || fail "unity JSON: $(cat "$tmp/u.json")"
 import json, sys
+assert json.load(open(sys.argv[1]))["knots"] == 0
 g = json.load(open(sys.argv[1]))["groups"][0]
 assert g["standing"] is True and g["order_mean"] is None and g["order_min"] is None
 assert g["speed_mean_mps"] < 0.1 * g["leader_speed_mean_mps"]

@@ -132,6 +132,13 @@ TEST(HerdMetrics, AFlockThatStandsWhileItsLeaderWalksIsStandingNotOrdered) {
   EXPECT_EQ(text.find("order"), std::string::npos) << text;
 }
 
+TEST(HerdMetrics, TheSummaryCountsKnots) {
+  HerdMetrics m;
+  m.knots = 3;
+  const std::string text = format_metrics(m);
+  EXPECT_NE(text.find(", 3 knots"), std::string::npos) << text;
+}
+
 TEST(HerdMetrics, AFlockWalkingWithItsLeaderIsOrdered) {
   const GroupMetrics g = flock_behind_walking_leader(0.1);
   EXPECT_FALSE(g.standing);

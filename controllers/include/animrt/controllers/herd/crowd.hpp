@@ -75,11 +75,20 @@ struct CrowdParams {
   // waited passage_max_hold_s (see passage.hpp).
   double passage_width_radii = 6.5;
   double passage_max_hold_s = 60.0;
+  // Knots (see knot.hpp): travelling members that have not moved
+  // knot_progress_m for knot_still_s (0: never looked for), standing within
+  // knot_link_m of each other, are a knot; one side of it backs off.
+  double knot_still_s = 30.0;
+  double knot_progress_m = 0.3;
+  double knot_link_m = 0.4;
+  double knot_back_off_m = 1.5;
+  double knot_back_off_s = 20.0;
 };
 
 class CrowdGroup;
 class PassageRules;
 class CellIndex;
+class KnotRules;
 
 class Crowd {
  public:
@@ -99,6 +108,8 @@ class Crowd {
   const CrowdParams& params() const { return params_; }
   dtCrowd* native() { return crowd_; }
   std::size_t agent_count() const { return active_.size(); }
+  // Knots found so far (each once, when one side of it was made to yield).
+  long knots() const;
 
  private:
   friend class CrowdGroup;
@@ -117,6 +128,14 @@ class Crowd {
   // there, or where it meets one already standing.
   Vec2 passage_wait(int i, Vec2 v, std::span<const Agent> agents) const;
   void apply_passages(double t, std::span<const Agent> agents);
+  void apply_knots(double t, std::span<const Agent> agents);
+  // Where the crowd sends member i now: its back-off point, its waiting
+  // place, or its target.
+  bool request_current(int i);
+  // Set by its group each step: the member walks to its goal on its own.
+  void set_travelling(int i, bool travelling) {
+    travelling_[static_cast<std::size_t>(i)] = travelling ? 1 : 0;
+  }
   // Which agents take part in the crowd's update (see crowd.cpp).
   void select_participants();
 
@@ -128,6 +147,10 @@ class Crowd {
   std::vector<Vec2> target_;
   std::vector<Vec2> synced_;  // each agent's position before the last crowd update
   std::unique_ptr<PassageRules> passages_;
+  std::unique_ptr<KnotRules> knots_;
+  std::vector<char> travelling_;
+  std::vector<char> backing_;             // backing off out of a knot at the last step
+  std::vector<char> eligible_;            // scratch: travelling members no rule holds
   std::unique_ptr<CellIndex> grid_rows_;  // the proximity grid's items at the last update
   mutable std::vector<int> near_scratch_;
   double reach_m_ = 0.0;  // a passive agent this far from every member cannot matter to one

@@ -54,6 +54,7 @@ struct HerdMetrics {
   double min_clearance_m = 0.0;      // min over pairs of distance - sum of radii
   bool has_pair = false;
   long contact_stops = 0;  // figure-steps stopped by the herd's contact guard
+  long knots = 0;          // knots of crowd members found and backed off (crowd.hpp)
   std::vector<GroupMetrics> groups;
 };
 
@@ -78,6 +79,7 @@ class MetricsRecorder {
 
   HerdMetrics finish() const;
   void set_contact_stops(long stops) { contact_stops_ = stops; }
+  void set_knots(long knots) { knots_ = knots; }
 
  private:
   struct AgentTrack {
@@ -116,6 +118,7 @@ class MetricsRecorder {
   long steps_ = 0;
   long collisions_ = 0;
   long contact_stops_ = 0;
+  long knots_ = 0;
   double min_pair_ = 1e300;
   double min_clearance_ = 1e300;
   std::vector<int> order_;  // scratch: agents sorted by x
