@@ -43,6 +43,10 @@ start_sim() {
 }
 
 start_figure() {
+  # Emptied first: the new process may not have truncated them yet when
+  # the wait below first looks, and the last run's torque on is in them.
+  : > "$tmp/out.txt"
+  : > "$tmp/err.txt"
   "$animrt" run "$robot" --backend hardware --no-realtime "$@" > "$tmp/out.txt" 2> "$tmp/err.txt" &
   pid=$!
   for _ in $(seq 200); do

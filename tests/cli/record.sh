@@ -78,7 +78,7 @@ sed -e 's|^  type: gait|  type: show|' -e 's|^  file: ../gaits/walk.yaml.*|  fil
   --telemetry "$tmp/play.csv" > "$tmp/run.txt" 2>&1 || fail "playback failed: $(cat "$tmp/run.txt")"
 
 /usr/bin/python3 - "$show" "$tmp/moved.json" "$tmp/play.csv" <<'PY' || fail "recorded show"
-import csv, json, math, sys, yaml
+import bisect, csv, itertools, json, math, sys, yaml
 show = yaml.safe_load(open(sys.argv[1]))
 moved = json.load(open(sys.argv[2]))
 def at(keys, t):  # the show's linear interpolation
@@ -98,29 +98,30 @@ assert all(len(show["joints"][n]["keys"]) == 2 for n in still), "a still joint g
 # the shape must then match within 1 deg everywhere.
 # A move took effect between its sending and its acknowledgement: the
 # closest moment of that window counts.
-def worst(curve, shift):
+checked = [([sent + (acked - sent) * k / 4 for k in range(5)], hip, knee)
+           for sent, acked, hip, knee in itertools.takewhile(lambda m: m[0] <= 2.6, moved)]
+def worst(curve, shift, enough=math.inf):  # stops once at `enough`: it can only grow
     err = 0
-    for sent, acked, hip, knee in moved:
-        if sent > 2.6: break
-        window = [sent + (acked - sent) * k / 4 for k in range(5)]
+    for window, hip, knee in checked:
         err = max(err, min(max(abs(curve("lf_hip", t + shift) - hip),
                                abs(curve("rf_knee", t + shift) - knee)) for t in window))
+        if err >= enough: break
     return err
+def best(curve, shifts):  # the least worst() over the shifts
+    least = math.inf
+    for s in shifts:
+        least = min(least, worst(curve, s, least))
+    return least
 shifts = [i * 0.002 for i in range(-50, 51)]
-keys_err = min(worst(lambda n, t: at(tracks[n], t), s) for s in shifts)
+keys_err = best(lambda n, t: at(tracks[n], t), shifts)
 assert keys_err <= 1.0, f"show keys stray {keys_err:.2f} deg from what was moved"
 rows = list(csv.DictReader(open(sys.argv[3])))
 times = [float(r["time_s"]) for r in rows]
 meas = {n: [math.degrees(float(r[n + "_meas_rad"])) for r in rows] for n in tracks}
-def played(n, t):
-    lo, hi = 0, len(times) - 1
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if times[mid] < t: lo = mid + 1
-        else: hi = mid
-    return meas[n][lo]
+def played(n, t):  # the first sample at or after t (the last one after the run)
+    return meas[n][min(bisect.bisect_left(times, t), len(times) - 1)]
 # The playback starts after the start ramp: search the shift over the run.
-play_err = min(worst(played, s) for s in [i * 0.005 for i in range(0, int((times[-1] - 3) / 0.005))])
+play_err = best(played, [i * 0.005 for i in range(0, int((times[-1] - 3) / 0.005))])
 assert play_err <= 1.0, f"playback strays {play_err:.2f} deg from what was moved"
 print(f"keys within {keys_err:.2f} deg, playback within {play_err:.2f} deg")
 PY

@@ -20,6 +20,10 @@ trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 serve_in_background() {
+  # Emptied first: the new process may not have truncated them yet when
+  # await_line first looks, and an earlier serve's lines are in them.
+  : > "$tmp/out.txt"
+  : > "$tmp/err.txt"
   "$animrt" serve "$@" > "$tmp/out.txt" 2> "$tmp/err.txt" &
   pid=$!
 }
