@@ -25,6 +25,7 @@
 #include "evolve_pareto.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
+#include "walk_as_robot.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -32,6 +33,7 @@ namespace {
 struct EvolveArgs {
   std::string run_file;
   std::string out;
+  std::string robot;  // overrides the run file's robot:
   std::optional<int> threads;
   std::optional<std::uint64_t> seed;
   std::optional<int> population;
@@ -83,6 +85,7 @@ evolve::RunConfig load_config(const EvolveArgs& a) {
   // --generations counts the initial one; the run file counts those after it.
   if (a.generations) config.search.generations = *a.generations - 1;
   if (a.threads) config.threads = *a.threads;
+  if (!a.robot.empty()) config.robot = a.robot;
   if (config.search.elites >= config.search.population) {
     config.search.elites = std::max(0, config.search.population - 1);
   }
@@ -136,10 +139,11 @@ void print_header(const evolve::RunConfig& config, const evolve::ModelInfo& info
             << (config.search.mapping == evolve::Mapping::structured ? " (structured mapping)" : "")
             << ", model " << config.model << " (" << info.joints.size() << " actuators, "
             << info.mass_kg << " kg), population " << config.search.population << ", "
-            << config.search.generations + 1 << " generations, seed " << config.search.seed
-            << ", " << workers << " worker" << (workers == 1 ? "" : "s")
-            << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n'
-            << std::flush;
+            << config.search.generations + 1 << " generations, seed " << config.search.seed << ", "
+            << workers << " worker" << (workers == 1 ? "" : "s")
+            << (session ? " over " + std::to_string(session->size()) + " MPI ranks" : "") << '\n';
+  if (!config.robot.empty()) std::cout << describe_walk_as_robot(config.robot, config.walk) << '\n';
+  std::cout << std::flush;
 }
 
 // The history (CSV and plot) and the best gait written, the best reported.
@@ -211,6 +215,7 @@ int run_evolve(const EvolveArgs& a) {
   check_seed_drives_model(seed, factory);
   evolve::ModelInfo info{factory.model().actuated_joints, factory.model().hip_height_m,
                          factory.model().mass_kg};
+  if (!config.robot.empty()) walk_as_robot(config.robot, info, config.walk);
 
   std::unique_ptr<evolve::MpiSession> session;
   if (a.mpi) session = std::make_unique<evolve::MpiSession>(nullptr, nullptr);
@@ -259,6 +264,11 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--out", args->out,
                   "gait file to write (best of the last generation); with --pareto, a folder")
       ->required();
+  cmd->add_option("--robot", args->robot,
+                  "score every gait as this robot file's figure plays it: its joint limits at "
+                  "its loop rate, the reflex reading the attitude as its IMU reports it "
+                  "(overrides the run file's robot:)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--threads", args->threads, "evaluation threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--seed", args->seed, "random seed (overrides the run file)");

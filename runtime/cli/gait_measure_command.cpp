@@ -6,16 +6,17 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/evolve/fitness.hpp"
-#include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
 #include "gait_command.hpp"
 #include "subcommand.hpp"
+#include "walk_as_robot.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -28,9 +29,10 @@ struct MeasureArgs {
   double settle_s = 0.5;
   int warmup_cycles = 1;
   int measure_cycles = 3;
-  double balance_delay_ms = 0.0;
-  double balance_period_ms = 0.0;
-  std::string robot;  // play through this robot file's joint limits and loop rate
+  // Unset: every physics step and at once, or as the robot's IMU reports.
+  std::optional<double> balance_delay_ms;
+  std::optional<double> balance_period_ms;
+  std::string robot;  // play as this robot file's figure plays (walk_as_robot.hpp)
 };
 
 struct Stat {
@@ -49,24 +51,6 @@ struct Stat {
   }
 };
 
-// The robot file's limits, one per model joint (by name), and its loop period:
-// the walk plays its targets through the runtime's safety filter with them.
-void limit_as_robot(const std::string& path, const evolve::ModelInfo& model,
-                    evolve::WalkSettings& settings) {
-  const RobotConfig robot = load_robot_config(path);
-  settings.joint_limits.clear();
-  for (const std::string& name : model.joints) {
-    const auto it = std::find_if(robot.joints.begin(), robot.joints.end(),
-                                 [&](const JointSpec& j) { return j.name == name; });
-    if (it == robot.joints.end()) {
-      throw InputError(Location{path, 0, 0}, "joints",
-                       "no joint " + quote(name) + " of the model (--robot needs them all)");
-    }
-    settings.joint_limits.push_back(it->limits);
-  }
-  settings.limits_period_s = 1.0 / robot.rate_hz;
-}
-
 int run_measure(const MeasureArgs& a) {
   const GaitFile gait = load_gait_file(a.gait);
   sim::MujocoGaitSimulatorFactory factory(a.physics);
@@ -79,9 +63,9 @@ int run_measure(const MeasureArgs& a) {
   settings.warmup_cycles = a.warmup_cycles;
   settings.measure_cycles = a.measure_cycles;
   settings.perturb_rad = a.perturb_deg * M_PI / 180.0;
-  settings.balance_delay_s = a.balance_delay_ms / 1000.0;
-  settings.balance_period_s = a.balance_period_ms / 1000.0;
-  if (!a.robot.empty()) limit_as_robot(a.robot, simulator->info(), settings);
+  if (!a.robot.empty()) walk_as_robot(a.robot, simulator->info(), settings);
+  if (a.balance_delay_ms) settings.balance_delay_s = *a.balance_delay_ms / 1000.0;
+  if (a.balance_period_ms) settings.balance_period_s = *a.balance_period_ms / 1000.0;
 
   std::printf("walking %s on %s: %d starts, %.2f Hz, hip height %.3f m\n", a.gait.c_str(),
               a.physics.c_str(), a.seeds, f, h);
@@ -93,11 +77,13 @@ int run_measure(const MeasureArgs& a) {
     std::printf(
         "balance reflex: tilt_m %g, tilt_rate_m_s %g (legs on the ground stretch up to %g m)\n",
         gait.balance->tilt_m, gait.balance->tilt_rate_m_s, kMaxBalanceStretchM);
-    if (a.balance_delay_ms > 0.0) {
-      std::printf("balance reflex reads the trunk's attitude %g ms late\n", a.balance_delay_ms);
+    if (settings.balance_delay_s > 0.0) {
+      std::printf("balance reflex reads the trunk's attitude %g ms late\n",
+                  settings.balance_delay_s * 1000.0);
     }
-    if (a.balance_period_ms > 0.0) {
-      std::printf("balance reflex reads the trunk's attitude every %g ms\n", a.balance_period_ms);
+    if (settings.balance_period_s > 0.0) {
+      std::printf("balance reflex reads the trunk's attitude every %g ms\n",
+                  settings.balance_period_s * 1000.0);
     }
   }
   std::printf("%5s %6s %9s %9s %8s %9s %10s\n", "start", "fell", "fall s", "m/s", "stride m",
@@ -163,7 +149,8 @@ void add_gait_measure_command(CLI::App& gait) {
   cmd->add_option("--robot", args->robot,
                   "play the targets through this robot file's joint velocity, acceleration and "
                   "position limits at its loop rate, as `animrt run` does (its joints named as "
-                  "the model's)")
+                  "the model's); with an IMU in its imus:, the reflex reads the attitude at the "
+                  "part's report period and latency unless the --balance options say otherwise")
       ->check(CLI::ExistingFile);
   set_subcommand_body(cmd, [args] { return run_measure(*args); });
 }

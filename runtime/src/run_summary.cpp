@@ -62,6 +62,10 @@ void add_physics(std::string& out, const PhysicsReport& p) {
       p.falls > 0 ? fmt::format(" (first at {:.2f} s)", p.first_fall_s) : std::string()));
   line(fmt::format("physics, motion only: forward {:.3f} m in {:.2f} s, average speed {:.3f} m/s",
                    p.motion_forward_m, p.motion_s, p.average_speed_m_s));
+  if (p.duty_factor >= 0.0) {
+    line(fmt::format("physics, motion only: stride {:.3f} m, duty factor {:.3f}", p.stride_length_m,
+                     p.duty_factor));
+  }
   if (p.lockstep_waits_timed_out > 0) {
     line(
         fmt::format("physics: a bus kept the others waiting {} time(s); this lockstep run may "
@@ -128,7 +132,9 @@ nlohmann::json physics_json(const PhysicsReport& p) {
                         {"average_speed_m_s", p.average_speed_m_s},
                         {"falls", p.falls},
                         {"first_fall_s", p.first_fall_s},
-                        {"lockstep_waits_timed_out", p.lockstep_waits_timed_out}};
+                        {"lockstep_waits_timed_out", p.lockstep_waits_timed_out},
+                        {"stride_length_m", p.stride_length_m},
+                        {"duty_factor", p.duty_factor}};
 }
 
 }  // namespace

@@ -13,18 +13,12 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/core/joint.hpp"
 #include "animrt/core/safety_filter.hpp"
+#include "animrt/sim/mujoco/foot_meter.hpp"
 #include "animrt/sim/mujoco/mujoco_leg_model.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
 
 namespace animrt::sim {
 namespace {
-
-// A landing counts only after the foot was in the air for this fraction of
-// a stride: a real swing. Contacts chatter when a foot lands, and a foot
-// that bounces or stumbles touches down again within a tenth of a stride;
-// counting those as strides made the stride length a fraction of what the
-// walk covers per cycle (measured against speed / frequency in docs/evolve.md).
-constexpr double kMinSwingStrides = 0.15;
 
 int root_qpos(const mjModel* m, int torso) {
   const int j = m->body_jntadr[torso];
@@ -207,20 +201,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     limited.emplace(settings.joint_limits, settings.limits_period_s, d->ctrl);
   }
 
-  const std::size_t feet = mm.foot_geoms.size();
-  std::vector<int> foot_of(static_cast<std::size_t>(m->ngeom), -1);
-  for (std::size_t i = 0; i < feet; ++i)
-    foot_of[static_cast<std::size_t>(mm.foot_geoms[i])] = static_cast<int>(i);
-  std::vector<char> contact(feet, 0);
-  // A foot already down when measuring starts has not landed: only a foot
-  // that was in the air counts.
-  std::vector<long> air_steps(feet, 0);
-  std::vector<long> contact_steps(feet, 0);
-  struct Landing {
-    double t, x;
-  };
-  std::vector<std::vector<Landing>> landings(feet);
-  const long min_swing = std::max(1L, steps_for(kMinSwingStrides / f));
+  FootMeter feet(mm, dt, f);
   double energy = 0.0;
   double max_tilt = 0.0;  // rad
   double x0 = 0.0;
@@ -248,25 +229,7 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
     if (step == settle + warmup - 1) x0 = d->xpos[3 * mm.torso_body];
     if (step < settle + warmup) continue;
 
-    std::fill(contact.begin(), contact.end(), 0);
-    for (int c = 0; c < d->ncon; ++c) {
-      for (int g : {d->contact[c].geom1, d->contact[c].geom2}) {
-        const int foot = foot_of[static_cast<std::size_t>(g)];
-        if (foot >= 0) contact[static_cast<std::size_t>(foot)] = 1;
-      }
-    }
-    for (std::size_t i = 0; i < feet; ++i) {
-      if (contact[i]) {
-        if (air_steps[i] >= min_swing) {
-          landings[i].push_back(
-              {static_cast<double>(step) * dt, d->geom_xpos[3 * mm.foot_geoms[i]]});
-        }
-        air_steps[i] = 0;
-        ++contact_steps[i];
-      } else {
-        ++air_steps[i];
-      }
-    }
+    feet.step(d, static_cast<double>(step) * dt);
     for (int a = 0; a < m->nu; ++a) {
       energy += std::fabs(d->actuator_force[a] * d->actuator_velocity[a]) * dt;
     }
@@ -279,22 +242,8 @@ evolve::GaitMeasures MujocoGaitSimulator::walk(const GaitFile& gait,
   const double window = static_cast<double>(measure) * dt;
   out.distance = d->xpos[3 * mm.torso_body] - x0;
   out.speed = out.distance / window;
-  double contact_sum = 0;
-  for (long c : contact_steps) contact_sum += static_cast<double>(c);
-  out.duty_factor = contact_sum / (static_cast<double>(feet) * static_cast<double>(measure));
-  // A foot's advance from its first landing to its last, per stride period
-  // between them. A foot that bounces or stumbles lands more than once a
-  // stride; counting each landing as a stride would shorten it.
-  double stride_sum = 0;
-  double strides = 0;
-  for (const auto& l : landings) {
-    if (l.size() < 2) continue;
-    const double periods = std::round((l.back().t - l.front().t) * f);
-    if (periods < 1) continue;
-    stride_sum += l.back().x - l.front().x;
-    strides += periods;
-  }
-  out.stride_length = strides > 0 ? stride_sum / strides : 0.0;
+  out.duty_factor = feet.duty_factor();
+  out.stride_length = feet.stride_length_m();
   out.energy_per_cycle = energy / settings.measure_cycles;
   out.max_tilt_deg = max_tilt * 180.0 / M_PI;
   return out;

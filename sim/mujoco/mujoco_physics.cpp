@@ -145,6 +145,12 @@ void MujocoJointPhysics::step() {
     motion_x1_ = x;
     motion_t1_ = t;
   }
+  if (feet_ && start_mark_ == kRecorded && end_mark_ != kRecorded) feet_->step(data_.get(), t);
+}
+
+void MujocoJointPhysics::measure_feet(double stride_frequency_hz) {
+  std::lock_guard lock(mutex_);
+  feet_.emplace(meta_, model_->opt.timestep, stride_frequency_hz);
 }
 
 void MujocoJointPhysics::mark_motion_start() {
@@ -201,6 +207,10 @@ PhysicsMeasures MujocoJointPhysics::measures() const {
   out.first_fall_s = first_fall_s_;
   out.fallen = fallen_;
   out.lockstep_waits_timed_out = waits_timed_out_;
+  if (feet_) {
+    out.stride_length_m = feet_->stride_length_m();
+    out.duty_factor = feet_->duty_factor();
+  }
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/sim/mujoco/mujoco_physics.hpp"
 
@@ -69,6 +70,11 @@ std::vector<std::string> SimulatedBackend::start(RobotConfig& config, const Cloc
                                                              config.file, clock.now());
     physics = own_physics_.get();
     lines.push_back("physics: " + settings_.physics_model + " drives the simulated servos");
+    // A gait's feet are counted as the gait fitness counts them, so the
+    // run's stride and duty compare with gait measure's.
+    if (config.motion.type == "gait") {
+      own_physics_->measure_feet(load_gait_file(config.motion.file).stride_frequency());
+    }
   }
   devices_ = start_simulated_devices(config.buses, clock, physics);
   for (const auto& device : devices_) lines.push_back("simulated devices: " + device->describe());
@@ -126,6 +132,8 @@ void SimulatedBackend::report(RunSummary& summary) const {
   report.falls = m.falls;
   report.first_fall_s = m.first_fall_s;
   report.lockstep_waits_timed_out = m.lockstep_waits_timed_out;
+  report.stride_length_m = m.stride_length_m;
+  report.duty_factor = m.duty_factor;
   summary.physics = report;
 }
 

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "animrt/controllers/gait/gait_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/figure.hpp"
 #include "animrt/runtime/robot_loader.hpp"
@@ -180,6 +181,15 @@ TEST_F(PhysicsBackend, EvolvedGaitCarriesTheFigureForwardWithoutFalling) {
   EXPECT_NEAR(walk.physics.motion_s, kMotionS, 0.006);
   EXPECT_GT(walk.physics.motion_forward_m, 0.5 * walk.physics.forward_m);
   EXPECT_LE(walk.physics.motion_forward_m, walk.physics.forward_m + 0.02);
+  // The feet counted as the gait fitness counts them: a stride is what the
+  // figure covers in a stride period, and the feet are down part of it.
+  const double frequency =
+      load_gait_file(kSourceRoot + "/configs/gaits/quadruped_evolved.yaml").stride_frequency();
+  EXPECT_NEAR(walk.physics.stride_length_m,
+              walk.physics.motion_forward_m / walk.physics.motion_s / frequency,
+              0.25 * walk.physics.stride_length_m);
+  EXPECT_GT(walk.physics.duty_factor, 0.2);
+  EXPECT_LT(walk.physics.duty_factor, 0.95);
   // What the runtime measured over the wire is the physics' joint angle
   // (zero and direction of each binding applied), within a tick.
   ASSERT_EQ(walk.measured_at_end.size(), walk.joints_at_end.size());
@@ -198,6 +208,9 @@ TEST_F(PhysicsBackend, HoldingTheHomePoseGoesNowhere) {
   EXPECT_LT(std::abs(still.physics.sideways_m), 0.01);
   EXPECT_NEAR(still.physics.motion_s, kMotionS, 0.006);
   EXPECT_LT(std::abs(still.physics.motion_forward_m), 0.01);
+  // Standing: every foot down all the time, none ever lands.
+  EXPECT_EQ(still.physics.stride_length_m, 0.0);
+  EXPECT_GT(still.physics.duty_factor, 0.99);
 }
 
 TEST_F(PhysicsBackend, LockstepRunsAreIdentical) {

@@ -304,7 +304,7 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
             "run.yaml:5:22: search.population: expected an integer from 2 to 1000000, found \"1\"");
   EXPECT_EQ(error_of(head + "bogus: 1\n"),
             "run.yaml:5:1: bogus: unknown key (expected one of: name, grammar, model, seed_gait, "
-            "search, walk, fitness, threads)");
+            "robot, search, walk, fitness, threads)");
   EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 3}]}\n"),
             "run.yaml:5:39: fitness.weights[0].from_generation: the first stage must start at "
             "generation 0");
@@ -318,6 +318,8 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(ok.search.mapping, Mapping::standard);
   EXPECT_TRUE(ok.search.remember_walks);
   EXPECT_EQ(ok.grammar, "/a/b/g.bnf");
+  EXPECT_EQ(ok.robot, "");  // the walk as the physics alone plays it
+  EXPECT_EQ(parse_run_config(head + "robot: ../r.yaml\n", "/a/b/run.yaml").robot, "/a/r.yaml");
   EXPECT_EQ(ok.search.population, 75);
   EXPECT_EQ(ok.search.elites, 7);
   ASSERT_EQ(ok.weights.size(), 1u);

@@ -30,7 +30,7 @@ double get_in(const YamlNode& n, std::string_view key, double fallback, double l
 
 RunConfig from_root(const YamlNode& root) {
   root.allow_only(
-      {"name", "grammar", "model", "seed_gait", "search", "walk", "fitness", "threads"});
+      {"name", "grammar", "model", "seed_gait", "robot", "search", "walk", "fitness", "threads"});
   RunConfig c;
   c.file = root.file();
   c.name = root.at("name").as_string();
@@ -39,6 +39,7 @@ RunConfig from_root(const YamlNode& root) {
   c.model = resolve(c.file, root.at("model").as_string());
   c.seed_gait = resolve(c.file, root.at("seed_gait").as_string());
   c.threads = get_int(root, "threads", 0, 0, 1024);
+  if (auto r = root.find("robot")) c.robot = resolve(c.file, r->as_string());
 
   if (auto s = root.find("search")) {
     s->allow_only({"seed", "population", "generations", "elites", "tournament", "crossover",

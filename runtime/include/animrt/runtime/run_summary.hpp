@@ -64,6 +64,10 @@ struct PhysicsReport {
   int falls = 0;                     // upright -> fallen transitions (the gait fitness's criterion)
   double first_fall_s = -1.0;        // physics time of the first fall, -1 if none
   int lockstep_waits_timed_out = 0;  // a bus was late to a lockstep step: the run may not repeat
+  // A gait's feet during the motion, counted as the gait fitness counts
+  // them (-1: the motion is not a gait).
+  double stride_length_m = -1.0;
+  double duty_factor = -1.0;
 };
 
 enum class EndReason { duration, signal, fault };

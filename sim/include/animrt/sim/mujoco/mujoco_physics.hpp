@@ -18,11 +18,13 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "animrt/core/joint.hpp"
 #include "animrt/sim/joint_physics.hpp"
+#include "animrt/sim/mujoco/foot_meter.hpp"
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
 namespace animrt::sim {
@@ -50,6 +52,10 @@ struct PhysicsMeasures {
   double first_fall_s = -1.0;        // simulated time of the first fall, -1 if none
   bool fallen = false;               // fallen at the end
   int lockstep_waits_timed_out = 0;  // a bus kept the others waiting past the lockstep wait
+  // The feet over the motion, counted as the gait fitness counts them
+  // (FootMeter); -1 unless measure_feet() was called.
+  double stride_length_m = -1.0;
+  double duty_factor = -1.0;
 };
 
 // What an IMU on the torso measures: its attitude in the world (w, x, y, z,
@@ -93,6 +99,11 @@ class MujocoJointPhysics final : public JointPhysics {
   // lockstep the next step is the same one in every run.
   void mark_motion_start();
   void mark_motion_end();
+
+  // Counts the feet's contacts over the motion (between the marks) for a
+  // gait of this stride frequency, as the gait fitness does; before the
+  // motion starts.
+  void measure_feet(double stride_frequency_hz);
 
   PhysicsMeasures measures() const;
   TorsoPose torso_pose() const;
@@ -146,6 +157,7 @@ class MujocoJointPhysics final : public JointPhysics {
   std::atomic<int> end_mark_{kNone};
   double motion_x0_ = 0.0, motion_t0_ = 0.0;  // recorded at the start mark
   double motion_x1_ = 0.0, motion_t1_ = 0.0;  // recorded at the end mark
+  std::optional<FootMeter> feet_;             // with measure_feet()
 };
 
 }  // namespace animrt::sim

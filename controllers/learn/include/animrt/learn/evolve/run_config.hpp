@@ -53,6 +53,10 @@ struct RunConfig {
       seed_gait;  // path: timing (froude), limbs, joint mapping, curve names in grammar order
   SearchSettings search;
   WalkSettings walk;
+  // Path of a robot file (`robot:`): the walk is played as that figure
+  // plays it (its joint limits, loop period and IMU); empty: as the physics
+  // alone. The command line applies it (it knows robot files).
+  std::string robot;
   std::vector<WeightStage> weights;   // at least one, the first from generation 0
   std::vector<FreedomStage> freedom;  // empty: every curve free all the time
   int threads = 0;                    // 0: all cores
