@@ -7,7 +7,11 @@ namespace animrt {
 namespace {
 
 constexpr double kSettledVelocity = 1e-3;  // rad/s: the stop ramp has ended
-constexpr double kMaxSettleTime = 2.0;     // s after the stop ramp, at most
+// A joint has arrived at the stop pose when measured this close to it (rad
+// or m) for kArrivedHold seconds on end: near enough, and still.
+constexpr double kArrivedRad = 0.05;  // about 3 deg
+constexpr double kArrivedM = 0.003;
+constexpr double kArrivedHold = 0.05;
 // A late bus is judged by its answers once its I/O thread is done (every
 // transaction is bounded by the bus timeout); only a bus stuck for ten
 // watchdog times, at most the watchdog plus two seconds (a thread that never
@@ -139,6 +143,7 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
   phase_ = Phase::stop_ramp;
   phase_start_ = t;
   stop_start_ = t;
+  arrived_since_ = -1.0;
 }
 
 void CycleState::begin_hold(const RobotModel& model, double t) {
@@ -146,7 +151,8 @@ void CycleState::begin_hold(const RobotModel& model, double t) {
   // moves within the limits, and nothing heads for home.
   const auto position = filter_.position();
   std::copy(position.begin(), position.end(), ramp_from_.begin());
-  ramp_.plan(ramp_from_, ramp_from_, model.limits, model.safety.tilt_hold_s);
+  std::copy(position.begin(), position.end(), ramp_to_.begin());
+  ramp_.plan(ramp_from_, ramp_to_, model.limits, model.safety.tilt_hold_s);
   if (phase_ == Phase::motion) {
     motion_time_ = t - motion_start_;
     emit(CycleEvent{EventKind::motion_ended, t});
@@ -154,6 +160,7 @@ void CycleState::begin_hold(const RobotModel& model, double t) {
   phase_ = Phase::stop_ramp;
   phase_start_ = t;
   stop_start_ = t;
+  arrived_since_ = -1.0;
 }
 
 // The stages of step(), in the order it runs them. Each reads and writes the
@@ -539,13 +546,53 @@ struct CycleStages {
     }
   }
 
-  // The run is done once the stop ramp has ended and the joints have
-  // settled (or the settling took too long).
-  static void settle(CycleState& s, double t) {
+  // A joint that can move and was measured away from its stop pose this
+  // cycle. A faulted joint is held, and one whose device did not answer
+  // this cycle has no measurement: neither is waited for (the watchdogs
+  // judge a silent device).
+  static bool off_stop_pose(const RobotModel& model, const CycleState& s, std::size_t j, double t) {
+    const JointSlot slot = s.slots_[j];
+    if (s.joint_faulted(j) || !s.active_[j] || s.last_ok_[slot.bus][slot.device] != t) {
+      return false;
+    }
+    const double tolerance = model.prismatic[j] ? kArrivedM : kArrivedRad;
+    return !(std::abs(s.measured_[j] - s.ramp_to_[j]) <= tolerance);
+  }
+
+  // How long after its start a stop waits for the joints: the settling
+  // time after the ramp, ending a cycle before the stop deadline would cut
+  // torque without the warning.
+  static double settle_limit(const RobotModel& model, const CycleState& s) {
+    return std::min(s.ramp_.duration() + kStopSettleTime,
+                    std::max(s.ramp_.duration(), model.safety.stop_deadline_s - model.dt));
+  }
+
+  // The run is done once the stop ramp has ended, the command is at rest and
+  // every joint that can move is measured at the stop pose, still: after a
+  // stalled cycle the command may rest while the servos still travel, and
+  // torque off there would drop them short of home. A joint that has not
+  // arrived a bounded time after the ramp is named, and torque goes off.
+  static void settle(const RobotModel& model, CycleState& s, double t) {
     if (s.phase_ != Phase::stop_ramp || t - s.phase_start_ < s.ramp_.duration()) return;
     double fastest = 0.0;
     for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
-    if (fastest < kSettledVelocity || t - s.phase_start_ >= s.ramp_.duration() + kMaxSettleTime) {
+    bool arrived = fastest < kSettledVelocity;
+    for (std::size_t j = 0; arrived && j < s.slots_.size(); ++j) {
+      arrived = !off_stop_pose(model, s, j, t);
+    }
+    if (!arrived) {
+      s.arrived_since_ = -1.0;
+    } else if (s.arrived_since_ < 0.0) {
+      s.arrived_since_ = t;
+    }
+    if (arrived && t - s.arrived_since_ >= kArrivedHold - kTimeEps) {
+      s.phase_ = Phase::done;
+    } else if (t - s.phase_start_ >= settle_limit(model, s) - kTimeEps) {
+      for (std::size_t j = 0; j < s.slots_.size(); ++j) {
+        if (!off_stop_pose(model, s, j, t)) continue;
+        s.emit(CycleEvent{EventKind::stop_unreached, t, static_cast<int>(j), s.slots_[j].bus,
+                          s.slots_[j].device, DeviceHealth::ok, s.measured_[j] - s.ramp_to_[j]});
+      }
       s.phase_ = Phase::done;
     }
   }
@@ -582,7 +629,7 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
   S::control_show(motion, s, in, out);
   S::sample_targets(model, motion, s, in.t);
   S::filter_and_route(s, in, out);
-  S::settle(s, in.t);
+  S::settle(model, s, in.t);
   ++s.cycles_;
   return out;
 }

@@ -31,6 +31,10 @@ namespace animrt {
 
 enum class Phase { start_ramp, motion, stop_ramp, done };
 
+// How long after its ramp a stop waits for the joints to arrive (s), at
+// most, and never up to the stop deadline.
+inline constexpr double kStopSettleTime = 2.0;
+
 // One bus's results for this cycle.
 struct BusIo {
   // Its read came back in time: positions and health are this cycle's, and
@@ -84,6 +88,7 @@ enum class EventKind : std::uint8_t {
   health_warning,   // bus, device, check, value: logged and counted; the run goes on
   sensor_stale,     // an IMU silent past its stale timeout: bus = IMU index, value = age (s)
   tilted,           // the tilt watch: value = the larger of |roll| and |pitch| (rad)
+  stop_unreached,   // joint, value = measured - stop pose: not there when torque went off
 };
 
 // Which health limit an event is about.
@@ -182,6 +187,7 @@ class CycleState {
   double phase_start_ = 0.0;
   double motion_start_ = 0.0;
   double stop_start_ = 0.0;
+  double arrived_since_ = -1.0;  // the joints measured at the stop pose since (s)
   double motion_time_ = 0.0;
   CycleEnd end_;
   std::uint64_t cycles_ = 0;
