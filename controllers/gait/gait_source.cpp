@@ -3,6 +3,7 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -12,6 +13,24 @@
 
 namespace animrt {
 namespace {
+
+// Strides a plain gait takes to wind down at a stop.
+constexpr double kWindDownStrides = 2.0;
+constexpr int kGaitMeanSamples = 256;
+
+// Each curve's mean over one stride, summed as fractions so a finite but
+// huge curve does not overflow.
+std::vector<double> stride_means(const std::vector<Expression>& curves) {
+  std::vector<double> means;
+  for (const Expression& c : curves) {
+    double mean = 0.0;
+    for (int i = 0; i < kGaitMeanSamples; ++i) {
+      mean += c.eval(static_cast<double>(i) / kGaitMeanSamples) / kGaitMeanSamples;
+    }
+    means.push_back(mean);
+  }
+  return means;
+}
 
 class GaitSource final : public MotionSource {
  public:
@@ -25,7 +44,10 @@ class GaitSource final : public MotionSource {
   };
 
   GaitSource(double frequency, std::vector<Expression> curves, std::vector<Drive> drives)
-      : frequency_(frequency), curves_(std::move(curves)), drives_(std::move(drives)) {
+      : frequency_(frequency),
+        curves_(std::move(curves)),
+        means_(stride_means(curves_)),
+        drives_(std::move(drives)) {
     for (const Drive& d : drives_) driven_.push_back(d.joint);
   }
 
@@ -33,19 +55,39 @@ class GaitSource final : public MotionSource {
 
   void sample(double t, std::span<double> targets) const override {
     const double cycles = frequency_ * t;
+    const double rest = 1.0 - swing_at(t);  // 0 while walking: the curves exactly
     for (const Drive& d : drives_) {
       if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
-      const double deg =
-          d.gain * curves_[static_cast<std::size_t>(d.curve)].eval(cycles - d.phase) + d.offset_deg;
+      const auto c = static_cast<std::size_t>(d.curve);
+      const double value = curves_[c].eval(cycles - d.phase);
+      const double deg = d.gain * (value + rest * (means_[c] - value)) + d.offset_deg;
       targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);
     }
   }
 
+  // The walk winds down over kWindDownStrides strides: every joint's swing
+  // about its stride mean fades to nothing while the legs keep the cadence,
+  // so the steps shorten and the body slows with them.
+  double wind_down(double t) override {
+    wind_start_ = t;
+    return kWindDownStrides / frequency_;
+  }
+
  private:
+  // The swing's scale at motion time t: 1 while walking, easing to 0 over
+  // the wind-down (smoothstep: no jump in the joints' speed at either end).
+  double swing_at(double t) const {
+    if (wind_start_ < 0.0 || t <= wind_start_) return 1.0;
+    const double u = std::min(1.0, (t - wind_start_) * frequency_ / kWindDownStrides);
+    return 1.0 - u * u * (3.0 - 2.0 * u);
+  }
+
   double frequency_;
   std::vector<Expression> curves_;
+  std::vector<double> means_;  // per curve, over one stride: the pose a wound-down walk stands in
   std::vector<Drive> drives_;
   std::vector<int> driven_;
+  double wind_start_ = -1.0;  // motion time the wind-down began (-1: walking)
 };
 
 std::string joint_names(std::span<const JointSpec> joints) {

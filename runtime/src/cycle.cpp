@@ -140,10 +140,33 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
     motion_time_ = t - motion_start_;
     emit(CycleEvent{EventKind::motion_ended, t});
   }
+  // After a wind-down the stop began at its request: the deadline counts from there.
+  if (phase_ != Phase::stop_ramp) stop_start_ = t;
+  phase_ = Phase::stop_ramp;
+  phase_start_ = t;
+  arrived_since_ = -1.0;
+  wind_end_ = -1.0;
+}
+
+void CycleState::request_stop(const RobotModel& model, MotionSource& motion, double t) {
+  // The wind-down leaves the ramp and the settling their time before the
+  // stop deadline, which counts from the request.
+  const double room =
+      model.safety.stop_deadline_s - model.safety.stop_ramp_s - kStopSettleTime - model.dt;
+  const double wind = phase_ == Phase::motion && !manual_
+                          ? std::min(motion.wind_down(t - motion_start_), room)
+                          : 0.0;
+  if (!(wind >= model.dt)) {
+    begin_stop(model, t);
+    return;
+  }
+  motion_time_ = t - motion_start_;
+  emit(CycleEvent{EventKind::motion_ended, t});
   phase_ = Phase::stop_ramp;
   phase_start_ = t;
   stop_start_ = t;
   arrived_since_ = -1.0;
+  wind_end_ = t + wind;
 }
 
 void CycleState::begin_hold(const RobotModel& model, double t) {
@@ -161,6 +184,7 @@ void CycleState::begin_hold(const RobotModel& model, double t) {
   phase_start_ = t;
   stop_start_ = t;
   arrived_since_ = -1.0;
+  wind_end_ = -1.0;
 }
 
 // The stages of step(), in the order it runs them. Each reads and writes the
@@ -169,7 +193,8 @@ struct CycleStages {
   // Controls from outside, read once at the start of the cycle.
   static void take_controls(const RobotModel& model, MotionSource& motion, CycleState& s,
                             const CycleInputs& in) {
-    if (in.steer) motion.steer(*in.steer);
+    // A winding-down walk is not steered back into walking.
+    if (in.steer && !s.winding_down()) motion.steer(*in.steer);
     const JogCommand* jog = in.jog;
     if (jog && jog->joint >= 0 && static_cast<std::size_t>(jog->joint) < model.joint_count() &&
         std::isfinite(jog->offset)) {
@@ -438,18 +463,22 @@ struct CycleStages {
 
   // Phase changes: a fault or a stop starts the stop ramp, so does the end of
   // the motion's duration; the end of the start ramp starts the motion.
-  static void change_phase(const RobotModel& model, CycleState& s, const CycleInputs& in,
-                           bool fault) {
-    if (s.phase_ == Phase::stop_ramp) return;
+  static void change_phase(const RobotModel& model, MotionSource& motion, CycleState& s,
+                           const CycleInputs& in, bool fault) {
     const double t = in.t;
+    if (s.phase_ == Phase::stop_ramp) {
+      // A wind-down ends in the ramp home, at its end or at once on a fault.
+      if (s.winding_down() && (fault || t >= s.wind_end_ - kTimeEps)) s.begin_stop(model, t);
+      return;
+    }
     if (fault) {
       s.begin_stop(model, t);
     } else if (in.stop) {
       s.end_.stopped = true;
-      s.begin_stop(model, t);
+      s.request_stop(model, motion, t);
     } else if (s.phase_ == Phase::motion && in.motion_duration_s > 0.0 &&
                t - s.motion_start_ >= in.motion_duration_s - kTimeEps) {
-      s.begin_stop(model, t);
+      s.request_stop(model, motion, t);
     } else if (s.phase_ == Phase::start_ramp &&
                t - s.phase_start_ >= s.ramp_.duration() - kTimeEps) {
       s.phase_ = Phase::motion;
@@ -520,10 +549,12 @@ struct CycleStages {
                              double t) {
     if (s.phase_ == Phase::motion && s.manual_) {
       std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
-    } else if (s.phase_ == Phase::motion) {
+    } else if (s.phase_ == Phase::motion || s.winding_down()) {
       sample_motion(model, motion, s, t);
     }
-    if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
+    if (s.phase_ != Phase::motion && !s.winding_down()) {
+      s.ramp_.sample(t - s.phase_start_, s.targets_);
+    }
     s.show_ = motion.show_position(s.phase_ == Phase::motion       ? t - s.motion_start_
                                    : s.phase_ == Phase::start_ramp ? 0.0
                                                                    : s.motion_time_);
@@ -563,8 +594,9 @@ struct CycleStages {
   // time after the ramp, ending a cycle before the stop deadline would cut
   // torque without the warning.
   static double settle_limit(const RobotModel& model, const CycleState& s) {
+    const double before = s.phase_start_ - s.stop_start_;  // a wind-down's
     return std::min(s.ramp_.duration() + kStopSettleTime,
-                    std::max(s.ramp_.duration(), model.safety.stop_deadline_s - model.dt));
+                    std::max(s.ramp_.duration(), model.safety.stop_deadline_s - model.dt - before));
   }
 
   // The run is done once the stop ramp has ended, the command is at rest and
@@ -573,7 +605,10 @@ struct CycleStages {
   // torque off there would drop them short of home. A joint that has not
   // arrived a bounded time after the ramp is named, and torque goes off.
   static void settle(const RobotModel& model, CycleState& s, double t) {
-    if (s.phase_ != Phase::stop_ramp || t - s.phase_start_ < s.ramp_.duration()) return;
+    if (s.phase_ != Phase::stop_ramp || s.winding_down() ||
+        t - s.phase_start_ < s.ramp_.duration()) {
+      return;
+    }
     double fastest = 0.0;
     for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
     bool arrived = fastest < kSettledVelocity;
@@ -624,7 +659,7 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     ++s.cycles_;
     return out;
   }
-  S::change_phase(model, s, in, fault);
+  S::change_phase(model, motion, s, in, fault);
   S::take_manual(model, s, in);
   S::control_show(motion, s, in, out);
   S::sample_targets(model, motion, s, in.t);

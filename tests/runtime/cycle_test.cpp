@@ -30,9 +30,15 @@ class LambdaSource : public MotionSource {
     for (std::size_t j = 0; j < targets.size(); ++j) targets[j] = fn(j, t);
   }
   void steer(const MotionCommand& command) override { steered = command; }
+  double wind_down(double t) override {
+    wound_at.push_back(t);
+    return wind;
+  }
 
   std::function<double(std::size_t, double)> fn = [](std::size_t, double) { return 0.0; };
   MotionCommand steered{-1.0, -1.0};
+  double wind = 0.0;             // what wind_down() asks for (s)
+  std::vector<double> wound_at;  // motion times wind_down() was called at
 
  private:
   std::vector<int> driven_;
@@ -485,6 +491,89 @@ TEST(Cycle, TheWaitForAJointEndsBeforeTheStopDeadlineWouldCutTorque) {
   EXPECT_LT(unreached->t - ended->t, 2.0);
   EXPECT_FALSE(bench.has(EventKind::stop_deadline));
   EXPECT_FALSE(bench.state.end().torque_cut);
+}
+
+// A source that winds down at a stop keeps playing (here its joints keep
+// moving at 0.4 rad/s) for the time it asked for; the ramp home follows, and
+// the motion ended at the request.
+TEST(Cycle, AStopRequestLetsTheMotionWindDownBeforeTheRampHome) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 0.6;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  for (int i = 0; i < 50; ++i) bench.cycle();
+  bench.in.stop = true;
+  const double asked = static_cast<double>(bench.count) / kRate;
+  bench.cycle();
+  bench.in.stop = false;
+  ASSERT_EQ(bench.motion.wound_at.size(), 1u);
+  EXPECT_NEAR(bench.motion.wound_at[0], asked - bench.state.motion_start(), 1e-9);
+  EXPECT_NEAR(bench.first(EventKind::motion_ended)->t, asked, 1e-9);
+  EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
+  EXPECT_TRUE(bench.state.winding_down());
+  while (bench.state.winding_down() && bench.count < 1000) bench.cycle();
+  const double ramp_start = static_cast<double>(bench.count - 1) / kRate;
+  EXPECT_NEAR(ramp_start - asked, 0.6, 0.011);
+  // The motion played to the end of its wind-down, 0.6 s after the request.
+  EXPECT_NEAR(bench.state.measured()[0], 0.4 * (bench.motion.wound_at[0] + 0.6), 0.01);
+  bench.run_until(Phase::done);
+  EXPECT_TRUE(bench.state.end().stopped);
+  EXPECT_FALSE(bench.state.end().fault);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(bench.state.measured()[j], 0.0, 1e-9);
+  EXPECT_EQ(bench.motion.wound_at.size(), 1u);
+}
+
+// A fault never waits for a wind-down: before one it ramps home at once,
+// and during one it ends it.
+TEST(Cycle, AFaultRampsHomeAtOnceWindingDownOrNot) {
+  for (const bool during : {false, true}) {
+    Bench bench(two_bus_model());
+    bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+    bench.motion.wind = 1.0;
+    bench.begin();
+    bench.run_until(Phase::motion);
+    for (int i = 0; i < 20; ++i) bench.cycle();
+    if (during) {
+      bench.in.stop = true;
+      bench.cycle();
+      bench.in.stop = false;
+      for (int i = 0; i < 10; ++i) bench.cycle();
+      ASSERT_TRUE(bench.state.winding_down());
+    }
+    bench.health[0][1] = DeviceHealth::hardware_error;
+    bench.cycle();
+    ASSERT_TRUE(bench.has(EventKind::device_fault));
+    EXPECT_EQ(bench.state.phase(), Phase::stop_ramp) << during;
+    EXPECT_FALSE(bench.state.winding_down()) << during;
+    EXPECT_EQ(bench.motion.wound_at.size(), during ? 1u : 0u);
+    bench.run_until(Phase::done);
+    EXPECT_TRUE(bench.state.end().fault);
+    EXPECT_NEAR(bench.state.measured()[0], 0.0, 1e-9) << during;
+  }
+}
+
+// However long a source asks to wind down, the stop leaves its ramp and the
+// wait for the joints their time before the deadline, which counts from
+// the request: the stop ends on time, without a torque cut.
+TEST(Cycle, AWindDownIsCutShortToFitTheStopDeadline) {
+  RobotModel model = two_bus_model();
+  model.safety.stop_deadline_s = 3.0;
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 100.0;
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  bench.run_until(Phase::stop_ramp);
+  const double asked = bench.first(EventKind::motion_ended)->t;
+  while (bench.state.winding_down() && bench.count < 2000) bench.cycle();
+  const double ramp_start = static_cast<double>(bench.count - 1) / kRate;
+  EXPECT_NEAR(ramp_start - asked, 3.0 - 0.5 - kStopSettleTime, 0.011);
+  bench.run_until(Phase::done);
+  EXPECT_FALSE(bench.state.end().torque_cut);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+  EXPECT_LT(static_cast<double>(bench.count) / kRate - asked, 3.0);
 }
 
 TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {

@@ -136,6 +136,8 @@ class CycleState {
 
   Phase phase() const { return phase_; }
   bool done() const { return phase_ == Phase::done; }
+  // In the stop, before its ramp: the motion still plays, winding down.
+  bool winding_down() const { return wind_end_ >= 0.0; }
   double motion_time() const { return motion_time_; }
   double motion_start() const { return motion_start_; }  // run time the motion began
   const CycleEnd& end() const { return end_; }
@@ -181,6 +183,9 @@ class CycleState {
   friend struct CycleStages;  // step()'s stages (cycle.cpp)
   void emit(const CycleEvent& event);
   void begin_stop(const RobotModel& model, double t);
+  // A stop request in the motion: the source winds down first if it asks
+  // to (MotionSource::wind_down), then the ramp home begins.
+  void request_stop(const RobotModel& model, MotionSource& motion, double t);
   void begin_hold(const RobotModel& model, double t);
 
   Phase phase_ = Phase::start_ramp;
@@ -188,6 +193,7 @@ class CycleState {
   double motion_start_ = 0.0;
   double stop_start_ = 0.0;
   double arrived_since_ = -1.0;  // the joints measured at the stop pose since (s)
+  double wind_end_ = -1.0;       // the motion winds down until (s); -1: not winding down
   double motion_time_ = 0.0;
   CycleEnd end_;
   std::uint64_t cycles_ = 0;
