@@ -54,7 +54,7 @@ class GaitSource final : public MotionSource {
   std::span<const int> driven_joints() const override { return driven_; }
 
   void sample(double t, std::span<double> targets) const override {
-    const double cycles = frequency_ * t;
+    const double cycles = frequency_ * stride_time(t);
     const double rest = 1.0 - swing_at(t);  // 0 while walking: the curves exactly
     for (const Drive& d : drives_) {
       if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
@@ -65,21 +65,34 @@ class GaitSource final : public MotionSource {
     }
   }
 
-  // The walk winds down over kWindDownStrides strides: every joint's swing
-  // about its stride mean fades to nothing while the legs keep the cadence,
-  // so the steps shorten and the body slows with them.
+  // The walk winds down over the time of kWindDownStrides strides: every
+  // joint's swing about its stride mean and the cadence ease to nothing
+  // together (as a steered gait blends to a stand), so the steps shorten
+  // and slow and the body slows with them.
   double wind_down(double t) override {
     wind_start_ = t;
     return kWindDownStrides / frequency_;
   }
 
  private:
-  // The swing's scale at motion time t: 1 while walking, easing to 0 over
-  // the wind-down (smoothstep: no jump in the joints' speed at either end).
+  // How far into the wind-down motion time t is, 0 to 1 (0 while walking).
+  double wind_at(double t) const {
+    if (wind_start_ < 0.0 || t <= wind_start_) return 0.0;
+    return std::min(1.0, (t - wind_start_) * frequency_ / kWindDownStrides);
+  }
+  // The swing's scale: 1 while walking, easing to 0 over the wind-down
+  // (smoothstep: no jump in the joints' speed at either end).
   double swing_at(double t) const {
-    if (wind_start_ < 0.0 || t <= wind_start_) return 1.0;
-    const double u = std::min(1.0, (t - wind_start_) * frequency_ / kWindDownStrides);
+    const double u = wind_at(t);
     return 1.0 - u * u * (3.0 - 2.0 * u);
+  }
+  // The gait's own time, whose rate is the swing's scale: the integral of
+  // 1 - smoothstep over the wind-down (half a wind-down's time at its end).
+  double stride_time(double t) const {
+    const double u = wind_at(t);
+    if (u <= 0.0) return t;
+    const double length = kWindDownStrides / frequency_;
+    return wind_start_ + length * (u - u * u * u + 0.5 * u * u * u * u);
   }
 
   double frequency_;
