@@ -62,6 +62,7 @@ struct Stop {
   double first_fall_s = -1.0;
   double ended_s = 0.0;  // physics time at the end of the run
   std::size_t unreached = 0;
+  std::string named;  // the joints not home at torque off
 };
 
 Stop run(const std::string& file, double walk_s, bool wind_down) {
@@ -77,7 +78,11 @@ Stop run(const std::string& file, double walk_s, bool wind_down) {
   options.raise_device_threads = nullptr;
   const RunSummary summary = figure.run(options);
   const sim::PhysicsMeasures m = simulated.mujoco_physics()->measures();
-  return {m.falls, m.first_fall_s, m.simulated_s, summary.stop_warnings.size()};
+  Stop stop{m.falls, m.first_fall_s, m.simulated_s, summary.stop_warnings.size(), ""};
+  for (const std::string& w : summary.stop_warnings) {
+    stop.named += " " + w.substr(0, w.find(" when torque"));
+  }
+  return stop;
 }
 
 }  // namespace
@@ -91,8 +96,9 @@ int main() {
     const double walk = 2.0 + 0.25 * i;
     const Stop dead = run(file, walk, false);
     const Stop wound = run(file, walk, true);
-    std::printf("%5.2f  %d %6.2f %6.2f  %d %6.2f %6.2f %zu\n", walk, dead.falls, dead.first_fall_s,
-                dead.ended_s, wound.falls, wound.first_fall_s, wound.ended_s, wound.unreached);
+    std::printf("%5.2f  %d %6.2f %6.2f  %d %6.2f %6.2f %zu%s\n", walk, dead.falls,
+                dead.first_fall_s, dead.ended_s, wound.falls, wound.first_fall_s, wound.ended_s,
+                wound.unreached, wound.named.c_str());
     dead_falls += dead.falls > 0;
     wound_falls += wound.falls > 0;
     ++runs;
