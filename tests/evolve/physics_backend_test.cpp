@@ -256,8 +256,7 @@ TEST_F(PhysicsBackend, SeedHorseWalksInALockstepRunWithoutFalling) {
 // home from mid-stride), it topples; when its walk winds down first (two
 // strides of ever shorter steps), it stands through the ramp home and the
 // wait for its joints. (Stopped dead after 2 to 7 s of walking in steps of
-// 0.25 s it fell in 5 of 21 runs; wound down over 1, 2 or 3 strides in none:
-// docs/results/horse_stop.md.)
+// 0.25 s it fell in 5 of 21 runs, wound down in none: docs/results/horse_stop.md.)
 TEST_F(PhysicsBackend, AWalkingHorseStopsOnItsFeetOnlyWhenItsWalkWindsDown) {
   files_.push_back(write_horse_robot("horse_stop"));
   constexpr double kWalkS = 2.0;
