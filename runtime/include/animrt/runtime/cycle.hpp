@@ -137,7 +137,7 @@ class CycleState {
   Phase phase() const { return phase_; }
   bool done() const { return phase_ == Phase::done; }
   // In the stop, before its ramp: the motion still plays, winding down.
-  bool winding_down() const { return wind_end_ >= 0.0; }
+  bool winding_down() const { return phase_ == Phase::stop_ramp && wind_end_ >= 0.0; }
   double motion_time() const { return motion_time_; }
   double motion_start() const { return motion_start_; }  // run time the motion began
   const CycleEnd& end() const { return end_; }
