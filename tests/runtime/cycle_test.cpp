@@ -553,6 +553,27 @@ TEST(Cycle, AFaultRampsHomeAtOnceWindingDownOrNot) {
   }
 }
 
+// A second stop (an abort) during a wind-down cuts torque at once, as
+// during a ramp.
+TEST(Cycle, AnAbortDuringAWindDownCutsTorqueAtOnce) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 1.0;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  for (int i = 0; i < 20; ++i) bench.cycle();
+  bench.in.stop = true;
+  for (int i = 0; i < 10; ++i) bench.cycle();
+  ASSERT_TRUE(bench.state.winding_down());
+  bench.in.abort = true;
+  const CycleOutputs& out = bench.cycle();
+  EXPECT_TRUE(out.torque_off_now);
+  EXPECT_TRUE(bench.state.done());
+  EXPECT_FALSE(bench.state.winding_down());
+  EXPECT_TRUE(bench.state.end().torque_cut);
+  EXPECT_TRUE(bench.has(EventKind::aborted));
+}
+
 // However long a source asks to wind down, the stop leaves its ramp and the
 // wait for the joints their time before the deadline, which counts from
 // the request: the stop ends on time, without a torque cut.
