@@ -3,6 +3,7 @@
 #include "animrt/controllers/gait/gait_source.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -12,6 +13,24 @@
 
 namespace animrt {
 namespace {
+
+// Strides a plain gait takes to wind down at a stop.
+constexpr double kWindDownStrides = 2.0;
+constexpr int kGaitMeanSamples = 256;
+
+// Each curve's mean over one stride, summed as fractions so a finite but
+// huge curve does not overflow.
+std::vector<double> stride_means(const std::vector<Expression>& curves) {
+  std::vector<double> means;
+  for (const Expression& c : curves) {
+    double mean = 0.0;
+    for (int i = 0; i < kGaitMeanSamples; ++i) {
+      mean += c.eval(static_cast<double>(i) / kGaitMeanSamples) / kGaitMeanSamples;
+    }
+    means.push_back(mean);
+  }
+  return means;
+}
 
 class GaitSource final : public MotionSource {
  public:
@@ -25,27 +44,63 @@ class GaitSource final : public MotionSource {
   };
 
   GaitSource(double frequency, std::vector<Expression> curves, std::vector<Drive> drives)
-      : frequency_(frequency), curves_(std::move(curves)), drives_(std::move(drives)) {
+      : frequency_(frequency),
+        curves_(std::move(curves)),
+        means_(stride_means(curves_)),
+        drives_(std::move(drives)) {
     for (const Drive& d : drives_) driven_.push_back(d.joint);
   }
 
   std::span<const int> driven_joints() const override { return driven_; }
 
   void sample(double t, std::span<double> targets) const override {
-    const double cycles = frequency_ * t;
+    const double cycles = frequency_ * stride_time(t);
+    const double rest = 1.0 - swing_at(t);  // 0 while walking: the curves exactly
     for (const Drive& d : drives_) {
       if (static_cast<std::size_t>(d.joint) >= targets.size()) continue;
-      const double deg =
-          d.gain * curves_[static_cast<std::size_t>(d.curve)].eval(cycles - d.phase) + d.offset_deg;
+      const auto c = static_cast<std::size_t>(d.curve);
+      const double value = curves_[c].eval(cycles - d.phase);
+      const double deg = d.gain * (value + rest * (means_[c] - value)) + d.offset_deg;
       targets[static_cast<std::size_t>(d.joint)] = deg_to_rad(deg);
     }
   }
 
+  // The walk winds down over the time of kWindDownStrides strides: every
+  // joint's swing about its stride mean and the cadence ease to nothing
+  // together (as a steered gait blends to a stand), so the steps shorten
+  // and slow and the body slows with them.
+  double wind_down(double t) override {
+    wind_start_ = t;
+    return kWindDownStrides / frequency_;
+  }
+
  private:
+  // How far into the wind-down motion time t is, 0 to 1 (0 while walking).
+  double wind_at(double t) const {
+    if (wind_start_ < 0.0 || t <= wind_start_) return 0.0;
+    return std::min(1.0, (t - wind_start_) * frequency_ / kWindDownStrides);
+  }
+  // The swing's scale: 1 while walking, easing to 0 over the wind-down
+  // (smoothstep: no jump in the joints' speed at either end).
+  double swing_at(double t) const {
+    const double u = wind_at(t);
+    return 1.0 - u * u * (3.0 - 2.0 * u);
+  }
+  // The gait's own time, whose rate is the swing's scale: the integral of
+  // 1 - smoothstep over the wind-down (half a wind-down's time at its end).
+  double stride_time(double t) const {
+    const double u = wind_at(t);
+    if (u <= 0.0) return t;
+    const double length = kWindDownStrides / frequency_;
+    return wind_start_ + length * (u - u * u * u + 0.5 * u * u * u * u);
+  }
+
   double frequency_;
   std::vector<Expression> curves_;
+  std::vector<double> means_;  // per curve, over one stride: the pose a wound-down walk stands in
   std::vector<Drive> drives_;
   std::vector<int> driven_;
+  double wind_start_ = -1.0;  // motion time the wind-down began (-1: walking)
 };
 
 std::string joint_names(std::span<const JointSpec> joints) {

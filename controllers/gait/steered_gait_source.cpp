@@ -66,6 +66,15 @@ void SteeredGaitSource::steer(const MotionCommand& command) {
   target_spot_ = target_speed_ == 0.0 && target_turn_ != 0.0 && steering_.turn_on_the_spot;
 }
 
+double SteeredGaitSource::wind_down(double t) {
+  advance(t);
+  target_speed_ = 0.0;
+  target_turn_ = 0.0;
+  target_spot_ = false;
+  // The blend falls linearly at 1 / blend_time_s_; a turn on the spot blends out as fast.
+  return std::max(blend_, spot_) * blend_time_s_;
+}
+
 MotionCommand SteeredGaitSource::current() const {
   if (!started_) return {0.0, 0.0};
   return {speed_ * smoothstep(blend_) * (1.0 - smoothstep(spot_)), turn_};

@@ -7,7 +7,11 @@ namespace animrt {
 namespace {
 
 constexpr double kSettledVelocity = 1e-3;  // rad/s: the stop ramp has ended
-constexpr double kMaxSettleTime = 2.0;     // s after the stop ramp, at most
+// A joint has arrived at the stop pose when measured this close to it (rad
+// or m) for kArrivedHold seconds on end: near enough, and still.
+constexpr double kArrivedRad = 0.05;  // about 3 deg
+constexpr double kArrivedM = 0.003;
+constexpr double kArrivedHold = 0.05;
 // A late bus is judged by its answers once its I/O thread is done (every
 // transaction is bounded by the bus timeout); only a bus stuck for ten
 // watchdog times, at most the watchdog plus two seconds (a thread that never
@@ -136,9 +140,33 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
     motion_time_ = t - motion_start_;
     emit(CycleEvent{EventKind::motion_ended, t});
   }
+  // After a wind-down the stop began at its request: the deadline counts from there.
+  if (phase_ != Phase::stop_ramp) stop_start_ = t;
+  phase_ = Phase::stop_ramp;
+  phase_start_ = t;
+  arrived_since_ = -1.0;
+  wind_end_ = -1.0;
+}
+
+void CycleState::request_stop(const RobotModel& model, MotionSource& motion, double t) {
+  // The wind-down leaves the ramp and the settling their time before the
+  // stop deadline, which counts from the request.
+  const double room =
+      model.safety.stop_deadline_s - model.safety.stop_ramp_s - kStopSettleTime - model.dt;
+  const double wind = phase_ == Phase::motion && !manual_
+                          ? std::min(motion.wind_down(t - motion_start_), room)
+                          : 0.0;
+  if (!(wind >= model.dt)) {
+    begin_stop(model, t);
+    return;
+  }
+  motion_time_ = t - motion_start_;
+  emit(CycleEvent{EventKind::motion_ended, t});
   phase_ = Phase::stop_ramp;
   phase_start_ = t;
   stop_start_ = t;
+  arrived_since_ = -1.0;
+  wind_end_ = t + wind;
 }
 
 void CycleState::begin_hold(const RobotModel& model, double t) {
@@ -146,7 +174,8 @@ void CycleState::begin_hold(const RobotModel& model, double t) {
   // moves within the limits, and nothing heads for home.
   const auto position = filter_.position();
   std::copy(position.begin(), position.end(), ramp_from_.begin());
-  ramp_.plan(ramp_from_, ramp_from_, model.limits, model.safety.tilt_hold_s);
+  std::copy(position.begin(), position.end(), ramp_to_.begin());
+  ramp_.plan(ramp_from_, ramp_to_, model.limits, model.safety.tilt_hold_s);
   if (phase_ == Phase::motion) {
     motion_time_ = t - motion_start_;
     emit(CycleEvent{EventKind::motion_ended, t});
@@ -154,6 +183,8 @@ void CycleState::begin_hold(const RobotModel& model, double t) {
   phase_ = Phase::stop_ramp;
   phase_start_ = t;
   stop_start_ = t;
+  arrived_since_ = -1.0;
+  wind_end_ = -1.0;
 }
 
 // The stages of step(), in the order it runs them. Each reads and writes the
@@ -162,7 +193,8 @@ struct CycleStages {
   // Controls from outside, read once at the start of the cycle.
   static void take_controls(const RobotModel& model, MotionSource& motion, CycleState& s,
                             const CycleInputs& in) {
-    if (in.steer) motion.steer(*in.steer);
+    // A winding-down walk is not steered back into walking.
+    if (in.steer && !s.winding_down()) motion.steer(*in.steer);
     const JogCommand* jog = in.jog;
     if (jog && jog->joint >= 0 && static_cast<std::size_t>(jog->joint) < model.joint_count() &&
         std::isfinite(jog->offset)) {
@@ -431,18 +463,22 @@ struct CycleStages {
 
   // Phase changes: a fault or a stop starts the stop ramp, so does the end of
   // the motion's duration; the end of the start ramp starts the motion.
-  static void change_phase(const RobotModel& model, CycleState& s, const CycleInputs& in,
-                           bool fault) {
-    if (s.phase_ == Phase::stop_ramp) return;
+  static void change_phase(const RobotModel& model, MotionSource& motion, CycleState& s,
+                           const CycleInputs& in, bool fault) {
     const double t = in.t;
+    if (s.phase_ == Phase::stop_ramp) {
+      // A wind-down ends in the ramp home, at its end or at once on a fault.
+      if (s.winding_down() && (fault || t >= s.wind_end_ - kTimeEps)) s.begin_stop(model, t);
+      return;
+    }
     if (fault) {
       s.begin_stop(model, t);
     } else if (in.stop) {
       s.end_.stopped = true;
-      s.begin_stop(model, t);
+      s.request_stop(model, motion, t);
     } else if (s.phase_ == Phase::motion && in.motion_duration_s > 0.0 &&
                t - s.motion_start_ >= in.motion_duration_s - kTimeEps) {
-      s.begin_stop(model, t);
+      s.request_stop(model, motion, t);
     } else if (s.phase_ == Phase::start_ramp &&
                t - s.phase_start_ >= s.ramp_.duration() - kTimeEps) {
       s.phase_ = Phase::motion;
@@ -513,10 +549,12 @@ struct CycleStages {
                              double t) {
     if (s.phase_ == Phase::motion && s.manual_) {
       std::copy(s.manual_pose_.begin(), s.manual_pose_.end(), s.targets_.begin());
-    } else if (s.phase_ == Phase::motion) {
+    } else if (s.phase_ == Phase::motion || s.winding_down()) {
       sample_motion(model, motion, s, t);
     }
-    if (s.phase_ != Phase::motion) s.ramp_.sample(t - s.phase_start_, s.targets_);
+    if (s.phase_ != Phase::motion && !s.winding_down()) {
+      s.ramp_.sample(t - s.phase_start_, s.targets_);
+    }
     s.show_ = motion.show_position(s.phase_ == Phase::motion       ? t - s.motion_start_
                                    : s.phase_ == Phase::start_ramp ? 0.0
                                                                    : s.motion_time_);
@@ -539,13 +577,57 @@ struct CycleStages {
     }
   }
 
-  // The run is done once the stop ramp has ended and the joints have
-  // settled (or the settling took too long).
-  static void settle(CycleState& s, double t) {
-    if (s.phase_ != Phase::stop_ramp || t - s.phase_start_ < s.ramp_.duration()) return;
+  // A joint that can move and was measured away from its stop pose this
+  // cycle. A faulted joint is held, and one whose device did not answer
+  // this cycle has no measurement: neither is waited for (the watchdogs
+  // judge a silent device).
+  static bool off_stop_pose(const RobotModel& model, const CycleState& s, std::size_t j, double t) {
+    const JointSlot slot = s.slots_[j];
+    if (s.joint_faulted(j) || !s.active_[j] || s.last_ok_[slot.bus][slot.device] != t) {
+      return false;
+    }
+    const double tolerance = model.prismatic[j] ? kArrivedM : kArrivedRad;
+    return !(std::abs(s.measured_[j] - s.ramp_to_[j]) <= tolerance);
+  }
+
+  // How long after its start a stop waits for the joints: the settling
+  // time after the ramp, ending a cycle before the stop deadline would cut
+  // torque without the warning.
+  static double settle_limit(const RobotModel& model, const CycleState& s) {
+    const double before = s.phase_start_ - s.stop_start_;  // a wind-down's
+    return std::min(s.ramp_.duration() + kStopSettleTime,
+                    std::max(s.ramp_.duration(), model.safety.stop_deadline_s - model.dt - before));
+  }
+
+  // The run is done once the stop ramp has ended, the command is at rest and
+  // every joint that can move is measured at the stop pose, still: after a
+  // stalled cycle the command may rest while the servos still travel, and
+  // torque off there would drop them short of home. A joint that has not
+  // arrived a bounded time after the ramp is named, and torque goes off.
+  static void settle(const RobotModel& model, CycleState& s, double t) {
+    if (s.phase_ != Phase::stop_ramp || s.winding_down() ||
+        t - s.phase_start_ < s.ramp_.duration()) {
+      return;
+    }
     double fastest = 0.0;
     for (double v : s.filter_.velocity()) fastest = std::max(fastest, std::abs(v));
-    if (fastest < kSettledVelocity || t - s.phase_start_ >= s.ramp_.duration() + kMaxSettleTime) {
+    bool arrived = fastest < kSettledVelocity;
+    for (std::size_t j = 0; arrived && j < s.slots_.size(); ++j) {
+      arrived = !off_stop_pose(model, s, j, t);
+    }
+    if (!arrived) {
+      s.arrived_since_ = -1.0;
+    } else if (s.arrived_since_ < 0.0) {
+      s.arrived_since_ = t;
+    }
+    if (arrived && t - s.arrived_since_ >= kArrivedHold - kTimeEps) {
+      s.phase_ = Phase::done;
+    } else if (t - s.phase_start_ >= settle_limit(model, s) - kTimeEps) {
+      for (std::size_t j = 0; j < s.slots_.size(); ++j) {
+        if (!off_stop_pose(model, s, j, t)) continue;
+        s.emit(CycleEvent{EventKind::stop_unreached, t, static_cast<int>(j), s.slots_[j].bus,
+                          s.slots_[j].device, DeviceHealth::ok, s.measured_[j] - s.ramp_to_[j]});
+      }
       s.phase_ = Phase::done;
     }
   }
@@ -577,12 +659,12 @@ const CycleOutputs& step(const RobotModel& model, MotionSource& motion, CycleSta
     ++s.cycles_;
     return out;
   }
-  S::change_phase(model, s, in, fault);
+  S::change_phase(model, motion, s, in, fault);
   S::take_manual(model, s, in);
   S::control_show(motion, s, in, out);
   S::sample_targets(model, motion, s, in.t);
   S::filter_and_route(s, in, out);
-  S::settle(s, in.t);
+  S::settle(model, s, in.t);
   ++s.cycles_;
   return out;
 }

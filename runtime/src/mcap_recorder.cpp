@@ -251,6 +251,9 @@ std::string McapRecorder::describe(std::span<const double> e) const {
       return "stop deadline: the stop ramp ran over; torque off at once";
     case static_cast<int>(EventKind::aborted):
       return "second stop request: torque off at once";
+    case static_cast<int>(EventKind::stop_unreached):
+      return fmt::format("stop: {} not at its stop pose at torque off ({:.4g} off)", joint_name,
+                         e[6]);
     case static_cast<int>(kRecordStopRequest):
       return "stop requested: ramping to home";
     default:

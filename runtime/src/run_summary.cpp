@@ -160,6 +160,7 @@ std::string format_summary(const RunSummary& s) {
       s.motion_time_s));
   for (const auto& fault : s.faults) line("FAULT " + fault);
   for (const auto& warning : s.health_warnings) line("WARNING " + warning);
+  for (const auto& warning : s.stop_warnings) line("WARNING " + warning);
   if (!s.torque_cut.empty()) line("TORQUE CUT " + s.torque_cut);
   line(fmt::format("cycles: {}, overruns: {}, skipped cycles: {}", s.cycles, s.overruns,
                    s.skipped_cycles));
@@ -213,6 +214,7 @@ nlohmann::json to_json(const RunSummary& s) {
   j["exit_code"] = s.exit_code();
   j["faults"] = s.faults;
   j["health_warnings"] = s.health_warnings;
+  j["stop_warnings"] = s.stop_warnings;
   j["cycles"] = s.cycles;
   j["overruns"] = s.overruns;
   j["skipped_cycles"] = s.skipped_cycles;

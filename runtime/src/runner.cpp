@@ -358,6 +358,12 @@ void Runner::Impl::report_events(const CycleState& state, RunSummary& summary) c
       summary.health_warnings.push_back(fmt::format("bus {} id {} ({}): {} at t={:.3f} s", bus.name,
                                                     actuator.device_id, actuator.joint,
                                                     health_text(model, buses, e), e.t));
+    } else if (e.kind == EventKind::stop_unreached) {
+      const auto joint = static_cast<std::size_t>(e.joint);
+      summary.stop_warnings.push_back(fmt::format(
+          "joint {}: {} off its stop pose when torque went off at t={:.3f} s, the stop's wait "
+          "for the joints over (blocked, or slower than the stop ramp?)",
+          model.joint_names[joint], joint_value(e.value, model.prismatic[joint] != 0), e.t));
     } else if (std::string line = describe_event(model, buses, config.lag_notes, e);
                !line.empty()) {
       summary.faults.push_back(std::move(line));

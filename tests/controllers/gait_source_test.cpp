@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -102,6 +104,29 @@ TEST_F(GaitSourceTest, TargetsAreRadians) {
   std::vector<double> targets(joints_.size(), 0.0);
   source_->sample(0.125, targets);
   EXPECT_NEAR(targets[2], 15.0 * kPi / 180.0, 1e-15);
+}
+
+// At a stop the walk winds down over two strides (1 s at 2 Hz): it starts
+// where the walk is, keeps stepping with an ever smaller swing, and stands
+// in each curve's stride mean (wave: 10) once the time it asked is over.
+TEST_F(GaitSourceTest, AWindDownEasesTheSwingToTheStrideMeanOverTwoStrides) {
+  const auto walking = sample_deg(1.1);
+  EXPECT_DOUBLE_EQ(source_->wind_down(1.1), 1.0);
+  const auto at_request = sample_deg(1.1);
+  EXPECT_DOUBLE_EQ(at_request[2], walking[2]);
+  double first_stride = 0.0, second_stride = 0.0;
+  for (double t = 1.1; t < 2.1; t += 0.005) {
+    const double swing = std::abs(sample_deg(t)[2] - 10.0);
+    (t < 1.6 ? first_stride : second_stride) =
+        std::max(t < 1.6 ? first_stride : second_stride, swing);
+  }
+  EXPECT_GT(first_stride, 3.0);
+  EXPECT_LT(second_stride, first_stride);
+  for (double t = 2.1; t < 3.0; t += 0.05) {
+    const auto deg = sample_deg(t);
+    EXPECT_NEAR(deg[2], 10.0, 1e-9) << t;
+    EXPECT_NEAR(deg[1], -17.0, 1e-9) << t;
+  }
 }
 
 TEST_F(GaitSourceTest, SampleDoesNotAllocate) {

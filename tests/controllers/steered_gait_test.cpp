@@ -149,6 +149,26 @@ TEST(SteeredGait, ZeroSpeedStandsInTheMeanPoseAndStays) {
   EXPECT_GT(swing(rig.run(2.0)[0]), 5.0);
 }
 
+// A stop winds the walk down: the source stands as on a command under the
+// slowest speed, within the time it says, and takes no steering back into
+// the walk from the cycle (the cycle holds it back).
+TEST(SteeredGait, AWindDownStandsInTheMeanPoseWithinTheTimeItAsks) {
+  Rig rig;
+  rig.source->steer({rig.st().max_speed_m_s(), 0.0});
+  rig.run(2.0);
+  const double asked = rig.source->wind_down(rig.t);
+  EXPECT_GT(asked, 0.5);
+  EXPECT_LE(asked, 1.0 / rig.st().min_speed_m_s() + 10.0);
+  const auto winding = rig.run(asked + kDt);  // to the first cycle at or past it
+  EXPECT_GT(swing(winding[0]), 1.0);          // it kept stepping
+  const auto after = rig.run(1.0);
+  for (const auto& r : after) {
+    EXPECT_NEAR(r.first, kMeanDeg, 1e-9);
+    EXPECT_NEAR(r.second, kMeanDeg, 1e-9);
+  }
+  EXPECT_EQ(rig.steered.current().speed_m_s, 0.0);
+}
+
 TEST(SteeredGait, SpeedRampsAtTheAccelerationLimit) {
   Rig rig;
   const double lo = rig.st().min_speed_m_s(), hi = rig.st().max_speed_m_s();

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -29,9 +30,15 @@ class LambdaSource : public MotionSource {
     for (std::size_t j = 0; j < targets.size(); ++j) targets[j] = fn(j, t);
   }
   void steer(const MotionCommand& command) override { steered = command; }
+  double wind_down(double t) override {
+    wound_at.push_back(t);
+    return wind;
+  }
 
   std::function<double(std::size_t, double)> fn = [](std::size_t, double) { return 0.0; };
   MotionCommand steered{-1.0, -1.0};
+  double wind = 0.0;             // what wind_down() asks for (s)
+  std::vector<double> wound_at;  // motion times wind_down() was called at
 
  private:
   std::vector<int> driven_;
@@ -318,7 +325,8 @@ TEST(Cycle, AnErrorBelowTheLimitOrABriefGlitchIsNoFault) {
   bench.in.motion_duration_s = 2.0;
   bench.begin();
   bench.follow = false;
-  for (int i = 0; i < 400 && !bench.state.done(); ++i) {
+  // Joint 0 never reaches home: the stop waits for it, then names it.
+  for (int i = 0; i < 700 && !bench.state.done(); ++i) {
     const CycleOutputs& out = bench.cycle();
     for (std::size_t b = 0; b < 2; ++b) bench.positions[b] = out.bus_commands[b];
     bench.positions[0][0] += 0.25;                  // under 15 deg, always
@@ -326,6 +334,8 @@ TEST(Cycle, AnErrorBelowTheLimitOrABriefGlitchIsNoFault) {
   }
   EXPECT_TRUE(bench.state.done());
   EXPECT_FALSE(bench.has(EventKind::following_error));
+  ASSERT_TRUE(bench.has(EventKind::stop_unreached));
+  EXPECT_EQ(bench.first(EventKind::stop_unreached)->joint, 0);
   EXPECT_NEAR(bench.state.max_error(0), 0.25, 1e-6);
   EXPECT_NEAR(bench.state.max_error(2), 1.0, 1e-6);
 }
@@ -368,6 +378,223 @@ TEST(Cycle, AnAbortCutsTorqueAtOnce) {
   EXPECT_TRUE(out.torque_off_now);
   EXPECT_TRUE(bench.state.done());
   EXPECT_TRUE(bench.has(EventKind::aborted));
+}
+
+// Servos slower than the filter may command: each travels toward its last
+// goal at `speed` over the run's time, stalls of the loop included, and stops
+// short of `floor` (a blocked joint) where one is set.
+struct SlowServos {
+  explicit SlowServos(Bench& b) : bench(b), goals(b.positions) { bench.follow = false; }
+  // One cycle at the bench's time; returns the largest step of a command.
+  double cycle() {
+    const double now = static_cast<double>(bench.count) / kRate;
+    const double reach = speed * (now - last);
+    last = now;
+    for (std::size_t b = 0; b < goals.size(); ++b) {
+      for (std::size_t d = 0; d < goals[b].size(); ++d) {
+        double& p = bench.positions[b][d];
+        p += std::clamp(goals[b][d] - p, -reach, reach);
+        p = std::max(p, floor[b][d]);
+      }
+    }
+    const CycleOutputs& out = bench.cycle();
+    double step = 0.0;
+    for (std::size_t b = 0; b < goals.size(); ++b) {
+      if (!out.write[b]) continue;
+      for (std::size_t d = 0; d < goals[b].size(); ++d) {
+        step = std::max(step, std::abs(out.bus_commands[b][d] - goals[b][d]));
+      }
+      goals[b] = out.bus_commands[b];
+    }
+    return step;
+  }
+
+  Bench& bench;
+  std::vector<std::vector<double>> goals;
+  std::vector<std::vector<double>> floor{{-9.0, -9.0}, {-9.0, -9.0}};
+  double speed = 1.0;  // rad/s: keeps up with the ramps, not with the filter's 2 rad/s
+  double last = 0.0;
+};
+
+TEST(Cycle, AStallDuringTheStopRampKeepsTorqueOnUntilTheServosAreHome) {
+  RobotModel model = two_bus_model();
+  model.safety.start_ramp_s = 1.0;
+  model.safety.stop_ramp_s = 1.0;
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double) { return 0.4; };
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  SlowServos servos(bench);
+  double largest_step = 0.0;
+  bool stalled = false;
+  while (!bench.state.done() && bench.count < 2000) {
+    largest_step = std::max(largest_step, servos.cycle());
+    const CycleEvent* ended = bench.first(EventKind::motion_ended);
+    if (!stalled && ended && static_cast<double>(bench.count) / kRate >= ended->t + 0.1) {
+      bench.count += 80;  // the loop stalls 0.8 s: most of the ramp's time passes at once
+      stalled = true;
+    }
+  }
+  ASSERT_TRUE(stalled);
+  ASSERT_TRUE(bench.state.done());
+  EXPECT_FALSE(bench.state.end().fault);
+  // The command never jumped, and torque went off with every servo home.
+  EXPECT_LE(largest_step, model.limits[0].max_velocity / kRate + 1e-9);
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_NEAR(bench.state.measured()[j], 0.0, 0.05) << "joint " << j;
+  }
+  EXPECT_FALSE(bench.has(EventKind::stop_unreached));
+}
+
+TEST(Cycle, AJointThatNeverArrivesEndsTheStopABoundedTimeAfterTheRampAndIsNamed) {
+  RobotModel model = two_bus_model();
+  model.safety.start_ramp_s = 1.0;
+  model.safety.stop_ramp_s = 1.0;
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double) { return 0.4; };
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  SlowServos servos(bench);
+  servos.floor[1][1] = 0.1;  // joint 3 is blocked 0.1 rad short of home
+  while (!bench.state.done() && bench.count < 2000) servos.cycle();
+  ASSERT_TRUE(bench.state.done());
+  const CycleEvent* ended = bench.first(EventKind::motion_ended);
+  const CycleEvent* unreached = bench.first(EventKind::stop_unreached);
+  ASSERT_NE(ended, nullptr);
+  ASSERT_NE(unreached, nullptr);
+  EXPECT_EQ(unreached->joint, 3);
+  EXPECT_NEAR(unreached->value, 0.1, 1e-9);
+  EXPECT_NEAR(unreached->t - ended->t, 1.0 + kStopSettleTime, 0.011);
+  int named = 0;
+  for (const CycleEvent& e : bench.events) named += e.kind == EventKind::stop_unreached ? 1 : 0;
+  EXPECT_EQ(named, 1);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+}
+
+TEST(Cycle, TheWaitForAJointEndsBeforeTheStopDeadlineWouldCutTorque) {
+  RobotModel model = two_bus_model();
+  model.safety.start_ramp_s = 1.0;
+  model.safety.stop_ramp_s = 1.0;
+  model.safety.stop_deadline_s = 2.0;  // under the ramp and the whole wait
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double) { return 0.4; };
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  SlowServos servos(bench);
+  servos.floor[0][0] = 0.1;
+  while (!bench.state.done() && bench.count < 2000) servos.cycle();
+  const CycleEvent* ended = bench.first(EventKind::motion_ended);
+  const CycleEvent* unreached = bench.first(EventKind::stop_unreached);
+  ASSERT_NE(ended, nullptr);
+  ASSERT_NE(unreached, nullptr);
+  EXPECT_EQ(unreached->joint, 0);
+  EXPECT_LT(unreached->t - ended->t, 2.0);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+  EXPECT_FALSE(bench.state.end().torque_cut);
+}
+
+// A source that winds down at a stop keeps playing (here its joints keep
+// moving at 0.4 rad/s) for the time it asked for; the ramp home follows, and
+// the motion ended at the request.
+TEST(Cycle, AStopRequestLetsTheMotionWindDownBeforeTheRampHome) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 0.6;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  for (int i = 0; i < 50; ++i) bench.cycle();
+  bench.in.stop = true;
+  const double asked = static_cast<double>(bench.count) / kRate;
+  bench.cycle();
+  bench.in.stop = false;
+  ASSERT_EQ(bench.motion.wound_at.size(), 1u);
+  EXPECT_NEAR(bench.motion.wound_at[0], asked - bench.state.motion_start(), 1e-9);
+  EXPECT_NEAR(bench.first(EventKind::motion_ended)->t, asked, 1e-9);
+  EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
+  EXPECT_TRUE(bench.state.winding_down());
+  while (bench.state.winding_down() && bench.count < 1000) bench.cycle();
+  const double ramp_start = static_cast<double>(bench.count - 1) / kRate;
+  EXPECT_NEAR(ramp_start - asked, 0.6, 0.011);
+  // The motion played to the end of its wind-down, 0.6 s after the request.
+  EXPECT_NEAR(bench.state.measured()[0], 0.4 * (bench.motion.wound_at[0] + 0.6), 0.01);
+  bench.run_until(Phase::done);
+  EXPECT_TRUE(bench.state.end().stopped);
+  EXPECT_FALSE(bench.state.end().fault);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(bench.state.measured()[j], 0.0, 1e-9);
+  EXPECT_EQ(bench.motion.wound_at.size(), 1u);
+}
+
+// A fault never waits for a wind-down: before one it ramps home at once,
+// and during one it ends it.
+TEST(Cycle, AFaultRampsHomeAtOnceWindingDownOrNot) {
+  for (const bool during : {false, true}) {
+    Bench bench(two_bus_model());
+    bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+    bench.motion.wind = 1.0;
+    bench.begin();
+    bench.run_until(Phase::motion);
+    for (int i = 0; i < 20; ++i) bench.cycle();
+    if (during) {
+      bench.in.stop = true;
+      bench.cycle();
+      bench.in.stop = false;
+      for (int i = 0; i < 10; ++i) bench.cycle();
+      ASSERT_TRUE(bench.state.winding_down());
+    }
+    bench.health[0][1] = DeviceHealth::hardware_error;
+    bench.cycle();
+    ASSERT_TRUE(bench.has(EventKind::device_fault));
+    EXPECT_EQ(bench.state.phase(), Phase::stop_ramp) << during;
+    EXPECT_FALSE(bench.state.winding_down()) << during;
+    EXPECT_EQ(bench.motion.wound_at.size(), during ? 1u : 0u);
+    bench.run_until(Phase::done);
+    EXPECT_TRUE(bench.state.end().fault);
+    EXPECT_NEAR(bench.state.measured()[0], 0.0, 1e-9) << during;
+  }
+}
+
+// A second stop (an abort) during a wind-down cuts torque at once, as
+// during a ramp.
+TEST(Cycle, AnAbortDuringAWindDownCutsTorqueAtOnce) {
+  Bench bench(two_bus_model());
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 1.0;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  for (int i = 0; i < 20; ++i) bench.cycle();
+  bench.in.stop = true;
+  for (int i = 0; i < 10; ++i) bench.cycle();
+  ASSERT_TRUE(bench.state.winding_down());
+  bench.in.abort = true;
+  const CycleOutputs& out = bench.cycle();
+  EXPECT_TRUE(out.torque_off_now);
+  EXPECT_TRUE(bench.state.done());
+  EXPECT_FALSE(bench.state.winding_down());
+  EXPECT_TRUE(bench.state.end().torque_cut);
+  EXPECT_TRUE(bench.has(EventKind::aborted));
+}
+
+// However long a source asks to wind down, the stop leaves its ramp and the
+// wait for the joints their time before the deadline, which counts from
+// the request: the stop ends on time, without a torque cut.
+TEST(Cycle, AWindDownIsCutShortToFitTheStopDeadline) {
+  RobotModel model = two_bus_model();
+  model.safety.stop_deadline_s = 3.0;
+  Bench bench(model);
+  bench.motion.fn = [](std::size_t, double t) { return 0.4 * t; };
+  bench.motion.wind = 100.0;
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  bench.run_until(Phase::motion);
+  bench.run_until(Phase::stop_ramp);
+  const double asked = bench.first(EventKind::motion_ended)->t;
+  while (bench.state.winding_down() && bench.count < 2000) bench.cycle();
+  const double ramp_start = static_cast<double>(bench.count - 1) / kRate;
+  EXPECT_NEAR(ramp_start - asked, 3.0 - 0.5 - kStopSettleTime, 0.011);
+  bench.run_until(Phase::done);
+  EXPECT_FALSE(bench.state.end().torque_cut);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+  EXPECT_LT(static_cast<double>(bench.count) / kRate - asked, 3.0);
 }
 
 TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {

@@ -175,9 +175,35 @@ class ClockCounter final : public MotionSource {
     start_ns = clock.start;
   }
   void stop() override { ++stops; }
+  double wind_down(double t) override {
+    wound_at = t;
+    return wind;
+  }
   int starts = 0, stops = 0;
   Nanos start_ns = -1;
+  double wind = 0.0;  // what wind_down() asks for (s)
+  double wound_at = -1.0;
 };
+
+// A stop winds every layer down at once (a walk under a show): the layered
+// source asks for the longest, and a show layer asks for none.
+TEST(Show, LayersWindDownTogetherForAsLongAsTheSlowestAsks) {
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  auto a = std::make_unique<ClockCounter>();
+  auto b = std::make_unique<ClockCounter>();
+  a->wind = 1.5;
+  b->wind = 2.5;
+  ClockCounter* pa = a.get();
+  ClockCounter* pb = b.get();
+  layers.push_back(std::move(a));
+  layers.push_back(load_show_source(write("w.yaml", kShow), joints()));
+  layers.push_back(std::move(b));
+  auto s = make_layered_source(std::move(layers));
+  EXPECT_DOUBLE_EQ(s->wind_down(4.0), 2.5);
+  EXPECT_DOUBLE_EQ(pa->wound_at, 4.0);
+  EXPECT_DOUBLE_EQ(pb->wound_at, 4.0);
+  EXPECT_DOUBLE_EQ(load_show_source(write("w2.yaml", kShow), joints())->wind_down(4.0), 0.0);
+}
 
 TEST(Show, LayersPassTheRunsClockToEveryLayer) {
   std::vector<std::unique_ptr<MotionSource>> layers;

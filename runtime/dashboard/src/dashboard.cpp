@@ -180,6 +180,10 @@ struct DashboardServer::Impl {
         return "the stop ramp ran over its deadline: torque switched off";
       case EventKind::aborted:
         return "abort: torque switched off";
+      case EventKind::stop_unreached:
+        return fmt::format("{}: not at its stop pose when torque went off ({:.4f} {} off)",
+                           joint(e.joint), e.value,
+                           model.prismatic[static_cast<std::size_t>(e.joint)] ? "m" : "rad");
       default:
         return {};
     }

@@ -84,6 +84,15 @@ class MotionSource {
   // attitude). Same rules as sample(); the pointers live for this call only.
   virtual void sense(const Sensors& /*sensors*/) {}
 
+  // A stop was asked for at motion time `t` (a stop request or the end of
+  // the run's duration; never a fault, which ramps home at once): a source
+  // that must come to rest by itself before its joints go home (a walk
+  // that winds down while it keeps stepping, so the body slows instead of
+  // being stopped dead) begins to, and returns how long that takes (s).
+  // The cycle samples it that long, cut short to fit the stop deadline,
+  // then ramps home. 0: ramp home at once. Same rules as sample().
+  virtual double wind_down(double /*t*/) { return 0.0; }
+
   // A show's transport: a source that plays a show keeps its own playhead,
   // which maps the motion's time `t` (as sample() gets it) to the show's.
   // control() acts at motion time `t` (the cycle's, before sample()): a seek

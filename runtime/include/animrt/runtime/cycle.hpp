@@ -31,6 +31,10 @@ namespace animrt {
 
 enum class Phase { start_ramp, motion, stop_ramp, done };
 
+// How long after its ramp a stop waits for the joints to arrive (s), at
+// most, and never up to the stop deadline.
+inline constexpr double kStopSettleTime = 2.0;
+
 // One bus's results for this cycle.
 struct BusIo {
   // Its read came back in time: positions and health are this cycle's, and
@@ -84,6 +88,7 @@ enum class EventKind : std::uint8_t {
   health_warning,   // bus, device, check, value: logged and counted; the run goes on
   sensor_stale,     // an IMU silent past its stale timeout: bus = IMU index, value = age (s)
   tilted,           // the tilt watch: value = the larger of |roll| and |pitch| (rad)
+  stop_unreached,   // joint, value = measured - stop pose: not there when torque went off
 };
 
 // Which health limit an event is about.
@@ -131,6 +136,8 @@ class CycleState {
 
   Phase phase() const { return phase_; }
   bool done() const { return phase_ == Phase::done; }
+  // In the stop, before its ramp: the motion still plays, winding down.
+  bool winding_down() const { return phase_ == Phase::stop_ramp && wind_end_ >= 0.0; }
   double motion_time() const { return motion_time_; }
   double motion_start() const { return motion_start_; }  // run time the motion began
   const CycleEnd& end() const { return end_; }
@@ -176,12 +183,17 @@ class CycleState {
   friend struct CycleStages;  // step()'s stages (cycle.cpp)
   void emit(const CycleEvent& event);
   void begin_stop(const RobotModel& model, double t);
+  // A stop request in the motion: the source winds down first if it asks
+  // to (MotionSource::wind_down), then the ramp home begins.
+  void request_stop(const RobotModel& model, MotionSource& motion, double t);
   void begin_hold(const RobotModel& model, double t);
 
   Phase phase_ = Phase::start_ramp;
   double phase_start_ = 0.0;
   double motion_start_ = 0.0;
   double stop_start_ = 0.0;
+  double arrived_since_ = -1.0;  // the joints measured at the stop pose since (s)
+  double wind_end_ = -1.0;       // the motion winds down until (s); -1: not winding down
   double motion_time_ = 0.0;
   CycleEnd end_;
   std::uint64_t cycles_ = 0;

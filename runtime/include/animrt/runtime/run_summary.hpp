@@ -82,6 +82,8 @@ struct RunSummary {
   std::vector<std::string> faults;  // one line per faulted device
   // One line per health warning (a value past a warning limit; the run went on).
   std::vector<std::string> health_warnings;
+  // One line per joint not at the stop pose when torque went off.
+  std::vector<std::string> stop_warnings;
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;        // cycles that ended after the next deadline
   std::uint64_t skipped_cycles = 0;  // whole cycles left out after an overrun

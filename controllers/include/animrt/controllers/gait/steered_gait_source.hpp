@@ -48,6 +48,9 @@ class SteeredGaitSource final : public MotionSource {
   std::span<const int> driven_joints() const override { return driven_; }
   void sample(double t, std::span<double> targets) const override;
   void steer(const MotionCommand& command) override;
+  // A stop: the walk is told to stand (as a command under the slowest
+  // speed), and the swing blends out over the walk/stand blend time.
+  double wind_down(double t) override;
 
   // The command in force after clamping (speed 0 = stand).
   MotionCommand target() const { return {target_speed_, target_turn_}; }
