@@ -78,6 +78,10 @@ void CuePlayer::stop() {
   }
 }
 
+const CueStep& CuePlayer::step_of(const Layer& layer) const {
+  return cues_[static_cast<std::size_t>(layer.cue)].steps[static_cast<std::size_t>(layer.step)];
+}
+
 double CuePlayer::weight(const Layer& layer) const {
   if (layer.fade_s <= 0.0) return 1.0;
   return smootherstep((play_ - layer.fade_start) / layer.fade_s);
@@ -85,8 +89,7 @@ double CuePlayer::weight(const Layer& layer) const {
 
 void CuePlayer::sample_layer(Layer& layer) const {
   for (std::size_t j = 0; j < joints_.size(); ++j) layer.pose[j] = joints_[j].home;
-  const CueStep& step = cues_[static_cast<std::size_t>(layer.cue)].steps[layer.step];
-  step.source->sample(play_ - layer.t0, layer.pose);
+  step_of(layer).source->sample(play_ - layer.t0, layer.pose);
 }
 
 // The crossfade's length: the cue's, or longer where the gap between the
@@ -212,6 +215,44 @@ void CuePlayer::compact() const {
   count_ -= base;
 }
 
+// A pause slows the play time to a halt and a resume speeds it up again,
+// both smoothly. A wind-down keeps the goal it began with.
+void CuePlayer::warp(double t) const {
+  const double dt = std::max(0.0, t - last_t_);
+  last_t_ = t;
+  step_dt_ = dt;
+  const double goal = winding_ ? wind_goal_ : requests_.paused() ? 0.0 : 1.0;
+  const double ease = dt / kPauseRampS;
+  rate_phase_ =
+      goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
+  play_ += smootherstep(rate_phase_) * dt;
+  pause_sound();
+  // A cue waiting to start at a time into it (a timecode) goes on running.
+  if (waiting_ && waiting_at_ > 0.0) waiting_at_ += smootherstep(rate_phase_) * dt;
+}
+
+// Every motion still seen winds down on its own time (a crossfade's two
+// together: the stop waits for the slower). A source two layers share (a
+// cue looping into itself) is asked once, on the newest layer's time.
+double CuePlayer::wind_down(double t) {
+  if (!begun_ || winding_) return 0.0;
+  warp(t);
+  winding_ = true;
+  wind_goal_ = requests_.paused() ? 0.0 : 1.0;
+  // A pausing cue comes to rest by itself when its easing ends (0: it stands).
+  if (wind_goal_ == 0.0) return rate_phase_ * kPauseRampS;
+  double longest = 0.0;
+  for (std::size_t i = count_; i-- > 0;) {
+    MotionSource* source = step_of(layers_[i]).source.get();
+    bool seen = false;
+    for (std::size_t k = i + 1; k < count_; ++k) seen |= step_of(layers_[k]).source.get() == source;
+    if (!seen) longest = std::max(longest, source->wind_down(play_ - layers_[i].t0));
+  }
+  // The wind-down is in play time; a resume still easing in lags behind by
+  // less than what is left of its easing.
+  return longest > 0.0 ? longest + (1.0 - rate_phase_) * kPauseRampS : 0.0;
+}
+
 void CuePlayer::advance(double t) const {
   if (!begun_) {
     begun_ = true;
@@ -221,19 +262,9 @@ void CuePlayer::advance(double t) const {
       send_sound(static_cast<int>(s), false, false, 0.0);
     push(idle_, 0, false);
   }
-  const double dt = std::max(0.0, t - last_t_);
-  last_t_ = t;
-  step_dt_ = dt;
-  // A pause slows the play time to a halt and a resume speeds it up again,
-  // both smoothly.
-  const double goal = requests_.paused() ? 0.0 : 1.0;
-  const double ease = dt / kPauseRampS;
-  rate_phase_ =
-      goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
-  play_ += smootherstep(rate_phase_) * dt;
-  pause_sound();
-  // A cue waiting to start at a time into it (a timecode) goes on running.
-  if (waiting_ && waiting_at_ > 0.0) waiting_at_ += smootherstep(rate_phase_) * dt;
+  warp(t);
+  // Winding down at a stop: what plays goes on to rest, nothing new starts.
+  if (winding_) return;
   int asked = 0;
   double at = 0.0;
   if (requests_.take(asked, at) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {

@@ -74,6 +74,10 @@ class CuePlayer final : public MotionSource {
   void sample(double t, std::span<double> targets) const override;
   void start(const MotionClock& clock) override;
   void stop() override;
+  // At a stop, what plays winds down (a walking cue eases to a stand) and
+  // no other cue or step starts; a pause eases to rest instead, and a cue
+  // that is paused already asks for nothing.
+  double wind_down(double t) override;
 
   // Read from any thread while it plays.
   int current_cue() const { return current_.load(std::memory_order_relaxed); }
@@ -104,6 +108,8 @@ class CuePlayer final : public MotionSource {
   static constexpr std::size_t kMaxLayers = 4;
 
   void advance(double t) const;
+  void warp(double t) const;  // the play time at motion time t
+  const CueStep& step_of(const Layer& layer) const;
   // `asked`: a trigger's (a cue asked for again starts again, and counts);
   // `at_s`: the time into the step it starts at.
   void push(int cue, int step, bool asked, double at_s = 0.0) const;
@@ -137,6 +143,8 @@ class CuePlayer final : public MotionSource {
   mutable double play_ = 0.0;        // play time: motion time slowed by pauses
   mutable double rate_phase_ = 1.0;  // 1 playing, 0 paused, between: easing
   mutable bool waiting_ = false;     // a request waits for a free slot
+  bool winding_ = false;             // a stop's wind-down began: nothing new starts
+  double wind_goal_ = 1.0;           // the playback rate's goal while it winds down
   mutable int waiting_cue_ = 0;
   mutable double waiting_at_ = 0.0;  // its time into the cue
   mutable std::vector<double> out_, prev_out_, scratch_;
