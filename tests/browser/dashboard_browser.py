@@ -282,6 +282,9 @@ def run_test(args, tmp, page_holder):
         check(page.js("return document.getElementById('readonly-note').hidden;"),
               "the read-only note shows although the page has the token")
 
+        # The stream opens before its first state: the device table fills from that.
+        page.wait("a first state in the device table", lambda: page.js(
+            "return document.querySelectorAll('#device-table tbody tr').length > 0;"), 10)
         rows = joint_values(page)
         devices = page.text("#device-table") or ""
         for name in names:
