@@ -16,7 +16,7 @@ void walk_as_robot(const std::string& robot_file, const evolve::ModelInfo& model
     const auto it = std::find_if(robot.joints.begin(), robot.joints.end(),
                                  [&](const JointSpec& j) { return j.name == name; });
     if (it == robot.joints.end()) {
-      throw InputError(Location{robot_file, 0, 0}, "joints",
+      throw InputError(robot.joints_where, "joints",
                        "no joint " + quote(name) + " of the model (--robot needs them all)");
     }
     settings.joint_limits.push_back(it->limits);

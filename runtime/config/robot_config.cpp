@@ -639,6 +639,7 @@ RobotConfig load_robot_config(const std::string& path) {
   config.buses = parse_buses(buses, config.rate_hz);
   check_bus_timeouts(buses, config, safety);
   parse_joints(root.at("joints"), config);
+  config.joints_where = key_location(root, "joints");
   check_switch_ids(buses, config);
   check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and

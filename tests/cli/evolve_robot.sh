@@ -57,7 +57,10 @@ bare=$("$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/b.yaml" --threads 1 2>&1)
 sed -e 's/^  lf_elbow:/  lf_elbow_renamed:/' "$tmp/robot.yaml" > "$tmp/lacking.yaml"
 out=$("$animrt" evolve "$tmp/evolve.yaml" --out "$tmp/n.yaml" --robot "$tmp/lacking.yaml" 2>&1)
 code=$?
-[[ $code -eq 2 && $out == *"lacking.yaml"* && $out == *'"lf_elbow"'* ]] ||
-  fail "a robot without a model joint (exit $code): $out"
+# One line naming the robot file, the line of its joints key and the joint.
+line=$(grep -n '^joints:' "$tmp/lacking.yaml" | cut -d: -f1)
+expected="error: $tmp/lacking.yaml:$line:1: joints: no joint \"lf_elbow\" of the model (--robot needs them all)"
+[[ $code -eq 2 && $out == "$expected" ]] ||
+  fail "a robot without a model joint (exit $code): '$out', expected '$expected'"
 [[ ! -e $tmp/n.yaml ]] || fail "a refused robot wrote a gait"
 echo "ok"

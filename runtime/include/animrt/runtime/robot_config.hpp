@@ -69,6 +69,7 @@ struct RobotConfig {
   double rate_hz = 200.0;
   SafetyConfig safety;
   std::vector<JointSpec> joints;
+  Location joints_where;         // of the `joints` key (a joint another file needs is named there)
   std::vector<BusConfig> buses;  // each with its actuators (joint_index filled in)
   std::vector<ImuConfig> imus;   // the first is the trunk's
   MotionConfig motion;
