@@ -222,7 +222,7 @@ void CuePlayer::warp(double t) const {
   last_t_ = t;
   step_dt_ = dt;
   const double goal = winding_ ? wind_goal_ : requests_.paused() ? 0.0 : 1.0;
-  const double ease = dt / kPauseRampS;
+  const double ease = dt / ease_s_;
   rate_phase_ =
       goal > rate_phase_ ? std::min(goal, rate_phase_ + ease) : std::max(goal, rate_phase_ - ease);
   play_ += smootherstep(rate_phase_) * dt;
@@ -234,23 +234,32 @@ void CuePlayer::warp(double t) const {
 // Every motion still seen winds down on its own time (a crossfade's two
 // together: the stop waits for the slower). A source two layers share (a
 // cue looping into itself) is asked once, on the newest layer's time.
-double CuePlayer::wind_down(double t) {
-  if (!begun_ || winding_) return 0.0;
+double CuePlayer::wind_down(double t, double granted_s) {
+  if (!begun_ || winding_ || !(granted_s > 0.0)) return 0.0;
   warp(t);
   winding_ = true;
   wind_goal_ = requests_.paused() ? 0.0 : 1.0;
-  // A pausing cue comes to rest by itself when its easing ends (0: it stands).
-  if (wind_goal_ == 0.0) return rate_phase_ * kPauseRampS;
+  // A pausing cue comes to rest by itself when its easing ends (0: it
+  // stands), sooner when the stop grants less time.
+  if (wind_goal_ == 0.0) {
+    ease_s_ = std::min(kPauseRampS, granted_s / std::max(rate_phase_, 1e-9));
+    return rate_phase_ * ease_s_;
+  }
+  // The wind-down is in play time; a resume still easing in lags behind by
+  // less than what is left of its easing, which the sources' time leaves.
+  const double lag = (1.0 - rate_phase_) * ease_s_;
+  const double granted_play = granted_s - lag;
+  if (!(granted_play > 0.0)) return 0.0;
   double longest = 0.0;
   for (std::size_t i = count_; i-- > 0;) {
     MotionSource* source = step_of(layers_[i]).source.get();
     bool seen = false;
     for (std::size_t k = i + 1; k < count_; ++k) seen |= step_of(layers_[k]).source.get() == source;
-    if (!seen) longest = std::max(longest, source->wind_down(play_ - layers_[i].t0));
+    if (!seen) {
+      longest = std::max(longest, source->wind_down(play_ - layers_[i].t0, granted_play));
+    }
   }
-  // The wind-down is in play time; a resume still easing in lags behind by
-  // less than what is left of its easing.
-  return longest > 0.0 ? longest + (1.0 - rate_phase_) * kPauseRampS : 0.0;
+  return longest > 0.0 ? longest + lag : 0.0;
 }
 
 void CuePlayer::advance(double t) const {

@@ -65,20 +65,23 @@ class GaitSource final : public MotionSource {
     }
   }
 
-  // The walk winds down over the time of kWindDownStrides strides: every
-  // joint's swing about its stride mean and the cadence ease to nothing
-  // together (as a steered gait blends to a stand), so the steps shorten
-  // and slow and the body slows with them.
-  double wind_down(double t) override {
+  // The walk winds down over the time of kWindDownStrides strides, or over
+  // the time the stop grants when that is shorter: every joint's swing
+  // about its stride mean and the cadence ease to nothing together (as a
+  // steered gait blends to a stand), so the steps shorten and slow and the
+  // body slows with them, and the figure stands when the time is up.
+  double wind_down(double t, double granted_s) override {
+    if (!(granted_s > 0.0)) return 0.0;
     wind_start_ = t;
-    return kWindDownStrides / frequency_;
+    wind_length_ = std::min(kWindDownStrides / frequency_, granted_s);
+    return wind_length_;
   }
 
  private:
   // How far into the wind-down motion time t is, 0 to 1 (0 while walking).
   double wind_at(double t) const {
     if (wind_start_ < 0.0 || t <= wind_start_) return 0.0;
-    return std::min(1.0, (t - wind_start_) * frequency_ / kWindDownStrides);
+    return std::min(1.0, (t - wind_start_) / wind_length_);
   }
   // The swing's scale: 1 while walking, easing to 0 over the wind-down
   // (smoothstep: no jump in the joints' speed at either end).
@@ -91,8 +94,7 @@ class GaitSource final : public MotionSource {
   double stride_time(double t) const {
     const double u = wind_at(t);
     if (u <= 0.0) return t;
-    const double length = kWindDownStrides / frequency_;
-    return wind_start_ + length * (u - u * u * u + 0.5 * u * u * u * u);
+    return wind_start_ + wind_length_ * (u - u * u * u + 0.5 * u * u * u * u);
   }
 
   double frequency_;
@@ -101,6 +103,7 @@ class GaitSource final : public MotionSource {
   std::vector<Drive> drives_;
   std::vector<int> driven_;
   double wind_start_ = -1.0;  // motion time the wind-down began (-1: walking)
+  double wind_length_ = 1.0;  // its length (s)
 };
 
 std::string joint_names(std::span<const JointSpec> joints) {

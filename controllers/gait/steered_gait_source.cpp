@@ -42,6 +42,7 @@ SteeredGaitSource::SteeredGaitSource(const GaitSteering& steering, double native
   max_speed_ = steering_.max_speed_m_s();
   native_frequency_hz_ = native_frequency_hz;
   blend_time_s_ = 1.0 / frequency_at(min_speed_);
+  stand_time_s_ = blend_time_s_;
   target_speed_ = std::clamp(native_speed_, min_speed_, max_speed_);
 }
 
@@ -66,13 +67,17 @@ void SteeredGaitSource::steer(const MotionCommand& command) {
   target_spot_ = target_speed_ == 0.0 && target_turn_ != 0.0 && steering_.turn_on_the_spot;
 }
 
-double SteeredGaitSource::wind_down(double t) {
+double SteeredGaitSource::wind_down(double t, double granted_s) {
+  if (!(granted_s > 0.0)) return 0.0;
   advance(t);
   target_speed_ = 0.0;
   target_turn_ = 0.0;
   target_spot_ = false;
-  // The blend falls linearly at 1 / blend_time_s_; a turn on the spot blends out as fast.
-  return std::max(blend_, spot_) * blend_time_s_;
+  // The blend falls linearly at 1 / blend_time_s_ (a turn on the spot blends
+  // out as fast), faster when the stop grants less time: it stands in time.
+  const double left = std::max(blend_, spot_);
+  stand_time_s_ = std::min(blend_time_s_, granted_s / std::max(left, 1e-9));
+  return left * stand_time_s_;
 }
 
 MotionCommand SteeredGaitSource::current() const {
@@ -104,11 +109,11 @@ void SteeredGaitSource::advance(double t) const {
   const bool walking = target_speed_ > 0.0 || target_spot_;
   speed_ = step_toward(speed_, target_speed_ > 0.0 ? target_speed_ : min_speed_,
                        steering_.max_acceleration_m_s2 * dt);
-  blend_ = std::clamp(blend_ + (walking ? dt : -dt) / blend_time_s_, 0.0, 1.0);
+  blend_ = std::clamp(blend_ + (walking ? dt / blend_time_s_ : -dt / stand_time_s_), 0.0, 1.0);
   // Into and out of the turn on the spot over a stride, as walk and stand.
-  spot_ = std::clamp(spot_ + (target_spot_ ? dt : -dt) / blend_time_s_, 0.0, 1.0);
+  spot_ = std::clamp(spot_ + (target_spot_ ? dt / blend_time_s_ : -dt / stand_time_s_), 0.0, 1.0);
   turn_ = step_toward(turn_, walking ? target_turn_ : 0.0,
-                      steering_.max_turn_rad_s * dt / blend_time_s_);
+                      steering_.max_turn_rad_s * dt / stand_time_s_);
   phase_ += frequency_at(speed_) * smoothstep(blend_) * dt;
 }
 

@@ -257,11 +257,11 @@ class LayeredSource final : public MotionSource {
   void start(const MotionClock& clock) override {
     for (const auto& l : layers_) l->start(clock);
   }
-  // Every layer winds down together (a walk under a show's head moves): the
-  // stop waits for the slowest.
-  double wind_down(double t) override {
+  // Every layer winds down together (a walk under a show's head moves),
+  // each within the time granted: the stop waits for the slowest.
+  double wind_down(double t, double granted_s) override {
     double longest = 0.0;
-    for (const auto& l : layers_) longest = std::max(longest, l->wind_down(t));
+    for (const auto& l : layers_) longest = std::max(longest, l->wind_down(t, granted_s));
     return longest;
   }
   void follow_sound(const std::string& show_file, const SoundClock& clock) override {

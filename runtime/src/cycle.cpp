@@ -150,11 +150,12 @@ void CycleState::begin_stop(const RobotModel& model, double t) {
 
 void CycleState::request_stop(const RobotModel& model, MotionSource& motion, double t) {
   // The wind-down leaves the ramp and the settling their time before the
-  // stop deadline, which counts from the request.
+  // stop deadline, which counts from the request: the motion is granted
+  // the rest and eases to rest within it. The cut is kept as a guard.
   const double room =
       model.safety.stop_deadline_s - model.safety.stop_ramp_s - kStopSettleTime - model.dt;
-  const double wind = phase_ == Phase::motion && !manual_
-                          ? std::min(motion.wind_down(t - motion_start_), room)
+  const double wind = phase_ == Phase::motion && !manual_ && room >= model.dt
+                          ? std::min(motion.wind_down(t - motion_start_, room), room)
                           : 0.0;
   if (!(wind >= model.dt)) {
     begin_stop(model, t);

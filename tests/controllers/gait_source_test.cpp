@@ -14,6 +14,9 @@
 namespace animrt {
 namespace {
 
+// More time than any wind-down asks for: the stop deadline does not cut it.
+constexpr double kGaitAmpleS = 100.0;
+
 const char* const kGait = R"yaml(name: test
 stride_frequency_hz: 2.0
 curves:
@@ -111,7 +114,7 @@ TEST_F(GaitSourceTest, TargetsAreRadians) {
 // in each curve's stride mean (wave: 10) once the time it asked is over.
 TEST_F(GaitSourceTest, AWindDownEasesTheSwingToTheStrideMeanOverTwoStrides) {
   const auto walking = sample_deg(1.1);
-  EXPECT_DOUBLE_EQ(source_->wind_down(1.1), 1.0);
+  EXPECT_DOUBLE_EQ(source_->wind_down(1.1, kGaitAmpleS), 1.0);
   const auto at_request = sample_deg(1.1);
   EXPECT_DOUBLE_EQ(at_request[2], walking[2]);
   double first_stride = 0.0, second_stride = 0.0;
@@ -127,6 +130,34 @@ TEST_F(GaitSourceTest, AWindDownEasesTheSwingToTheStrideMeanOverTwoStrides) {
     EXPECT_NEAR(deg[2], 10.0, 1e-9) << t;
     EXPECT_NEAR(deg[1], -17.0, 1e-9) << t;
   }
+}
+
+// A stop that grants less than two strides (here 0.3 s of the 1 s) gets a
+// shorter wind-down, not a cut one: the swing and the cadence ease out
+// over the time granted, and the figure stands in the stride means when
+// it is up, for the ramp home to start from a stand.
+TEST_F(GaitSourceTest, AWindDownGrantedLessThanTwoStridesStandsWhenTheGrantedTimeIsUp) {
+  const auto walking = sample_deg(1.1);
+  EXPECT_DOUBLE_EQ(source_->wind_down(1.1, 0.3), 0.3);
+  EXPECT_DOUBLE_EQ(sample_deg(1.1)[2], walking[2]);
+  double swing = 0.0;
+  for (double t = 1.1; t < 1.25; t += 0.005)
+    swing = std::max(swing, std::abs(sample_deg(t)[2] - 10.0));
+  EXPECT_GT(swing, 1.0);  // it kept stepping at first
+  for (double t = 1.4; t < 2.5; t += 0.01) {
+    const auto deg = sample_deg(t);
+    EXPECT_NEAR(deg[2], 10.0, 1e-9) << t;
+    EXPECT_NEAR(deg[1], -17.0, 1e-9) << t;
+  }
+  // Its speed eases to nothing too: no jump from the last step to the stand.
+  EXPECT_NEAR(sample_deg(1.399)[2], 10.0, 1e-3);
+}
+
+// Nothing granted: the walk is left as it is, for the ramp home at once.
+TEST_F(GaitSourceTest, AWindDownGrantedNoTimeAsksForNone) {
+  const auto walking = sample_deg(1.3);
+  EXPECT_EQ(source_->wind_down(1.1, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(sample_deg(1.3)[2], walking[2]);
 }
 
 TEST_F(GaitSourceTest, SampleDoesNotAllocate) {

@@ -19,6 +19,9 @@
 namespace animrt {
 namespace {
 
+// More time than any wind-down asks for: the stop deadline does not cut it.
+constexpr double kSteeredAmpleS = 100.0;
+
 constexpr double kDt = 0.005;  // the quadruped's 200 Hz cycle
 constexpr double kMeanDeg = 10.0;
 constexpr double kSwingDeg = 20.0;
@@ -156,7 +159,7 @@ TEST(SteeredGait, AWindDownStandsInTheMeanPoseWithinTheTimeItAsks) {
   Rig rig;
   rig.source->steer({rig.st().max_speed_m_s(), 0.0});
   rig.run(2.0);
-  const double asked = rig.source->wind_down(rig.t);
+  const double asked = rig.source->wind_down(rig.t, kSteeredAmpleS);
   EXPECT_GT(asked, 0.5);
   EXPECT_LE(asked, 1.0 / rig.st().min_speed_m_s() + 10.0);
   const auto winding = rig.run(asked + kDt);  // to the first cycle at or past it

@@ -17,6 +17,9 @@
 namespace animrt {
 namespace {
 
+// More time than any wind-down asks for: the stop deadline does not cut it.
+constexpr double kCueAmpleS = 100.0;
+
 const std::string kWindRoot = ANIMRT_SOURCE_DIR;
 
 // The quadruped's walk (a steered gait at its own speed) and a pose, each a
@@ -74,8 +77,8 @@ TEST(CueWindDown, AWalkingCueWindsDownAsItsGaitDoes) {
   WalkCues f(0);
   const int k = 263;  // mid-stride
   f.play_to(k);
-  const double asked = f.player->wind_down(k * f.dt);
-  const double own = f.reference->wind_down(k * f.dt);
+  const double asked = f.player->wind_down(k * f.dt, kCueAmpleS);
+  const double own = f.reference->wind_down(k * f.dt, kCueAmpleS);
   ASSERT_GT(own, 1.0);
   EXPECT_DOUBLE_EQ(asked, own);
   // A cue asked for while it winds down waits: the walk goes on to rest.
@@ -103,6 +106,33 @@ TEST(CueWindDown, AWalkingCueWindsDownAsItsGaitDoes) {
   EXPECT_LT(last_swing, 0.3 * first_swing);
 }
 
+// A stop that grants the walking cue less than its own wind-down: the
+// player hands the grant on, and the walk stands, as the gait alone does,
+// when the granted time is up.
+TEST(CueWindDown, AWalkingCueStandsWithinTheTimeGranted) {
+  WalkCues f(0);
+  const int k = 263;
+  f.play_to(k);
+  const double own = WalkCues(0).reference->wind_down(k * f.dt, kCueAmpleS);
+  const double granted = 0.4 * own;
+  const double asked = f.player->wind_down(k * f.dt, granted);
+  EXPECT_DOUBLE_EQ(asked, f.reference->wind_down(k * f.dt, granted));
+  EXPECT_LE(asked, granted);
+  std::vector<double> stood;
+  while ((f.next - k) * f.dt <= granted + 0.5) {
+    f.cycle();
+    ASSERT_LT(f.gap(), 1e-9) << "at " << (f.next - 1) * f.dt;
+    if ((f.next - 1 - k) * f.dt >= granted) {
+      if (stood.empty()) stood = f.pose;
+      for (int j : f.player->driven_joints()) {
+        const auto i = static_cast<std::size_t>(j);
+        ASSERT_NEAR(f.pose[i], stood[i], 1e-9) << "joint " << j << " at " << (f.next - 1) * f.dt;
+      }
+    }
+  }
+  EXPECT_FALSE(stood.empty());
+}
+
 // Mid-crossfade from a pose into the walk: both motions are asked, the stop
 // waits for the walk, and the fade completes into the wound-down walk.
 TEST(CueWindDown, ACrossfadeWaitsForTheLongerMotion) {
@@ -114,8 +144,8 @@ TEST(CueWindDown, ACrossfadeWaitsForTheLongerMotion) {
   f.play_to(asked_at + 40);
   const double fade = f.player->last_crossfade_s();
   ASSERT_GT(fade, 40 * f.dt);
-  const double asked = f.player->wind_down(f.next * f.dt);
-  const double own = f.reference->wind_down(40 * f.dt);
+  const double asked = f.player->wind_down(f.next * f.dt, kCueAmpleS);
+  const double own = f.reference->wind_down(40 * f.dt, kCueAmpleS);
   EXPECT_DOUBLE_EQ(asked, own);
   ASSERT_LT(fade, own);
   while ((f.next - asked_at) * f.dt < own) {
@@ -136,14 +166,14 @@ TEST(CueWindDown, APausedCueStandsAlreadyAndAPausingOneEasesToRest) {
   g.requests.pause(true);
   g.play_to(400);
   // The pause was first seen at cycle 200, over the step from cycle 199.
-  EXPECT_NEAR(f.player->wind_down(240 * f.dt), kPauseRampS - 41 * f.dt, 1e-9);
-  EXPECT_EQ(g.player->wind_down(400 * g.dt), 0.0);
+  EXPECT_NEAR(f.player->wind_down(240 * f.dt, kCueAmpleS), kPauseRampS - 41 * f.dt, 1e-9);
+  EXPECT_EQ(g.player->wind_down(400 * g.dt, kCueAmpleS), 0.0);
 }
 
 TEST(CueWindDown, APoseCueAsksForNothing) {
   WalkCues f(1);
   f.play_to(100);
-  EXPECT_EQ(f.player->wind_down(100 * f.dt), 0.0);
+  EXPECT_EQ(f.player->wind_down(100 * f.dt, kCueAmpleS), 0.0);
 }
 
 }  // namespace

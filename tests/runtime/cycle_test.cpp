@@ -8,10 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 
+#include "animrt/controllers/gait/gait_source.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -30,8 +32,9 @@ class LambdaSource : public MotionSource {
     for (std::size_t j = 0; j < targets.size(); ++j) targets[j] = fn(j, t);
   }
   void steer(const MotionCommand& command) override { steered = command; }
-  double wind_down(double t) override {
+  double wind_down(double t, double granted_s) override {
     wound_at.push_back(t);
+    granted.push_back(granted_s);
     return wind;
   }
 
@@ -39,6 +42,7 @@ class LambdaSource : public MotionSource {
   MotionCommand steered{-1.0, -1.0};
   double wind = 0.0;             // what wind_down() asks for (s)
   std::vector<double> wound_at;  // motion times wind_down() was called at
+  std::vector<double> granted;   // the time each call granted
 
  private:
   std::vector<int> driven_;
@@ -595,6 +599,80 @@ TEST(Cycle, AWindDownIsCutShortToFitTheStopDeadline) {
   EXPECT_FALSE(bench.state.end().torque_cut);
   EXPECT_FALSE(bench.has(EventKind::stop_deadline));
   EXPECT_LT(static_cast<double>(bench.count) / kRate - asked, 3.0);
+}
+
+// The motion is told the time the stop deadline leaves it (the deadline
+// less the ramp, the wait for the joints and a cycle), so it can come to
+// rest within it.
+TEST(Cycle, AStopGrantsTheMotionTheTimeItsDeadlineLeaves) {
+  RobotModel model = two_bus_model();
+  model.safety.stop_deadline_s = 4.0;
+  Bench bench(model);
+  bench.motion.wind = 0.2;
+  bench.in.motion_duration_s = 0.5;
+  bench.begin();
+  bench.run_until(Phase::done);
+  ASSERT_EQ(bench.motion.granted.size(), 1u);
+  EXPECT_NEAR(bench.motion.granted[0], 4.0 - 0.5 - kStopSettleTime - 1.0 / kRate, 1e-12);
+  // No time left for a wind-down: the motion is not asked, the ramp starts at once.
+  model.safety.stop_deadline_s = 0.5 + kStopSettleTime;
+  Bench tight(model);
+  tight.motion.wind = 0.2;
+  tight.in.motion_duration_s = 0.5;
+  tight.begin();
+  tight.run_until(Phase::done);
+  EXPECT_TRUE(tight.motion.granted.empty());
+  EXPECT_FALSE(tight.state.end().torque_cut);
+}
+
+// A walk whose two strides (2 s at 1 Hz) do not fit the stop deadline
+// (3 s: 0.49 s are left after the 0.5 s ramp and the 2 s wait) winds down
+// in the time granted, completely: it stands when the ramp home begins,
+// and the stop ends inside its deadline.
+TEST(Cycle, AWalkWoundDownInTheTimeGrantedStandsWhenTheRampBegins) {
+  RobotModel model = two_bus_model();
+  model.safety.stop_deadline_s = 3.0;
+  Bench bench(model);
+  const std::string path = ::testing::TempDir() + "/cycle_walk.yaml";
+  std::ofstream(path) << "name: walk\nstride_frequency_hz: 1.0\n"
+                         "curves: {swing: \"5 + 10*sin(2*PI*t)\"}\n"
+                         "limbs: {a: 0.0, b: 0.25, c: 0.5, d: 0.75}\n"
+                         "joints:\n  j0: {curve: swing, limb: a}\n  j1: {curve: swing, limb: b}\n"
+                         "  j2: {curve: swing, limb: c}\n  j3: {curve: swing, limb: d}\n";
+  std::vector<JointSpec> joints(4);
+  for (std::size_t j = 0; j < 4; ++j) {
+    joints[j].name = "j" + std::to_string(j);
+    joints[j].limits = model.limits[j];
+  }
+  bench.show = load_gait_source(path, joints);
+  bench.in.motion_duration_s = 1.3;  // mid-stride
+  bench.begin();
+  bench.run_until(Phase::stop_ramp);
+  ASSERT_TRUE(bench.state.winding_down());
+  const double asked = bench.first(EventKind::motion_ended)->t;
+  while (bench.state.winding_down() && bench.count < 2000) bench.cycle();
+  const double ramp_start = static_cast<double>(bench.count - 1) / kRate;
+  EXPECT_NEAR(ramp_start - asked, 3.0 - 0.5 - kStopSettleTime - 1.0 / kRate, 0.011);
+  // The walk stands (each joint at its stride mean, 5 deg, and still) from
+  // the end of the time granted on.
+  const double granted_end = ramp_start - bench.state.motion_start();
+  for (const double after : {0.0, 0.1, 1.0}) {
+    std::vector<double> pose(4, 0.0);
+    bench.show->sample(granted_end + after, pose);
+    for (std::size_t j = 0; j < 4; ++j) {
+      EXPECT_NEAR(pose[j], deg_to_rad(5.0), 1e-9) << "joint " << j << ", " << after << " s after";
+    }
+  }
+  // What the figure was sent as the ramp began: near the stand already.
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_NEAR(bench.state.measured()[j], deg_to_rad(5.0), deg_to_rad(0.5)) << "joint " << j;
+  }
+  bench.run_until(Phase::done);
+  EXPECT_FALSE(bench.state.end().torque_cut);
+  EXPECT_FALSE(bench.has(EventKind::stop_deadline));
+  EXPECT_FALSE(bench.has(EventKind::stop_unreached));
+  EXPECT_LT(static_cast<double>(bench.count - 1) / kRate - asked, 3.0);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(bench.state.measured()[j], 0.0, 1e-9);
 }
 
 TEST(Cycle, SteeringReachesTheMotionSourceAtTheStartOfTheCycle) {

@@ -17,6 +17,9 @@
 namespace animrt {
 namespace {
 
+// More time than any wind-down asks for: the stop deadline does not cut it.
+constexpr double kShowAmpleS = 100.0;
+
 std::string write(const std::string& name, const std::string& text) {
   const std::string path =
       ::testing::TempDir() + "/" +
@@ -175,9 +178,9 @@ class ClockCounter final : public MotionSource {
     start_ns = clock.start;
   }
   void stop() override { ++stops; }
-  double wind_down(double t) override {
+  double wind_down(double t, double granted_s) override {
     wound_at = t;
-    return wind;
+    return std::min(wind, granted_s);
   }
   int starts = 0, stops = 0;
   Nanos start_ns = -1;
@@ -199,10 +202,11 @@ TEST(Show, LayersWindDownTogetherForAsLongAsTheSlowestAsks) {
   layers.push_back(load_show_source(write("w.yaml", kShow), joints()));
   layers.push_back(std::move(b));
   auto s = make_layered_source(std::move(layers));
-  EXPECT_DOUBLE_EQ(s->wind_down(4.0), 2.5);
+  EXPECT_DOUBLE_EQ(s->wind_down(4.0, kShowAmpleS), 2.5);
   EXPECT_DOUBLE_EQ(pa->wound_at, 4.0);
   EXPECT_DOUBLE_EQ(pb->wound_at, 4.0);
-  EXPECT_DOUBLE_EQ(load_show_source(write("w2.yaml", kShow), joints())->wind_down(4.0), 0.0);
+  EXPECT_DOUBLE_EQ(load_show_source(write("w2.yaml", kShow), joints())->wind_down(4.0, kShowAmpleS),
+                   0.0);
 }
 
 TEST(Show, LayersPassTheRunsClockToEveryLayer) {

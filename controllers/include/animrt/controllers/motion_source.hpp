@@ -89,9 +89,12 @@ class MotionSource {
   // that must come to rest by itself before its joints go home (a walk
   // that winds down while it keeps stepping, so the body slows instead of
   // being stopped dead) begins to, and returns how long that takes (s).
-  // The cycle samples it that long, cut short to fit the stop deadline,
-  // then ramps home. 0: ramp home at once. Same rules as sample().
-  virtual double wind_down(double /*t*/) { return 0.0; }
+  // `granted_s` is the most the stop deadline leaves for it: a source
+  // comes fully to rest within it (a shorter wind-down, never a cut one)
+  // and returns at most that. The cycle samples it that long, then ramps
+  // home. 0: ramp home at once (a motion with nothing to wind down). Same
+  // rules as sample().
+  virtual double wind_down(double /*t*/, double /*granted_s*/) { return 0.0; }
 
   // A show's transport: a source that plays a show keeps its own playhead,
   // which maps the motion's time `t` (as sample() gets it) to the show's.

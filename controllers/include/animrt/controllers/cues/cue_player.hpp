@@ -77,7 +77,7 @@ class CuePlayer final : public MotionSource {
   // At a stop, what plays winds down (a walking cue eases to a stand) and
   // no other cue or step starts; a pause eases to rest instead, and a cue
   // that is paused already asks for nothing.
-  double wind_down(double t) override;
+  double wind_down(double t, double granted_s) override;
 
   // Read from any thread while it plays.
   int current_cue() const { return current_.load(std::memory_order_relaxed); }
@@ -145,6 +145,7 @@ class CuePlayer final : public MotionSource {
   mutable bool waiting_ = false;     // a request waits for a free slot
   bool winding_ = false;             // a stop's wind-down began: nothing new starts
   double wind_goal_ = 1.0;           // the playback rate's goal while it winds down
+  double ease_s_ = kPauseRampS;      // pause/resume easing time (shorter in a granted wind-down)
   mutable int waiting_cue_ = 0;
   mutable double waiting_at_ = 0.0;  // its time into the cue
   mutable std::vector<double> out_, prev_out_, scratch_;

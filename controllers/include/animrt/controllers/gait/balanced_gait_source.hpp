@@ -33,7 +33,7 @@ class BalancedGaitSource final : public MotionSource {
   std::span<const int> driven_joints() const override { return gait_->driven_joints(); }
   void sample(double t, std::span<double> targets) const override;
   void steer(const MotionCommand& command) override { gait_->steer(command); }
-  double wind_down(double t) override { return gait_->wind_down(t); }
+  double wind_down(double t, double granted_s) override { return gait_->wind_down(t, granted_s); }
   void sense(const Sensors& sensors) override;
   void start(const MotionClock& clock) override { gait_->start(clock); }
   void stop() override { gait_->stop(); }

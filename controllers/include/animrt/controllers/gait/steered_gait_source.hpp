@@ -49,8 +49,9 @@ class SteeredGaitSource final : public MotionSource {
   void sample(double t, std::span<double> targets) const override;
   void steer(const MotionCommand& command) override;
   // A stop: the walk is told to stand (as a command under the slowest
-  // speed), and the swing blends out over the walk/stand blend time.
-  double wind_down(double t) override;
+  // speed), and the swing blends out over the walk/stand blend time, or
+  // faster to stand within the time granted.
+  double wind_down(double t, double granted_s) override;
 
   // The command in force after clamping (speed 0 = stand).
   MotionCommand target() const { return {target_speed_, target_turn_}; }
@@ -75,6 +76,7 @@ class SteeredGaitSource final : public MotionSource {
   double native_length_ = 0.0;  // stride length at the native Froude number
   double native_frequency_hz_ = 1.0;
   double blend_time_s_ = 1.0;  // walk/stand blend and full-turn ramp time
+  double stand_time_s_ = 1.0;  // the same towards a stand (shorter in a granted wind-down)
   double min_speed_ = 0.0, max_speed_ = 0.0;
 
   double target_speed_ = 0.0;  // 0 or within [min_speed_, max_speed_]
