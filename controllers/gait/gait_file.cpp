@@ -509,6 +509,19 @@ double exact_dps(double rad_s) {
   return c;
 }
 
+// Steering and the balance reflex are for a walk.
+void validate_walks(const GaitFile& gait) {
+  if (gait.walks) return;
+  if (gait.steering) {
+    throw InputError(gait.walks_where, "walks",
+                     "a gait that does not walk cannot be steered: remove steering or walks");
+  }
+  if (gait.balance) {
+    throw InputError(gait.walks_where, "walks",
+                     "a gait that does not walk has no balance reflex: remove balance or walks");
+  }
+}
+
 }  // namespace
 
 double GaitFile::stride_frequency() const {
@@ -547,7 +560,8 @@ bool operator==(const FroudeTiming& a, const FroudeTiming& b) {
 bool operator==(const GaitFile& a, const GaitFile& b) {
   return a.name == b.name && a.stride_frequency_hz == b.stride_frequency_hz &&
          a.froude == b.froude && a.curves == b.curves && a.limbs == b.limbs &&
-         a.joints == b.joints && a.steering == b.steering && a.balance == b.balance;
+         a.joints == b.joints && a.steering == b.steering && a.balance == b.balance &&
+         a.walks == b.walks;
 }
 bool operator==(const GaitBalance& a, const GaitBalance& b) {
   return a.tilt_m == b.tilt_m && a.tilt_rate_m_s == b.tilt_rate_m_s;
@@ -570,7 +584,7 @@ bool operator==(const GaitSteering& a, const GaitSteering& b) {
 GaitFile parse_gait_file(const std::string& text, const std::string& file_name) {
   const YamlNode root = YamlNode::load_string(text, file_name);
   root.allow_only({"name", "stride_frequency_hz", "froude", "curves", "limbs", "joints", "steering",
-                   "balance"});
+                   "balance", "walks"});
   GaitFile gait;
   gait.file = file_name;
   const YamlNode name = root.at("name");
@@ -582,6 +596,11 @@ GaitFile parse_gait_file(const std::string& text, const std::string& file_name) 
   read_joints(root, gait);
   read_steering(root, gait);
   read_balance(root, gait);
+  if (const auto walks = root.find("walks")) {
+    gait.walks = walks->as_bool();
+    gait.walks_where = walks->location();
+  }
+  validate_walks(gait);
   return gait;
 }
 
@@ -684,6 +703,7 @@ void validate_gait(const GaitFile& gait) {
     }
   }
   validate_steering(gait);
+  validate_walks(gait);
   if (gait.balance) {
     const GaitBalance& b = *gait.balance;
     const auto gain = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= kMaxBalanceGain; };
@@ -740,6 +760,7 @@ std::string format_gait_file(const GaitFile& gait) {
     if (s.spot_swing_offset != s.swing_offset)
       out += "  spot_swing_offset: " + shortest_exact(s.spot_swing_offset) + "\n";
   }
+  if (!gait.walks) out += "walks: false\n";
   if (gait.balance) {
     out += "balance: {tilt_m: " + shortest_exact(gait.balance->tilt_m) +
            ", tilt_rate_m_s: " + shortest_exact(gait.balance->tilt_rate_m_s) + "}\n";

@@ -43,11 +43,13 @@ class GaitSource final : public MotionSource {
     double offset_deg = 0.0;
   };
 
-  GaitSource(double frequency, std::vector<Expression> curves, std::vector<Drive> drives)
+  GaitSource(double frequency, std::vector<Expression> curves, std::vector<Drive> drives,
+             bool walks)
       : frequency_(frequency),
         curves_(std::move(curves)),
         means_(stride_means(curves_)),
-        drives_(std::move(drives)) {
+        drives_(std::move(drives)),
+        walks_(walks) {
     for (const Drive& d : drives_) driven_.push_back(d.joint);
   }
 
@@ -71,7 +73,7 @@ class GaitSource final : public MotionSource {
   // steered gait blends to a stand), so the steps shorten and slow and the
   // body slows with them, and the figure stands when the time is up.
   double wind_down(double t, double granted_s) override {
-    if (!(granted_s > 0.0)) return 0.0;
+    if (!walks_ || !(granted_s > 0.0)) return 0.0;
     wind_start_ = t;
     wind_length_ = std::min(kWindDownStrides / frequency_, granted_s);
     return wind_length_;
@@ -102,6 +104,7 @@ class GaitSource final : public MotionSource {
   std::vector<double> means_;  // per curve, over one stride: the pose a wound-down walk stands in
   std::vector<Drive> drives_;
   std::vector<int> driven_;
+  bool walks_ = true;         // a sway that carries no weight has nothing to wind down
   double wind_start_ = -1.0;  // motion time the wind-down began (-1: walking)
   double wind_length_ = 1.0;  // its length (s)
 };
@@ -140,7 +143,7 @@ std::unique_ptr<MotionSource> source_for(const GaitFile& gait, std::span<const J
   }
   if (!gait.steering) {
     return std::make_unique<GaitSource>(gait.stride_frequency(), std::move(curves),
-                                        std::move(drives));
+                                        std::move(drives), gait.walks);
   }
   const GaitSteering& steering = *gait.steering;
   std::vector<SteeredGaitSource::Drive> steered;

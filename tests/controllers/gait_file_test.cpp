@@ -95,7 +95,7 @@ TEST(GaitFile, FroudeTiming) {
 TEST(GaitFile, UnknownKeys) {
   EXPECT_EQ(gait_file_error(with_line(1, "name: test\nspeed: 3")),
             "g.yaml:2:1: speed: unknown key (expected one of: name, stride_frequency_hz, froude, "
-            "curves, limbs, joints, steering, balance)");
+            "curves, limbs, joints, steering, balance, walks)");
   EXPECT_EQ(gait_file_error(with_line(10, "  j1: {curve: hip, limb: a, gain: 2}")),
             "g.yaml:10:29: joints.j1.gain: unknown key (expected one of: curve, limb, sign, scale, "
             "offset_deg)");
@@ -261,6 +261,26 @@ GaitFile odd_gait() {
   g.joints.push_back({"x: y", "curve with spaces", "1", 1, -99.99999999999999, 5e-324, {}});
   g.joints.push_back({"z", "null", "front", 1, 1.0, 0.0, {}});
   return g;
+}
+
+// walks: false marks a periodic motion that is not a walk (it winds down
+// at no stop); it survives a write and a read, and a gait that does not
+// walk cannot be steered or balanced.
+TEST(GaitFile, Walks) {
+  EXPECT_TRUE(parse_gait_file(join(kBase), "g.yaml").walks);
+  const GaitFile g = parse_gait_file(with_line(1, "name: test\nwalks: false"), "g.yaml");
+  EXPECT_FALSE(g.walks);
+  const GaitFile back = parse_gait_file(format_gait_file(g), "back.yaml");
+  EXPECT_FALSE(back.walks);
+  EXPECT_TRUE(back == g) << format_gait_file(g);
+  GaitFile other = g;
+  other.walks = true;
+  EXPECT_FALSE(other == g);
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nwalks: maybe")),
+            "g.yaml:2:8: walks: expected true or false, found \"maybe\"");
+  EXPECT_EQ(gait_file_error(with_line(1, "name: test\nwalks: false\nbalance: {tilt_m: 0.3}")),
+            "g.yaml:2:8: walks: a gait that does not walk has no balance reflex: remove balance or "
+            "walks");
 }
 
 TEST(GaitFile, Balance) {

@@ -160,6 +160,22 @@ TEST_F(GaitSourceTest, AWindDownGrantedNoTimeAsksForNone) {
   EXPECT_DOUBLE_EQ(sample_deg(1.3)[2], walking[2]);
 }
 
+// A gait that does not walk (an animatronic's sway) has nothing to wind
+// down: a stop ramps it home at once, and it plays on as before until then.
+TEST(GaitSource, AGaitThatDoesNotWalkAsksForNoWindDown) {
+  std::string text = kGait;
+  text.replace(text.find("curves:"), 0, "walks: false\n");
+  const auto joints = robot({"x", "j2", "j1", "j3", "y"});
+  const auto sway = load_gait_source(write_temp("sway.yaml", text), joints);
+  const auto walk = load_gait_source(write_temp("walk.yaml", kGait), joints);
+  EXPECT_EQ(sway->wind_down(1.1, kGaitAmpleS), 0.0);
+  EXPECT_DOUBLE_EQ(walk->wind_down(1.1, kGaitAmpleS), 1.0);
+  std::vector<double> a(joints.size(), 0.0), b(joints.size(), 0.0);
+  sway->sample(1.3, a);
+  load_gait_source(write_temp("walk2.yaml", kGait), joints)->sample(1.3, b);
+  EXPECT_EQ(a, b);
+}
+
 TEST_F(GaitSourceTest, SampleDoesNotAllocate) {
   std::vector<double> targets(joints_.size(), 0.0);
   test::AllocationCounter counter;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <any>
 #include <cmath>
 #include <fstream>
@@ -93,6 +94,21 @@ TEST(MixedFigure, TheShowRunsOnAllThreeBusesInLockstep) {
   EXPECT_GT(std::count(text.begin(), text.end(), '\n'), 300);
   EXPECT_NEAR(rig.sim("face").device_position(0), 0.0, deg_to_rad(0.1));
   EXPECT_NEAR(rig.sim("torso").device_position(1), 0.0, deg_to_rad(0.5));
+}
+
+// The figure does not walk (its neck sway is a gait that says so): a stop
+// has nothing to wind down and ramps home at once; the motion is not
+// played past the request.
+TEST(MixedFigure, AStopRampsHomeAtOnceWithNothingToWindDown) {
+  EXPECT_EQ(load_robot(kFigure).motion->wind_down(1.0, 100.0), 0.0);
+  Rig rig(true, 0, 0.2, 0.3);
+  double last = -1.0;
+  rig.probe->on_sample = [&](double t) { last = std::max(last, t); };
+  RunSummary s = rig.run(1.0);
+  EXPECT_EQ(s.end_reason, EndReason::duration);
+  EXPECT_TRUE(s.faults.empty());
+  EXPECT_GT(last, 0.9);
+  EXPECT_LT(last, 1.0);
 }
 
 TEST(MixedFigure, ASlowBusChangesNothingInLockstep) {

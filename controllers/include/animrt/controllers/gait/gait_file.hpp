@@ -79,7 +79,12 @@ struct GaitFile {
   // it the gait plays at its own timing and ignores commands.
   std::optional<GaitSteering> steering;
   std::optional<GaitBalance> balance;
-  std::string file;  // where it was loaded from ("" when built in memory)
+  // false: a periodic motion that carries no weight (an animatronic's
+  // neck sway), not a walk: a stop ramps it home at once instead of
+  // winding it down to a stand first.
+  bool walks = true;
+  Location walks_where;  // of the walks key
+  std::string file;      // where it was loaded from ("" when built in memory)
 
   // Stride cycles per second, from whichever timing is set (0 if neither).
   double stride_frequency() const;
