@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "animrt/controllers/cues/pose_source.hpp"
 
@@ -21,6 +23,34 @@ std::vector<JointSpec> dmx_two_joints() {
     j.home = 0.1;
   }
   return joints;
+}
+
+// Cues that wind down at a stop (a walking cue): asked for the time it
+// grants, and how long they take.
+class WindsDown final : public MotionSource {
+ public:
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double, std::span<double> targets) const override { targets[0] = 0.2; }
+  double wind_down(double t, double granted_s) override {
+    asked_at = t;
+    granted = granted_s;
+    return 0.75 * granted_s;
+  }
+  double asked_at = -1.0, granted = -1.0;
+
+ private:
+  std::vector<int> driven_{0};
+};
+
+// A stop under serve with DMX joints winds the cues down as without them.
+TEST(DmxJoints, AStopWindsTheCuesDownUnderTheDmxJoints) {
+  DmxJointInputs inputs({{1, 1, 0, -1.0, 1.0}});
+  auto cues = std::make_unique<WindsDown>();
+  WindsDown* inner = cues.get();
+  DmxJointSource source(std::move(cues), inputs, dmx_two_joints(), 0.5);
+  EXPECT_DOUBLE_EQ(source.wind_down(2.5, 1.2), 0.9);
+  EXPECT_DOUBLE_EQ(inner->asked_at, 2.5);
+  EXPECT_DOUBLE_EQ(inner->granted, 1.2);
 }
 
 TEST(DmxJoints, LevelsMapOntoTheRangeInEightAndSixteenBits) {

@@ -194,6 +194,27 @@ TEST(QuadrupedLockstep, AHardwareErrorFaultsTheDeviceAtOnce) {
   }
 }
 
+// The rig plays the motion as `animrt run` does, the stop's wind-down
+// included: the walk goes on stepping after the request (its walk/stand
+// blend, 1 s), then ramps home.
+TEST(QuadrupedLockstep, AStopRequestWindsTheWalkDownFirst) {
+  Rig rig;
+  RunControls controls;
+  double last = 0.0;
+  rig.probe->on_sample = [&](double t) {
+    last = t;
+    if (t >= 0.7) controls.stop.store(true);
+  };
+  RunOptions options = rig.options(0.0);
+  options.controls = &controls;
+  RunSummary s = rig.run(options);
+  EXPECT_EQ(s.end_reason, EndReason::signal);
+  EXPECT_EQ(s.exit_code(), 0);
+  EXPECT_NEAR(s.motion_time_s, 0.7, 0.011);
+  EXPECT_GT(last, 0.7 + 0.5);
+  EXPECT_TRUE(s.stop_warnings.empty());
+}
+
 TEST(QuadrupedLockstep, AStopRequestRampsHome) {
   Rig rig;
   RunControls controls;

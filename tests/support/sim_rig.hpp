@@ -39,7 +39,9 @@ class ProbeSource final : public MotionSource {
     if (on_sample) on_sample(t);
     inner_->sample(t, targets);
   }
+  void steer(const MotionCommand& command) override { inner_->steer(command); }
   void sense(const Sensors& sensors) override { inner_->sense(sensors); }
+  double wind_down(double t, double granted_s) override { return inner_->wind_down(t, granted_s); }
   void control(const ShowCommand& command, double t) override { inner_->control(command, t); }
   ShowPosition show_position(double t) const override { return inner_->show_position(t); }
   void start(const MotionClock& clock) override { inner_->start(clock); }

@@ -62,6 +62,8 @@ class DmxJointSource final : public MotionSource {
   void sample(double t, std::span<double> targets) const override;
   void steer(const MotionCommand& command) override { cues_->steer(command); }
   void sense(const Sensors& sensors) override { cues_->sense(sensors); }
+  // The DMX joints follow their channels while the cues wind down.
+  double wind_down(double t, double granted_s) override { return cues_->wind_down(t, granted_s); }
   void control(const ShowCommand& command, double t) override { cues_->control(command, t); }
   ShowPosition show_position(double t) const override { return cues_->show_position(t); }
   void start(const MotionClock& clock) override { cues_->start(clock); }
