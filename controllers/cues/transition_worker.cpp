@@ -8,6 +8,13 @@
 
 namespace animrt {
 
+seqnet::CompletionOptions TransitionWorker::completion_options() {
+  seqnet::CompletionOptions options;
+  options.retries = 0;
+  options.blend = true;
+  return options;
+}
+
 TransitionWorker::TransitionWorker(const std::vector<Model>& models, int dims, int capacity,
                                    int buffers)
     : models_(models), dims_(dims), capacity_(capacity) {
@@ -81,7 +88,7 @@ void TransitionWorker::compute(int model, int frames, int buffer) {
       keys(j, 0) = from_[static_cast<std::size_t>(j)];
       keys(j, 1) = to_[static_cast<std::size_t>(j)];
     }
-    const seqnet::Completion done = net.complete(keys, {frames - 1});
+    const seqnet::Completion done = net.complete(keys, {frames - 1}, completion_options());
     bool finite = true;
     for (int f = 0; f <= frames; ++f) {
       for (int j = 0; j < dims; ++j) {

@@ -110,7 +110,7 @@ seqnet::FrameMatrix completion(const std::vector<double>& from, const std::vecto
   seqnet::SeqNetInference net(model(), "tiny.model");
   seqnet::FrameMatrix keys(2, 2);
   keys << from[0], to[0], from[1], to[1];
-  return net.complete(keys, {frames - 1}).frames;
+  return net.complete(keys, {frames - 1}, TransitionWorker::completion_options()).frames;
 }
 
 TEST(LearnedTransition, TheInBetweenIsTheModelsCompletionFromThePresentPose) {

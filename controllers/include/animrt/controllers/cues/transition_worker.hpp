@@ -26,6 +26,7 @@ namespace animrt {
 namespace seqnet {
 struct ModelFile;
 class SeqNetInference;
+struct CompletionOptions;
 }  // namespace seqnet
 
 class TransitionWorker {
@@ -39,6 +40,11 @@ class TransitionWorker {
   // in-betweens can be held at once (played, and one being computed).
   TransitionWorker(const std::vector<Model>& models, int dims, int capacity, int buffers);
   ~TransitionWorker();
+  // The completion's options: the first try alone (no retries from random
+  // states: each would cost as much again), its chains blended, so the
+  // work per in-between is one forward and one backward chain.
+  static seqnet::CompletionOptions completion_options();
+
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;
 
