@@ -23,6 +23,7 @@
 #include "animrt/runtime/cue_file.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "seqnet/tiny_joint_model.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace animrt::learned_transition_test {
 namespace {
@@ -272,6 +273,30 @@ TEST(LearnedTransition, ABurstOfTriggersComputesOneInBetweenAtATime) {
   // The figure answered: within the bound, by the crossfade when nothing was ready.
   EXPECT_GE(rig.player.starts(1), 1u);
   EXPECT_EQ(rig.player.current_cue(), 1);
+}
+
+TEST(LearnedTransition, TheCycleNeitherAllocatesNorWaitsForTheWorker) {
+  Rig rig(true, true, false);
+  for (int i = 0; i < 10; ++i) rig.step();
+  long allocations = 0;
+  int waited = 0;
+  {
+    test::AllocationCounter counter;
+    rig.requests.cue(1);
+    // The same cycle time again and again until the frames are there: the
+    // figure plays on meanwhile, and each call returns at once.
+    const auto begin = std::chrono::steady_clock::now();
+    while (rig.player.learned_played() == 0 && rig.player.learned_late() == 0 &&
+           std::chrono::steady_clock::now() - begin < std::chrono::seconds(5)) {
+      rig.player.sample(rig.t(), rig.out);
+      ++waited;
+    }
+    for (int i = 0; i < 160; ++i, ++rig.k) rig.player.sample(rig.t(), rig.out);  // no copies
+    allocations = counter.count();
+  }
+  EXPECT_EQ(rig.player.learned_played(), 1u);
+  EXPECT_GE(waited, 1);
+  EXPECT_EQ(allocations, 0);
 }
 
 // --- the cue file ---
