@@ -317,8 +317,9 @@ void CuePlayer::settle() const {
   const CueTransition& tr = c.transition;
   const MotionSource& next = *c.steps[static_cast<std::size_t>(p.step)].source;
   const auto left = [&p] {
-    return std::max(std::chrono::nanoseconds(0), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                     p.wall_deadline - std::chrono::steady_clock::now()));
+    return std::max(std::chrono::nanoseconds(0),
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        p.wall_deadline - std::chrono::steady_clock::now()));
   };
   // The worker may still be busy with a request since replaced.
   if (!p.posted && lockstep_) worker_->wait(0, left());

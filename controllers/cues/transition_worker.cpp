@@ -20,9 +20,9 @@ TransitionWorker::TransitionWorker(const std::vector<Model>& models, int dims, i
     : models_(models), dims_(dims), capacity_(capacity) {
   for (const Model& m : models_)
     nets_.push_back(std::make_unique<seqnet::SeqNetInference>(*m.file, m.path));
-  values_.assign(static_cast<std::size_t>(buffers),
-                 std::vector<double>(static_cast<std::size_t>(dims) *
-                                     static_cast<std::size_t>(capacity)));
+  values_.assign(
+      static_cast<std::size_t>(buffers),
+      std::vector<double>(static_cast<std::size_t>(dims) * static_cast<std::size_t>(capacity)));
   ok_.assign(static_cast<std::size_t>(buffers), 0);
   from_.assign(static_cast<std::size_t>(dims), 0.0);
   to_.assign(static_cast<std::size_t>(dims), 0.0);

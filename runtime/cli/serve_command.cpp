@@ -118,11 +118,11 @@ std::string cue_summary_json(const RunSummary& summary, const CuePlayer& player,
                        {"taken", requests.taken()},
                        {"cycles_waited", player.deferred()}};
   if (const TransitionWorker* worker = player.transition_worker()) {
-    j["learned_transitions"] = {{"played", player.learned_played()},
-                                {"late", player.learned_late()},
-                                {"unusable", player.learned_unusable()},
-                                {"max_compute_s", 1e-9 * static_cast<double>(
-                                                      worker->max_compute().count())}};
+    j["learned_transitions"] = {
+        {"played", player.learned_played()},
+        {"late", player.learned_late()},
+        {"unusable", player.learned_unusable()},
+        {"max_compute_s", 1e-9 * static_cast<double>(worker->max_compute().count())}};
   }
   return j.dump(2) + '\n';
 }
@@ -184,8 +184,8 @@ int serve(const ServeArgs& args) {
   auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
                                             robot.config.joints, requests);
   if (TransitionWorker* worker = player->transition_worker()) {
-    worker->set_delay(std::chrono::nanoseconds(
-        static_cast<std::int64_t>(transition_delay_for_test() * 1e9)));
+    worker->set_delay(
+        std::chrono::nanoseconds(static_cast<std::int64_t>(transition_delay_for_test() * 1e9)));
   }
   const CuePlayer& playing = *player;
   // Declared before the figure: the players outlive the cue player that tells them.

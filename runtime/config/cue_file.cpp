@@ -165,7 +165,8 @@ TransitionDraft read_transition(const YamlNode& node, const std::string& cue_pat
   }
   if (how == "crossfade") {
     for (const char* key : {"model", "frame_s"}) {
-      if (auto extra = node.find(key)) extra->fail("only a learned transition takes a " + std::string(key));
+      if (auto extra = node.find(key))
+        extra->fail("only a learned transition takes a " + std::string(key));
     }
     return draft;
   }
@@ -215,8 +216,7 @@ TransitionDraft read_transition(const YamlNode& node, const std::string& cue_pat
       std::string names;
       for (const JointSpec& j : robot.joints) names += (names.empty() ? "" : ", ") + j.name;
       model_node.fail("model " + quote_path(tr.model_file) + " moves joint " + quote(name) +
-                      ", which robot " + robot.name + " does not have (its joints: " + names +
-                      ")");
+                      ", which robot " + robot.name + " does not have (its joints: " + names + ")");
     }
     tr.joints.push_back(index);
   }
@@ -426,8 +426,8 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
                                             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
                                             "0123456789_-") == std::string::npos;
     if (!plain) node.fail("a cue's name is letters, digits, _ and - (it is an OSC address)");
-    loaded.cues.push_back(make_cue(name, node, crossfade, default_transition, path, robot, models,
-                                   loaded.warnings));
+    loaded.cues.push_back(
+        make_cue(name, node, crossfade, default_transition, path, robot, models, loaded.warnings));
     drafts.push_back({node.find("then"), node.find("loop"), node});
     const auto dmx = node.find("dmx");
     loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);

@@ -137,12 +137,14 @@ TEST(LearnedTransition, TheInBetweenIsTheModelsCompletionFromThePresentPose) {
     const auto& at = played[static_cast<std::size_t>(8 * f)];
     for (int j = 0; j < 2; ++j) {
       EXPECT_NEAR(at[static_cast<std::size_t>(j)], frames(j, f), 1e-9) << "frame " << f;
-      apart = std::max(apart, std::abs(at[static_cast<std::size_t>(j)] -
-                                       crossfaded[static_cast<std::size_t>(8 * f)]
-                                                 [static_cast<std::size_t>(j)]));
+      apart = std::max(
+          apart,
+          std::abs(at[static_cast<std::size_t>(j)] -
+                   crossfaded[static_cast<std::size_t>(8 * f)][static_cast<std::size_t>(j)]));
     }
   }
-  EXPECT_GT(apart, 0.01) << "the model's in-between is the crossfade itself: the test shows nothing";
+  EXPECT_GT(apart, 0.01)
+      << "the model's in-between is the crossfade itself: the test shows nothing";
   // Where the transition ends, the cue's pose, as the crossfade's.
   for (int j = 0; j < 2; ++j) {
     EXPECT_NEAR(played.back()[static_cast<std::size_t>(j)],
@@ -174,7 +176,8 @@ TEST(LearnedTransition, NoJumpAtEitherSeamBetweenMovingMotions) {
   rig.requests.cue(1);
   for (int i = 0; i < 1300; ++i) x.push_back(rig.step());
   ASSERT_EQ(rig.player.learned_played(), 1u);
-  const auto end = start + static_cast<std::size_t>(std::lround(rig.player.last_crossfade_s() / dt));
+  const auto end =
+      start + static_cast<std::size_t>(std::lround(rig.player.last_crossfade_s() / dt));
   // The model's own frames leave the present pose at another velocity than
   // the sway's (else this test could not tell a jump).
   const double fade = rig.player.last_crossfade_s();
@@ -266,7 +269,8 @@ TEST(LearnedTransition, ABurstOfTriggersComputesOneInBetweenAtATime) {
     rig.requests.cue(1);
     rig.step();
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   // Each request replaces the one waiting; the worker took a new job only
   // when it had finished the last (one per 20 ms at most).
   EXPECT_LE(rig.player.transition_worker()->jobs(), 2 + static_cast<std::uint64_t>(wall / 0.02));
@@ -367,7 +371,9 @@ TEST(LearnedTransitionFile, ACueAndTheFilesDefaultTakeALearnedTransition) {
 TEST(LearnedTransitionFile, ABadTransitionIsRefusedWithItsLineAndKey) {
   Files f;
   const std::string file = f.cue_file("");
-  const auto with = [](const std::string& t) { return std::string(kCues) + "    transition: " + t + "\n"; };
+  const auto with = [](const std::string& t) {
+    return std::string(kCues) + "    transition: " + t + "\n";
+  };
   struct Case {
     std::string text;
     std::string where;
@@ -377,17 +383,17 @@ TEST(LearnedTransitionFile, ABadTransitionIsRefusedWithItsLineAndKey) {
        ":6: cues.reach.transition.model: ", "file not found"},
       {with("{interpolation: learned, model: corrupt.model, frame_s: 0.04}"),
        ":6: cues.reach.transition.model: ", "corrupt.model"},
-      {with("{interpolation: spline}"), ":6: cues.reach.transition.interpolation: ",
-       "expected crossfade or learned"},
-      {with("{interpolation: crossfade, model: tiny.model}"), ":6: cues.reach.transition.model: ",
-       "only a learned transition"},
-      {with("{interpolation: learned, model: tiny.model}"), ":6: cues.reach.transition",
-       "frame_s"},
+      {with("{interpolation: spline}"),
+       ":6: cues.reach.transition.interpolation: ", "expected crossfade or learned"},
+      {with("{interpolation: crossfade, model: tiny.model}"),
+       ":6: cues.reach.transition.model: ", "only a learned transition"},
+      {with("{interpolation: learned, model: tiny.model}"), ":6: cues.reach.transition", "frame_s"},
       {with("{interpolation: learned, model: tiny.model, frame_s: 2}"),
        ":6: cues.reach.transition.frame_s: ", ""},
       {with("{interpolation: learned, model: tiny.model, frame_s: 0.04, blend: 1}"),
        ":6: cues.reach.transition", "blend"},
-      {with("{interpolation: learned, model: tiny.model, frame_s: 0.04}") + "    crossfade_s: 0.05\n",
+      {with("{interpolation: learned, model: tiny.model, frame_s: 0.04}") +
+           "    crossfade_s: 0.05\n",
        ":7: cues.reach.crossfade_s: ", "at least two of the model's frames"},
   };
   for (const Case& c : cases) {

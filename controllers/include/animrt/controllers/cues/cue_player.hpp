@@ -134,8 +134,8 @@ class CuePlayer final : public MotionSource {
     double t0 = 0.0;          // play time at which the step's source had t = 0
     double fade_start = 0.0;  // play time
     double fade_s = 0.0;
-    int learned = -1;         // the in-between's buffer while it plays, -1 none
-    int frames = 0;           // its frames after the present pose
+    int learned = -1;  // the in-between's buffer while it plays, -1 none
+    int frames = 0;    // its frames after the present pose
     std::vector<double> pose;
   };
   // A learned transition asked for, whose in-between is being computed.
@@ -149,7 +149,7 @@ class CuePlayer final : public MotionSource {
     int buffer = 0;
     int frames = 0;
     double fade = 0.0;
-    double deadline = 0.0;  // motion time
+    double deadline = 0.0;                                  // motion time
     std::chrono::steady_clock::time_point wall_deadline{};  // lockstep
   };
   static constexpr std::size_t kMaxLayers = 4;
