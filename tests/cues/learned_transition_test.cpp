@@ -33,11 +33,11 @@ namespace fs = std::filesystem;
 constexpr double kDt = 1.0 / 128;
 constexpr double kFrameS = 1.0 / 16;  // 8 cycles
 
-std::vector<JointSpec> joints() {
+std::vector<JointSpec> joints(double max_velocity = 10.0) {
   std::vector<JointSpec> j(2);
   j[0].name = "hip";
   j[1].name = "knee";
-  for (JointSpec& s : j) s.limits = {-3.0, 3.0, 10.0, 100.0};
+  for (JointSpec& s : j) s.limits = {-3.0, 3.0, max_velocity, 100.0};
   return j;
 }
 
@@ -93,8 +93,8 @@ struct Rig {
   double dt;
   std::vector<double> out = std::vector<double>(2, 0.0);
   int k = 0;  // cycles sampled
-  Rig(bool moving, bool with_model, bool lockstep, double cycle = kDt)
-      : player(cues(moving, with_model), 0, joints(), requests), dt(cycle) {
+  Rig(bool moving, bool with_model, bool lockstep, double cycle = kDt, double max_velocity = 10.0)
+      : player(cues(moving, with_model), 0, joints(max_velocity), requests), dt(cycle) {
     player.start(MotionClock{nullptr, 0, lockstep});
   }
   double t() const { return k * dt; }
@@ -301,6 +301,20 @@ TEST(LearnedTransition, TheCycleNeitherAllocatesNorWaitsForTheWorker) {
   EXPECT_EQ(rig.player.learned_played(), 1u);
   EXPECT_GE(waited, 1);
   EXPECT_EQ(allocations, 0);
+}
+
+TEST(LearnedTransition, ATransitionLengthenedPastItsBuffersCrossfadesAndIsCounted) {
+  // Joints slow enough that the 0.5 rad gap stretches the crossfade to 31 s:
+  // 500 frames, past the 64 allocated.
+  Rig rig(false, true, true, kDt, 0.1);
+  Rig plain(false, false, true, kDt, 0.1);
+  for (int i = 0; i < 10; ++i) rig.step(), plain.step();
+  rig.requests.cue(1);
+  plain.requests.cue(1);
+  for (int i = 0; i < 50; ++i) ASSERT_EQ(rig.step(), plain.step()) << "cycle " << i;
+  EXPECT_GT(rig.player.last_crossfade_s(), 64 * kFrameS);
+  EXPECT_EQ(rig.player.learned_unusable(), 1u);
+  EXPECT_EQ(rig.player.learned_played(), 0u);
 }
 
 // --- the cue file ---
