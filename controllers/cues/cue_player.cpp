@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "animrt/controllers/seqnet/model_file.hpp"
 #include "animrt/controllers/show/show_audio.hpp"
 
 namespace animrt {
@@ -46,7 +47,36 @@ CuePlayer::CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joi
   out_.assign(joints_.size(), 0.0);
   prev_out_.assign(joints_.size(), 0.0);
   scratch_.assign(joints_.size(), 0.0);
+  // One worker for every learned transition, its models read once each. It
+  // holds an in-between for each layer that can play one, and one more
+  // being computed; each up to four times the cue's crossfade in frames
+  // (the crossfade is lengthened for a far start; a longer one crossfades).
+  std::vector<TransitionWorker::Model> models;
+  int dims = 0, capacity = 0;
+  for (const Cue& cue : cues_) {
+    int index = -1;
+    if (cue.transition.learned()) {
+      for (std::size_t m = 0; m < models.size(); ++m) {
+        if (models[m].file == cue.transition.model) index = static_cast<int>(m);
+      }
+      if (index < 0) {
+        index = static_cast<int>(models.size());
+        models.push_back({cue.transition.model, cue.transition.model_file});
+      }
+      dims = std::max(dims, static_cast<int>(cue.transition.joints.size()));
+      capacity = std::max(
+          capacity,
+          static_cast<int>(std::lround(4.0 * cue.crossfade_s / cue.transition.frame_s)) + 1);
+    }
+    model_of_cue_.push_back(index);
+  }
+  if (!models.empty()) {
+    worker_ = std::make_unique<TransitionWorker>(models, dims, std::max(capacity, 64),
+                                                 static_cast<int>(kMaxLayers) + 1);
+  }
 }
+
+CuePlayer::~CuePlayer() = default;
 
 std::uint64_t CuePlayer::starts(int cue) const {
   if (cue < 0 || static_cast<std::size_t>(cue) >= cues_.size()) return 0;
@@ -67,6 +97,7 @@ void CuePlayer::play_sound(const std::string& show_file, ShowAudioPlayer& player
 
 void CuePlayer::start(const MotionClock& clock) {
   clock_start_ = clock.start;
+  lockstep_ = clock.lockstep;
   for (Cue& cue : cues_) {
     for (CueStep& step : cue.steps) step.source->start(clock);
   }
@@ -133,17 +164,20 @@ void CuePlayer::locate(int cue, double at_s, int& step, double& within) const {
   within = std::min(within, c.steps[static_cast<std::size_t>(step)].duration_s);
 }
 
-void CuePlayer::push(int cue, int step, bool asked, double at_s) const {
+void CuePlayer::push(int cue, int step, bool asked, double at_s, double fade) const {
   const bool changes = asked || count_ == 0 || layers_[count_ - 1].cue != cue;
   const Cue& c = cues_[static_cast<std::size_t>(cue)];
-  const double fade =
-      count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source, at_s);
+  if (fade < 0.0) {
+    fade =
+        count_ == 0 ? 0.0 : ease_in_time(c, *c.steps[static_cast<std::size_t>(step)].source, at_s);
+  }
   Layer& layer = layers_[count_];
   layer.cue = cue;
   layer.step = step;
   layer.t0 = play_ - at_s;
   layer.fade_start = play_;
   layer.fade_s = fade;
+  layer.learned = -1;
   ++count_;
   if ((step == 0 || asked) && changes) starts_[static_cast<std::size_t>(cue)].fetch_add(1);
   current_.store(cue, std::memory_order_relaxed);
@@ -262,6 +296,130 @@ double CuePlayer::wind_down(double t, double granted_s) {
   return longest > 0.0 ? longest + lag : 0.0;
 }
 
+void CuePlayer::enter(int cue, int step, bool asked, double at_s) const {
+  const bool changes = asked || count_ == 0 || layers_[count_ - 1].cue != cue;
+  if (!worker_ || count_ == 0 || !changes || model_of_cue_[static_cast<std::size_t>(cue)] < 0) {
+    pending_.active = false;
+    push(cue, step, asked, at_s);
+    return;
+  }
+  // A newer request replaces one still being computed, but the figure
+  // answers within the bound of the first.
+  if (!pending_.active) {
+    pending_.deadline = last_t_ + kLearnedWaitS;
+    pending_.wall_deadline =
+        std::chrono::steady_clock::now() +
+        std::chrono::nanoseconds(static_cast<std::int64_t>(kLearnedWaitS * 1e9));
+  }
+  pending_.active = true;
+  pending_.cue = cue;
+  pending_.step = step;
+  pending_.asked = asked;
+  pending_.within = at_s;
+  pending_.posted = false;
+  settle();
+}
+
+void CuePlayer::settle() const {
+  Pending& p = pending_;
+  const Cue& c = cues_[static_cast<std::size_t>(p.cue)];
+  const CueTransition& tr = c.transition;
+  const MotionSource& next = *c.steps[static_cast<std::size_t>(p.step)].source;
+  const auto left = [&p] {
+    return std::max(std::chrono::nanoseconds(0),
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        p.wall_deadline - std::chrono::steady_clock::now()));
+  };
+  // The worker may still be busy with a request since replaced.
+  if (!p.posted && lockstep_) worker_->wait(0, left());
+  if (!p.posted && worker_->idle()) {
+    // The crossfade's time (lengthened as usual), whole frames of the model's
+    // (stretched a little so the last lands on the crossfade's end).
+    p.fade = ease_in_time(c, next, p.within);
+    p.frames = static_cast<int>(std::lround(p.fade / tr.frame_s));
+    // A buffer no layer plays from (there is always one: a layer each, and one more).
+    for (p.buffer = 0; p.buffer + 1 < worker_->buffers(); ++p.buffer) {
+      bool used = false;
+      for (std::size_t i = 0; i < count_; ++i) used |= layers_[i].learned == p.buffer;
+      if (!used) break;
+    }
+    if (p.frames < 2 || p.frames + 1 > worker_->capacity()) {
+      learned_unusable_.fetch_add(1, std::memory_order_relaxed);
+      p.active = false;
+      push(p.cue, p.step, p.asked, p.within, p.fade);
+      return;
+    }
+    // From the present targets to the next motion where the crossfade ends.
+    std::vector<double>& at_end = layers_[count_].pose;  // the slot the layer will take
+    for (std::size_t j = 0; j < joints_.size(); ++j) at_end[j] = joints_[j].home;
+    next.sample(p.within + p.fade, at_end);
+    const std::span<double> from = worker_->from();
+    const std::span<double> to = worker_->to();
+    for (std::size_t m = 0; m < tr.joints.size(); ++m) {
+      from[m] = out_[static_cast<std::size_t>(tr.joints[m])];
+      to[m] = at_end[static_cast<std::size_t>(tr.joints[m])];
+    }
+    p.job = worker_->post(model_of_cue_[static_cast<std::size_t>(p.cue)], p.frames, p.buffer);
+    p.posted = true;
+  }
+  if (p.posted && lockstep_) worker_->wait(p.job, left());
+  if (p.posted && worker_->finished(p.job)) {
+    p.active = false;
+    if (!worker_->ok(p.buffer)) {
+      learned_unusable_.fetch_add(1, std::memory_order_relaxed);
+      push(p.cue, p.step, p.asked, p.within, p.fade);
+      return;
+    }
+    push(p.cue, p.step, p.asked, p.within, p.fade);
+    Layer& layer = layers_[count_ - 1];
+    layer.learned = p.buffer;
+    layer.frames = p.frames;
+    learned_played_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  // Not ready in time: the crossfade (its result, when it comes, is dropped).
+  if (lockstep_ ? left().count() == 0 : last_t_ >= p.deadline) {
+    learned_late_.fetch_add(1, std::memory_order_relaxed);
+    p.active = false;
+    push(p.cue, p.step, p.asked, p.within);
+  }
+}
+
+// The targets of a learned transition: the crossfade, eased over to the
+// model's frames (a cubic through them, neighbours' slopes) in the first
+// quarter and back in the last, with a weight whose first and second
+// derivatives vanish at both ends: at the seams the played motion is the
+// crossfade's, which joins the old and the new motion without a step; in
+// between it is the model's in-between.
+void CuePlayer::apply_learned(Layer& layer) const {
+  const double s = (play_ - layer.fade_start) / layer.fade_s;
+  if (!(s < 1.0)) {
+    layer.learned = -1;
+    return;
+  }
+  const double h = smootherstep(std::min(s, 1.0 - s) / kLearnedEaseShare);
+  if (h <= 0.0) return;
+  const CueTransition& tr = cues_[static_cast<std::size_t>(layer.cue)].transition;
+  const int n = layer.frames;
+  const double x = std::max(0.0, s) * n;
+  const int i = std::min(static_cast<int>(x), n - 1);
+  const double u = x - i;
+  const double u2 = u * u, u3 = u2 * u;
+  const TransitionWorker& w = *worker_;
+  for (std::size_t m = 0; m < tr.joints.size(); ++m) {
+    const int d = static_cast<int>(m);
+    const double v0 = w.frame(layer.learned, i, d);
+    const double v1 = w.frame(layer.learned, i + 1, d);
+    const double m0 = i > 0 ? (v1 - w.frame(layer.learned, i - 1, d)) / 2.0 : v1 - v0;
+    const double m1 = i + 1 < n ? (w.frame(layer.learned, i + 2, d) - v0) / 2.0 : v1 - v0;
+    const auto j = static_cast<std::size_t>(tr.joints[m]);
+    const double at = std::clamp((2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * m0 +
+                                     (-2 * u3 + 3 * u2) * v1 + (u3 - u2) * m1,
+                                 joints_[j].limits.min_position, joints_[j].limits.max_position);
+    out_[j] += h * (at - out_[j]);
+  }
+}
+
 void CuePlayer::advance(double t) const {
   if (!begun_) {
     begun_ = true;
@@ -272,8 +430,12 @@ void CuePlayer::advance(double t) const {
     push(idle_, 0, false);
   }
   warp(t);
-  // Winding down at a stop: what plays goes on to rest, nothing new starts.
-  if (winding_) return;
+  // Winding down at a stop: what plays goes on to rest, nothing new starts
+  // (an in-between still being computed is given up).
+  if (winding_) {
+    pending_.active = false;
+    return;
+  }
   int asked = 0;
   double at = 0.0;
   if (requests_.take(asked, at) && asked >= 0 && static_cast<std::size_t>(asked) < cues_.size()) {
@@ -287,11 +449,16 @@ void CuePlayer::advance(double t) const {
       int step = 0;
       double within = 0.0;
       locate(waiting_cue_, waiting_at_, step, within);
-      push(waiting_cue_, step, true, within);
       waiting_ = false;
+      enter(waiting_cue_, step, true, within);
     } else {
       deferred_.fetch_add(1, std::memory_order_relaxed);
     }
+    return;
+  }
+  // While an in-between is computed the figure plays on what it plays.
+  if (pending_.active) {
+    settle();
     return;
   }
   const Layer& top = layers_[count_ - 1];
@@ -303,7 +470,7 @@ void CuePlayer::advance(double t) const {
   } else if (cue.loop || top.cue == idle_) {
     push(top.cue, 0, false);
   } else {
-    push(cue.then < 0 ? idle_ : cue.then, 0, false);
+    enter(cue.then < 0 ? idle_ : cue.then, 0, false, 0.0);
   }
 }
 
@@ -313,12 +480,14 @@ void CuePlayer::sample(double t, std::span<double> targets) const {
   for (std::size_t i = 0; i < count_; ++i) sample_layer(layers_[i]);
   std::swap(prev_out_, out_);
   std::copy(layers_[0].pose.begin(), layers_[0].pose.end(), out_.begin());
+  if (layers_[0].learned >= 0) apply_learned(layers_[0]);
   for (std::size_t i = 1; i < count_; ++i) {
     const double w = weight(layers_[i]);
     for (int j : driven_) {
       const auto k = static_cast<std::size_t>(j);
       out_[k] += w * (layers_[i].pose[k] - out_[k]);
     }
+    if (layers_[i].learned >= 0) apply_learned(layers_[i]);
   }
   last_dt_ = step_dt_;
   for (int j : driven_) {

@@ -5,6 +5,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -70,6 +71,10 @@ void slow_exit_for_test() {
   if (const double seconds = seconds_of("ANIMRT_TEST_SLOW_EXIT_S"); seconds >= 0.0) {
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
   }
+}
+
+double transition_delay_for_test() {
+  return std::max(0.0, seconds_of("ANIMRT_TEST_TRANSITION_DELAY_S"));
 }
 
 }  // namespace animrt::cli

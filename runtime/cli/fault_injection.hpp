@@ -12,10 +12,14 @@
 //     Called just before the run, on the thread that runs the loop.
 //   ANIMRT_TEST_SLOW_EXIT_S=SECONDS: `animrt serve` waits that long after
 //     the run, before its summary, as a loaded machine's slow exit would.
+//   ANIMRT_TEST_TRANSITION_DELAY_S=SECONDS: `animrt serve`'s learned
+//     in-betweens each take at least that long to compute (a slow model).
 
 namespace animrt::cli {
 
 void start_fault_injection();
 void slow_exit_for_test();
+// The seconds of ANIMRT_TEST_TRANSITION_DELAY_S, 0 when unset.
+double transition_delay_for_test();
 
 }  // namespace animrt::cli

@@ -87,6 +87,13 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
             << "cue requests: " << requests.posted() << " posted, " << requests.taken()
             << " taken by the cycle (the rest replaced by a newer one first), " << player.deferred()
             << " cycles waited for a crossfade to end\n";
+  if (const TransitionWorker* worker = player.transition_worker()) {
+    std::cout << "learned transitions: " << player.learned_played() << " played, "
+              << player.learned_late() << " crossfaded (not computed within "
+              << kLearnedWaitS * 1000.0 << " ms), " << player.learned_unusable()
+              << " crossfaded (unusable), compute " << worker->max_compute().count() / 1000
+              << " us at most\n";
+  }
   if (player.sound_commands_lost() > 0) {
     std::cout << "sound: " << player.sound_commands_lost()
               << " commands lost (a player had fallen behind)\n";
@@ -110,6 +117,13 @@ std::string cue_summary_json(const RunSummary& summary, const CuePlayer& player,
   j["cue_requests"] = {{"posted", requests.posted()},
                        {"taken", requests.taken()},
                        {"cycles_waited", player.deferred()}};
+  if (const TransitionWorker* worker = player.transition_worker()) {
+    j["learned_transitions"] = {
+        {"played", player.learned_played()},
+        {"late", player.learned_late()},
+        {"unusable", player.learned_unusable()},
+        {"max_compute_s", 1e-9 * static_cast<double>(worker->max_compute().count())}};
+  }
   return j.dump(2) + '\n';
 }
 
@@ -169,6 +183,10 @@ int serve(const ServeArgs& args) {
   CueRequests requests;
   auto player = std::make_unique<CuePlayer>(std::move(loaded.cues), loaded.idle,
                                             robot.config.joints, requests);
+  if (TransitionWorker* worker = player->transition_worker()) {
+    worker->set_delay(
+        std::chrono::nanoseconds(static_cast<std::int64_t>(transition_delay_for_test() * 1e9)));
+  }
   const CuePlayer& playing = *player;
   // Declared before the figure: the players outlive the cue player that tells them.
   ServeSound sound(args.sound, args.lockstep, *player);

@@ -7,6 +7,9 @@
 #include "animrt/controllers/cues/pose_source.hpp"
 #include "animrt/controllers/head/audio.hpp"
 #include "animrt/controllers/head/head_source.hpp"
+#include "animrt/controllers/seqnet/inference.hpp"
+#include "animrt/controllers/seqnet/model_file.hpp"
+#include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/input_file.hpp"
 #include "animrt/core/yaml_doc.hpp"
@@ -136,14 +139,109 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
   return step;
 }
 
+// A transition as written, and where, so that a cue it does not fit can
+// be refused with its line.
+struct TransitionDraft {
+  CueTransition transition;
+  std::optional<YamlNode> node;
+};
+
+// The model files the transitions name, each read and checked once.
+using ModelCache = std::map<std::string, std::shared_ptr<const seqnet::ModelFile>>;
+
+// `transition: {interpolation: crossfade}` or `{interpolation: learned,
+// model: FILE, frame_s: S}`: the model is read and checked against the
+// robot now, so a bad one stops the cue file at load with its line.
+TransitionDraft read_transition(const YamlNode& node, const std::string& cue_path,
+                                const RobotConfig& robot, ModelCache& models,
+                                std::vector<std::string>& warnings) {
+  node.allow_only({"interpolation", "model", "frame_s"});
+  TransitionDraft draft;
+  draft.node = node;
+  const YamlNode kind = node.at("interpolation");
+  const std::string how = kind.as_string();
+  if (how != "crossfade" && how != "learned") {
+    kind.fail("expected crossfade or learned, found " + quote(how));
+  }
+  if (how == "crossfade") {
+    for (const char* key : {"model", "frame_s"}) {
+      if (auto extra = node.find(key))
+        extra->fail("only a learned transition takes a " + std::string(key));
+    }
+    return draft;
+  }
+  CueTransition& tr = draft.transition;
+  const YamlNode frame = node.at("frame_s");
+  tr.frame_s = frame.as_double_in(0.001, 1.0);
+  const YamlNode model_node = node.at("model");
+  tr.model_file = resolve(model_node, cue_path);
+  if (auto known = models.find(tr.model_file); known != models.end()) {
+    tr.model = known->second;
+  } else {
+    seqnet::ModelFile model;
+    try {
+      model = seqnet::read_model_file(tr.model_file);
+    } catch (const InputError& e) {
+      model_node.fail("model " + quote_path(tr.model_file) + ": " + e.what());
+    } catch (const std::exception& e) {
+      model_node.fail("cannot read model " + quote_path(tr.model_file) + ": " + e.what());
+    }
+    if (model.shape.kind != seqnet::ModelKind::joints) {
+      model_node.fail("model " + quote_path(tr.model_file) + " is a " +
+                      seqnet::kind_name(model.shape.kind) +
+                      " model; a transition needs a joint-space model (animrt seq train on joint "
+                      "CSVs)");
+    }
+    try {
+      seqnet::check_model_output(model, tr.model_file);
+      seqnet::SeqNetInference net(model, tr.model_file);  // every parameter of its shape
+    } catch (const std::exception& e) {
+      model_node.fail(e.what());
+    }
+    const std::string w = seqnet::interpolation_warning(model, tr.model_file);
+    if (!w.empty()) {
+      const Location at = model_node.location();
+      warnings.push_back(at.file + ":" + std::to_string(at.line) + ": " + model_node.path() + ": " +
+                         w.substr(w.find(' ') + 1));  // without "warning: "
+    }
+    tr.model = std::make_shared<const seqnet::ModelFile>(std::move(model));
+    models.emplace(tr.model_file, tr.model);
+  }
+  for (const std::string& name : tr.model->joint_names) {
+    int index = -1;
+    for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+      if (robot.joints[j].name == name) index = static_cast<int>(j);
+    }
+    if (index < 0) {
+      std::string names;
+      for (const JointSpec& j : robot.joints) names += (names.empty() ? "" : ", ") + j.name;
+      model_node.fail("model " + quote_path(tr.model_file) + " moves joint " + quote(name) +
+                      ", which robot " + robot.name + " does not have (its joints: " + names + ")");
+    }
+    tr.joints.push_back(index);
+  }
+  return draft;
+}
+
 Cue make_cue(const std::string& name, const YamlNode& node, double crossfade,
-             const std::string& cue_path, const RobotConfig& robot,
-             std::vector<std::string>& warnings) {
-  node.allow_only({"play", "crossfade_s", "loop", "then", "dmx", "timecode", "midi"});
+             const TransitionDraft& default_transition, const std::string& cue_path,
+             const RobotConfig& robot, ModelCache& models, std::vector<std::string>& warnings) {
+  node.allow_only({"play", "crossfade_s", "transition", "loop", "then", "dmx", "timecode", "midi"});
   Cue cue;
   cue.name = name;
   cue.crossfade_s = crossfade;
   if (auto c = node.find("crossfade_s")) cue.crossfade_s = c->as_double_in(0.0, 60.0);
+  const TransitionDraft transition =
+      node.has("transition")
+          ? read_transition(node.at("transition"), cue_path, robot, models, warnings)
+          : default_transition;
+  cue.transition = transition.transition;
+  if (cue.transition.learned() && cue.crossfade_s < 2.0 * cue.transition.frame_s) {
+    const YamlNode& at = node.has("crossfade_s") ? node.at("crossfade_s") : *transition.node;
+    at.fail("cue " + cue.name + ": a learned transition needs a crossfade of at least two of the " +
+            "model's frames (" + format_number(2.0 * cue.transition.frame_s) + " s), found " +
+            format_number(cue.crossfade_s) + " s");
+  }
   const YamlNode play = node.at("play");
   std::vector<YamlNode> steps = play.is_sequence() ? play.items() : std::vector<YamlNode>{play};
   if (steps.empty()) play.fail("expected at least one step, found an empty list");
@@ -301,7 +399,7 @@ int find_cue(const std::vector<Cue>& cues, const std::string& name) {
 LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   const YamlNode root = YamlNode::load_file(path);
   LoadedCues loaded;
-  root.allow_only({"idle", "crossfade_s", "cues", "artnet", "sacn", "ltc"});
+  root.allow_only({"idle", "crossfade_s", "transition", "cues", "artnet", "sacn", "ltc"});
   if (auto ltc = root.find("ltc")) {
     ltc->allow_only({"fps", "freewheel_s"});
     loaded.ltc = true;
@@ -316,6 +414,10 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
   }
   const double crossfade =
       root.has("crossfade_s") ? root.at("crossfade_s").as_double_in(0.0, 60.0) : 1.0;
+  ModelCache models;
+  TransitionDraft default_transition;
+  if (auto t = root.find("transition"))
+    default_transition = read_transition(*t, path, robot, models, loaded.warnings);
   std::vector<CueDraft> drafts;
   const YamlNode list = root.at("cues");
   if (!list.is_map()) list.fail("expected a map of cue names to cues, found " + list.describe());
@@ -324,7 +426,8 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
                                             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
                                             "0123456789_-") == std::string::npos;
     if (!plain) node.fail("a cue's name is letters, digits, _ and - (it is an OSC address)");
-    loaded.cues.push_back(make_cue(name, node, crossfade, path, robot, loaded.warnings));
+    loaded.cues.push_back(
+        make_cue(name, node, crossfade, default_transition, path, robot, models, loaded.warnings));
     drafts.push_back({node.find("then"), node.find("loop"), node});
     const auto dmx = node.find("dmx");
     loaded.dmx_values.push_back(dmx ? static_cast<int>(dmx->as_int_in(1, 255)) : 0);

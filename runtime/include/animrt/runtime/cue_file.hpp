@@ -3,6 +3,8 @@
 //
 //   idle: rest                      # the cue played at the start and between cues
 //   crossfade_s: 1.0                # default crossfade into every cue
+//   transition: {interpolation: learned, model: neck.model, frame_s: 0.04}
+//                                   # default way into every cue (crossfade if left out)
 //   artnet: {universe: 0, channel: 1}   # a DMX channel's value (a cue's dmx) asks for it
 //   sacn: {universe: 1, channel: 1,     # the same over sACN (E1.31)
 //          joints: {neck_pan: {channel: 2, fine: 3, range: [-45, 45]}}, hold_s: 2}

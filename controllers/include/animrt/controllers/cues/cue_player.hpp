@@ -26,6 +26,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "animrt/controllers/cues/cue_requests.hpp"
+#include "animrt/controllers/cues/transition_worker.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/controllers/show/sound_clock.hpp"
 #include "animrt/core/joint.hpp"
@@ -50,10 +52,21 @@ struct CueStep {
   int sound = -1;                // the player's: its sound track, -1 none
 };
 
+// How a cue is entered: the crossfade, or (with a model) a learned
+// in-between from the present pose to the cue's pose at the crossfade's end.
+struct CueTransition {
+  std::shared_ptr<const seqnet::ModelFile> model;  // null: the crossfade
+  std::string model_file;
+  double frame_s = 0.04;    // the model's frame time
+  std::vector<int> joints;  // the robot's joint of each model input
+  bool learned() const { return model != nullptr; }
+};
+
 struct Cue {
   std::string name;
   std::vector<CueStep> steps;
   double crossfade_s = 1.0;  // into this cue, and between its steps
+  CueTransition transition;  // into this cue (a trigger or a handover)
   bool loop = false;         // after its last step, its first again
   int then = -1;             // after its last step (not looping): this cue; -1 the idle cue
 };
@@ -64,11 +77,18 @@ inline constexpr double kPauseRampS = 0.5;
 // The share of a joint's velocity and acceleration limits a crossfade may
 // use on its own.
 inline constexpr double kCrossfadeLimitShare = 0.3;
+// How long a learned in-between may take to compute, from the first
+// request it answers: then the cue crossfades in instead (counted).
+inline constexpr double kLearnedWaitS = 0.1;
+// The share of a learned transition at each end over which the played
+// targets ease from the crossfade to the model's frames and back.
+inline constexpr double kLearnedEaseShare = 0.25;
 
 class CuePlayer final : public MotionSource {
  public:
   // `idle` indexes `cues`. `joints` are the robot's (limits and home pose).
   CuePlayer(std::vector<Cue> cues, int idle, std::vector<JointSpec> joints, CueRequests& requests);
+  ~CuePlayer() override;
 
   std::span<const int> driven_joints() const override { return driven_; }
   void sample(double t, std::span<double> targets) const override;
@@ -88,6 +108,17 @@ class CuePlayer final : public MotionSource {
   // The crossfade time of the newest change (after any lengthening).
   double last_crossfade_s() const { return last_fade_.load(std::memory_order_relaxed); }
 
+  // Learned transitions: played, fallen back to the crossfade because the
+  // in-between was not ready within kLearnedWaitS, or because it could not
+  // be used (not finite, more frames than planned for).
+  std::uint64_t learned_played() const { return learned_played_.load(std::memory_order_relaxed); }
+  std::uint64_t learned_late() const { return learned_late_.load(std::memory_order_relaxed); }
+  std::uint64_t learned_unusable() const {
+    return learned_unusable_.load(std::memory_order_relaxed);
+  }
+  // The worker that computes them (null when no cue has one).
+  TransitionWorker* transition_worker() const { return worker_.get(); }
+
   // The steps that play `show_file` sound through `player` (before the run,
   // outside the cycle; the player's origin is the motion's start). It is
   // told from the cycle when to play, and is silent until its step is taken.
@@ -103,7 +134,23 @@ class CuePlayer final : public MotionSource {
     double t0 = 0.0;          // play time at which the step's source had t = 0
     double fade_start = 0.0;  // play time
     double fade_s = 0.0;
+    int learned = -1;  // the in-between's buffer while it plays, -1 none
+    int frames = 0;    // its frames after the present pose
     std::vector<double> pose;
+  };
+  // A learned transition asked for, whose in-between is being computed.
+  struct Pending {
+    bool active = false;
+    int cue = 0, step = 0;
+    bool asked = false;
+    double within = 0.0;
+    bool posted = false;
+    std::uint64_t job = 0;
+    int buffer = 0;
+    int frames = 0;
+    double fade = 0.0;
+    double deadline = 0.0;                                  // motion time
+    std::chrono::steady_clock::time_point wall_deadline{};  // lockstep
   };
   static constexpr std::size_t kMaxLayers = 4;
 
@@ -112,7 +159,13 @@ class CuePlayer final : public MotionSource {
   const CueStep& step_of(const Layer& layer) const;
   // `asked`: a trigger's (a cue asked for again starts again, and counts);
   // `at_s`: the time into the step it starts at.
-  void push(int cue, int step, bool asked, double at_s = 0.0) const;
+  void push(int cue, int step, bool asked, double at_s = 0.0, double fade = -1.0) const;
+  // A change into `cue`: a learned transition's computation begins, or the
+  // crossfade at once.
+  void enter(int cue, int step, bool asked, double at_s) const;
+  // A pending learned transition: posted, taken when ready, or given up.
+  void settle() const;
+  void apply_learned(Layer& layer) const;
   // The step of `cue` and the time into it at `at_s` into the cue.
   void locate(int cue, double at_s, int& step, double& within) const;
   double ease_in_time(const Cue& cue, const MotionSource& next, double at_s) const;
@@ -134,6 +187,13 @@ class CuePlayer final : public MotionSource {
   mutable std::atomic<int> current_{-1};
   mutable std::atomic<std::uint64_t> deferred_{0};
   mutable std::atomic<double> last_fade_{0.0};
+  std::unique_ptr<TransitionWorker> worker_;
+  std::vector<int> model_of_cue_;  // the worker's model index, -1 crossfade
+  // On a lockstep clock (not real time) the cycle waits for an in-between,
+  // up to kLearnedWaitS of wall time, so that a run is repeatable.
+  bool lockstep_ = false;
+  mutable Pending pending_;
+  mutable std::atomic<std::uint64_t> learned_played_{0}, learned_late_{0}, learned_unusable_{0};
 
   // The playback state: the cycle's alone (sample() is const to its caller).
   mutable std::array<Layer, kMaxLayers> layers_;
