@@ -183,7 +183,8 @@ TEST(SeqTrainingStep, FusedConvolutionSplitBetweenThreadsComputesWhatItsLayersDo
 // The rows of a sparse matrix as the kernel walks them: columns ascending,
 // a pair given twice summed, a vertex without neighbours an empty row.
 TEST(SeqTrainingStep, RingRowsSortAndSumLikeACoalescedSparseMatrix) {
-  const RingRows m = ring_rows(4, {2, 0, 2, 0, 2}, {3, 1, 0, 1, 1}, {1.0F, 0.5F, 2.0F, 0.25F, 4.0F});
+  const RingRows m =
+      ring_rows(4, {2, 0, 2, 0, 2}, {3, 1, 0, 1, 1}, {1.0F, 0.5F, 2.0F, 0.25F, 4.0F});
   EXPECT_EQ(m.start, (std::vector<std::int32_t>{0, 1, 1, 4, 4}));
   EXPECT_EQ(m.col, (std::vector<std::int32_t>{1, 0, 1, 3}));
   EXPECT_EQ(m.weight, (std::vector<float>{0.75F, 2.0F, 4.0F, 1.0F}));

@@ -41,7 +41,8 @@ RingRows ring_rows(int vertices, const std::vector<std::int64_t>& rows,
     m.start[static_cast<std::size_t>(rows[k]) + 1] = static_cast<std::int32_t>(m.col.size());
   }
   // Rows without entries end where the row before them does.
-  for (std::size_t i = 1; i < m.start.size(); ++i) m.start[i] = std::max(m.start[i], m.start[i - 1]);
+  for (std::size_t i = 1; i < m.start.size(); ++i)
+    m.start[i] = std::max(m.start[i], m.start[i - 1]);
   return m;
 }
 
@@ -50,14 +51,15 @@ namespace {
 constexpr auto kLanes = static_cast<std::size_t>(kConvLanes);
 
 // out (n numbers) = sum_k w_k x[col_k] over one row of m, rows of n numbers.
-[[gnu::always_inline]] inline void gather_row(const RingRows& m, int row, const float* __restrict x, std::size_t n,
-                       float* __restrict out) {
+[[gnu::always_inline]] inline void gather_row(const RingRows& m, int row, const float* __restrict x,
+                                              std::size_t n, float* __restrict out) {
   std::fill(out, out + n, 0.0F);
   for (std::int32_t k = m.start[static_cast<std::size_t>(row)];
        k < m.start[static_cast<std::size_t>(row) + 1]; ++k) {
     const float w = m.weight[static_cast<std::size_t>(k)];
-    const float* __restrict src = x + static_cast<std::size_t>(m.col[static_cast<std::size_t>(k)]) * n;
-    #pragma omp simd
+    const float* __restrict src =
+        x + static_cast<std::size_t>(m.col[static_cast<std::size_t>(k)]) * n;
+#pragma omp simd
     for (std::size_t i = 0; i < n; ++i) out[i] += w * src[i];
   }
 }
@@ -71,8 +73,8 @@ template <std::size_t W>
                                                  const float* __restrict r,
                                                  const float* __restrict w_self,
                                                  const float* __restrict w_ring,
-                                                 const float* __restrict bias,
-                                                 float* __restrict yv, std::size_t w) {
+                                                 const float* __restrict bias, float* __restrict yv,
+                                                 std::size_t w) {
   const std::size_t width = W > 0 ? W : w;
   const auto nb = static_cast<std::size_t>(s.batch);
   const auto in = static_cast<std::size_t>(s.in), out = static_cast<std::size_t>(s.out);
@@ -193,14 +195,14 @@ void mesh_conv_backward_local(const ConvShape& s, const float* x, const float* r
     for (; b + kLanes <= nb; b += kLanes) {
       backward_chunk<kLanes>(s, x + xo + b, ring + xo + b,
                              squashed != nullptr ? squashed + yo + b : nullptr, grad_y + yo + b,
-                             w_self, w_ring, grad_x + xo + b, through + xo + b, acc_self,
-                             acc_ring, acc_bias, local.data(), kLanes);
+                             w_self, w_ring, grad_x + xo + b, through + xo + b, acc_self, acc_ring,
+                             acc_bias, local.data(), kLanes);
     }
     if (b < nb) {
       backward_chunk<0>(s, x + xo + b, ring + xo + b,
-                        squashed != nullptr ? squashed + yo + b : nullptr, grad_y + yo + b,
-                        w_self, w_ring, grad_x + xo + b, through + xo + b, acc_self, acc_ring,
-                        acc_bias, local.data(), nb - b);
+                        squashed != nullptr ? squashed + yo + b : nullptr, grad_y + yo + b, w_self,
+                        w_ring, grad_x + xo + b, through + xo + b, acc_self, acc_ring, acc_bias,
+                        local.data(), nb - b);
     }
   }
 }
@@ -216,7 +218,7 @@ void mesh_conv_backward_ring(const ConvShape& s, const RingRows& adjoint, const 
       const float w = adjoint.weight[static_cast<std::size_t>(k)];
       const float* __restrict src =
           through + static_cast<std::size_t>(adjoint.col[static_cast<std::size_t>(k)]) * n;
-      #pragma omp simd
+#pragma omp simd
       for (std::size_t i = 0; i < n; ++i) gx[i] += w * src[i];
     }
   }

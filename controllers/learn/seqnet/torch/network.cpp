@@ -114,8 +114,8 @@ struct FusedMeshConv : torch::autograd::Function<FusedMeshConv> {
     const auto saved = ctx->get_saved_variables();
     const torch::Tensor &x = saved[0], &ring = saved[1], &y = saved[2];
     const torch::Tensor &w_self = saved[3], &w_ring = saved[4];
-    const auto rings = c10::static_intrusive_pointer_cast<MeshConvRings>(
-        ctx->saved_data["rings"].toCapsule());
+    const auto rings =
+        c10::static_intrusive_pointer_cast<MeshConvRings>(ctx->saved_data["rings"].toCapsule());
     const bool squash = ctx->saved_data["squash"].toBool();
     const ConvShape s{static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
                       static_cast<int>(w_self.size(0)), static_cast<int>(x.size(2))};
@@ -128,13 +128,12 @@ struct FusedMeshConv : torch::autograd::Function<FusedMeshConv> {
     torch::Tensor acc_bias = torch::zeros({threads, s.out, kConvLanes}, x.options());
     at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
       const std::int64_t t = at::get_thread_num();
-      mesh_conv_backward_local(s, x.data_ptr<float>(), ring.data_ptr<float>(),
-                               squash ? y.data_ptr<float>() : nullptr, g.data_ptr<float>(),
-                               w_self.data_ptr<float>(), w_ring.data_ptr<float>(),
-                               gx.data_ptr<float>(), through.data_ptr<float>(),
-                               acc_self[t].data_ptr<float>(), acc_ring[t].data_ptr<float>(),
-                               acc_bias[t].data_ptr<float>(), static_cast<int>(first),
-                               static_cast<int>(last));
+      mesh_conv_backward_local(
+          s, x.data_ptr<float>(), ring.data_ptr<float>(), squash ? y.data_ptr<float>() : nullptr,
+          g.data_ptr<float>(), w_self.data_ptr<float>(), w_ring.data_ptr<float>(),
+          gx.data_ptr<float>(), through.data_ptr<float>(), acc_self[t].data_ptr<float>(),
+          acc_ring[t].data_ptr<float>(), acc_bias[t].data_ptr<float>(), static_cast<int>(first),
+          static_cast<int>(last));
     });
     at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
       mesh_conv_backward_ring(s, rings->adjoint, through.data_ptr<float>(), gx.data_ptr<float>(),

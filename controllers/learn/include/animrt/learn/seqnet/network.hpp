@@ -62,7 +62,7 @@ class MeshConvImpl : public torch::nn::Module {
  private:
   MeshGraph graph_;
   bool transpose_;
-  torch::Tensor matrix_, adjoint_;  // sparse V x V: the product and its adjoint
+  torch::Tensor matrix_, adjoint_;           // sparse V x V: the product and its adjoint
   c10::intrusive_ptr<MeshConvRings> rings_;  // the same by rows, for forward_fused
 };
 TORCH_MODULE(MeshConv);
