@@ -8,6 +8,7 @@
 
 #include <numbers>
 
+#include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 #include "animrt/learn/seqnet/shapes.hpp"
 
@@ -124,21 +125,22 @@ TEST(SeqTrainingStep, TrainStepUpdatesFloatParametersFromTheCollectedGradients) 
   }
 }
 
-// One fused node per convolution (and its tanh) against the layer-by-layer
-// formulation: the same output and the same gradients, both directions.
-void expect_fused_equals_plain(bool transpose, bool squash) {
+// One fused node per convolution (and its tanh), the loops of
+// mesh_conv_kernel.hpp on [V, C, B], against the layer-by-layer
+// formulation of libtorch's ops (sparse product, two products and bias on
+// [V, B, C]): the same output and the same gradients, both directions.
+void expect_fused_equals_plain(const MeshSequence& bar, int batch, bool transpose, bool squash) {
   torch::manual_seed(13);
-  const SmallMesh m;
-  const MeshGraph graph = mesh_graph(m.bar.vertex_count(), m.bar.triangles);
+  const MeshGraph graph = mesh_graph(bar.vertex_count(), bar.triangles);
   MeshConv conv(9, 7, graph, transpose);
-  const torch::Tensor x0 = torch::rand({m.bar.vertex_count(), 3, 9}) * 2 - 1;
-  const torch::Tensor weights = torch::rand({m.bar.vertex_count(), 3, 7});
+  const torch::Tensor x0 = torch::rand({bar.vertex_count(), batch, 9}) * 2 - 1;
+  const torch::Tensor weights = torch::rand({bar.vertex_count(), batch, 7});
   auto run = [&](bool fused) {
     conv->zero_grad();
     const torch::Tensor x = x0.clone().requires_grad_();
     torch::Tensor y;
     if (fused) {
-      y = conv->forward_fused(x, squash);
+      y = conv->forward_fused(x.permute({0, 2, 1}).contiguous(), squash).permute({0, 2, 1});
     } else {
       y = conv->forward_vertices_first(x);
       if (squash) y = torch::tanh(y);
@@ -152,15 +154,40 @@ void expect_fused_equals_plain(bool transpose, bool squash) {
   ASSERT_EQ(plain.size(), 5U);
   for (std::size_t k = 0; k < plain.size(); ++k) {
     EXPECT_GT(plain[k].abs().max().item<double>(), 0.0) << k;
-    EXPECT_LT(worst_relative(fused[k], plain[k]), 1e-5) << k;
+    EXPECT_LT(worst_relative(fused[k], plain[k]), 1e-5)
+        << "output/x/W1/b/W2 " << k << ", batch " << batch << ", transpose " << transpose
+        << ", squash " << squash;
   }
 }
 
 TEST(SeqTrainingStep, FusedConvolutionComputesWhatItsLayersDo) {
   torch::set_num_threads(1);
+  const SmallMesh m;
   for (bool transpose : {false, true}) {
-    for (bool squash : {false, true}) expect_fused_equals_plain(transpose, squash);
+    for (bool squash : {false, true}) expect_fused_equals_plain(m.bar, 3, transpose, squash);
   }
+}
+
+// At the training batch (16, a whole vector) and an odd one, on a mesh
+// large enough that two threads split its vertices and add up two sets of
+// weight gradients.
+TEST(SeqTrainingStep, FusedConvolutionSplitBetweenThreadsComputesWhatItsLayersDo) {
+  const MeshSequence bar = make_twisting_bar(12, 20, 4.0, std::numbers::pi, 1);
+  ASSERT_GT(bar.vertex_count(), 200);
+  torch::set_num_threads(2);
+  expect_fused_equals_plain(bar, 16, false, true);
+  expect_fused_equals_plain(bar, 5, true, true);
+  torch::set_num_threads(1);
+}
+
+// The rows of a sparse matrix as the kernel walks them: columns ascending,
+// a pair given twice summed, a vertex without neighbours an empty row.
+TEST(SeqTrainingStep, RingRowsSortAndSumLikeACoalescedSparseMatrix) {
+  const RingRows m =
+      ring_rows(4, {2, 0, 2, 0, 2}, {3, 1, 0, 1, 1}, {1.0F, 0.5F, 2.0F, 0.25F, 4.0F});
+  EXPECT_EQ(m.start, (std::vector<std::int32_t>{0, 1, 1, 4, 4}));
+  EXPECT_EQ(m.col, (std::vector<std::int32_t>{1, 0, 1, 3}));
+  EXPECT_EQ(m.weight, (std::vector<float>{0.75F, 2.0F, 4.0F, 1.0F}));
 }
 
 }  // namespace

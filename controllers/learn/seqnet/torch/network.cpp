@@ -1,5 +1,6 @@
 #include "animrt/learn/seqnet/network.hpp"
 
+#include <ATen/Parallel.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <set>
 
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
 namespace animrt::seqnet {
 
@@ -75,41 +77,74 @@ struct Squash : torch::autograd::Function<Squash> {
   }
 };
 
-// One mesh convolution on [V, B, C] (vertices first), its tanh included
-// when `squash`, as one autograd node: y = act(x W1^T + (M x) W2^T + b).
-// Autograd would record a node per view, product and tanh and add the two
-// paths of x's gradient itself; here backward forms the same gradients in
-// five products.
+// One mesh convolution on [V, C, B] (batch innermost), its tanh included
+// when `squash`, as one autograd node: y = act(W1 x + W2 (M x) + b) per
+// vertex, by the loops of mesh_conv_kernel.hpp over ranges of vertices
+// (split between libtorch's threads). Backward forms the gradients of x,
+// both weights and the bias in two passes over the vertices.
 struct FusedMeshConv : torch::autograd::Function<FusedMeshConv> {
+  static constexpr std::int64_t grain = 64;  // vertices a thread takes at least
+
   static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& x,
                                const torch::Tensor& w_self, const torch::Tensor& bias,
-                               const torch::Tensor& w_ring, const torch::Tensor& matrix,
-                               const torch::Tensor& adjoint, bool squash) {
-    const std::int64_t v = x.size(0), batch = x.size(1), c = x.size(2);
-    const torch::Tensor flat = x.reshape({v * batch, c});
-    const torch::Tensor ring = torch::mm(matrix, x.reshape({v, batch * c})).view({v * batch, c});
-    torch::Tensor y = torch::addmm(bias, flat, w_self.t());
-    y.addmm_(ring, w_ring.t());
+                               const torch::Tensor& w_ring,
+                               const c10::intrusive_ptr<MeshConvRings>& rings, bool squash) {
+    TORCH_CHECK(x.dim() == 3 && x.scalar_type() == torch::kFloat32 && x.is_contiguous(),
+                "mesh convolution: x must be a contiguous float [V, C, B]");
+    const ConvShape s{static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
+                      static_cast<int>(w_self.size(0)), static_cast<int>(x.size(2))};
+    TORCH_CHECK(s.vertices == rings->matrix.vertices && s.in == w_self.size(1),
+                "mesh convolution: x does not fit the mesh or the weights");
+    const torch::Tensor ws = w_self.contiguous(), wr = w_ring.contiguous(), b = bias.contiguous();
+    torch::Tensor ring = torch::empty_like(x);
+    torch::Tensor y = torch::empty({s.vertices, s.out, s.batch}, x.options());
+    at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
+      mesh_conv_forward(s, rings->matrix, x.data_ptr<float>(), ws.data_ptr<float>(),
+                        wr.data_ptr<float>(), b.data_ptr<float>(), ring.data_ptr<float>(),
+                        y.data_ptr<float>(), static_cast<int>(first), static_cast<int>(last));
+    });
     if (squash) squash_(y);
-    ctx->save_for_backward({flat, ring, y, w_self, w_ring});
-    ctx->saved_data["adjoint"] = adjoint;
+    ctx->save_for_backward({x, ring, y, ws, wr});
+    ctx->saved_data["rings"] = c10::IValue::make_capsule(rings);
     ctx->saved_data["squash"] = squash;
-    return y.view({v, batch, -1});
+    return y;
   }
   static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
                                                torch::autograd::tensor_list grad) {
     const auto saved = ctx->get_saved_variables();
-    const torch::Tensor &flat = saved[0], &ring = saved[1], &y = saved[2];
+    const torch::Tensor &x = saved[0], &ring = saved[1], &y = saved[2];
     const torch::Tensor &w_self = saved[3], &w_ring = saved[4];
-    const std::int64_t v = grad[0].size(0), batch = grad[0].size(1);
-    torch::Tensor g = grad[0].reshape({v * batch, -1});
-    if (ctx->saved_data["squash"].toBool()) g = torch::tanh_backward(g, y);
-    const torch::Tensor through_ring = torch::mm(g, w_ring).view({v, -1});
-    torch::Tensor gx = torch::mm(g, w_self).view({v, -1});
-    gx.addmm_(ctx->saved_data["adjoint"].toTensor(), through_ring);
-    const torch::Tensor gt = g.t();
-    return {gx.view({v, batch, -1}), torch::mm(gt, flat), g.sum(0),       torch::mm(gt, ring),
-            torch::Tensor(),         torch::Tensor(),     torch::Tensor()};
+    const auto rings =
+        c10::static_intrusive_pointer_cast<MeshConvRings>(ctx->saved_data["rings"].toCapsule());
+    const bool squash = ctx->saved_data["squash"].toBool();
+    const ConvShape s{static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
+                      static_cast<int>(w_self.size(0)), static_cast<int>(x.size(2))};
+    const torch::Tensor g = grad[0].contiguous();
+    torch::Tensor gx = torch::empty_like(x), through = torch::empty_like(x);
+    // One set of weight-gradient sums per thread, added up after.
+    const std::int64_t threads = at::get_num_threads();
+    torch::Tensor acc_self = torch::zeros({threads, s.out, s.in, kConvLanes}, x.options());
+    torch::Tensor acc_ring = torch::zeros_like(acc_self);
+    torch::Tensor acc_bias = torch::zeros({threads, s.out, kConvLanes}, x.options());
+    at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
+      const std::int64_t t = at::get_thread_num();
+      mesh_conv_backward_local(
+          s, x.data_ptr<float>(), ring.data_ptr<float>(), squash ? y.data_ptr<float>() : nullptr,
+          g.data_ptr<float>(), w_self.data_ptr<float>(), w_ring.data_ptr<float>(),
+          gx.data_ptr<float>(), through.data_ptr<float>(), acc_self[t].data_ptr<float>(),
+          acc_ring[t].data_ptr<float>(), acc_bias[t].data_ptr<float>(), static_cast<int>(first),
+          static_cast<int>(last));
+    });
+    at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
+      mesh_conv_backward_ring(s, rings->adjoint, through.data_ptr<float>(), gx.data_ptr<float>(),
+                              static_cast<int>(first), static_cast<int>(last));
+    });
+    return {gx,
+            acc_self.sum(at::IntArrayRef{0, 3}),
+            acc_bias.sum(at::IntArrayRef{0, 2}),
+            acc_ring.sum(at::IntArrayRef{0, 3}),
+            torch::Tensor(),
+            torch::Tensor()};
   }
 };
 
@@ -135,6 +170,18 @@ MeshConvImpl::MeshConvImpl(int in, int out, MeshGraph graph, bool transpose)
     matrix_ = transpose_ ? adjoint : mean;
     adjoint_ = transpose_ ? mean : adjoint;
   }
+  const auto list = [](const torch::Tensor& t, auto element) {
+    using T = decltype(element);
+    const torch::Tensor c = t.contiguous();
+    return std::vector<T>(c.data_ptr<T>(), c.data_ptr<T>() + c.numel());
+  };
+  const auto rows = list(graph_.rows, std::int64_t{}), cols = list(graph_.cols, std::int64_t{});
+  const auto weights = list(graph_.weights, 0.0F);
+  RingRows mean_rows = ring_rows(static_cast<int>(v), rows, cols, weights);
+  RingRows adjoint_rows = ring_rows(static_cast<int>(v), cols, rows, weights);
+  rings_ = c10::make_intrusive<MeshConvRings>();
+  rings_->matrix = transpose_ ? std::move(adjoint_rows) : std::move(mean_rows);
+  rings_->adjoint = transpose_ ? std::move(mean_rows) : std::move(adjoint_rows);
 }
 
 torch::Tensor MeshConvImpl::ring_vertices_first(const torch::Tensor& x) const {
@@ -152,8 +199,8 @@ torch::Tensor MeshConvImpl::forward(const torch::Tensor& x) {
 }
 
 torch::Tensor MeshConvImpl::forward_fused(const torch::Tensor& x, bool squash) {
-  return FusedMeshConv::apply(x.contiguous(), self->weight, self->bias, neighbours->weight, matrix_,
-                              adjoint_, squash);
+  return FusedMeshConv::apply(x.contiguous(), self->weight, self->bias, neighbours->weight, rings_,
+                              squash);
 }
 
 torch::Tensor MeshConvImpl::forward_vertices_first(const torch::Tensor& x) {
@@ -211,7 +258,7 @@ void SeqNetImpl::zero_output_layer() {
 
 namespace {
 
-// A Sequential of mesh convolutions and tanh on [V, B, C]; a convolution
+// A Sequential of mesh convolutions and tanh on [V, C, B]; a convolution
 // and the tanh after it run as one node.
 torch::Tensor run_vertices_first(torch::nn::Sequential& layers, torch::Tensor h) {
   const auto children = layers->children();
@@ -233,10 +280,10 @@ torch::Tensor run_vertices_first(torch::nn::Sequential& layers, torch::Tensor h)
 torch::Tensor SeqNetImpl::encoded(const torch::Tensor& x) {
   const std::int64_t batch = x.size(0);
   if (shape_.kind != ModelKind::mesh) return encoder->forward(x);
-  // Vertices first through the convolutions, back to [B, V C] for the
-  // dense layers.
-  torch::Tensor h = x.view({batch, shape_.nodes(), 9}).transpose(0, 1).contiguous();
-  return run_vertices_first(encoder, h).transpose(0, 1).reshape({batch, -1});
+  // [V, C, B] through the convolutions, back to [B, V C] for the dense
+  // layers.
+  torch::Tensor h = x.view({batch, shape_.nodes(), 9}).permute({1, 2, 0}).contiguous();
+  return run_vertices_first(encoder, h).permute({2, 0, 1}).reshape({batch, -1});
 }
 
 std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& x) {
@@ -252,8 +299,8 @@ torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
   const std::int64_t batch = dense.size(0);
   if (shape_.kind != ModelKind::mesh) return decoder->forward(torch::tanh(dense));
   torch::Tensor h = Squash::apply(dense);
-  h = h.view({batch, shape_.nodes(), shape_.channels}).transpose(0, 1).contiguous();
-  return run_vertices_first(decoder, h).transpose(0, 1).reshape({batch, -1});
+  h = h.view({batch, shape_.nodes(), shape_.channels}).permute({1, 2, 0}).contiguous();
+  return run_vertices_first(decoder, h).permute({2, 0, 1}).reshape({batch, -1});
 }
 
 // Inputs and output gradients of one dense layer over the steps of a run.

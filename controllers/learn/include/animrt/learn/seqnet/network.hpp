@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "animrt/controllers/seqnet/model_file.hpp"
+#include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
 namespace animrt::seqnet {
 
@@ -32,6 +33,12 @@ struct MeshGraph {
 };
 MeshGraph mesh_graph(int vertex_count, const std::vector<std::array<int, 3>>& triangles);
 
+// A convolution's ring matrix M and its adjoint M^T by rows, shared with
+// the autograd nodes of its steps.
+struct MeshConvRings : torch::CustomClassHolder {
+  RingRows matrix, adjoint;
+};
+
 // Eq. 2 on [B, V, C] inputs: y_i = W1 x_i + W2 mean_{j in N(i)} x_j + b.
 // The transpose spreads instead of gathering: y_j = W1 x_j + W2 sum_{i: j in
 // N(i)} x_i / d_i + b (the adjoint of the neighbour mean).
@@ -39,10 +46,11 @@ class MeshConvImpl : public torch::nn::Module {
  public:
   MeshConvImpl(int in, int out, MeshGraph graph, bool transpose);
   torch::Tensor forward(const torch::Tensor& x);
-  // The same on [V, B, C] (vertices first, contiguous), as the network runs it.
+  // The same on [V, B, C] (vertices first, contiguous), by libtorch's ops.
   torch::Tensor forward_vertices_first(const torch::Tensor& x);
-  // The same, then tanh when `squash`, as one autograd node (one iteration
-  // of training records far fewer operations).
+  // The same on [V, C, B] (the batch innermost), then tanh when `squash`,
+  // as one autograd node of hand-written loops (mesh_conv_kernel.hpp), as
+  // the network runs it.
   torch::Tensor forward_fused(const torch::Tensor& x, bool squash);
   // The neighbour mean (or its adjoint) alone, on [B, V, C] and on [V, B, C].
   torch::Tensor ring(const torch::Tensor& x) const;
@@ -54,7 +62,8 @@ class MeshConvImpl : public torch::nn::Module {
  private:
   MeshGraph graph_;
   bool transpose_;
-  torch::Tensor matrix_, adjoint_;  // sparse V x V: the product and its adjoint
+  torch::Tensor matrix_, adjoint_;           // sparse V x V: the product and its adjoint
+  c10::intrusive_ptr<MeshConvRings> rings_;  // the same by rows, for forward_fused
 };
 TORCH_MODULE(MeshConv);
 
