@@ -278,6 +278,7 @@ def run(animrt, out, iterations, chosen, fixed_window=None, training_clip=False)
             if not os.path.isdir(truth_dir):
                 subprocess.run([animrt, 'seq', 'reconstruct', bin_path, '--out', truth_dir],
                                check=True, capture_output=True)
+            os.makedirs(work, exist_ok=True)
             model = os.path.join(work, 'net.model')
             cpu, wall, line = train(animrt, bin_path, model, held[0], window, iterations)
             print(f'{name}: held out {held[0]} ({held[2]} frames, {vertices} vertices), window '
@@ -308,14 +309,16 @@ def table(out):
           'interpolation | hold earlier key | network, pieces aligned | linear, pieces aligned |')
     print('|' + '---|' * 15)
     with open(os.path.join(out, 'results.tsv')) as f:
-        for line in f:
-            (setting, name, clip, frames, vertices, window, windows, gap, gaps, merged, iterations,
-             cpu, net, untrained, linear, hold, net_shape, linear_shape, _) = line.split('\t')
-            best = min(float(linear), float(hold))
-            mark = '**' if float(net) < best else ''
-            print(f'| {setting} | {name} | {clip} | {frames} | {vertices} | {window} ({windows}) | '
-                  f'{iterations} ({cpu}) | {gap} | {gaps} | {mark}{net}{mark} | {untrained} | '
-                  f'{linear} | {hold} | {net_shape} | {linear_shape} |')
+        rows = [line.rstrip('\n').split('\t') for line in f]
+    # By file, the default setting first, then by iterations, clip and gap.
+    rows.sort(key=lambda r: (r[1], r[0] != 'default', int(r[10]), r[2], int(r[7])))
+    for row in rows:
+        (setting, name, clip, frames, vertices, window, windows, gap, gaps, merged, iterations,
+         cpu, net, untrained, linear, hold, net_shape, linear_shape, _) = row
+        mark = '**' if float(net) < min(float(linear), float(hold)) else ''
+        print(f'| {setting} | {name} | {clip} | {frames} | {vertices} | {window} ({windows}) | '
+              f'{iterations} ({cpu}) | {gap} | {gaps} | {mark}{net}{mark} | {untrained} | '
+              f'{linear} | {hold} | {net_shape} | {linear_shape} |')
 
 
 def main():
