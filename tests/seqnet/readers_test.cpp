@@ -77,6 +77,25 @@ TEST(Md2Reader, HeaderFramesScaleTranslateSeamsAndClips) {
   EXPECT_EQ(s.clips[1].first, 2);
 }
 
+// Quake II numbers the frames of each animation from 01 after its own
+// number (Irrlicht's faerie: death101..death106, death201..); a number that
+// does not follow on starts a new clip.
+TEST(Md2Reader, ANumberThatDoesNotFollowOnStartsAClip) {
+  const std::string path = seqtest::temp_path("deaths.md2");
+  std::vector<Md2Frame> frames;
+  for (const char* name : {"death101", "death102", "death201", "death202", "death203", "run1",
+                           "run2", "run1", "stand1", "stand2", "stand3"}) {
+    frames.push_back({{1, 1, 1}, {0, 0, 0}, name});
+  }
+  make_md2(frames).save(path);
+  const MeshSequence s = read_md2(path);
+  std::vector<std::string> got;
+  for (const auto& c : s.clips)
+    got.push_back(c.name + " " + std::to_string(c.first) + "+" + std::to_string(c.count));
+  EXPECT_EQ(got, (std::vector<std::string>{"death1 0+2", "death2 2+3", "run_1 5+2", "run_2 7+1",
+                                           "stand 8+3"}));
+}
+
 TEST(Md2Reader, GzipIsTransparent) {
   const Bytes b = make_md2(three_frames());
   const std::string path = seqtest::temp_path("tetra.md2.gz");
