@@ -311,7 +311,7 @@ def table(out):
     with open(os.path.join(out, 'results.tsv')) as f:
         rows = [line.rstrip('\n').split('\t') for line in f]
     # By file, the default setting first, then by iterations, clip and gap.
-    rows.sort(key=lambda r: (r[1], r[0] != 'default', int(r[10]), r[2], int(r[7])))
+    rows.sort(key=lambda r: (r[1], r[0] != 'default', r[0], int(r[10]), r[2], int(r[7])))
     for row in rows:
         (setting, name, clip, frames, vertices, window, windows, gap, gaps, merged, iterations,
          cpu, net, untrained, linear, hold, net_shape, linear_shape, _) = row
