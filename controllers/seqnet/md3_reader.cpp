@@ -96,7 +96,10 @@ std::vector<Clip> clips_from_cfg(const std::string& cfg, const std::string& mode
     if ((lower && torso) || (upper && legs)) continue;
     CfgEntry e = entries[i];
     if (lower && legs) e.first -= skip;
-    if (e.first < 0 || e.count < 1 || e.first + e.count > frames) {
+    // A clip of no frames (merman's LEGS_TURN) names nothing: the engine
+    // plays no frame for it, so it is left out rather than refused.
+    if (e.count == 0) continue;
+    if (e.first < 0 || e.first + e.count > frames) {
       throw InputError(Location{cfg, e.line, 1}, kAnimationNames[i],
                        "frames " + std::to_string(e.first) + ".." +
                            std::to_string(e.first + e.count - 1) + " are outside " + model + "'s " +
@@ -159,8 +162,11 @@ MeshSequence read_md3(const std::string& file) {
                    std::to_string(surface_frames) + " frames, the header says " +
                        std::to_string(num_frames));
     }
-    check_count(file, key, "vertex count", verts, 1, kMaxVerts);
-    check_count(file, key, "triangle count", tris, 1, kMaxTriangles);
+    // An empty surface (no vertices and no triangles, as tony's l_belt)
+    // is loaded by the engine and draws nothing; it adds nothing here.
+    const bool empty = verts == 0 && tris == 0;
+    check_count(file, key, "vertex count", verts, empty ? 0 : 1, kMaxVerts);
+    check_count(file, key, "triangle count", tris, empty ? 0 : 1, kMaxTriangles);
     if (ofs_tris < 108 || ofs_xyz < 108 || ofs_end < 108) {
       detail::fail(file, key, "an offset points into the surface header");
     }

@@ -90,7 +90,7 @@ int detach_non_manifold(MeshSequence& sequence) {
   return detached;
 }
 
-void validate_mesh(const MeshSequence& sequence, const std::string& file) {
+void validate_mesh(const MeshSequence& sequence, const std::string& file, bool pose) {
   if (sequence.frames.empty()) fail(file, "", "has no frames");
   if (sequence.triangles.empty()) fail(file, "", "has no triangles");
   const int v = sequence.vertex_count();
@@ -129,7 +129,9 @@ void validate_mesh(const MeshSequence& sequence, const std::string& file) {
   }
   // Zero area is judged in the first frame only: it is the template the
   // deformation features are measured against. Later frames may legitimately
-  // flatten a triangle (quantised game formats do).
+  // flatten a triangle (quantised game formats do), and so may a key or an
+  // initial frame, which is measured against a model's template.
+  if (pose) return;
   const Positions& rest = sequence.frames.front();
   const double diagonal = (rest.rowwise().maxCoeff() - rest.rowwise().minCoeff()).norm();
   const double tiny = 1e-14 * diagonal * diagonal;

@@ -23,7 +23,9 @@ int detach_non_manifold(MeshSequence& sequence);
 // Throws InputError naming `file` and the frame for: no frames or no
 // triangles, frames of different sizes, a vertex index out of range, a
 // triangle that repeats a vertex or has zero area, an edge shared by more
-// than two triangles, a position that is not finite.
-void validate_mesh(const MeshSequence& sequence, const std::string& file);
+// than two triangles, a position that is not finite. Zero area is judged in
+// the first frame, and only when that frame is the sequence's own template:
+// a posed frame of a known mesh (`pose`) may flatten a triangle.
+void validate_mesh(const MeshSequence& sequence, const std::string& file, bool pose = false);
 
 }  // namespace animrt::seqnet::detail

@@ -197,6 +197,15 @@ MeshSequence read_obj_sequence(const std::string& folder) {
   return out;
 }
 
+MeshSequence read_mesh_pose(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec) || detail::extension_without_gz(path) != ".obj")
+    return read_mesh_sequence(path);
+  MeshSequence out = parse_obj(path);
+  detail::validate_mesh(out, path, true);
+  return out;
+}
+
 MeshSequence read_mesh_sequence(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return read_obj_sequence(path);

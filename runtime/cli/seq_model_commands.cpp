@@ -33,7 +33,7 @@ struct MeshFrames {
 MeshFrames read_mesh_frames(const std::vector<std::string>& files, const std::string& option) {
   MeshFrames m;
   for (const std::string& file : files) {
-    const seqnet::MeshSequence s = seqnet::read_mesh_sequence(file);
+    const seqnet::MeshSequence s = seqnet::read_mesh_pose(file);
     if (s.frames.empty()) throw InputError(Location{file, 0, 0}, option, "no frame");
     m.frames.push_back(s.frames.front());
     m.triangles = s.triangles;

@@ -86,6 +86,14 @@ for pair in 0000:0000 0004:0010 0008:0020; do
 done
 cmp -s <(grep '^v ' "$tmp/filled/frame_0002.obj") <(grep '^v ' "$tmp/filled/frame_0000.obj") &&
   fail "an in-between mesh is a copy of the key"
+# A key may flatten a triangle, as a game pose can (frame 28 of sydney.md2):
+# it is measured against the model's template. Vertex 2 onto vertex 1
+# flattens the triangle 1 7 2.
+awk '/^v / { n++; if (n == 1) first = $0; if (n == 2) { print first; next } } { print }' \
+  "$tmp/plate/frame_0010.obj" > "$tmp/flat.obj"
+out=$("$animrt" seq complete "$tmp/plate.model" --keys "$tmp/plate/frame_0000.obj" "$tmp/flat.obj" \
+  --gap 2 --out "$tmp/f3" 2>&1) || fail "a key with a flattened triangle was refused: $out"
+[[ $(ls "$tmp/f3" | wc -l) -eq 4 ]] || fail "complete wrote $(ls "$tmp/f3" | wc -l) frames, expected 4"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/other.obj"
 out=$("$animrt" seq complete "$tmp/plate.model" --keys "$tmp/other.obj" "$tmp/other.obj" --gap 2 --out "$tmp/f2" 2>&1)
 code=$?

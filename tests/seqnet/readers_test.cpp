@@ -77,6 +77,25 @@ TEST(Md2Reader, HeaderFramesScaleTranslateSeamsAndClips) {
   EXPECT_EQ(s.clips[1].first, 2);
 }
 
+// Quake II numbers the frames of each animation from 01 after its own
+// number (Irrlicht's faerie: death101..death106, death201..); a number that
+// does not follow on starts a new clip.
+TEST(Md2Reader, ANumberThatDoesNotFollowOnStartsAClip) {
+  const std::string path = seqtest::temp_path("deaths.md2");
+  std::vector<Md2Frame> frames;
+  for (const char* name : {"death101", "death102", "death201", "death202", "death203", "run1",
+                           "run2", "run1", "stand1", "stand2", "stand3"}) {
+    frames.push_back({{1, 1, 1}, {0, 0, 0}, name});
+  }
+  make_md2(frames).save(path);
+  const MeshSequence s = read_md2(path);
+  std::vector<std::string> got;
+  for (const auto& c : s.clips)
+    got.push_back(c.name + " " + std::to_string(c.first) + "+" + std::to_string(c.count));
+  EXPECT_EQ(got, (std::vector<std::string>{"death1 0+2", "death2 2+3", "run_1 5+2", "run_2 7+1",
+                                           "stand 8+3"}));
+}
+
 TEST(Md2Reader, GzipIsTransparent) {
   const Bytes b = make_md2(three_frames());
   const std::string path = seqtest::temp_path("tetra.md2.gz");
@@ -232,6 +251,77 @@ TEST(Md3Reader, BadFilesNameFileAndPart) {
   EXPECT_NE(e.find("surface count"), std::string::npos) << e;
 }
 
+// A surface with no vertices and no triangles at the end of `b` (OpenArena's
+// tony has two: l_belt and u_vest).
+void add_empty_surface(Bytes& b, int frames) {
+  b.text("IDP3", 4);
+  b.text("l_belt", 64);
+  for (int v : {0, frames, 1, 0, 0, 108, 108, 108, 108, 108}) b.i32(v);
+  b.put_i32(84, 3);  // the header's surface count
+}
+
+TEST(Md3Reader, EmptySurfacesAreSkipped) {
+  const std::string path = seqtest::temp_path("empty_surface.md3");
+  Bytes b = make_md3(2, 2);
+  add_empty_surface(b, 2);
+  b.save(path);
+  const MeshSequence s = read_md3(path);
+  EXPECT_EQ(s.vertex_count(), 8);
+  EXPECT_EQ(s.triangles.size(), 8u);
+  EXPECT_EQ(s.frames[1].col(3), Eigen::Vector3d(0, 0.5, 10));
+
+  // Vertices without triangles, or triangles without vertices, are not
+  // an empty surface: still refused.
+  Bytes verts_only = b;
+  verts_only.put_i32(verts_only.size() - 108 + 80, 5);
+  verts_only.save(path);
+  std::string e = error_of(path, read_md3);
+  EXPECT_NE(e.find("surface 2: triangle count is 0"), std::string::npos) << e;
+  Bytes tris_only = b;
+  tris_only.put_i32(tris_only.size() - 108 + 84, 1);
+  tris_only.save(path);
+  e = error_of(path, read_md3);
+  EXPECT_NE(e.find("surface 2: vertex count is 0"), std::string::npos) << e;
+}
+
+// animation.cfg of 25 lines for a 4-frame lower.md3: BOTH_ at frames 0..1,
+// TORSO_ from 2 and LEGS_WALKCR from 4 (the engine's numbering), so the legs
+// move down by 2 to frames 2..3 of the file.
+std::string animation_cfg(const std::string& legs_turn) {
+  std::string cfg = "sex m\n// first, count, looping, fps\n";
+  for (int i = 0; i < 6; ++i) cfg += "0 2 0 10\n";   // BOTH_
+  for (int i = 0; i < 7; ++i) cfg += "2 1 0 10\n";   // TORSO_
+  for (int i = 0; i < 11; ++i) cfg += "4 2 2 15\n";  // LEGS_WALKCR .. LEGS_IDLECR
+  return cfg + legs_turn + "\t// LEGS_TURN\n";
+}
+
+TEST(Md3Reader, AClipOfNoFramesIsLeftOutAndAClipOutsideTheFileIsRefused) {
+  namespace fs = std::filesystem;
+  const std::string dir = seqtest::temp_path("md3_empty_clip");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string model = dir + "/lower.md3";
+  make_md3(4, 4).save(model);
+  // OpenArena's merman: "192 0 0 0 // LEGS_TURN", past the file's frames.
+  seqtest::write_text(dir + "/animation.cfg", animation_cfg("192\t0\t0\t0"));
+  const MeshSequence s = read_md3(model);
+  ASSERT_EQ(s.clips.size(), 17u);  // 6 BOTH_ and 11 LEGS_, no LEGS_TURN
+  EXPECT_EQ(s.clips.front().name, "BOTH_DEATH1");
+  EXPECT_EQ(s.clips.back().name, "LEGS_IDLECR");
+  EXPECT_EQ(s.clips.back().first, 2);
+  EXPECT_EQ(s.clips.back().count, 2);
+
+  seqtest::write_text(dir + "/animation.cfg", animation_cfg("6 2 0 10"));
+  EXPECT_EQ(error_of(model, read_md3),
+            dir + "/animation.cfg:27:1: LEGS_TURN: frames 4..5 are outside " + model +
+                "'s 4 frames");
+  seqtest::write_text(dir + "/animation.cfg", animation_cfg("5 1 0 10"));
+  const MeshSequence turn = read_md3(model);
+  ASSERT_EQ(turn.clips.size(), 18u);
+  EXPECT_EQ(turn.clips.back().name, "LEGS_TURN");
+  EXPECT_EQ(turn.clips.back().first, 3);
+}
+
 TEST(ObjReader, PolygonsNegativeIndicesAndIgnoredAttributes) {
   const std::string path = seqtest::temp_path("quad.obj");
   seqtest::write_text(path,
@@ -265,6 +355,22 @@ TEST(ObjReader, BadFacesNameLineAndColumn) {
   e = error_of(path, read_obj);
   EXPECT_NE(e.find("non-manifold"), std::string::npos) << e;
   EXPECT_NE(e.find("frame 0"), std::string::npos) << e;
+}
+
+// A key or initial frame is a pose of a model's mesh: a triangle it
+// flattens (frame 28 of sydney.md2 flattens one) is not a reason to refuse
+// it, since the model's template is what its features are measured against.
+TEST(ObjReader, APoseMayFlattenATriangleATemplateMayNot) {
+  const std::string path = seqtest::temp_path("pose.obj");
+  seqtest::write_text(path, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 2 3 4\nf 1 2 3\n");
+  EXPECT_EQ(error_of(path, read_obj), path + ": frame 0: triangle 2 has zero area");
+  EXPECT_EQ(error_of(path, read_mesh_sequence), path + ": frame 0: triangle 2 has zero area");
+  const MeshSequence pose = read_mesh_pose(path);
+  EXPECT_EQ(pose.vertex_count(), 4);
+  EXPECT_EQ(pose.triangles.size(), 3u);
+  // Everything else is still checked.
+  seqtest::write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n");
+  EXPECT_NE(error_of(path, read_mesh_pose).find("repeats a vertex"), std::string::npos);
 }
 
 TEST(ObjReader, FolderInNameOrderWithOneConnectivity) {

@@ -66,6 +66,24 @@ TEST(RealModels, SydneyMd2HeaderFramesAndClips) {
   EXPECT_EQ(covered, s.frame_count());
 }
 
+// faerie.md2 numbers its three deaths death101.., death201.., death301..:
+// three clips, not one that jumps from a lying pose to a standing one.
+TEST(RealModels, FaerieMd2DeathsAreThreeClips) {
+  const std::string path = "/usr/share/doc/libirrlicht-dev/media/faerie.md2.gz";
+  if (!std::filesystem::exists(path)) {
+    ADD_FAILURE() << path << " is missing: install the Debian package libirrlicht-doc";
+    return;
+  }
+  const MeshSequence s = read_md2(path);
+  EXPECT_EQ(find_clip(s, "death"), nullptr);
+  for (const auto& [name, count] : {std::pair{"death1", 6}, {"death2", 6}, {"death3", 8},
+                                    {"pain1", 4}, {"pain3", 4}, {"stand", 40}}) {
+    const Clip* c = find_clip(s, name);
+    ASSERT_NE(c, nullptr) << name;
+    EXPECT_EQ(c->count, count) << name;
+  }
+}
+
 TEST(RealModels, SydneyRoundTrip) {
   const std::string path = seqtest::sydney_path();
   if (path.empty()) return;

@@ -22,6 +22,11 @@ MeshSequence read_md2(const std::string& file);
 MeshSequence read_md3(const std::string& file);
 // By extension (.obj, .md2, .md3, each optionally .gz) or a folder of OBJs.
 MeshSequence read_mesh_sequence(const std::string& path);
+// One posed frame of a model's mesh (a key or an initial frame): as
+// read_mesh_sequence, but an OBJ's triangles may have zero area, since the
+// frame is measured against the model's template, not against itself (a
+// game pose can flatten a triangle: frame 28 of Irrlicht's sydney.md2).
+MeshSequence read_mesh_pose(const std::string& path);
 
 // One OBJ per frame: DIR/frame_0000.obj, ... (the folder is created).
 void write_obj_sequence(const std::string& folder, const MeshSequence& sequence);
