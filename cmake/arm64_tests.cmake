@@ -96,10 +96,3 @@ animrt_arm64_test(lockstep 3
   integration_can/quadruped_can_lockstep_test.cpp
   integration_feetech/arm_sts_lockstep_test.cpp
   integration_mixed/mixed_figure_test.cpp)
-
-# The loop's timing on the simulated quadruped (bench/bench_loop.cpp), built
-# only when asked for (`--target bench_loop`): under the emulator a sanity
-# check of the cross build, never a figure for a board.
-add_executable(bench_loop EXCLUDE_FROM_ALL ${CMAKE_SOURCE_DIR}/bench/bench_loop.cpp)
-target_link_libraries(bench_loop PRIVATE animrt_runtime animrt_sim)
-target_compile_definitions(bench_loop PRIVATE ANIMRT_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
