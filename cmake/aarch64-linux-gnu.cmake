@@ -1,7 +1,7 @@
 # Cross-compiling for arm64 with Debian's cross toolchain
 # (crossbuild-essential-arm64) against a sysroot of Debian's arm64 -dev
 # packages, extracted by packaging/arm64-sysroot (ANIMRT_ARM64_SYSROOT;
-# `make cross-arm64` builds it under the cross build directory). The
+# `make test-arm64` builds it under the cross build directory). The
 # binaries run here under qemu-user (qemu-aarch64-static, with the
 # sysroot's loader and libraries), which ctest puts in front of every test.
 set(CMAKE_SYSTEM_NAME Linux)

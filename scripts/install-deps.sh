@@ -27,13 +27,13 @@ packages=(
   chromium chromium-driver python3-selenium
   # A figure's computer: the service's readiness and watchdog (sd_notify),
   # the Debian packages (make deb) and their checks (systemd-analyze, lintian),
-  # the arm64 cross toolchain and emulator (make cross-arm64; its arm64 -dev
+  # the arm64 cross toolchain and emulator (make test-arm64; its arm64 -dev
   # libraries are extracted into a sysroot by packaging/arm64-sysroot, never
   # installed: libyaml-cpp-dev:arm64 would replace the host's libyaml-cpp-dev).
   libsystemd-dev systemd dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static
   # The packages installed into a fresh Debian 12 root (make test-install:
   # mmdebstrap, fetching from Debian's archive; it also builds the arm64
-  # sysroot of make cross-arm64) and that root booted with
+  # sysroot of make test-arm64) and that root booted with
   # systemd (make test-boot: an ext4 image written by mkfs.ext4 -d, read
   # back by debugfs; depmod for the guest's modules).
   mmdebstrap e2fsprogs kmod
