@@ -24,8 +24,17 @@ notify() { /usr/bin/python3 "$root/tests/cli/service_notify.py" "$@"; }
 count() { awk -v m="$2" -v from="$3" -v to="$4" '$2 == m && $1 >= from && $1 < to' "$1" | wc -l; }
 at() { awk -v m="$2" '$2 == m { print $1; exit }' "$1"; }
 
+# The three services below run at the same time (each observed on a socket
+# of its own): the test waits on their clocks, not on its machine.
 # Ready, alive, stopped by SIGTERM one second after READY.
-notify "$tmp/term.txt" 200000 30 --term-after-ready 1 -- "${serve[@]}"
+notify "$tmp/term.txt" 200000 30 --term-after-ready 1 -- "${serve[@]}" &
+# A clean stop whose exit is slow (the summary written on a loaded machine):
+# the figure is released, and the watchdog is fed until the process exits.
+ANIMRT_TEST_SLOW_EXIT_S=1.5 notify "$tmp/slow.txt" 200000 30 --term-after-ready 0.3 -- "${serve[@]}" &
+# The loop stalls 2.5 s after the run began: the pings stop, the process lives on.
+ANIMRT_TEST_STALL_LOOP_AFTER_S=2.5 notify "$tmp/stall.txt" 200000 6 -- "${serve[@]}" &
+wait
+
 log=$(cat "$tmp/term.txt")
 ready=$(at "$tmp/term.txt" READY=1)
 [[ -n $ready ]] || fail "no READY=1: $log"
@@ -38,9 +47,7 @@ stopping=$(at "$tmp/term.txt" STOPPING=1)
 grep -q " exit 0$" "$tmp/term.txt" || fail "SIGTERM did not end the service with exit 0: $log"
 [[ $(grep -c "READY=1\|STOPPING=1" "$tmp/term.txt") == 2 ]] || fail "sent twice: $log"
 
-# A clean stop whose exit is slow (the summary written on a loaded machine):
-# the figure is released, and the watchdog is fed until the process exits.
-ANIMRT_TEST_SLOW_EXIT_S=1.5 notify "$tmp/slow.txt" 200000 30 --term-after-ready 0.3 -- "${serve[@]}"
+# The slow exit.
 log=$(cat "$tmp/slow.txt")
 grep -q " exit 0$" "$tmp/slow.txt" || fail "slow exit: not ended with exit 0: $log"
 exited=$(at "$tmp/slow.txt" exit)
@@ -48,8 +55,7 @@ last=$(awk '$2 == "WATCHDOG=1" { t = $1 } END { print t }' "$tmp/slow.txt")
 awk -v t="$last" -v e="$exited" 'BEGIN { exit !(t != "" && e - t < 0.75) }' ||
   fail "slow exit: no watchdog ping in the last 0.75 s before the exit: $log"
 
-# The loop stalls 2.5 s after the run began: the pings stop, the process lives on.
-ANIMRT_TEST_STALL_LOOP_AFTER_S=2.5 notify "$tmp/stall.txt" 200000 6 -- "${serve[@]}"
+# The stalled loop.
 log=$(cat "$tmp/stall.txt")
 ready=$(at "$tmp/stall.txt" READY=1)
 [[ -n $ready ]] || fail "stall: no READY=1 before the stall (a loaded machine?): $log"

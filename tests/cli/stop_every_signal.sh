@@ -18,8 +18,22 @@ trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; [[ -n $cat_pid ]] && kill $c
 start_sim
 expect_torque_off "before any run"
 
+# What a signal starts is the same stop request whether the walk winds down
+# first or not; the wind-down only adds its two strides to every stop. So
+# SIGTERM (systemd's stop) and the second-signal case below stop the walking
+# figure as it is, winding its walk down, and every other signal stops a
+# copy whose stop deadline leaves the wind-down no room (2 s of settling
+# after the 0.5 s ramp): it ramps home at once, as every stop did before
+# walks wound down.
+walking=$robot
+no_wind_down=$tmp/quadruped_no_wind_down.yaml
+sed -E "s|^(safety:)$|\1\n  stop_deadline_s: 2.5|" "$walking" > "$no_wind_down"
+grep -q "^  stop_deadline_s: 2.5$" "$no_wind_down" || fail "could not set the stop deadline: $(head -30 "$no_wind_down")"
+
 # The motion has started (the start ramp is 0.5 s) when the signal comes.
 for sig in HUP INT TERM QUIT USR1 USR2 ALRM VTALRM PROF XCPU XFSZ; do
+  robot=$no_wind_down
+  [[ $sig == TERM ]] && robot=$walking
   start_figure
   sleep 0.8
   kill -$sig $pid
@@ -32,6 +46,8 @@ for sig in HUP INT TERM QUIT USR1 USR2 ALRM VTALRM PROF XCPU XFSZ; do
   grep -q "deactivate: torque off" "$tmp/err.txt" || fail "SIG$sig: $(cat "$tmp/err.txt")"
   expect_torque_off "SIG$sig"
 done
+
+robot=$no_wind_down
 
 # SIGPIPE: stderr goes to a reader that leaves (a closed terminal's pipe,
 # `2>&1 | head`); the signal is a stop, not a silent death.
@@ -64,7 +80,9 @@ grep -q "ended by stop request" "$tmp/out.txt" || fail "SIGPIPE: $(head -3 "$tmp
 grep -q "TORQUE CUT" "$tmp/out.txt" && fail "SIGPIPE cut torque: $(head -3 "$tmp/out.txt")"
 expect_torque_off "SIGPIPE"
 
-# A second signal, of another kind than the first, cuts torque at once.
+# A second signal, of another kind than the first, cuts torque at once,
+# here during the walk's wind-down.
+robot=$walking
 start_figure
 sleep 0.8
 kill -HUP $pid
