@@ -254,6 +254,13 @@ class LayeredSource final : public MotionSource {
   void control(const ShowCommand& command, double t) override {
     for (const auto& l : layers_) l->control(command, t);
   }
+  // A steered gait under a show's head moves is steered as on its own.
+  void steer(const MotionCommand& command) override {
+    for (const auto& l : layers_) l->steer(command);
+  }
+  void sense(const Sensors& sensors) override {
+    for (const auto& l : layers_) l->sense(sensors);
+  }
   void start(const MotionClock& clock) override {
     for (const auto& l : layers_) l->start(clock);
   }

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Ctrl-C on a run of the simulated quadruped: the first SIGINT ramps home and
-# exits 0; a second one switches torque off at once and exits 5, saying so.
-# A stop from the dashboard is not a first Ctrl-C: one SIGINT during its
-# ramp leaves the ramp to finish.
+# Ctrl-C on a run of the simulated quadruped: the first SIGINT winds the walk
+# down, ramps home and exits 0; a second one switches torque off at once and
+# exits 5, saying so. A stop from the dashboard is not a first Ctrl-C: one
+# SIGINT during its stop (the wind-down, then the ramp) leaves it to finish.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -12,8 +12,9 @@ trap '[[ -n $pid ]] && kill -KILL $pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 # The shipped quadruped with a short start ramp (its files made absolute):
-# the motion is under way sooner. The stop ramp stays as shipped (2 s), so
-# a second signal 0.3 s into it still finds it running. Slack for a busy
+# the motion is under way sooner. The stop stays as shipped (the walk's
+# wind-down, then a 2 s ramp), so a second signal 0.3 s into it still finds
+# it running. Slack for a busy
 # machine, as in figure_on_sim.bash: only a signal may end these runs,
 # never a late answer.
 here=$(cd "$root/configs/robots" && pwd)

@@ -178,6 +178,8 @@ class ClockCounter final : public MotionSource {
     start_ns = clock.start;
   }
   void stop() override { ++stops; }
+  void steer(const MotionCommand& command) override { steered = command; }
+  void sense(const Sensors& sensors) override { sensed = &sensors; }
   double wind_down(double t, double granted_s) override {
     wound_at = t;
     return std::min(wind, granted_s);
@@ -186,7 +188,31 @@ class ClockCounter final : public MotionSource {
   Nanos start_ns = -1;
   double wind = 0.0;  // what wind_down() asks for (s)
   double wound_at = -1.0;
+  MotionCommand steered{-1.0, -1.0};
+  const Sensors* sensed = nullptr;
 };
+
+// The herd's or the dashboard's steering, and the cycle's sensor readings,
+// reach every layer (a steered walk under a show's head moves).
+TEST(Show, LayersPassSteeringAndSensorsToEveryLayer) {
+  std::vector<std::unique_ptr<MotionSource>> layers;
+  auto a = std::make_unique<ClockCounter>();
+  auto b = std::make_unique<ClockCounter>();
+  ClockCounter* pa = a.get();
+  ClockCounter* pb = b.get();
+  layers.push_back(std::move(a));
+  layers.push_back(load_show_source(write("st.yaml", kShow), joints()));
+  layers.push_back(std::move(b));
+  auto s = make_layered_source(std::move(layers));
+  s->steer(MotionCommand{0.3, -0.2});
+  const Sensors sensors{};
+  s->sense(sensors);
+  for (const ClockCounter* c : {pa, pb}) {
+    EXPECT_DOUBLE_EQ(c->steered.speed_m_s, 0.3);
+    EXPECT_DOUBLE_EQ(c->steered.turn_rad_s, -0.2);
+    EXPECT_EQ(c->sensed, &sensors);
+  }
+}
 
 // A stop winds every layer down at once (a walk under a show): the layered
 // source asks for the longest, and a show layer asks for none.
