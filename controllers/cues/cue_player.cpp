@@ -109,6 +109,18 @@ void CuePlayer::stop() {
   }
 }
 
+void CuePlayer::steer(const MotionCommand& command) {
+  for (Cue& cue : cues_) {
+    for (CueStep& step : cue.steps) step.source->steer(command);
+  }
+}
+
+void CuePlayer::sense(const Sensors& sensors) {
+  for (Cue& cue : cues_) {
+    for (CueStep& step : cue.steps) step.source->sense(sensors);
+  }
+}
+
 const CueStep& CuePlayer::step_of(const Layer& layer) const {
   return cues_[static_cast<std::size_t>(layer.cue)].steps[static_cast<std::size_t>(layer.step)];
 }

@@ -182,6 +182,47 @@ struct TwoPoses {
   }
 };
 
+// A motion that keeps the steering and sensor readings it was last given.
+class Listens final : public MotionSource {
+ public:
+  std::span<const int> driven_joints() const override { return driven_; }
+  void sample(double, std::span<double> targets) const override { targets[0] = 0.0; }
+  void steer(const MotionCommand& command) override { steered = command; }
+  void sense(const Sensors& sensors) override { sensed = &sensors; }
+  MotionCommand steered{-1.0, -1.0};
+  const Sensors* sensed = nullptr;
+
+ private:
+  std::vector<int> driven_{0};
+};
+
+// The herd's or the dashboard's steering and the trunk's IMU reach a cue's
+// walk, the one playing and the one that will (a steered or balanced gait).
+TEST(Crossfade, EveryCuesMotionIsSteeredAndSensesAsItWouldAlone) {
+  const RobotConfig robot = load_robot_config(kFadeRoot + "/configs/robots/animatronic.yaml");
+  CueRequests requests;
+  std::vector<Cue> cues(2);
+  auto a = std::make_unique<Listens>();
+  auto b = std::make_unique<Listens>();
+  const Listens* pa = a.get();
+  const Listens* pb = b.get();
+  cues[0].name = "rest";
+  cues[0].steps.push_back({std::move(a), kForever});
+  cues[1].name = "walk";
+  cues[1].steps.push_back({std::move(b), kForever});
+  CuePlayer player(std::move(cues), 0, robot.joints, requests);
+  std::vector<double> pose(robot.joints.size(), 0.0);
+  player.sample(0.0, pose);
+  player.steer(MotionCommand{0.4, 0.1});
+  const Sensors sensors{};
+  player.sense(sensors);
+  for (const Listens* l : {pa, pb}) {
+    EXPECT_DOUBLE_EQ(l->steered.speed_m_s, 0.4);
+    EXPECT_DOUBLE_EQ(l->steered.turn_rad_s, 0.1);
+    EXPECT_EQ(l->sensed, &sensors);
+  }
+}
+
 TEST(Crossfade, TakesTheCuesTimeWhenTheLimitsAllowIt) {
   TwoPoses f(2.0);
   f.at(0.0);

@@ -94,6 +94,10 @@ class CuePlayer final : public MotionSource {
   void sample(double t, std::span<double> targets) const override;
   void start(const MotionClock& clock) override;
   void stop() override;
+  // Steering and the cycle's sensor readings reach every cue's motion, so a
+  // steered or balanced walk has them whenever it plays.
+  void steer(const MotionCommand& command) override;
+  void sense(const Sensors& sensors) override;
   // At a stop, what plays winds down (a walking cue eases to a stand) and
   // no other cue or step starts; a pause eases to rest instead, and a cue
   // that is paused already asks for nothing.
