@@ -192,18 +192,34 @@ class ClockCounter final : public MotionSource {
   const Sensors* sensed = nullptr;
 };
 
+// Two recording layers around a show layer, as a walk under a show's head
+// moves is layered; `a` and `b` point at the recording ones.
+struct ThreeLayers {
+  ClockCounter* a = nullptr;
+  ClockCounter* b = nullptr;
+  std::unique_ptr<MotionSource> source;
+  ThreeLayers(const std::string& show_file, double wind_a = 0.0, double wind_b = 0.0) {
+    std::vector<std::unique_ptr<MotionSource>> layers;
+    auto first = std::make_unique<ClockCounter>();
+    auto last = std::make_unique<ClockCounter>();
+    first->wind = wind_a;
+    last->wind = wind_b;
+    a = first.get();
+    b = last.get();
+    layers.push_back(std::move(first));
+    layers.push_back(load_show_source(write(show_file, kShow), joints()));
+    layers.push_back(std::move(last));
+    source = make_layered_source(std::move(layers));
+  }
+};
+
 // The herd's or the dashboard's steering, and the cycle's sensor readings,
 // reach every layer (a steered walk under a show's head moves).
 TEST(Show, LayersPassSteeringAndSensorsToEveryLayer) {
-  std::vector<std::unique_ptr<MotionSource>> layers;
-  auto a = std::make_unique<ClockCounter>();
-  auto b = std::make_unique<ClockCounter>();
-  ClockCounter* pa = a.get();
-  ClockCounter* pb = b.get();
-  layers.push_back(std::move(a));
-  layers.push_back(load_show_source(write("st.yaml", kShow), joints()));
-  layers.push_back(std::move(b));
-  auto s = make_layered_source(std::move(layers));
+  ThreeLayers l("st.yaml");
+  const auto& s = l.source;
+  ClockCounter* pa = l.a;
+  ClockCounter* pb = l.b;
   s->steer(MotionCommand{0.3, -0.2});
   const Sensors sensors{};
   s->sense(sensors);
@@ -217,17 +233,10 @@ TEST(Show, LayersPassSteeringAndSensorsToEveryLayer) {
 // A stop winds every layer down at once (a walk under a show): the layered
 // source asks for the longest, and a show layer asks for none.
 TEST(Show, LayersWindDownTogetherForAsLongAsTheSlowestAsks) {
-  std::vector<std::unique_ptr<MotionSource>> layers;
-  auto a = std::make_unique<ClockCounter>();
-  auto b = std::make_unique<ClockCounter>();
-  a->wind = 1.5;
-  b->wind = 2.5;
-  ClockCounter* pa = a.get();
-  ClockCounter* pb = b.get();
-  layers.push_back(std::move(a));
-  layers.push_back(load_show_source(write("w.yaml", kShow), joints()));
-  layers.push_back(std::move(b));
-  auto s = make_layered_source(std::move(layers));
+  ThreeLayers l("w.yaml", 1.5, 2.5);
+  const auto& s = l.source;
+  ClockCounter* pa = l.a;
+  ClockCounter* pb = l.b;
   EXPECT_DOUBLE_EQ(s->wind_down(4.0, kShowAmpleS), 2.5);
   EXPECT_DOUBLE_EQ(pa->wound_at, 4.0);
   EXPECT_DOUBLE_EQ(pb->wound_at, 4.0);
@@ -236,15 +245,10 @@ TEST(Show, LayersWindDownTogetherForAsLongAsTheSlowestAsks) {
 }
 
 TEST(Show, LayersPassTheRunsClockToEveryLayer) {
-  std::vector<std::unique_ptr<MotionSource>> layers;
-  auto a = std::make_unique<ClockCounter>();
-  auto b = std::make_unique<ClockCounter>();
-  ClockCounter* pa = a.get();
-  ClockCounter* pb = b.get();
-  layers.push_back(std::move(a));
-  layers.push_back(load_show_source(write("d.yaml", kShow), joints()));
-  layers.push_back(std::move(b));
-  auto s = make_layered_source(std::move(layers));
+  ThreeLayers l("d.yaml");
+  const auto& s = l.source;
+  ClockCounter* pa = l.a;
+  ClockCounter* pb = l.b;
   const ManualClock clock(7);
   s->start(MotionClock{&clock, 42, true});
   s->stop();
