@@ -8,6 +8,7 @@
 
 #include <numbers>
 
+#include "animrt/learn/seqnet/dense_kernel.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 #include "animrt/learn/seqnet/shapes.hpp"
@@ -178,6 +179,32 @@ TEST(SeqTrainingStep, FusedConvolutionSplitBetweenThreadsComputesWhatItsLayersDo
   expect_fused_equals_plain(bar, 16, false, true);
   expect_fused_equals_plain(bar, 5, true, true);
   torch::set_num_threads(1);
+}
+
+// The dense layers' loops on [K, B] against libtorch's product: W x + b
+// and W^T g (W packed by its transpose's strides), 21 output rows (two
+// blocks and a partial one) at a batch of a whole vector and five more.
+TEST(SeqTrainingStep, BatchInnerDenseProductsComputeWhatLibtorchDoes) {
+  torch::manual_seed(17);
+  const int rows = 21, cols = 37, batch = 21;
+  const torch::Tensor w = torch::rand({rows, cols}) - 0.5;
+  const torch::Tensor bias = torch::rand({rows});
+  const torch::Tensor x = torch::rand({cols, batch}) - 0.5, g = torch::rand({rows, batch}) - 0.5;
+  const auto blocks = (rows + kDenseRows - 1) / kDenseRows;
+  const auto t_blocks = (cols + kDenseRows - 1) / kDenseRows;
+  std::vector<float> packed(dense_packed_size(rows, cols)), t_packed(dense_packed_size(cols, rows));
+  pack_dense_rows(w.data_ptr<float>(), rows, cols, cols, 1, packed.data());
+  pack_dense_rows(w.data_ptr<float>(), cols, rows, 1, cols, t_packed.data());
+  torch::Tensor y = torch::full({rows, batch}, 7.0F), gx = torch::full({cols, batch}, 7.0F);
+  // In two calls, as two threads split the blocks.
+  dense_batch_inner(packed.data(), bias.data_ptr<float>(), x.data_ptr<float>(), rows, cols, batch,
+                    y.data_ptr<float>(), 0, 1);
+  dense_batch_inner(packed.data(), bias.data_ptr<float>(), x.data_ptr<float>(), rows, cols, batch,
+                    y.data_ptr<float>(), 1, blocks);
+  dense_batch_inner(t_packed.data(), nullptr, g.data_ptr<float>(), cols, rows, batch,
+                    gx.data_ptr<float>(), 0, t_blocks);
+  EXPECT_LT(worst_relative(y, torch::addmm(bias.unsqueeze(1), w, x)), 1e-6);
+  EXPECT_LT(worst_relative(gx, torch::mm(w.t(), g)), 1e-6);
 }
 
 // The rows of a sparse matrix as the kernel walks them: columns ascending,

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/dense_kernel.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
 namespace animrt::seqnet {
@@ -280,10 +281,16 @@ torch::Tensor run_vertices_first(torch::nn::Sequential& layers, torch::Tensor h)
 torch::Tensor SeqNetImpl::encoded(const torch::Tensor& x) {
   const std::int64_t batch = x.size(0);
   if (shape_.kind != ModelKind::mesh) return encoder->forward(x);
-  // [V, C, B] through the convolutions, back to [B, V C] for the dense
-  // layers.
+  // Back to [B, V C] for the dense layers.
+  return encoded_batch_inner(x).view({shape_.nodes(), -1, batch}).permute({2, 0, 1}).reshape(
+      {batch, -1});
+}
+
+torch::Tensor SeqNetImpl::encoded_batch_inner(const torch::Tensor& x) {
+  // [V, C, B] through the convolutions.
+  const std::int64_t batch = x.size(0);
   torch::Tensor h = x.view({batch, shape_.nodes(), 9}).permute({1, 2, 0}).contiguous();
-  return run_vertices_first(encoder, h).permute({2, 0, 1}).reshape({batch, -1});
+  return run_vertices_first(encoder, h).view({-1, batch});
 }
 
 std::pair<torch::Tensor, torch::Tensor> SeqNetImpl::encode(const torch::Tensor& x) {
@@ -303,6 +310,71 @@ torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
   return run_vertices_first(decoder, h).permute({2, 0, 1}).reshape({batch, -1});
 }
 
+torch::Tensor SeqNetImpl::decode_batch_inner(const torch::Tensor& dense) {
+  const std::int64_t batch = dense.size(1);
+  const torch::Tensor h = Squash::apply(dense).view({shape_.nodes(), shape_.channels, batch});
+  return run_vertices_first(decoder, h).permute({2, 0, 1}).reshape({batch, -1});
+}
+
+namespace {
+
+// A dense layer's weight W (out x in) packed for dense_kernel.hpp's
+// products: W for forward, W^T for the input's gradient.
+struct DensePack : torch::CustomClassHolder {
+  int out = 0, in = 0;
+  std::vector<float> forward, backward;
+};
+
+c10::intrusive_ptr<DensePack> pack_dense(const torch::Tensor& weight) {
+  const torch::Tensor w = weight.detach().contiguous();
+  auto p = c10::make_intrusive<DensePack>();
+  p->out = static_cast<int>(w.size(0));
+  p->in = static_cast<int>(w.size(1));
+  p->forward.resize(dense_packed_size(p->out, p->in));
+  p->backward.resize(dense_packed_size(p->in, p->out));
+  pack_dense_rows(w.data_ptr<float>(), p->out, p->in, p->in, 1, p->forward.data());
+  pack_dense_rows(w.data_ptr<float>(), p->in, p->out, 1, p->in, p->backward.data());
+  return p;
+}
+
+constexpr std::int64_t kDenseGrain = 4;  // blocks of output rows a thread takes at least
+
+// y = W x + b on x [in, B] (the batch innermost) to y [out, B], with W and
+// b outside autograd (their gradients are the tape's); x's gradient W^T g.
+struct BatchInnerDense : torch::autograd::Function<BatchInnerDense> {
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& x,
+                               const torch::Tensor& bias, const c10::intrusive_ptr<DensePack>& w) {
+    TORCH_CHECK(x.dim() == 2 && x.size(0) == w->in && x.scalar_type() == torch::kFloat32,
+                "dense layer: x must be float [in, B]");
+    const torch::Tensor xc = x.contiguous(), b = bias.detach().contiguous();
+    const auto batch = static_cast<int>(x.size(1));
+    torch::Tensor y = torch::empty({w->out, batch}, x.options());
+    const auto blocks = (w->out + kDenseRows - 1) / kDenseRows;
+    at::parallel_for(0, blocks, kDenseGrain, [&](std::int64_t first, std::int64_t last) {
+      dense_batch_inner(w->forward.data(), b.data_ptr<float>(), xc.data_ptr<float>(), w->out,
+                        w->in, batch, y.data_ptr<float>(), static_cast<int>(first),
+                        static_cast<int>(last));
+    });
+    ctx->saved_data["w"] = c10::IValue::make_capsule(w);
+    return y;
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grad) {
+    const auto w = c10::static_intrusive_pointer_cast<DensePack>(ctx->saved_data["w"].toCapsule());
+    const torch::Tensor g = grad[0].contiguous();
+    const auto batch = static_cast<int>(g.size(1));
+    torch::Tensor gx = torch::empty({w->in, batch}, g.options());
+    const auto blocks = (w->in + kDenseRows - 1) / kDenseRows;
+    at::parallel_for(0, blocks, kDenseGrain, [&](std::int64_t first, std::int64_t last) {
+      dense_batch_inner(w->backward.data(), nullptr, g.data_ptr<float>(), w->in, w->out, batch,
+                        gx.data_ptr<float>(), static_cast<int>(first), static_cast<int>(last));
+    });
+    return {gx, torch::Tensor(), torch::Tensor()};
+  }
+};
+
+}  // namespace
+
 // Inputs and output gradients of one dense layer over the steps of a run.
 struct DenseTape {
   std::vector<torch::Tensor> inputs, grads;
@@ -317,6 +389,21 @@ struct DenseTape {
     std::weak_ptr<DenseTape> tape = self;
     y.register_hook([tape, slot](const torch::Tensor& g) {
       if (auto t = tape.lock()) t->grads[slot] = g;
+    });
+    return y;
+  }
+
+  // The same on x [in, B] to [out, B] (the batch innermost), W packed.
+  torch::Tensor apply_batch_inner(const std::shared_ptr<DenseTape>& self, const torch::Tensor& x,
+                                  const c10::intrusive_ptr<DensePack>& weight,
+                                  const torch::Tensor& bias) {
+    torch::Tensor y = BatchInnerDense::apply(x, bias, weight);
+    const std::size_t slot = inputs.size();
+    inputs.push_back(x.detach().t());
+    grads.emplace_back();
+    std::weak_ptr<DenseTape> tape = self;
+    y.register_hook([tape, slot](const torch::Tensor& g) {
+      if (auto t = tape.lock()) t->grads[slot] = g.t();
     });
     return y;
   }
@@ -399,12 +486,27 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   }
   const torch::Tensor weight = torch::cat({to_mu->weight, to_logvar->weight});
   const torch::Tensor bias = torch::cat({to_mu->bias, to_logvar->bias});
+  // A mesh model's taped steps run the dense layers on the batch-innermost
+  // activations of the convolutions, by the loops of dense_kernel.hpp.
+  const bool inner = tape && shape_.kind == ModelKind::mesh;
+  c10::intrusive_ptr<DensePack> latent_pack, hidden_pack;
+  if (inner) {
+    latent_pack = pack_dense(weight);
+    hidden_pack = pack_dense(from_hidden->weight);
+  }
   for (int t = 1; t < n; ++t) {
-    const torch::Tensor h = encoded(x);
-    const std::vector<torch::Tensor> latent =
-        (tape ? latent_tape->apply(latent_tape, h, weight, bias)
-              : torch::addmm(bias, h, weight.t()))
-            .chunk(2, 1);
+    torch::Tensor latent_out;
+    if (inner) {
+      latent_out =
+          latent_tape->apply_batch_inner(latent_tape, encoded_batch_inner(x), latent_pack, bias)
+              .t()
+              .contiguous();
+    } else {
+      const torch::Tensor h = encoded(x);
+      latent_out =
+          tape ? latent_tape->apply(latent_tape, h, weight, bias) : torch::addmm(bias, h, weight.t());
+    }
+    const std::vector<torch::Tensor> latent = latent_out.chunk(2, 1);
     const torch::Tensor& mu = latent[0];
     const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
@@ -412,10 +514,17 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
     auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
     state = next_state;
     const torch::Tensor o = out.squeeze(0);
-    const torch::Tensor generated =
-        x + (tape ? decode_from(
-                        hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias))
-                  : decode(o));
+    torch::Tensor change;
+    if (inner) {
+      change = decode_batch_inner(hidden_tape->apply_batch_inner(
+          hidden_tape, o.t().contiguous(), hidden_pack, from_hidden->bias));
+    } else if (tape) {
+      change = decode_from(
+          hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias));
+    } else {
+      change = decode(o);
+    }
+    const torch::Tensor generated = x + change;
     x = t < u ? given[t] : generated;
     frames.push_back(x);
     mus.push_back(mu);

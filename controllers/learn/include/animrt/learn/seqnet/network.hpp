@@ -88,6 +88,11 @@ class SeqNetImpl : public torch::nn::Module {
   torch::Tensor decode(const torch::Tensor& h);
   // The same from the decoder's first dense layer's output (before tanh).
   torch::Tensor decode_from(const torch::Tensor& dense);
+  // A mesh model's encoder output with the batch innermost, [V C, B], and
+  // the decoder from the dense layer's output so laid out, [V C, B] ->
+  // [B, D]: what the training step's dense products take and give.
+  torch::Tensor encoded_batch_inner(const torch::Tensor& x);
+  torch::Tensor decode_batch_inner(const torch::Tensor& dense);
   // Every state entry sign * s0 (sign +1 forward, -1 backward).
   LstmState initial_state(int batch, double sign) const;
   // Runs the chain from `given` ([u, B, D], u >= 1) to n frames: the given
