@@ -1,4 +1,5 @@
-// The grid's neighbour search against a scan of all pairs.
+// The grid's neighbour search (and its any-point test) against a scan of
+// all pairs.
 
 #include "animrt/controllers/herd/spatial_grid.hpp"
 
@@ -66,6 +67,7 @@ TEST(SpatialGrid, QueriesEqualAllPairsOnRandomSets) {
           g.query(p, r, got);
           std::sort(got.begin(), got.end());
           ASSERT_EQ(got, brute(pts, p, r)) << "n " << n << " r " << r << " cell " << r * cell_scale;
+          ASSERT_EQ(g.any_within(p, r), !got.empty()) << "n " << n << " r " << r;
         }
         for (int i = 0; i < n; i += std::max(1, n / 50)) {
           g.query_near(i, r, got);

@@ -37,7 +37,18 @@ class SpatialGrid {
 
   // Calls f(j, d2) for every point j with |p_j - p| <= r, d2 = |p_j - p|^2.
   template <class F>
-  void for_each_within(Vec2 p, double r, F&& f) const;
+  void for_each_within(Vec2 p, double r, F&& f) const {
+    visit_within(p, r, [&](int j, double d2) {
+      f(j, d2);
+      return false;
+    });
+  }
+
+  // Whether any point lies within r of p (the query of for_each_within,
+  // stopping at the first point it finds).
+  bool any_within(Vec2 p, double r) const {
+    return visit_within(p, r, [](int, double) { return true; });
+  }
 
   // As for_each_within around point i's position, leaving i itself out.
   template <class F>
@@ -61,6 +72,10 @@ class SpatialGrid {
   Cell cell_of(Vec2 p) const;
   std::size_t bucket_of(Cell c) const;
   void sort_into_buckets();
+  // Calls f(j, d2) for the points within r of p, in query order, until f
+  // returns true; returns whether it did.
+  template <class F>
+  bool visit_within(Vec2 p, double r, F&& f) const;
 
   double cell_ = 1.0;
   std::size_t mask_ = 0;              // table size - 1 (a power of two)
@@ -78,8 +93,8 @@ class SpatialGrid {
 inline constexpr std::int64_t kGridCoordLimit = std::int64_t{1} << 40;
 
 template <class F>
-void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
-  if (pos_.empty() || !(r >= 0.0) || !std::isfinite(p.x) || !std::isfinite(p.y)) return;
+bool SpatialGrid::visit_within(Vec2 p, double r, F&& f) const {
+  if (pos_.empty() || !(r >= 0.0) || !std::isfinite(p.x) || !std::isfinite(p.y)) return false;
   const double r2 = r * r;
   // Widened by a hair so that rounding in p +- r never drops a border cell.
   const double w = r * (1.0 + 1e-12) + 1e-12 * (std::abs(p.x) + std::abs(p.y));
@@ -91,9 +106,9 @@ void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
     // The disc covers more cells than there are points: a scan is cheaper.
     for (std::size_t j = 0; j < pos_.size(); ++j) {
       const double d2 = norm2(pos_[j] - p);
-      if (d2 <= r2) f(static_cast<int>(j), d2);
+      if (d2 <= r2 && f(static_cast<int>(j), d2)) return true;
     }
-    return;
+    return false;
   }
   for (std::int64_t cy = lo.y; cy <= hi.y; ++cy) {
     for (std::int64_t cx = lo.x; cx <= hi.x; ++cx) {
@@ -102,10 +117,11 @@ void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
       for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) {
         if (!(sorted_cell_[k] == c)) continue;  // another cell hashed here
         const double d2 = norm2(sorted_pos_[k] - p);
-        if (d2 <= r2) f(sorted_[k], d2);
+        if (d2 <= r2 && f(sorted_[k], d2)) return true;
       }
     }
   }
+  return false;
 }
 
 }  // namespace animrt::herd
