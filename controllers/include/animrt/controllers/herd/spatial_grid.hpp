@@ -1,7 +1,10 @@
 #pragma once
 // Neighbour search on the ground plane: a uniform grid of square cells,
 // hashed into a fixed table so that any position (however far out) has a
-// cell and memory depends only on the number of points.
+// cell and memory depends only on the number of points. Points that span
+// few cells (at most 8 per table bucket) are laid out as a dense array of
+// cells instead, row by row, so that a query reads each row of its cells
+// as one run without hashing; the results are the same either way.
 //
 // build() sorts the points into the table by counting sort (stable, so a
 // cell lists its points in index order) and reuses its arrays: once it has
@@ -11,6 +14,7 @@
 // order of the results depends only on the positions, the cell size and the
 // radius.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -72,6 +76,7 @@ class SpatialGrid {
   Cell cell_of(Vec2 p) const;
   std::size_t bucket_of(Cell c) const;
   void sort_into_buckets();
+  void sort_into_cells();  // the dense layout
   // Calls f(j, d2) for the points within r of p, in query order, until f
   // returns true; returns whether it did.
   template <class F>
@@ -79,11 +84,14 @@ class SpatialGrid {
 
   double cell_ = 1.0;
   std::size_t mask_ = 0;              // table size - 1 (a power of two)
+  bool dense_ = false;                // cells laid out row by row, not hashed
+  std::int64_t xmin_ = 0, ymin_ = 0;  // dense: the first cell
+  std::int64_t width_ = 0, height_ = 0;
   std::vector<Vec2> pos_;             // input order
   std::vector<Cell> cell_idx_;        // input order
-  std::vector<std::uint32_t> start_;  // bucket b holds sorted_[start_[b], start_[b+1])
-  std::vector<int> sorted_;           // point indices, grouped by bucket
-  std::vector<Cell> sorted_cell_;     // their cells
+  std::vector<std::uint32_t> start_;  // bucket (dense: cell) b holds sorted_[start_[b], start_[b+1])
+  std::vector<int> sorted_;           // point indices, grouped by bucket or cell
+  std::vector<Cell> sorted_cell_;     // their cells (hashed layout)
   std::vector<Vec2> sorted_pos_;      // their positions
 };
 
@@ -107,6 +115,21 @@ bool SpatialGrid::visit_within(Vec2 p, double r, F&& f) const {
     for (std::size_t j = 0; j < pos_.size(); ++j) {
       const double d2 = norm2(pos_[j] - p);
       if (d2 <= r2 && f(static_cast<int>(j), d2)) return true;
+    }
+    return false;
+  }
+  if (dense_) {
+    // The same cells in the same order: each row's cells lie side by side.
+    const std::int64_t xa = std::max(lo.x, xmin_), xb = std::min(hi.x, xmin_ + width_ - 1);
+    const std::int64_t ya = std::max(lo.y, ymin_), yb = std::min(hi.y, ymin_ + height_ - 1);
+    if (xa > xb) return false;
+    for (std::int64_t cy = ya; cy <= yb; ++cy) {
+      const auto row = static_cast<std::size_t>((cy - ymin_) * width_);
+      const std::uint32_t to = start_[row + static_cast<std::size_t>(xb - xmin_) + 1];
+      for (std::uint32_t k = start_[row + static_cast<std::size_t>(xa - xmin_)]; k < to; ++k) {
+        const double d2 = norm2(sorted_pos_[k] - p);
+        if (d2 <= r2 && f(sorted_[k], d2)) return true;
+      }
     }
     return false;
   }
