@@ -220,9 +220,9 @@ class CrowdGroup final : public GroupSteering {
   std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
-  std::vector<bool> frontier_;  // free slots that may be taken next
-  std::vector<int> open_;       // free frontier slots, in index order
-  std::vector<int> taken_;      // taken slots
+  std::vector<bool> frontier_;        // free slots that may be taken next
+  std::vector<int> open_;             // free frontier slots, in index order
+  std::vector<int> taken_;            // taken slots
   std::vector<std::size_t> to_slot_;  // scratch: the members heading for a slot, in order
   std::vector<std::vector<int>> neighbours_;
   double assign_distance_ = 0.0;

@@ -89,7 +89,7 @@ class SpatialGrid {
   std::int64_t width_ = 0, height_ = 0;
   std::vector<Vec2> pos_;             // input order
   std::vector<Cell> cell_idx_;        // input order
-  std::vector<std::uint32_t> start_;  // bucket (dense: cell) b holds sorted_[start_[b], start_[b+1])
+  std::vector<std::uint32_t> start_;  // bucket or cell b: sorted_[start_[b], start_[b+1])
   std::vector<int> sorted_;           // point indices, grouped by bucket or cell
   std::vector<Cell> sorted_cell_;     // their cells (hashed layout)
   std::vector<Vec2> sorted_pos_;      // their positions
