@@ -56,6 +56,7 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   has_target_.assign(agents.size(), false);
   target_.assign(agents.size(), Vec2{});
   synced_.assign(agents.size(), Vec2{});
+  facing_.assign(agents.size(), Vec2{});
   asking_.assign(agents.size(), false);
   was_held_.assign(agents.size(), 0);
   hold_at_.assign(agents.size(), Vec2{});
@@ -179,7 +180,7 @@ void Crowd::sync(int i, const Agent& a) {
       request_current(i);
     }
   }
-  const auto v = NavWorld::to_recast(a.velocity());
+  const auto v = NavWorld::to_recast(facing_[static_cast<std::size_t>(i)] * a.speed);
   dtVcopy(ag->vel, v.data());
   if (!active_[static_cast<std::size_t>(i)]) crowd_->requestMoveVelocity(i, v.data());
 }
@@ -191,6 +192,7 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
   last_t_ = t;
   world_.update(t, agents);
   for (std::size_t i = 0; i < agents.size(); ++i) {
+    facing_[i] = heading_vector(agents[i].heading);  // read again by keep_right
     sync(static_cast<int>(i), agents[i]);
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
@@ -221,10 +223,8 @@ void Crowd::select_participants() {
   if (!member_at_.empty()) members_near_.build(std::span<const Vec2>(member_at_), reach_m_);
   in_update_.clear();
   for (std::size_t i = 0; i < active_.size(); ++i) {
-    bool take = active_[i];
-    if (!take && !member_at_.empty()) {
-      members_near_.for_each_within(synced_[i], reach_m_, [&](int, double) { take = true; });
-    }
+    const bool take =
+        active_[i] || (!member_at_.empty() && members_near_.any_within(synced_[i], reach_m_));
     crowd_->getEditableAgent(static_cast<int>(i))->active = take;
     if (take) in_update_.push_back(static_cast<int>(i));
   }
@@ -344,7 +344,7 @@ Vec2 Crowd::safe_velocity(int i, Vec2 v, std::span<const Agent> agents) const {
   // only turns, in place).
   const dtCrowdAgent* ag = crowd_->getAgent(i);
   const Agent& a = agents[static_cast<std::size_t>(i)];
-  const Vec2 h = heading_vector(a.heading);
+  const Vec2 h = facing_[static_cast<std::size_t>(i)];
   for (int k = 0; k < ag->nneis; ++k) {
     const Agent& b = agents[static_cast<std::size_t>(ag->neis[k].idx)];
     const Vec2 d = b.position - a.position;
@@ -398,7 +398,8 @@ Vec2 Crowd::keep_right(int i, Vec2 v, std::span<const Agent> agents) const {
     const double ahead = dot(d, way);
     // Oncoming: ahead, within range, facing more than 120 degrees away
     // from this way, and in the lane (not already passing to the side).
-    if (ahead <= 0.0 || ahead > range || dot(heading_vector(b.heading), way) > -0.5) continue;
+    if (ahead <= 0.0 || ahead > range || dot(facing_[static_cast<std::size_t>(j)], way) > -0.5)
+      continue;
     if (std::abs(dot(d, right)) >= lane) continue;
     urge = std::max(urge, 1.0 - ahead / range);
   }
@@ -434,6 +435,7 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
     crowd_.request_target(m, params_.target);
   }
   state_.assign(members_.size(), State::kTravelling);
+  to_slot_.reserve(members_.size());
   slot_of_.assign(members_.size(), -1);
   candidate_.assign(members_.size(), -1);
   stall_since_.assign(members_.size(), 0.0);
@@ -595,12 +597,17 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   }
   // A travelling member standing on a slot whose holder has not arrived
   // takes it over, and the holder looks again: otherwise each waits for
-  // the other.
+  // the other. The holders are listed first, in member order, and a member
+  // that takes a slot over joins the list.
+  to_slot_.clear();
   for (std::size_t k = 0; k < members_.size(); ++k) {
+    if (state_[k] == State::kToSlot) to_slot_.push_back(k);
+  }
+  for (std::size_t k = 0; k < members_.size() && !to_slot_.empty(); ++k) {
     if (state_[k] != State::kTravelling) continue;
     const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
-    for (std::size_t j = 0; j < members_.size(); ++j) {
-      if (state_[j] != State::kToSlot) continue;
+    for (const std::size_t j : to_slot_) {
+      if (state_[j] != State::kToSlot) continue;  // it gave its slot up
       const Vec2 slot = slots_[static_cast<std::size_t>(slot_of_[j])];
       const Vec2 q = agents[static_cast<std::size_t>(members_[j])].position;
       if (norm(p - slot) < 0.5 * spacing_ && norm(p - slot) < norm(q - slot)) {
@@ -611,6 +618,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
         candidate_[j] = -1;
         state_[j] = State::kTravelling;
         crowd_.request_target(members_[j], target);
+        const auto at = std::lower_bound(to_slot_.begin(), to_slot_.end(), k);
+        if (at == to_slot_.end() || *at != k) to_slot_.insert(at, k);
         break;
       }
     }

@@ -11,15 +11,16 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
   MotionCommand want;
   const Vec2 h = heading_vector(agent.heading);
   const double error = std::atan2(cross(h, desired), dot(h, desired));
+  const double cos_error = std::cos(error);
   // A figure that cannot turn only walks toward a velocity ahead of it:
   // walking on could never bring it round to one behind.
-  const bool reachable_way = walk.max_turn(walk.min_speed()) > 0.0 || std::cos(error) > 0.0;
+  const bool reachable_way = walk.max_turn(walk.min_speed()) > 0.0 || cos_error > 0.0;
   const bool wants_walk = wanted >= 0.5 * walk.min_speed() && wanted > 1e-9;
   // A figure that can turn on the spot turns there toward a velocity behind
   // it, once it can stop this step, rather than walk a circle into whatever
   // stands before it (a wall, a neighbour).
   const double spot = walk.spot_turn();
-  if (wants_walk && spot > 0.0 && std::cos(error) < 0.0 &&
+  if (wants_walk && spot > 0.0 && cos_error < 0.0 &&
       agent.speed - walk.max_acceleration() * dt < walk.min_speed()) {
     return {0.0, std::clamp(error / kHeadingTimeConstant_s, -spot, spot)};
   }
@@ -27,7 +28,7 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
     // Walk on at no less than the slowest gait while turning toward a
     // velocity behind the figure: a gait turns only while it walks.
     want.speed_m_s =
-        std::clamp(wanted * std::max(std::cos(error), 0.0), walk.min_speed(), walk.max_speed());
+        std::clamp(wanted * std::max(cos_error, 0.0), walk.min_speed(), walk.max_speed());
     const double max_turn = walk.max_turn(want.speed_m_s);
     want.turn_rad_s = std::clamp(error / kHeadingTimeConstant_s, -max_turn, max_turn);
   }

@@ -192,6 +192,9 @@ void Herd::step() {
     grid_.for_each_near(static_cast<int>(i), reach, [&](int j, double) {
       const Agent& other = agents_[static_cast<std::size_t>(j)];
       const double contact = next.radius + other.radius;
+      // Clear of contact by far more than rounding: no need of the exact
+      // distances (most neighbours of the query are).
+      if (norm2(next.position - other.position) > contact * contact * (1 + 1e-9)) return;
       const double before = norm(agents_[i].position - other.position);
       const double after = norm(next.position - other.position);
       if (after < contact && after < before) {

@@ -29,6 +29,7 @@ ReynoldsFlock::ReynoldsFlock(std::vector<int> members, const ReynoldsFlockParams
   validate(params_);
   check_members(members_, "ReynoldsFlock");
   grid_.reserve(std::max(herd_capacity, herd_size_needed(members_)));
+  velocity_.resize(members_.size());
 }
 
 void ReynoldsFlock::steer(double /*t*/, double dt, std::span<const Agent> agents,
@@ -43,9 +44,11 @@ void ReynoldsFlock::steer(double /*t*/, double dt, std::span<const Agent> agents
   if (use_grid) grid_.build(agents, rs);
 
   Vec2 center, flock_vel;
-  for (const int i : members_) {
-    center += agents[static_cast<std::size_t>(i)].position;
-    flock_vel += agents[static_cast<std::size_t>(i)].velocity();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Agent& a = agents[static_cast<std::size_t>(members_[k])];
+    velocity_[k] = a.velocity();
+    center += a.position;
+    flock_vel += velocity_[k];
   }
   if (n > 0) {
     center = center / static_cast<double>(n);
@@ -53,10 +56,11 @@ void ReynoldsFlock::steer(double /*t*/, double dt, std::span<const Agent> agents
   }
   const Vec2 target = target_.position();
 
-  for (const int i : members_) {
+  for (std::size_t k = 0; k < n; ++k) {
+    const int i = members_[k];
     const Agent& a = agents[static_cast<std::size_t>(i)];
     const Vec2 pos = a.position;
-    const Vec2 v = a.velocity();
+    const Vec2 v = velocity_[k];
 
     // Coincident agents give no direction apart and are skipped.
     Vec2 separation;

@@ -19,6 +19,10 @@ std::int64_t coord(double v) {
   return static_cast<std::int64_t>(std::floor(std::clamp(v, -lim, lim)));
 }
 
+// The most cells a dense layout of n points may have: a few times the
+// hashed table, so that the table's array holds either.
+std::size_t dense_cells(std::size_t n) { return 8 * table_size(n); }
+
 }  // namespace
 
 void SpatialGrid::reserve(std::size_t n) {
@@ -27,7 +31,7 @@ void SpatialGrid::reserve(std::size_t n) {
   sorted_.reserve(n);
   sorted_cell_.reserve(n);
   sorted_pos_.reserve(n);
-  start_.reserve(table_size(n) + 1);
+  start_.reserve(dense_cells(n) + 1);
 }
 
 SpatialGrid::Cell SpatialGrid::cell_of(Vec2 p) const {
@@ -66,11 +70,34 @@ void SpatialGrid::sort_into_buckets() {
   const std::size_t t = table_size(n);
   mask_ = t - 1;
   cell_idx_.resize(n);
-  start_.assign(t + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    cell_idx_[i] = cell_of(pos_[i]);
-    ++start_[bucket_of(cell_idx_[i]) + 1];
+  // Either layout fits the arrays of the other: switching allocates nothing.
+  if (start_.capacity() < dense_cells(n) + 1) start_.reserve(dense_cells(n) + 1);
+  if (sorted_cell_.capacity() < n) sorted_cell_.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) cell_idx_[i] = cell_of(pos_[i]);
+  dense_ = false;
+  if (n > 0) {
+    Cell lo = cell_idx_[0], hi = lo;
+    for (const Cell& c : cell_idx_) {
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y)};
+    }
+    // Differences of coordinates within +-(kGridCoordLimit + 1) fit in 64 bits.
+    const double cells =
+        (static_cast<double>(hi.x - lo.x) + 1.0) * (static_cast<double>(hi.y - lo.y) + 1.0);
+    dense_ = cells <= static_cast<double>(dense_cells(n));
+    if (dense_) {
+      xmin_ = lo.x;
+      ymin_ = lo.y;
+      width_ = hi.x - lo.x + 1;
+      height_ = hi.y - lo.y + 1;
+    }
   }
+  if (dense_) {
+    sort_into_cells();
+    return;
+  }
+  start_.assign(t + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++start_[bucket_of(cell_idx_[i]) + 1];
   for (std::size_t b = 0; b < t; ++b) start_[b + 1] += start_[b];
   sorted_.resize(n);
   sorted_cell_.resize(n);
@@ -84,6 +111,27 @@ void SpatialGrid::sort_into_buckets() {
     sorted_pos_[k] = pos_[i];
   }
   for (std::size_t b = t; b > 0; --b) start_[b] = start_[b - 1];
+  start_[0] = 0;
+}
+
+void SpatialGrid::sort_into_cells() {
+  const std::size_t n = pos_.size();
+  const auto cells = static_cast<std::size_t>(width_ * height_);
+  const auto at = [&](Cell c) {
+    return static_cast<std::size_t>((c.y - ymin_) * width_ + (c.x - xmin_));
+  };
+  start_.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++start_[at(cell_idx_[i]) + 1];
+  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+  sorted_.resize(n);
+  sorted_pos_.resize(n);
+  // Stable, as for the buckets: a cell lists its points in index order.
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t k = start_[at(cell_idx_[i])]++;
+    sorted_[k] = static_cast<int>(i);
+    sorted_pos_[k] = pos_[i];
+  }
+  for (std::size_t c = cells; c > 0; --c) start_[c] = start_[c - 1];
   start_[0] = 0;
 }
 

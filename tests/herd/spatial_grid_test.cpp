@@ -1,4 +1,5 @@
-// The grid's neighbour search against a scan of all pairs.
+// The grid's neighbour search (and its any-point test) against a scan of
+// all pairs.
 
 #include "animrt/controllers/herd/spatial_grid.hpp"
 
@@ -66,12 +67,49 @@ TEST(SpatialGrid, QueriesEqualAllPairsOnRandomSets) {
           g.query(p, r, got);
           std::sort(got.begin(), got.end());
           ASSERT_EQ(got, brute(pts, p, r)) << "n " << n << " r " << r << " cell " << r * cell_scale;
+          ASSERT_EQ(g.any_within(p, r), !got.empty()) << "n " << n << " r " << r;
         }
         for (int i = 0; i < n; i += std::max(1, n / 50)) {
           g.query_near(i, r, got);
           std::sort(got.begin(), got.end());
           ASSERT_EQ(got, brute(pts, pts[static_cast<std::size_t>(i)], r, i)) << "point " << i;
         }
+      }
+    }
+  }
+}
+
+TEST(SpatialGrid, DenseAndHashedLayoutsAnswerInTheSameOrder) {
+  // Points in a 24 m square span few cells: a dense layout. One point far
+  // out spans too many for it: the hashed table. Queries near the square
+  // never reach the far point, so both must answer alike, order included.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-12.0, 12.0);
+  for (const double r : {0.3, 1.0, 2.5}) {
+    for (const double cell_scale : {1.0, 0.5, 2.0}) {
+      std::vector<Vec2> pts;
+      for (int i = 0; i < 600; ++i) {
+        Vec2 p{u(rng), u(rng)};
+        if (i % 5 == 1) p = {std::round(p.x / r) * r, std::round(p.y / r) * r};
+        if (i % 5 == 2 && !pts.empty()) p = pts.back();
+        pts.push_back(p);
+      }
+      std::vector<Vec2> with_far = pts;
+      with_far.push_back({3e7, -4e7});
+      SpatialGrid dense, hashed;
+      dense.build(pts, r * cell_scale);
+      hashed.build(with_far, r * cell_scale);
+      std::vector<int> a, b;
+      for (int q = 0; q < 200; ++q) {
+        const Vec2 p = q % 2 == 0 ? pts[static_cast<std::size_t>(q)] : Vec2{u(rng), u(rng)};
+        dense.query(p, r, a);
+        hashed.query(p, r, b);
+        ASSERT_EQ(a, b) << "r " << r << " cell " << r * cell_scale;
+        std::sort(b.begin(), b.end());
+        ASSERT_EQ(b, brute(pts, p, r));
+        dense.query_near(q, r, a);
+        hashed.query_near(q, r, b);
+        ASSERT_EQ(a, b);
       }
     }
   }
@@ -123,7 +161,13 @@ TEST(SpatialGrid, RebuildingDoesNotAllocate) {
   std::vector<int> out;
   out.reserve(1000);
   std::vector<std::vector<Vec2>> sets;
-  for (int k = 0; k < 5; ++k) sets.push_back(points(1000 - k * 100, 0.7, rng));
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (int k = 0; k < 5; ++k) {
+    sets.push_back(points(1000 - k * 100, 0.7, rng));  // far points: hashed
+    std::vector<Vec2> near;                            // a 20 m square: dense
+    for (int i = 0; i < 1000 - k * 150; ++i) near.push_back({u(rng), u(rng)});
+    sets.push_back(near);
+  }
   animrt::test::AllocationCounter c;
   for (const auto& s : sets) {
     g.build(s, 0.7);

@@ -146,6 +146,7 @@ class Crowd {
   std::vector<bool> has_target_;
   std::vector<Vec2> target_;
   std::vector<Vec2> synced_;  // each agent's position before the last crowd update
+  std::vector<Vec2> facing_;  // each agent's heading vector at the last step
   std::unique_ptr<PassageRules> passages_;
   std::unique_ptr<KnotRules> knots_;
   std::vector<char> travelling_;
@@ -219,9 +220,10 @@ class CrowdGroup final : public GroupSteering {
   std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
-  std::vector<bool> frontier_;  // free slots that may be taken next
-  std::vector<int> open_;       // free frontier slots, in index order
-  std::vector<int> taken_;      // taken slots
+  std::vector<bool> frontier_;        // free slots that may be taken next
+  std::vector<int> open_;             // free frontier slots, in index order
+  std::vector<int> taken_;            // taken slots
+  std::vector<std::size_t> to_slot_;  // scratch: the members heading for a slot, in order
   std::vector<std::vector<int>> neighbours_;
   double assign_distance_ = 0.0;
   double spacing_ = 0.0;

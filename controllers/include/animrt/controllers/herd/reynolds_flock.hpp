@@ -70,6 +70,7 @@ class ReynoldsFlock : public GroupSteering {
   std::mt19937_64 rng_;
   NeighbourSearch search_ = NeighbourSearch::grid;
   SpatialGrid grid_;
+  std::vector<Vec2> velocity_;  // scratch: each member's velocity, in member order
 };
 
 }  // namespace animrt::herd

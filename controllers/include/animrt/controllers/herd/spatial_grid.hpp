@@ -1,7 +1,10 @@
 #pragma once
 // Neighbour search on the ground plane: a uniform grid of square cells,
 // hashed into a fixed table so that any position (however far out) has a
-// cell and memory depends only on the number of points.
+// cell and memory depends only on the number of points. Points that span
+// few cells (at most 8 per table bucket) are laid out as a dense array of
+// cells instead, row by row, so that a query reads each row of its cells
+// as one run without hashing; the results are the same either way.
 //
 // build() sorts the points into the table by counting sort (stable, so a
 // cell lists its points in index order) and reuses its arrays: once it has
@@ -11,6 +14,7 @@
 // order of the results depends only on the positions, the cell size and the
 // radius.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -37,7 +41,18 @@ class SpatialGrid {
 
   // Calls f(j, d2) for every point j with |p_j - p| <= r, d2 = |p_j - p|^2.
   template <class F>
-  void for_each_within(Vec2 p, double r, F&& f) const;
+  void for_each_within(Vec2 p, double r, F&& f) const {
+    visit_within(p, r, [&](int j, double d2) {
+      f(j, d2);
+      return false;
+    });
+  }
+
+  // Whether any point lies within r of p (the query of for_each_within,
+  // stopping at the first point it finds).
+  bool any_within(Vec2 p, double r) const {
+    return visit_within(p, r, [](int, double) { return true; });
+  }
 
   // As for_each_within around point i's position, leaving i itself out.
   template <class F>
@@ -61,14 +76,22 @@ class SpatialGrid {
   Cell cell_of(Vec2 p) const;
   std::size_t bucket_of(Cell c) const;
   void sort_into_buckets();
+  void sort_into_cells();  // the dense layout
+  // Calls f(j, d2) for the points within r of p, in query order, until f
+  // returns true; returns whether it did.
+  template <class F>
+  bool visit_within(Vec2 p, double r, F&& f) const;
 
   double cell_ = 1.0;
   std::size_t mask_ = 0;              // table size - 1 (a power of two)
+  bool dense_ = false;                // cells laid out row by row, not hashed
+  std::int64_t xmin_ = 0, ymin_ = 0;  // dense: the first cell
+  std::int64_t width_ = 0, height_ = 0;
   std::vector<Vec2> pos_;             // input order
   std::vector<Cell> cell_idx_;        // input order
-  std::vector<std::uint32_t> start_;  // bucket b holds sorted_[start_[b], start_[b+1])
-  std::vector<int> sorted_;           // point indices, grouped by bucket
-  std::vector<Cell> sorted_cell_;     // their cells
+  std::vector<std::uint32_t> start_;  // bucket or cell b: sorted_[start_[b], start_[b+1])
+  std::vector<int> sorted_;           // point indices, grouped by bucket or cell
+  std::vector<Cell> sorted_cell_;     // their cells (hashed layout)
   std::vector<Vec2> sorted_pos_;      // their positions
 };
 
@@ -78,8 +101,8 @@ class SpatialGrid {
 inline constexpr std::int64_t kGridCoordLimit = std::int64_t{1} << 40;
 
 template <class F>
-void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
-  if (pos_.empty() || !(r >= 0.0) || !std::isfinite(p.x) || !std::isfinite(p.y)) return;
+bool SpatialGrid::visit_within(Vec2 p, double r, F&& f) const {
+  if (pos_.empty() || !(r >= 0.0) || !std::isfinite(p.x) || !std::isfinite(p.y)) return false;
   const double r2 = r * r;
   // Widened by a hair so that rounding in p +- r never drops a border cell.
   const double w = r * (1.0 + 1e-12) + 1e-12 * (std::abs(p.x) + std::abs(p.y));
@@ -91,9 +114,24 @@ void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
     // The disc covers more cells than there are points: a scan is cheaper.
     for (std::size_t j = 0; j < pos_.size(); ++j) {
       const double d2 = norm2(pos_[j] - p);
-      if (d2 <= r2) f(static_cast<int>(j), d2);
+      if (d2 <= r2 && f(static_cast<int>(j), d2)) return true;
     }
-    return;
+    return false;
+  }
+  if (dense_) {
+    // The same cells in the same order: each row's cells lie side by side.
+    const std::int64_t xa = std::max(lo.x, xmin_), xb = std::min(hi.x, xmin_ + width_ - 1);
+    const std::int64_t ya = std::max(lo.y, ymin_), yb = std::min(hi.y, ymin_ + height_ - 1);
+    if (xa > xb) return false;
+    for (std::int64_t cy = ya; cy <= yb; ++cy) {
+      const auto row = static_cast<std::size_t>((cy - ymin_) * width_);
+      const std::uint32_t to = start_[row + static_cast<std::size_t>(xb - xmin_) + 1];
+      for (std::uint32_t k = start_[row + static_cast<std::size_t>(xa - xmin_)]; k < to; ++k) {
+        const double d2 = norm2(sorted_pos_[k] - p);
+        if (d2 <= r2 && f(sorted_[k], d2)) return true;
+      }
+    }
+    return false;
   }
   for (std::int64_t cy = lo.y; cy <= hi.y; ++cy) {
     for (std::int64_t cx = lo.x; cx <= hi.x; ++cx) {
@@ -102,10 +140,11 @@ void SpatialGrid::for_each_within(Vec2 p, double r, F&& f) const {
       for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) {
         if (!(sorted_cell_[k] == c)) continue;  // another cell hashed here
         const double d2 = norm2(sorted_pos_[k] - p);
-        if (d2 <= r2) f(sorted_[k], d2);
+        if (d2 <= r2 && f(sorted_[k], d2)) return true;
       }
     }
   }
+  return false;
 }
 
 }  // namespace animrt::herd
