@@ -1,11 +1,13 @@
-// Knots: figures of two teams meeting head on in a gap the passage rules do
-// not cover (slanted walls) lock there, each nose to another with its way
-// ahead. The crowd notices a knot of members making no progress and lets
-// one side back off.
+// Knots: figures of two teams meeting head on in a gap no passage rule
+// governs (here a slanted gap with the passage rules off) lock there, each
+// nose to another with its way ahead. The crowd notices a knot of members
+// making no progress and lets one side back off. With the passage rules,
+// which find gaps between walls at any angle, the streams take turns.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
+#include "animrt/controllers/herd/passage.hpp"
 #include "herd/crowd_sim.hpp"
 
 namespace animrt::herd {
@@ -16,7 +18,7 @@ Vec2 rotated(Vec2 p, double a) {
 }
 
 // A wall across the ground with one gap `gap` wide and `depth` deep, turned
-// by `yaw` about the origin (not axis-aligned: no passage rules).
+// by `yaw` about the origin.
 NavWorldConfig slanted_gap_world(double gap, double depth, double yaw) {
   NavWorldConfig c;
   c.bounds = {-14, -10, 14, 10};
@@ -75,11 +77,19 @@ KnotResult run_knot(int per_team, std::uint64_t seed, double t_max, CrowdParams 
   return res;
 }
 
-// Five a team through a slanted 2 m gap, seed 1: all ten stood for good
-// (0 of 10 arrived in 400 s; seed 3 too, seed 2 got through). A knot is
-// found, one side backs off, and all arrive without touching.
+CrowdParams without_passage_rules() {
+  CrowdParams p;
+  p.passage_width_radii = 0.0;
+  return p;
+}
+
+// Five a team through a slanted 2 m gap, seed 1, no passage rules: all ten
+// stood for good (0 of 10 arrived in 400 s; seed 3 too, seed 2 got
+// through). A knot is found, one side backs off, and all arrive without
+// touching.
 TEST(CrowdKnot, SlantedGapKnotIsFoundAndResolves) {
-  const KnotResult r = run_knot(5, 1, 400.0, {}, slanted_gap_world(2.0, 2.0, 0.5), 0.26);
+  const KnotResult r =
+      run_knot(5, 1, 400.0, without_passage_rules(), slanted_gap_world(2.0, 2.0, 0.5), 0.26);
   EXPECT_EQ(r.collisions, 0);
   EXPECT_GE(r.knots, 1);
   EXPECT_EQ(r.arrived, r.agents);
@@ -87,11 +97,35 @@ TEST(CrowdKnot, SlantedGapKnotIsFoundAndResolves) {
 
 // Without the knot rules the same scene stays knotted.
 TEST(CrowdKnot, WithoutKnotRulesTheSlantedGapStaysKnotted) {
-  CrowdParams p;
+  CrowdParams p = without_passage_rules();
   p.knot_still_s = 0.0;
   const KnotResult r = run_knot(5, 1, 400.0, p, slanted_gap_world(2.0, 2.0, 0.5), 0.26);
   EXPECT_EQ(r.knots, 0);
   EXPECT_LT(r.arrived, r.agents);
+}
+
+// The same slanted gap with the passage rules and without the knot rules:
+// the gap is a passage, one stream waits beside its mouth while the other
+// passes, and all ten arrive without a knot forming (before the finder
+// took walls at any angle, this stayed knotted: the test above).
+TEST(CrowdKnot, SlantedGapStreamsTakeTurns) {
+  CrowdParams p;
+  p.knot_still_s = 0.0;
+  const KnotResult r = run_knot(5, 1, 400.0, p, slanted_gap_world(2.0, 2.0, 0.5), 0.26);
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_EQ(r.arrived, r.agents);
+}
+
+// The passage finder takes walls at any angle: the turned wall's gap is
+// found across its own axis, as the same wall unturned would be.
+TEST(CrowdKnot, FindsTheSlantedGapAsAPassage) {
+  const auto found = find_passages(slanted_gap_world(2.0, 2.0, 0.5).walls, 2.3);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NEAR(found[0].centre.x, 0.0, 1e-9);
+  EXPECT_NEAR(found[0].centre.y, 0.0, 1e-9);
+  EXPECT_NEAR(found[0].half_width, 1.0, 1e-9);
+  EXPECT_NEAR(found[0].half_length, 1.0, 1e-9);
+  EXPECT_NEAR(std::abs(dot(found[0].axis, rotated({1, 0}, 0.5))), 1.0, 1e-9);
 }
 
 }  // namespace
