@@ -11,6 +11,7 @@ namespace animrt::herd {
 namespace {
 
 int idx(int dir) { return dir > 0 ? 0 : 1; }
+constexpr signed char kNotThrough = 2;  // the figure's way does not lead through the passage
 
 // A box's extent on the ground when it is axis-aligned (yaw a multiple of
 // 90 degrees); false for any other yaw.
@@ -255,6 +256,7 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
   hold_.resize(agents.size());
   queued_.resize(agents.size(), 0);
   queue_at_.resize(agents.size());
+  way_.resize(agents.size() * passages_.size(), 0);
   was_held_by_.swap(held_by_);
   was_held_by_.resize(agents.size(), -1);
   held_by_.assign(agents.size(), -1);
@@ -292,21 +294,34 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
                        std::numeric_limits<double>::infinity()};
   std::vector<signed char>& dir_of = dir_of_;
   dir_of.assign(agents.size(), 0);
+  const std::size_t np = passages_.size();
   for (std::size_t i = 0; i < agents.size(); ++i) {
-    if (!active[i]) continue;
+    signed char& known = way_[i * np + static_cast<std::size_t>(index)];
     const Vec2 d = agents[i].position - p.centre;
-    const double way = dot(target[i] - p.centre, u);
-    if (std::abs(way) <= hl) continue;  // its goal is in the passage itself
-    const int dir = way > 0 ? 1 : -1;
-    const double s = dot(d, u) * dir;  // < 0 before the passage, > 0 past it
+    const double along = dot(d, u);
     const double side = std::abs(dot(d, across));
-    if (s > hl + params_.clear_m || s < -reach || side > hw + params_.approach_m) continue;
+    if (!active[i] || std::abs(along) > std::max(reach, hl + params_.clear_m) ||
+        side > hw + params_.approach_m) {
+      known = 0;
+      continue;
+    }
     // Only a figure that sees the passage from where it stands asks for
-    // it: walls at any angle leave figures round a corner from a gap that
-    // lies straight ahead of their goal (past it, or not there yet). One
-    // the passage holds keeps asking while it walks to its place.
-    const bool in_it = std::abs(s) <= hl && side <= hw + agents[i].radius;
-    if (!in_it && was_held_by_[i] != index && !sees(p, agents[i].position)) continue;
+    // it: walls at any angle leave figures round a corner from a gap (past
+    // it, or not there yet). One the passage holds keeps asking while it
+    // walks to its place.
+    const bool in_it = std::abs(along) <= hl && side <= hw + agents[i].radius;
+    if (!in_it && was_held_by_[i] != index && !sees(p, agents[i].position)) {
+      known = 0;
+      continue;
+    }
+    if (known == 0) known = way_through(p, agents[i].position, target[i]);
+    if (known == kNotThrough) continue;
+    const int dir = known;
+    const double s = along * dir;  // < 0 before the passage, > 0 past it
+    if (s > hl + params_.clear_m || s < -reach) {
+      known = 0;
+      continue;
+    }
     const int k = dir > 0 ? 0 : 1;
     dir_of[i] = static_cast<signed char>(dir);
     ++want[k];
@@ -368,6 +383,26 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
         p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)] : choose_side(p, dir, agents, target);
     hold_[i] = wait_place(p, dir, on);
   }
+}
+
+signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal) const {
+  // Without a mesh, or while no way leads to the goal (a gap closed for
+  // now), the goal's side of the passage in a straight line decides.
+  const double way = dot(goal - p.centre, p.axis);
+  const signed char straight = std::abs(way) <= p.half_length ? kNotThrough : (way > 0 ? 1 : -1);
+  if (!world_) return straight;
+  const int from = dot(pos - p.centre, p.axis) < 0.0 ? -1 : 1;  // the side it stands on
+  const Vec2 near = p.centre + p.axis * (from * p.half_length);
+  const Vec2 far = p.centre - p.axis * (from * p.half_length);
+  const auto direct = world_->path_length(pos, goal);
+  const auto to = world_->path_length(pos, near);
+  const auto on = world_->path_length(far, goal);
+  if (!direct || !to || !on) return straight;
+  // Through the passage when the way there and on from the far mouth is
+  // no longer than the shortest way, but for the corners it cuts.
+  return *to + 2 * p.half_length + *on <= *direct + 2 * p.half_width + 1.0
+             ? static_cast<signed char>(-from)
+             : kNotThrough;
 }
 
 Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {

@@ -87,6 +87,10 @@ class PassageRules {
   // Whether the figure at pos sees the mouth of p on its side (no wall
   // between it and the mouth's nearest point).
   bool sees(const Passage& p, Vec2 pos) const;
+  // The way (+1, -1) a figure at pos walking to goal goes through p, or
+  // 2 when its way does not lead through it: by the mesh's shortest
+  // paths (a maze turns ways round wall ends), else by the goal's side.
+  signed char way_through(const Passage& p, Vec2 pos, Vec2 goal) const;
   // Where figures of way dir wait for p on side +1 (right) or -1 (left).
   Vec2 wait_place(const Passage& p, int dir, int side) const;
   int choose_side(Passage& p, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
@@ -100,6 +104,9 @@ class PassageRules {
   std::vector<Vec2> hold_;
   // Per agent: the passage that holds it (this update, the last one), or -1.
   std::vector<int> held_by_, was_held_by_;
+  // Per agent and passage: its way through, decided as it comes near
+  // (0: not yet, 2: not through), kept while it stays near.
+  std::vector<signed char> way_;
   // Per agent: its direction (+1, -1) while it asks for the passage at hand, else 0.
   std::vector<signed char> dir_of_;
   // Per agent: queued at a one-lane mouth (1 since the last update, 2 this
