@@ -1,6 +1,7 @@
 #pragma once
-// Right of way at narrow passages: where two walls leave a gap too narrow
-// for two streams to pass each other, the gap is used one way at a time.
+// Right of way at narrow passages: where two walls (at any angle) leave a
+// gap too narrow for two streams to pass each other, the gap is used one
+// way at a time.
 // Each passage decides for itself (no central schedule): the first figure
 // to come near takes it for its direction; figures the other way wait
 // beside the mouth, clear of the way out; once the other way has waited
