@@ -55,6 +55,7 @@ WallExtent extent_of(const Box& b) {
 // The part [lo, hi] of the line q + dir * s inside one extent of a slab
 // along axis n: false when the line misses it.
 bool clip(Vec2 q, Vec2 dir, Vec2 n, double e0, double e1, double& lo, double& hi) {
+  if (e0 > e1) return false;  // a wall thinner than the margin blocks() leaves
   const double k = dot(dir, n), q0 = dot(q, n);
   if (k == 0.0) return q0 >= e0 && q0 <= e1;
   double s0 = (e0 - q0) / k, s1 = (e1 - q0) / k;
