@@ -77,7 +77,7 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
     pp.max_width_radii = params_.passage_width_radii;
     pp.max_hold_s = params_.passage_max_hold_s;
     passages_ = std::make_unique<PassageRules>(world_.config().walls,
-                                               rmax + params_.avoidance_margin_m, pp);
+                                               rmax + params_.avoidance_margin_m, pp, &world_);
     if (passages_->empty()) passages_.reset();
   }
   for (std::size_t i = 0; i < agents.size(); ++i) {

@@ -1,11 +1,17 @@
 #include "animrt/controllers/herd/passage.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
+#include "animrt/controllers/herd/nav_world.hpp"
+
 namespace animrt::herd {
 namespace {
+
+int idx(int dir) { return dir > 0 ? 0 : 1; }
+constexpr signed char kNotThrough = 2;  // the figure's way does not lead through the passage
 
 // A box's extent on the ground when it is axis-aligned (yaw a multiple of
 // 90 degrees); false for any other yaw.
@@ -18,46 +24,232 @@ bool aligned_extent(const Box& b, Rect& r) {
   return true;
 }
 
-// The passage between two intervals on one axis, overlapping on the other:
-// gap [lo, hi] across, overlap [a, b] along.
-Passage make_passage(double lo, double hi, double a, double b, bool across_is_y) {
-  Passage p;
-  const double mid = (lo + hi) / 2, along = (a + b) / 2;
-  p.centre = across_is_y ? Vec2{along, mid} : Vec2{mid, along};
-  p.axis = across_is_y ? Vec2{1, 0} : Vec2{0, 1};
-  p.half_width = (hi - lo) / 2;
-  p.half_length = (b - a) / 2;
-  return p;
+// A box turned by a multiple of 90 degrees takes its corners and extent
+// from its extent on the ground, with no rounding of the turn, so gaps
+// between such walls come out exact.
+WallExtent extent_of(const Box& b) {
+  WallExtent s;
+  Rect r;
+  if (aligned_extent(b, r)) {
+    s.corner = {Vec2{r.xmin, r.ymin}, Vec2{r.xmax, r.ymin}, Vec2{r.xmax, r.ymax},
+                Vec2{r.xmin, r.ymax}};
+    s.ax = {1, 0};
+    s.ay = {0, 1};
+    s.a0 = r.xmin;
+    s.a1 = r.xmax;
+    s.b0 = r.ymin;
+    s.b1 = r.ymax;
+    return s;
+  }
+  s.ax = heading_vector(b.yaw_rad);
+  s.ay = {-s.ax.y, s.ax.x};
+  const Vec2 hx = s.ax * (b.size.x / 2), hy = s.ay * (b.size.y / 2);
+  s.corner = {b.center - hx - hy, b.center + hx - hy, b.center + hx + hy, b.center - hx + hy};
+  s.a0 = dot(b.center, s.ax) - b.size.x / 2;
+  s.a1 = dot(b.center, s.ax) + b.size.x / 2;
+  s.b0 = dot(b.center, s.ay) - b.size.y / 2;
+  s.b1 = dot(b.center, s.ay) + b.size.y / 2;
+  return s;
+}
+
+// The part [lo, hi] of the line q + dir * s inside one extent of a slab
+// along axis n: false when the line misses it.
+bool clip(Vec2 q, Vec2 dir, Vec2 n, double e0, double e1, double& lo, double& hi) {
+  if (e0 > e1) return false;  // a wall thinner than the margin blocks() leaves
+  const double k = dot(dir, n), q0 = dot(q, n);
+  if (k == 0.0) return q0 >= e0 && q0 <= e1;
+  double s0 = (e0 - q0) / k, s1 = (e1 - q0) / k;
+  if (s0 > s1) std::swap(s0, s1);
+  lo = std::max(lo, s0);
+  hi = std::min(hi, s1);
+  return lo <= hi;
+}
+
+// Where the line q + dir * s crosses the wall, as [lo, hi] in s.
+bool line_through(const WallExtent& w, Vec2 q, Vec2 dir, double& lo, double& hi) {
+  lo = -std::numeric_limits<double>::infinity();
+  hi = std::numeric_limits<double>::infinity();
+  return clip(q, dir, w.ax, w.a0, w.a1, lo, hi) && clip(q, dir, w.ay, w.b0, w.b1, lo, hi);
+}
+
+// Whether the segment from p to q passes through the wall's inside (a
+// centimetre in from its faces: grazing a face or a corner is no block).
+bool blocks(const WallExtent& w, Vec2 p, Vec2 q) {
+  constexpr double kIn = 0.01;
+  double lo = 0.0, hi = 1.0;
+  const Vec2 d = q - p;
+  return clip(p, d, w.ax, w.a0 + kIn, w.a1 - kIn, lo, hi) &&
+         clip(p, d, w.ay, w.b0 + kIn, w.b1 - kIn, lo, hi) && lo < hi;
+}
+
+Vec2 closest_on_segment(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 d = b - a;
+  const double l2 = norm2(d);
+  const double u = l2 > 0.0 ? std::clamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
+  return a + d * u;
+}
+
+// Whether two walls overlap (no axis of either separates them).
+bool overlap(const WallExtent& a, const WallExtent& b) {
+  for (const WallExtent* w : {&a, &b}) {
+    for (const Vec2 n : {w->ax, w->ay}) {
+      double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo,
+             b_hi = -a_lo;
+      for (const Vec2 c : a.corner) {
+        a_lo = std::min(a_lo, dot(c, n));
+        a_hi = std::max(a_hi, dot(c, n));
+      }
+      for (const Vec2 c : b.corner) {
+        b_lo = std::min(b_lo, dot(c, n));
+        b_hi = std::max(b_hi, dot(c, n));
+      }
+      if (a_hi <= b_lo || b_hi <= a_lo) return false;
+    }
+  }
+  return true;
+}
+
+// The gap across between two walls on the line axis * t + across * s, and
+// its middle; infinite where the line misses either wall or they overlap.
+double gap_at(const WallExtent& a, const WallExtent& b, Vec2 axis, Vec2 across, double t,
+              double* mid) {
+  double a0, a1, b0, b1;
+  const Vec2 q = axis * t;
+  if (!line_through(a, q, across, a0, a1) || !line_through(b, q, across, b0, b1))
+    return std::numeric_limits<double>::infinity();
+  if (a1 <= b0) {
+    if (mid) *mid = (a1 + b0) / 2;
+    return b0 - a1;
+  }
+  if (b1 <= a0) {
+    if (mid) *mid = (b1 + a0) / 2;
+    return a0 - b1;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+// The narrow gap between two walls at any angle: across it is the way
+// between their nearest points, and it runs along the perpendicular as far
+// as both walls face each other and the gap stays under max_width (for two
+// parallel walls, their whole overlap; for slanted ones, the stretch round
+// the narrowest point).
+bool passage_between(const WallExtent& a, const WallExtent& b, double max_width, Passage& out) {
+  if (overlap(a, b)) return false;
+  double best = std::numeric_limits<double>::infinity();
+  Vec2 pa, pb;
+  for (int k = 0; k < 4; ++k) {
+    for (int e = 0; e < 4; ++e) {
+      const Vec2 qb = closest_on_segment(a.corner[k], b.corner[e], b.corner[(e + 1) % 4]);
+      if (const double d = norm(qb - a.corner[k]); d < best) {
+        best = d;
+        pa = a.corner[k];
+        pb = qb;
+      }
+      const Vec2 qa = closest_on_segment(b.corner[k], a.corner[e], a.corner[(e + 1) % 4]);
+      if (const double d = norm(qa - b.corner[k]); d < best) {
+        best = d;
+        pa = qa;
+        pb = b.corner[k];
+      }
+    }
+  }
+  if (!(best > 0.0) || best >= max_width) return false;
+  Vec2 across = (pb - pa) / best;
+  // Walls square to each other meet square: no rounding in the direction.
+  if (std::abs(across.x) < 1e-9) across = {0, across.y > 0 ? 1.0 : -1.0};
+  if (std::abs(across.y) < 1e-9) across = {across.x > 0 ? 1.0 : -1.0, 0};
+  Vec2 axis{-across.y, across.x};
+  if (axis.x < 0.0 || (axis.x == 0.0 && axis.y < 0.0)) axis = axis * -1.0;
+  across = {-axis.y, axis.x};
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const WallExtent* w : {&a, &b}) {
+    double w_lo = std::numeric_limits<double>::infinity(), w_hi = -w_lo;
+    for (const Vec2 c : w->corner) {
+      w_lo = std::min(w_lo, dot(c, axis));
+      w_hi = std::max(w_hi, dot(c, axis));
+    }
+    lo = w == &a ? w_lo : std::max(lo, w_lo);
+    hi = w == &a ? w_hi : std::min(hi, w_hi);
+  }
+  if (!(hi > lo)) return false;
+  // The narrowest point: the gap is convex along the axis (both walls
+  // convex), flat between parallel faces, where the nearest points found
+  // may sit at a corner, at the very end of the overlap.
+  double pinch = std::clamp(dot(pa, axis), lo, hi);
+  double narrowest = gap_at(a, b, axis, across, pinch, nullptr);
+  for (double l = lo, h = hi; h - l > 1e-9 * (1.0 + std::abs(l));) {
+    const double m0 = l + (h - l) / 3, m1 = h - (h - l) / 3;
+    const double g0 = gap_at(a, b, axis, across, m0, nullptr);
+    const double g1 = gap_at(a, b, axis, across, m1, nullptr);
+    if (g0 < narrowest) {
+      narrowest = g0;
+      pinch = m0;
+    }
+    if (g1 < narrowest) {
+      narrowest = g1;
+      pinch = m1;
+    }
+    (g0 <= g1 ? h : l) = g0 <= g1 ? m1 : m0;
+  }
+  if (!(narrowest < max_width)) return false;
+  // The gap widens away from its narrowest point (both walls convex): the
+  // passage ends where it reaches max_width.
+  const auto end = [&](double far) {
+    if (gap_at(a, b, axis, across, far, nullptr) < max_width) return far;
+    double in = pinch, beyond = far;
+    for (int k = 0; k < 48; ++k) {
+      const double m = (in + beyond) / 2;
+      (gap_at(a, b, axis, across, m, nullptr) < max_width ? in : beyond) = m;
+    }
+    return in;
+  };
+  const double t0 = end(lo), t1 = end(hi);
+  if (!(t1 > t0)) return false;
+  const double t = (t0 + t1) / 2;
+  double mid = 0.0;
+  if (!std::isfinite(gap_at(a, b, axis, across, t, &mid))) return false;
+  out = Passage{};
+  out.centre = axis * t + across * mid;
+  out.axis = axis;
+  out.half_width = narrowest / 2;
+  out.half_length = (t1 - t0) / 2;
+  return true;
 }
 
 }  // namespace
 
 std::vector<Passage> find_passages(std::span<const Box> walls, double max_width) {
+  std::vector<WallExtent> w;
+  for (const Box& b : walls) w.push_back(extent_of(b));
   std::vector<Passage> out;
-  for (std::size_t i = 0; i < walls.size(); ++i) {
-    Rect a;
-    if (!aligned_extent(walls[i], a)) continue;
-    for (std::size_t j = i + 1; j < walls.size(); ++j) {
-      Rect b;
-      if (!aligned_extent(walls[j], b)) continue;
-      const double ox0 = std::max(a.xmin, b.xmin), ox1 = std::min(a.xmax, b.xmax);
-      const double oy0 = std::max(a.ymin, b.ymin), oy1 = std::min(a.ymax, b.ymax);
-      if (ox1 > ox0) {  // one above the other: the gap is in y
-        const double lo = std::min(a.ymax, b.ymax), hi = std::max(a.ymin, b.ymin);
-        if (hi > lo && hi - lo < max_width) out.push_back(make_passage(lo, hi, ox0, ox1, true));
-      } else if (oy1 > oy0) {  // side by side: the gap is in x
-        const double lo = std::min(a.xmax, b.xmax), hi = std::max(a.xmin, b.xmin);
-        if (hi > lo && hi - lo < max_width) out.push_back(make_passage(lo, hi, oy0, oy1, false));
-      }
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    for (std::size_t j = i + 1; j < w.size(); ++j) {
+      Passage p;
+      if (passage_between(w[i], w[j], max_width, p)) out.push_back(p);
     }
   }
   return out;
 }
 
-PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params)
+PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params,
+                           const NavWorld* world)
     : passages_(find_passages(walls, params.max_width_radii * avoid_radius)),
       avoid_radius_(avoid_radius),
-      params_(params) {}
+      params_(params),
+      world_(world) {
+  for (const Box& b : walls) walls_.push_back(extent_of(b));
+}
+
+bool PassageRules::sees(const Passage& p, Vec2 pos) const {
+  const Vec2 u = p.axis, across{-u.y, u.x};
+  const Vec2 mouth = p.centre + u * (dot(pos - p.centre, u) < 0.0 ? -p.half_length : p.half_length);
+  const Vec2 to =
+      closest_on_segment(pos, mouth - across * p.half_width, mouth + across * p.half_width);
+  for (const WallExtent& w : walls_) {
+    if (blocks(w, pos, to)) return false;
+  }
+  return true;
+}
 
 void PassageRules::update(double t, std::span<const Agent> agents, std::span<const Vec2> target,
                           const std::vector<bool>& active) {
@@ -65,7 +257,12 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
   hold_.resize(agents.size());
   queued_.resize(agents.size(), 0);
   queue_at_.resize(agents.size());
-  for (Passage& p : passages_) update_one(t, p, agents, target, active);
+  way_.resize(agents.size() * passages_.size(), 0);
+  was_held_by_.swap(held_by_);
+  was_held_by_.resize(agents.size(), -1);
+  held_by_.assign(agents.size(), -1);
+  for (std::size_t k = 0; k < passages_.size(); ++k)
+    update_one(t, static_cast<int>(k), passages_[k], agents, target, active);
   // A figure keeps its place in a queue only while it stays queued.
   for (char& q : queued_) q = q == 2 ? 1 : 0;
 }
@@ -88,7 +285,7 @@ int PassageRules::single_file(const Passage& p, std::span<const Agent> agents) c
   return next;
 }
 
-void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agents,
+void PassageRules::update_one(double t, int index, Passage& p, std::span<const Agent> agents,
                               std::span<const Vec2> target, const std::vector<bool>& active) {
   const Vec2 u = p.axis, across{-u.y, u.x};
   const double hl = p.half_length, hw = p.half_width;
@@ -98,22 +295,40 @@ void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agent
                        std::numeric_limits<double>::infinity()};
   std::vector<signed char>& dir_of = dir_of_;
   dir_of.assign(agents.size(), 0);
+  const std::size_t np = passages_.size();
   for (std::size_t i = 0; i < agents.size(); ++i) {
-    if (!active[i]) continue;
+    signed char& known = way_[i * np + static_cast<std::size_t>(index)];
     const Vec2 d = agents[i].position - p.centre;
-    const double way = dot(target[i] - p.centre, u);
-    if (std::abs(way) <= hl) continue;  // its goal is in the passage itself
-    const int dir = way > 0 ? 1 : -1;
-    const double s = dot(d, u) * dir;  // < 0 before the passage, > 0 past it
+    const double along = dot(d, u);
     const double side = std::abs(dot(d, across));
-    if (s > hl + params_.clear_m || s < -reach || side > hw + params_.approach_m) continue;
+    if (!active[i] || std::abs(along) > std::max(reach, hl + params_.clear_m) ||
+        side > hw + params_.approach_m) {
+      known = 0;
+      continue;
+    }
+    // Only a figure that sees the passage from where it stands asks for
+    // it: walls at any angle leave figures round a corner from a gap (past
+    // it, or not there yet). One the passage holds keeps asking while it
+    // walks to its place.
+    const bool in_it = std::abs(along) <= hl && side <= hw + agents[i].radius;
+    if (!in_it && was_held_by_[i] != index && !sees(p, agents[i].position)) {
+      known = 0;
+      continue;
+    }
+    if (known == 0) known = way_through(p, agents[i].position, target[i]);
+    if (known == kNotThrough) continue;
+    const int dir = known;
+    const double s = along * dir;  // < 0 before the passage, > 0 past it
+    if (s > hl + params_.clear_m || s < -reach) {
+      known = 0;
+      continue;
+    }
     const int k = dir > 0 ? 0 : 1;
     dir_of[i] = static_cast<signed char>(dir);
     ++want[k];
     if (s >= -(hl + params_.close_m)) ++in[k];
     nearest[k] = std::min(nearest[k], -s);
   }
-  const auto idx = [](int dir) { return dir > 0 ? 0 : 1; };
   if (p.owner == 0) {
     if (want[0] + want[1] > 0) p.owner = nearest[0] <= nearest[1] ? 1 : -1;
     p.waiting_since = -1.0;
@@ -154,17 +369,76 @@ void PassageRules::update_one(double t, Passage& p, std::span<const Agent> agent
           norm(agents[i].position - (p.centre - u * (dir * hl))) > params_.queue_m)
         continue;
       held_[i] = 1;
+      held_by_[i] = index;
       if (!queued_[i]) queue_at_[i] = agents[i].position;
       queued_[i] = 2;
       hold_[i] = queue_at_[i];
       continue;
     }
-    // Beside the mouth on the figure's right, clear of the way out of the
-    // passage (figures coming out keep to their own right, the other side).
-    const Vec2 way = u * dir, right{way.y, -way.x};
+    // Beside the mouth, clear of the way out of the passage: on the
+    // figure's right (figures coming out keep to their own right, the
+    // other side), unless the way out turns there (below).
     held_[i] = 1;
-    hold_[i] = p.centre - way * (hl + 3.0 + avoid_radius_) + right * (hw + 2.5);
+    held_by_[i] = index;
+    const int on =
+        p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)] : choose_side(p, dir, agents, target);
+    hold_[i] = wait_place(p, dir, on);
   }
+}
+
+signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal) const {
+  // Without a mesh, or while no way leads to the goal (a gap closed for
+  // now), the goal's side of the passage in a straight line decides.
+  const double way = dot(goal - p.centre, p.axis);
+  const signed char straight = std::abs(way) <= p.half_length ? kNotThrough : (way > 0 ? 1 : -1);
+  if (!world_) return straight;
+  const int from = dot(pos - p.centre, p.axis) < 0.0 ? -1 : 1;  // the side it stands on
+  const Vec2 near = p.centre + p.axis * (from * p.half_length);
+  const Vec2 far = p.centre - p.axis * (from * p.half_length);
+  const auto direct = world_->path_length(pos, goal);
+  const auto to = world_->path_length(pos, near);
+  const auto on = world_->path_length(far, goal);
+  if (!direct || !to || !on) return straight;
+  // Through the passage when the way there and on from the far mouth is
+  // no longer than the shortest way, but for the corners it cuts.
+  return *to + 2 * p.half_length + *on <= *direct + 2 * p.half_width + 1.0
+             ? static_cast<signed char>(-from)
+             : kNotThrough;
+}
+
+Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {
+  const Vec2 way = p.axis * dir, right{way.y, -way.x};
+  return p.centre - way * (p.half_length + 3.0 + avoid_radius_) +
+         right * (side * (p.half_width + 2.5));
+}
+
+int PassageRules::choose_side(Passage& p, int dir, std::span<const Agent> agents,
+                              std::span<const Vec2> target) {
+  // The other way's figures come out toward their goals: where the walls
+  // turn their way out to this way's right (a maze), waiting there would
+  // stand in it. The place on the left is taken instead when it is in
+  // sight of the mouth on this side, and the other way's path to its goal
+  // from the right place is shorter than from the left one by over
+  // kTurnMargin (a real turn, not the noise of the mesh).
+  constexpr double kTurnMargin = 2.0;
+  if (!world_) return 1;
+  int other = -1;
+  for (std::size_t i = 0; i < agents.size() && other < 0; ++i) {
+    if (dir_of_[i] == -dir) other = static_cast<int>(i);
+  }
+  if (other < 0) return 1;  // decided once the other way is there
+  const Vec2 goal = target[static_cast<std::size_t>(other)];
+  const Vec2 right = wait_place(p, dir, 1), left = wait_place(p, dir, -1);
+  const Vec2 mouth = p.centre - p.axis * (dir * p.half_length);
+  int side = 1;
+  const auto from_left = world_->path_length(left, goal);
+  const auto from_right = world_->path_length(right, goal);
+  bool left_in_sight = world_->on_mesh(left, 0.05);
+  for (const WallExtent& w : walls_) left_in_sight = left_in_sight && !blocks(w, mouth, left);
+  if (left_in_sight && from_left && (!from_right || *from_right + kTurnMargin < *from_left))
+    side = -1;
+  p.wait_side[idx(dir)] = side;
+  return side;
 }
 
 }  // namespace animrt::herd

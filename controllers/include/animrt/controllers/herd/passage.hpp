@@ -1,18 +1,22 @@
 #pragma once
-// Right of way at narrow passages: where two walls leave a gap too narrow
-// for two streams to pass each other, the gap is used one way at a time.
+// Right of way at narrow passages: where two walls (at any angle) leave a
+// gap too narrow for two streams to pass each other, the gap is used one
+// way at a time.
 // Each passage decides for itself (no central schedule): the first figure
 // to come near takes it for its direction; figures the other way wait
 // beside the mouth, clear of the way out; once the other way has waited
 // max_hold_s the passage admits no new figures of the owning direction,
 // and when the last of them is through, ownership swaps.
 
+#include <array>
 #include <span>
 #include <vector>
 
 #include "animrt/controllers/herd/agent.hpp"
 
 namespace animrt::herd {
+
+class NavWorld;
 
 struct PassageParams {
   // Gaps narrower than this many avoidance radii are passages (two
@@ -37,15 +41,32 @@ struct Passage {
   int owner = 0;                // +1: along axis, -1: against it, 0: free
   double waiting_since = -1.0;  // when the other way began to wait, or -1
   bool closing = false;         // the owner admits no one new
+  // Per way (+1, -1): the side its figures wait on, +1 right, -1 left, 0
+  // not decided yet.
+  int wait_side[2] = {0, 0};
 };
 
-// Gaps between two axis-aligned walls, narrower than max_width, whose
-// facing sides overlap.
+// A wall as the passage finder measures it: its corners (counter-clockwise)
+// and its extent along its own two axes.
+struct WallExtent {
+  std::array<Vec2, 4> corner;
+  Vec2 ax, ay;
+  double a0 = 0.0, a1 = 0.0, b0 = 0.0, b1 = 0.0;  // dot(p, ax) in [a0, a1], dot(p, ay) in [b0, b1]
+};
+
+// Gaps narrower than max_width between two walls at any angle. A passage
+// runs across the way between the walls' nearest points, along the
+// stretch where both walls face each other and the gap stays under
+// max_width: for two parallel walls their whole overlap, for slanted ones
+// the stretch round the narrowest point (its half_width is there).
 std::vector<Passage> find_passages(std::span<const Box> walls, double max_width);
 
 class PassageRules {
  public:
-  PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params = {});
+  // With a world, the waiting places follow the way out where the walls
+  // turn it (choose_side); without one, figures wait on their right.
+  PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params = {},
+               const NavWorld* world = nullptr);
 
   // Decides, for every active agent walking to target[i], whether it must
   // wait, and where (hold_point).
@@ -57,18 +78,36 @@ class PassageRules {
   bool empty() const { return passages_.empty(); }
 
  private:
-  void update_one(double t, Passage& p, std::span<const Agent> agents, std::span<const Vec2> target,
-                  const std::vector<bool>& active);
+  void update_one(double t, int index, Passage& p, std::span<const Agent> agents,
+                  std::span<const Vec2> target, const std::vector<bool>& active);
 
   // In a passage one figure wide, the owner's figure outside it that is
   // nearest its mouth (the next to go in); -1 for a wider one.
   int single_file(const Passage& p, std::span<const Agent> agents) const;
 
+  // Whether the figure at pos sees the mouth of p on its side (no wall
+  // between it and the mouth's nearest point).
+  bool sees(const Passage& p, Vec2 pos) const;
+  // The way (+1, -1) a figure at pos walking to goal goes through p, or
+  // 2 when its way does not lead through it: by the mesh's shortest
+  // paths (a maze turns ways round wall ends), else by the goal's side.
+  signed char way_through(const Passage& p, Vec2 pos, Vec2 goal) const;
+  // Where figures of way dir wait for p on side +1 (right) or -1 (left).
+  Vec2 wait_place(const Passage& p, int dir, int side) const;
+  int choose_side(Passage& p, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
+
   std::vector<Passage> passages_;
+  std::vector<WallExtent> walls_;
   double avoid_radius_;
   PassageParams params_;
+  const NavWorld* world_ = nullptr;
   std::vector<char> held_;
   std::vector<Vec2> hold_;
+  // Per agent: the passage that holds it (this update, the last one), or -1.
+  std::vector<int> held_by_, was_held_by_;
+  // Per agent and passage: its way through, decided as it comes near
+  // (0: not yet, 2: not through), kept while it stays near.
+  std::vector<signed char> way_;
   // Per agent: its direction (+1, -1) while it asks for the passage at hand, else 0.
   std::vector<signed char> dir_of_;
   // Per agent: queued at a one-lane mouth (1 since the last update, 2 this
