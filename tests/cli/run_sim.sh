@@ -13,9 +13,9 @@ fail() { echo "FAIL: $*"; exit 1; }
 # The shipped quadruped with 0.5 s ramps and a stop deadline that leaves the
 # walk's wind-down no room (2 s of settling after the ramp), its files made
 # absolute: what is checked here is the run's summary and telemetry, not how
-# long the figure takes to start and stop (stop_signals stops the shipped
-# ramps and wind-down, dashboard_busy_browser runs them to their end). The
-# shipped watchdog and bus timeout stay.
+# long the figure takes to start and stop (stop_signals stops with the
+# shipped wind-down and stop ramp, dashboard_busy_browser runs the shipped
+# file unchanged). The shipped watchdog and bus timeout stay.
 here=$(cd "$root/configs/robots" && pwd)
 robot=$tmp/quadruped.yaml
 sed -E -e "s#^(\s*(file|model):\s*)\.\./#\1$here/../#" -e "s#^(\s*(start|stop)_ramp_s:\s*)[0-9.]+#\10.5#" \
