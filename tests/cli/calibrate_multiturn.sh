@@ -99,10 +99,13 @@ PY
 # current-based position mode, kept in EEPROM.
 "$animrt" servo "$pty" --protocol dynamixel2 --id 1 --baud 1000000 set-mode current-position \
   > "$tmp/mode.txt" 2>&1 || fail "set-mode: $(cat "$tmp/mode.txt")"
-# The next run on them (--backend hardware against the simulator's pty).
+# The next run on them (--backend hardware against the simulator's pty),
+# with a stop deadline that leaves the walk's wind-down no room: the run
+# is here for its configure.
 sed -E -e "s|^(\s*port:\s*)\S+|\1$pty|" -e "s|^(\s*watchdog_timeout_s:\s*)[0-9.]+|\12.0|" \
   -e "s|^(\s*timeout_ms:\s*)[0-9]+|\120|" -e "s#^(\s*(start|stop)_ramp_s:\s*)[0-9.]+#\10.3#" \
-  "$robot" > "$tmp/robots/run.yaml"
+  -e "s|^(safety:)$|\1\n  stop_deadline_s: 2.3|" "$robot" > "$tmp/robots/run.yaml"
+grep -q "^  stop_deadline_s: 2.3$" "$tmp/robots/run.yaml" || fail "could not set the stop deadline"
 "$animrt" run "$tmp/robots/run.yaml" --backend hardware --no-realtime --duration 0.5 \
   > "$tmp/run.txt" 2>&1 || fail "run: $(cat "$tmp/run.txt")"
 grep -q "id 1 (lf_hip) was in Operating Mode 5 (current-based position), set to 3 (position)" \

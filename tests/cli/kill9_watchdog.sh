@@ -29,9 +29,12 @@ read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
 # resolved against the shipped folder), with answer timeouts of 40 ms: the
 # simulator shares this machine with whatever else runs, and a configure
 # that gives up on a late answer would end the test before it began.
+# Its stop ramp is 0.5 s: the first run dies by kill -9 and the second is
+# stopped to see it end cleanly, neither for the ramp's length.
 patient='s#timeout_ms: [0-9]*#timeout_ms: 40#'
 sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" -e "$patient" \
-  "$root/configs/robots/quadruped.yaml" > "$tmp/robot.yaml"
+  -e "s#stop_ramp_s: [0-9.]*#stop_ramp_s: 0.5#" "$root/configs/robots/quadruped.yaml" > "$tmp/robot.yaml"
+grep -q "stop_ramp_s: 0.5" "$tmp/robot.yaml" || fail "could not shorten the stop ramp: $(head -30 "$tmp/robot.yaml")"
 
 start_run() {
   "$animrt" run "$tmp/robot.yaml" --backend hardware --no-realtime > "$tmp/out.txt" 2> "$tmp/err.txt" &

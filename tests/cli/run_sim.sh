@@ -10,7 +10,20 @@ sim_pid=""
 trap '[[ -n $sim_pid ]] && kill $sim_pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-"$animrt" run "$root/configs/robots/quadruped.yaml" --backend sim --duration 1 --no-realtime \
+# The shipped quadruped with 0.5 s ramps and a stop deadline that leaves the
+# walk's wind-down no room (2 s of settling after the ramp), its files made
+# absolute: what is checked here is the run's summary and telemetry, not how
+# long the figure takes to start and stop (stop_signals stops with the
+# shipped wind-down and stop ramp, dashboard_busy_browser runs the shipped
+# file unchanged). The shipped watchdog and bus timeout stay.
+here=$(cd "$root/configs/robots" && pwd)
+robot=$tmp/quadruped.yaml
+sed -E -e "s#^(\s*(file|model):\s*)\.\./#\1$here/../#" -e "s#^(\s*(start|stop)_ramp_s:\s*)[0-9.]+#\10.5#" \
+  -e "s|^(safety:)$|\1\n  stop_deadline_s: 2.5|" "$here/quadruped.yaml" > "$robot"
+grep -q "start_ramp_s: 0.5" "$robot" && grep -q "stop_ramp_s: 0.5" "$robot" &&
+  grep -q "^  stop_deadline_s: 2.5$" "$robot" || fail "could not shorten the ramps: $(head -30 "$robot")"
+
+"$animrt" run "$robot" --backend sim --duration 1 --no-realtime \
   --telemetry "$tmp/t.csv" --summary-json "$tmp/s.json" > "$tmp/out.txt" 2> "$tmp/err.txt" \
   || fail "run failed: $(cat "$tmp/out.txt" "$tmp/err.txt")"
 grep -q "^cycles: " "$tmp/out.txt" || fail "no summary: $(cat "$tmp/out.txt")"
