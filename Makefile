@@ -82,9 +82,9 @@ test-boot: deb
 # plays, the dashboard), the simulated devices and the tests that check what
 # a 64-bit ARM build could get wrong (codecs, the cycle, the devices, lockstep
 # figures: cmake/arm64_tests.cmake), cross-compiled with Debian's cross
-# toolchain at -O1 without debug information against a sysroot of Debian's
-# arm64 -dev packages ($(ARM64_BUILD)/sysroot, fetched once from Debian's
-# archive), and run under qemu-user.
+# toolchain at -O1 (the tests' own sources at -O0) without debug information
+# against a sysroot of Debian's arm64 -dev packages ($(ARM64_BUILD)/sysroot,
+# fetched once from Debian's archive), and run under qemu-user.
 ARM64_BUILD ?= build-arm64
 test-arm64: deps
 	packaging/arm64-sysroot $(ARM64_BUILD)/sysroot

@@ -26,5 +26,18 @@ set(ENV{PKG_CONFIG_SYSROOT_DIR} "${ANIMRT_ARM64_SYSROOT}")
 set(ENV{PKG_CONFIG_LIBDIR}
     "${ANIMRT_ARM64_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${ANIMRT_ARM64_SYSROOT}/usr/share/pkgconfig")
 set(ENV{PKG_CONFIG_PATH} "")
+# MuJoCo's CMake package asks for OpenGL, which the sysroot leaves out.
+list(APPEND CMAKE_MODULE_PATH ${CMAKE_CURRENT_LIST_DIR}/arm64)
+# Debian's cross g++ looks for LLVM's linker (-fuse-ld=lld, CMakeLists.txt)
+# as ld.lld among its own programs, not on PATH: a directory that holds only
+# that name, handed to it with -B.
+find_program(ANIMRT_LD_LLD ld.lld)
+if(ANIMRT_LD_LLD)
+  file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/cross-ld)
+  file(CREATE_LINK ${ANIMRT_LD_LLD} ${CMAKE_BINARY_DIR}/cross-ld/ld.lld SYMBOLIC)
+  foreach(kind EXE SHARED MODULE)
+    set(CMAKE_${kind}_LINKER_FLAGS_INIT "-B${CMAKE_BINARY_DIR}/cross-ld/")
+  endforeach()
+endif()
 find_program(ANIMRT_QEMU_AARCH64 qemu-aarch64-static REQUIRED)
 set(CMAKE_CROSSCOMPILING_EMULATOR ${ANIMRT_QEMU_AARCH64} -L ${ANIMRT_ARM64_SYSROOT})
