@@ -2,14 +2,9 @@
 
 #include <algorithm>
 
-// Compiled for AVX-512, AVX2 and the baseline, picked at load time, with
-// the batch loops marked for the vectoriser (as mesh_conv_kernel.cpp).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define ANIMRT_VECTOR_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define ANIMRT_VECTOR_CLONES
-#endif
+#include "vector_clones.hpp"
+
+// The batch loops are marked for the vectoriser (as mesh_conv_kernel.cpp).
 
 namespace animrt::seqnet {
 

@@ -4,17 +4,10 @@
 #include <cstddef>
 #include <numeric>
 
-// Each loop is compiled for AVX-512, AVX2 and the baseline, and the best
-// the CPU has is picked at load time: the library itself is built for the
-// baseline, where the batch loops would run four numbers at a time. The
-// batch loops are marked for the vectoriser (-fopenmp-simd): their rows
+#include "vector_clones.hpp"
+
+// The batch loops are marked for the vectoriser (-fopenmp-simd): their rows
 // never overlap, which the compiler cannot prove by itself.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define ANIMRT_VECTOR_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define ANIMRT_VECTOR_CLONES
-#endif
 
 namespace animrt::seqnet {
 
