@@ -93,45 +93,36 @@ void SpatialGrid::sort_into_buckets() {
     }
   }
   if (dense_) {
-    sort_into_cells();
-    return;
+    sort_by(static_cast<std::size_t>(width_ * height_), [&](Cell c) {
+      return static_cast<std::size_t>((c.y - ymin_) * width_ + (c.x - xmin_));
+    });
+  } else {
+    sort_by(t, [&](Cell c) { return bucket_of(c); });
   }
-  start_.assign(t + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++start_[bucket_of(cell_idx_[i]) + 1];
-  for (std::size_t b = 0; b < t; ++b) start_[b + 1] += start_[b];
-  sorted_.resize(n);
-  sorted_cell_.resize(n);
-  sorted_pos_.resize(n);
-  // Fill each bucket in index order: start_[b] walks forward while filling,
-  // and ends where bucket b+1 began, so it is shifted back afterwards.
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = start_[bucket_of(cell_idx_[i])]++;
-    sorted_[k] = static_cast<int>(i);
-    sorted_cell_[k] = cell_idx_[i];
-    sorted_pos_[k] = pos_[i];
-  }
-  for (std::size_t b = t; b > 0; --b) start_[b] = start_[b - 1];
-  start_[0] = 0;
 }
 
-void SpatialGrid::sort_into_cells() {
+// A stable counting sort of the points into `slots` slots (the dense
+// layout's cells, or the hashed layout's buckets, which also keep each
+// point's cell, since several cells share a bucket): a slot lists its
+// points in index order.
+template <class SlotOf>
+void SpatialGrid::sort_by(std::size_t slots, SlotOf slot_of) {
   const std::size_t n = pos_.size();
-  const auto cells = static_cast<std::size_t>(width_ * height_);
-  const auto at = [&](Cell c) {
-    return static_cast<std::size_t>((c.y - ymin_) * width_ + (c.x - xmin_));
-  };
-  start_.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++start_[at(cell_idx_[i]) + 1];
-  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+  start_.assign(slots + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++start_[slot_of(cell_idx_[i]) + 1];
+  for (std::size_t b = 0; b < slots; ++b) start_[b + 1] += start_[b];
   sorted_.resize(n);
   sorted_pos_.resize(n);
-  // Stable, as for the buckets: a cell lists its points in index order.
+  if (!dense_) sorted_cell_.resize(n);
+  // start_[b] walks forward while slot b fills, ending where slot b+1
+  // began, so it is shifted back afterwards.
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = start_[at(cell_idx_[i])]++;
+    const std::size_t k = start_[slot_of(cell_idx_[i])]++;
     sorted_[k] = static_cast<int>(i);
     sorted_pos_[k] = pos_[i];
+    if (!dense_) sorted_cell_[k] = cell_idx_[i];
   }
-  for (std::size_t c = cells; c > 0; --c) start_[c] = start_[c - 1];
+  for (std::size_t b = slots; b > 0; --b) start_[b] = start_[b - 1];
   start_[0] = 0;
 }
 

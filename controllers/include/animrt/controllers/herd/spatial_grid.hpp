@@ -76,7 +76,8 @@ class SpatialGrid {
   Cell cell_of(Vec2 p) const;
   std::size_t bucket_of(Cell c) const;
   void sort_into_buckets();
-  void sort_into_cells();  // the dense layout
+  template <class SlotOf>
+  void sort_by(std::size_t slots, SlotOf slot_of);
   // Calls f(j, d2) for the points within r of p, in query order, until f
   // returns true; returns whether it did.
   template <class F>
