@@ -303,11 +303,8 @@ torch::Tensor SeqNetImpl::decode(const torch::Tensor& hidden) {
 }
 
 torch::Tensor SeqNetImpl::decode_from(const torch::Tensor& dense) {
-  const std::int64_t batch = dense.size(0);
   if (shape_.kind != ModelKind::mesh) return decoder->forward(torch::tanh(dense));
-  torch::Tensor h = Squash::apply(dense);
-  h = h.view({batch, shape_.nodes(), shape_.channels}).permute({1, 2, 0}).contiguous();
-  return run_vertices_first(decoder, h).permute({2, 0, 1}).reshape({batch, -1});
+  return decode_batch_inner(dense.t().contiguous());  // the squash is per element
 }
 
 torch::Tensor SeqNetImpl::decode_batch_inner(const torch::Tensor& dense) {
