@@ -60,6 +60,32 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   asking_.assign(agents.size(), false);
   was_held_.assign(agents.size(), 0);
   hold_at_.assign(agents.size(), Vec2{});
+  const std::size_t walls = world_.config().moving.size();
+  wall_of_.assign(agents.size(), -1);
+  wall_at_.assign(agents.size(), Vec2{});
+  wall_decided_.assign(agents.size() * walls, 0);
+  wall_drop_.assign(walls, 0);
+  wall_was_down_.assign(walls, 0);
+  // A moving wall closes a gap when both ends of its long side meet a
+  // static wall or the ground's edge (no figure passes between).
+  wall_in_gap_.assign(walls, 0);
+  const NavWorldConfig& wc = world_.config();
+  for (std::size_t w = 0; w < walls; ++w) {
+    const Box& b = wc.moving[w].footprint;
+    const Vec2 ax = heading_vector(b.yaw_rad), ay{-ax.y, ax.x};
+    const Vec2 along = b.size.x <= b.size.y ? ay : ax;
+    const double half = 0.5 * std::max(b.size.x, b.size.y);
+    const double pass = 2.0 * wc.agent_radius_m;
+    bool closed = true;
+    for (const double end : {-half, half}) {
+      const Vec2 e = b.center + along * end;
+      bool shut = e.x - wc.bounds.xmin < pass || wc.bounds.xmax - e.x < pass ||
+                  e.y - wc.bounds.ymin < pass || wc.bounds.ymax - e.y < pass;
+      for (const Box& s : wc.walls) shut = shut || NavWorld::distance_to_box(e, s) < pass;
+      closed = closed && shut;
+    }
+    wall_in_gap_[w] = closed ? 1 : 0;
+  }
   travelling_.assign(agents.size(), 0);
   backing_.assign(agents.size(), 0);
   eligible_.assign(agents.size(), 0);
@@ -196,7 +222,7 @@ void Crowd::step(double t, double dt, std::span<const Agent> agents) {
     sync(static_cast<int>(i), agents[i]);
     synced_[i] = NavWorld::from_recast(crowd_->getAgent(static_cast<int>(i))->npos);
   }
-  if (passages_) apply_passages(t, agents);
+  if (passages_ || !world_.config().moving.empty()) apply_passages(t, agents);
   if (knots_) apply_knots(t, agents);
   select_participants();
   // The crowd registers each agent of its update in its grid as it stands now.
@@ -269,15 +295,28 @@ bool Crowd::retarget(int i, Vec2 target) {
 
 void Crowd::apply_passages(double t, std::span<const Agent> agents) {
   for (std::size_t i = 0; i < agents.size(); ++i) asking_[i] = active_[i] && has_target_[i];
-  passages_->update(t, agents, target_, asking_);
+  if (passages_) passages_->update(t, agents, target_, asking_);
+  for (std::size_t w = 0; w < wall_drop_.size(); ++w) {
+    const char down = world_.obstacle_down(w) ? 1 : 0;
+    if (down && !wall_was_down_[w]) ++wall_drop_[w];
+    wall_was_down_[w] = down;
+  }
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const int k = static_cast<int>(i);
-    const char held = passages_->held(k) ? 1 : 0;
+    // A passage's rule first: it decides who goes through a narrow gap.
+    Vec2 at;
+    char held = 0;
+    if (passages_ && passages_->held(k)) {
+      held = 1;
+      at = passages_->hold_point(k);
+    } else if (asking_[i] && wait_for_wall(t, k, agents, at)) {
+      held = 1;
+    }
     if (backing_[i]) {  // backing off out of a knot first; the knot rules send it on after
-      if (held) hold_at_[i] = passages_->hold_point(k);
-    } else if (held && (!was_held_[i] || norm(passages_->hold_point(k) - hold_at_[i]) > 1e-9)) {
-      retarget(k, passages_->hold_point(k));
-      hold_at_[i] = passages_->hold_point(k);
+      if (held) hold_at_[i] = at;
+    } else if (held && (!was_held_[i] || norm(at - hold_at_[i]) > 1e-9)) {
+      retarget(k, at);
+      hold_at_[i] = at;
     } else if (!held && was_held_[i] && has_target_[i]) {
       retarget(k, target_[i]);
     }
@@ -285,9 +324,71 @@ void Crowd::apply_passages(double t, std::span<const Agent> agents) {
   }
 }
 
+bool Crowd::wait_for_wall(double t, int i, std::span<const Agent> agents, Vec2& at) {
+  // A moving wall that drops into a gap sends every plan through that gap
+  // the long way round, and when it rises, back: slow figures swung from
+  // one gap to the other and back every few seconds, near the wall (where
+  // the two ways part widely) they made no headway, and those the drop
+  // had turned jammed the other gap. The wall rises on its schedule, so a
+  // member whose way through the gap (walking to the wall's near face,
+  // waiting there till it rises, on from its far face) is quicker than
+  // the way round walks to the near face and waits there. Decided once
+  // per member and drop; while no way round leads on (a closed gate), the
+  // plan stands it as before. Only for a wall that closes a gap between
+  // walls: one standing free is walked round in a few strides, and a
+  // pony sent to its face to wait turned there slowly, stood at a wall
+  // corner on the way and lost more than the way round costs.
+  const auto k = static_cast<std::size_t>(i);
+  const auto& walls = world_.config().moving;
+  int& of = wall_of_[k];
+  if (of >= 0 && world_.obstacle_down(static_cast<std::size_t>(of))) {
+    at = wall_at_[k];
+    return true;
+  }
+  of = -1;
+  const Agent& a = agents[k];
+  const double speed = crowd_->getAgent(i)->params.maxSpeed;
+  for (std::size_t w = 0; w < walls.size() && of < 0; ++w) {
+    int& decided = wall_decided_[k * walls.size() + w];
+    if (!wall_in_gap_[w] || !world_.obstacle_down(w) || decided == wall_drop_[w]) continue;
+    decided = wall_drop_[w];
+    const MovingObstacle& m = walls[w];
+    const Box& b = m.footprint;
+    // Through the box along its thin side.
+    const Vec2 ax = heading_vector(b.yaw_rad), ay{-ax.y, ax.x};
+    const bool thin_x = b.size.x <= b.size.y;
+    const Vec2 n = thin_x ? ax : ay, along = thin_x ? ay : ax;
+    const double depth = 0.5 * std::min(b.size.x, b.size.y);
+    const double half = 0.5 * std::max(b.size.x, b.size.y);
+    const double r = a.radius + params_.avoidance_margin_m;
+    const double clear = depth + r + 0.15;  // off the mesh the wall carves
+    const Vec2 d = a.position - b.center;
+    const double side = dot(d, n) < 0.0 ? -1.0 : 1.0;
+    const double reach = std::max(half - r, 0.0);
+    const double lateral = std::clamp(dot(d, along), -reach, reach);
+    const Vec2 near = b.center + n * (side * clear) + along * lateral;
+    const Vec2 far = near - n * (side * 2.0 * clear);
+    const auto round = world_.path_length(a.position, target_[k]);
+    if (!round) continue;
+    const auto to = world_.path_length(a.position, near);
+    const auto on = world_.path_length(far, target_[k]);
+    if (!to || !on || !(speed > 0.0)) continue;
+    const double u = t - m.phase_s;
+    const double local = u - std::floor(u / m.period_s) * m.period_s;
+    const double rises_in = std::max(0.0, m.down_fraction * m.period_s - local);
+    const double through = std::max(*to / speed, rises_in) + (2.0 * clear + *on) / speed;
+    if (through >= *round / speed) continue;
+    of = static_cast<int>(w);
+    wall_at_[k] = near;
+  }
+  if (of < 0) return false;
+  at = wall_at_[k];
+  return true;
+}
+
 Vec2 Crowd::passage_wait(int i, Vec2 v, std::span<const Agent> agents) const {
   const auto k = static_cast<std::size_t>(i);
-  if (!passages_ || !was_held_[k] || backing_[k]) return v;
+  if (!was_held_[k] || backing_[k]) return v;
   const Agent& a = agents[k];
   const double here = norm(a.position - hold_at_[k]);
   if (here < kWaitRadius) return {};

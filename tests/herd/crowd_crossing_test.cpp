@@ -34,23 +34,17 @@ TEST(CrowdCrossing, TeamsCrossAndGatherWithoutCollisions) {
 
 // Slow figures and a wall that drops into one gap and rises again (drops
 // deferred while figures stand under it): all cross without touching
-// each other or a wall, and gather, within three times their
-// straight-line time.
-TEST(CrowdCrossing, SlowTeamsCrossThroughTheMovingWall) {
+// each other or a wall, and gather, within twice their straight-line
+// time (the full goal). It was 2.49 while every drop of the wall sent the
+// plans through its gap the long way round, through the other gap, and
+// every rise back: the slowest swung between the two gaps near the wall
+// and jammed the other one. Figures whose way through the gap is quicker
+// now wait at the wall's face (docs/herd.md, Crowds).
+TEST(CrowdCrossing, GoalSlowTeamsMovingWall) {
   const auto r = test::run_crossing(0.06, 0.12, true, 25, 11, 1400.0);
-  print(r);
   EXPECT_GT(r.drops, 10);
   EXPECT_GT(r.deferred_drops, 0);
-  EXPECT_EQ(r.collisions, 0);
-  EXPECT_EQ(r.wall_contacts, 0);
-  EXPECT_EQ(r.arrived, r.agents);
-  EXPECT_LT(r.max_time_ratio, 3.0);
-}
-
-// The full goal for the slow teams: within twice the straight-line time.
-// Not reached yet (2.8 here); run with --gtest_also_run_disabled_tests.
-TEST(CrowdCrossing, DISABLED_GoalSlowTeamsMovingWall) {
-  expect_goal(test::run_crossing(0.06, 0.12, true, 25, 11, 1400.0));
+  expect_goal(r);
 }
 
 TEST(CrowdCrossing, SameSeedSameRun) {

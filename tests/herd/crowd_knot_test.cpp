@@ -163,6 +163,30 @@ TEST(CrowdKnot, MazeTopStreamsTakeTurnsRoundTheWallsEnd) {
   EXPECT_EQ(r.arrived, r.agents);
 }
 
+// The same scene on seed 1: 17 of 20 arrive by 600 s and no more by
+// 900 s. Blue 10 and 12, through the gap early, stood among red's waiting
+// figures north-west of it; their way to their goal (round the wall's end)
+// counted as through the gap again (through and back lies within the
+// corners' allowance of way_through), so when the gap swapped to red they
+// went back through it with red, and blue 12, just out of the south-east
+// mouth, met red 6 in it nose to nose for good (neither way waits: both
+// count as red's). Deciding that a way leads through only when the goal
+// is nearer from the far mouth brings all 20 home on seed 1 (307 s), but
+// seed 4 falls from 18 to 7 of 20 (blue figures just out of their far
+// mouth hold the gap while red's waiting figures stand in their way out)
+// and seed 2 takes 468 s against 377 s, so it is not in. Not met yet;
+// run with --gtest_also_run_disabled_tests.
+TEST(CrowdKnot, DISABLED_GoalMazeTopSeed1EveryFigureArrives) {
+  Teams teams;
+  teams.red_spawn = {-5, -3, -2, 1};
+  teams.blue_spawn = {2, -3, 5, 1};
+  teams.red_goal = {3.5, -4};
+  teams.blue_goal = {-3.5, -4};
+  const KnotResult r = run_knot(10, 1, 600.0, {}, maze_top_world(), 0.785, teams);
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_EQ(r.arrived, r.agents);
+}
+
 // The passage finder takes walls at any angle: the turned wall's gap is
 // found across its own axis, as the same wall unturned would be.
 TEST(CrowdKnot, FindsTheSlantedGapAsAPassage) {

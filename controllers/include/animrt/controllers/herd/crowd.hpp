@@ -128,6 +128,9 @@ class Crowd {
   // there, or where it meets one already standing.
   Vec2 passage_wait(int i, Vec2 v, std::span<const Agent> agents) const;
   void apply_passages(double t, std::span<const Agent> agents);
+  // A member whose way leads through the gap a moving wall closes for now
+  // waits at the wall's near face (see crowd.cpp); true with its place.
+  bool wait_for_wall(double t, int i, std::span<const Agent> agents, Vec2& at);
   void apply_knots(double t, std::span<const Agent> agents);
   // Where the crowd sends member i now: its back-off point, its waiting
   // place, or its target.
@@ -161,6 +164,14 @@ class Crowd {
   std::vector<bool> asking_;    // active members with a target
   std::vector<char> was_held_;
   std::vector<Vec2> hold_at_;  // where each held member waits
+  // Per member: the moving wall it waits for (-1: none), where, and per
+  // member and wall the drop it was last decided for.
+  std::vector<int> wall_of_;
+  std::vector<Vec2> wall_at_;
+  std::vector<int> wall_decided_;
+  std::vector<int> wall_drop_;       // per moving wall: drops seen, counting this one
+  std::vector<char> wall_was_down_;  // per moving wall: down at the last step
+  std::vector<char> wall_in_gap_;    // per moving wall: it closes a gap between walls
   double dt_ = 0.0;
   double last_t_ = -1e300;
   bool stepped_ = false;
