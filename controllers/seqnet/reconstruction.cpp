@@ -146,12 +146,18 @@ std::vector<Positions> reconstruct_all(const SequenceFeatures& features) {
   const Reconstructor solver(features.rest, features.triangles);
   std::vector<Positions> out;
   for (int f = 0; f < static_cast<int>(features.frames.size()); ++f) {
-    out.push_back(solver.solve(features.raw(f)));
-    if (!features.placement.empty()) {
-      place(solver.neighbourhood(), out.back(), features.placement[static_cast<std::size_t>(f)]);
-    }
+    out.push_back(reconstruct_frame(solver, features, f));
   }
   return out;
+}
+
+Positions reconstruct_frame(const Reconstructor& solver, const SequenceFeatures& features,
+                            int frame) {
+  Positions p = solver.solve(features.raw(frame));
+  if (!features.placement.empty()) {
+    place(solver.neighbourhood(), p, features.placement[static_cast<std::size_t>(frame)]);
+  }
+  return p;
 }
 
 Eigen::Matrix3Xd piece_offsets(const Neighbourhood& ring, const Positions& placed,

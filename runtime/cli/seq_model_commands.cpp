@@ -190,15 +190,21 @@ struct EvaluateArgs {
 int run_evaluate(const EvaluateArgs& a) {
   const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
   const seqnet::SequenceFeatures data = seqnet::read_feature_file(a.data);
-  const seqnet::Evaluation e = seqnet::evaluate(model, a.model, data, a.options);
+  seqnet::EvaluationOptions options = a.options;
+  options.data_path = a.data;
+  const seqnet::Evaluation e = seqnet::evaluate(model, a.model, data, options);
   int held = 0;
   for (const auto& p : e.pieces) held += p.count;
-  std::printf(
-      "%s: %llu iterations; held out (seed %llu, %g %%): %d of %zu frames of %s in %zu "
-      "pieces\n",
-      a.model.c_str(), static_cast<unsigned long long>(model.iteration),
-      static_cast<unsigned long long>(model.seed), 100.0 * a.options.held_out, held,
-      data.frames.size(), a.data.c_str(), e.pieces.size());
+  char how[64];
+  if (options.held_out_clips.empty()) {
+    std::snprintf(how, sizeof how, "seed %llu, %g %%", static_cast<unsigned long long>(model.seed),
+                  100.0 * options.held_out);
+  } else {
+    std::snprintf(how, sizeof how, "the clips named");
+  }
+  std::printf("%s: %llu iterations; held out (%s): %d of %zu frames of %s in %zu pieces\n",
+              a.model.c_str(), static_cast<unsigned long long>(model.iteration), how, held,
+              data.frames.size(), a.data.c_str(), e.pieces.size());
   for (const auto& p : e.pieces) {
     std::printf("  %s frames %d..%d\n", p.name.c_str(), p.first, p.first + p.count - 1);
   }
@@ -222,6 +228,16 @@ int run_evaluate(const EvaluateArgs& a) {
         c.gaps, a.options.gap, c.merged, 100.0 * a.options.completion.threshold, c.learned,
         c.feature_linear, c.vertex_linear, 100.0 * std::abs(1.0 - c.learned / best),
         c.learned <= best ? "below" : "above");
+  }
+  if (c.placed_frames > 0) {
+    const double change =
+        c.placed_vertex_linear > 0 ? 1.0 - c.placed / c.placed_vertex_linear : 0.0;
+    std::printf(
+        "complete the key meshes as seq complete does, placed, nothing aligned (mean vertex "
+        "error as a fraction of the bounding-box diagonal, %d frames): learned %.2f %%  linear "
+        "vertex interpolation %.2f %%  (%.0f %% %s than linear vertex interpolation)\n",
+        c.placed_frames, 100.0 * c.placed, 100.0 * c.placed_vertex_linear, 100.0 * std::abs(change),
+        change >= 0 ? "better" : "worse");
   }
   if (!e.change_generated.empty()) {
     std::printf(
@@ -294,6 +310,9 @@ void add_seq_model_commands(CLI::App& seq) {
   evaluate->add_option("FEATURES", ev->data, "the feature file it was trained on")->required();
   evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
       ->check(CLI::Range(0.0, 1.0));
+  evaluate->add_option("--held-out-clip", ev->options.held_out_clips,
+                       "the clip the model was trained with held out whole (seq train "
+                       "--held-out-clip) instead of the fraction; repeatable");
   evaluate->add_option("--gap", ev->options.gap, "completion: frames between keys")
       ->check(CLI::Range(1, 100000));
   evaluate

@@ -3,15 +3,23 @@
 // very step each frame generates the truth, linear extrapolation from three
 // frames is exact and from one is not, feature-space interpolation is exact
 // and vertex-space is not; the change per frame is the step's, and 0 for a
-// model that never moves; a model of another template is refused.
+// model that never moves; a model of another template is refused; on a
+// walking bar with its placement, the completion placed as `seq complete`
+// places it is measured against linear vertex interpolation with nothing
+// aligned, on the clips named, and the trainer's held-out line measures
+// the same.
 
 #include "animrt/learn/seqnet/evaluation.hpp"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <Eigen/Geometry>
+#include <numbers>
+
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/learn/seqnet/held_out_completion.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 #include "animrt/learn/seqnet/training.hpp"
 #include "net_test_util.hpp"
@@ -159,6 +167,97 @@ TEST(SeqEvaluation, AnotherTemplateIsRefused) {
     FAIL() << "accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("another template"), std::string::npos) << e.what();
+  }
+}
+
+// A bar (frame 0, the template) then two clips of 21 frames, both moving
+// at one constant velocity: "straight" keeps its pose, "turning" also turns
+// about its own centroid by 12 degrees a frame. Absolute frames, so the
+// features carry their placement.
+SequenceFeatures walking_bar() {
+  MeshSequence s = make_bar(3, 5, 4.0);
+  const Positions rest = s.frames.front();
+  const Eigen::Vector3d centre = rest.rowwise().mean();
+  const Eigen::Vector3d velocity(0.05, 0.02, 0.0);
+  for (const double turn : {0.0, std::numbers::pi / 15}) {
+    for (int t = 0; t < 21; ++t) {
+      const Eigen::Matrix3d r =
+          Eigen::AngleAxisd(turn * t, Eigen::Vector3d::UnitX()).toRotationMatrix();
+      s.frames.push_back(((r * (rest.colwise() - centre)).colwise() + centre).colwise() +
+                         velocity * t);
+    }
+  }
+  SequenceFeatures f = compute_features(s);
+  f.clips = {Clip{"straight", 1, 21, 25.0}, Clip{"turning", 22, 21, 25.0}};
+  return f;
+}
+
+TEST(SeqEvaluation, PlacedCompletionAgainstLinearVertexInterpolationOnNamedClips) {
+  const SequenceFeatures f = walking_bar();
+  const std::string path = nettest::temp_path("evaluation_walking_bar.feat");
+  write_feature_file(path, f);
+  // An untrained model as training starts it: the decoder's last layer at
+  // zero, so blended completion is linear interpolation of the key features.
+  ModelFile m = load_training_set({path}, 7).description;
+  ASSERT_EQ(m.shape.placement_nodes, 1);
+  m.shape.latent = 5;
+  m.shape.hidden = 6;
+  m.shape.window = 12;
+  m.seed = 7;
+  torch::manual_seed(3);
+  SeqNet net(m.shape, mesh_graph(m.shape.vertex_count, m.triangles));
+  net->zero_output_layer();
+  m.parameters = save_parameters(*net);
+  EvaluationOptions o = options();
+  o.horizons = {2};
+  o.change_frames = 0;
+  o.data_path = path;
+  const auto placed = [&](const ModelFile& model, const std::string& clip) {
+    o.held_out_clips = {clip};
+    const Evaluation e = evaluate(model, "m.model", f, o);
+    EXPECT_EQ(e.pieces.size(), 1U);
+    EXPECT_EQ(e.pieces.front().name, clip);
+    EXPECT_EQ(e.pieces.front().count, 21);
+    EXPECT_EQ(e.completion.placed_frames, 16);  // 4 gaps of 4 frames
+    return e.completion;
+  };
+  // Straight on: the figure where it is, interpolated either way.
+  const CompletionRow straight = placed(m, "straight");
+  EXPECT_LT(straight.placed, 1e-5);
+  EXPECT_LT(straight.placed_vertex_linear, 1e-9);
+  // Turning: the features turn the bar, its vertices' straight lines cut
+  // the corner (60 degrees between keys).
+  const CompletionRow turning = placed(m, "turning");
+  EXPECT_LT(turning.placed, 1e-5);
+  EXPECT_GT(turning.placed_vertex_linear, 0.02);
+  // The trainer's held-out line measures the same.
+  const HeldOutCompletion held =
+      measure_held_out_completion(m, load_training_set({path}, 7, 0.2, {"turning"}), o.gap);
+  EXPECT_EQ(held.gap, o.gap);
+  EXPECT_NEAR(held.placed, turning.placed, 1e-12);
+  EXPECT_NEAR(held.placed_interpolation, turning.placed_vertex_linear, 1e-12);
+  // A model whose every step adds a change completes off the truth, and
+  // worse than the vertices' straight lines.
+  ModelFile off = m;
+  bool found = false;
+  for (NamedArray& a : off.parameters) {
+    if (a.name != "decoder.4.self.bias") continue;
+    std::fill(a.values.begin(), a.values.end(), 0.05F);
+    found = true;
+  }
+  ASSERT_TRUE(found);
+  EXPECT_GT(placed(off, "straight").placed, 0.01);
+  EXPECT_GT(placed(off, "turning").placed, turning.placed_vertex_linear);
+  // A name that is no clip is refused, naming the file and the clips.
+  o.held_out_clips = {"walk"};
+  try {
+    evaluate(m, "m.model", f, o);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("no clip named 'walk' (the clips: straight, turning)"), std::string::npos)
+        << what;
   }
 }
 

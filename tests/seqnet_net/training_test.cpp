@@ -128,6 +128,12 @@ TEST(SeqTraining, MeshLossFallsOnATinyBar) {
   const ModelFile m = read_model_file(o.out);
   EXPECT_EQ(m.shape.kind, ModelKind::mesh);
   EXPECT_EQ(m.shape.vertex_count, 5 * 6 + 2);
+  // The features carry their placement: the held-out line also gives the
+  // completion placed against linear vertex interpolation.
+  const std::string text = log.str();
+  const auto line = text.find("held out at iteration 40: completion of 8-frame gaps ");
+  ASSERT_NE(line, std::string::npos) << text;
+  EXPECT_LT(text.find("; placed vertices ", line), text.find('\n', line)) << text;
 }
 
 TEST(SeqTraining, SameSeedRepeatsAndAResumeEqualsOneRun) {

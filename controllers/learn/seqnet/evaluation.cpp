@@ -7,6 +7,7 @@
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
+#include "animrt/learn/seqnet/held_out_completion.hpp"
 #include "animrt/learn/seqnet/interpolation.hpp"
 
 namespace animrt::seqnet {
@@ -29,6 +30,27 @@ double vertex_error(const Positions& truth, const Positions& got, const Neighbou
   return error_up_to_translation(truth, got, ring).mean * diagonal;
 }
 
+// Completion of every piece's keys as `seq complete` does it from key
+// meshes, placed, against linear interpolation of the keys' vertices
+// (the placed fields of CompletionRow).
+void complete_placed(const ModelFile& model, const std::string& model_path,
+                     const SequenceFeatures& data, const Reconstructor& solver,
+                     const std::vector<Clip>& pieces, const EvaluationOptions& o,
+                     SeqNetInference& net, CompletionRow& c) {
+  PlacedCompletion sums;
+  for (const Clip& p : pieces) {
+    std::vector<Positions> frames;
+    for (int f = p.first; f < p.first + p.count; ++f) {
+      frames.push_back(reconstruct_frame(solver, data, f));
+    }
+    add_placed_completion(model, model_path, net, frames, o.gap, o.completion, sums);
+  }
+  c.placed_frames = sums.frames;
+  if (sums.frames == 0) return;
+  c.placed = sums.network / sums.frames;
+  c.placed_vertex_linear = sums.interpolation / sums.frames;
+}
+
 }  // namespace
 
 Evaluation evaluate(const ModelFile& model, const std::string& model_path,
@@ -44,7 +66,8 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
   }
   Evaluation e;
   const int n = static_cast<int>(data.frames.size());
-  e.pieces = held_out_pieces(n, data.clips, o.held_out, model.seed, 0);
+  e.pieces = o.held_out_clips.empty() ? held_out_pieces(n, data.clips, o.held_out, model.seed, 0)
+                                      : named_clips(data.clips, o.held_out_clips, o.data_path);
   if (e.pieces.empty()) {
     throw InputError(Location{model_path, 0, 0}, "held out", "no held-out frames in the data");
   }
@@ -136,6 +159,9 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
         ++c.frames;
       }
     }
+  }
+  if (model.shape.placement_nodes > 0 && !data.placement.empty()) {
+    complete_placed(model, model_path, data, solver, e.pieces, o, net, c);
   }
   if (c.frames > 0) {
     c.learned /= c.frames;

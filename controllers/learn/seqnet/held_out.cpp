@@ -4,6 +4,8 @@
 #include <cmath>
 #include <random>
 
+#include "animrt/core/error.hpp"
+
 namespace animrt::seqnet {
 
 std::pair<int, int> held_out_block(int n, double fraction, std::uint64_t seed, int dataset) {
@@ -24,6 +26,30 @@ std::vector<Clip> held_out_pieces(int n, const std::vector<Clip>& clips, double 
     const int a = std::max(c.first, first);
     const int b = std::min(c.first + c.count, first + count);
     if (a < b) out.push_back(Clip{c.name, a, b - a, c.fps});
+  }
+  std::sort(out.begin(), out.end(), [](const Clip& x, const Clip& y) { return x.first < y.first; });
+  return out;
+}
+
+void check_clip_names(const std::vector<std::string>& wanted, const std::vector<std::string>& have,
+                      const std::string& file) {
+  for (const std::string& w : wanted) {
+    if (std::find(have.begin(), have.end(), w) != have.end()) continue;
+    std::string known;
+    for (const std::string& h : have) known += (known.empty() ? "" : ", ") + h;
+    throw InputError(Location{file, 0, 0}, "--held-out-clip",
+                     "no clip named '" + w + "' (the clips: " + known + ")");
+  }
+}
+
+std::vector<Clip> named_clips(const std::vector<Clip>& clips, const std::vector<std::string>& names,
+                              const std::string& file) {
+  std::vector<std::string> have;
+  for (const Clip& c : clips) have.push_back(c.name);
+  check_clip_names(names, have, file);
+  std::vector<Clip> out;
+  for (const Clip& c : clips) {
+    if (std::find(names.begin(), names.end(), c.name) != names.end()) out.push_back(c);
   }
   std::sort(out.begin(), out.end(), [](const Clip& x, const Clip& y) { return x.first < y.first; });
   return out;

@@ -15,6 +15,7 @@
 #include "animrt/controllers/seqnet/feature_file.hpp"
 #include "animrt/controllers/seqnet/joint_csv.hpp"
 #include "animrt/controllers/seqnet/placement_nodes.hpp"
+#include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/blas_kernels.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
@@ -44,6 +45,7 @@ void add_clip(TrainingSet& set, int dataset, const std::vector<std::vector<float
     Segment s;
     s.dataset = dataset;
     s.held_out = held;
+    s.first = start;
     s.count = stop - start;
     for (int f = start; f < stop; ++f) {
       const auto& v = frames[static_cast<std::size_t>(f)];
@@ -56,16 +58,6 @@ void add_clip(TrainingSet& set, int dataset, const std::vector<std::vector<float
 
 bool listed(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
-}
-
-void check_clip_names(const std::vector<std::string>& wanted, const std::vector<std::string>& have,
-                      const std::string& file) {
-  for (const std::string& w : wanted) {
-    if (listed(have, w)) continue;
-    std::string known;
-    for (const std::string& h : have) known += (known.empty() ? "" : ", ") + h;
-    fail(file, 0, 0, "--held-out-clip", "no clip named '" + w + "' (the clips: " + known + ")");
-  }
 }
 
 std::string duration(double seconds) {
@@ -91,7 +83,9 @@ std::vector<std::string> parameter_names(const SeqNetImpl& net) {
 }
 
 // "held out at iteration 200: completion of 9-frame gaps 2.30 %, linear
-// interpolation 1.39 % (65 % worse than interpolation)".
+// interpolation 1.39 % (65 % worse than interpolation)", then for mesh data
+// with its placement "; placed vertices 1.90 % of the diagonal, linear
+// vertex interpolation 3.49 % (46 % better)".
 std::string held_out_line(const HeldOutCompletion& h, int iteration) {
   if (h.gaps == 0) {
     return "held out at iteration " + std::to_string(iteration) +
@@ -102,12 +96,21 @@ std::string held_out_line(const HeldOutCompletion& h, int iteration) {
            ": the model's completion is not finite";
   }
   const double change = h.interpolation > 0 ? h.network / h.interpolation - 1.0 : 0.0;
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "held out at iteration %d: completion of %d-frame gaps %.2f %%, linear "
-                "interpolation %.2f %% (%.0f %% %s than interpolation)",
-                iteration, h.gap, 100.0 * h.network, 100.0 * h.interpolation,
-                100.0 * std::abs(change), change < 0 ? "better" : "worse");
+  char line[512];
+  int n = std::snprintf(line, sizeof line,
+                        "held out at iteration %d: completion of %d-frame gaps %.2f %%, linear "
+                        "interpolation %.2f %% (%.0f %% %s than interpolation)",
+                        iteration, h.gap, 100.0 * h.network, 100.0 * h.interpolation,
+                        100.0 * std::abs(change), change < 0 ? "better" : "worse");
+  if (h.placed >= 0 && n > 0 && n < static_cast<int>(sizeof line)) {
+    const double placed =
+        h.placed_interpolation > 0 ? h.placed / h.placed_interpolation - 1.0 : 0.0;
+    std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n),
+                  "; placed vertices %.2f %% of the diagonal, linear vertex interpolation "
+                  "%.2f %% (%.0f %% %s)",
+                  100.0 * h.placed, 100.0 * h.placed_interpolation, 100.0 * std::abs(placed),
+                  placed < 0 ? "better" : "worse");
+  }
   return line;
 }
 
@@ -176,6 +179,15 @@ TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64
     for (const Clip& c : clips) {
       add_clip(set, 0, frames, c.first, c.count,
                listed(held_out_clips, c.name) ? std::pair<int, int>{c.first, c.count} : block);
+    }
+    if (!f.placement.empty()) {
+      const Reconstructor solver(f.rest, f.triangles);
+      for (Segment& s : set.segments) {
+        if (!s.held_out) continue;
+        for (int k = s.first; k < s.first + s.count; ++k) {
+          s.placed.push_back(reconstruct_frame(solver, f, k));
+        }
+      }
     }
     return set;
   }

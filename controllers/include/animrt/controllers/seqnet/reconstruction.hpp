@@ -46,6 +46,9 @@ class Reconstructor {
 // when the features carry their placement, else each piece pinned at its
 // template vertex.
 std::vector<Positions> reconstruct_all(const SequenceFeatures& features);
+// Frame `frame` of a feature set so: `solver` of its template and triangles.
+Positions reconstruct_frame(const Reconstructor& solver, const SequenceFeatures& features,
+                            int frame);
 
 // The mean offset of every connected piece of `placed` from the same piece
 // of `frame` (3 x pieces), and `frame` with its pieces moved by such offsets:

@@ -17,6 +17,11 @@ namespace animrt::seqnet {
 
 struct EvaluationOptions {
   double held_out = 0.2;  // the trainer's fraction (its seed is the model's)
+  // Clips of the feature file held out whole instead of the fraction (the
+  // trainer's --held-out-clip); a name that is no clip is an InputError
+  // naming `data_path`.
+  std::vector<std::string> held_out_clips;
+  std::string data_path;
   std::vector<int> initial_frames{1, 3};
   std::vector<int> horizons{5, 10, 15};  // generated frames measured
   int gap = 9;                           // completion: frames between keys
@@ -43,6 +48,16 @@ struct CompletionRow {
   double learned = 0;
   double feature_linear = 0;
   double vertex_linear = 0;
+  // The same keys completed as `seq complete` completes key meshes (their
+  // features and body velocity taken from the keys alone) and placed, with
+  // nothing aligned: mean over the in-between frames of the mean vertex
+  // distance to the true frame as a fraction of its bounding-box diagonal,
+  // and the same for linear interpolation of the keys' vertices. Measured
+  // (placed_frames > 0) when the model has placement nodes and the feature
+  // file its placement.
+  int placed_frames = 0;
+  double placed = 0;
+  double placed_vertex_linear = 0;
 };
 
 struct Evaluation {

@@ -4,6 +4,7 @@
 // it out, and the evaluation, which measures on it.
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -21,5 +22,15 @@ std::pair<int, int> held_out_block(int n, double fraction, std::uint64_t seed, i
 // Without clips the whole set is one clip. `name` is the clip's.
 std::vector<Clip> held_out_pieces(int n, const std::vector<Clip>& clips, double fraction,
                                   std::uint64_t seed, int dataset);
+
+// Throws InputError naming `file` and --held-out-clip, listing the clips
+// `have`, for a name in `wanted` that is none of them.
+void check_clip_names(const std::vector<std::string>& wanted, const std::vector<std::string>& have,
+                      const std::string& file);
+
+// The clips named in `names` (--held-out-clip), held out whole, in frame
+// order; an unknown name is refused as by check_clip_names.
+std::vector<Clip> named_clips(const std::vector<Clip>& clips, const std::vector<std::string>& names,
+                              const std::string& file);
 
 }  // namespace animrt::seqnet

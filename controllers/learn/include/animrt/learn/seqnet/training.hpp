@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "animrt/controllers/seqnet/mesh_sequence.hpp"
 #include "animrt/controllers/seqnet/model_file.hpp"
 
 namespace animrt::seqnet {
@@ -18,8 +19,13 @@ namespace animrt::seqnet {
 struct Segment {
   int dataset = 0;
   bool held_out = false;
+  int first = 0;  // its first frame in its data file
   int count = 0;
   std::vector<float> values;
+  // A held-out segment of a feature file with its placement: its frames'
+  // vertices in absolute coordinates (what the placed completion is
+  // measured against).
+  std::vector<Positions> placed;
 };
 
 struct TrainingSet {
