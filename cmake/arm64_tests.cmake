@@ -30,6 +30,32 @@ set(arm64_left_out Mailbox.AReaderNeverSeesAHalfWrittenValue
     TelemetryRing.ProducerAndConsumerThreadsLoseNothing)
 list(JOIN arm64_left_out ":" arm64_left_out)
 
+# The tests' settings: their own sources at -O0, the code they test (the
+# libraries, the test support) at -O1: 11 s less compile CPU for 2 s more
+# under the emulator (docs/results/packaging.md#the-arm64-tier).
+function(animrt_arm64_test_settings target)
+  target_compile_options(${target} PRIVATE -O0)
+  target_link_libraries(${target} PRIVATE animrt_runtime animrt_sim animrt_arm64_test_support
+                        GTest::gtest GTest::gmock GTest::gtest_main)
+  target_compile_definitions(${target} PRIVATE ANIMRT_SOURCE_DIR="${ANIMRT_SOURCE_DIR}"
+                             ANIMRT_BINARY_DIR="${CMAKE_BINARY_DIR}")
+endfunction()
+
+# The standard library, gtest and yaml-cpp (what the 17 unity sources of the
+# four executables parse each, yaml-cpp 9 of them) as one precompiled header,
+# built once with the tests' settings and used by every executable
+# (REUSE_FROM), as the sanitizer build's test binaries do (tests/CMakeLists.txt).
+# At -O0 GCC 12's false -Warray-bounds from inside a precompiled header does
+# not arise (the warning needs the optimiser). CMake passes -Winvalid-pch:
+# a header that does not fit the flags fails the -Werror build.
+add_library(animrt_arm64_test_pch OBJECT tests/support/test_pch.cpp)
+animrt_arm64_test_settings(animrt_arm64_test_pch)
+target_precompile_headers(animrt_arm64_test_pch PRIVATE
+  <algorithm> <any> <array> <atomic> <chrono> <cmath> <condition_variable> <cstdint> <cstring>
+  <filesystem> <fstream> <functional> <iomanip> <iostream> <map> <memory> <mutex> <numeric>
+  <optional> <regex> <set> <span> <sstream> <string> <string_view> <thread> <tuple>
+  <unordered_map> <utility> <variant> <vector> <gtest/gtest.h> <yaml-cpp/yaml.h>)
+
 # COST: ctest starts the executables whose entries run longest (the lockstep
 # figures, then the loop) first, so that short entries fill the end.
 function(animrt_arm64_test name cost)
@@ -39,14 +65,8 @@ function(animrt_arm64_test name cost)
   add_executable(${target} ${srcs})
   # One unity source per test folder, as the native test binaries build.
   animrt_unity_by_folder(${target} "${srcs}")
-  # The tests' own sources at -O0, the code they test (the libraries, the
-  # test support) at -O1: 11 s less compile CPU for 2 s more under the
-  # emulator (docs/results/packaging.md#the-arm64-tier).
-  target_compile_options(${target} PRIVATE -O0)
-  target_link_libraries(${target} PRIVATE animrt_runtime animrt_sim animrt_arm64_test_support
-                        GTest::gtest GTest::gmock GTest::gtest_main)
-  target_compile_definitions(${target} PRIVATE ANIMRT_SOURCE_DIR="${ANIMRT_SOURCE_DIR}"
-                             ANIMRT_BINARY_DIR="${CMAKE_BINARY_DIR}")
+  animrt_arm64_test_settings(${target})
+  target_precompile_headers(${target} REUSE_FROM animrt_arm64_test_pch)
   # The suites of each folder, from the TEST(Suite, ...) lines of its sources.
   set(folders)
   foreach(src ${srcs})

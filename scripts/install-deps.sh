@@ -35,8 +35,9 @@ packages=(
   # mmdebstrap, fetching from Debian's archive; it also builds the arm64
   # sysroot of make test-arm64) and that root booted with
   # systemd (make test-boot: an ext4 image written by mkfs.ext4 -d, read
-  # back by debugfs; depmod for the guest's modules).
-  mmdebstrap e2fsprogs kmod
+  # back by debugfs; depmod for the guest's modules). uidmap: mmdebstrap run
+  # by a user (its unshare mode) needs newuidmap to build the sysroot.
+  mmdebstrap uidmap e2fsprogs kmod
 )
 # npm for the MCAP test's reader (below): Debian's, unless a Node.js with npm
 # is installed already (Debian's npm package conflicts with other Node builds).

@@ -126,7 +126,7 @@ def include_violations(root):
 # Anything in the runtime library's link closure whose name matches is a
 # learner or a dependency the loop must not carry.
 FORBIDDEN_LINKS = re.compile(
-    r"animrt_(learn|seq_corpus|evolve_mpi|seqnet_torch|sim|herd|evolve_dashboard|"
+    r"animrt_(learn|evolve|seq_corpus|evolve_mpi|seqnet_torch|sim|herd|evolve_dashboard|"
     r"herd_dashboard)\b|torch|c10|MPI|mpi|Recast|Detour|mujoco", re.IGNORECASE)
 
 
