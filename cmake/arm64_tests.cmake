@@ -50,11 +50,7 @@ endfunction()
 # a header that does not fit the flags fails the -Werror build.
 add_library(animrt_arm64_test_pch OBJECT tests/support/test_pch.cpp)
 animrt_arm64_test_settings(animrt_arm64_test_pch)
-target_precompile_headers(animrt_arm64_test_pch PRIVATE
-  <algorithm> <any> <array> <atomic> <chrono> <cmath> <condition_variable> <cstdint> <cstring>
-  <filesystem> <fstream> <functional> <iomanip> <iostream> <map> <memory> <mutex> <numeric>
-  <optional> <regex> <set> <span> <sstream> <string> <string_view> <thread> <tuple>
-  <unordered_map> <utility> <variant> <vector> <gtest/gtest.h> <yaml-cpp/yaml.h>)
+target_precompile_headers(animrt_arm64_test_pch PRIVATE ${ANIMRT_TEST_PCH_HEADERS})
 
 # COST: ctest starts the executables whose entries run longest (the lockstep
 # figures, then the loop) first, so that short entries fill the end.

@@ -68,23 +68,27 @@ Crowd::Crowd(NavWorld& world, std::span<const Agent> agents, CrowdParams params)
   wall_was_down_.assign(walls, 0);
   // A moving wall closes a gap when both ends of its long side meet a
   // static wall or the ground's edge (no figure passes between).
-  wall_in_gap_.assign(walls, 0);
   const NavWorldConfig& wc = world_.config();
-  for (std::size_t w = 0; w < walls; ++w) {
-    const Box& b = wc.moving[w].footprint;
+  wall_gaps_.clear();
+  for (const MovingObstacle& m : wc.moving) {
+    const Box& b = m.footprint;
     const Vec2 ax = heading_vector(b.yaw_rad), ay{-ax.y, ax.x};
-    const Vec2 along = b.size.x <= b.size.y ? ay : ax;
-    const double half = 0.5 * std::max(b.size.x, b.size.y);
+    const bool thin_x = b.size.x <= b.size.y;
+    WallGap g;
+    g.across = thin_x ? ax : ay;
+    g.along = thin_x ? ay : ax;
+    g.depth = 0.5 * std::min(b.size.x, b.size.y);
+    g.half = 0.5 * std::max(b.size.x, b.size.y);
     const double pass = 2.0 * wc.agent_radius_m;
-    bool closed = true;
-    for (const double end : {-half, half}) {
-      const Vec2 e = b.center + along * end;
+    g.closes_gap = true;
+    for (const double end : {-g.half, g.half}) {
+      const Vec2 e = b.center + g.along * end;
       bool shut = e.x - wc.bounds.xmin < pass || wc.bounds.xmax - e.x < pass ||
                   e.y - wc.bounds.ymin < pass || wc.bounds.ymax - e.y < pass;
       for (const Box& s : wc.walls) shut = shut || NavWorld::distance_to_box(e, s) < pass;
-      closed = closed && shut;
+      g.closes_gap = g.closes_gap && shut;
     }
-    wall_in_gap_[w] = closed ? 1 : 0;
+    wall_gaps_.push_back(g);
   }
   travelling_.assign(agents.size(), 0);
   backing_.assign(agents.size(), 0);
@@ -163,8 +167,20 @@ bool Crowd::request_target(int i, Vec2 target) {
   dtPolyRef ref = 0;
   float nearest[3];
   world_.query()->findNearestPoly(p.data(), ext, &world_.filter(), &ref, nearest);
-  has_target_[static_cast<std::size_t>(i)] = true;
-  target_[static_cast<std::size_t>(i)] = target;
+  const auto k = static_cast<std::size_t>(i);
+  if (!has_target_[k] || norm(target - target_[k]) > 1e-9) {
+    // A new target (a slot swapped while travelling): whether to wait for
+    // a moving wall is decided again for it, and a wait already begun
+    // sends the member back to the wall's face.
+    std::fill_n(wall_decided_.begin() + static_cast<std::ptrdiff_t>(k * wall_gaps_.size()),
+                wall_gaps_.size(), 0);
+    if (wall_of_[k] >= 0) {
+      wall_of_[k] = -1;
+      was_held_[k] = 0;
+    }
+  }
+  has_target_[k] = true;
+  target_[k] = target;
   return ref && crowd_->requestMoveTarget(i, ref, nearest);
 }
 
@@ -350,16 +366,14 @@ bool Crowd::wait_for_wall(double t, int i, std::span<const Agent> agents, Vec2& 
   const double speed = crowd_->getAgent(i)->params.maxSpeed;
   for (std::size_t w = 0; w < walls.size() && of < 0; ++w) {
     int& decided = wall_decided_[k * walls.size() + w];
-    if (!wall_in_gap_[w] || !world_.obstacle_down(w) || decided == wall_drop_[w]) continue;
+    const WallGap& g = wall_gaps_[w];
+    if (!g.closes_gap || !world_.obstacle_down(w) || decided == wall_drop_[w]) continue;
     decided = wall_drop_[w];
     const MovingObstacle& m = walls[w];
     const Box& b = m.footprint;
     // Through the box along its thin side.
-    const Vec2 ax = heading_vector(b.yaw_rad), ay{-ax.y, ax.x};
-    const bool thin_x = b.size.x <= b.size.y;
-    const Vec2 n = thin_x ? ax : ay, along = thin_x ? ay : ax;
-    const double depth = 0.5 * std::min(b.size.x, b.size.y);
-    const double half = 0.5 * std::max(b.size.x, b.size.y);
+    const Vec2 n = g.across, along = g.along;
+    const double depth = g.depth, half = g.half;
     const double r = a.radius + params_.avoidance_margin_m;
     const double clear = depth + r + 0.15;  // off the mesh the wall carves
     const Vec2 d = a.position - b.center;
@@ -373,9 +387,7 @@ bool Crowd::wait_for_wall(double t, int i, std::span<const Agent> agents, Vec2& 
     const auto to = world_.path_length(a.position, near);
     const auto on = world_.path_length(far, target_[k]);
     if (!to || !on || !(speed > 0.0)) continue;
-    const double u = t - m.phase_s;
-    const double local = u - std::floor(u / m.period_s) * m.period_s;
-    const double rises_in = std::max(0.0, m.down_fraction * m.period_s - local);
+    const double rises_in = std::max(0.0, m.down_fraction * m.period_s - m.time_in_period(t));
     const double through = std::max(*to / speed, rises_in) + (2.0 * clear + *on) / speed;
     if (through >= *round / speed) continue;
     of = static_cast<int>(w);

@@ -367,9 +367,7 @@ void NavWorld::update(double t, std::span<const Agent> agents) {
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     const MovingObstacle& m = config_.moving[i];
     ObstacleState& st = obstacles_[i];
-    const double u = t - m.phase_s;
-    const double local = u - std::floor(u / m.period_s) * m.period_s;
-    const bool want_down = local < m.down_fraction * m.period_s;
+    const bool want_down = m.time_in_period(t) < m.down_fraction * m.period_s;
     if (!want_down) {
       st.deferred_this_window = false;
       st.dropped_this_window = false;

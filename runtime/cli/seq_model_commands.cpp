@@ -19,6 +19,7 @@
 #include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/evaluation.hpp"
+#include "animrt/learn/seqnet/held_out.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -230,14 +231,12 @@ int run_evaluate(const EvaluateArgs& a) {
         c.learned <= best ? "below" : "above");
   }
   if (c.placed_frames > 0) {
-    const double change =
-        c.placed_vertex_linear > 0 ? 1.0 - c.placed / c.placed_vertex_linear : 0.0;
     std::printf(
         "complete the key meshes as seq complete does, placed, nothing aligned (mean vertex "
         "error as a fraction of the bounding-box diagonal, %d frames): learned %.2f %%  linear "
-        "vertex interpolation %.2f %%  (%.0f %% %s than linear vertex interpolation)\n",
-        c.placed_frames, 100.0 * c.placed, 100.0 * c.placed_vertex_linear, 100.0 * std::abs(change),
-        change >= 0 ? "better" : "worse");
+        "vertex interpolation %.2f %%  (%s than linear vertex interpolation)\n",
+        c.placed_frames, 100.0 * c.placed, 100.0 * c.placed_vertex_linear,
+        seqnet::compared_with(c.placed, c.placed_vertex_linear).c_str());
   }
   if (!e.change_generated.empty()) {
     std::printf(
@@ -308,11 +307,14 @@ void add_seq_model_commands(CLI::App& seq) {
       "generation, completion, change per frame");
   evaluate->add_option("MODEL", ev->model, "mesh model file (animrt seq train)")->required();
   evaluate->add_option("FEATURES", ev->data, "the feature file it was trained on")->required();
-  evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
-      ->check(CLI::Range(0.0, 1.0));
-  evaluate->add_option("--held-out-clip", ev->options.held_out_clips,
-                       "the clip the model was trained with held out whole (seq train "
-                       "--held-out-clip) instead of the fraction; repeatable");
+  auto* fraction =
+      evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
+          ->check(CLI::Range(0.0, 1.0));
+  evaluate
+      ->add_option("--held-out-clip", ev->options.held_out_clips,
+                   "the clip the model was trained with held out whole (seq train "
+                   "--held-out-clip) instead of the fraction; repeatable")
+      ->excludes(fraction);
   evaluate->add_option("--gap", ev->options.gap, "completion: frames between keys")
       ->check(CLI::Range(1, 100000));
   evaluate

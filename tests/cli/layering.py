@@ -48,6 +48,9 @@ def layer_of(rel):
     if rel.startswith("controllers/learn/seq_corpus/") or rel.startswith(
             "controllers/learn/include/animrt/learn/seq_corpus/"):
         return "learn_physics"
+    if rel.startswith(("controllers/learn/evolve/",
+                       "controllers/learn/include/animrt/learn/evolve/")):
+        return "learn_evolve"  # animrt_evolve, linked alone by the fuzz harnesses
     if rel.startswith("controllers/learn/"):
         return "learn"
     if rel.startswith("controllers/"):
@@ -74,6 +77,7 @@ ALLOWED = {
     "bridge": ({"core", "bridge"}, set()),
     "play": ({"core", "controllers"}, set()),
     "learn": ({"core", "controllers", "learn"}, set()),
+    "learn_evolve": ({"core", "controllers", "learn"}, set()),
     "learn_physics": ({"core", "controllers", "learn", "sim"}, set()),
     # sim implements two interfaces the runtime declares: posing a figure
     # (sim/mujoco) and standing behind a figure as its backend (the builder
@@ -88,6 +92,8 @@ ALLOWED = {
 
 # Header paths a rule set may not include even inside an allowed folder.
 FORBIDDEN_PREFIXES = {
+    # The evolver links no other learner (its fuzz harnesses link it alone).
+    "learn_evolve": ("animrt/learn/head", "animrt/learn/seqnet/", "animrt/learn/seq_corpus/"),
     "runtime": ("animrt/controllers/herd/",),  # Recast: animrt_herd, not the loop's
     # The loop knows no dashboard and no builder: they sit above it.
     "loop": ("animrt/controllers/herd/", "animrt/runtime/dashboard.hpp",

@@ -1,6 +1,7 @@
 #include "animrt/learn/seqnet/evaluation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "animrt/controllers/seqnet/placement_nodes.hpp"
@@ -45,6 +46,10 @@ void complete_placed(const ModelFile& model, const std::string& model_path,
     }
     add_placed_completion(model, model_path, net, frames, o.gap, o.completion, sums);
   }
+  if (sums.frames > 0 && !std::isfinite(sums.network)) {
+    throw InputError(Location{model_path, 0, 0}, "model",
+                     "its placed completion is not finite (a diverged or corrupt model)");
+  }
   c.placed_frames = sums.frames;
   if (sums.frames == 0) return;
   c.placed = sums.network / sums.frames;
@@ -67,7 +72,7 @@ Evaluation evaluate(const ModelFile& model, const std::string& model_path,
   Evaluation e;
   const int n = static_cast<int>(data.frames.size());
   e.pieces = o.held_out_clips.empty() ? held_out_pieces(n, data.clips, o.held_out, model.seed, 0)
-                                      : named_clips(data.clips, o.held_out_clips, o.data_path);
+                                      : named_clips(data.clips, n, o.held_out_clips, o.data_path);
   if (e.pieces.empty()) {
     throw InputError(Location{model_path, 0, 0}, "held out", "no held-out frames in the data");
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "animrt/core/error.hpp"
@@ -42,17 +43,27 @@ void check_clip_names(const std::vector<std::string>& wanted, const std::vector<
   }
 }
 
-std::vector<Clip> named_clips(const std::vector<Clip>& clips, const std::vector<std::string>& names,
-                              const std::string& file) {
+std::vector<Clip> named_clips(const std::vector<Clip>& clips, int frames,
+                              const std::vector<std::string>& names, const std::string& file) {
+  std::vector<Clip> all = clips;
+  if (all.empty()) all.push_back(Clip{"all", 0, frames, 0.0});
   std::vector<std::string> have;
-  for (const Clip& c : clips) have.push_back(c.name);
+  for (const Clip& c : all) have.push_back(c.name);
   check_clip_names(names, have, file);
   std::vector<Clip> out;
-  for (const Clip& c : clips) {
+  for (const Clip& c : all) {
     if (std::find(names.begin(), names.end(), c.name) != names.end()) out.push_back(c);
   }
   std::sort(out.begin(), out.end(), [](const Clip& x, const Clip& y) { return x.first < y.first; });
   return out;
+}
+
+std::string compared_with(double error, double reference) {
+  const double change = reference > 0 ? error / reference - 1.0 : 0.0;
+  char text[48];
+  std::snprintf(text, sizeof text, "%.0f %% %s", 100.0 * std::abs(change),
+                change < 0 ? "better" : "worse");
+  return text;
 }
 
 }  // namespace animrt::seqnet

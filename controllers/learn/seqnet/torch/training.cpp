@@ -86,6 +86,13 @@ std::vector<std::string> parameter_names(const SeqNetImpl& net) {
 // interpolation 1.39 % (65 % worse than interpolation)", then for mesh data
 // with its placement "; placed vertices 1.90 % of the diagonal, linear
 // vertex interpolation 3.49 % (46 % better)".
+// A fraction as a percentage with two decimals: "3.49 %".
+std::string percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f %%", 100.0 * fraction);
+  return text;
+}
+
 std::string held_out_line(const HeldOutCompletion& h, int iteration) {
   if (h.gaps == 0) {
     return "held out at iteration " + std::to_string(iteration) +
@@ -95,21 +102,14 @@ std::string held_out_line(const HeldOutCompletion& h, int iteration) {
     return "held out at iteration " + std::to_string(iteration) +
            ": the model's completion is not finite";
   }
-  const double change = h.interpolation > 0 ? h.network / h.interpolation - 1.0 : 0.0;
-  char line[512];
-  int n = std::snprintf(line, sizeof line,
-                        "held out at iteration %d: completion of %d-frame gaps %.2f %%, linear "
-                        "interpolation %.2f %% (%.0f %% %s than interpolation)",
-                        iteration, h.gap, 100.0 * h.network, 100.0 * h.interpolation,
-                        100.0 * std::abs(change), change < 0 ? "better" : "worse");
-  if (h.placed >= 0 && n > 0 && n < static_cast<int>(sizeof line)) {
-    const double placed =
-        h.placed_interpolation > 0 ? h.placed / h.placed_interpolation - 1.0 : 0.0;
-    std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n),
-                  "; placed vertices %.2f %% of the diagonal, linear vertex interpolation "
-                  "%.2f %% (%.0f %% %s)",
-                  100.0 * h.placed, 100.0 * h.placed_interpolation, 100.0 * std::abs(placed),
-                  placed < 0 ? "better" : "worse");
+  std::string line = "held out at iteration " + std::to_string(iteration) + ": completion of " +
+                     std::to_string(h.gap) + "-frame gaps " + percent(h.network) +
+                     ", linear interpolation " + percent(h.interpolation) + " (" +
+                     compared_with(h.network, h.interpolation) + " than interpolation)";
+  if (h.placed >= 0) {
+    line += "; placed vertices " + percent(h.placed) + " of the diagonal, linear vertex " +
+            "interpolation " + percent(h.placed_interpolation) + " (" +
+            compared_with(h.placed, h.placed_interpolation) + ")";
   }
   return line;
 }

@@ -171,7 +171,12 @@ class Crowd {
   std::vector<int> wall_decided_;
   std::vector<int> wall_drop_;       // per moving wall: drops seen, counting this one
   std::vector<char> wall_was_down_;  // per moving wall: down at the last step
-  std::vector<char> wall_in_gap_;    // per moving wall: it closes a gap between walls
+  struct WallGap {     // per moving wall, from its footprint
+    Vec2 across, along;  // unit axes through its thin and along its long side
+    double depth = 0.0, half = 0.0;  // half its thickness and half its length
+    bool closes_gap = false;         // both ends meet a static wall or the ground's edge
+  };
+  std::vector<WallGap> wall_gaps_;
   double dt_ = 0.0;
   double last_t_ = -1e300;
   bool stepped_ = false;

@@ -10,6 +10,7 @@
 // Recast yaw).
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -34,6 +35,12 @@ struct MovingObstacle {
   double period_s = 8.0;
   double down_fraction = 0.5;
   double phase_s = 0.0;
+  // Time into the current period at time t; the wall is down for the
+  // first down_fraction of each period.
+  double time_in_period(double t) const {
+    const double u = t - phase_s;
+    return u - std::floor(u / period_s) * period_s;
+  }
 };
 
 struct NavWorldConfig {

@@ -29,8 +29,13 @@ void check_clip_names(const std::vector<std::string>& wanted, const std::vector<
                       const std::string& file);
 
 // The clips named in `names` (--held-out-clip), held out whole, in frame
-// order; an unknown name is refused as by check_clip_names.
-std::vector<Clip> named_clips(const std::vector<Clip>& clips, const std::vector<std::string>& names,
-                              const std::string& file);
+// order; an unknown name is refused as by check_clip_names. A file of
+// `frames` frames without clips is one clip, "all", as the trainer reads it.
+std::vector<Clip> named_clips(const std::vector<Clip>& clips, int frames,
+                              const std::vector<std::string>& names, const std::string& file);
+
+// An error against a reference's, as the held-out lines print it: "46 %
+// better" (smaller) or "3 % worse" (not smaller).
+std::string compared_with(double error, double reference);
 
 }  // namespace animrt::seqnet
