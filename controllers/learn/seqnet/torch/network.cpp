@@ -9,6 +9,7 @@
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/dense_kernel.hpp"
+#include "animrt/learn/seqnet/lstm_step.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
 namespace animrt::seqnet {
@@ -422,6 +423,7 @@ struct DenseTape {
 struct DenseTapes {
   bool on = false;
   std::vector<std::shared_ptr<DenseTape>> latent, hidden;  // one per run
+  std::vector<c10::intrusive_ptr<LstmPack>> lstm;            // one per run
 };
 
 namespace {
@@ -459,8 +461,13 @@ void SeqNetImpl::finish_gradients() {
     add_gradient(from_hidden->weight, w);
     add_gradient(from_hidden->bias, b);
   }
+  auto lstm_params = lstm->named_parameters();
+  for (const auto& pack : tapes_->lstm) {
+    for (const auto& [name, g] : lstm_gradients(*pack)) add_gradient(lstm_params[name], g);
+  }
   tapes_->latent.clear();
   tapes_->hidden.clear();
+  tapes_->lstm.clear();
 }
 
 LstmState SeqNetImpl::initial_state(int batch, double sign) const {
@@ -487,6 +494,9 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   // activations of the convolutions, by the loops of dense_kernel.hpp.
   const bool inner = tape && shape_.kind == ModelKind::mesh;
   c10::intrusive_ptr<DensePack> latent_pack, hidden_pack;
+  // Taped steps run the LSTM as one node per step (lstm_step.hpp).
+  c10::intrusive_ptr<LstmPack> lstm_pack;
+  if (tape) lstm_pack = tapes_->lstm.emplace_back(pack_lstm(*lstm));
   if (inner) {
     latent_pack = pack_dense(weight);
     hidden_pack = pack_dense(from_hidden->weight);
@@ -508,9 +518,16 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
     const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
     if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
-    auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
-    state = next_state;
-    const torch::Tensor o = out.squeeze(0);
+    torch::Tensor o;
+    if (lstm_pack) {
+      auto [h, c] = lstm_step(z, std::get<0>(state), std::get<1>(state), lstm_pack);
+      o = h[shape_.lstm_layers - 1];
+      state = {h, c};
+    } else {
+      auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
+      state = next_state;
+      o = out.squeeze(0);
+    }
     torch::Tensor change;
     if (inner) {
       change = decode_batch_inner(hidden_tape->apply_batch_inner(
