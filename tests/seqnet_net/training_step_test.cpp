@@ -226,7 +226,7 @@ TEST(SeqTrainingStep, RingRowsSortAndSumLikeACoalescedSparseMatrix) {
 TEST(SeqTrainingStep, FusedLstmStepComputesWhatLibtorchsLstmDoes) {
   torch::set_num_threads(1);
   torch::manual_seed(23);
-  const int layers = 2, in = 5, hidden = 7, batch = 3, steps = 3;
+  const int layers = 2, in = 5, hidden = 7, batch = 19, steps = 3;
   torch::nn::LSTM plain(torch::nn::LSTMOptions(in, hidden).num_layers(layers));
   torch::nn::LSTM fused(torch::nn::LSTMOptions(in, hidden).num_layers(layers));
   {
@@ -256,14 +256,17 @@ TEST(SeqTrainingStep, FusedLstmStepComputesWhatLibtorchsLstmDoes) {
   }
   std::tie(a.h, a.c) = state;
   a.loss = a.loss + (a.c * wc).sum();
+  // The fused step's states have the batch innermost, [layers, hidden, B].
   const c10::intrusive_ptr<LstmPack> pack = pack_lstm(*fused);
-  b.h = b.h0;
-  b.c = b.c0;
+  b.h = b.h0.transpose(1, 2);
+  b.c = b.c0.transpose(1, 2);
   b.loss = torch::zeros({});
   for (int t = 0; t < steps; ++t) {
     std::tie(b.h, b.c) = lstm_step(b.z[t], b.h, b.c, pack);
-    b.loss = b.loss + (b.h[layers - 1] * wh[t]).sum();
+    b.loss = b.loss + (b.h[layers - 1].t() * wh[t]).sum();
   }
+  b.h = b.h.transpose(1, 2);
+  b.c = b.c.transpose(1, 2);
   b.loss = b.loss + (b.c * wc).sum();
   EXPECT_LT(worst_relative(b.h, a.h), 1e-5);
   EXPECT_LT(worst_relative(b.c, a.c), 1e-5);

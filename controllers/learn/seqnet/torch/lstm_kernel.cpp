@@ -18,57 +18,82 @@ float tanh_by_sigmoid(float a) { return 2.0F / (1.0F + std::exp(-2.0F * a)) - 1.
 }  // namespace
 
 void lstm_cell_forward(float* gates, const float* c, float* c_next, float* h_next, float* tanh_c,
-                       int batch, int hidden) {
-  const auto nh = static_cast<std::size_t>(hidden);
-  for (std::size_t n = 0; n < static_cast<std::size_t>(batch); ++n) {
-    float* __restrict g = gates + n * 4 * nh;
-    const float* __restrict cr = c + n * nh;
-    float* __restrict cn = c_next + n * nh;
-    float* __restrict hn = h_next + n * nh;
-    float* __restrict tc = tanh_c + n * nh;
-    for (std::size_t j = 0; j < nh; ++j) {
-      const float i = sigmoid(g[j]);
-      const float f = sigmoid(g[nh + j]);
-      const float u = tanh_by_sigmoid(g[2 * nh + j]);
-      const float o = sigmoid(g[3 * nh + j]);
-      g[j] = i;
-      g[nh + j] = f;
-      g[2 * nh + j] = u;
-      g[3 * nh + j] = o;
-      const float next = f * cr[j] + i * u;
-      const float t = tanh_by_sigmoid(next);
-      cn[j] = next;
-      tc[j] = t;
-      hn[j] = o * t;
-    }
+                       int count) {
+  const auto n = static_cast<std::size_t>(count);
+  float* __restrict gi = gates;
+  float* __restrict gf = gates + n;
+  float* __restrict gg = gates + 2 * n;
+  float* __restrict go = gates + 3 * n;
+  const float* __restrict cr = c;
+  float* __restrict cn = c_next;
+  float* __restrict hn = h_next;
+  float* __restrict tc = tanh_c;
+  for (std::size_t k = 0; k < n; ++k) {
+    const float i = sigmoid(gi[k]);
+    const float f = sigmoid(gf[k]);
+    const float u = tanh_by_sigmoid(gg[k]);
+    const float o = sigmoid(go[k]);
+    gi[k] = i;
+    gf[k] = f;
+    gg[k] = u;
+    go[k] = o;
+    const float next = f * cr[k] + i * u;
+    const float t = tanh_by_sigmoid(next);
+    cn[k] = next;
+    tc[k] = t;
+    hn[k] = o * t;
   }
 }
+
+namespace {
+
+// h's gradient from one array or the sum of two: TWO known at compile time
+// so that the vectorised loop never reads a null `gh_b`.
+template <bool TWO>
+[[gnu::always_inline]] inline void cell_backward(const float* gates, const float* c,
+                                                 const float* tanh_c, const float* gh_a,
+                                                 const float* gh_b, const float* gc,
+                                                 float* d_gates, float* gc_prev, std::size_t n) {
+  const float* __restrict gi = gates;
+  const float* __restrict gf = gates + n;
+  const float* __restrict gg = gates + 2 * n;
+  const float* __restrict go = gates + 3 * n;
+  const float* __restrict cr = c;
+  const float* __restrict tc = tanh_c;
+  const float* __restrict ha = gh_a;
+  const float* __restrict hb = gh_b;
+  const float* __restrict gcn = gc;
+  float* __restrict di = d_gates;
+  float* __restrict df = d_gates + n;
+  float* __restrict dg = d_gates + 2 * n;
+  float* __restrict dout = d_gates + 3 * n;
+  float* __restrict gp = gc_prev;
+#pragma omp simd
+  for (std::size_t k = 0; k < n; ++k) {
+    float dh = ha[k];
+    if constexpr (TWO) dh += hb[k];
+    const float i = gi[k], f = gf[k], u = gg[k], o = go[k];
+    const float t = tc[k];
+    const float dc = gcn[k] + dh * o * (1.0F - t * t);
+    di[k] = dc * u * i * (1.0F - i);
+    df[k] = dc * cr[k] * f * (1.0F - f);
+    dg[k] = dc * i * (1.0F - u * u);
+    dout[k] = dh * t * o * (1.0F - o);
+    gp[k] = dc * f;
+  }
+}
+
+}  // namespace
 
 ANIMRT_VECTOR_CLONES
 void lstm_cell_backward(const float* gates, const float* c, const float* tanh_c, const float* gh_a,
                         const float* gh_b, const float* gc, float* d_gates, float* gc_prev,
-                        int batch, int hidden) {
-  const auto nh = static_cast<std::size_t>(hidden);
-  for (std::size_t n = 0; n < static_cast<std::size_t>(batch); ++n) {
-    const float* __restrict g = gates + n * 4 * nh;
-    const float* __restrict cr = c + n * nh;
-    const float* __restrict tc = tanh_c + n * nh;
-    float* __restrict d = d_gates + n * 4 * nh;
-    float* __restrict gp = gc_prev + n * nh;
-#pragma omp simd
-    for (std::size_t j = 0; j < nh; ++j) {
-      float dh = 0.0F;
-      if (gh_a != nullptr) dh += gh_a[n * nh + j];
-      if (gh_b != nullptr) dh += gh_b[n * nh + j];
-      const float i = g[j], f = g[nh + j], u = g[2 * nh + j], o = g[3 * nh + j];
-      const float t = tc[j];
-      const float dc = (gc != nullptr ? gc[n * nh + j] : 0.0F) + dh * o * (1.0F - t * t);
-      d[j] = dc * u * i * (1.0F - i);
-      d[nh + j] = dc * cr[j] * f * (1.0F - f);
-      d[2 * nh + j] = dc * i * (1.0F - u * u);
-      d[3 * nh + j] = dh * t * o * (1.0F - o);
-      gp[j] = dc * f;
-    }
+                        int count) {
+  const auto n = static_cast<std::size_t>(count);
+  if (gh_b != nullptr) {
+    cell_backward<true>(gates, c, tanh_c, gh_a, gh_b, gc, d_gates, gc_prev, n);
+  } else {
+    cell_backward<false>(gates, c, tanh_c, gh_a, gh_b, gc, d_gates, gc_prev, n);
   }
 }
 

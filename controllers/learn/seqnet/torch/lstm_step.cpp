@@ -1,5 +1,10 @@
 #include "animrt/learn/seqnet/lstm_step.hpp"
 
+#include <ATen/Parallel.h>
+
+#include <cstring>
+
+#include "animrt/learn/seqnet/dense_kernel.hpp"
 #include "animrt/learn/seqnet/lstm_kernel.hpp"
 
 namespace animrt::seqnet {
@@ -13,14 +18,21 @@ c10::intrusive_ptr<LstmPack> pack_lstm(torch::nn::LSTMImpl& lstm) {
   p->layers = static_cast<int>(o.num_layers());
   p->hidden = o.hidden_size();
   const auto params = lstm.named_parameters();
+  const auto gates = static_cast<int>(4 * p->hidden);
   for (int l = 0; l < p->layers; ++l) {
     const std::string k = "_l" + std::to_string(l);
-    const torch::Tensor wi = params["weight_ih" + k].detach(), wh = params["weight_hh" + k].detach();
-    p->in.push_back(wi.size(1));
-    p->weight_t.push_back(torch::cat({wi, wh}, 1).t().contiguous());
-    p->weight_x.push_back(wi.contiguous());
-    p->weight_h.push_back(wh.contiguous());
-    p->bias.push_back(params["bias_ih" + k].detach() + params["bias_hh" + k].detach());
+    const torch::Tensor w =
+        torch::cat({params["weight_ih" + k].detach(), params["weight_hh" + k].detach()}, 1)
+            .contiguous();
+    const auto cols = static_cast<int>(w.size(1));
+    p->in.push_back(cols - p->hidden);
+    auto& f = p->forward.emplace_back(dense_packed_size(gates, cols));
+    auto& b = p->backward.emplace_back(dense_packed_size(cols, gates));
+    pack_dense_rows(w.data_ptr<float>(), gates, cols, cols, 1, f.data());
+    pack_dense_rows(w.data_ptr<float>(), cols, gates, 1, cols, b.data());
+    const torch::Tensor bias =
+        (params["bias_ih" + k].detach() + params["bias_hh" + k].detach()).contiguous();
+    p->bias.emplace_back(bias.data_ptr<float>(), bias.data_ptr<float>() + gates);
   }
   p->inputs.resize(static_cast<std::size_t>(p->layers));
   p->grads.resize(static_cast<std::size_t>(p->layers));
@@ -29,36 +41,57 @@ c10::intrusive_ptr<LstmPack> pack_lstm(torch::nn::LSTMImpl& lstm) {
 
 namespace {
 
+constexpr std::int64_t kLstmGrain = 4;  // blocks of output rows a thread takes at least
+
+// y [rows, B] = packed x [cols, B] (+ bias), the blocks split between threads.
+void product(const std::vector<float>& packed, const float* bias, const torch::Tensor& x, int rows,
+             torch::Tensor& y) {
+  const auto cols = static_cast<int>(x.size(0)), batch = static_cast<int>(x.size(1));
+  const auto blocks = (rows + kDenseRows - 1) / kDenseRows;
+  at::parallel_for(0, blocks, kLstmGrain, [&](std::int64_t first, std::int64_t last) {
+    dense_batch_inner(packed.data(), bias, x.data_ptr<float>(), rows, cols, batch,
+                      y.data_ptr<float>(), static_cast<int>(first), static_cast<int>(last));
+  });
+}
+
 struct LstmStep : torch::autograd::Function<LstmStep> {
   static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx,
                                                 const torch::Tensor& z, const torch::Tensor& h,
                                                 const torch::Tensor& c,
                                                 const c10::intrusive_ptr<LstmPack>& p) {
-    const std::int64_t batch = z.size(0), hidden = p->hidden;
-    TORCH_CHECK(z.dim() == 2 && z.size(1) == p->in[0] && z.scalar_type() == torch::kFloat32 &&
-                    h.sizes() == c.sizes() && h.size(0) == p->layers && h.size(1) == batch &&
-                    h.size(2) == hidden,
-                "fused LSTM step: z must be float [B, in], h and c [layers, B, hidden]");
+    const std::int64_t batch = z.size(0), hidden = p->hidden, in = p->in[0];
+    TORCH_CHECK(z.dim() == 2 && z.size(1) == in && z.scalar_type() == torch::kFloat32 &&
+                    h.sizes() == c.sizes() && h.size(0) == p->layers && h.size(1) == hidden &&
+                    h.size(2) == batch,
+                "fused LSTM step: z must be float [B, in], h and c [layers, hidden, B]");
     const torch::Tensor hc = h.contiguous(), cc = c.contiguous();
     torch::Tensor h_next = torch::empty_like(hc), c_next = torch::empty_like(cc);
+    const auto count = static_cast<int>(hidden * batch);
     std::vector<torch::Tensor> gates, tanh_c;
     std::vector<std::int64_t> slots;
-    torch::Tensor x = z.contiguous();
     for (int l = 0; l < p->layers; ++l) {
-      const torch::Tensor xh = torch::cat({x, hc[l]}, 1);
-      torch::Tensor a = torch::addmm(p->bias[l], xh, p->weight_t[l]);
-      torch::Tensor t = torch::empty({batch, hidden}, z.options());
-      torch::Tensor hn = h_next[l], cn = c_next[l];
-      lstm_cell_forward(a.data_ptr<float>(), cc[l].data_ptr<float>(), cn.data_ptr<float>(),
-                        hn.data_ptr<float>(), t.data_ptr<float>(), static_cast<int>(batch),
-                        static_cast<int>(hidden));
-      auto& inputs = p->inputs[static_cast<std::size_t>(l)];
+      const auto k = static_cast<std::size_t>(l);
+      const std::int64_t width = p->in[k];
+      // [x h] with the batch innermost: z transposed, or the layer below's h.
+      torch::Tensor xh = torch::empty({width + hidden, batch}, z.options());
+      float* xp = xh.data_ptr<float>();
+      if (l == 0) {
+        xh.slice(0, 0, width).copy_(z.t());
+      } else {
+        std::memcpy(xp, h_next[l - 1].data_ptr<float>(), sizeof(float) * count);
+      }
+      std::memcpy(xp + width * batch, hc[l].data_ptr<float>(), sizeof(float) * count);
+      torch::Tensor a = torch::empty({4 * hidden, batch}, z.options());
+      product(p->forward[k], p->bias[k].data(), xh, static_cast<int>(4 * hidden), a);
+      torch::Tensor t = torch::empty({hidden, batch}, z.options());
+      lstm_cell_forward(a.data_ptr<float>(), cc[l].data_ptr<float>(), c_next[l].data_ptr<float>(),
+                        h_next[l].data_ptr<float>(), t.data_ptr<float>(), count);
+      auto& inputs = p->inputs[k];
       slots.push_back(static_cast<std::int64_t>(inputs.size()));
       inputs.push_back(xh);
-      p->grads[static_cast<std::size_t>(l)].emplace_back();
+      p->grads[k].emplace_back();
       gates.push_back(a);
       tanh_c.push_back(t);
-      x = hn;
     }
     ctx->saved_data["p"] = c10::IValue::make_capsule(p);
     ctx->saved_data["gates"] = gates;
@@ -76,24 +109,27 @@ struct LstmStep : torch::autograd::Function<LstmStep> {
     const std::vector<std::int64_t> slots = ctx->saved_data["slots"].toIntVector();
     const torch::Tensor c = ctx->saved_data["c"].toTensor();
     const torch::Tensor gh = grad[0].contiguous(), gc = grad[1].contiguous();
-    const std::int64_t batch = c.size(1), hidden = p->hidden;
+    const std::int64_t hidden = p->hidden, batch = c.size(2);
+    const auto count = static_cast<int>(hidden * batch);
     torch::Tensor gh_prev = torch::empty_like(c), gc_prev = torch::empty_like(c);
     torch::Tensor from_above;  // the gradient of layer l's output from layer l + 1's input
     for (int l = p->layers - 1; l >= 0; --l) {
       const auto k = static_cast<std::size_t>(l);
-      torch::Tensor d = torch::empty({batch, 4 * hidden}, c.options());
-      torch::Tensor gcp = gc_prev[l];
+      const std::int64_t width = p->in[k];
+      torch::Tensor d = torch::empty({4 * hidden, batch}, c.options());
       lstm_cell_backward(gates[k].data_ptr<float>(), c[l].data_ptr<float>(),
                          tanh_c[k].data_ptr<float>(), gh[l].data_ptr<float>(),
                          from_above.defined() ? from_above.data_ptr<float>() : nullptr,
-                         gc[l].data_ptr<float>(), d.data_ptr<float>(), gcp.data_ptr<float>(),
-                         static_cast<int>(batch), static_cast<int>(hidden));
-      torch::Tensor ghp = gh_prev[l];
-      torch::mm_out(ghp, d, p->weight_h[k]);
-      from_above = torch::mm(d, p->weight_x[k]);
+                         gc[l].data_ptr<float>(), d.data_ptr<float>(),
+                         gc_prev[l].data_ptr<float>(), count);
+      torch::Tensor gxh = torch::empty({width + hidden, batch}, c.options());
+      product(p->backward[k], nullptr, d, static_cast<int>(width + hidden), gxh);
+      std::memcpy(gh_prev[l].data_ptr<float>(), gxh.data_ptr<float>() + width * batch,
+                  sizeof(float) * count);
+      from_above = gxh.slice(0, 0, width);  // the leading rows: contiguous
       p->grads[k][static_cast<std::size_t>(slots[k])] = d;
     }
-    return {from_above, gh_prev, gc_prev, torch::Tensor()};
+    return {from_above.t(), gh_prev, gc_prev, torch::Tensor()};
   }
 };
 
@@ -118,8 +154,9 @@ std::vector<std::pair<std::string, torch::Tensor>> lstm_gradients(const LstmPack
       g.push_back(pack.grads[k][s]);
     }
     if (g.empty()) continue;
-    const torch::Tensor gs = torch::cat(g), xs = torch::cat(x);
-    const torch::Tensor w = torch::mm(gs.t(), xs), b = gs.sum(0);
+    // [4H, steps B] by [steps B, in + H]: every step's d [x h]^T summed.
+    const torch::Tensor gs = torch::cat(g, 1), xs = torch::cat(x, 1);
+    const torch::Tensor w = torch::mm(gs, xs.t()), b = gs.sum(1);
     const std::string n = "_l" + std::to_string(l);
     out.emplace_back("weight_ih" + n, w.slice(1, 0, pack.in[k]));
     out.emplace_back("weight_hh" + n, w.slice(1, pack.in[k]));

@@ -494,9 +494,14 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   // activations of the convolutions, by the loops of dense_kernel.hpp.
   const bool inner = tape && shape_.kind == ModelKind::mesh;
   c10::intrusive_ptr<DensePack> latent_pack, hidden_pack;
-  // Taped steps run the LSTM as one node per step (lstm_step.hpp).
+  // Taped steps run the LSTM as one node per step (lstm_step.hpp), on
+  // states with the batch innermost.
   c10::intrusive_ptr<LstmPack> lstm_pack;
-  if (tape) lstm_pack = tapes_->lstm.emplace_back(pack_lstm(*lstm));
+  if (tape) {
+    lstm_pack = tapes_->lstm.emplace_back(pack_lstm(*lstm));
+    state = {std::get<0>(state).transpose(1, 2).contiguous(),
+             std::get<1>(state).transpose(1, 2).contiguous()};
+  }
   if (inner) {
     latent_pack = pack_dense(weight);
     hidden_pack = pack_dense(from_hidden->weight);
@@ -518,10 +523,11 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
     const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
     if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
-    torch::Tensor o;
+    torch::Tensor o, o_inner;  // [B, hidden], and [hidden, B] from the fused step
     if (lstm_pack) {
       auto [h, c] = lstm_step(z, std::get<0>(state), std::get<1>(state), lstm_pack);
-      o = h[shape_.lstm_layers - 1];
+      o_inner = h[shape_.lstm_layers - 1];
+      o = o_inner.t();
       state = {h, c};
     } else {
       auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
@@ -530,8 +536,8 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
     }
     torch::Tensor change;
     if (inner) {
-      change = decode_batch_inner(hidden_tape->apply_batch_inner(
-          hidden_tape, o.t().contiguous(), hidden_pack, from_hidden->bias));
+      change = decode_batch_inner(
+          hidden_tape->apply_batch_inner(hidden_tape, o_inner, hidden_pack, from_hidden->bias));
     } else if (tape) {
       change = decode_from(
           hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias));

@@ -1,8 +1,9 @@
 #pragma once
 // One step of a multi-layer LSTM (libtorch's nn::LSTM: gates in the order
 // input, forget, cell, output; biases b_ih and b_hh) as one autograd node:
-// per layer one product of [x h] with the stacked weights and one pass of
-// lstm_kernel.hpp's loops, forward and backward. The chain is
+// per layer one product of the stacked weights with [x h] (dense_kernel.hpp's
+// loops, the batch innermost, the weights packed once per chain) and one
+// pass of lstm_kernel.hpp's loops, forward and backward. The chain is
 // autoregressive (each step's input is made from the previous step's
 // output), so the steps cannot be one call over the window; libtorch's LSTM
 // ran a few dozen operations per step instead of a few.
@@ -14,6 +15,8 @@
 
 #include <torch/torch.h>
 
+#include <cstdint>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,12 +27,11 @@ struct LstmPack : torch::CustomClassHolder {
   int layers = 0;
   std::int64_t hidden = 0;
   std::vector<std::int64_t> in;           // each layer's input width
-  std::vector<torch::Tensor> weight_t;    // [in + H, 4H]: (W_ih W_hh)^T, forward
-  std::vector<torch::Tensor> weight_x;    // [4H, in]: W_ih, the input's gradient
-  std::vector<torch::Tensor> weight_h;    // [4H, H]: W_hh, the state's gradient
-  std::vector<torch::Tensor> bias;        // [4H]: b_ih + b_hh
-  // Per layer, per step: [x h] and the gates' pre-activation gradient
-  // (undefined where backward did not reach).
+  // Per layer, W = (W_ih W_hh) [4H, in + H] packed for forward and W^T
+  // for the gradient of [x h]; the bias b_ih + b_hh.
+  std::vector<std::vector<float>> forward, backward, bias;
+  // Per layer, per step: [x h] and the gates' pre-activation gradient,
+  // the batch innermost (undefined where backward did not reach).
   std::vector<std::vector<torch::Tensor>> inputs, grads;
 };
 
@@ -37,8 +39,9 @@ struct LstmPack : torch::CustomClassHolder {
 // batch second, with biases).
 c10::intrusive_ptr<LstmPack> pack_lstm(torch::nn::LSTMImpl& lstm);
 
-// z [B, in], state h and c [layers, B, H] -> the next state; the output is
-// the next h's last layer. Gradients flow to z and the state.
+// z [B, in], state h and c [layers, H, B] (the batch innermost) -> the
+// next state so laid out; the output is the next h's last layer, [H, B].
+// Gradients flow to z and the state.
 std::pair<torch::Tensor, torch::Tensor> lstm_step(const torch::Tensor& z, const torch::Tensor& h,
                                                   const torch::Tensor& c,
                                                   const c10::intrusive_ptr<LstmPack>& pack);
