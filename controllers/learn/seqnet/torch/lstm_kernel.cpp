@@ -1,22 +1,13 @@
 #include "animrt/learn/seqnet/lstm_kernel.hpp"
 
-#include <cmath>
 #include <cstddef>
 
 #include "vector_clones.hpp"
+#include "vector_exp.hpp"
 
 namespace animrt::seqnet {
 
-namespace {
-
-float sigmoid(float a) { return 1.0F / (1.0F + std::exp(-a)); }
-
-// tanh(a) = 2 sigmoid(2a) - 1: one exp instead of glibc's slower tanhf
-// (the two agree to about 2e-7 absolute).
-float tanh_by_sigmoid(float a) { return 2.0F / (1.0F + std::exp(-2.0F * a)) - 1.0F; }
-
-}  // namespace
-
+ANIMRT_VECTOR_CLONES
 void lstm_cell_forward(float* gates, const float* c, float* c_next, float* h_next, float* tanh_c,
                        int count) {
   const auto n = static_cast<std::size_t>(count);
@@ -28,17 +19,18 @@ void lstm_cell_forward(float* gates, const float* c, float* c_next, float* h_nex
   float* __restrict cn = c_next;
   float* __restrict hn = h_next;
   float* __restrict tc = tanh_c;
+#pragma omp simd
   for (std::size_t k = 0; k < n; ++k) {
-    const float i = sigmoid(gi[k]);
-    const float f = sigmoid(gf[k]);
-    const float u = tanh_by_sigmoid(gg[k]);
-    const float o = sigmoid(go[k]);
+    const float i = vector_sigmoid(gi[k]);
+    const float f = vector_sigmoid(gf[k]);
+    const float u = vector_tanh(gg[k]);
+    const float o = vector_sigmoid(go[k]);
     gi[k] = i;
     gf[k] = f;
     gg[k] = u;
     go[k] = o;
     const float next = f * cr[k] + i * u;
-    const float t = tanh_by_sigmoid(next);
+    const float t = vector_tanh(next);
     cn[k] = next;
     tc[k] = t;
     hn[k] = o * t;
@@ -95,6 +87,13 @@ void lstm_cell_backward(const float* gates, const float* c, const float* tanh_c,
   } else {
     cell_backward<false>(gates, c, tanh_c, gh_a, gh_b, gc, d_gates, gc_prev, n);
   }
+}
+
+ANIMRT_VECTOR_CLONES
+void tanh_in_place(float* y, std::size_t count) {
+  float* __restrict v = y;
+#pragma omp simd
+  for (std::size_t k = 0; k < count; ++k) v[k] = vector_tanh(v[k]);
 }
 
 }  // namespace animrt::seqnet

@@ -9,6 +9,7 @@
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/dense_kernel.hpp"
+#include "animrt/learn/seqnet/lstm_kernel.hpp"
 #include "animrt/learn/seqnet/lstm_step.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
@@ -61,14 +62,18 @@ struct RingProduct : torch::autograd::Function<RingProduct> {
   }
 };
 
-// tanh in place as 2 sigmoid(2 y) - 1: libtorch's vectorised sigmoid is
-// more than twice as fast as its tanh here, and the two agree to 2e-7.
-torch::Tensor& squash_(torch::Tensor& y) { return y.mul_(2.0).sigmoid_().mul_(2.0).sub_(1.0); }
+// tanh in place as 2 sigmoid(2 y) - 1 in one pass (lstm_kernel.hpp):
+// libtorch's tanh took four times as long, its sigmoid four passes.
+torch::Tensor& squash_(torch::Tensor& y) {
+  TORCH_CHECK(y.is_contiguous() && y.scalar_type() == torch::kFloat32, "tanh: contiguous float");
+  tanh_in_place(y.data_ptr<float>(), static_cast<std::size_t>(y.numel()));
+  return y;
+}
 
 // tanh by squash_, as an autograd node (backward: tanh's, from the output).
 struct Squash : torch::autograd::Function<Squash> {
   static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& x) {
-    torch::Tensor y = x.clone();
+    torch::Tensor y = x.clone(at::MemoryFormat::Contiguous);
     squash_(y);
     ctx->save_for_backward({y});
     return y;

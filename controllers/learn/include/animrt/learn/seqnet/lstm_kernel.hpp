@@ -8,11 +8,15 @@
 // order input, forget, cell, output (as libtorch's LSTM); the states are
 // one block each, laid out alike.
 
+#include <cstddef>
+
 namespace animrt::seqnet {
 
 // `gates` holds the pre-activations a = W [x h] + b and is overwritten by
 // the activations (sigmoid, sigmoid, tanh, sigmoid). c' = f c + i g,
-// h' = o tanh(c'); tanh(c') is kept for backward.
+// h' = o tanh(c'); tanh(c') is kept for backward. tanh is 2 sigmoid(2a) - 1
+// with exp in plain arithmetic (vector_exp.hpp), so the loop runs a vector
+// of entries at a time.
 void lstm_cell_forward(float* gates, const float* c, float* c_next, float* h_next, float* tanh_c,
                        int count);
 
@@ -22,5 +26,9 @@ void lstm_cell_forward(float* gates, const float* c, float* c_next, float* h_nex
 void lstm_cell_backward(const float* gates, const float* c, const float* tanh_c, const float* gh_a,
                         const float* gh_b, const float* gc, float* d_gates, float* gc_prev,
                         int count);
+
+// tanh of `count` numbers in place, as the cell's (the network's tanh
+// after its convolutions and dense layer).
+void tanh_in_place(float* y, std::size_t count);
 
 }  // namespace animrt::seqnet
