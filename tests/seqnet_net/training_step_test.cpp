@@ -243,8 +243,12 @@ TEST(SeqTrainingStep, FusedLstmStepComputesWhatLibtorchsLstmDoes) {
     torch::Tensor z, h0, c0, loss, h, c;
   };
   auto leaves = [&] {
-    return Run{z.clone().requires_grad_(), h0.clone().requires_grad_(),
-               c0.clone().requires_grad_(), {}, {}, {}};
+    return Run{z.clone().requires_grad_(),
+               h0.clone().requires_grad_(),
+               c0.clone().requires_grad_(),
+               {},
+               {},
+               {}};
   };
   Run a = leaves(), b = leaves();
   std::tuple<torch::Tensor, torch::Tensor> state{a.h0, a.c0};

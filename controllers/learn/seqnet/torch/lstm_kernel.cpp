@@ -44,8 +44,8 @@ namespace {
 template <bool TWO>
 [[gnu::always_inline]] inline void cell_backward(const float* gates, const float* c,
                                                  const float* tanh_c, const float* gh_a,
-                                                 const float* gh_b, const float* gc,
-                                                 float* d_gates, float* gc_prev, std::size_t n) {
+                                                 const float* gh_b, const float* gc, float* d_gates,
+                                                 float* gc_prev, std::size_t n) {
   const float* __restrict gi = gates;
   const float* __restrict gf = gates + n;
   const float* __restrict gg = gates + 2 * n;

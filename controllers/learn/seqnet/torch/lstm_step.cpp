@@ -117,11 +117,10 @@ struct LstmStep : torch::autograd::Function<LstmStep> {
       const auto k = static_cast<std::size_t>(l);
       const std::int64_t width = p->in[k];
       torch::Tensor d = torch::empty({4 * hidden, batch}, c.options());
-      lstm_cell_backward(gates[k].data_ptr<float>(), c[l].data_ptr<float>(),
-                         tanh_c[k].data_ptr<float>(), gh[l].data_ptr<float>(),
-                         from_above.defined() ? from_above.data_ptr<float>() : nullptr,
-                         gc[l].data_ptr<float>(), d.data_ptr<float>(),
-                         gc_prev[l].data_ptr<float>(), count);
+      lstm_cell_backward(
+          gates[k].data_ptr<float>(), c[l].data_ptr<float>(), tanh_c[k].data_ptr<float>(),
+          gh[l].data_ptr<float>(), from_above.defined() ? from_above.data_ptr<float>() : nullptr,
+          gc[l].data_ptr<float>(), d.data_ptr<float>(), gc_prev[l].data_ptr<float>(), count);
       torch::Tensor gxh = torch::empty({width + hidden, batch}, c.options());
       product(p->backward[k], nullptr, d, static_cast<int>(width + hidden), gxh);
       std::memcpy(gh_prev[l].data_ptr<float>(), gxh.data_ptr<float>() + width * batch,

@@ -16,7 +16,6 @@
 #include <torch/torch.h>
 
 #include <cstdint>
-
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,7 +25,7 @@ namespace animrt::seqnet {
 struct LstmPack : torch::CustomClassHolder {
   int layers = 0;
   std::int64_t hidden = 0;
-  std::vector<std::int64_t> in;           // each layer's input width
+  std::vector<std::int64_t> in;  // each layer's input width
   // Per layer, W = (W_ih W_hh) [4H, in + H] packed for forward and W^T
   // for the gradient of [x h]; the bias b_ih + b_hh.
   std::vector<std::vector<float>> forward, backward, bias;
