@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "animrt/learn/seqnet/dense_kernel.hpp"
+#include "animrt/learn/seqnet/lstm_step.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 #include "animrt/learn/seqnet/network.hpp"
 #include "animrt/learn/seqnet/shapes.hpp"
@@ -215,6 +216,79 @@ TEST(SeqTrainingStep, RingRowsSortAndSumLikeACoalescedSparseMatrix) {
   EXPECT_EQ(m.start, (std::vector<std::int32_t>{0, 1, 1, 4, 4}));
   EXPECT_EQ(m.col, (std::vector<std::int32_t>{1, 0, 1, 3}));
   EXPECT_EQ(m.weight, (std::vector<float>{0.75F, 2.0F, 4.0F, 1.0F}));
+}
+
+// The fused LSTM step (one node per step, lstm_step.hpp) against
+// libtorch's LSTM over three chained steps: the states, and the gradients
+// of the inputs, of the initial state and of every weight (formed from
+// the pack after backward), for a loss that reaches every step's h and the
+// last c.
+TEST(SeqTrainingStep, FusedLstmStepComputesWhatLibtorchsLstmDoes) {
+  torch::set_num_threads(1);
+  torch::manual_seed(23);
+  const int layers = 2, in = 5, hidden = 7, batch = 19, steps = 3;
+  torch::nn::LSTM plain(torch::nn::LSTMOptions(in, hidden).num_layers(layers));
+  torch::nn::LSTM fused(torch::nn::LSTMOptions(in, hidden).num_layers(layers));
+  {
+    torch::NoGradGuard no_grad;
+    for (const auto& item : plain->named_parameters()) {
+      fused->named_parameters()[item.key()].copy_(item.value());
+    }
+  }
+  const torch::Tensor z = torch::randn({steps, batch, in});
+  const torch::Tensor h0 = torch::randn({layers, batch, hidden}) * 0.5;
+  const torch::Tensor c0 = torch::randn({layers, batch, hidden}) * 2.0;
+  const torch::Tensor wh = torch::randn({steps, batch, hidden}), wc = torch::randn(c0.sizes());
+  struct Run {
+    torch::Tensor z, h0, c0, loss, h, c;
+  };
+  auto leaves = [&] {
+    return Run{z.clone().requires_grad_(),
+               h0.clone().requires_grad_(),
+               c0.clone().requires_grad_(),
+               {},
+               {},
+               {}};
+  };
+  Run a = leaves(), b = leaves();
+  std::tuple<torch::Tensor, torch::Tensor> state{a.h0, a.c0};
+  a.loss = torch::zeros({});
+  for (int t = 0; t < steps; ++t) {
+    auto [out, next] = plain->forward(a.z[t].unsqueeze(0), state);
+    state = next;
+    a.loss = a.loss + (out.squeeze(0) * wh[t]).sum();
+  }
+  std::tie(a.h, a.c) = state;
+  a.loss = a.loss + (a.c * wc).sum();
+  // The fused step's states have the batch innermost, [layers, hidden, B].
+  const c10::intrusive_ptr<LstmPack> pack = pack_lstm(*fused);
+  b.h = b.h0.transpose(1, 2);
+  b.c = b.c0.transpose(1, 2);
+  b.loss = torch::zeros({});
+  for (int t = 0; t < steps; ++t) {
+    std::tie(b.h, b.c) = lstm_step(b.z[t], b.h, b.c, pack);
+    b.loss = b.loss + (b.h[layers - 1].t() * wh[t]).sum();
+  }
+  b.h = b.h.transpose(1, 2);
+  b.c = b.c.transpose(1, 2);
+  b.loss = b.loss + (b.c * wc).sum();
+  EXPECT_LT(worst_relative(b.h, a.h), 1e-5);
+  EXPECT_LT(worst_relative(b.c, a.c), 1e-5);
+  a.loss.backward();
+  b.loss.backward();
+  EXPECT_LT(worst_relative(b.z.grad(), a.z.grad()), 1e-5);
+  EXPECT_LT(worst_relative(b.h0.grad(), a.h0.grad()), 1e-5);
+  EXPECT_LT(worst_relative(b.c0.grad(), a.c0.grad()), 1e-5);
+  // The weights are outside autograd: their gradients come from the pack.
+  const auto grads = lstm_gradients(*pack);
+  ASSERT_EQ(grads.size(), 4U * layers);
+  for (const auto& [name, g] : grads) {
+    const torch::Tensor want = plain->named_parameters()[name].grad();
+    ASSERT_TRUE(want.defined()) << name;
+    EXPECT_GT(want.abs().max().item<double>(), 0.0) << name;
+    EXPECT_LT(worst_relative(g, want), 1e-5) << name;
+    EXPECT_FALSE(fused->named_parameters()[name].grad().defined()) << name;
+  }
 }
 
 }  // namespace

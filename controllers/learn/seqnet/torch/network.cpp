@@ -9,6 +9,8 @@
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/dense_kernel.hpp"
+#include "animrt/learn/seqnet/lstm_kernel.hpp"
+#include "animrt/learn/seqnet/lstm_step.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
 
 namespace animrt::seqnet {
@@ -60,14 +62,18 @@ struct RingProduct : torch::autograd::Function<RingProduct> {
   }
 };
 
-// tanh in place as 2 sigmoid(2 y) - 1: libtorch's vectorised sigmoid is
-// more than twice as fast as its tanh here, and the two agree to 2e-7.
-torch::Tensor& squash_(torch::Tensor& y) { return y.mul_(2.0).sigmoid_().mul_(2.0).sub_(1.0); }
+// tanh in place as 2 sigmoid(2 y) - 1 in one pass (lstm_kernel.hpp):
+// libtorch's tanh took four times as long, its sigmoid four passes.
+torch::Tensor& squash_(torch::Tensor& y) {
+  TORCH_CHECK(y.is_contiguous() && y.scalar_type() == torch::kFloat32, "tanh: contiguous float");
+  tanh_in_place(y.data_ptr<float>(), static_cast<std::size_t>(y.numel()));
+  return y;
+}
 
 // tanh by squash_, as an autograd node (backward: tanh's, from the output).
 struct Squash : torch::autograd::Function<Squash> {
   static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& x) {
-    torch::Tensor y = x.clone();
+    torch::Tensor y = x.clone(at::MemoryFormat::Contiguous);
     squash_(y);
     ctx->save_for_backward({y});
     return y;
@@ -422,6 +428,7 @@ struct DenseTape {
 struct DenseTapes {
   bool on = false;
   std::vector<std::shared_ptr<DenseTape>> latent, hidden;  // one per run
+  std::vector<c10::intrusive_ptr<LstmPack>> lstm;            // one per run
 };
 
 namespace {
@@ -459,8 +466,13 @@ void SeqNetImpl::finish_gradients() {
     add_gradient(from_hidden->weight, w);
     add_gradient(from_hidden->bias, b);
   }
+  auto lstm_params = lstm->named_parameters();
+  for (const auto& pack : tapes_->lstm) {
+    for (const auto& [name, g] : lstm_gradients(*pack)) add_gradient(lstm_params[name], g);
+  }
   tapes_->latent.clear();
   tapes_->hidden.clear();
+  tapes_->lstm.clear();
 }
 
 LstmState SeqNetImpl::initial_state(int batch, double sign) const {
@@ -487,6 +499,14 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   // activations of the convolutions, by the loops of dense_kernel.hpp.
   const bool inner = tape && shape_.kind == ModelKind::mesh;
   c10::intrusive_ptr<DensePack> latent_pack, hidden_pack;
+  // Taped steps run the LSTM as one node per step (lstm_step.hpp), on
+  // states with the batch innermost.
+  c10::intrusive_ptr<LstmPack> lstm_pack;
+  if (tape) {
+    lstm_pack = tapes_->lstm.emplace_back(pack_lstm(*lstm));
+    state = {std::get<0>(state).transpose(1, 2).contiguous(),
+             std::get<1>(state).transpose(1, 2).contiguous()};
+  }
   if (inner) {
     latent_pack = pack_dense(weight);
     hidden_pack = pack_dense(from_hidden->weight);
@@ -508,13 +528,21 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
     const torch::Tensor& logvar = latent[1];
     torch::Tensor z = mu;
     if (sample) z = mu + torch::randn_like(mu) * torch::exp(0.5 * logvar);
-    auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
-    state = next_state;
-    const torch::Tensor o = out.squeeze(0);
+    torch::Tensor o, o_inner;  // [B, hidden], and [hidden, B] from the fused step
+    if (lstm_pack) {
+      auto [h, c] = lstm_step(z, std::get<0>(state), std::get<1>(state), lstm_pack);
+      o_inner = h[shape_.lstm_layers - 1];
+      o = o_inner.t();
+      state = {h, c};
+    } else {
+      auto [out, next_state] = lstm->forward(z.unsqueeze(0), state);
+      state = next_state;
+      o = out.squeeze(0);
+    }
     torch::Tensor change;
     if (inner) {
-      change = decode_batch_inner(hidden_tape->apply_batch_inner(
-          hidden_tape, o.t().contiguous(), hidden_pack, from_hidden->bias));
+      change = decode_batch_inner(
+          hidden_tape->apply_batch_inner(hidden_tape, o_inner, hidden_pack, from_hidden->bias));
     } else if (tape) {
       change = decode_from(
           hidden_tape->apply(hidden_tape, o, from_hidden->weight, from_hidden->bias));
