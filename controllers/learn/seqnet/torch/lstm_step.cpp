@@ -1,7 +1,5 @@
 #include "animrt/learn/seqnet/lstm_step.hpp"
 
-#include <ATen/Parallel.h>
-
 #include <cstring>
 
 #include "animrt/learn/seqnet/dense_kernel.hpp"
@@ -41,17 +39,12 @@ c10::intrusive_ptr<LstmPack> pack_lstm(torch::nn::LSTMImpl& lstm) {
 
 namespace {
 
-constexpr std::int64_t kLstmGrain = 4;  // blocks of output rows a thread takes at least
-
-// y [rows, B] = packed x [cols, B] (+ bias), the blocks split between threads.
+// y [rows, B] = packed x [cols, B] (+ bias).
 void product(const std::vector<float>& packed, const float* bias, const torch::Tensor& x, int rows,
              torch::Tensor& y) {
-  const auto cols = static_cast<int>(x.size(0)), batch = static_cast<int>(x.size(1));
-  const auto blocks = (rows + kDenseRows - 1) / kDenseRows;
-  at::parallel_for(0, blocks, kLstmGrain, [&](std::int64_t first, std::int64_t last) {
-    dense_batch_inner(packed.data(), bias, x.data_ptr<float>(), rows, cols, batch,
-                      y.data_ptr<float>(), static_cast<int>(first), static_cast<int>(last));
-  });
+  dense_batch_inner_threads(packed.data(), bias, x.data_ptr<float>(), rows,
+                            static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
+                            y.data_ptr<float>());
 }
 
 struct LstmStep : torch::autograd::Function<LstmStep> {

@@ -319,6 +319,16 @@ torch::Tensor SeqNetImpl::decode_batch_inner(const torch::Tensor& dense) {
   return run_vertices_first(decoder, h).permute({2, 0, 1}).reshape({batch, -1});
 }
 
+void dense_batch_inner_threads(const float* packed, const float* bias, const float* x, int rows,
+                               int cols, int batch, float* y) {
+  constexpr std::int64_t kGrain = 4;  // blocks of output rows a thread takes at least
+  const auto blocks = (rows + kDenseRows - 1) / kDenseRows;
+  at::parallel_for(0, blocks, kGrain, [&](std::int64_t first, std::int64_t last) {
+    dense_batch_inner(packed, bias, x, rows, cols, batch, y, static_cast<int>(first),
+                      static_cast<int>(last));
+  });
+}
+
 namespace {
 
 // A dense layer's weight W (out x in) packed for dense_kernel.hpp's
@@ -340,7 +350,6 @@ c10::intrusive_ptr<DensePack> pack_dense(const torch::Tensor& weight) {
   return p;
 }
 
-constexpr std::int64_t kDenseGrain = 4;  // blocks of output rows a thread takes at least
 
 // y = W x + b on x [in, B] (the batch innermost) to y [out, B], with W and
 // b outside autograd (their gradients are the tape's); x's gradient W^T g.
@@ -352,12 +361,8 @@ struct BatchInnerDense : torch::autograd::Function<BatchInnerDense> {
     const torch::Tensor xc = x.contiguous(), b = bias.detach().contiguous();
     const auto batch = static_cast<int>(x.size(1));
     torch::Tensor y = torch::empty({w->out, batch}, x.options());
-    const auto blocks = (w->out + kDenseRows - 1) / kDenseRows;
-    at::parallel_for(0, blocks, kDenseGrain, [&](std::int64_t first, std::int64_t last) {
-      dense_batch_inner(w->forward.data(), b.data_ptr<float>(), xc.data_ptr<float>(), w->out,
-                        w->in, batch, y.data_ptr<float>(), static_cast<int>(first),
-                        static_cast<int>(last));
-    });
+    dense_batch_inner_threads(w->forward.data(), b.data_ptr<float>(), xc.data_ptr<float>(), w->out,
+                              w->in, batch, y.data_ptr<float>());
     ctx->saved_data["w"] = c10::IValue::make_capsule(w);
     return y;
   }
@@ -367,11 +372,8 @@ struct BatchInnerDense : torch::autograd::Function<BatchInnerDense> {
     const torch::Tensor g = grad[0].contiguous();
     const auto batch = static_cast<int>(g.size(1));
     torch::Tensor gx = torch::empty({w->in, batch}, g.options());
-    const auto blocks = (w->in + kDenseRows - 1) / kDenseRows;
-    at::parallel_for(0, blocks, kDenseGrain, [&](std::int64_t first, std::int64_t last) {
-      dense_batch_inner(w->backward.data(), nullptr, g.data_ptr<float>(), w->in, w->out, batch,
-                        gx.data_ptr<float>(), static_cast<int>(first), static_cast<int>(last));
-    });
+    dense_batch_inner_threads(w->backward.data(), nullptr, g.data_ptr<float>(), w->in, w->out,
+                              batch, gx.data_ptr<float>());
     return {gx, torch::Tensor(), torch::Tensor()};
   }
 };

@@ -82,10 +82,6 @@ std::vector<std::string> parameter_names(const SeqNetImpl& net) {
   return names;
 }
 
-// "held out at iteration 200: completion of 9-frame gaps 2.30 %, linear
-// interpolation 1.39 % (65 % worse than interpolation)", then for mesh data
-// with its placement "; placed vertices 1.90 % of the diagonal, linear
-// vertex interpolation 3.49 % (46 % better)".
 // A fraction as a percentage with two decimals: "3.49 %".
 std::string percent(double fraction) {
   char text[32];
@@ -93,6 +89,10 @@ std::string percent(double fraction) {
   return text;
 }
 
+// "held out at iteration 200: completion of 9-frame gaps 2.30 %, linear
+// interpolation 1.39 % (65 % worse than interpolation)", then for mesh data
+// with its placement "; placed vertices 1.90 % of the diagonal, linear
+// vertex interpolation 3.49 % (46 % better)".
 std::string held_out_line(const HeldOutCompletion& h, int iteration) {
   if (h.gaps == 0) {
     return "held out at iteration " + std::to_string(iteration) +

@@ -30,10 +30,11 @@ namespace animrt::seqnet {
   return p * std::bit_cast<float>(bits);
 }
 
-// tanh(a) = 2 sigmoid(2a) - 1, within 1.8e-7 absolute of tanh.
 [[gnu::always_inline]] inline float vector_sigmoid(float a) {
   return 1.0F / (1.0F + vector_exp(-a));
 }
+
+// tanh(a) = 2 sigmoid(2a) - 1, within 1.8e-7 absolute of tanh.
 [[gnu::always_inline]] inline float vector_tanh(float a) {
   return 2.0F / (1.0F + vector_exp(-2.0F * a)) - 1.0F;
 }

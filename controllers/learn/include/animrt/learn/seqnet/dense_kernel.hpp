@@ -27,4 +27,9 @@ void pack_dense_rows(const float* m, int rows, int cols, std::ptrdiff_t row_stri
 void dense_batch_inner(const float* packed, const float* bias, const float* x, int rows, int cols,
                        int batch, float* y, int first_block, int last_block);
 
+// dense_batch_inner over all the output rows, the blocks split between
+// libtorch's threads (defined beside the network's dense node, network.cpp).
+void dense_batch_inner_threads(const float* packed, const float* bias, const float* x, int rows,
+                               int cols, int batch, float* y);
+
 }  // namespace animrt::seqnet
