@@ -4,7 +4,8 @@
 # report printed, joint-space generation from a CSV, a model of another
 # joint set and a corrupt model refused with exit 2 and one line naming the
 # file; then completion between OBJ keys with a mesh model, two folders as
-# one feature file of two clips, and seq evaluate on a model trained on it.
+# one feature file of two clips, and seq evaluate on a model trained on it
+# (--held-out and --held-out-clip together refused).
 set -uo pipefail
 animrt=$1
 root=$2
@@ -129,6 +130,13 @@ out=$("$animrt" seq evaluate "$tmp/two.model" "$tmp/two.bin" --gap 1 --change-fr
   fail "evaluate failed: $out"
 [[ $out == *"2 iterations; held out (seed 4, 20 %): 6 of 30 frames"* && $out == *"complete "*" gaps of 1 frames"* &&
   $out == *"generated t = 1..3: "* ]] || fail "evaluate: $out"
+# The held-out fraction and named clips are two ways to say the same
+# thing: both together are refused with one error naming both.
+out=$("$animrt" seq evaluate "$tmp/two.model" "$tmp/two.bin" --held-out 0.2 --held-out-clip plate_a 2>&1)
+code=$?
+first=$(echo "$out" | head -1)
+[[ $code -eq 1 && ($first == "--held-out excludes --held-out-clip" || $first == "--held-out-clip excludes --held-out") ]] ||
+  fail "--held-out with --held-out-clip: exit $code: $out"
 "$animrt" seq features "$tmp/plate_b" --out "$tmp/b.bin" >/dev/null || fail "features of plate_b"
 out=$("$animrt" seq evaluate "$tmp/plate.model" "$tmp/b.bin" 2>&1)
 code=$?

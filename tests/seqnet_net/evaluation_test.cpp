@@ -1,13 +1,14 @@
 // Evaluation on held-out frames: the pieces are the trainer's held-out
-// segments; on features that move linearly in time a model that adds that
-// very step each frame generates the truth, linear extrapolation from three
-// frames is exact and from one is not, feature-space interpolation is exact
-// and vertex-space is not; the change per frame is the step's, and 0 for a
+// segments (a feature file without clips is one clip named "all"); on
+// features that move linearly in time a model that adds that very step
+// each frame generates the truth, linear extrapolation from three frames
+// is exact and from one is not, feature-space interpolation is exact and
+// vertex-space is not; the change per frame is the step's, and 0 for a
 // model that never moves; a model of another template is refused; on a
 // walking bar with its placement, the completion placed as `seq complete`
 // places it is measured against linear vertex interpolation with nothing
 // aligned, on the clips named, and the trainer's held-out line measures
-// the same.
+// the same; a model whose placed completion is not finite is refused.
 
 #include "animrt/learn/seqnet/evaluation.hpp"
 
@@ -18,6 +19,8 @@
 #include <numbers>
 
 #include "animrt/controllers/seqnet/feature_file.hpp"
+#include "animrt/controllers/seqnet/model_file.hpp"
+#include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/held_out_completion.hpp"
 #include "animrt/learn/seqnet/network.hpp"
@@ -105,6 +108,32 @@ TEST(SeqEvaluation, PiecesAreTheTrainersHeldOutSegments) {
     total += p.count;
   }
   EXPECT_EQ(total, kFrames / 2);
+
+  // A feature file without clips (one input) is read as one clip named
+  // "all", as the trainer reads it: held out by that name, it is every
+  // frame; by the fraction, its piece is named "all" too.
+  SequenceFeatures one = f;
+  one.clips.clear();
+  const std::string one_path = nettest::temp_path("evaluation_no_clips.feat");
+  write_feature_file(one_path, one);
+  ASSERT_TRUE(read_feature_file(one_path).clips.empty());
+  EvaluationOptions o = options();
+  o.data_path = one_path;
+  o.held_out_clips = {"all"};
+  const Evaluation all = evaluate(m, "m.model", one, o);
+  ASSERT_EQ(all.pieces.size(), 1U);
+  EXPECT_EQ(all.pieces.front().name, "all");
+  EXPECT_EQ(all.pieces.front().first, 0);
+  EXPECT_EQ(all.pieces.front().count, kFrames);
+  const TrainingSet whole = load_training_set({one_path}, m.seed, 0.5, {"all"});
+  ASSERT_EQ(whole.segments.size(), 1U);
+  EXPECT_TRUE(whole.segments.front().held_out);
+  EXPECT_EQ(whole.segments.front().count, kFrames);
+  o.held_out_clips.clear();
+  const Evaluation by_fraction = evaluate(m, "m.model", one, o);
+  ASSERT_EQ(by_fraction.pieces.size(), 1U);
+  EXPECT_EQ(by_fraction.pieces.front().name, "all");
+  EXPECT_EQ(by_fraction.pieces.front().count, kFrames / 2);
 }
 
 TEST(SeqEvaluation, TheTrueStepGeneratesTheTruthAndBaselinesBehave) {
@@ -248,6 +277,29 @@ TEST(SeqEvaluation, PlacedCompletionAgainstLinearVertexInterpolationOnNamedClips
   ASSERT_TRUE(found);
   EXPECT_GT(placed(off, "straight").placed, 0.01);
   EXPECT_GT(placed(off, "turning").placed, turning.placed_vertex_linear);
+  // A model file whose placement nodes' range is finite but vast (up to
+  // 1e300): the file is read and its outputs check finite, but a float's
+  // rounding of a normalised key, scaled back, is a velocity of some 1e291
+  // per frame, and the placed in-betweens' error overflows. One error
+  // naming the model, not a figure that is no number.
+  ModelFile vast = m;
+  const auto n = static_cast<std::size_t>(9 * vast.shape.vertex_count);
+  ASSERT_EQ(vast.low.size(), n + 9);
+  for (std::size_t i = n; i < vast.low.size(); ++i) {
+    vast.low[i] = -1.0;
+    vast.high[i] = 1e300;
+  }
+  const std::string vast_path = nettest::temp_path("evaluation_vast.model");
+  write_model_file(vast_path, vast);
+  o.held_out_clips = {"turning"};
+  try {
+    evaluate(read_checked_model(vast_path), vast_path, f, o);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(vast_path), std::string::npos) << what;
+    EXPECT_NE(what.find("its placed completion is not finite"), std::string::npos) << what;
+  }
   // A name that is no clip is refused, naming the file and the clips.
   o.held_out_clips = {"walk"};
   try {
