@@ -82,6 +82,25 @@ bool blocks(const WallExtent& w, Vec2 p, Vec2 q) {
          clip(p, d, w.ay, w.b0 + kIn, w.b1 - kIn, lo, hi) && lo < hi;
 }
 
+// Whether the segments ab and cd cross (touching counts).
+bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const auto side = [](Vec2 o, Vec2 p, Vec2 q) { return cross(p - o, q - o); };
+  const double s1 = side(a, b, c), s2 = side(a, b, d), s3 = side(c, d, a), s4 = side(c, d, b);
+  return ((s1 <= 0.0 && s2 >= 0.0) || (s1 >= 0.0 && s2 <= 0.0)) &&
+         ((s3 <= 0.0 && s4 >= 0.0) || (s3 >= 0.0 && s4 <= 0.0));
+}
+
+// Whether a path (its corners) crosses the passage's middle, from wall to
+// wall.
+bool crosses_middle(const Passage& p, const std::vector<Vec2>& path) {
+  const Vec2 across{-p.axis.y, p.axis.x};
+  const Vec2 a = p.centre - across * p.half_width, b = p.centre + across * p.half_width;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    if (segments_cross(path[i - 1], path[i], a, b)) return true;
+  }
+  return false;
+}
+
 Vec2 closest_on_segment(Vec2 p, Vec2 a, Vec2 b) {
   const Vec2 d = b - a;
   const double l2 = norm2(d);
@@ -401,9 +420,14 @@ signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal) con
   if (!direct || !to || !on) return straight;
   // Through the passage when the way there and on from the far mouth is
   // no longer than the shortest way, but for the corners it cuts.
-  return *to + 2 * p.half_length + *on <= *direct + 2 * p.half_width + 1.0
-             ? static_cast<signed char>(-from)
-             : kNotThrough;
+  if (*to + 2 * p.half_length + *on > *direct + 2 * p.half_width + 1.0) return kNotThrough;
+  // Through and back is no way through: a figure already out of a short
+  // passage whose way turns round the end of one of its walls is within
+  // the corners' allowance, yet its way on from the far mouth leads back
+  // across the passage.
+  const auto back = world_->path(far, goal);
+  if (back && crosses_middle(p, *back)) return kNotThrough;
+  return static_cast<signed char>(-from);
 }
 
 Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {

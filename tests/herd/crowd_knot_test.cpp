@@ -176,7 +176,7 @@ TEST(CrowdKnot, MazeTopStreamsTakeTurnsRoundTheWallsEnd) {
 // mouth hold the gap while red's waiting figures stand in their way out)
 // and seed 2 takes 468 s against 377 s, so it is not in. Not met yet;
 // run with --gtest_also_run_disabled_tests.
-TEST(CrowdKnot, DISABLED_GoalMazeTopSeed1EveryFigureArrives) {
+TEST(CrowdKnot, GoalMazeTopSeed1EveryFigureArrives) {
   Teams teams;
   teams.red_spawn = {-5, -3, -2, 1};
   teams.blue_spawn = {2, -3, 5, 1};
