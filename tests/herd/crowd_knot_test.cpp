@@ -145,6 +145,29 @@ TEST(CrowdKnot, FindsTheMazesDiagonalGap) {
   EXPECT_NEAR(found[0].centre.y, 4.4, 0.2);
 }
 
+// A figure 2.5 m out of the maze top's gap north-west, going home round
+// the wall's end, is no figure of the way through the gap south-east: its
+// way there and back through the 0.5 m gap lies within the corners'
+// allowance, but its way on from the far mouth leads back across the gap.
+// With the gap held by a figure coming up from the south-east, it is not
+// held; one beside it whose goal lies through the gap waits.
+TEST(CrowdKnot, ThroughAndBackIsNoWayThroughTheGap) {
+  const NavWorldConfig config = maze_top_world();
+  NavWorld world(config);
+  PassageRules rules(config.walls, 0.35, {}, &world);
+  ASSERT_EQ(rules.passages().size(), 1u);
+  const Passage& p = rules.passages()[0];
+  std::vector<Agent> agents(3);
+  agents[0].position = p.centre + p.axis * 1.0;  // south-east of the gap
+  agents[1].position = p.centre - p.axis * 2.5;  // north-west, out of it
+  agents[2].position = agents[1].position + Vec2{0.8, 0.0};
+  const std::vector<Vec2> targets{{-3.5, -4}, {-3.5, -4}, {3.5, -4}};
+  rules.update(0.0, agents, targets, std::vector<bool>(3, true));
+  EXPECT_FALSE(rules.held(0));  // its way has the gap
+  EXPECT_FALSE(rules.held(1));
+  EXPECT_TRUE(rules.held(2));
+}
+
 // Ten a team round the wall's end through the diagonal gap, figures
 // turning 45 degrees a second (the maze's). The gap is a passage whose ways
 // come out round the wall's end: each figure's way through it comes from
