@@ -25,8 +25,6 @@ constexpr double kResnapDistance = 0.5;  // a figure this far from its crowd age
 constexpr double kWaitRadius = 1.0;  // a figure waiting for a passage stands this near its place
 constexpr double kQueueGap = 0.3;    // or this near another that stands waiting there
 constexpr double kQueueReach = 2.5;  // within this of its place
-// A member that stays this near one spot beside its gathering stands there.
-constexpr double kGatherStillM = 0.3;
 
 // A uniform draw in [0, 1) from the top 53 bits: the same numbers on every
 // standard library, unlike std::uniform_real_distribution.
@@ -555,8 +553,6 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   candidate_.assign(members_.size(), -1);
   stall_since_.assign(members_.size(), 0.0);
   for (int m : members_) stall_anchor_.push_back(agents[static_cast<std::size_t>(m)].position);
-  gather_anchor_ = stall_anchor_;
-  gather_since_.assign(members_.size(), 0.0);
   make_slots(rmax + crowd_.params().avoidance_margin_m);
 }
 
@@ -756,24 +752,16 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       crowd_.stop(members_[k]);
       continue;
     }
-    // A member that has stayed within kGatherStillM of one spot for
-    // stall_time_s next to the gathering (within a spacing and a half of
-    // an arrived member) has gathered where it stands; its slot, if it
-    // held one, is free again.
+    // A member that has stood still for stall_time_s next to the gathering
+    // (within a spacing and a half of an arrived member) has gathered
+    // where it stands; its slot, if it held one, is free again.
     if (state_[k] == State::kArrived) continue;
     if (norm(p - stall_anchor_[k]) > 0.1) {
       stall_anchor_[k] = p;
       stall_since_[k] = t;
-    }
-    // Turning about on one spot at its slowest walk counts as standing: a
-    // member whose slot lies behind figures that gathered where they stood
-    // circles there for good, a little more than 0.1 m across.
-    if (norm(p - gather_anchor_[k]) > kGatherStillM) {
-      gather_anchor_[k] = p;
-      gather_since_[k] = t;
       continue;
     }
-    if (params_.stall_time_s <= 0.0 || t - gather_since_[k] < params_.stall_time_s) continue;
+    if (params_.stall_time_s <= 0.0 || t - stall_since_[k] < params_.stall_time_s) continue;
     bool beside = false;
     for (std::size_t j = 0; j < members_.size() && !beside; ++j) {
       beside = state_[j] == State::kArrived &&

@@ -194,8 +194,8 @@ struct CrowdGroupParams {
   // two spacings) head for a free slot at the edge of the gathering.
   double assign_distance_m = 0.0;
   double arrive_tolerance_m = 0.2;  // a member this close to its slot has arrived
-  // A member that stays within 0.3 m of one spot this long beside the
-  // gathering has arrived where it stands (0: never).
+  // A member that stands still this long beside the gathering has arrived
+  // where it stands (0: never).
   double stall_time_s = 20.0;
 };
 
@@ -233,8 +233,6 @@ class CrowdGroup final : public GroupSteering {
   std::vector<int> slot_of_;        // per member, -1 while travelling
   std::vector<Vec2> stall_anchor_;  // where each member was when it last moved 0.1 m
   std::vector<double> stall_since_;
-  std::vector<Vec2> gather_anchor_;  // where each member was when it last moved 0.3 m
-  std::vector<double> gather_since_;
   std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
