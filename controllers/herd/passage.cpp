@@ -349,18 +349,17 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
       // Round a wall's end from the passage, its way through it: on its
       // way the figure comes round the corner into the other way's way
       // out, so while that way has the passage it waits where it is.
-      double to = 0.0;
-      if (round == 0 && t >= round_next_[i * np + static_cast<std::size_t>(index)]) {
-        round = way_round(p, agents[i].position, target[i], to);
-        if (round == 0) round_next_[i * np + static_cast<std::size_t>(index)] = t + 1.0;  // not near yet: asked again in a second
-        else round_to_[i * np + static_cast<std::size_t>(index)] = to;
+      const std::size_t at = i * np + static_cast<std::size_t>(index);
+      if (round == 0 && t >= round_next_[at]) {
+        round = way_round(p, agents[i].position, target[i], round_to_[at]);
+        if (round == 0) round_next_[at] = t + 1.0;  // not near yet: asked again in a second
       }
       if (round == 0 || round == kNotThrough) continue;
       const int k = round > 0 ? 0 : 1;
       dir_of[i] = round;
       round_of_[i] = 1;
       ++want[k];
-      nearest[k] = std::min(nearest[k], round_to_[i * np + static_cast<std::size_t>(index)] + hl);
+      nearest[k] = std::min(nearest[k], round_to_[at] + hl);
       continue;
     }
     round = 0;
