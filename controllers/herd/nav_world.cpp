@@ -439,8 +439,9 @@ struct PathResult {
   double length = 0.0;
 };
 
+// The shortest path's corners go to `corners` when given.
 PathResult find_path(dtNavMeshQuery& q, const dtQueryFilter& filter, Vec2 from, Vec2 to,
-                     double snap_m, bool want_length) {
+                     double snap_m, bool want_length, std::vector<Vec2>* corners = nullptr) {
   const float ext[3] = {static_cast<float>(snap_m), 2.0f, static_cast<float>(snap_m)};
   const auto a = NavWorld::to_recast(from);
   const auto b = NavWorld::to_recast(to);
@@ -457,13 +458,18 @@ PathResult find_path(dtNavMeshQuery& q, const dtQueryFilter& filter, Vec2 from, 
     return {};
   }
   PathResult r{true, 0.0};
-  if (!want_length) return r;
+  if (!want_length && !corners) return r;
   std::vector<float> pts(3 * kMaxPathPolys);
   int np = 0;
   q.findStraightPath(pa, pb, path.data(), n, pts.data(), nullptr, nullptr, &np, kMaxPathPolys);
   for (int i = 1; i < np; ++i) {
     r.length += norm(NavWorld::from_recast(&pts[3 * static_cast<std::size_t>(i)]) -
                      NavWorld::from_recast(&pts[3 * static_cast<std::size_t>(i - 1)]));
+  }
+  if (corners) {
+    corners->clear();
+    for (int i = 0; i < np; ++i)
+      corners->push_back(NavWorld::from_recast(&pts[3 * static_cast<std::size_t>(i)]));
   }
   return r;
 }
@@ -477,6 +483,13 @@ std::optional<double> NavWorld::path_length(Vec2 from, Vec2 to, double snap_m) c
   const PathResult r = find_path(*query_, parts_->filter, from, to, snap_m, true);
   if (!r.complete) return std::nullopt;
   return r.length;
+}
+
+std::optional<std::vector<Vec2>> NavWorld::path(Vec2 from, Vec2 to, double snap_m) const {
+  std::vector<Vec2> corners;
+  if (!find_path(*query_, parts_->filter, from, to, snap_m, false, &corners).complete)
+    return std::nullopt;
+  return corners;
 }
 
 }  // namespace animrt::herd

@@ -12,6 +12,9 @@ namespace {
 
 int idx(int dir) { return dir > 0 ? 0 : 1; }
 constexpr signed char kNotThrough = 2;  // the figure's way does not lead through the passage
+// A figure round a corner from a passage nearer its mouth than this (by
+// the mesh) when its way must wait walks on round the corner.
+constexpr double kRoundGoesOnM = 3.0;
 
 // A box's extent on the ground when it is axis-aligned (yaw a multiple of
 // 90 degrees); false for any other yaw.
@@ -80,6 +83,25 @@ bool blocks(const WallExtent& w, Vec2 p, Vec2 q) {
   const Vec2 d = q - p;
   return clip(p, d, w.ax, w.a0 + kIn, w.a1 - kIn, lo, hi) &&
          clip(p, d, w.ay, w.b0 + kIn, w.b1 - kIn, lo, hi) && lo < hi;
+}
+
+// Whether the segments ab and cd cross (touching counts).
+bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const auto side = [](Vec2 o, Vec2 p, Vec2 q) { return cross(p - o, q - o); };
+  const double s1 = side(a, b, c), s2 = side(a, b, d), s3 = side(c, d, a), s4 = side(c, d, b);
+  return ((s1 <= 0.0 && s2 >= 0.0) || (s1 >= 0.0 && s2 <= 0.0)) &&
+         ((s3 <= 0.0 && s4 >= 0.0) || (s3 >= 0.0 && s4 <= 0.0));
+}
+
+// Whether a path (its corners) crosses the passage's middle, from wall to
+// wall.
+bool crosses_middle(const Passage& p, const std::vector<Vec2>& path) {
+  const Vec2 across{-p.axis.y, p.axis.x};
+  const Vec2 a = p.centre - across * p.half_width, b = p.centre + across * p.half_width;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    if (segments_cross(path[i - 1], path[i], a, b)) return true;
+  }
+  return false;
 }
 
 Vec2 closest_on_segment(Vec2 p, Vec2 a, Vec2 b) {
@@ -261,6 +283,13 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
   was_held_by_.swap(held_by_);
   was_held_by_.resize(agents.size(), -1);
   held_by_.assign(agents.size(), -1);
+  was_stood_by_.swap(stood_by_);
+  was_stood_by_.resize(agents.size(), -1);
+  stood_by_.assign(agents.size(), -1);
+  stand_at_.resize(agents.size());
+  round_way_.resize(agents.size() * passages_.size(), 0);
+  round_to_.resize(agents.size() * passages_.size(), 0.0);
+  round_next_.resize(agents.size() * passages_.size(), 0.0);
   for (std::size_t k = 0; k < passages_.size(); ++k)
     update_one(t, static_cast<int>(k), passages_[k], agents, target, active);
   // A figure keeps its place in a queue only while it stays queued.
@@ -296,6 +325,7 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
   std::vector<signed char>& dir_of = dir_of_;
   dir_of.assign(agents.size(), 0);
   const std::size_t np = passages_.size();
+  round_of_.assign(agents.size(), 0);
   for (std::size_t i = 0; i < agents.size(); ++i) {
     signed char& known = way_[i * np + static_cast<std::size_t>(index)];
     const Vec2 d = agents[i].position - p.centre;
@@ -304,6 +334,7 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     if (!active[i] || std::abs(along) > std::max(reach, hl + params_.clear_m) ||
         side > hw + params_.approach_m) {
       known = 0;
+      round_way_[i * np + static_cast<std::size_t>(index)] = 0;
       continue;
     }
     // Only a figure that sees the passage from where it stands asks for
@@ -311,10 +342,27 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     // it, or not there yet). One the passage holds keeps asking while it
     // walks to its place.
     const bool in_it = std::abs(along) <= hl && side <= hw + agents[i].radius;
-    if (!in_it && was_held_by_[i] != index && !sees(p, agents[i].position)) {
+    signed char& round = round_way_[i * np + static_cast<std::size_t>(index)];
+    if (!in_it && (was_held_by_[i] != index || was_stood_by_[i] == index) &&
+        !sees(p, agents[i].position)) {
       known = 0;
+      // Round a wall's end from the passage, its way through it: on its
+      // way the figure comes round the corner into the other way's way
+      // out, so while that way has the passage it waits where it is.
+      const std::size_t at = i * np + static_cast<std::size_t>(index);
+      if (round == 0 && t >= round_next_[at]) {
+        round = way_round(p, agents[i].position, target[i], round_to_[at]);
+        if (round == 0) round_next_[at] = t + 1.0;  // not near yet: asked again in a second
+      }
+      if (round == 0 || round == kNotThrough) continue;
+      const int k = round > 0 ? 0 : 1;
+      dir_of[i] = round;
+      round_of_[i] = 1;
+      ++want[k];
+      nearest[k] = std::min(nearest[k], round_to_[at] + hl);
       continue;
     }
+    round = 0;
     if (known == 0) known = way_through(p, agents[i].position, target[i]);
     if (known == kNotThrough) continue;
     const int dir = known;
@@ -353,6 +401,21 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
   for (std::size_t i = 0; i < agents.size(); ++i) {
     const int dir = dir_of[i];
     if (dir == 0 || held_[i]) continue;
+    if (round_of_[i]) {
+      if (dir == p.owner && !p.closing) continue;
+      // One already at the corner goes on: stood there, it would stand in
+      // the way out it was to keep clear of.
+      if (was_stood_by_[i] != index &&
+          world_->path_length(agents[i].position, p.centre - u * (dir * hl)).value_or(0.0) <
+              kRoundGoesOnM)
+        continue;
+      held_[i] = 1;
+      held_by_[i] = index;
+      stood_by_[i] = index;
+      if (was_stood_by_[i] != index) stand_at_[i] = agents[i].position;
+      hold_[i] = stand_at_[i];
+      continue;
+    }
     const Vec2 d = agents[i].position - p.centre;
     const double s = dot(d, u) * dir;
     const double side = std::abs(dot(d, across));
@@ -386,13 +449,27 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
   }
 }
 
+signed char PassageRules::way_round(const Passage& p, Vec2 pos, Vec2 goal, double& to) const {
+  if (!world_) return kNotThrough;
+  const auto plus = world_->path_length(pos, p.centre + p.axis * p.half_length);
+  const auto minus = world_->path_length(pos, p.centre - p.axis * p.half_length);
+  if (!plus && !minus) return kNotThrough;
+  const int from = !minus || (plus && *plus <= *minus) ? 1 : -1;
+  to = from > 0 ? *plus : *minus;
+  if (to > params_.approach_m) return 0;
+  return way_through(p, pos, goal, from);
+}
+
 signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal) const {
+  return way_through(p, pos, goal, dot(pos - p.centre, p.axis) < 0.0 ? -1 : 1);
+}
+
+signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal, int from) const {
   // Without a mesh, or while no way leads to the goal (a gap closed for
   // now), the goal's side of the passage in a straight line decides.
   const double way = dot(goal - p.centre, p.axis);
   const signed char straight = std::abs(way) <= p.half_length ? kNotThrough : (way > 0 ? 1 : -1);
   if (!world_) return straight;
-  const int from = dot(pos - p.centre, p.axis) < 0.0 ? -1 : 1;  // the side it stands on
   const Vec2 near = p.centre + p.axis * (from * p.half_length);
   const Vec2 far = p.centre - p.axis * (from * p.half_length);
   const auto direct = world_->path_length(pos, goal);
@@ -401,9 +478,14 @@ signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal) con
   if (!direct || !to || !on) return straight;
   // Through the passage when the way there and on from the far mouth is
   // no longer than the shortest way, but for the corners it cuts.
-  return *to + 2 * p.half_length + *on <= *direct + 2 * p.half_width + 1.0
-             ? static_cast<signed char>(-from)
-             : kNotThrough;
+  if (*to + 2 * p.half_length + *on > *direct + 2 * p.half_width + 1.0) return kNotThrough;
+  // Through and back is no way through: a figure already out of a short
+  // passage whose way turns round the end of one of its walls is within
+  // the corners' allowance, yet its way on from the far mouth leads back
+  // across the passage.
+  const auto back = world_->path(far, goal);
+  if (back && crosses_middle(p, *back)) return kNotThrough;
+  return static_cast<signed char>(-from);
 }
 
 Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {

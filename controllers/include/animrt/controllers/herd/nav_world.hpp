@@ -97,6 +97,10 @@ class NavWorld {
   // Length of the shortest path along the mesh, or nothing without a
   // complete path.
   std::optional<double> path_length(Vec2 from, Vec2 to, double snap_m = 0.3) const;
+  // The shortest path's corners along the mesh, from the point on the mesh
+  // nearest `from` to the one nearest `to`, or nothing without a complete
+  // path.
+  std::optional<std::vector<Vec2>> path(Vec2 from, Vec2 to, double snap_m = 0.3) const;
   static double straight_length(Vec2 from, Vec2 to) { return norm(to - from); }
   // The nearest point on the mesh within snap_m, or nothing.
   std::optional<Vec2> nearest_on_mesh(Vec2 p, double snap_m) const;

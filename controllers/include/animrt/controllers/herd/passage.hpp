@@ -92,6 +92,11 @@ class PassageRules {
   // 2 when its way does not lead through it: by the mesh's shortest
   // paths (a maze turns ways round wall ends), else by the goal's side.
   signed char way_through(const Passage& p, Vec2 pos, Vec2 goal) const;
+  // The same from side `from` (+1, -1) of the passage.
+  signed char way_through(const Passage& p, Vec2 pos, Vec2 goal, int from) const;
+  // For a figure round a corner from p: its side is the mouth nearer by the
+  // mesh (`to` away); 0 while that is farther than approach_m.
+  signed char way_round(const Passage& p, Vec2 pos, Vec2 goal, double& to) const;
   // Where figures of way dir wait for p on side +1 (right) or -1 (left).
   Vec2 wait_place(const Passage& p, int dir, int side) const;
   int choose_side(Passage& p, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
@@ -105,6 +110,18 @@ class PassageRules {
   std::vector<Vec2> hold_;
   // Per agent: the passage that holds it (this update, the last one), or -1.
   std::vector<int> held_by_, was_held_by_;
+  // Per agent: the passage that holds it where it stands, round a corner
+  // from it (this update, the last one), and where.
+  std::vector<int> stood_by_, was_stood_by_;
+  std::vector<Vec2> stand_at_;
+  // Per agent and passage: the way through of a figure round a corner
+  // from it (0: not decided, 2: not through), its path to the mouth, and
+  // when to ask again while it is not near; per agent, round a corner from
+  // the passage at hand.
+  std::vector<signed char> round_way_;
+  std::vector<double> round_to_;
+  std::vector<double> round_next_;
+  std::vector<char> round_of_;
   // Per agent and passage: its way through, decided as it comes near
   // (0: not yet, 2: not through), kept while it stays near.
   std::vector<signed char> way_;
