@@ -161,6 +161,15 @@ TEST_F(SeqNetTest, L2IsTheMeanSquareOfTheWeightMatricesOnly) {
     lin->bias.fill_(10.0F);
   }
   EXPECT_FLOAT_EQ(l2_loss(*lin).item<float>(), 12.5F);
+  // Its gradient, by autograd and added by hand (as the training step
+  // does): 2 w / 2 entries, scaled; the bias gets none.
+  (0.3 * l2_loss(*lin)).backward();
+  const torch::Tensor by_autograd = lin->weight.grad().clone();
+  EXPECT_NEAR(by_autograd[0][1].item<double>(), 1.2, 1e-6);
+  EXPECT_FALSE(lin->bias.grad().defined());
+  add_l2_gradient(*lin, 0.3);
+  EXPECT_TRUE(torch::allclose(lin->weight.grad(), 2 * by_autograd, 1e-6, 0.0));
+  EXPECT_FALSE(lin->bias.grad().defined());
 }
 
 TEST_F(SeqNetTest, BatchLossWeighsTheTermsAsThePaper) {

@@ -586,8 +586,31 @@ torch::Tensor l2_loss(const torch::nn::Module& net) {
   return count == 0 ? sum : sum / static_cast<double>(count);
 }
 
-LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                     bool bidirectional, double l2_weight) {
+void add_l2_gradient(const torch::nn::Module& net, double scale) {
+  torch::NoGradGuard no_grad;
+  std::int64_t count = 0;
+  for (const auto& p : net.parameters()) {
+    if (p.dim() >= 2) count += p.numel();
+  }
+  if (count == 0) return;
+  // d/dw of sum(w^2) / count.
+  const double factor = 2.0 * scale / static_cast<double>(count);
+  for (auto p : net.parameters()) {
+    if (p.dim() < 2) continue;
+    if (p.grad().defined()) {
+      p.mutable_grad().add_(p.detach(), factor);
+    } else {
+      p.mutable_grad() = p.detach() * factor;
+    }
+  }
+}
+
+namespace {
+
+// batch_loss; with `l2_in_graph` false the L2 term's value is in the total
+// but not on the tape (the caller adds its gradient: add_l2_gradient).
+LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
+                           bool bidirectional, double l2_weight, bool l2_in_graph) {
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
@@ -612,9 +635,21 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
     l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
     l.bidir = torch::zeros({});
   }
-  l.l2 = l2_loss(*net);
+  if (l2_in_graph) {
+    l.l2 = l2_loss(*net);
+  } else {
+    torch::NoGradGuard no_grad;
+    l.l2 = l2_loss(*net);
+  }
   l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l2_weight * l.l2);
   return l;
+}
+
+}  // namespace
+
+LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
+                     bool bidirectional, double l2_weight) {
+  return batch_loss_terms(net, truth, sample, kl_weight, bidirectional, l2_weight, true);
 }
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
@@ -622,7 +657,9 @@ LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double
   net->collect_dense_gradients(true);
   LossTerms l;
   try {
-    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+    // The L2 term's gradient is added after backward: on the tape it was a
+    // few passes over every weight, forward and backward, for 2 w / count.
+    l = batch_loss_terms(net, truth, true, kl_weight, bidirectional, l2_weight, false);
   } catch (...) {
     net->collect_dense_gradients(false);
     throw;
@@ -630,6 +667,7 @@ LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double
   net->collect_dense_gradients(false);
   l.total.backward();
   net->finish_gradients();
+  add_l2_gradient(*net, 0.1 * l2_weight);
   adam.step();
   return l;
 }

@@ -139,6 +139,9 @@ torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& back
 torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar);
 // Mean square of the weights (matrices, not biases) of the module.
 torch::Tensor l2_loss(const torch::nn::Module& net);
+// Adds `scale` times l2_loss's gradient to each weight's gradient (what
+// backward through scale * l2_loss would add).
+void add_l2_gradient(const torch::nn::Module& net, double scale);
 
 struct LossTerms {
   torch::Tensor recon, bidir, kl, l2, total;
