@@ -223,7 +223,10 @@ TEST_F(SeqNetTest, AdamFollowsItsUpdateRule) {
   Adam many({q}, 0.01);
   for (int step = 1; step <= 3; ++step) {
     const torch::Tensor g = torch::randn({37});
-    q.mutable_grad() = g.clone();
+    // The second step's gradient is a strided view (a gradient need not be
+    // contiguous).
+    q.mutable_grad() = step == 2 ? torch::stack({g, g}, 1).select(1, 0) : g.clone();
+    ASSERT_EQ(q.grad().is_contiguous(), step != 2);
     many.step();
     EXPECT_EQ(q.grad().abs().max().item<float>(), 0.0F) << "the gradient is zeroed";
     m_ref.mul_(0.9).add_(g, 0.1);

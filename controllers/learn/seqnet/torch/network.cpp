@@ -739,9 +739,10 @@ void Adam::step() {
     torch::Tensor& p = params_[i];
     if (!p.grad().defined()) continue;
     torch::Tensor& g = p.mutable_grad();
-    TORCH_CHECK(p.is_contiguous() && g.is_contiguous() && p.scalar_type() == torch::kFloat32 &&
+    if (!g.is_contiguous()) g = g.contiguous();
+    TORCH_CHECK(p.is_contiguous() && p.scalar_type() == torch::kFloat32 &&
                     g.scalar_type() == torch::kFloat32 && g.sizes() == p.sizes(),
-                "Adam: contiguous float parameters and gradients");
+                "Adam: float parameters and gradients of their shape");
     adam_update(p.data_ptr<float>(), g.data_ptr<float>(), m_[i].data_ptr<float>(),
                 v_[i].data_ptr<float>(), static_cast<std::size_t>(p.numel()), k);
   }
