@@ -161,6 +161,15 @@ TEST_F(SeqNetTest, L2IsTheMeanSquareOfTheWeightMatricesOnly) {
     lin->bias.fill_(10.0F);
   }
   EXPECT_FLOAT_EQ(l2_loss(*lin).item<float>(), 12.5F);
+  // Its gradient, by autograd and added by hand (as the training step
+  // does): 2 w / 2 entries, scaled; the bias gets none.
+  (0.3 * l2_loss(*lin)).backward();
+  const torch::Tensor by_autograd = lin->weight.grad().clone();
+  EXPECT_NEAR(by_autograd[0][1].item<double>(), 1.2, 1e-6);
+  EXPECT_FALSE(lin->bias.grad().defined());
+  add_l2_gradient(*lin, 0.3);
+  EXPECT_TRUE(torch::allclose(lin->weight.grad(), 2 * by_autograd, 1e-6, 0.0));
+  EXPECT_FALSE(lin->bias.grad().defined());
 }
 
 TEST_F(SeqNetTest, BatchLossWeighsTheTermsAsThePaper) {
@@ -206,6 +215,26 @@ TEST_F(SeqNetTest, AdamFollowsItsUpdateRule) {
   const double m = 0.08 / 0.19, v = 0.004996 / (1.0 - 0.999 * 0.999);
   EXPECT_NEAR(p.item<float>(), -0.1 - 0.1 * m / (std::sqrt(v) + 1e-8), 1e-6);
   EXPECT_EQ(adam.steps(), 2);
+  // Many entries (the update's vector body and its tail), three steps:
+  // libtorch's operations on the same gradients give the same numbers.
+  torch::manual_seed(2);
+  torch::Tensor q = torch::randn({37}, torch::requires_grad());
+  torch::Tensor q_ref = q.detach().clone(), m_ref = torch::zeros({37}), v_ref = torch::zeros({37});
+  Adam many({q}, 0.01);
+  for (int step = 1; step <= 3; ++step) {
+    const torch::Tensor g = torch::randn({37});
+    // The second step's gradient is a strided view (a gradient need not be
+    // contiguous).
+    q.mutable_grad() = step == 2 ? torch::stack({g, g}, 1).select(1, 0) : g.clone();
+    ASSERT_EQ(q.grad().is_contiguous(), step != 2);
+    many.step();
+    EXPECT_EQ(q.grad().abs().max().item<float>(), 0.0F) << "the gradient is zeroed";
+    m_ref.mul_(0.9).add_(g, 0.1);
+    v_ref.mul_(0.999).addcmul_(g, g, 0.001);
+    q_ref.addcdiv_(m_ref / (1.0 - std::pow(0.9, step)),
+                   (v_ref / (1.0 - std::pow(0.999, step))).sqrt_().add_(1e-8), -0.01);
+    EXPECT_TRUE(torch::allclose(q.detach(), q_ref, 1e-6, 1e-7)) << "step " << step;
+  }
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <torch/torch.h>
 
 #include <numbers>
+#include <tuple>
+#include <utility>
 
 #include "animrt/learn/seqnet/dense_kernel.hpp"
 #include "animrt/learn/seqnet/lstm_step.hpp"
@@ -53,6 +55,34 @@ TEST(SeqTrainingStep, BothChainsInOneBatchGiveTheLossOfTwoSeparateRuns) {
   const double kl = 0.5 * (kl_loss(f.mu, f.logvar) + kl_loss(b.mu, b.logvar)).item<double>();
   EXPECT_NEAR(l.kl.item<double>(), kl, 1e-5 * kl);
   EXPECT_GT(l.bidir.item<double>(), 0.0);
+}
+
+TEST(SeqTrainingStep, ChainLossesComputeWhatReconAndBidirLossDo) {
+  // An odd number of frames (the middle one meets itself reversed) and
+  // rows of 37 (the loops' vector body and tail).
+  torch::manual_seed(17);
+  const torch::Tensor truth = torch::rand({5, 3, 37}) - 0.5;
+  const torch::Tensor frames0 = torch::rand({5, 6, 37}) - 0.5;
+  const auto run = [&](bool fused, double recon_weight, double bidir_weight) {
+    const torch::Tensor frames = frames0.clone().requires_grad_(true);
+    torch::Tensor recon, bidir;
+    if (fused) {
+      std::tie(recon, bidir) = chain_losses(frames, truth);
+    } else {
+      const torch::Tensor f = frames.slice(1, 0, 3), b = frames.slice(1, 3);
+      recon = recon_loss(f, b, truth);
+      bidir = bidir_loss(f, b);
+    }
+    (recon_weight * recon + bidir_weight * bidir).backward();
+    return std::tuple{recon.item<double>(), bidir.item<double>(), frames.grad()};
+  };
+  for (const auto& [wr, wb] : {std::pair{1.0, 0.5}, std::pair{0.0, 1.0}, std::pair{1.0, 0.0}}) {
+    const auto [recon, bidir, grad] = run(true, wr, wb);
+    const auto [recon_ref, bidir_ref, grad_ref] = run(false, wr, wb);
+    EXPECT_NEAR(recon, recon_ref, 1e-6 * recon_ref);
+    EXPECT_NEAR(bidir, bidir_ref, 1e-6 * bidir_ref);
+    EXPECT_LT(worst_relative(grad, grad_ref), 1e-5) << wr << " " << wb;
+  }
 }
 
 // Every parameter's gradient, plain autograd against the collected path.

@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/dense_kernel.hpp"
 #include "animrt/learn/seqnet/lstm_kernel.hpp"
 #include "animrt/learn/seqnet/lstm_step.hpp"
 #include "animrt/learn/seqnet/mesh_conv_kernel.hpp"
+#include "animrt/learn/seqnet/train_kernel.hpp"
 
 namespace animrt::seqnet {
 
@@ -571,6 +573,49 @@ torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& back
   return (forward - backward.flip(0)).pow(2).flatten(1).mean(1).sum();
 }
 
+namespace {
+
+// recon_loss and bidir_loss of the two chains as one autograd node over
+// the frames of both [n, 2 B, D] (train_kernel.hpp): one pass forward, one
+// backward, where libtorch's slices, flips, differences, squares and means
+// each took a pass over the frames, forward and backward.
+struct ChainLosses : torch::autograd::Function<ChainLosses> {
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx,
+                                                const torch::Tensor& frames,
+                                                const torch::Tensor& truth) {
+    TORCH_CHECK(frames.dim() == 3 && truth.dim() == 3 && frames.size(0) == truth.size(0) &&
+                    frames.size(1) == 2 * truth.size(1) && frames.size(2) == truth.size(2) &&
+                    frames.scalar_type() == torch::kFloat32 &&
+                    truth.scalar_type() == torch::kFloat32,
+                "chain losses: frames [n, 2B, D] and truth [n, B, D], float");
+    const torch::Tensor f = frames.contiguous(), x = truth.contiguous();
+    double recon = 0.0, bidir = 0.0;
+    chain_loss_sums(f.data_ptr<float>(), x.data_ptr<float>(), static_cast<int>(x.size(0)),
+                    static_cast<int>(x.size(1)), static_cast<int>(x.size(2)), &recon, &bidir);
+    ctx->save_for_backward({f, x});
+    return {torch::tensor(static_cast<float>(recon)), torch::tensor(static_cast<float>(bidir))};
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grad) {
+    const auto saved = ctx->get_saved_variables();
+    const torch::Tensor &f = saved[0], &x = saved[1];
+    const auto scalar = [](const torch::Tensor& g) { return g.defined() ? g.item<float>() : 0.0F; };
+    torch::Tensor df = torch::empty_like(f);
+    chain_losses_backward(f.data_ptr<float>(), x.data_ptr<float>(), static_cast<int>(x.size(0)),
+                          static_cast<int>(x.size(1)), static_cast<int>(x.size(2)), scalar(grad[0]),
+                          scalar(grad[1]), df.data_ptr<float>());
+    return {df, torch::Tensor()};
+  }
+};
+
+}  // namespace
+
+std::pair<torch::Tensor, torch::Tensor> chain_losses(const torch::Tensor& frames,
+                                                     const torch::Tensor& truth) {
+  const auto out = ChainLosses::apply(frames, truth);
+  return {out[0], out[1]};
+}
+
 torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar) {
   return (-0.5 * (1.0 + logvar - mu.pow(2) - logvar.exp())).mean();
 }
@@ -586,8 +631,31 @@ torch::Tensor l2_loss(const torch::nn::Module& net) {
   return count == 0 ? sum : sum / static_cast<double>(count);
 }
 
-LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                     bool bidirectional, double l2_weight) {
+void add_l2_gradient(const torch::nn::Module& net, double scale) {
+  torch::NoGradGuard no_grad;
+  std::int64_t count = 0;
+  for (const auto& p : net.parameters()) {
+    if (p.dim() >= 2) count += p.numel();
+  }
+  if (count == 0) return;
+  // d/dw of sum(w^2) / count.
+  const double factor = 2.0 * scale / static_cast<double>(count);
+  for (auto p : net.parameters()) {
+    if (p.dim() < 2) continue;
+    if (p.grad().defined()) {
+      p.mutable_grad().add_(p.detach(), factor);
+    } else {
+      p.mutable_grad() = p.detach() * factor;
+    }
+  }
+}
+
+namespace {
+
+// batch_loss; with `l2_in_graph` false the L2 term's value is in the total
+// but not on the tape (the caller adds its gradient: add_l2_gradient).
+LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
+                           bool bidirectional, double l2_weight, bool l2_in_graph) {
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
@@ -599,9 +667,7 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
                          torch::cat({std::get<1>(f0), std::get<1>(b0)}, 1)};
     const torch::Tensor starts = torch::cat({truth.slice(0, 0, 1), truth.slice(0, n - 1, n)}, 1);
     const Chain c = net->run(starts, n, both, sample);
-    const torch::Tensor f = c.frames.slice(1, 0, batch), b = c.frames.slice(1, batch);
-    l.recon = recon_loss(f, b, truth);
-    l.bidir = bidir_loss(f, b);
+    std::tie(l.recon, l.bidir) = chain_losses(c.frames, truth);
     // Both halves are the same size: the mean over both is the mean of the
     // two chains' means.
     l.kl = kl_loss(c.mu, c.logvar);
@@ -612,9 +678,21 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
     l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
     l.bidir = torch::zeros({});
   }
-  l.l2 = l2_loss(*net);
+  if (l2_in_graph) {
+    l.l2 = l2_loss(*net);
+  } else {
+    torch::NoGradGuard no_grad;
+    l.l2 = l2_loss(*net);
+  }
   l.total = l.recon + 0.5 * l.bidir + 0.1 * (kl_weight * l.kl + l2_weight * l.l2);
   return l;
+}
+
+}  // namespace
+
+LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
+                     bool bidirectional, double l2_weight) {
+  return batch_loss_terms(net, truth, sample, kl_weight, bidirectional, l2_weight, true);
 }
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
@@ -622,7 +700,9 @@ LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double
   net->collect_dense_gradients(true);
   LossTerms l;
   try {
-    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+    // The L2 term's gradient is added after backward: on the tape it was a
+    // few passes over every weight, forward and backward, for 2 w / count.
+    l = batch_loss_terms(net, truth, true, kl_weight, bidirectional, l2_weight, false);
   } catch (...) {
     net->collect_dense_gradients(false);
     throw;
@@ -630,6 +710,7 @@ LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double
   net->collect_dense_gradients(false);
   l.total.backward();
   net->finish_gradients();
+  add_l2_gradient(*net, 0.1 * l2_weight);
   adam.step();
   return l;
 }
@@ -648,14 +729,22 @@ void Adam::step() {
   const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
   const double c1 = 1.0 - std::pow(b1, static_cast<double>(steps_));
   const double c2 = 1.0 - std::pow(b2, static_cast<double>(steps_));
-  for (std::size_t k = 0; k < params_.size(); ++k) {
-    torch::Tensor& p = params_[k];
+  // One pass per parameter (train_kernel.hpp) where libtorch's operations
+  // took ten.
+  const AdamConstants k{static_cast<float>(b1),  static_cast<float>(1.0 - b1),
+                        static_cast<float>(b2),  static_cast<float>(1.0 - b2),
+                        static_cast<float>(c1),  static_cast<float>(c2),
+                        static_cast<float>(eps), static_cast<float>(-lr_)};
+  for (std::size_t i = 0; i < params_.size(); ++i) {
+    torch::Tensor& p = params_[i];
     if (!p.grad().defined()) continue;
-    const torch::Tensor g = p.grad();
-    m_[k].mul_(b1).add_(g, 1.0 - b1);
-    v_[k].mul_(b2).addcmul_(g, g, 1.0 - b2);
-    p.addcdiv_(m_[k] / c1, (v_[k] / c2).sqrt_().add_(eps), -lr_);
-    p.mutable_grad().zero_();
+    torch::Tensor& g = p.mutable_grad();
+    if (!g.is_contiguous()) g = g.contiguous();
+    TORCH_CHECK(p.is_contiguous() && p.scalar_type() == torch::kFloat32 &&
+                    g.scalar_type() == torch::kFloat32 && g.sizes() == p.sizes(),
+                "Adam: float parameters and gradients of their shape");
+    adam_update(p.data_ptr<float>(), g.data_ptr<float>(), m_[i].data_ptr<float>(),
+                v_[i].data_ptr<float>(), static_cast<std::size_t>(p.numel()), k);
   }
 }
 

@@ -135,10 +135,18 @@ torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& back
                          const torch::Tensor& truth);
 // sum_i |S^f_i - S^b_{n+1-i}|
 torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward);
+// Both at once on the frames of both chains run as one batch, [n, 2 B, D]
+// (the forward chain's B sequences first): {recon, bidir}, one autograd
+// node.
+std::pair<torch::Tensor, torch::Tensor> chain_losses(const torch::Tensor& frames,
+                                                     const torch::Tensor& truth);
 // KL(N(mu, exp(logvar)) || N(0, 1)), mean over all latent entries.
 torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar);
 // Mean square of the weights (matrices, not biases) of the module.
 torch::Tensor l2_loss(const torch::nn::Module& net);
+// Adds `scale` times l2_loss's gradient to each weight's gradient (what
+// backward through scale * l2_loss would add).
+void add_l2_gradient(const torch::nn::Module& net, double scale);
 
 struct LossTerms {
   torch::Tensor recon, bidir, kl, l2, total;
