@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release sanitize-build test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install test-boot arm64-build test-arm64 clean
+.PHONY: deps build demo test test-release sanitize-build test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install install-root test-boot arm64-build test-arm64 clean
 
 deps:
 	@scripts/install-deps.sh
@@ -24,9 +24,11 @@ demo: build
 # Every test tier: unit and integration on the warnings-as-errors build, then
 # again under AddressSanitizer and UndefinedBehaviorSanitizer, then every
 # fuzz harness for a few seconds, the hardware-in-the-loop tier in a QEMU
-# guest, and the arm64 build's tests under qemu-user. The later tiers'
-# builds run beside the earlier tiers' tests at idle CPU priority
-# (scripts/test-tiers: the tests mostly wait, on ptys, clocks and browsers).
+# guest, the arm64 build's tests under qemu-user, and the Debian packages
+# installed into a fresh Debian 12 root and booted with their service under
+# QEMU (as root). The later tiers' builds, and the packages' root, are made
+# beside the earlier tiers' tests at idle CPU priority (scripts/test-tiers:
+# the tests mostly wait, on ptys, clocks, browsers and guests).
 test: deps
 	scripts/test-tiers
 
@@ -69,13 +71,19 @@ deb: build
 # root is cached in $(BUILD)/install/cache, the first run fetches it from
 # Debian's archive) and checked there: the service user, the files, the
 # unit, every shipped robot file validated from the installed paths. Needs
-# root. Not part of `make test` (docs/results/packaging.md: what it costs).
+# root. `make test-boot` runs it first.
 test-install: deb
 	packaging/test-install $(BUILD)
 
+# Only the root test-install needs, fetched and cached (make test does it in
+# the background).
+install-root: deb
+	packaging/test-install --root-only $(BUILD)
+
 # That installed system booted with systemd under QEMU (TCG): the service
 # plays a figure on the host's simulated servos, a shutdown ramps it home
-# and turns torque off. Results in $(BUILD)/hil-boot.
+# and turns torque off. Results in $(BUILD)/hil-boot. Needs root; the last
+# tier of `make test`.
 test-boot: deb
 	tests/hil/boot $(BUILD)
 
