@@ -6,7 +6,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TEST_SECONDS ?= 3
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build demo test test-release test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install test-boot test-arm64 clean
+.PHONY: deps build demo test test-release sanitize-build test-sanitize test-fuzz test-hil fuzz fuzz-build bench deb test-install install-root test-boot arm64-build test-arm64 clean
 
 deps:
 	@scripts/install-deps.sh
@@ -23,21 +23,24 @@ demo: build
 
 # Every test tier: unit and integration on the warnings-as-errors build, then
 # again under AddressSanitizer and UndefinedBehaviorSanitizer, then every
-# fuzz harness for a few seconds, then the hardware-in-the-loop tier in a
-# QEMU guest. The arm64 tier (`make test-arm64`) is not in it: with it, a
-# fresh clone's `make test` took 36.4 minutes, past its 35-minute budget
-# (docs/results/test_suite.md, docs/results/packaging.md#the-arm64-tier).
-test: test-release test-sanitize
-	$(MAKE) test-fuzz
-	$(MAKE) test-hil
+# fuzz harness for a few seconds, the hardware-in-the-loop tier in a QEMU
+# guest, the arm64 build's tests under qemu-user, and the Debian packages
+# installed into a fresh Debian 12 root and booted with their service under
+# QEMU (as root). The later tiers' builds, and the packages' root, are made
+# beside the earlier tiers' tests at idle CPU priority (scripts/test-tiers:
+# the tests mostly wait, on ptys, clocks, browsers and guests).
+test: deps
+	scripts/test-tiers
 
 test-release: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
-test-sanitize: deps
+sanitize-build: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DANIMRT_WERROR=ON -DANIMRT_SANITIZE=ON \
 	  -DANIMRT_BENCH=OFF
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
+
+test-sanitize: sanitize-build
 	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS)
 
 # libFuzzer harnesses of every decoder and file parser (tests/fuzz), in a
@@ -68,13 +71,19 @@ deb: build
 # root is cached in $(BUILD)/install/cache, the first run fetches it from
 # Debian's archive) and checked there: the service user, the files, the
 # unit, every shipped robot file validated from the installed paths. Needs
-# root. Not part of `make test` (docs/results/packaging.md: what it costs).
+# root. `make test-boot` runs it first.
 test-install: deb
 	packaging/test-install $(BUILD)
 
+# Only the root test-install needs, fetched and cached (make test does it in
+# the background).
+install-root: deb
+	packaging/test-install --root-only $(BUILD)
+
 # That installed system booted with systemd under QEMU (TCG): the service
 # plays a figure on the host's simulated servos, a shutdown ramps it home
-# and turns torque off. Results in $(BUILD)/hil-boot.
+# and turns torque off. Results in $(BUILD)/hil-boot. Needs root; the last
+# tier of `make test`.
 test-boot: deb
 	tests/hil/boot $(BUILD)
 
@@ -86,12 +95,14 @@ test-boot: deb
 # against a sysroot of Debian's arm64 -dev packages ($(ARM64_BUILD)/sysroot,
 # fetched once from Debian's archive), and run under qemu-user.
 ARM64_BUILD ?= build-arm64
-test-arm64: deps
+arm64-build: deps
 	packaging/arm64-sysroot $(ARM64_BUILD)/sysroot
 	cmake -S . -B $(ARM64_BUILD) -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake \
 	  -DANIMRT_ARM64_SYSROOT=$(abspath $(ARM64_BUILD))/sysroot -DANIMRT_RUNTIME_ONLY=ON \
 	  -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG" -DANIMRT_WERROR=ON
 	cmake --build $(ARM64_BUILD) -j $(JOBS)
+
+test-arm64: arm64-build
 	ctest --test-dir $(ARM64_BUILD) --output-on-failure -j $(JOBS)
 
 bench: build
