@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/dense_kernel.hpp"
@@ -560,15 +562,39 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   return {torch::stack(frames), torch::stack(mus), torch::stack(logvars)};
 }
 
+namespace {
+// Per frame, the mean over its B x D entries of the (weighted) squares.
+torch::Tensor frame_distances(const torch::Tensor& difference, const torch::Tensor& weight) {
+  const torch::Tensor squares = difference.pow(2);
+  return (weight.defined() ? squares * weight : squares).flatten(1).mean(1);
+}
+}  // namespace
+
 torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& backward,
-                         const torch::Tensor& truth) {
-  const torch::Tensor f = (forward - truth).pow(2).flatten(1).mean(1);
-  const torch::Tensor b = (backward - truth.flip(0)).pow(2).flatten(1).mean(1);
+                         const torch::Tensor& truth, const torch::Tensor& weight) {
+  const torch::Tensor f = frame_distances(forward - truth, weight);
+  const torch::Tensor b = frame_distances(backward - truth.flip(0), weight);
   return (f + b).sum();
 }
 
-torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward) {
-  return (forward - backward.flip(0)).pow(2).flatten(1).mean(1).sum();
+torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward,
+                         const torch::Tensor& weight) {
+  return frame_distances(forward - backward.flip(0), weight).sum();
+}
+
+torch::Tensor frame_weights(int dims, int placement_values, double placement_weight) {
+  if (!(placement_weight > 0) || !std::isfinite(placement_weight)) {
+    throw std::invalid_argument("placement weight " + std::to_string(placement_weight) +
+                                ": must be a positive number");
+  }
+  if (placement_values < 0 || placement_values > dims) {
+    throw std::invalid_argument("placement values " + std::to_string(placement_values) +
+                                " of a frame of " + std::to_string(dims));
+  }
+  if (placement_weight == 1.0 || placement_values == 0) return {};
+  torch::Tensor w = torch::ones({dims});
+  w.slice(0, dims - placement_values, dims).fill_(placement_weight);
+  return w;
 }
 
 torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar) {
@@ -587,7 +613,7 @@ torch::Tensor l2_loss(const torch::nn::Module& net) {
 }
 
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                     bool bidirectional, double l2_weight) {
+                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight) {
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
@@ -600,8 +626,8 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
     const torch::Tensor starts = torch::cat({truth.slice(0, 0, 1), truth.slice(0, n - 1, n)}, 1);
     const Chain c = net->run(starts, n, both, sample);
     const torch::Tensor f = c.frames.slice(1, 0, batch), b = c.frames.slice(1, batch);
-    l.recon = recon_loss(f, b, truth);
-    l.bidir = bidir_loss(f, b);
+    l.recon = recon_loss(f, b, truth, frame_weight);
+    l.bidir = bidir_loss(f, b, frame_weight);
     // Both halves are the same size: the mean over both is the mean of the
     // two chains' means.
     l.kl = kl_loss(c.mu, c.logvar);
@@ -609,7 +635,7 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
     const Chain f = net->run(truth.slice(0, 0, 1), n, net->initial_state(batch, 1.0), sample);
     l.kl = kl_loss(f.mu, f.logvar);
     // One direction: its reconstruction counted twice, to keep the scale.
-    l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
+    l.recon = 2.0 * frame_distances(f.frames - truth, frame_weight).sum();
     l.bidir = torch::zeros({});
   }
   l.l2 = l2_loss(*net);
@@ -618,11 +644,11 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
 }
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
-                     bool bidirectional, double l2_weight) {
+                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight) {
   net->collect_dense_gradients(true);
   LossTerms l;
   try {
-    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight);
+    l = batch_loss(net, truth, true, kl_weight, bidirectional, l2_weight, frame_weight);
   } catch (...) {
     net->collect_dense_gradients(false);
     throw;
