@@ -36,6 +36,10 @@ code=$?
 [[ $out == *"$tmp/bad.ckpt"* ]] || fail "corrupt checkpoint not named: $out"
 [[ $(echo "$out" | wc -l) -eq 1 ]] || fail "more than one line: $out"
 
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/n.model" --placement-weight 0 2>&1) &&
+  fail "placement weight 0 accepted: $out"
+[[ $out == *"--placement-weight"* ]] || fail "placement weight 0 not named: $out"
+
 printf 'time_s,hip\n0,zero\n' > "$tmp/bad.csv"
 out=$("$animrt" seq train "$tmp/bad.csv" --out "$tmp/n.model" 2>&1)
 code=$?

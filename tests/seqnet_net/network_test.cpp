@@ -7,6 +7,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace animrt::seqnet {
 namespace {
@@ -140,6 +141,15 @@ TEST_F(SeqNetTest, ReconstructionAndBidirectionalLossesByHand) {
   EXPECT_FLOAT_EQ(bidir_loss(f, b).item<float>(), 4.0F);
   EXPECT_FLOAT_EQ(bidir_loss(f, f.flip(0)).item<float>(), 0.0F);
   EXPECT_FLOAT_EQ(recon_loss(truth, truth.flip(0), truth).item<float>(), 0.0F);
+  // The last number weighed 3 (a placement number): each frame's (0, 2)
+  // error is (1 * 0 + 3 * 4) / 2 = 6.
+  const torch::Tensor w = frame_weights(2, 1, 3.0);
+  ASSERT_TRUE(w.defined());
+  EXPECT_FLOAT_EQ(recon_loss(f, b, truth, w).item<float>(), 12.0F);
+  EXPECT_FLOAT_EQ(bidir_loss(f, b, w).item<float>(), 12.0F);
+  EXPECT_FALSE(frame_weights(2, 1, 1.0).defined());
+  EXPECT_THROW(frame_weights(2, 1, 0.0), std::invalid_argument);
+  EXPECT_THROW(frame_weights(2, 1, std::nan("")), std::invalid_argument);
 }
 
 TEST_F(SeqNetTest, KlDivergenceByHand) {

@@ -59,29 +59,40 @@ TEST(SeqTrainingStep, BothChainsInOneBatchGiveTheLossOfTwoSeparateRuns) {
 
 TEST(SeqTrainingStep, ChainLossesComputeWhatReconAndBidirLossDo) {
   // An odd number of frames (the middle one meets itself reversed) and
-  // rows of 37 (the loops' vector body and tail).
+  // rows of 37 (the loops' vector body and tail); unweighted, and with the
+  // last numbers of a frame weighted as --placement-weight does.
   torch::manual_seed(17);
   const torch::Tensor truth = torch::rand({5, 3, 37}) - 0.5;
   const torch::Tensor frames0 = torch::rand({5, 6, 37}) - 0.5;
-  const auto run = [&](bool fused, double recon_weight, double bidir_weight) {
+  const auto run = [&](bool fused, double recon_weight, double bidir_weight,
+                       const torch::Tensor& weight) {
     const torch::Tensor frames = frames0.clone().requires_grad_(true);
     torch::Tensor recon, bidir;
     if (fused) {
-      std::tie(recon, bidir) = chain_losses(frames, truth);
+      std::tie(recon, bidir) = chain_losses(frames, truth, weight);
     } else {
       const torch::Tensor f = frames.slice(1, 0, 3), b = frames.slice(1, 3);
-      recon = recon_loss(f, b, truth);
-      bidir = bidir_loss(f, b);
+      recon = recon_loss(f, b, truth, weight);
+      bidir = bidir_loss(f, b, weight);
     }
     (recon_weight * recon + bidir_weight * bidir).backward();
     return std::tuple{recon.item<double>(), bidir.item<double>(), frames.grad()};
   };
-  for (const auto& [wr, wb] : {std::pair{1.0, 0.5}, std::pair{0.0, 1.0}, std::pair{1.0, 0.0}}) {
-    const auto [recon, bidir, grad] = run(true, wr, wb);
-    const auto [recon_ref, bidir_ref, grad_ref] = run(false, wr, wb);
-    EXPECT_NEAR(recon, recon_ref, 1e-6 * recon_ref);
-    EXPECT_NEAR(bidir, bidir_ref, 1e-6 * bidir_ref);
-    EXPECT_LT(worst_relative(grad, grad_ref), 1e-5) << wr << " " << wb;
+  const torch::Tensor placement = frame_weights(37, 9, 100.0);
+  double unweighted = 0.0;
+  for (const torch::Tensor& weight : {torch::Tensor(), placement}) {
+    for (const auto& [wr, wb] : {std::pair{1.0, 0.5}, std::pair{0.0, 1.0}, std::pair{1.0, 0.0}}) {
+      const auto [recon, bidir, grad] = run(true, wr, wb, weight);
+      const auto [recon_ref, bidir_ref, grad_ref] = run(false, wr, wb, weight);
+      EXPECT_NEAR(recon, recon_ref, 1e-6 * recon_ref);
+      EXPECT_NEAR(bidir, bidir_ref, 1e-6 * bidir_ref);
+      EXPECT_LT(worst_relative(grad, grad_ref), 1e-5) << wr << " " << wb << " " << weight.defined();
+      if (!weight.defined() && wr == 1.0 && wb == 0.5) unweighted = recon;
+      // The weight counts: 9 of 37 numbers at 100 are many times the sum.
+      if (weight.defined() && wr == 1.0 && wb == 0.5) {
+        EXPECT_GT(recon, 10.0 * unweighted);
+      }
+    }
   }
 }
 

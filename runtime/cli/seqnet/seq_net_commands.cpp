@@ -82,6 +82,11 @@ void add_seq_net_commands(CLI::App& app) {
       ->check(CLI::Range(0.0, 100.0));
   train->add_option("--l2-weight", train_args->l2_weight, "0 turns the L2 term off (ablation)")
       ->check(CLI::Range(0.0, 100.0));
+  train
+      ->add_option("--placement-weight", train_args->placement_weight,
+                   "weight of the placement numbers (where the body goes) in the loss, "
+                   "against 1 for each deformation feature")
+      ->check(CLI::Range(1e-3, 1e4));
   train->add_flag("!--unidirectional", train_args->bidirectional,
                   "forward chain only, no L_bidir (ablation)");
   set_subcommand_body(train, [train_args] { return run_train(*train_args); });

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 
 #include "animrt/core/error.hpp"
@@ -562,15 +564,39 @@ Chain SeqNetImpl::run(const torch::Tensor& given, int n, LstmState state, bool s
   return {torch::stack(frames), torch::stack(mus), torch::stack(logvars)};
 }
 
+namespace {
+// Per frame, the mean over its B x D entries of the (weighted) squares.
+torch::Tensor frame_distances(const torch::Tensor& difference, const torch::Tensor& weight) {
+  const torch::Tensor squares = difference.pow(2);
+  return (weight.defined() ? squares * weight : squares).flatten(1).mean(1);
+}
+}  // namespace
+
 torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& backward,
-                         const torch::Tensor& truth) {
-  const torch::Tensor f = (forward - truth).pow(2).flatten(1).mean(1);
-  const torch::Tensor b = (backward - truth.flip(0)).pow(2).flatten(1).mean(1);
+                         const torch::Tensor& truth, const torch::Tensor& weight) {
+  const torch::Tensor f = frame_distances(forward - truth, weight);
+  const torch::Tensor b = frame_distances(backward - truth.flip(0), weight);
   return (f + b).sum();
 }
 
-torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward) {
-  return (forward - backward.flip(0)).pow(2).flatten(1).mean(1).sum();
+torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward,
+                         const torch::Tensor& weight) {
+  return frame_distances(forward - backward.flip(0), weight).sum();
+}
+
+torch::Tensor frame_weights(int dims, int placement_values, double placement_weight) {
+  if (!(placement_weight > 0) || !std::isfinite(placement_weight)) {
+    throw std::invalid_argument("placement weight " + std::to_string(placement_weight) +
+                                ": must be a positive number");
+  }
+  if (placement_values < 0 || placement_values > dims) {
+    throw std::invalid_argument("placement values " + std::to_string(placement_values) +
+                                " of a frame of " + std::to_string(dims));
+  }
+  if (placement_weight == 1.0 || placement_values == 0) return {};
+  torch::Tensor w = torch::ones({dims});
+  w.slice(0, dims - placement_values, dims).fill_(placement_weight);
+  return w;
 }
 
 namespace {
@@ -582,37 +608,50 @@ namespace {
 struct ChainLosses : torch::autograd::Function<ChainLosses> {
   static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx,
                                                 const torch::Tensor& frames,
-                                                const torch::Tensor& truth) {
+                                                const torch::Tensor& truth,
+                                                const torch::Tensor& weight) {
     TORCH_CHECK(frames.dim() == 3 && truth.dim() == 3 && frames.size(0) == truth.size(0) &&
                     frames.size(1) == 2 * truth.size(1) && frames.size(2) == truth.size(2) &&
                     frames.scalar_type() == torch::kFloat32 &&
                     truth.scalar_type() == torch::kFloat32,
                 "chain losses: frames [n, 2B, D] and truth [n, B, D], float");
-    const torch::Tensor f = frames.contiguous(), x = truth.contiguous();
+    TORCH_CHECK(weight.numel() == 0 || (weight.dim() == 1 && weight.size(0) == truth.size(2) &&
+                                        weight.scalar_type() == torch::kFloat32),
+                "chain losses: weight [D], float, or none");
+    const torch::Tensor f = frames.contiguous(), x = truth.contiguous(), w = weight.contiguous();
     double recon = 0.0, bidir = 0.0;
-    chain_loss_sums(f.data_ptr<float>(), x.data_ptr<float>(), static_cast<int>(x.size(0)),
-                    static_cast<int>(x.size(1)), static_cast<int>(x.size(2)), &recon, &bidir);
-    ctx->save_for_backward({f, x});
+    chain_loss_sums(f.data_ptr<float>(), x.data_ptr<float>(), weight_data(w),
+                    static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
+                    static_cast<int>(x.size(2)), &recon, &bidir);
+    ctx->save_for_backward({f, x, w});
     return {torch::tensor(static_cast<float>(recon)), torch::tensor(static_cast<float>(bidir))};
   }
   static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
                                                torch::autograd::tensor_list grad) {
     const auto saved = ctx->get_saved_variables();
-    const torch::Tensor &f = saved[0], &x = saved[1];
+    const torch::Tensor &f = saved[0], &x = saved[1], &w = saved[2];
     const auto scalar = [](const torch::Tensor& g) { return g.defined() ? g.item<float>() : 0.0F; };
     torch::Tensor df = torch::empty_like(f);
-    chain_losses_backward(f.data_ptr<float>(), x.data_ptr<float>(), static_cast<int>(x.size(0)),
-                          static_cast<int>(x.size(1)), static_cast<int>(x.size(2)), scalar(grad[0]),
-                          scalar(grad[1]), df.data_ptr<float>());
-    return {df, torch::Tensor()};
+    chain_losses_backward(f.data_ptr<float>(), x.data_ptr<float>(), weight_data(w),
+                          static_cast<int>(x.size(0)), static_cast<int>(x.size(1)),
+                          static_cast<int>(x.size(2)), scalar(grad[0]), scalar(grad[1]),
+                          df.data_ptr<float>());
+    return {df, torch::Tensor(), torch::Tensor()};
+  }
+  // An autograd function's tensor arguments must be defined: no weight is
+  // an empty one.
+  static const float* weight_data(const torch::Tensor& w) {
+    return w.numel() > 0 ? w.data_ptr<float>() : nullptr;
   }
 };
 
 }  // namespace
 
 std::pair<torch::Tensor, torch::Tensor> chain_losses(const torch::Tensor& frames,
-                                                     const torch::Tensor& truth) {
-  const auto out = ChainLosses::apply(frames, truth);
+                                                     const torch::Tensor& truth,
+                                                     const torch::Tensor& weight) {
+  const auto out = ChainLosses::apply(frames, truth,
+                                      weight.defined() ? weight : torch::empty({0}));
   return {out[0], out[1]};
 }
 
@@ -655,7 +694,8 @@ namespace {
 // batch_loss; with `l2_in_graph` false the L2 term's value is in the total
 // but not on the tape (the caller adds its gradient: add_l2_gradient).
 LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                           bool bidirectional, double l2_weight, bool l2_in_graph) {
+                           bool bidirectional, double l2_weight, const torch::Tensor& frame_weight,
+                           bool l2_in_graph) {
   const auto n = static_cast<int>(truth.size(0));
   const auto batch = static_cast<int>(truth.size(1));
   LossTerms l;
@@ -667,7 +707,7 @@ LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample,
                          torch::cat({std::get<1>(f0), std::get<1>(b0)}, 1)};
     const torch::Tensor starts = torch::cat({truth.slice(0, 0, 1), truth.slice(0, n - 1, n)}, 1);
     const Chain c = net->run(starts, n, both, sample);
-    std::tie(l.recon, l.bidir) = chain_losses(c.frames, truth);
+    std::tie(l.recon, l.bidir) = chain_losses(c.frames, truth, frame_weight);
     // Both halves are the same size: the mean over both is the mean of the
     // two chains' means.
     l.kl = kl_loss(c.mu, c.logvar);
@@ -675,7 +715,7 @@ LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample,
     const Chain f = net->run(truth.slice(0, 0, 1), n, net->initial_state(batch, 1.0), sample);
     l.kl = kl_loss(f.mu, f.logvar);
     // One direction: its reconstruction counted twice, to keep the scale.
-    l.recon = 2.0 * (f.frames - truth).pow(2).flatten(1).mean(1).sum();
+    l.recon = 2.0 * frame_distances(f.frames - truth, frame_weight).sum();
     l.bidir = torch::zeros({});
   }
   if (l2_in_graph) {
@@ -691,18 +731,20 @@ LossTerms batch_loss_terms(SeqNet& net, const torch::Tensor& truth, bool sample,
 }  // namespace
 
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight,
-                     bool bidirectional, double l2_weight) {
-  return batch_loss_terms(net, truth, sample, kl_weight, bidirectional, l2_weight, true);
+                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight) {
+  return batch_loss_terms(net, truth, sample, kl_weight, bidirectional, l2_weight, frame_weight,
+                          true);
 }
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
-                     bool bidirectional, double l2_weight) {
+                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight) {
   net->collect_dense_gradients(true);
   LossTerms l;
   try {
     // The L2 term's gradient is added after backward: on the tape it was a
     // few passes over every weight, forward and backward, for 2 w / count.
-    l = batch_loss_terms(net, truth, true, kl_weight, bidirectional, l2_weight, false);
+    l = batch_loss_terms(net, truth, true, kl_weight, bidirectional, l2_weight, frame_weight,
+                         false);
   } catch (...) {
     net->collect_dense_gradients(false);
     throw;

@@ -326,6 +326,12 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     shape.window = o.window;
     shape.stride = o.stride;
   }
+  if (o.placement_weight != 1.0 && shape.placement_nodes == 0) {
+    fail(o.data.front(), 0, 0, "placement weight",
+         "the data has no placement numbers to weigh (mesh feature files carry them)");
+  }
+  const torch::Tensor frame_weight =
+      frame_weights(set.dims, 9 * shape.placement_nodes, o.placement_weight);
   const int span = (shape.window - 1) * shape.stride + 1;
   int longest = 0;
   std::vector<std::size_t> usable;
@@ -469,7 +475,8 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     }
     const torch::Tensor truth =
         torch::from_blob(values.data(), {shape.window, o.batch, set.dims}, torch::kFloat32);
-    const LossTerms l = train_step(net, adam, truth, o.kl_weight, o.bidirectional, o.l2_weight);
+    const LossTerms l = train_step(net, adam, truth, o.kl_weight, o.bidirectional, o.l2_weight,
+                                     frame_weight);
     ++iteration;
     result.last = record(l);
     if (!std::isfinite(result.last.total)) {

@@ -130,16 +130,25 @@ TORCH_MODULE(SeqNet);
 
 // Loss terms (docs/seqnet.md, "Losses"). S^f, S^b and X are [n, B, D]; a
 // frame's distance is the mean squared difference over its B x D entries.
+// `weight` [D] (optional) weighs each number of a frame in its distance.
 // sum_i |S^f_i - X_i| + |S^b_i - X_{n+1-i}|
 torch::Tensor recon_loss(const torch::Tensor& forward, const torch::Tensor& backward,
-                         const torch::Tensor& truth);
+                         const torch::Tensor& truth, const torch::Tensor& weight = {});
 // sum_i |S^f_i - S^b_{n+1-i}|
-torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward);
+torch::Tensor bidir_loss(const torch::Tensor& forward, const torch::Tensor& backward,
+                         const torch::Tensor& weight = {});
 // Both at once on the frames of both chains run as one batch, [n, 2 B, D]
 // (the forward chain's B sequences first): {recon, bidir}, one autograd
-// node.
+// node; `weight` as above.
 std::pair<torch::Tensor, torch::Tensor> chain_losses(const torch::Tensor& frames,
-                                                     const torch::Tensor& truth);
+                                                     const torch::Tensor& truth,
+                                                     const torch::Tensor& weight = {});
+// Weights of a frame's D numbers: `placement_weight` for the last
+// `placement_values` (the placement nodes: where the body goes and where
+// the other pieces sit), 1 for the rest; undefined (no weighting) when all
+// are 1. Throws std::invalid_argument for a weight that is not positive
+// and finite.
+torch::Tensor frame_weights(int dims, int placement_values, double placement_weight);
 // KL(N(mu, exp(logvar)) || N(0, 1)), mean over all latent entries.
 torch::Tensor kl_loss(const torch::Tensor& mu, const torch::Tensor& logvar);
 // Mean square of the weights (matrices, not biases) of the module.
@@ -154,16 +163,19 @@ struct LossTerms {
 // L_recon + 0.5 L_bidir + 0.1 (L_KL + L2) for one batch of ground-truth
 // windows X [n, B, D]: the forward chain from X_1 with +s0, the backward
 // chain from X_n with -s0. `kl_weight`, `l2_weight` and `bidirectional`
-// switch terms off for ablations (1, 1 and true: the paper).
+// switch terms off for ablations (1, 1 and true: the paper); `frame_weight`
+// (frame_weights) weighs the frame distances of L_recon and L_bidir.
 LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, double kl_weight = 1.0,
-                     bool bidirectional = true, double l2_weight = 1.0);
+                     bool bidirectional = true, double l2_weight = 1.0,
+                     const torch::Tensor& frame_weight = {});
 
 class Adam;
 
 // One training iteration on the windows X [n, B, D]: batch_loss with
 // latent sampling, its gradients, one Adam step. Returns the loss terms.
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight = 1.0,
-                     bool bidirectional = true, double l2_weight = 1.0);
+                     bool bidirectional = true, double l2_weight = 1.0,
+                     const torch::Tensor& frame_weight = {});
 
 // Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
 // that a checkpoint saves and restores exactly.

@@ -13,14 +13,15 @@ namespace animrt::seqnet {
 // backward chain in the last B) against the truth X [n, B, D]:
 //   recon = sum_t mean (F^f_t - X_t)^2 + mean (F^b_t - X_{n-1-t})^2
 //   bidir = sum_t mean (F^f_t - F^b_{n-1-t})^2
-// each mean over the B x D entries of a frame; sums in double.
-void chain_loss_sums(const float* frames, const float* truth, int n, int batch, int dims,
-                     double* recon, double* bidir);
+// each mean over the B x D entries of a frame; sums in double. `weight`
+// [D] (null: all 1) weighs each of a frame's D numbers in its squares.
+void chain_loss_sums(const float* frames, const float* truth, const float* weight, int n,
+                     int batch, int dims, double* recon, double* bidir);
 
 // Their gradient with respect to F, for the gradients `g_recon` and
 // `g_bidir` of the two sums, into `d_frames` [n, 2B, D].
-void chain_losses_backward(const float* frames, const float* truth, int n, int batch, int dims,
-                           float g_recon, float g_bidir, float* d_frames);
+void chain_losses_backward(const float* frames, const float* truth, const float* weight, int n,
+                           int batch, int dims, float g_recon, float g_bidir, float* d_frames);
 
 // One Adam step on `count` numbers, in libtorch's order of operations:
 // m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g g,
