@@ -13,6 +13,7 @@ copy_robot() {
 
 # start_sim ROBOT: serves its devices; sets sim_pid and pty (the first serial bus).
 start_sim() {
+  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
   "$animrt" sim "$1" --control "$tmp/ctl" > "$tmp/sim.txt" 2>&1 &
   sim_pid=$!
   for _ in $(seq 100); do

@@ -16,6 +16,7 @@ pid=""
 start_sim() {
   "/usr/bin/python3" -c 'import serial' 2> /dev/null \
     || fail "python3-serial not found for /usr/bin/python3 (scripts/install-deps.sh installs it)"
+  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
   "$animrt" sim "$root/configs/robots/quadruped.yaml" > "$tmp/sim.txt" 2>&1 &
   sim_pid=$!
   for _ in $(seq 50); do

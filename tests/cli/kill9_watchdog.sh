@@ -89,6 +89,7 @@ sim_pid=""
 # The animatronic figure: Dynamixel neck, Maestro face (its serial timeout is
 # a setting of the board; the simulated board holds what the robot file
 # says), Modbus torso (no guard: validate says so).
+: > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
 "$animrt" sim "$root/configs/robots/animatronic.yaml" > "$tmp/sim.txt" 2>&1 &
 sim_pid=$!
 for _ in $(seq 50); do

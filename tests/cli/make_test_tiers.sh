@@ -18,6 +18,10 @@ echo "start $target $(chrt -p $$ 2>/dev/null | sed -n 's/.*policy: //p')" >> "$F
 case $target in
   *-build|deb|install-root) echo $$ > "$FAKE_DIR/$target.pid"; sleep "${FAKE_SLOW:-0.3}" ;;
 esac
+# A tier may wait until a background build has started.
+if [ -n "${FAKE_AFTER:-}" ] && [ "$target" = "${FAKE_FAIL:-}" ]; then
+  for _ in $(seq 100); do [ -e "$FAKE_DIR/$FAKE_AFTER.pid" ] && break; sleep 0.05; done
+fi
 [ "$target" = "${FAKE_FAIL:-}" ] && { echo "the build of $target broke"; exit 2; }
 echo "end $target" >> "$FAKE_LOG"
 FAKE
@@ -54,7 +58,8 @@ grep -q "^start test-fuzz\|^start test-hil\|^start test-arm64" "$tmp/broken" && 
 
 # --- a tier fails while the background builds run: they are stopped ------------
 rm -f "$tmp"/*.pid
-FAKE_SLOW=30 FAKE_FAIL=test-release run stopped && fail "a failed release tier passed"
+FAKE_SLOW=30 FAKE_FAIL=test-release FAKE_AFTER=sanitize-build run stopped &&
+  fail "a failed release tier passed"
 pid=$(cat "$tmp/sanitize-build.pid" 2>/dev/null) || fail "the sanitizer build never started: $(cat "$tmp/stopped")"
 for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
 kill -0 "$pid" 2>/dev/null && { kill "$pid"; fail "the sanitizer build kept running after the release tier failed"; }

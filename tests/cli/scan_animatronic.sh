@@ -16,6 +16,7 @@ trap '[[ -n $sim_pid ]] && kill $sim_pid 2>/dev/null; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 start_sim() {
+  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
   "$animrt" sim "$@" > "$tmp/sim.txt" 2>&1 &
   sim_pid=$!
   for _ in $(seq 50); do

@@ -129,6 +129,7 @@ out=$("$animrt" scan "$junk" --protocol dynamixel2,feetech --baud 1000000 --ids 
 # servos plugged in at once are a collision at id 1.
 kill $sim_pid
 wait $sim_pid 2> /dev/null
+: > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
 "$animrt" sim "$root/configs/robots/arm_sts.yaml" --factory --control "$tmp/ctl" > "$tmp/sim.txt" 2>&1 &
 sim_pid=$!
 for _ in $(seq 50); do

@@ -13,6 +13,7 @@ ctl() {
   /usr/bin/python3 -c 'import socket,sys; s=socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); s.sendall((sys.argv[2]+"\n").encode()); print(s.makefile().readline(), end="")' "$tmp/ctl" "$1"
 }
 start_sim() {
+  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
   "$animrt" sim "$root/configs/robots/quadruped.yaml" --factory --state "$tmp/state" \
     --control "$tmp/ctl" > "$tmp/sim.txt" 2>&1 &
   sim_pid=$!
