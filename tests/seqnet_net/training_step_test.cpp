@@ -209,6 +209,9 @@ TEST(SeqTrainingStep, FusedConvolutionComputesWhatItsLayersDo) {
   for (bool transpose : {false, true}) {
     for (bool squash : {false, true}) expect_fused_equals_plain(m.bar, 3, transpose, squash);
   }
+  // 9 input channels and a batch of whole vectors run with the channels in
+  // registers: here two vectors per vertex.
+  for (bool transpose : {false, true}) expect_fused_equals_plain(m.bar, 32, transpose, true);
 }
 
 // At the training batch (16, a whole vector) and an odd one, on a mesh

@@ -132,30 +132,46 @@ struct FusedMeshConv : torch::autograd::Function<FusedMeshConv> {
                       static_cast<int>(w_self.size(0)), static_cast<int>(x.size(2))};
     const torch::Tensor g = grad[0].contiguous();
     torch::Tensor gx = torch::empty_like(x), through = torch::empty_like(x);
-    // One set of weight-gradient sums per thread, added up after.
-    const std::int64_t threads = at::get_num_threads();
-    torch::Tensor acc_self = torch::zeros({threads, s.out, s.in, kConvLanes}, x.options());
-    torch::Tensor acc_ring = torch::zeros_like(acc_self);
-    torch::Tensor acc_bias = torch::zeros({threads, s.out, kConvLanes}, x.options());
+    // One set of weight-gradient sums per thread ([W1 | W2 | b], each
+    // number kConvLanes wide), added up after in a plain loop: as libtorch
+    // tensors they were six more operations per node.
+    const auto threads = static_cast<std::size_t>(at::get_num_threads());
+    const auto weights = static_cast<std::size_t>(s.out) * static_cast<std::size_t>(s.in);
+    const std::size_t numbers = 2 * weights + static_cast<std::size_t>(s.out);
+    std::vector<float> acc(threads * numbers * kConvLanes, 0.0F);
     at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
-      const std::int64_t t = at::get_thread_num();
+      float* a = acc.data() + static_cast<std::size_t>(at::get_thread_num()) * numbers * kConvLanes;
       mesh_conv_backward_local(
           s, x.data_ptr<float>(), ring.data_ptr<float>(), squash ? y.data_ptr<float>() : nullptr,
           g.data_ptr<float>(), w_self.data_ptr<float>(), w_ring.data_ptr<float>(),
-          gx.data_ptr<float>(), through.data_ptr<float>(), acc_self[t].data_ptr<float>(),
-          acc_ring[t].data_ptr<float>(), acc_bias[t].data_ptr<float>(), static_cast<int>(first),
-          static_cast<int>(last));
+          gx.data_ptr<float>(), through.data_ptr<float>(), a, a + weights * kConvLanes,
+          a + 2 * weights * kConvLanes, static_cast<int>(first), static_cast<int>(last));
     });
     at::parallel_for(0, s.vertices, grain, [&](std::int64_t first, std::int64_t last) {
       mesh_conv_backward_ring(s, rings->adjoint, through.data_ptr<float>(), gx.data_ptr<float>(),
                               static_cast<int>(first), static_cast<int>(last));
     });
-    return {gx,
-            acc_self.sum(at::IntArrayRef{0, 3}),
-            acc_bias.sum(at::IntArrayRef{0, 2}),
-            acc_ring.sum(at::IntArrayRef{0, 3}),
-            torch::Tensor(),
-            torch::Tensor()};
+    // Each gradient its own tensor (autograd may keep it as the .grad).
+    torch::Tensor g_self = torch::empty({s.out, s.in}, x.options());
+    torch::Tensor g_ring = torch::empty({s.out, s.in}, x.options());
+    torch::Tensor g_bias = torch::empty({s.out}, x.options());
+    // Number k of [W1 | W2 | b] summed over threads and lanes.
+    const auto sum = [&](std::size_t k) {
+      float total = 0.0F;
+      for (std::size_t t = 0; t < threads; ++t) {
+        const float* lanes = acc.data() + (t * numbers + k) * kConvLanes;
+        for (int j = 0; j < kConvLanes; ++j) total += lanes[j];
+      }
+      return total;
+    };
+    for (std::size_t k = 0; k < weights; ++k) {
+      g_self.data_ptr<float>()[k] = sum(k);
+      g_ring.data_ptr<float>()[k] = sum(weights + k);
+    }
+    for (std::size_t k = 0; k < static_cast<std::size_t>(s.out); ++k) {
+      g_bias.data_ptr<float>()[k] = sum(2 * weights + k);
+    }
+    return {gx, g_self, g_bias, g_ring, torch::Tensor(), torch::Tensor()};
   }
 };
 
