@@ -13,12 +13,16 @@ source "$(dirname "$0")/seq_data.bash"
 write_walk_csv "$tmp/walk.csv"
 
 out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 10 --checkpoint-every 5 \
-  --report-every 5 "${small[@]}" 2>&1) || fail "train failed: $out"
+  --report-every 5 --clip-gradient 1e-6 "${small[@]}" 2>&1) || fail "train failed: $out"
+[[ $out == *"gradient clipped to 1e-06 in 10 of 10 iterations (largest norm "* ]] ||
+  fail "no clipping line: $out"
+[[ $out == *"best held-out completion: iteration 10, kept in $tmp/m.model.best"* ]] ||
+  fail "no best model line: $out"
 line='iteration 5/10  recon [0-9.e+-]+  bidir [0-9.e+-]+  KL [0-9.e+-]+  L2 [0-9.e+-]+  total [0-9.e+-]+  [0-9.]+ it/s  left [0-9]+:[0-9][0-9]'
 [[ $out =~ $line ]] || fail "no progress line: $out"
 [[ $out == *"iteration 10/10 "* ]] || fail "no last progress line: $out"
 [[ $out == *"held-out reconstruction loss per frame"* ]] || fail "no held-out loss: $out"
-for f in m.model m.model.ckpt m.model.svg; do
+for f in m.model m.model.ckpt m.model.svg m.model.best; do
   [[ -s $tmp/$f ]] || fail "$f not written"
 done
 grep -q '<svg' "$tmp/m.model.svg" || fail "plot is not SVG"
@@ -39,6 +43,9 @@ code=$?
 out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/n.model" --placement-weight 0 2>&1) &&
   fail "placement weight 0 accepted: $out"
 [[ $out == *"--placement-weight"* ]] || fail "placement weight 0 not named: $out"
+out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/n.model" --clip-gradient -1 2>&1) &&
+  fail "negative clip accepted: $out"
+[[ $out == *"--clip-gradient"* ]] || fail "negative clip not named: $out"
 
 printf 'time_s,hip\n0,zero\n' > "$tmp/bad.csv"
 out=$("$animrt" seq train "$tmp/bad.csv" --out "$tmp/n.model" 2>&1)

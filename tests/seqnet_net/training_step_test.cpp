@@ -168,6 +168,59 @@ TEST(SeqTrainingStep, TrainStepUpdatesFloatParametersFromTheCollectedGradients) 
   }
 }
 
+// Clipping scales every gradient by one factor, and only when all of them
+// together are longer than the limit; a train_step whose gradients stay
+// under it moves the weights exactly as one without clipping.
+TEST(SeqTrainingStep, ClippingScalesAllGradientsTogetherOnlyWhenLonger) {
+  torch::set_num_threads(1);
+  const SmallMesh m;
+  SeqNet net = m.net(5);
+  Adam adam(net->parameters(), 1e-3);
+  double count = 0;
+  for (torch::Tensor& p : net->parameters()) {
+    p.mutable_grad() = torch::full_like(p, 0.5);
+    count += static_cast<double>(p.numel());
+  }
+  const double norm = 0.5 * std::sqrt(count);
+  EXPECT_NEAR(adam.clip(2 * norm), norm, 1e-9 * norm);
+  for (const torch::Tensor& p : net->parameters()) EXPECT_EQ(p.grad().max().item<float>(), 0.5f);
+  EXPECT_NEAR(adam.clip(norm / 4), norm, 1e-9 * norm);
+  for (const torch::Tensor& p : net->parameters()) {
+    EXPECT_NEAR(p.grad().min().item<double>(), 0.125, 1e-7);
+    EXPECT_NEAR(p.grad().max().item<double>(), 0.125, 1e-7);
+  }
+
+  SeqNet plain = m.net(11), roomy = m.net(11), tight = m.net(11);
+  const torch::Tensor truth = torch::rand({5, 2, m.shape.input_dims()}) * 1.9 - 0.95;
+  Adam adam_plain(plain->parameters(), 1e-3), adam_roomy(roomy->parameters(), 1e-3),
+      adam_tight(tight->parameters(), 1e-3);
+  torch::manual_seed(1);
+  EXPECT_EQ(train_step(plain, adam_plain, truth).gradient_norm, 0.0);  // not computed
+  torch::manual_seed(1);
+  const double seen = train_step(roomy, adam_roomy, truth, 1, true, 1, {}, 1e9).gradient_norm;
+  EXPECT_GT(seen, 0.0);
+  torch::manual_seed(1);
+  EXPECT_NEAR(train_step(tight, adam_tight, truth, 1, true, 1, {}, seen / 100).gradient_norm, seen,
+              1e-9 * seen);
+  // A second step: Adam's first step moves each weight by the step size
+  // whatever the gradient's length, its second one by the moments.
+  torch::manual_seed(2);
+  train_step(plain, adam_plain, truth);
+  torch::manual_seed(2);
+  train_step(roomy, adam_roomy, truth, 1, true, 1, {}, 1e9);
+  torch::manual_seed(2);
+  train_step(tight, adam_tight, truth, 1, true, 1, {}, seen / 100);
+  double apart = 0;
+  for (const auto& item : plain->named_parameters()) {
+    EXPECT_TRUE(torch::equal(roomy->named_parameters()[item.key()], item.value())) << item.key();
+    apart = std::max(apart, (tight->named_parameters()[item.key()] - item.value())
+                                .abs()
+                                .max()
+                                .item<double>());
+  }
+  EXPECT_GT(apart, 1e-5);
+}
+
 // One fused node per convolution (and its tanh), the loops of
 // mesh_conv_kernel.hpp on [V, C, B], against the layer-by-layer
 // formulation of libtorch's ops (sparse product, two products and bias on

@@ -8,6 +8,7 @@
 #include <torch/torch.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -96,6 +97,48 @@ TEST(SeqTraining, PrintsHeldOutCompletionAgainstInterpolationAndKeepsIt) {
   EXPECT_EQ(m.held_out_gap, 9);
   const std::string warning = interpolation_warning(m, o.out);
   EXPECT_EQ(warning.empty(), r.held_out_completion < r.held_out_interpolation) << warning;
+
+  // OUT.best is the model of the lowest held-out completion printed.
+  int best_at = 0;
+  double best = 1e9;
+  for (int at : {10, 20, 25}) {
+    const std::string head =
+        "held out at iteration " + std::to_string(at) + ": completion of 9-frame gaps ";
+    const double value = std::stod(text.substr(text.find(head) + head.size()));
+    if (value < best) best = value, best_at = at;
+  }
+  EXPECT_EQ(r.best_iteration, best_at);
+  const ModelFile kept = read_model_file(o.out + ".best");
+  EXPECT_EQ(kept.iteration, static_cast<std::uint64_t>(best_at));
+  EXPECT_NEAR(100.0 * kept.held_out_completion, best, 0.005);
+  EXPECT_NE(text.find("best held-out completion: iteration " + std::to_string(best_at) +
+                      ", kept in " + o.out + ".best"),
+            std::string::npos)
+      << text;
+}
+
+// A resumed training measures the OUT.best it finds first and replaces it
+// only with a better model.
+TEST(SeqTraining, AResumeKeepsABetterBestModel) {
+  const std::string data = nettest::write_joint_csv("best.csv", 80);
+  TrainOptions a = tiny_options(data, "best_a.model");
+  a.iterations = 40;
+  a.held_out_every = 10;
+  std::ostringstream log;
+  train(a, log);
+  const ModelFile better = read_model_file(a.out + ".best");
+  TrainOptions b = tiny_options(data, "best_b.model");
+  b.iterations = 5;
+  b.held_out_every = 5;
+  EXPECT_EQ(train(b, log).best_iteration, 5);
+  std::filesystem::copy_file(a.out + ".best", b.out + ".best",
+                             std::filesystem::copy_options::overwrite_existing);
+  b.resume = b.out + ".ckpt";
+  b.iterations = 10;
+  const TrainResult r = train(b, log);
+  ASSERT_LT(better.held_out_completion, r.held_out_completion) << log.str();  // the setup
+  EXPECT_EQ(r.best_iteration, 0);
+  EXPECT_EQ(read_model_file(b.out + ".best").iteration, better.iteration);
 }
 
 TEST(SeqTraining, AModelNeverBetterThanInterpolationIsWarnedOf) {

@@ -87,6 +87,10 @@ void add_seq_net_commands(CLI::App& app) {
                    "weight of the placement numbers (where the body goes) in the loss, "
                    "against 1 for each deformation feature")
       ->check(CLI::Range(1e-3, 1e4));
+  train
+      ->add_option("--clip-gradient", train_args->clip_gradient,
+                   "scale all gradients together down to this L2 norm when longer (0: never)")
+      ->check(CLI::Range(0.0, 1e9));
   train->add_flag("!--unidirectional", train_args->bidirectional,
                   "forward chain only, no L_bidir (ablation)");
   set_subcommand_body(train, [train_args] { return run_train(*train_args); });

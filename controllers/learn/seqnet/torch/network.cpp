@@ -753,7 +753,8 @@ LossTerms batch_loss(SeqNet& net, const torch::Tensor& truth, bool sample, doubl
 }
 
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight,
-                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight) {
+                     bool bidirectional, double l2_weight, const torch::Tensor& frame_weight,
+                     double clip_gradient) {
   net->collect_dense_gradients(true);
   LossTerms l;
   try {
@@ -769,6 +770,7 @@ LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double
   l.total.backward();
   net->finish_gradients();
   add_l2_gradient(*net, 0.1 * l2_weight);
+  if (clip_gradient > 0) l.gradient_norm = adam.clip(clip_gradient);
   adam.step();
   return l;
 }
@@ -779,6 +781,24 @@ Adam::Adam(std::vector<torch::Tensor> parameters, double learning_rate)
     m_.push_back(torch::zeros_like(p));
     v_.push_back(torch::zeros_like(p));
   }
+}
+
+double Adam::clip(double max_norm) {
+  torch::NoGradGuard no_grad;
+  double sum = 0;
+  for (const torch::Tensor& p : params_) {
+    if (!p.grad().defined()) continue;
+    const torch::Tensor g = p.grad().contiguous();
+    const float* x = g.data_ptr<float>();
+    for (std::int64_t i = 0, n = g.numel(); i < n; ++i) sum += static_cast<double>(x[i]) * x[i];
+  }
+  const double norm = std::sqrt(sum);
+  if (norm > max_norm) {
+    for (torch::Tensor& p : params_) {
+      if (p.grad().defined()) p.mutable_grad().mul_(max_norm / norm);
+    }
+  }
+  return norm;
 }
 
 void Adam::step() {

@@ -438,17 +438,40 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     return count == 0 ? -1.0 : sum / count;
   };
 
+  // OUT.best keeps the model of the best held-out measurement so far, so a
+  // training that runs on past its best (or is thrown off by one batch)
+  // still leaves it. Placed vertices decide where they are measured. A
+  // resumed run first measures the OUT.best it finds, on this data.
+  const std::string best_path = o.out + ".best";
+  auto score = [](const HeldOutCompletion& h) {
+    return h.placed >= 0 ? h.placed : h.network;
+  };
+  double best_score = -1;
+  TrainResult result;
+  if (resuming && std::ifstream(best_path).good()) {
+    const ModelFile kept = read_model_file(best_path);
+    best_score = score(measure_held_out_completion(kept, set, 9, o.blend));
+  }
   auto measure = [&] {
     measured = HeldOutCompletion{};
-    measured = measure_held_out_completion(model_file(false), set, 9, o.blend);
+    ModelFile now = model_file(false);
+    measured = measure_held_out_completion(now, set, 9, o.blend);
     progress << held_out_line(measured, iteration) << std::endl;
+    const double s = score(measured);
+    if (s >= 0 && (best_score < 0 || s < best_score)) {
+      best_score = s;
+      now.held_out_completion = measured.network;
+      now.held_out_interpolation = measured.interpolation;
+      now.held_out_gap = measured.gap;
+      write_model_file(best_path, now);
+      result.best_iteration = iteration;
+    }
   };
 
   // Said once the data and checkpoint are accepted (an error stays one line).
   const std::string kernels = blas_kernels();
   progress << "libtorch threads " << torch::get_num_threads() << ", BLAS kernels "
            << (kernels.empty() ? "not OpenBLAS" : kernels) << '\n';
-  TrainResult result;
   const auto t0 = std::chrono::steady_clock::now();
   const int first_iteration = iteration;
   std::discrete_distribution<std::size_t> pick(starts.begin(), starts.end());
@@ -476,8 +499,12 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     const torch::Tensor truth =
         torch::from_blob(values.data(), {shape.window, o.batch, set.dims}, torch::kFloat32);
     const LossTerms l = train_step(net, adam, truth, o.kl_weight, o.bidirectional, o.l2_weight,
-                                     frame_weight);
+                                     frame_weight, o.clip_gradient);
     ++iteration;
+    if (o.clip_gradient > 0) {
+      if (l.gradient_norm > o.clip_gradient) ++result.clipped;
+      result.largest_gradient_norm = std::max(result.largest_gradient_norm, l.gradient_norm);
+    }
     result.last = record(l);
     if (!std::isfinite(result.last.total)) {
       throw std::runtime_error("training diverged at iteration " + std::to_string(iteration) +
@@ -517,6 +544,15 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
     progress << "held-out reconstruction loss per frame " << result.held_out << '\n';
   } else {
     progress << "held-out reconstruction loss: no held-out piece of 2 frames or more\n";
+  }
+  if (o.clip_gradient > 0) {
+    progress << "gradient clipped to " << o.clip_gradient << " in " << result.clipped << " of "
+             << result.run << " iterations (largest norm " << result.largest_gradient_norm
+             << ")\n";
+  }
+  if (result.best_iteration > 0) {
+    progress << "best held-out completion: iteration " << result.best_iteration << ", kept in "
+             << best_path << '\n';
   }
   progress << "model " << o.out << ", checkpoint " << o.out << ".ckpt, loss plot " << o.out
            << ".svg\n";

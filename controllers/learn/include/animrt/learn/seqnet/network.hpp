@@ -159,6 +159,9 @@ void add_l2_gradient(const torch::nn::Module& net, double scale);
 
 struct LossTerms {
   torch::Tensor recon, bidir, kl, l2, total;
+  // The L2 norm of all gradients together before any clipping (train_step
+  // with clipping on; 0 otherwise).
+  double gradient_norm = 0;
 };
 // L_recon + 0.5 L_bidir + 0.1 (L_KL + L2) for one batch of ground-truth
 // windows X [n, B, D]: the forward chain from X_1 with +s0, the backward
@@ -173,9 +176,12 @@ class Adam;
 
 // One training iteration on the windows X [n, B, D]: batch_loss with
 // latent sampling, its gradients, one Adam step. Returns the loss terms.
+// `clip_gradient` > 0 scales all gradients together down to that L2 norm
+// when they are longer (Adam::clip), so one unusual batch cannot throw the
+// weights far; 0 leaves them as they are.
 LossTerms train_step(SeqNet& net, Adam& adam, const torch::Tensor& truth, double kl_weight = 1.0,
                      bool bidirectional = true, double l2_weight = 1.0,
-                     const torch::Tensor& frame_weight = {});
+                     const torch::Tensor& frame_weight = {}, double clip_gradient = 0);
 
 // Adam (beta 0.9, 0.999, eps 1e-8) over the net's parameters, with state
 // that a checkpoint saves and restores exactly.
@@ -183,6 +189,10 @@ class Adam {
  public:
   Adam(std::vector<torch::Tensor> parameters, double learning_rate);
   void step();  // uses each parameter's grad; then zeroes the grads
+  // The L2 norm of all parameters' gradients together; when it is above
+  // `max_norm` every gradient is scaled by max_norm / norm. Returns the
+  // norm before scaling.
+  double clip(double max_norm);
   std::int64_t steps() const { return steps_; }
   std::vector<NamedArray> state(const std::vector<std::string>& names) const;
   // Throws InputError (naming `file`) when the state does not fit.

@@ -87,6 +87,9 @@ struct TrainOptions {
   // 1 for every deformation feature; > 0. Other than 1 needs mesh data with
   // placement. The held-out lines are measured unweighted.
   double placement_weight = 1.0;
+  // All gradients together scaled down to this L2 norm when longer (0: no
+  // clipping; train_step).
+  double clip_gradient = 0.0;
 };
 
 struct LossRecord {
@@ -101,6 +104,14 @@ struct TrainResult {
   // Held-out completion and linear interpolation at the end (-1: not measured).
   double held_out_completion = -1;
   double held_out_interpolation = -1;
+  // The measurement kept in OUT.best: the best held-out completion of the
+  // run (placed vertices where measured, else features) and its iteration
+  // (0: none written).
+  int best_iteration = 0;
+  // Iterations whose gradient norm was above clip_gradient, and the
+  // largest norm of the run (0 without clipping).
+  int clipped = 0;
+  double largest_gradient_norm = 0;
   double seconds = 0;
 };
 
