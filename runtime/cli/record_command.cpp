@@ -254,9 +254,10 @@ Hold hold_compliant(LimpFigure& figure, const std::vector<Track>& tracks, double
   hold.goals.assign(figure.config().joints.size(), std::nan(""));
   if (percent <= 0.0) return hold;
   std::vector<double> positions;
-  figure.read(positions);
   std::vector<std::string> limp;
   for (const Track& t : tracks) {
+    // Held where it is, as its servo says (never a lost answer's old value).
+    figure.read_fresh(t.joint, positions);
     if (figure.hold_weakly(t.joint, percent / 100.0)) {
       hold.goals[t.joint] = positions[t.joint];
       hold.any = true;
