@@ -163,6 +163,9 @@ Sampling sample(LimpFigure& figure, std::vector<Track>& tracks, double duration_
       track.times.push_back(t);
       track.values.push_back(track.prismatic ? v : rad_to_deg(v));
     }
+    // The duration is time, not a count of reads: reads that ran late (a
+    // busy host, silent devices) give fewer samples, never a longer take.
+    if (duration_s > 0 && since_start(answered) >= duration_s) break;
     next.tv_nsec += period_ns;
     while (next.tv_nsec >= 1'000'000'000L) {
       next.tv_nsec -= 1'000'000'000L;
