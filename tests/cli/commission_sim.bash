@@ -36,12 +36,20 @@ start_sim() {
   read -r _ _ pty < <(grep "^serial " "$tmp/sim.txt")
 }
 
-# stop_sim: SIGINT, as Ctrl-C; a simulator that has not ended 10 s later is
-# killed and the test fails.
+# stop_sim: SIGINT, as Ctrl-C, once the process is animrt (the shell's
+# child before its exec would take a SIGINT by running this script's EXIT
+# trap); a simulator that has not ended 10 s later is killed and the test
+# fails.
 stop_sim() {
   [[ -n ${sim_pid:-} ]] || return 0
-  local pid=$sim_pid
+  local pid=$sim_pid exe
   sim_pid=""
+  exe=$(readlink -f "$animrt")
+  for _ in $(seq 1000); do
+    [[ $(readlink "/proc/$pid/exe" 2>/dev/null) == "$exe" ]] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+  done
   kill -INT "$pid" 2>/dev/null || return 0
   for _ in $(seq 200); do
     kill -0 "$pid" 2>/dev/null || { wait "$pid" 2>/dev/null; return 0; }
