@@ -127,14 +127,16 @@ void follow(LimpFigure& figure, std::size_t j, Seen& seen, bool live,
   const ActuatorBinding& a = *figure.binding(j);
   const long period_ns = static_cast<long>(1e9 / figure.config().rate_hz);
   std::vector<double> positions;
+  std::vector<bool> fresh;
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   const double t0 = next.tv_sec + next.tv_nsec * 1e-9;
   double shown = -1.0;
   RunControls& controls = commissioning_controls();
   while (!controls.stop.load()) {
-    figure.read(positions);
-    seen.add(raw_ticks(a, positions[j]));
+    figure.read(positions, &fresh);
+    // Only what the servo said: a lost answer leaves an old value, or none.
+    if (fresh[j]) seen.add(raw_ticks(a, positions[j]));
     const double t = next.tv_sec + next.tv_nsec * 1e-9 - t0;
     if (live && t - shown >= 0.1) {
       shown = t;
@@ -150,6 +152,11 @@ void follow(LimpFigure& figure, std::size_t j, Seen& seen, bool live,
     sleep_until(next, period_ns);
   }
   if (live) std::cout << '\n';
+  // At least the position where it was left, read.
+  if (std::isnan(seen.last_raw) && !controls.stop.load()) {
+    figure.read_fresh(j, positions);
+    seen.add(raw_ticks(a, positions[j]));
+  }
 }
 
 // One answer line from the user (raw reads: enter_pressed() reads the same
@@ -176,7 +183,7 @@ bool ask_yes(const std::string& question) {
 double jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
   if (!figure.hold_weakly(j, args.jog_percent / 100.0)) return std::nan("");
   std::vector<double> positions;
-  figure.read(positions);
+  figure.read_fresh(j, positions);
   const double start = positions[j];
   std::vector<double> goals(positions.size(), std::nan(""));
   goals[j] = start + deg_to_rad(args.jog_deg);
@@ -186,7 +193,8 @@ double jog(LimpFigure& figure, std::size_t j, const CalibrateArgs& args) {
   for (int k = 0; k < 10 && !commissioning_controls().stop.load(); ++k) {
     sleep_until(next, 50'000'000L);
   }
-  figure.read(positions);
+  // Where the jog took it as its servo says, never a lost answer's old value.
+  figure.read_fresh(j, positions);
   figure.let_go();
   return rad_to_deg(positions[j] - start);
 }

@@ -123,6 +123,16 @@ void LimpFigure::read(std::vector<double>& joints, std::vector<bool>* fresh) {
   }
 }
 
+void LimpFigure::read_fresh(std::size_t j, std::vector<double>& joints) {
+  std::vector<bool> fresh;
+  for (int k = 0; k < kFreshReads; ++k) {
+    read(joints, &fresh);
+    if (fresh.at(j)) return;
+  }
+  throw DeviceError("joint " + config().joints.at(j).name + ": its device did not answer " +
+                    std::to_string(kFreshReads) + " reads of its position in a row");
+}
+
 const ActuatorBinding* LimpFigure::binding(std::size_t joint) const {
   for (const BusConfig& bus : config().buses) {
     for (const ActuatorBinding& a : bus.actuators) {

@@ -32,6 +32,12 @@ class LimpFigure {
   // whose device did not answer keeps its previous value and is not
   // `fresh` (when given). Throws DeviceError for a bus that fails.
   void read(std::vector<double>& joints, std::vector<bool>* fresh = nullptr);
+  // As read(), with joint `j`'s own device answered: read again while its
+  // answer was lost (late or damaged on a busy line), up to kFreshReads
+  // reads, so a position nobody read is never taken for one. Throws
+  // DeviceError naming the joint when none came.
+  static constexpr int kFreshReads = 5;
+  void read_fresh(std::size_t j, std::vector<double>& joints);
   // Joint `j` held by a weak torque (`share` of its servo's current limit)
   // where it is: a hand moves it, and it stays where it is left once write()
   // follows it. False when its servo has no current control (it stays

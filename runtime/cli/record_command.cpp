@@ -163,6 +163,9 @@ Sampling sample(LimpFigure& figure, std::vector<Track>& tracks, double duration_
       track.times.push_back(t);
       track.values.push_back(track.prismatic ? v : rad_to_deg(v));
     }
+    // The duration is time, not a count of reads: reads that ran late (a
+    // busy host, silent devices) give fewer samples, never a longer take.
+    if (duration_s > 0 && since_start(answered) >= duration_s) break;
     next.tv_nsec += period_ns;
     while (next.tv_nsec >= 1'000'000'000L) {
       next.tv_nsec -= 1'000'000'000L;
@@ -254,9 +257,10 @@ Hold hold_compliant(LimpFigure& figure, const std::vector<Track>& tracks, double
   hold.goals.assign(figure.config().joints.size(), std::nan(""));
   if (percent <= 0.0) return hold;
   std::vector<double> positions;
-  figure.read(positions);
   std::vector<std::string> limp;
   for (const Track& t : tracks) {
+    // Held where it is, as its servo says (never a lost answer's old value).
+    figure.read_fresh(t.joint, positions);
     if (figure.hold_weakly(t.joint, percent / 100.0)) {
       hold.goals[t.joint] = positions[t.joint];
       hold.any = true;

@@ -11,11 +11,23 @@ copy_robot() {
   ln -sfn "$root/configs/models" "$tmp/models"
 }
 
+# launch_sim ROBOT: starts serving its devices (sets sim_pid), without
+# waiting for them. A script's background job starts with SIGINT ignored, so
+# a SIGINT sent before animrt has its handlers (stop_sim after a failed
+# start) would be lost and the wait for the simulator never end: it starts
+# with SIGINT at its default, which ends it until its handler takes over.
+launch_sim() {
+  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
+  (
+    trap - INT QUIT
+    exec "$animrt" sim "$1" --control "$tmp/ctl"
+  ) > "$tmp/sim.txt" 2>&1 &
+  sim_pid=$!
+}
+
 # start_sim ROBOT: serves its devices; sets sim_pid and pty (the first serial bus).
 start_sim() {
-  : > "$tmp/sim.txt"  # emptied first: the last sim's lines are not this one's
-  "$animrt" sim "$1" --control "$tmp/ctl" > "$tmp/sim.txt" 2>&1 &
-  sim_pid=$!
+  launch_sim "$1"
   for _ in $(seq 100); do
     grep -q "^control " "$tmp/sim.txt" && break
     sleep 0.1
@@ -24,9 +36,28 @@ start_sim() {
   read -r _ _ pty < <(grep "^serial " "$tmp/sim.txt")
 }
 
+# stop_sim: SIGINT, as Ctrl-C, once the process is animrt (the shell's
+# child before its exec would take a SIGINT by running this script's EXIT
+# trap); a simulator that has not ended 10 s later is killed and the test
+# fails.
 stop_sim() {
-  [[ -n ${sim_pid:-} ]] && kill -INT "$sim_pid" 2>/dev/null && wait "$sim_pid" 2>/dev/null
+  [[ -n ${sim_pid:-} ]] || return 0
+  local pid=$sim_pid exe
   sim_pid=""
+  exe=$(readlink -f "$animrt")
+  for _ in $(seq 1000); do
+    [[ $(readlink "/proc/$pid/exe" 2>/dev/null) == "$exe" ]] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+  done
+  kill -INT "$pid" 2>/dev/null || return 0
+  for _ in $(seq 200); do
+    kill -0 "$pid" 2>/dev/null || { wait "$pid" 2>/dev/null; return 0; }
+    sleep 0.05
+  done
+  kill -KILL "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+  fail "animrt sim did not end within 10 s of SIGINT: $(cat "$tmp/sim.txt")"
 }
 
 ctl() {

@@ -5,7 +5,8 @@
 # leaves it (the recorder's goal follows the hand), the show holds what was
 # moved within 1 deg, and afterwards torque is off and the servo is back in
 # position mode. A torque a hand cannot overpower (40 %) refuses the hand.
-# A Feetech STS servo is held the same way by its Torque Limit.
+# A Feetech STS servo is held the same way by its Torque Limit. A simulator
+# stopped by SIGINT while it starts ends.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -17,6 +18,13 @@ source "$root/tests/cli/commission_sim.bash"
 
 copy_robot quadruped
 robot=$tmp/robots/quadruped.yaml
+# A simulator stopped while it starts ends all the same, whenever the SIGINT
+# comes: before its handler is in place (its default action) or after.
+for delay in 0 0.01 0.03 0.06; do
+  launch_sim "$robot"
+  sleep "$delay"
+  stop_sim
+done
 start_sim "$robot"
 
 # The hand: once record holds the figure, lf_hip (id 1) to +26.4 deg, then

@@ -74,10 +74,12 @@ void RvcReader::serve() {
       }
       last_ = r;
       have_last_ = true;
-      readings_.post(r);
+      // Counted before it is posted: whoever takes a reading sees counters
+      // that include it.
       frames_.store(stream_.frames(), std::memory_order_relaxed);
       checksum_errors_.store(stream_.checksum_errors(), std::memory_order_relaxed);
       lost_.store(stream_.lost_frames(), std::memory_order_relaxed);
+      readings_.post(r);
     }
   }
 }
