@@ -171,7 +171,8 @@ using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
 [[gnu::always_inline]] inline void store(float* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 
 bool in_registers(const ConvShape& s) {
-  return static_cast<std::size_t>(s.in) == kRegisterIn && s.batch % kConvLanes == 0;
+  return static_cast<std::size_t>(s.in) == kRegisterIn &&
+         static_cast<std::size_t>(s.batch) % kLanes == 0;
 }
 
 // Forward of one vertex and chunk (offset b into the batch).
