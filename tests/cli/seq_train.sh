@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # animrt seq train on a tiny joint-angle CSV: exit code, progress lines,
-# model, checkpoint and plot written, a resume from the checkpoint, and bad
-# input refused with exit 2 and the file named; then a mesh model trained on a
-# bending plate and seq generate from it.
+# model, checkpoint and plot written, a resume from the checkpoint (a
+# truncated best model beside it set aside), and bad input refused with
+# exit 2 and the file named; then a mesh model trained on a bending plate
+# and seq generate from it.
 set -uo pipefail
 animrt=$1
 tmp=$(mktemp -d)
@@ -27,8 +28,16 @@ for f in m.model m.model.ckpt m.model.svg m.model.best; do
 done
 grep -q '<svg' "$tmp/m.model.svg" || fail "plot is not SVG"
 
+# A truncated best model is set aside, not taken for the model in training.
+head -c 100 "$tmp/m.model.best" > "$tmp/cut.best"
+mv "$tmp/cut.best" "$tmp/m.model.best"
 out=$("$animrt" seq train "$tmp/walk.csv" --out "$tmp/m.model" --iterations 14 --resume "$tmp/m.model.ckpt" \
   --report-every 2 "${small[@]}" 2>&1) || fail "resume failed: $out"
+[[ $out == *"note: $tmp/m.model.best is not a best model of this training: cannot be read: "*"; moved to $tmp/m.model.best.stale"* ]] ||
+  fail "truncated best model not set aside: $out"
+[[ $(wc -c < "$tmp/m.model.best.stale") -eq 100 ]] || fail "the set-aside best model is not the truncated one"
+[[ $out == *"best held-out completion: iteration 14, kept in $tmp/m.model.best"* ]] ||
+  fail "no best model after the set-aside one: $out"
 [[ $out == *"iteration 12/14 "* && $out == *"iteration 14/14 "* ]] || fail "resume did not continue: $out"
 [[ $out != *"iteration 2/14 "* ]] || fail "resume started over: $out"
 [[ $out == *"trained 4 iterations (14 in all)"* ]] || fail "resume count: $out"

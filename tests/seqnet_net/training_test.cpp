@@ -117,8 +117,15 @@ TEST(SeqTraining, PrintsHeldOutCompletionAgainstInterpolationAndKeepsIt) {
       << text;
 }
 
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 // A resumed training measures the OUT.best it finds first and replaces it
-// only with a better model.
+// only with a better model; the run's end names the kept one. An OUT.best
+// that cannot be read, or is of another training, is moved to
+// OUT.best.stale with one line saying why, and the training goes on.
 TEST(SeqTraining, AResumeKeepsABetterBestModel) {
   const std::string data = nettest::write_joint_csv("best.csv", 80);
   TrainOptions a = tiny_options(data, "best_a.model");
@@ -135,10 +142,49 @@ TEST(SeqTraining, AResumeKeepsABetterBestModel) {
                              std::filesystem::copy_options::overwrite_existing);
   b.resume = b.out + ".ckpt";
   b.iterations = 10;
-  const TrainResult r = train(b, log);
-  ASSERT_LT(better.held_out_completion, r.held_out_completion) << log.str();  // the setup
+  std::ostringstream resumed;
+  const TrainResult r = train(b, resumed);
+  ASSERT_LT(better.held_out_completion, r.held_out_completion) << resumed.str();  // the setup
   EXPECT_EQ(r.best_iteration, 0);
+  EXPECT_EQ(r.kept_best_iteration, static_cast<int>(better.iteration));
   EXPECT_EQ(read_model_file(b.out + ".best").iteration, better.iteration);
+  EXPECT_NE(resumed.str().find("best held-out completion: iteration " +
+                               std::to_string(better.iteration) + " (an earlier run), kept in " +
+                               b.out + ".best\n"),
+            std::string::npos)
+      << resumed.str();
+  EXPECT_EQ(resumed.str().find("note:"), std::string::npos) << resumed.str();
+
+  // Resumes with nothing left to train: the one measurement at the end
+  // writes the best model once the stale one is moved aside.
+  const std::string best = b.out + ".best", stale = best + ".stale";
+  ModelFile other_window = better;
+  other_window.shape.window = 16;
+  ModelFile other_joints = better;
+  other_joints.joint_names.back() = "toe";
+  auto bytes_of = [](const ModelFile& m) {
+    const std::vector<std::uint8_t> v = model_file_bytes(m);
+    return std::string(v.begin(), v.end());
+  };
+  const std::string whole = bytes_of(better);
+  const std::pair<std::string, std::string> cases[] = {
+      {whole.substr(0, whole.size() / 2), "cannot be read: "},
+      {bytes_of(other_window), "another network (window 16 against 8)"},
+      {bytes_of(other_joints),
+       "trained on another joint set: the data lacks toe; the model lacks ankle"}};
+  for (const auto& [bytes, why] : cases) {
+    std::filesystem::remove(stale);
+    std::ofstream(best, std::ios::binary | std::ios::trunc) << bytes;
+    std::ostringstream aside;
+    const TrainResult s = train(b, aside);
+    EXPECT_NE(aside.str().find("note: " + best + " is not a best model of this training: " + why),
+              std::string::npos)
+        << aside.str();
+    EXPECT_NE(aside.str().find("; moved to " + stale + "\n"), std::string::npos) << aside.str();
+    EXPECT_TRUE(file_text(stale) == bytes) << why;  // moved, not rewritten
+    EXPECT_EQ(s.best_iteration, 10) << why;
+    EXPECT_EQ(read_model_file(best).iteration, 10U) << why;
+  }
 }
 
 TEST(SeqTraining, AModelNeverBetterThanInterpolationIsWarnedOf) {

@@ -139,6 +139,55 @@ void append_placement(ModelFile& d, const SequenceFeatures& f,
   }
 }
 
+// Why the model in `kept` is not one of the training that makes `now`
+// (another data kind, joint set or mesh, network, seed and so held-out
+// split, or feature mapping): its held-out figure would not compare with
+// this training's. Empty when it is one.
+std::string not_of_this_training(const ModelFile& kept, const ModelFile& now,
+                                 const std::string& file) {
+  try {
+    if (now.shape.kind == ModelKind::mesh) {
+      check_model_mesh(kept, file, now.shape.vertex_count, now.triangles);
+    } else {
+      check_model_joints(kept, file, now.joint_names);
+    }
+  } catch (const InputError& e) {
+    return e.message();
+  }
+  const NetShape& a = kept.shape;
+  const NetShape& b = now.shape;
+  const bool mesh = b.kind == ModelKind::mesh;
+  const std::pair<const char*, std::pair<double, double>> sizes[] = {
+      {"placement nodes", {a.placement_nodes, b.placement_nodes}},
+      {"encoder layers", {a.conv_layers, b.conv_layers}},
+      {"channels", {mesh ? a.channels : 0, mesh ? b.channels : 0}},
+      {"dense width", {mesh ? 0 : a.dense_width, mesh ? 0 : b.dense_width}},
+      {"latent", {a.latent, b.latent}},
+      {"hidden", {a.hidden, b.hidden}},
+      {"LSTM layers", {a.lstm_layers, b.lstm_layers}},
+      {"window", {a.window, b.window}},
+      {"stride", {a.stride, b.stride}},
+      {"s0", {a.s0, b.s0}}};
+  std::string network;
+  for (const auto& [name, values] : sizes) {
+    if (values.first == values.second) continue;
+    std::ostringstream d;
+    d << (network.empty() ? "" : ", ") << name << ' ' << values.first << " against "
+      << values.second;
+    network += d.str();
+  }
+  if (!network.empty()) return "another network (" + network + ")";
+  if (kept.seed != now.seed) {
+    return "trained from seed " + std::to_string(kept.seed) + ", this training from seed " +
+           std::to_string(now.seed) + " (another held-out split)";
+  }
+  if (kept.low != now.low || kept.high != now.high || kept.rest.cols() != now.rest.cols() ||
+      kept.rest != now.rest) {
+    return "another feature mapping or template (fitted to other data)";
+  }
+  return {};
+}
+
 }  // namespace
 
 TrainingSet load_training_set(const std::vector<std::string>& files, std::uint64_t seed,
@@ -441,16 +490,40 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
   // OUT.best keeps the model of the best held-out measurement so far, so a
   // training that runs on past its best (or is thrown off by one batch)
   // still leaves it. Placed vertices decide where they are measured. A
-  // resumed run first measures the OUT.best it finds, on this data.
+  // resumed run first measures the OUT.best it finds, on this data; one
+  // that cannot be read or measured, or is of another training, is moved
+  // to OUT.best.stale (kept for the user, not compared) and the run goes on.
   const std::string best_path = o.out + ".best";
   auto score = [](const HeldOutCompletion& h) {
     return h.placed >= 0 ? h.placed : h.network;
   };
   double best_score = -1;
   TrainResult result;
-  if (resuming && std::ifstream(best_path).good()) {
-    const ModelFile kept = read_model_file(best_path);
-    best_score = score(measure_held_out_completion(kept, set, 9, o.blend));
+  std::error_code no_best;
+  if (resuming && std::filesystem::exists(best_path, no_best)) {
+    std::string why;
+    try {
+      const ModelFile kept = read_model_file(best_path);
+      why = not_of_this_training(kept, model_file(false), best_path);
+      if (why.empty()) {
+        best_score = score(measure_held_out_completion(kept, set, 9, o.blend));
+        if (best_score >= 0) result.kept_best_iteration = static_cast<int>(kept.iteration);
+      }
+    } catch (const InputError& e) {
+      why = "cannot be read: " + (e.key().empty() ? "" : e.key() + ": ") + e.message();
+    } catch (const std::exception& e) {
+      why = std::string("cannot be measured: ") + e.what();
+    }
+    if (!why.empty()) {
+      const std::string stale = best_path + ".stale";
+      std::error_code error;
+      std::filesystem::rename(best_path, stale, error);
+      progress << "note: " << best_path << " is not a best model of this training: " << why
+               << (error ? "; it cannot be moved (" + error.message() +
+                               "), the first held-out measurement replaces it"
+                         : "; moved to " + stale)
+               << '\n';
+    }
   }
   auto measure = [&] {
     measured = HeldOutCompletion{};
@@ -465,6 +538,7 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
       now.held_out_gap = measured.gap;
       write_model_file(best_path, now);
       result.best_iteration = iteration;
+      result.kept_best_iteration = -1;
     }
   };
 
@@ -553,6 +627,9 @@ TrainResult train(const TrainOptions& o, std::ostream& progress) {
   if (result.best_iteration > 0) {
     progress << "best held-out completion: iteration " << result.best_iteration << ", kept in "
              << best_path << '\n';
+  } else if (result.kept_best_iteration >= 0) {
+    progress << "best held-out completion: iteration " << result.kept_best_iteration
+             << " (an earlier run), kept in " << best_path << '\n';
   }
   progress << "model " << o.out << ", checkpoint " << o.out << ".ckpt, loss plot " << o.out
            << ".svg\n";

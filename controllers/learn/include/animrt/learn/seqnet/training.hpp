@@ -108,6 +108,9 @@ struct TrainResult {
   // run (placed vertices where measured, else features) and its iteration
   // (0: none written).
   int best_iteration = 0;
+  // On a resume: the iteration of the OUT.best found there when it was
+  // measured first and no measurement of this run beat it (-1: none).
+  int kept_best_iteration = -1;
   // Iterations whose gradient norm was above clip_gradient, and the
   // largest norm of the run (0 without clipping).
   int clipped = 0;
