@@ -48,21 +48,23 @@ SimulatedBus* find_bus(const NamedBuses& buses, std::string_view name) {
 }
 
 std::string control_reply(const NamedBuses& buses, std::string_view line) {
+  static constexpr char kVerbs[] = "(expected hand, hand-path, get, plug or unplug)";
   const std::vector<std::string_view> w = words(line);
-  if (w.empty()) return "error: empty command (expected hand, get, plug or unplug)";
+  if (w.empty()) return std::string("error: empty command ") + kVerbs;
   const std::string_view verb = w[0];
   const bool hand = verb == "hand";
+  const bool path = verb == "hand-path";
   const bool get = verb == "get";
   const bool plug = verb == "plug" || verb == "unplug";
-  if (!hand && !get && !plug) {
-    return "error: unknown command '" + std::string(verb) +
-           "' (expected hand, get, plug or unplug)";
+  if (!hand && !path && !get && !plug) {
+    return "error: unknown command '" + std::string(verb) + "' " + kVerbs;
   }
-  const std::size_t arity = hand ? 4 : 3;
-  if (w.size() != arity) {
-    return std::string("error: usage: ") + (hand  ? "hand BUS ID TICKS"
-                                            : get ? "get BUS ID"
-                                                  : std::string(verb) + " BUS INDEX");
+  const std::size_t arity = hand ? 4 : path ? 5 : 3;
+  if (path ? w.size() < arity : w.size() != arity) {
+    return std::string("error: usage: ") + (hand   ? "hand BUS ID TICKS"
+                                            : path ? "hand-path BUS ID READS TICKS..."
+                                            : get  ? "get BUS ID"
+                                                   : std::string(verb) + " BUS INDEX");
   }
   SimulatedBus* bus = find_bus(buses, w[1]);
   if (bus == nullptr) return "error: no bus '" + std::string(w[1]) + "'";
@@ -70,10 +72,23 @@ std::string control_reply(const NamedBuses& buses, std::string_view line) {
   if (!number(w[2], index) || index < 0) {
     return "error: '" + std::string(w[2]) + "' is not " + (plug ? "an index" : "an id");
   }
-  if (hand) {
-    std::int32_t ticks = 0;
-    if (!number(w[3], ticks)) return "error: '" + std::string(w[3]) + "' is not a tick count";
-    bus->hand_move(static_cast<int>(index), ticks);
+  if (hand || path) {
+    const std::size_t first = hand ? 3 : 4;
+    int reads = 1;
+    if (path && (!number(w[3], reads) || reads < 1)) {
+      return "error: '" + std::string(w[3]) + "' is not a count of reads (1 or more)";
+    }
+    std::vector<std::int32_t> ticks(w.size() - first);
+    for (std::size_t k = first; k < w.size(); ++k) {
+      if (!number(w[k], ticks[k - first])) {
+        return "error: '" + std::string(w[k]) + "' is not a tick count";
+      }
+    }
+    if (hand) {
+      bus->hand_move(static_cast<int>(index), ticks.front());
+    } else {
+      bus->hand_path(static_cast<int>(index), ticks, reads);
+    }
     return "ok";
   }
   if (get) {

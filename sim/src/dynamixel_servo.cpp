@@ -380,7 +380,13 @@ StatusError DynamixelServo::read(std::uint16_t address, std::uint16_t length,
                                  std::span<std::uint8_t> out) const {
   if (length == 0 || out.size() < length) return StatusError::data_length;
   if (static_cast<std::size_t>(address) + length > table_.size()) return StatusError::access;
-  for (std::size_t i = 0; i < length; ++i) out[i] = table_[resolve(address + i)];
+  bool position = false;
+  for (std::size_t i = 0; i < length; ++i) {
+    const std::uint16_t at = resolve(address + i);
+    out[i] = table_[at];
+    position = position || (at >= xreg::present_position && at < xreg::present_position + 4);
+  }
+  if (position) ++position_reads_;
   return StatusError::none;
 }
 

@@ -168,6 +168,7 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
     std::lock_guard lock(mutex_);
     firmware_.handle(packet, now, answers_, any_baud_ ? 0 : line::line_baud(master_));
     keeper_.save(firmware_);
+    if (!hand_paths_.empty()) follow_hand_paths(now);
   }
   if (packet.instruction != dxl::inst::status) ++packets_;
 
@@ -264,12 +265,41 @@ void DynamixelSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int
 }
 
 void DynamixelSimBus::hand_move(int device_id, std::int32_t ticks) {
+  hand_path(device_id, {ticks}, 1);
+}
+
+void DynamixelSimBus::hand_path(int device_id, const std::vector<std::int32_t>& ticks,
+                                int reads_per_step) {
+  if (ticks.empty()) throw std::invalid_argument("a hand path needs at least one position");
+  if (reads_per_step < 1) throw std::invalid_argument("a hand path needs 1 or more reads a step");
   std::lock_guard lock(mutex_);
   DynamixelServo& s = servo_or_throw(firmware_, config_, device_id);
   if (!s.yields_to_hand()) throw std::logic_error("torque is on");
-  if (!s.hand_move(ticks, clock_.now())) {
+  if (!s.hand_move(ticks.front(), clock_.now())) {
     throw std::logic_error("the physics model moves this joint");
   }
+  // The hand is elsewhere now: a path it was following ends.
+  std::erase_if(hand_paths_, [&](const HandPath& p) { return p.device_id == device_id; });
+  if (ticks.size() > 1) {
+    hand_paths_.push_back({device_id, ticks, 1, reads_per_step, s.position_reads()});
+  }
+}
+
+void DynamixelSimBus::follow_hand_paths(Nanos now) {
+  for (HandPath& p : hand_paths_) {
+    DynamixelServo& s = *firmware_.find_configured(p.device_id);
+    if (s.position_reads() - p.reads_at_step < static_cast<std::uint64_t>(p.reads_per_step)) {
+      continue;
+    }
+    // Against a torque too strong for a hand the hand lets go: the path ends.
+    if (!s.yields_to_hand() || !s.hand_move(p.ticks[p.next], now)) {
+      p.next = p.ticks.size();
+      continue;
+    }
+    ++p.next;
+    p.reads_at_step = s.position_reads();
+  }
+  std::erase_if(hand_paths_, [](const HandPath& p) { return p.next >= p.ticks.size(); });
 }
 
 SimulatedBus::ServoReadout DynamixelSimBus::servo_readout(int device_id) const {

@@ -36,25 +36,25 @@ cp "$robot" "$tmp/original.yaml"
 start_sim "$robot"
 
 # The hand: up 3.5 turns of the servo, down 1.2 turns below the start, then
-# home 1.7 turns up; in steps, each read while calibrate follows it.
-steps='[3000, 6000, 9000, 12000, 16384, 13000, 8000, 4000, 0, -2867, 0, 3000, 6963]'
+# home 1.7 turns up; in steps of up to 3000 ticks (more than half a turn, so
+# a calibrate that unwrapped them as one turn's would get the range wrong).
+# The simulator's hand path takes each step after the servo has answered 5
+# reads of its position, so calibrate sees every step whatever the load
+# (within --seconds-per-joint: 65 of its 200 Hz reads).
+steps='3000 6000 9000 12000 16384 13000 8000 4000 0 -2867 0 3000 6963'
 /usr/bin/python3 - "$tmp/ctl" "$steps" "$tmp/out.txt" "$animrt" calibrate "$robot" --port "legs=$pty" \
   --non-interactive --seconds-per-joint 2.0 --joint lf_knee <<'PY'
-import json, socket, subprocess, sys, time
-ctl, steps, out = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3]
-def hand(ticks):
-    s = socket.socket(socket.AF_UNIX); s.connect(ctl)
-    s.sendall(f"hand legs 2 {ticks}\n".encode())
-    reply = s.makefile().readline()
-    assert reply.startswith("ok"), reply
+import socket, subprocess, sys
+ctl, steps, out = sys.argv[1], sys.argv[2], sys.argv[3]
 proc = subprocess.Popen(sys.argv[4:], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 log = []
 for line in proc.stdout:
     log.append(line)
     if line.startswith("lf_knee: move it"):
-        for t in steps:
-            time.sleep(0.08)
-            hand(t)
+        s = socket.socket(socket.AF_UNIX); s.connect(ctl)
+        s.sendall(f"hand-path legs 2 5 {steps}\n".encode())
+        reply = s.makefile().readline()
+        assert reply.startswith("ok"), reply
 proc.wait()
 open(out, "w").write("".join(log))
 sys.exit(proc.returncode)

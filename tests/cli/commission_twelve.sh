@@ -10,7 +10,8 @@ animrt=$1
 root=$2
 tmp=$(mktemp -d)
 sim_pid=""
-trap '[[ -n $sim_pid ]] && kill $sim_pid 2>/dev/null; rm -rf "$tmp"' EXIT
+# The simulator saves its state file as it ends: waited for before its folder goes.
+trap '[[ -n $sim_pid ]] && { kill $sim_pid 2>/dev/null; wait $sim_pid 2>/dev/null; }; rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 ctl() {
   /usr/bin/python3 -c 'import socket,sys; s=socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); s.sendall((sys.argv[2]+"\n").encode()); print(s.makefile().readline(), end="")' "$tmp/ctl" "$1"

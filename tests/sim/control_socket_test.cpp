@@ -1,6 +1,7 @@
 // The control interface of `animrt sim`: a hand turns a limp servo through
-// the socket and the runtime's bus reads where it went; a servo with torque
-// on refuses the hand; an unplugged servo is silent until plugged in again.
+// the socket and the runtime's bus reads where it went, a hand path steps
+// on with the servo's reads; a servo with torque on refuses the hand; an
+// unplugged servo is silent until plugged in again.
 
 #include "animrt/sim/control_socket.hpp"
 
@@ -89,9 +90,32 @@ TEST(ControlSocket, HandTurnsALimpServoAndTheRuntimeReadsIt) {
     bus.read(q);
     EXPECT_NEAR(q[1], config.actuators[1].to_rad(2600), 1e-9);
 
+    // The test aid: a hand path takes its next step once the servo has
+    // answered 2 reads of its position at the one before; what is not a
+    // read of the servo (a `get`) does not move it on.
+    const auto reads_ticks = [&](int reads) {
+      std::vector<int> out;
+      for (int k = 0; k < reads; ++k) {
+        bus.read(q);
+        out.push_back(config.actuators[1].to_ticks(q[1]));
+      }
+      return out;
+    };
+    EXPECT_EQ(client.ask("hand-path legs 4 2 100 -200 300"), "ok");
+    EXPECT_EQ(client.ask("get legs 4"), "ok ticks=100 torque=0 id=4 baud=1000000");
+    EXPECT_EQ(client.ask("get legs 4"), "ok ticks=100 torque=0 id=4 baud=1000000");
+    EXPECT_EQ(reads_ticks(7), (std::vector<int>{100, 100, -200, -200, 300, 300, 300}));
+    // A new hand move ends a path.
+    EXPECT_EQ(client.ask("hand-path legs 4 1 500 600"), "ok");
+    EXPECT_EQ(client.ask("hand legs 4 2600"), "ok");
+    EXPECT_EQ(reads_ticks(3), (std::vector<int>{2600, 2600, 2600}));
+    EXPECT_EQ(client.ask("hand-path legs 4 0 1 2").rfind("error: '0' is not a count", 0), 0u);
+    EXPECT_EQ(client.ask("hand-path legs 4 1").rfind("error: usage: hand-path", 0), 0u);
+
     bus.activate();  // torque on: the servo holds, a hand cannot turn it
     EXPECT_EQ(client.ask("get legs 4"), "ok ticks=2600 torque=1 id=4 baud=1000000");
     EXPECT_EQ(client.ask("hand legs 4 1000"), "error: torque is on");
+    EXPECT_EQ(client.ask("hand-path legs 4 1 1000 1100"), "error: torque is on");
     bus.read(q);
     EXPECT_NEAR(q[1], config.actuators[1].to_rad(2600), 1e-9);
     bus.deactivate();

@@ -5,6 +5,10 @@
 //
 //   hand BUS ID TICKS   turn the shaft of servo ID to raw position TICKS
 //                       (refused with "error: torque is on" while it is)
+//   hand-path BUS ID READS TICKS...
+//                       a test aid: the hand turns it to each TICKS in turn,
+//                       one step after every READS reads of its position
+//                       (SimulatedBus::hand_path)
 //   get BUS ID          "ok ticks=<present> torque=<0|1> id=<ID register> baud=<baud>"
 //   plug BUS INDEX      connect the INDEX-th device of the bus (0-based, the
 //   unplug BUS INDEX    robot file's order) / disconnect it

@@ -218,6 +218,10 @@ class DynamixelServo {
   int baud() const;  // the Baud Rate register in bits per second
   // Present Position (raw) at `now`, without changing the state.
   std::int32_t present_ticks(Nanos now) const;
+  // How many reads this servo has answered that carried its Present
+  // Position (directly or through Indirect Data): what a test's scripted
+  // hand counts to move in step with a host's reads, not with a timer.
+  std::uint64_t position_reads() const { return position_reads_; }
 
   // Fault injection: the next `answers` status packets (every one while
   // answers < 0) leave `delay_ns` of real time late, so a client sees late
@@ -287,7 +291,8 @@ class DynamixelServo {
   std::uint16_t pending_length_ = 0;
   // Fault injection and the goal log.
   Nanos answer_delay_ns_ = 0;
-  mutable int delayed_answers_left_ = 0;  // < 0: every answer
+  mutable int delayed_answers_left_ = 0;      // < 0: every answer
+  mutable std::uint64_t position_reads_ = 0;  // counted by read(), which changes no register
   std::vector<GoalRecord> goal_ring_;
   std::uint64_t goals_received_ = 0;
   void log_goal(std::uint16_t address, std::span<const std::uint8_t> data, bool accepted);

@@ -89,6 +89,8 @@ class DynamixelSimBus final : public SimulatedBus {
   // Late answers (see DynamixelServo::set_answer_delay) and the goal log.
   void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
   void hand_move(int device_id, std::int32_t ticks) override;
+  void hand_path(int device_id, const std::vector<std::int32_t>& ticks,
+                 int reads_per_step) override;
   ServoReadout servo_readout(int device_id) const override;
   void set_device_plugged(std::size_t index, bool plugged) override;
   std::vector<GoalRecord> device_goal_log(int device_id) const;
@@ -102,6 +104,15 @@ class DynamixelSimBus final : public SimulatedBus {
   void send(std::span<const std::uint8_t> bytes);
   void send_paced();  // answers_ at the times in due_
   Nanos wire_ns(std::size_t bytes) const;
+  // The test aid of hand_path: under mutex_, after each packet.
+  struct HandPath {
+    int device_id = 0;
+    std::vector<std::int32_t> ticks;
+    std::size_t next = 1;             // ticks[next] comes after ...
+    int reads_per_step = 1;           // ... this many reads at ticks[next - 1],
+    std::uint64_t reads_at_step = 0;  // counted from the servo's position_reads() here
+  };
+  void follow_hand_paths(Nanos now);
   void close_fds();
 
   BusConfig config_;
@@ -113,7 +124,8 @@ class DynamixelSimBus final : public SimulatedBus {
 
   mutable std::mutex mutex_;  // guards firmware_
   DynamixelFirmware firmware_;
-  ServoStartupKeeper keeper_;  // under mutex_
+  ServoStartupKeeper keeper_;         // under mutex_
+  std::vector<HandPath> hand_paths_;  // under mutex_
 
   JointPhysics* physics_ = nullptr;
   int party_ = -1;  // lockstep with physics: this bus's party (JointPhysics::reach)

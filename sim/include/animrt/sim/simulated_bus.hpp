@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "animrt/bridge/bus_config.hpp"
 #include "animrt/bridge/lockstep_line.hpp"
@@ -78,6 +79,21 @@ class SimulatedBus {
     (void)device_id;
     (void)ticks;
     throw std::logic_error("simulated bus " + endpoint() + ": hands are not modelled");
+  }
+  // A test aid, not something a servo or a person does: a hand that turns
+  // the shaft (as hand_move) to ticks[0] at once, then on to each next
+  // position once the servo has answered `reads_per_step` reads of its
+  // Present Position at the one before, so that a host reading it sees
+  // every step whatever the load on the machine. It ends at the last
+  // position (held, as by hand_move); hand_move or a new path replaces
+  // it, torque too strong for a hand ends it. Throws as hand_move, and
+  // std::invalid_argument for no positions or reads_per_step < 1.
+  virtual void hand_path(int device_id, const std::vector<std::int32_t>& ticks,
+                         int reads_per_step) {
+    (void)device_id;
+    (void)ticks;
+    (void)reads_per_step;
+    throw std::logic_error("simulated bus " + endpoint() + ": hand paths are not modelled");
   }
   virtual ServoReadout servo_readout(int device_id) const {
     (void)device_id;
