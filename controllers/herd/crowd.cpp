@@ -553,6 +553,9 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   candidate_.assign(members_.size(), -1);
   stall_since_.assign(members_.size(), 0.0);
   for (int m : members_) stall_anchor_.push_back(agents[static_cast<std::size_t>(m)].position);
+  headway_goal_.assign(members_.size(), params_.target);
+  headway_best_.assign(members_.size(), std::numeric_limits<double>::infinity());
+  headway_since_.assign(members_.size(), 0.0);
   make_slots(rmax + crowd_.params().avoidance_margin_m);
 }
 
@@ -752,16 +755,28 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       crowd_.stop(members_[k]);
       continue;
     }
-    // A member that has stood still for stall_time_s next to the gathering
-    // (within a spacing and a half of an arrived member) has gathered
-    // where it stands; its slot, if it held one, is free again.
     if (state_[k] == State::kArrived) continue;
     if (norm(p - stall_anchor_[k]) > 0.1) {
       stall_anchor_[k] = p;
       stall_since_[k] = t;
+    }
+    // A member that has come no closer to where it is going (its slot, the
+    // slot it heads for, or the target) for stall_time_s next to the
+    // gathering (within a spacing and a half of an arrived member) has
+    // gathered where it stands; its slot, if it held one, is free again.
+    // Standing still is one way of making no headway; being jostled to and
+    // fro between the members standing round it, or circling a slot that
+    // lies inside the figure's turning circle, are others.
+    const int heading_for = slot_of_[k] >= 0 ? slot_of_[k] : candidate_[k];
+    const Vec2 goal = heading_for >= 0 ? slots_[static_cast<std::size_t>(heading_for)] : target;
+    const double to_goal = norm(p - goal);
+    if (norm(goal - headway_goal_[k]) > 1e-9 || to_goal < headway_best_[k] - 0.1) {
+      headway_goal_[k] = goal;
+      headway_best_[k] = to_goal;
+      headway_since_[k] = t;
       continue;
     }
-    if (params_.stall_time_s <= 0.0 || t - stall_since_[k] < params_.stall_time_s) continue;
+    if (params_.stall_time_s <= 0.0 || t - headway_since_[k] < params_.stall_time_s) continue;
     bool beside = false;
     for (std::size_t j = 0; j < members_.size() && !beside; ++j) {
       beside = state_[j] == State::kArrived &&
@@ -774,9 +789,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     crowd_.stop(members_[k]);
   }
   for (std::size_t k = 0; k < members_.size(); ++k) {
-    const Vec2 p = agents[static_cast<std::size_t>(members_[k])].position;
-    crowd_.set_travelling(members_[k],
-                          state_[k] == State::kTravelling && norm(p - target) > assign_distance_);
+    crowd_.set_travelling(members_[k], state_[k] != State::kArrived);
   }
   crowd_.step(t, dt, agents);
   for (std::size_t k = 0; k < members_.size(); ++k) {

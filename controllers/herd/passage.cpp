@@ -374,7 +374,10 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     const int k = dir > 0 ? 0 : 1;
     dir_of[i] = static_cast<signed char>(dir);
     ++want[k];
-    if (s >= -(hl + params_.close_m)) ++in[k];
+    // Out of the far mouth, a figure no longer holds up a swap of the
+    // passage: the other way, standing at that mouth, may be what it must
+    // walk round.
+    if (s >= -(hl + params_.close_m) && s <= hl) ++in[k];
     nearest[k] = std::min(nearest[k], -s);
   }
   if (p.owner == 0) {
@@ -418,6 +421,7 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     }
     const Vec2 d = agents[i].position - p.centre;
     const double s = dot(d, u) * dir;
+    if (s > hl) continue;  // through: it walks on out, whoever has the passage now
     const double side = std::abs(dot(d, across));
     const bool inside = s >= -hl && side <= hw + agents[i].radius;
     // Closing, the owner's figures already near the mouth go on: stopped in

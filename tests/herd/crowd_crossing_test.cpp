@@ -88,6 +88,53 @@ TEST(CrowdCrossing, AFreeStandingMovingWallIsWalkedRound) {
   EXPECT_LT(longest_still, 1.0);  // waiting at its face, it stood 15 s
 }
 
+// A member that circles its slot at the gathering's edge (its slot inside
+// the figure's turning circle at its slowest walk: counterflow seed 24
+// kept one so for 400 s) comes no closer to it; after stall_time_s beside
+// an arrived member it has gathered where it stands, and its slot is free
+// again. While it came closer, it had not.
+TEST(CrowdCrossing, AMemberCirclingItsSlotBesideTheGatheringHasGathered) {
+  NavWorldConfig c;
+  c.bounds = {-8, -8, 8, 8};
+  NavWorld world(c);
+  std::vector<Agent> agents(2);
+  agents[0].position = {0, 0};   // at the target: arrives at once
+  agents[1].position = {-3, 0};  // comes up and takes a slot beside it
+  for (Agent& a : agents) a.radius = 0.25;
+  Crowd crowd(world, agents);
+  const CrowdGroupParams params{{0, 0}, 0.2, 0.2, 1};
+  CrowdGroup group(crowd, agents, {0, 1}, params);
+  const std::vector<double> vmax{group.max_speed(0), group.max_speed(1)};
+  std::vector<Vec2> desired(2);
+  const double dt = 0.1;
+  double t = 0.0;
+  for (; t < 60.0 && group.slot_index(1) < 0; t += dt) {
+    group.steer(t, dt, agents, desired);
+    test::move_figures(agents, desired, vmax, dt, 0.6);
+  }
+  ASSERT_TRUE(group.arrived(0));
+  ASSERT_GE(group.slot_index(1), 0);
+  ASSERT_FALSE(group.arrived(1));
+  const int slot = group.slot_index(1);
+  const Vec2 centre = group.slots()[static_cast<std::size_t>(slot)];
+  // Round the slot at 0.5 m, 0.1 m/s, first spiralling in from 0.9 m
+  // (0.1 m closer every 5 s) for 20 s, then on the circle.
+  const double start = t, w = 0.2;
+  double gathered_at = -1.0;
+  for (; t < start + 60.0 && gathered_at < 0.0; t += dt) {
+    const double k = t - start;
+    const double r = std::max(0.5, 0.9 - 0.1 * std::floor(k / 5.0));
+    agents[1].position = centre + heading_vector(w * k) * r;
+    agents[1].heading = w * k + M_PI / 2;
+    agents[1].speed = w * r;
+    group.steer(t, dt, agents, desired);
+    if (group.arrived(1)) gathered_at = k;
+  }
+  EXPECT_GE(gathered_at, 20.0 + params.stall_time_s - 5.0);
+  EXPECT_LT(gathered_at, 20.0 + params.stall_time_s + 1.0);
+  EXPECT_EQ(group.slot_index(1), -1);
+}
+
 TEST(CrowdCrossing, SameSeedSameRun) {
   const auto a = test::run_crossing(0.15, 0.25, true, 8, 3, 60.0);
   const auto b = test::run_crossing(0.15, 0.25, true, 8, 3, 60.0);

@@ -168,6 +168,68 @@ TEST(CrowdKnot, ThroughAndBackIsNoWayThroughTheGap) {
   EXPECT_TRUE(rules.held(2));
 }
 
+// A member on its last stretch to its team's gathering, nose to nose with
+// a figure of the other team on its way out, is in a knot as any other:
+// counterflow seed 29 stood two such for 580 s, the one near its gathering
+// not counted as travelling. Here both stand where they are put.
+TEST(CrowdKnot, AMemberNearItsGatheringCanBeInAKnot) {
+  NavWorldConfig c;
+  c.bounds = {-10, -6, 10, 6};
+  NavWorld world(c);
+  std::vector<Agent> agents(2);
+  agents[0].position = {2.0, 0.0};  // blue, 2 m from its target
+  agents[0].heading = M_PI;
+  agents[1].position = {1.4, 0.0};  // red, on its way east
+  agents[1].group = 1;
+  for (Agent& a : agents) a.radius = 0.25;
+  Crowd crowd(world, agents);
+  CrowdGroup blue(crowd, agents, {0}, {{0, 0}, 0.12, 0.12, 1});
+  CrowdGroup red(crowd, agents, {1}, {{8, 0}, 0.12, 0.12, 2});
+  std::vector<Vec2> desired(2);
+  for (double t = 0.0; t < 45.0; t += 0.1) {
+    blue.steer(t, 0.1, agents, desired);
+    red.steer(t, 0.1, agents, desired);
+  }
+  EXPECT_FALSE(blue.arrived(0));
+  EXPECT_GE(crowd.knots(), 1);
+}
+
+// The way that has the gap swaps, once the other way has waited its
+// longest hold, when its last figure is out of the far mouth. Until 1.5 m
+// out counted too: one that could not get that far (the other way,
+// waiting there, stood in its way on: maze seed 11 stood two figures of
+// one team and three of the other so for good) held the gap for ever. The
+// figure out of the mouth is not held back through it after the swap.
+TEST(CrowdKnot, AFigureOutOfTheFarMouthDoesNotHoldTheGap) {
+  const NavWorldConfig config = maze_top_world();
+  NavWorld world(config);
+  const PassageParams params;
+  PassageRules rules(config.walls, 0.35, params, &world);
+  ASSERT_EQ(rules.passages().size(), 1u);
+  const Passage& p = rules.passages()[0];
+  std::vector<Agent> agents(2);
+  agents[0].position = p.centre + p.axis * 1.0;  // south-east of the gap, its way has it
+  agents[1].position = p.centre - p.axis * 2.5 + Vec2{0.8, 0.0};  // north-west, waits
+  const std::vector<Vec2> targets{{-3.5, -4}, {3.5, -4}};
+  const std::vector<bool> active(2, true);
+  rules.update(0.0, agents, targets, active);
+  const int first_owner = rules.passages()[0].owner;
+  ASSERT_NE(first_owner, 0);
+  ASSERT_FALSE(rules.held(0));
+  ASSERT_TRUE(rules.held(1));
+  // Through, and stuck just out of the far mouth (within clear_m of it).
+  agents[0].position = p.centre - p.axis * (p.half_length + 0.4);
+  double swapped_at = -1.0;
+  for (double t = 1.0; t <= 200.0 && swapped_at < 0.0; t += 1.0) {
+    rules.update(t, agents, targets, active);
+    if (rules.passages()[0].owner != first_owner) swapped_at = t;
+  }
+  EXPECT_GE(swapped_at, params.max_hold_s);
+  EXPECT_LE(swapped_at, params.max_hold_s + 2.0);
+  EXPECT_FALSE(rules.held(1));
+  EXPECT_FALSE(rules.held(0));
+}
+
 // Ten a team round the wall's end through the diagonal gap, figures
 // turning 45 degrees a second (the maze's). The gap is a passage whose ways
 // come out round the wall's end: each figure's way through it comes from

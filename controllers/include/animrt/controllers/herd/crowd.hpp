@@ -135,7 +135,8 @@ class Crowd {
   // Where the crowd sends member i now: its back-off point, its waiting
   // place, or its target.
   bool request_current(int i);
-  // Set by its group each step: the member walks to its goal on its own.
+  // Set by its group each step: the member has not arrived (it walks to
+  // its target or its slot on its own, and may be in a knot).
   void set_travelling(int i, bool travelling) {
     travelling_[static_cast<std::size_t>(i)] = travelling ? 1 : 0;
   }
@@ -194,8 +195,8 @@ struct CrowdGroupParams {
   // two spacings) head for a free slot at the edge of the gathering.
   double assign_distance_m = 0.0;
   double arrive_tolerance_m = 0.2;  // a member this close to its slot has arrived
-  // A member that stands still this long beside the gathering has arrived
-  // where it stands (0: never).
+  // A member that comes no closer to its goal for this long beside the
+  // gathering has arrived where it stands (0: never).
   double stall_time_s = 20.0;
 };
 
@@ -231,8 +232,12 @@ class CrowdGroup final : public GroupSteering {
   std::vector<double> max_speed_;
   std::vector<State> state_;
   std::vector<int> slot_of_;        // per member, -1 while travelling
-  std::vector<Vec2> stall_anchor_;  // where each member was when it last moved 0.1 m
+  std::vector<Vec2> stall_anchor_;  // where each member was when it last moved 0.1 m (unstick)
   std::vector<double> stall_since_;
+  // Per member: the goal it last came 0.1 m closer to, how close, and since when.
+  std::vector<Vec2> headway_goal_;
+  std::vector<double> headway_best_;
+  std::vector<double> headway_since_;
   std::vector<int> candidate_;  // per travelling member: the slot it heads for, or -1
   std::vector<Vec2> slots_;     // sorted by distance from the target
   std::vector<bool> slot_taken_;
