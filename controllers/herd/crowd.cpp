@@ -766,11 +766,14 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     // gathered where it stands; its slot, if it held one, is free again.
     // Standing still is one way of making no headway; being jostled to and
     // fro between the members standing round it, or circling a slot that
-    // lies inside the figure's turning circle, are others.
+    // lies inside the figure's turning circle, are others. One pushed back
+    // by more than half a spacing starts afresh from there: walking back,
+    // it makes headway again.
     const int heading_for = slot_of_[k] >= 0 ? slot_of_[k] : candidate_[k];
     const Vec2 goal = heading_for >= 0 ? slots_[static_cast<std::size_t>(heading_for)] : target;
     const double to_goal = norm(p - goal);
-    if (norm(goal - headway_goal_[k]) > 1e-9 || to_goal < headway_best_[k] - 0.1) {
+    if (norm(goal - headway_goal_[k]) > 1e-9 || to_goal < headway_best_[k] - 0.1 ||
+        to_goal > headway_best_[k] + 0.5 * spacing_) {
       headway_goal_[k] = goal;
       headway_best_[k] = to_goal;
       headway_since_[k] = t;

@@ -40,7 +40,8 @@ start_sim "$robot"
 # a calibrate that unwrapped them as one turn's would get the range wrong).
 # The simulator's hand path takes each step after the servo has answered 5
 # reads of its position, so calibrate sees every step whatever the load
-# (within --seconds-per-joint: 65 of its 200 Hz reads).
+# (the path is done after 60 reads: the first step at once, then 12 of 5;
+# --seconds-per-joint 2.0 is some 400 reads at 200 Hz).
 steps='3000 6000 9000 12000 16384 13000 8000 4000 0 -2867 0 3000 6963'
 /usr/bin/python3 - "$tmp/ctl" "$steps" "$tmp/out.txt" "$animrt" calibrate "$robot" --port "legs=$pty" \
   --non-interactive --seconds-per-joint 2.0 --joint lf_knee <<'PY'

@@ -117,22 +117,65 @@ TEST(CrowdCrossing, AMemberCirclingItsSlotBesideTheGatheringHasGathered) {
   ASSERT_FALSE(group.arrived(1));
   const int slot = group.slot_index(1);
   const Vec2 centre = group.slots()[static_cast<std::size_t>(slot)];
-  // Round the slot at 0.5 m, 0.1 m/s, first spiralling in from 0.9 m
-  // (0.1 m closer every 5 s) for 20 s, then on the circle.
+  // Round the slot at 0.5 m, 0.1 m/s, first spiralling in from 1.1 m
+  // (0.2 m closer every 5 s) for 15 s, then on the circle.
   const double start = t, w = 0.2;
   double gathered_at = -1.0;
   for (; t < start + 60.0 && gathered_at < 0.0; t += dt) {
     const double k = t - start;
-    const double r = std::max(0.5, 0.9 - 0.1 * std::floor(k / 5.0));
+    const double r = std::max(0.5, 1.1 - 0.2 * std::floor(k / 5.0));
     agents[1].position = centre + heading_vector(w * k) * r;
     agents[1].heading = w * k + M_PI / 2;
     agents[1].speed = w * r;
     group.steer(t, dt, agents, desired);
     if (group.arrived(1)) gathered_at = k;
   }
-  EXPECT_GE(gathered_at, 20.0 + params.stall_time_s - 5.0);
-  EXPECT_LT(gathered_at, 20.0 + params.stall_time_s + 1.0);
+  EXPECT_GE(gathered_at, 15.0 + params.stall_time_s - 0.5);
+  EXPECT_LT(gathered_at, 15.0 + params.stall_time_s + 1.0);
   EXPECT_EQ(group.slot_index(1), -1);
+}
+
+// A member pushed back from its slot beside the gathering walks back with
+// headway though it is no closer than it once was: it has not gathered
+// where it stands on the way (measured from its closest approach, it did
+// after 20 s, 0.9 m from its slot).
+TEST(CrowdCrossing, AMemberPushedBackFromItsSlotIsStillOnItsWay) {
+  NavWorldConfig c;
+  c.bounds = {-8, -8, 8, 8};
+  NavWorld world(c);
+  std::vector<Agent> agents(2);
+  agents[0].position = {0, 0};
+  agents[1].position = {-3, 0};
+  for (Agent& a : agents) a.radius = 0.25;
+  Crowd crowd(world, agents);
+  const CrowdGroupParams params{{0, 0}, 0.2, 0.2, 1};
+  CrowdGroup group(crowd, agents, {0, 1}, params);
+  const std::vector<double> vmax{group.max_speed(0), group.max_speed(1)};
+  std::vector<Vec2> desired(2);
+  const double dt = 0.1;
+  double t = 0.0;
+  for (; t < 60.0 && group.slot_index(1) < 0; t += dt) {
+    group.steer(t, dt, agents, desired);
+    test::move_figures(agents, desired, vmax, dt, 0.6);
+  }
+  ASSERT_TRUE(group.arrived(0));
+  ASSERT_GE(group.slot_index(1), 0);
+  const Vec2 slot = group.slots()[static_cast<std::size_t>(group.slot_index(1))];
+  // 0.5 m off the slot for 5 s, then pushed 1.5 m off it (past the
+  // arrived member at the target), then walking back at 0.04 m/s.
+  const Vec2 away = normalized(agents[0].position - slot);
+  const double start = t;
+  bool gathered = false;
+  for (; t < start + 35.0 && !gathered; t += dt) {
+    const double k = t - start;
+    const double off = k < 5.0 ? 0.5 : std::max(0.5, 1.5 - 0.04 * (k - 5.0));
+    agents[1].position = slot + away * off;
+    agents[1].heading = std::atan2(-away.y, -away.x);
+    agents[1].speed = k < 5.0 ? 0.0 : 0.04;
+    group.steer(t, dt, agents, desired);
+    gathered = group.arrived(1);
+  }
+  EXPECT_FALSE(gathered) << "after " << t - start << " s";
 }
 
 TEST(CrowdCrossing, SameSeedSameRun) {

@@ -234,7 +234,8 @@ class CrowdGroup final : public GroupSteering {
   std::vector<int> slot_of_;        // per member, -1 while travelling
   std::vector<Vec2> stall_anchor_;  // where each member was when it last moved 0.1 m (unstick)
   std::vector<double> stall_since_;
-  // Per member: the goal it last came 0.1 m closer to, how close, and since when.
+  // Per member: its goal, the closest it has come to it since it last came
+  // 0.1 m closer (or fell back by half a spacing), and since when.
   std::vector<Vec2> headway_goal_;
   std::vector<double> headway_best_;
   std::vector<double> headway_since_;

@@ -28,9 +28,9 @@ class KnotRules {
  public:
   KnotRules(std::size_t agents, KnotParams params);
 
-  // `travelling[i]`: member i walks toward its goal on its own (not waiting
-  // by a rule, not gathering at its target). Backs off the yielding side of
-  // every new knot.
+  // `travelling[i]`: member i walks toward its goal or its slot at the
+  // gathering on its own (has not arrived, is not waiting by a rule). Backs
+  // off the yielding side of every new knot.
   void update(double t, std::span<const Agent> agents, std::span<const Vec2> target,
               std::span<const char> travelling);
   bool backing_off(int i) const { return until_[static_cast<std::size_t>(i)] >= 0.0; }

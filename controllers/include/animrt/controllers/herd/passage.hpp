@@ -23,8 +23,10 @@ struct PassageParams {
   // figures side by side need four, and room to pass them two more).
   double max_width_radii = 6.5;
   double approach_m = 6.0;  // figures this far from a mouth ask for the passage
-  // Figures this near a mouth go on through when their way closes, and
-  // every figure uses the passage until clear_m out of the far mouth.
+  // Figures this near a mouth go on through when their way closes; a
+  // figure keeps asking for the passage until clear_m out of the far mouth
+  // (its way keeps the passage while the other way does not ask), though
+  // once out of the mouth it no longer holds up a swap.
   double close_m = 2.5;
   double clear_m = 1.5;
   double max_hold_s = 60.0;  // the other way waits at most this long for a turn
