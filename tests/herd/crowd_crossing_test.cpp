@@ -88,51 +88,70 @@ TEST(CrowdCrossing, AFreeStandingMovingWallIsWalkedRound) {
   EXPECT_LT(longest_still, 1.0);  // waiting at its face, it stood 15 s
 }
 
+// A gathering of two: the first member stands at the target and has
+// arrived at once; the second walks up from 3 m and is given a slot
+// beside it.
+struct GatheringOfTwo {
+  static constexpr double dt = 0.1;
+  NavWorld world{ground()};
+  std::vector<Agent> agents = members();
+  Crowd crowd{world, agents};
+  CrowdGroupParams params{{0, 0}, 0.2, 0.2, 1};
+  CrowdGroup group{crowd, agents, {0, 1}, params};
+  std::vector<Vec2> desired = std::vector<Vec2>(2);
+  double t = 0.0;
+
+  static NavWorldConfig ground() {
+    NavWorldConfig c;
+    c.bounds = {-8, -8, 8, 8};
+    return c;
+  }
+  static std::vector<Agent> members() {
+    std::vector<Agent> a(2);
+    a[0].position = {0, 0};
+    a[1].position = {-3, 0};
+    for (Agent& m : a) m.radius = 0.25;
+    return a;
+  }
+  // Walks the second member up until it has a slot (60 s at most).
+  void walk_to_slot() {
+    const std::vector<double> vmax{group.max_speed(0), group.max_speed(1)};
+    for (; t < 60.0 && group.slot_index(1) < 0; t += dt) {
+      group.steer(t, dt, agents, desired);
+      test::move_figures(agents, desired, vmax, dt, 0.6);
+    }
+  }
+};
+
 // A member that circles its slot at the gathering's edge (its slot inside
 // the figure's turning circle at its slowest walk: counterflow seed 24
 // kept one so for 400 s) comes no closer to it; after stall_time_s beside
 // an arrived member it has gathered where it stands, and its slot is free
 // again. While it came closer, it had not.
 TEST(CrowdCrossing, AMemberCirclingItsSlotBesideTheGatheringHasGathered) {
-  NavWorldConfig c;
-  c.bounds = {-8, -8, 8, 8};
-  NavWorld world(c);
-  std::vector<Agent> agents(2);
-  agents[0].position = {0, 0};   // at the target: arrives at once
-  agents[1].position = {-3, 0};  // comes up and takes a slot beside it
-  for (Agent& a : agents) a.radius = 0.25;
-  Crowd crowd(world, agents);
-  const CrowdGroupParams params{{0, 0}, 0.2, 0.2, 1};
-  CrowdGroup group(crowd, agents, {0, 1}, params);
-  const std::vector<double> vmax{group.max_speed(0), group.max_speed(1)};
-  std::vector<Vec2> desired(2);
-  const double dt = 0.1;
-  double t = 0.0;
-  for (; t < 60.0 && group.slot_index(1) < 0; t += dt) {
-    group.steer(t, dt, agents, desired);
-    test::move_figures(agents, desired, vmax, dt, 0.6);
-  }
-  ASSERT_TRUE(group.arrived(0));
-  ASSERT_GE(group.slot_index(1), 0);
-  ASSERT_FALSE(group.arrived(1));
-  const int slot = group.slot_index(1);
-  const Vec2 centre = group.slots()[static_cast<std::size_t>(slot)];
+  GatheringOfTwo g;
+  g.walk_to_slot();
+  ASSERT_TRUE(g.group.arrived(0));
+  ASSERT_GE(g.group.slot_index(1), 0);
+  ASSERT_FALSE(g.group.arrived(1));
+  const int slot = g.group.slot_index(1);
+  const Vec2 centre = g.group.slots()[static_cast<std::size_t>(slot)];
   // Round the slot at 0.5 m, 0.1 m/s, first spiralling in from 1.1 m
   // (0.2 m closer every 5 s) for 15 s, then on the circle.
-  const double start = t, w = 0.2;
+  const double start = g.t, w = 0.2;
   double gathered_at = -1.0;
-  for (; t < start + 60.0 && gathered_at < 0.0; t += dt) {
-    const double k = t - start;
+  for (; g.t < start + 60.0 && gathered_at < 0.0; g.t += GatheringOfTwo::dt) {
+    const double k = g.t - start;
     const double r = std::max(0.5, 1.1 - 0.2 * std::floor(k / 5.0));
-    agents[1].position = centre + heading_vector(w * k) * r;
-    agents[1].heading = w * k + M_PI / 2;
-    agents[1].speed = w * r;
-    group.steer(t, dt, agents, desired);
-    if (group.arrived(1)) gathered_at = k;
+    g.agents[1].position = centre + heading_vector(w * k) * r;
+    g.agents[1].heading = w * k + M_PI / 2;
+    g.agents[1].speed = w * r;
+    g.group.steer(g.t, GatheringOfTwo::dt, g.agents, g.desired);
+    if (g.group.arrived(1)) gathered_at = k;
   }
-  EXPECT_GE(gathered_at, 15.0 + params.stall_time_s - 0.5);
-  EXPECT_LT(gathered_at, 15.0 + params.stall_time_s + 1.0);
-  EXPECT_EQ(group.slot_index(1), -1);
+  EXPECT_GE(gathered_at, 15.0 + g.params.stall_time_s - 0.5);
+  EXPECT_LT(gathered_at, 15.0 + g.params.stall_time_s + 1.0);
+  EXPECT_EQ(g.group.slot_index(1), -1);
 }
 
 // A member pushed back from its slot beside the gathering walks back with
@@ -140,42 +159,26 @@ TEST(CrowdCrossing, AMemberCirclingItsSlotBesideTheGatheringHasGathered) {
 // where it stands on the way (measured from its closest approach, it did
 // after 20 s, 0.9 m from its slot).
 TEST(CrowdCrossing, AMemberPushedBackFromItsSlotIsStillOnItsWay) {
-  NavWorldConfig c;
-  c.bounds = {-8, -8, 8, 8};
-  NavWorld world(c);
-  std::vector<Agent> agents(2);
-  agents[0].position = {0, 0};
-  agents[1].position = {-3, 0};
-  for (Agent& a : agents) a.radius = 0.25;
-  Crowd crowd(world, agents);
-  const CrowdGroupParams params{{0, 0}, 0.2, 0.2, 1};
-  CrowdGroup group(crowd, agents, {0, 1}, params);
-  const std::vector<double> vmax{group.max_speed(0), group.max_speed(1)};
-  std::vector<Vec2> desired(2);
-  const double dt = 0.1;
-  double t = 0.0;
-  for (; t < 60.0 && group.slot_index(1) < 0; t += dt) {
-    group.steer(t, dt, agents, desired);
-    test::move_figures(agents, desired, vmax, dt, 0.6);
-  }
-  ASSERT_TRUE(group.arrived(0));
-  ASSERT_GE(group.slot_index(1), 0);
-  const Vec2 slot = group.slots()[static_cast<std::size_t>(group.slot_index(1))];
+  GatheringOfTwo g;
+  g.walk_to_slot();
+  ASSERT_TRUE(g.group.arrived(0));
+  ASSERT_GE(g.group.slot_index(1), 0);
+  const Vec2 slot = g.group.slots()[static_cast<std::size_t>(g.group.slot_index(1))];
   // 0.5 m off the slot for 5 s, then pushed 1.5 m off it (past the
   // arrived member at the target), then walking back at 0.04 m/s.
-  const Vec2 away = normalized(agents[0].position - slot);
-  const double start = t;
+  const Vec2 away = normalized(g.agents[0].position - slot);
+  const double start = g.t;
   bool gathered = false;
-  for (; t < start + 35.0 && !gathered; t += dt) {
-    const double k = t - start;
+  for (; g.t < start + 35.0 && !gathered; g.t += GatheringOfTwo::dt) {
+    const double k = g.t - start;
     const double off = k < 5.0 ? 0.5 : std::max(0.5, 1.5 - 0.04 * (k - 5.0));
-    agents[1].position = slot + away * off;
-    agents[1].heading = std::atan2(-away.y, -away.x);
-    agents[1].speed = k < 5.0 ? 0.0 : 0.04;
-    group.steer(t, dt, agents, desired);
-    gathered = group.arrived(1);
+    g.agents[1].position = slot + away * off;
+    g.agents[1].heading = std::atan2(-away.y, -away.x);
+    g.agents[1].speed = k < 5.0 ? 0.0 : 0.04;
+    g.group.steer(g.t, GatheringOfTwo::dt, g.agents, g.desired);
+    gathered = g.group.arrived(1);
   }
-  EXPECT_FALSE(gathered) << "after " << t - start << " s";
+  EXPECT_FALSE(gathered) << "after " << g.t - start << " s";
 }
 
 TEST(CrowdCrossing, SameSeedSameRun) {
