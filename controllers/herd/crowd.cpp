@@ -556,7 +556,41 @@ CrowdGroup::CrowdGroup(Crowd& crowd, std::span<const Agent> agents, std::vector<
   headway_goal_.assign(members_.size(), params_.target);
   headway_best_.assign(members_.size(), std::numeric_limits<double>::infinity());
   headway_since_.assign(members_.size(), 0.0);
+  is_member_.assign(agents.size(), 0);
+  for (int m : members_) is_member_[static_cast<std::size_t>(m)] = 1;
   make_slots(rmax + crowd_.params().avoidance_margin_m);
+}
+
+void CrowdGroup::find_lanes(std::span<const Agent> agents) {
+  // A figure of another group still on its way where this group gathers
+  // (its target lies there, or the figure waits there for a gap, or it
+  // was pushed there) gets a lane, as wide as itself and three halves of
+  // a spacing, toward its target (not where it is sent for now: backing
+  // off a knot or waiting for a gap, it goes on that way after): slots in
+  // it are not taken, nor does a member gather in it, while the figure is
+  // there, so the gathering does not close round it for good.
+  lanes_.clear();
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    if (is_member_[i] || !crowd_.active_[i] || !crowd_.travelling_[i] || !crowd_.has_target_[i])
+      continue;
+    const Vec2 p = agents[i].position;
+    if (norm(p - params_.target) > assign_distance_) continue;
+    const Vec2 to = crowd_.target_[i] - p;
+    const double d = norm(to);
+    if (!(d > 1e-6)) continue;
+    lanes_.push_back(
+        {p, to / d, std::min(d, 2.0 * assign_distance_), agents[i].radius + 0.75 * spacing_});
+  }
+}
+
+bool CrowdGroup::in_lane(Vec2 q) const {
+  for (const Lane& l : lanes_) {
+    const Vec2 r = q - l.from;
+    const double u = dot(r, l.dir);
+    if (u >= -0.5 * spacing_ && u <= l.length && std::abs(cross(l.dir, r)) < l.half_width)
+      return true;
+  }
+  return false;
 }
 
 void CrowdGroup::make_slots(double radius) {
@@ -666,7 +700,18 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   // on its own side; it takes the slot once it is next to it. Arrivals so
   // settle on the side they come from and never walk through the members
   // already standing, and no slot is held by a member that cannot reach it.
+  // Slots in another group's lane are not taken (find_lanes).
   const Vec2 target = params_.target;
+  find_lanes(agents);
+  in_lane_.assign(slots_.size(), 0);
+  if (!lanes_.empty()) {
+    // Not the first slot (at the target): the gathering can always begin.
+    for (const int open : open_) {
+      if (open > 0)
+        in_lane_[static_cast<std::size_t>(open)] =
+            in_lane(slots_[static_cast<std::size_t>(open)]) ? 1 : 0;
+    }
+  }
   for (std::size_t k = 0; k < members_.size(); ++k) {
     if (state_[k] != State::kTravelling) continue;
     const int m = members_[k];
@@ -676,6 +721,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
     double best_cost = std::numeric_limits<double>::infinity(), kept_cost = best_cost;
     for (const int open : open_) {
       const auto s = static_cast<std::size_t>(open);
+      if (in_lane_[s]) continue;
       const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
       if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
       if (cost < best_cost && reachable(p, s)) {
@@ -688,6 +734,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       // never the target itself, which a slot holder may be heading for.
       for (const int open : open_) {
         const auto s = static_cast<std::size_t>(open);
+        if (in_lane_[s]) continue;
         const double cost = norm(slots_[s] - target) + 0.5 * norm(slots_[s] - p);
         if (static_cast<int>(s) == candidate_[k]) kept_cost = cost;
         if (cost < best_cost) {
@@ -701,7 +748,8 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       crowd_.request_target(m, best >= 0 ? slots_[static_cast<std::size_t>(best)] : target);
     }
     const int c = candidate_[k];
-    if (c >= 0 && norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
+    if (c >= 0 && !in_lane_[static_cast<std::size_t>(c)] &&
+        norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
       const auto b = static_cast<std::size_t>(c);
       take_slot(b);
       slot_of_[k] = c;
@@ -785,7 +833,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       beside = state_[j] == State::kArrived &&
                norm(agents[static_cast<std::size_t>(members_[j])].position - p) < 1.5 * spacing_;
     }
-    if (!beside) continue;
+    if (!beside || in_lane(p)) continue;  // not in another group's way out
     if (slot_of_[k] >= 0) free_slot(static_cast<std::size_t>(slot_of_[k]));
     slot_of_[k] = -1;
     state_[k] = State::kArrived;

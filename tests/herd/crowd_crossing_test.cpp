@@ -181,6 +181,50 @@ TEST(CrowdCrossing, AMemberPushedBackFromItsSlotIsStillOnItsWay) {
   EXPECT_FALSE(gathered) << "after " << g.t - start << " s";
 }
 
+// A figure of another team standing where a team gathers (in its spawn
+// area round the other team's target, or where it waits for a gap) keeps
+// a lane to its target: the team coming up from that side gathers round
+// the lane, and the figure walks out once it may. Without the lane the
+// team gathered between it and its way and walled it in for good
+// (counterflow seeds 10 and 69, a blue figure in the red gathering).
+TEST(CrowdCrossing, AFigureOfAnotherTeamKeepsItsWayOutOfTheGathering) {
+  NavWorldConfig c;
+  c.bounds = {-10, -10, 10, 10};
+  NavWorld world(c);
+  const int n = 16;
+  std::vector<Agent> agents(n + 1);
+  agents[0].position = {1.0, 0.0};  // the other team's figure, its target east
+  for (int k = 0; k < n; ++k) {     // the team, coming from the east
+    Agent& a = agents[static_cast<std::size_t>(k + 1)];
+    a.position = {4.0 + 1.2 * (k / 4), -1.5 + 1.0 * (k % 4)};
+    a.heading = M_PI;
+  }
+  for (Agent& a : agents) a.radius = 0.25;
+  Crowd crowd(world, agents);
+  CrowdGroup other(crowd, agents, {0}, {{9, 0}, 0.2, 0.2, 1});
+  std::vector<int> members(n);
+  for (int k = 0; k < n; ++k) members[static_cast<std::size_t>(k)] = k + 1;
+  CrowdGroup team(crowd, agents, members, {{0, 0}, 0.2, 0.2, 2});
+  const std::vector<double> vmax(agents.size(), 0.2);
+  std::vector<Vec2> desired(agents.size());
+  const double dt = 0.1;
+  int collisions = 0;
+  double t = 0.0;
+  for (;
+       t < 700.0 && other.arrived_count() + team.arrived_count() < static_cast<std::size_t>(n) + 1;
+       t += dt) {
+    other.steer(t, dt, agents, desired);
+    team.steer(t, dt, agents, desired);
+    if (t < 200.0) desired[0] = {};  // it stands while the team gathers
+    test::move_figures(agents, desired, vmax, dt, 0.6);
+    collisions += test::count_collisions(agents);
+  }
+  EXPECT_EQ(other.arrived_count(), 1u) << "the figure of the other team is still at "
+                                       << agents[0].position.x << ", " << agents[0].position.y;
+  EXPECT_EQ(team.arrived_count(), static_cast<std::size_t>(n));
+  EXPECT_EQ(collisions, 0);
+}
+
 TEST(CrowdCrossing, SameSeedSameRun) {
   const auto a = test::run_crossing(0.15, 0.25, true, 8, 3, 60.0);
   const auto b = test::run_crossing(0.15, 0.25, true, 8, 3, 60.0);

@@ -9,16 +9,20 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "animrt/controllers/herd/herd.hpp"
 
 namespace animrt::herd {
 namespace {
 
-HerdMetrics run_scene(const std::string& name, std::uint64_t seed) {
+HerdMetrics run_scene(const std::string& name, std::uint64_t seed, int team_size = 0) {
   const auto no_gait = [](const std::string&) -> std::string { return ""; };
-  Herd herd(load_herd_scene(std::string(ANIMRT_SOURCE_DIR) + "/configs/herd/" + name), no_gait,
-            seed);
+  HerdScene scene = load_herd_scene(std::string(ANIMRT_SOURCE_DIR) + "/configs/herd/" + name);
+  if (team_size > 0) {
+    for (GroupSpec& g : scene.groups) g.count = team_size;
+  }
+  Herd herd(std::move(scene), no_gait, seed);
   const long steps = std::lround(herd.scene().duration_s / herd.scene().step_s);
   herd.record_metrics();
   for (long k = 1; k <= steps; ++k) {
@@ -68,6 +72,22 @@ TEST(HerdNarrowGap, DISABLED_GoalCounterflowEverySeed) {
     const HerdMetrics m = run_scene("counterflow.yaml", seed);
     EXPECT_EQ(m.collisions, 0);
     EXPECT_EQ(arrivals(m), 24) << "seed " << seed;
+    for (const GroupMetrics& g : m.groups) EXPECT_LT(g.time_ratio_max, 3.0) << g.name;
+  }
+}
+
+// Held out: the counterflow with teams of 25 (the goal names team sizes up
+// to 25). Not met: every figure arrives on seeds 1-5 since gatherings keep
+// lanes for the other team (before, 18 of 250 did not), but the worst is
+// 3.2-4.1 times its straight-line time; on seeds 1-80, 24 runs leave
+// figures out (docs/results/herds.md, "The counterflow changed"). Five
+// runs of 50 figures are too long for the suite; run with
+// --gtest_also_run_disabled_tests.
+TEST(HerdNarrowGap, DISABLED_GoalCounterflowTeamsOf25) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const HerdMetrics m = run_scene("counterflow.yaml", seed, 25);
+    EXPECT_EQ(m.collisions, 0);
+    EXPECT_EQ(arrivals(m), 50) << "seed " << seed;
     for (const GroupMetrics& g : m.groups) EXPECT_LT(g.time_ratio_max, 3.0) << g.name;
   }
 }

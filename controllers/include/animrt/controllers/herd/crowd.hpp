@@ -223,6 +223,10 @@ class CrowdGroup final : public GroupSteering {
   enum class State { kTravelling, kToSlot, kArrived };
   void make_slots(double radius);
   bool reachable(Vec2 from, std::size_t slot) const;
+  // The lanes this step: one from each travelling figure of another group
+  // near the target toward its target.
+  void find_lanes(std::span<const Agent> agents);
+  bool in_lane(Vec2 q) const;
   void take_slot(std::size_t slot);  // keeps open_ and taken_ with slot_taken_
   void free_slot(std::size_t slot);
 
@@ -247,6 +251,13 @@ class CrowdGroup final : public GroupSteering {
   std::vector<int> taken_;            // taken slots
   std::vector<std::size_t> to_slot_;  // scratch: the members heading for a slot, in order
   std::vector<std::vector<int>> neighbours_;
+  std::vector<char> is_member_;  // per agent of the herd
+  struct Lane {
+    Vec2 from, dir;  // dir: unit
+    double length = 0.0, half_width = 0.0;
+  };
+  std::vector<Lane> lanes_;
+  std::vector<char> in_lane_;  // per slot: open and in a lane this step
   double assign_distance_ = 0.0;
   double spacing_ = 0.0;
 };
