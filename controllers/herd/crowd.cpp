@@ -583,6 +583,15 @@ void CrowdGroup::find_lanes(std::span<const Agent> agents) {
   }
 }
 
+void CrowdGroup::mark_lane_slots() {
+  if (lanes_.empty()) return;
+  // Not the first slot (at the target): the gathering can always begin.
+  for (const int open : open_) {
+    const auto s = static_cast<std::size_t>(open);
+    if (s > 0) in_lane_[s] = in_lane(slots_[s]) ? 1 : 0;
+  }
+}
+
 bool CrowdGroup::in_lane(Vec2 q) const {
   for (const Lane& l : lanes_) {
     const Vec2 r = q - l.from;
@@ -704,14 +713,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
   const Vec2 target = params_.target;
   find_lanes(agents);
   in_lane_.assign(slots_.size(), 0);
-  if (!lanes_.empty()) {
-    // Not the first slot (at the target): the gathering can always begin.
-    for (const int open : open_) {
-      if (open > 0)
-        in_lane_[static_cast<std::size_t>(open)] =
-            in_lane(slots_[static_cast<std::size_t>(open)]) ? 1 : 0;
-    }
-  }
+  mark_lane_slots();
   for (std::size_t k = 0; k < members_.size(); ++k) {
     if (state_[k] != State::kTravelling) continue;
     const int m = members_[k];
@@ -752,6 +754,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
         norm(slots_[static_cast<std::size_t>(c)] - p) < spacing_) {
       const auto b = static_cast<std::size_t>(c);
       take_slot(b);
+      mark_lane_slots();  // the slots it opened
       slot_of_[k] = c;
       state_[k] = State::kToSlot;
       for (std::size_t j = 0; j < members_.size(); ++j) {
@@ -774,7 +777,7 @@ void CrowdGroup::steer(double t, double dt, std::span<const Agent> agents,
       if (state_[j] != State::kToSlot) continue;  // it gave its slot up
       const Vec2 slot = slots_[static_cast<std::size_t>(slot_of_[j])];
       const Vec2 q = agents[static_cast<std::size_t>(members_[j])].position;
-      if (norm(p - slot) < 0.5 * spacing_ && norm(p - slot) < norm(q - slot)) {
+      if (norm(p - slot) < 0.5 * spacing_ && norm(p - slot) < norm(q - slot) && !in_lane(slot)) {
         slot_of_[k] = slot_of_[j];
         state_[k] = State::kToSlot;
         crowd_.request_target(members_[k], slot);

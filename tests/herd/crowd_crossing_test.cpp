@@ -186,7 +186,7 @@ TEST(CrowdCrossing, AMemberPushedBackFromItsSlotIsStillOnItsWay) {
 // a lane to its target: the team coming up from that side gathers round
 // the lane, and the figure walks out once it may. Without the lane the
 // team gathered between it and its way and walled it in for good
-// (counterflow seeds 10 and 69, a blue figure in the red gathering).
+// (counterflow seeds 10 and 69: a blue figure in the red gathering).
 TEST(CrowdCrossing, AFigureOfAnotherTeamKeepsItsWayOutOfTheGathering) {
   NavWorldConfig c;
   c.bounds = {-10, -10, 10, 10};

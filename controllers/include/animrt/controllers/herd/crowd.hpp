@@ -227,6 +227,8 @@ class CrowdGroup final : public GroupSteering {
   // near the target toward its target.
   void find_lanes(std::span<const Agent> agents);
   bool in_lane(Vec2 q) const;
+  // Marks the open slots (but the first) that lie in a lane in in_lane_.
+  void mark_lane_slots();
   void take_slot(std::size_t slot);  // keeps open_ and taken_ with slot_taken_
   void free_slot(std::size_t slot);
 
