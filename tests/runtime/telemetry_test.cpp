@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -34,10 +35,18 @@ TEST(TelemetryRing, KeepsOrderAndCountsDropsWhenFull) {
 TEST(TelemetryRing, ProducerAndConsumerThreadsLoseNothing) {
   TelemetryRing ring(3, 64);
   constexpr int kCount = 200000;
+  // A full or empty ring sleeps briefly: on a machine busy with other tests
+  // both threads may share one core, and a spinning (or merely yielding)
+  // one would hold it for whole time slices while the other cannot move
+  // (25 s instead of 0.05 s in a parallel CTest run).
   std::thread producer([&] {
     for (int i = 0; i < kCount;) {
       std::vector<double> r{double(i), double(i) * 2, double(i) * 3};
-      if (ring.push(r)) ++i;
+      if (ring.push(r)) {
+        ++i;
+      } else {
+        std::this_thread::sleep_for(std::chrono::microseconds(20));
+      }
     }
   });
   std::vector<double> out(3);
@@ -47,6 +56,8 @@ TEST(TelemetryRing, ProducerAndConsumerThreadsLoseNothing) {
       ASSERT_EQ(out[0], expected);
       ASSERT_EQ(out[2], expected * 3.0);
       ++expected;
+    } else {
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
     }
   }
   producer.join();

@@ -16,7 +16,9 @@
 // - one timeout semantics: BusConfig::timeout_s is the wait for ONE answer,
 //   from the instruction to the first answer and from each answer to the
 //   next, so N healthy servos never time out a read because N answers take
-//   longer than one; a silent servo costs one timeout. Past the wait the
+//   longer than one; a silent servo costs one timeout (a lifecycle step's
+//   retries wait two, then four: unicast; a ping's do not, its rounds are
+//   its patience). Past the wait the
 //   core looks once more without waiting: an answer queued while this
 //   thread was not running is not a timeout. On a lockstep line to
 //   simulated devices (lockstep_line.hpp) an answer is missing once the
@@ -238,11 +240,12 @@ class Link {
   // Sends tx()[0, length) and collects the answers of slots [0, count)
   // (data_length bytes each, or kAnyLength) until each answered or the wait
   // for the next answer ran out. `diagnostic`: a read for a diagnosis, whose
-  // fault bits are not counted again. Never throws or allocates.
+  // fault bits are not counted again. `wait`: the wait for one answer, the
+  // bus's timeout unless given. Never throws or allocates.
   void transact(std::size_t length, std::size_t count, std::size_t data_length,
-                bool diagnostic = false) {
+                bool diagnostic = false, std::chrono::microseconds wait = {}) {
     begin(length, count);
-    AnswerClock clock(timeout_, count);
+    AnswerClock clock(wait.count() > 0 ? wait : timeout_, count);
     std::size_t remaining = count;
     std::size_t expected = 0;  // first slot still waiting: whose answer comes next
     Packet packet;
@@ -295,13 +298,18 @@ class Link {
 
   // One device, one instruction in tx()[0, length): up to `tries` attempts
   // while nothing usable came (a verdict, ok or rejected, is not retried).
+  // Each retry waits twice as long as the try before it (one timeout, two,
+  // four): a host too busy to carry the line's bytes for a few timeouts (a
+  // desktop starting a browser) does not fail a lifecycle step, while a
+  // silent device costs 7 timeouts in 3 tries. An answer to an earlier try
+  // that comes during a later one is taken: it answers the same instruction.
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length, int tries,
                  bool diagnostic = false) {
     Answer a = Answer::timeout;
     if (length == 0) return a;
     for (int t = 0; t < tries; ++t) {
       ask(0, device);
-      transact(length, 1, data_length, diagnostic);
+      transact(length, 1, data_length, diagnostic, timeout_ * (std::int64_t{1} << std::min(t, 10)));
       a = answer_[0];
       if (a == Answer::ok || a == Answer::rejected) break;
     }
@@ -319,7 +327,12 @@ class Link {
     const std::size_t n = book_.size();
     std::vector<bool> garbled(n, false);
     const std::vector<bool> answered = ping_until_answered(n, [&](std::size_t i) {
-      const Answer a = unicast(i, encode(bus_ids_[i], tx()), kAnyLength, tries);
+      // Tries of one timeout each: the rounds are a ping's patience.
+      const std::size_t length = encode(bus_ids_[i], tx());
+      Answer a = Answer::timeout;
+      for (int t = 0; t < tries && a != Answer::ok && a != Answer::rejected; ++t) {
+        a = unicast(i, length, kAnyLength, 1);
+      }
       if (a == Answer::ok) seen(i);
       garbled[i] = a == Answer::garbled;
       return a == Answer::ok || a == Answer::rejected;
