@@ -459,6 +459,7 @@ void DynamixelBus::broadcast_bus_watchdog() {
 
 void DynamixelBus::deactivate() {
   armed_ = false;
+  const decltype(link_)::Stopping stopping(link_);
   try {
     for (std::size_t i = 0; i < link_.book().size(); ++i) {
       // Before torque off, so a clean stop leaves no guard armed (and clears

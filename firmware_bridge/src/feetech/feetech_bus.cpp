@@ -160,6 +160,7 @@ void FeetechBus::activate() {
 }
 
 void FeetechBus::deactivate() {
+  const decltype(link_)::Stopping stopping(link_);
   try {
     for (std::size_t i = 0; i < link_.book().size(); ++i) {
       write_byte(i, ft::reg::torque_enable, 0);

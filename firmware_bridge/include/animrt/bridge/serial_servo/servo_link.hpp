@@ -18,7 +18,7 @@
 //   next, so N healthy servos never time out a read because N answers take
 //   longer than one; a silent servo costs one timeout (a lifecycle step's
 //   retries wait two, then four: unicast; a ping's do not, its rounds are
-//   its patience). Past the wait the
+//   its patience, nor a stop's: Stopping). Past the wait the
 //   core looks once more without waiting: an answer queued while this
 //   thread was not running is not a timeout. On a lockstep line to
 //   simulated devices (lockstep_line.hpp) an answer is missing once the
@@ -301,20 +301,41 @@ class Link {
   // Each retry waits twice as long as the try before it (one timeout, two,
   // four): a host too busy to carry the line's bytes for a few timeouts (a
   // desktop starting a browser) does not fail a lifecycle step, while a
-  // silent device costs 7 timeouts in 3 tries. An answer to an earlier try
-  // that comes during a later one is taken: it answers the same instruction.
+  // silent device costs 7 timeouts in 3 tries. Within a Stopping scope each
+  // try waits one timeout. An answer to an earlier try that comes during a
+  // later one is taken: it answers the same instruction (the answers to the
+  // other tries come with it, back to back, and the next transaction's
+  // begin() discards them; one that came later still, from the same id and
+  // of the length the next read wants, would pass for its answer).
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length, int tries,
                  bool diagnostic = false) {
     Answer a = Answer::timeout;
     if (length == 0) return a;
     for (int t = 0; t < tries; ++t) {
       ask(0, device);
-      transact(length, 1, data_length, diagnostic, timeout_ * (std::int64_t{1} << std::min(t, 10)));
+      const int doubled = stopping_ ? 0 : std::min(t, 10);
+      transact(length, 1, data_length, diagnostic, timeout_ * (std::int64_t{1} << doubled));
       a = answer_[0];
       if (a == Answer::ok || a == Answer::rejected) break;
     }
     return a;
   }
+
+  // While one lives, unicast's retries wait one timeout each: stopping
+  // (deactivate), a silent device must hold up the torque-off of the
+  // devices after it, and of the buses after this one, no longer than it
+  // has to.
+  class Stopping {
+   public:
+    explicit Stopping(Link& link) : link_(link), was_(link.stopping_) { link.stopping_ = true; }
+    ~Stopping() { link_.stopping_ = was_; }
+    Stopping(const Stopping&) = delete;
+    Stopping& operator=(const Stopping&) = delete;
+
+   private:
+    Link& link_;
+    bool was_;
+  };
 
   // configure()'s search for the devices: pings each (kTries attempts, then
   // again for kPingRounds rounds while any is silent: ping_until_answered),
@@ -520,6 +541,7 @@ class Link {
   std::array<std::uint8_t, 256> rx_{};
   std::size_t rx_begin_ = 0, rx_end_ = 0;
   bool late_look_done_ = false;
+  bool stopping_ = false;  // within a Stopping scope
   typename Codec::Decoder decoder_;
 };
 
