@@ -36,7 +36,12 @@ sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" -e "$pat
   -e "s#stop_ramp_s: [0-9.]*#stop_ramp_s: 0.5#" "$root/configs/robots/quadruped.yaml" > "$tmp/robot.yaml"
 grep -q "stop_ramp_s: 0.5" "$tmp/robot.yaml" || fail "could not shorten the stop ramp: $(head -30 "$tmp/robot.yaml")"
 
+# The last run's output is emptied first: the new process may not have
+# opened (and truncated) it yet when the wait below first looks, and the
+# last run's torque on is in it.
 start_run() {
+  : > "$tmp/out.txt"
+  : > "$tmp/err.txt"
   "$animrt" run "$tmp/robot.yaml" --backend hardware --no-realtime > "$tmp/out.txt" 2> "$tmp/err.txt" &
   run_pid=$!
   for _ in $(seq 100); do

@@ -52,6 +52,7 @@ robot=$no_wind_down
 # SIGPIPE: stderr goes to a reader that leaves (a closed terminal's pipe,
 # `2>&1 | head`); the signal is a stop, not a silent death.
 mkfifo "$tmp/err.fifo"
+: > "$tmp/err.txt"  # the runs above started in it; the reader may not have truncated it yet
 cat "$tmp/err.fifo" > "$tmp/err.txt" &
 cat_pid=$!
 "$animrt" run "$robot" --backend hardware --no-realtime > "$tmp/out.txt" 2> "$tmp/err.fifo" &

@@ -39,7 +39,7 @@ GroupMetrics run_flock_scene(const std::string& name, std::uint64_t seed) {
 // on every seed: the boids are carried by their leader's move, as the
 // text's are children of the controller, and a figure the contact guard
 // stops turns on the spot out of the way (before: 2.1-3.4 m).
-// Seeds 1-5; the sanitizer build, many times slower (40 s for five), seed 1:
+// Seeds 1-5; the sanitizer build, many times slower (43 s for five), seed 1:
 // every seed runs the same code.
 #if defined(__SANITIZE_ADDRESS__)
 constexpr std::uint64_t kLastSeed = 1;
