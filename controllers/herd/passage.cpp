@@ -260,6 +260,14 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
       params_(params),
       world_(world) {
   for (const Box& b : walls) walls_.push_back(extent_of(b));
+  places_.resize(passages_.size());
+  for (std::size_t k = 0; k < passages_.size(); ++k) {
+    for (const int dir : {1, -1}) {
+      for (const int side : {1, -1})
+        places_[k][static_cast<std::size_t>(2 * idx(dir) + (side > 0 ? 0 : 1))] =
+            find_wait_place(passages_[k], dir, side);
+    }
+  }
 }
 
 bool PassageRules::sees(const Passage& p, Vec2 pos) const {
@@ -493,9 +501,30 @@ signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal, int
 }
 
 Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {
+  const auto k = static_cast<std::size_t>(&p - passages_.data());
+  return places_[k][static_cast<std::size_t>(2 * idx(dir) + (side > 0 ? 0 : 1))];
+}
+
+Vec2 PassageRules::find_wait_place(const Passage& p, int dir, int side) const {
   const Vec2 way = p.axis * dir, right{way.y, -way.x};
-  return p.centre - way * (p.half_length + 3.0 + avoid_radius_) +
-         right * (side * (p.half_width + 2.5));
+  const Vec2 mouth = p.centre - way * p.half_length;
+  const auto place = [&](double back, double aside) {
+    return mouth - way * (back + avoid_radius_) + right * (side * (p.half_width + aside));
+  };
+  if (!world_) return place(params_.wait_back_m, params_.wait_aside_m);
+  // Where walls leave no room there (a wall across, the mesh's edge): the
+  // first place nearer the passage's axis, 0.5 m at a time, then the same
+  // 1.5 m farther out from the wall, that a figure can stand on in sight
+  // of the mouth.
+  for (const double back : {params_.wait_back_m, params_.wait_back_m + 1.5}) {
+    for (double aside = params_.wait_aside_m; aside > 0.99; aside -= 0.5) {
+      const Vec2 at = place(back, aside);
+      bool clear = world_->on_mesh(at, 0.05);
+      for (const WallExtent& w : walls_) clear = clear && !blocks(w, mouth, at);
+      if (clear) return at;
+    }
+  }
+  return place(params_.wait_back_m, params_.wait_aside_m);
 }
 
 int PassageRules::choose_side(Passage& p, int dir, std::span<const Agent> agents,

@@ -131,5 +131,43 @@ TEST(CrowdCounterflow, FindsTheGapAsAPassage) {
   EXPECT_TRUE(find_passages(one_gap_world(3.5).walls, 2.3).empty());
 }
 
+// The way that waits stands beside its mouth, near the wall's face and
+// well to the side, where its crowd keeps clear of the way in to the mouth
+// and of the way out. Where a wall stands across that place, it waits at
+// the nearest place toward the mouth that a figure can stand on in sight
+// of the mouth.
+TEST(CrowdCounterflow, TheWaitingPlaceMovesOutOfAWallAcrossIt) {
+  const NavWorldConfig open = one_gap_world(2.0);
+  NavWorldConfig walled = open;
+  // East of the gap, square to its wall, across where the blue team waits.
+  walled.walls.push_back({{2.05, 1.0 + PassageParams{}.wait_aside_m}, {4.1, 0.5}, 0.0});
+  std::vector<Agent> agents(2);
+  agents[0].position = {-1.5, 0.0};  // red, nearer its mouth: its way has the gap
+  agents[1].position = {3.5, 0.0};   // blue, waits
+  for (Agent& a : agents) a.radius = 0.25;
+  const std::vector<Vec2> targets{{9, 0}, {-9, 0}};
+  const PassageParams params;
+  const double r = 0.35;  // the avoidance radius
+  for (const NavWorldConfig* config : {&open, static_cast<const NavWorldConfig*>(&walled)}) {
+    NavWorld world(*config);
+    PassageRules rules(config->walls, r, params, &world);
+    ASSERT_EQ(rules.passages().size(), 1u);
+    rules.update(0.0, agents, targets, std::vector<bool>(2, true));
+    ASSERT_FALSE(rules.held(0));
+    ASSERT_TRUE(rules.held(1));
+    const Vec2 at = rules.hold_point(1);
+    // Out from the east mouth (the wall's face at x = 0.25), on blue's right.
+    EXPECT_NEAR(at.x, 0.25 + params.wait_back_m + r, 1e-9);
+    if (config == &open) {
+      EXPECT_NEAR(at.y, 1.0 + params.wait_aside_m, 1e-9);
+    } else {
+      EXPECT_LT(at.y, 1.0 + params.wait_aside_m - 0.25 - 0.25);  // off the wall by a figure's radius
+      EXPECT_GT(at.y, 1.0);
+      EXPECT_TRUE(world.on_mesh(at, 0.05));
+      EXPECT_FALSE(world.in_wall(at, 0.25));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace animrt::herd

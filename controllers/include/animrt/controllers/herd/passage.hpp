@@ -30,6 +30,13 @@ struct PassageParams {
   double close_m = 2.5;
   double clear_m = 1.5;
   double max_hold_s = 60.0;  // the other way waits at most this long for a turn
+  // The other way waits round a place this far (m) out from the mouth,
+  // plus an avoidance radius, and this far to the side of the passage's
+  // edge: near the wall's face and well aside, its waiting crowd (two
+  // dozen figures stand 2-2.5 m round it) keeps clear of the way in to
+  // the mouth as well as of the way out.
+  double wait_back_m = 1.5;
+  double wait_aside_m = 4.0;
   // At a passage one figure wide, the owner's figures this near its mouth
   // queue there and go in one at a time.
   double queue_m = 1.5;
@@ -99,12 +106,15 @@ class PassageRules {
   // For a figure round a corner from p: its side is the mouth nearer by the
   // mesh (`to` away); 0 while that is farther than approach_m.
   signed char way_round(const Passage& p, Vec2 pos, Vec2 goal, double& to) const;
-  // Where figures of way dir wait for p on side +1 (right) or -1 (left).
+  // Where figures of way dir wait for p on side +1 (right) or -1 (left):
+  // found once for each passage, way and side (find_wait_place), in places_.
   Vec2 wait_place(const Passage& p, int dir, int side) const;
+  Vec2 find_wait_place(const Passage& p, int dir, int side) const;
   int choose_side(Passage& p, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
 
   std::vector<Passage> passages_;
   std::vector<WallExtent> walls_;
+  std::vector<std::array<Vec2, 4>> places_;  // per passage: way +1 right, left; way -1 right, left
   double avoid_radius_;
   PassageParams params_;
   const NavWorld* world_ = nullptr;
