@@ -274,6 +274,9 @@ TEST(SeqTrainingStep, FusedConvolutionSplitBetweenThreadsComputesWhatItsLayersDo
   const MeshSequence bar = make_twisting_bar(12, 20, 4.0, std::numbers::pi, 1);
   ASSERT_GT(bar.vertex_count(), 200);
   torch::set_num_threads(2);
+  // The suite runs in one process after cases that set one thread: a
+  // thread pool that ignored the second setting would run this on one.
+  ASSERT_EQ(at::get_num_threads(), 2);
   expect_fused_equals_plain(bar, 16, false, true);
   expect_fused_equals_plain(bar, 5, true, true);
   torch::set_num_threads(1);
