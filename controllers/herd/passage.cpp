@@ -11,6 +11,10 @@ namespace animrt::herd {
 namespace {
 
 int idx(int dir) { return dir > 0 ? 0 : 1; }
+// A passage's waiting places: way +1 right, left; way -1 right, left.
+std::size_t place_slot(int dir, int side) {
+  return static_cast<std::size_t>(2 * idx(dir) + (side > 0 ? 0 : 1));
+}
 constexpr signed char kNotThrough = 2;  // the figure's way does not lead through the passage
 // A figure round a corner from a passage nearer its mouth than this (by
 // the mesh) when its way must wait walks on round the corner.
@@ -264,8 +268,7 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
   for (std::size_t k = 0; k < passages_.size(); ++k) {
     for (const int dir : {1, -1}) {
       for (const int side : {1, -1})
-        places_[k][static_cast<std::size_t>(2 * idx(dir) + (side > 0 ? 0 : 1))] =
-            find_wait_place(passages_[k], dir, side);
+        places_[k][place_slot(dir, side)] = find_wait_place(passages_[k], dir, side);
     }
   }
 }
@@ -456,8 +459,8 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     held_[i] = 1;
     held_by_[i] = index;
     const int on =
-        p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)] : choose_side(p, dir, agents, target);
-    hold_[i] = wait_place(p, dir, on);
+        p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)] : choose_side(index, dir, agents, target);
+    hold_[i] = wait_place(index, dir, on);
   }
 }
 
@@ -500,9 +503,8 @@ signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal, int
   return static_cast<signed char>(-from);
 }
 
-Vec2 PassageRules::wait_place(const Passage& p, int dir, int side) const {
-  const auto k = static_cast<std::size_t>(&p - passages_.data());
-  return places_[k][static_cast<std::size_t>(2 * idx(dir) + (side > 0 ? 0 : 1))];
+Vec2 PassageRules::wait_place(int index, int dir, int side) const {
+  return places_[static_cast<std::size_t>(index)][place_slot(dir, side)];
 }
 
 Vec2 PassageRules::find_wait_place(const Passage& p, int dir, int side) const {
@@ -511,24 +513,31 @@ Vec2 PassageRules::find_wait_place(const Passage& p, int dir, int side) const {
   const auto place = [&](double back, double aside) {
     return mouth - way * (back + avoid_radius_) + right * (side * (p.half_width + aside));
   };
-  if (!world_) return place(params_.wait_back_m, params_.wait_aside_m);
-  // Where walls leave no room there (a wall across, the mesh's edge): the
-  // first place nearer the passage's axis, 0.5 m at a time, then the same
-  // 1.5 m farther out from the wall, that a figure can stand on in sight
-  // of the mouth.
+  const Vec2 first = place(params_.wait_back_m, params_.wait_aside_m);
+  if (!world_) return first;
+  // Where walls leave no room there (a wall across, the mesh's edge, a
+  // moving obstacle's footprint): the first place nearer the passage's
+  // axis, 0.5 m at a time down to 1 m aside, then the same 1.5 m farther
+  // out from the wall, that a figure can stand on in sight of the mouth
+  // (its middle); failing all, the nearest point of the mesh to the first.
+  const double least = std::min(1.0, params_.wait_aside_m);
   for (const double back : {params_.wait_back_m, params_.wait_back_m + 1.5}) {
-    for (double aside = params_.wait_aside_m; aside > 0.99; aside -= 0.5) {
+    for (double aside = params_.wait_aside_m; aside > least - 0.01; aside -= 0.5) {
       const Vec2 at = place(back, aside);
       bool clear = world_->on_mesh(at, 0.05);
       for (const WallExtent& w : walls_) clear = clear && !blocks(w, mouth, at);
+      for (const MovingObstacle& m : world_->config().moving)
+        clear = clear && NavWorld::distance_to_box(at, m.footprint) > avoid_radius_;
       if (clear) return at;
     }
   }
-  return place(params_.wait_back_m, params_.wait_aside_m);
+  return world_->nearest_on_mesh(first, 2.0 * (params_.wait_back_m + params_.wait_aside_m))
+      .value_or(first);
 }
 
-int PassageRules::choose_side(Passage& p, int dir, std::span<const Agent> agents,
+int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
                               std::span<const Vec2> target) {
+  Passage& p = passages_[static_cast<std::size_t>(index)];
   // The other way's figures come out toward their goals: where the walls
   // turn their way out to this way's right (a maze), waiting there would
   // stand in it. The place on the left is taken instead when it is in
@@ -543,7 +552,7 @@ int PassageRules::choose_side(Passage& p, int dir, std::span<const Agent> agents
   }
   if (other < 0) return 1;  // decided once the other way is there
   const Vec2 goal = target[static_cast<std::size_t>(other)];
-  const Vec2 right = wait_place(p, dir, 1), left = wait_place(p, dir, -1);
+  const Vec2 right = wait_place(index, dir, 1), left = wait_place(index, dir, -1);
   const Vec2 mouth = p.centre - p.axis * (dir * p.half_length);
   int side = 1;
   const auto from_left = world_->path_length(left, goal);

@@ -134,13 +134,14 @@ TEST(CrowdCounterflow, FindsTheGapAsAPassage) {
 // The way that waits stands beside its mouth, near the wall's face and
 // well to the side, where its crowd keeps clear of the way in to the mouth
 // and of the way out. Where a wall stands across that place, it waits at
-// the nearest place toward the mouth that a figure can stand on in sight
-// of the mouth.
+// the first place nearer the passage's axis (0.5 m at a time) that a
+// figure can stand on in sight of the mouth.
 TEST(CrowdCounterflow, TheWaitingPlaceMovesOutOfAWallAcrossIt) {
   const NavWorldConfig open = one_gap_world(2.0);
   NavWorldConfig walled = open;
-  // East of the gap, square to its wall, across where the blue team waits.
-  walled.walls.push_back({{2.05, 1.0 + PassageParams{}.wait_aside_m}, {4.1, 0.5}, 0.0});
+  // East of the gap, square to its wall, 1 m thick across where the blue
+  // team waits (4 m aside of the gap's edge): 4.5-5.5 m north of the axis.
+  walled.walls.push_back({{2.05, 1.0 + PassageParams{}.wait_aside_m}, {4.1, 1.0}, 0.0});
   std::vector<Agent> agents(2);
   agents[0].position = {-1.5, 0.0};  // red, nearer its mouth: its way has the gap
   agents[1].position = {3.5, 0.0};   // blue, waits
@@ -161,8 +162,9 @@ TEST(CrowdCounterflow, TheWaitingPlaceMovesOutOfAWallAcrossIt) {
     if (config == &open) {
       EXPECT_NEAR(at.y, 1.0 + params.wait_aside_m, 1e-9);
     } else {
-      EXPECT_LT(at.y, 1.0 + params.wait_aside_m - 0.25 - 0.25);  // off the wall by a figure's radius
-      EXPECT_GT(at.y, 1.0);
+      // 3.5 m aside lies in the wall's reach (within a figure's radius of
+      // it); 3 m aside, 0.25 m clear of that, is the first place free.
+      EXPECT_NEAR(at.y, 1.0 + params.wait_aside_m - 1.0, 1e-9);
       EXPECT_TRUE(world.on_mesh(at, 0.05));
       EXPECT_FALSE(world.in_wall(at, 0.25));
     }

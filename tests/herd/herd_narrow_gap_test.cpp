@@ -90,7 +90,7 @@ TEST(HerdNarrowGap, CounterflowTeamsOf25Seed2WithinThreeTimes) {
 }
 
 // Held out: the counterflow with teams of 25 (the goal names team sizes up
-// to 25). Met on seeds 1-5 (worst 2.94, seed 1's blue team; 3.35-4.13
+// to 25). Met on seeds 1-5 (worst 2.94, seed 1's blue team; 3.44-4.13
 // before the waiting place moved), not on every seed: on seeds 1-80 of
 // the scene with the gaits, 74 runs bring every figure home and 50 of
 // them within 3x (docs/results/herds.md, "The waiting place beside the

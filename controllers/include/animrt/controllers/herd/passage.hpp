@@ -106,15 +106,16 @@ class PassageRules {
   // For a figure round a corner from p: its side is the mouth nearer by the
   // mesh (`to` away); 0 while that is farther than approach_m.
   signed char way_round(const Passage& p, Vec2 pos, Vec2 goal, double& to) const;
-  // Where figures of way dir wait for p on side +1 (right) or -1 (left):
-  // found once for each passage, way and side (find_wait_place), in places_.
-  Vec2 wait_place(const Passage& p, int dir, int side) const;
+  // Where figures of way dir wait for passage `index` on side +1 (right)
+  // or -1 (left): found once for each passage, way and side
+  // (find_wait_place), in places_.
+  Vec2 wait_place(int index, int dir, int side) const;
   Vec2 find_wait_place(const Passage& p, int dir, int side) const;
-  int choose_side(Passage& p, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
+  int choose_side(int index, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
 
   std::vector<Passage> passages_;
   std::vector<WallExtent> walls_;
-  std::vector<std::array<Vec2, 4>> places_;  // per passage: way +1 right, left; way -1 right, left
+  std::vector<std::array<Vec2, 4>> places_;  // per passage (place_slot in passage.cpp)
   double avoid_radius_;
   PassageParams params_;
   const NavWorld* world_ = nullptr;
