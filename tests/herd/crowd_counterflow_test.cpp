@@ -171,5 +171,32 @@ TEST(CrowdCounterflow, TheWaitingPlaceMovesOutOfAWallAcrossIt) {
   }
 }
 
+// A gap near the scene's edge (its upper wall part 1 m long): no place
+// beside the mouth on that side has room, so the way whose right side it
+// is waits on its left, 4 m aside of the gap's other edge, instead of at
+// the mesh's edge beside the mouth (where its crowd stood round the
+// mouth: teams of 25 home on 4 of 20 seeds, 12 with this).
+TEST(CrowdCounterflow, AWayWithNoRoomOnItsRightWaitsOnItsLeft) {
+  NavWorldConfig c;
+  c.bounds = {-14, -7, 14, 7};
+  c.walls = {{{0, -1.5}, {0.5, 11}, 0.0}, {{0, 6.5}, {0.5, 1}, 0.0}};  // the gap at y 4..6
+  c.agent_radius_m = 0.25;
+  NavWorld world(c);
+  std::vector<Agent> agents(2);
+  agents[0].position = {-1.5, 5.0};  // red, nearer its mouth: its way has the gap
+  agents[1].position = {3.5, 5.0};   // blue, waits; its right is north, toward the edge
+  for (Agent& a : agents) a.radius = 0.25;
+  const std::vector<Vec2> targets{{9, 0}, {-9, 0}};
+  const PassageParams params;
+  PassageRules rules(c.walls, 0.35, params, &world);
+  ASSERT_EQ(rules.passages().size(), 1u);
+  rules.update(0.0, agents, targets, std::vector<bool>(2, true));
+  ASSERT_FALSE(rules.held(0));
+  ASSERT_TRUE(rules.held(1));
+  const Vec2 at = rules.hold_point(1);
+  EXPECT_NEAR(at.x, 0.25 + params.wait_back_m + 0.35, 1e-9);
+  EXPECT_NEAR(at.y, 4.0 - params.wait_aside_m, 1e-9);
+}
+
 }  // namespace
 }  // namespace animrt::herd
