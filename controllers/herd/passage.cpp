@@ -458,7 +458,8 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     }
     // Beside the mouth, clear of the way out of the passage: on the
     // figure's right (figures coming out keep to their own right, the
-    // other side), unless the way out turns there (below).
+    // other side), unless the way out turns there or the right has no
+    // room (choose_side).
     held_[i] = 1;
     held_by_[i] = index;
     const int on =
@@ -548,7 +549,8 @@ int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
   // stand in it. The place on the left is taken instead when it is in
   // sight of the mouth on this side, and the other way's path to its goal
   // from the right place is shorter than from the left one by over
-  // kTurnMargin (a real turn, not the noise of the mesh).
+  // kTurnMargin (a real turn, not the noise of the mesh). Last, a side
+  // with no clear place gives way to one with a clear place (below).
   constexpr double kTurnMargin = 2.0;
   if (!world_) return 1;
   int other = -1;

@@ -73,7 +73,8 @@ std::vector<Passage> find_passages(std::span<const Box> walls, double max_width)
 class PassageRules {
  public:
   // With a world, the waiting places follow the way out where the walls
-  // turn it (choose_side); without one, figures wait on their right.
+  // turn it and move where walls leave no room (choose_side,
+  // find_wait_place); without one, figures wait on their right.
   PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params = {},
                const NavWorld* world = nullptr);
 
@@ -110,8 +111,8 @@ class PassageRules {
   // or -1 (left): found once for each passage, way and side
   // (find_wait_place), in places_.
   Vec2 wait_place(int index, int dir, int side) const;
-  // `clear`: whether the place found is clear (else the first place,
-  // snapped to the mesh).
+  // `clear`: whether the place found is clear (else it is the first
+  // place, snapped to the mesh where the mesh is within reach).
   Vec2 find_wait_place(const Passage& p, int dir, int side, bool& clear) const;
   int choose_side(int index, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
 
