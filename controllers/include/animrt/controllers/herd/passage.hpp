@@ -26,7 +26,12 @@ struct PassageParams {
   // Figures this near a mouth go on through when their way closes; a
   // figure keeps asking for the passage until clear_m out of the far mouth
   // (its way keeps the passage while the other way does not ask), though
-  // once out of the mouth it no longer holds up a swap.
+  // once out of the mouth it no longer holds up a swap. Near is measured
+  // along the passage's axis only, and the waiting places (wait_back_m
+  // out) lie within it: a figure the closing holds walks to its place and
+  // goes on from there, so a team of two dozen passes whole before the
+  // swap. Measured sideways too, the ways took turns and lost
+  // (docs/results/herds.md, "Turns at the gap").
   double close_m = 2.5;
   double clear_m = 1.5;
   double max_hold_s = 60.0;  // the other way waits at most this long for a turn
