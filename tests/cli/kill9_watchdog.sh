@@ -26,15 +26,20 @@ read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
 [[ $kind == serial && $bus == legs && $pty == /dev/pts/* ]] || fail "sim line: $(cat "$tmp/sim.txt")"
 
 # The shipped robot, its port pointed at the simulator's pty (files it names
-# resolved against the shipped folder), with answer timeouts of 40 ms: the
-# simulator shares this machine with whatever else runs, and a configure
-# that gives up on a late answer would end the test before it began.
+# resolved against the shipped folder), with answer timeouts of 40 ms and
+# the runtime's watchdog at 2 s: the simulator shares this machine with
+# whatever else runs, and a configure that gives up on a late answer, or
+# servos faulted and switched off because the simulator was held up 0.1 s,
+# would end the test before it began. What is under test is the servos'
+# own Bus Watchdog (its default, 100 ms), which neither widens.
 # Its stop ramp is 0.5 s: the first run dies by kill -9 and the second is
 # stopped to see it end cleanly, neither for the ramp's length.
 patient='s#timeout_ms: [0-9]*#timeout_ms: 40#'
 sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" -e "$patient" \
+  -e "s#watchdog_timeout_s: [0-9.]*#watchdog_timeout_s: 2.0#" \
   -e "s#stop_ramp_s: [0-9.]*#stop_ramp_s: 0.5#" "$root/configs/robots/quadruped.yaml" > "$tmp/robot.yaml"
 grep -q "stop_ramp_s: 0.5" "$tmp/robot.yaml" || fail "could not shorten the stop ramp: $(head -30 "$tmp/robot.yaml")"
+grep -q "watchdog_timeout_s: 2.0" "$tmp/robot.yaml" || fail "could not widen the watchdog: $(head -30 "$tmp/robot.yaml")"
 
 # The last run's output is emptied first: the new process may not have
 # opened (and truncated) it yet when the wait below first looks, and the

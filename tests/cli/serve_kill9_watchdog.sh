@@ -21,9 +21,12 @@ done
 read -r kind bus pty < <(grep "^serial " "$tmp/sim.txt")
 [[ $kind == serial && $bus == neck && $pty == /dev/pts/* ]] || fail "sim line: $(cat "$tmp/sim.txt")"
 # The shipped head, its port at the simulator's pty, patient answer timeouts
-# (the simulator shares a busy machine).
+# and a runtime watchdog of 2 s (the simulator shares a busy machine; the
+# servos' own Bus Watchdog is what is under test).
 sed -e "s#port: /dev/ttyUSB0#port: $pty#" -e "s#\.\./#$root/configs/#g" \
-  -e 's#timeout_ms: [0-9]*#timeout_ms: 40#' "$root/configs/robots/head.yaml" > "$tmp/robot.yaml"
+  -e 's#timeout_ms: [0-9]*#timeout_ms: 40#' \
+  -e 's#watchdog_timeout_s: [0-9.]*#watchdog_timeout_s: 2.0#' "$root/configs/robots/head.yaml" > "$tmp/robot.yaml"
+grep -q "watchdog_timeout_s: 2.0" "$tmp/robot.yaml" || fail "could not widen the watchdog: $(head -30 "$tmp/robot.yaml")"
 
 "$animrt" serve "$tmp/robot.yaml" --cues "$root/configs/cues/head.yaml" --backend hardware \
   --no-realtime --no-osc > "$tmp/out.txt" 2> "$tmp/err.txt" &
