@@ -265,13 +265,10 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
       world_(world) {
   for (const Box& b : walls) walls_.push_back(extent_of(b));
   places_.resize(passages_.size());
-  place_clear_.resize(passages_.size());
   for (std::size_t k = 0; k < passages_.size(); ++k) {
     for (const int dir : {1, -1}) {
-      for (const int side : {1, -1}) {
-        const std::size_t slot = place_slot(dir, side);
-        places_[k][slot] = find_wait_place(passages_[k], dir, side, place_clear_[k][slot]);
-      }
+      for (const int side : {1, -1})
+        places_[k][place_slot(dir, side)] = find_wait_place(passages_[k], dir, side);
     }
   }
 }
@@ -508,18 +505,17 @@ signed char PassageRules::way_through(const Passage& p, Vec2 pos, Vec2 goal, int
 }
 
 Vec2 PassageRules::wait_place(int index, int dir, int side) const {
-  return places_[static_cast<std::size_t>(index)][place_slot(dir, side)];
+  return places_[static_cast<std::size_t>(index)][place_slot(dir, side)].at;
 }
 
-Vec2 PassageRules::find_wait_place(const Passage& p, int dir, int side, bool& clear) const {
+PassageRules::WaitPlace PassageRules::find_wait_place(const Passage& p, int dir, int side) const {
   const Vec2 way = p.axis * dir, right{way.y, -way.x};
   const Vec2 mouth = p.centre - way * p.half_length;
   const auto place = [&](double back, double aside) {
     return mouth - way * (back + avoid_radius_) + right * (side * (p.half_width + aside));
   };
   const Vec2 first = place(params_.wait_back_m, params_.wait_aside_m);
-  clear = true;
-  if (!world_) return first;
+  if (!world_) return {first, true};
   // Where walls leave no room there (a wall across, the mesh's edge, a
   // moving obstacle's footprint): the first place nearer the passage's
   // axis, 0.5 m at a time down to 1 m aside, then the same 1.5 m farther
@@ -529,16 +525,16 @@ Vec2 PassageRules::find_wait_place(const Passage& p, int dir, int side, bool& cl
   for (const double back : {params_.wait_back_m, params_.wait_back_m + 1.5}) {
     for (double aside = params_.wait_aside_m; aside > least - 0.01; aside -= 0.5) {
       const Vec2 at = place(back, aside);
-      clear = world_->on_mesh(at, 0.05);
+      bool clear = world_->on_mesh(at, 0.05);
       for (const WallExtent& w : walls_) clear = clear && !blocks(w, mouth, at);
       for (const MovingObstacle& m : world_->config().moving)
         clear = clear && NavWorld::distance_to_box(at, m.footprint) > avoid_radius_;
-      if (clear) return at;
+      if (clear) return {at, true};
     }
   }
-  clear = false;
-  return world_->nearest_on_mesh(first, 2.0 * (params_.wait_back_m + params_.wait_aside_m))
-      .value_or(first);
+  return {world_->nearest_on_mesh(first, 2.0 * (params_.wait_back_m + params_.wait_aside_m))
+              .value_or(first),
+          false};
 }
 
 int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
@@ -560,9 +556,10 @@ int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
   // A side with no clear place (its place snapped to the mesh's edge, as
   // where the passage lies near the scene's edge: there its crowd would
   // stand round the mouth) gives way to one with a clear place.
-  const auto& clear = place_clear_[static_cast<std::size_t>(index)];
+  const auto& places = places_[static_cast<std::size_t>(index)];
   const auto clearer = [&](int side) {
-    return !clear[place_slot(dir, side)] && clear[place_slot(dir, -side)] ? -side : side;
+    return !places[place_slot(dir, side)].clear && places[place_slot(dir, -side)].clear ? -side
+                                                                                      : side;
   };
   if (other < 0) return clearer(1);  // decided once the other way is there
   const Vec2 goal = target[static_cast<std::size_t>(other)];

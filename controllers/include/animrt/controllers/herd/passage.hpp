@@ -116,15 +116,18 @@ class PassageRules {
   // or -1 (left): found once for each passage, way and side
   // (find_wait_place), in places_.
   Vec2 wait_place(int index, int dir, int side) const;
-  // `clear`: whether the place found is clear (else it is the first
-  // place, snapped to the mesh where the mesh is within reach).
-  Vec2 find_wait_place(const Passage& p, int dir, int side, bool& clear) const;
+  // A waiting place, and whether it is clear (else it is the first place
+  // tried, snapped to the mesh where the mesh is within reach).
+  struct WaitPlace {
+    Vec2 at;
+    bool clear = true;
+  };
+  WaitPlace find_wait_place(const Passage& p, int dir, int side) const;
   int choose_side(int index, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
 
   std::vector<Passage> passages_;
   std::vector<WallExtent> walls_;
-  std::vector<std::array<Vec2, 4>> places_;  // per passage (place_slot in passage.cpp)
-  std::vector<std::array<bool, 4>> place_clear_;
+  std::vector<std::array<WaitPlace, 4>> places_;  // per passage (place_slot in passage.cpp)
   double avoid_radius_;
   PassageParams params_;
   const NavWorld* world_ = nullptr;
