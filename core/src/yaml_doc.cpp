@@ -124,7 +124,20 @@ YamlNode YamlNode::child(const YAML::Node& node, std::string path) const {
 std::string YamlNode::describe() const {
   if (!node_ || node_.IsNull()) return "nothing";
   if (node_.IsMap()) return "a map";
-  if (node_.IsSequence()) return "a list";
+  if (node_.IsSequence()) {
+    // A short list of plain values is shown, so that a wrong order or
+    // count can be seen in the message ("found [7, -4, -12, 4]").
+    constexpr std::size_t kShownItems = 8, kShownChars = 80;
+    const std::size_t n = node_.size();
+    const std::string counted = "a list of " + std::to_string(n) + (n == 1 ? " item" : " items");
+    if (n > kShownItems) return counted;
+    std::string text = "[";
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!node_[i].IsScalar()) return "a list";
+      text += (i > 0 ? ", " : "") + node_[i].Scalar();
+    }
+    return text.size() < kShownChars ? text + "]" : counted;
+  }
   return quote(node_.Scalar());
 }
 

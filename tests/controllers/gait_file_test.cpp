@@ -107,9 +107,9 @@ TEST(GaitFile, WrongTypes) {
   EXPECT_EQ(gait_file_error(with_line(2, "stride_frequency_hz: fast")),
             "g.yaml:2:22: stride_frequency_hz: expected a number, found \"fast\"");
   EXPECT_EQ(gait_file_error(with_lines(3, 5, "curves: [1, 2]")),
-            "g.yaml:3:9: curves: expected a map, found a list");
+            "g.yaml:3:9: curves: expected a map, found [1, 2]");
   EXPECT_EQ(gait_file_error(with_line(4, "  hip: [t]")),
-            "g.yaml:4:8: curves.hip: expected a string, found a list");
+            "g.yaml:4:8: curves.hip: expected a string, found [t]");
   EXPECT_EQ(gait_file_error(with_line(7, "  a: early")),
             "g.yaml:7:6: limbs.a: expected a number, found \"early\"");
   EXPECT_EQ(gait_file_error(with_line(11, "  j2: {curve: knee, limb: b, scale: big}")),

@@ -76,6 +76,23 @@ TEST(YamlNode, WrongTypeNamesWhatWasFound) {
   EXPECT_EQ(msg, "t.yaml:2:9: outer.rate: expected a number, found \"fast\"");
 }
 
+// A short list of plain values is shown as written, so that a swapped
+// pair or a missing item can be seen; lists of maps and long lists are
+// named, not printed.
+TEST(YamlNode, AListFoundWhereAValueBelongsIsShownWhenShort) {
+  const auto found = [](const std::string& text) {
+    return error_of(text, [](const YamlNode& n) { (void)n.at("v").as_string(); });
+  };
+  EXPECT_EQ(found("v: [7, -4, -12, 4]\n"),
+            "t.yaml:1:4: v: expected a string, found [7, -4, -12, 4]");
+  EXPECT_EQ(found("v: []\n"), "t.yaml:1:4: v: expected a string, found []");
+  EXPECT_EQ(found("v: [{a: 1}]\n"), "t.yaml:1:4: v: expected a string, found a list");
+  EXPECT_EQ(found("v: [1, 2, 3, 4, 5, 6, 7, 8, 9]\n"),
+            "t.yaml:1:4: v: expected a string, found a list of 9 items");
+  EXPECT_EQ(found("v: [" + std::string(90, 'x') + "]\n"),
+            "t.yaml:1:4: v: expected a string, found a list of 1 item");
+}
+
 TEST(YamlNode, MissingKeyNamesTheFullPath) {
   auto msg = error_of("outer:\n  x: 1\n", [](const YamlNode& n) { (void)n.at("outer").at("y"); });
   EXPECT_EQ(msg, "t.yaml:2:3: outer.y: required key is missing");

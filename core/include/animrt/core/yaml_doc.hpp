@@ -76,8 +76,9 @@ class YamlNode {
 
   // Throws InputError at this node.
   [[noreturn]] void fail(const std::string& message) const;
-  // What the node holds, for messages: "nothing", "a map", "a list" or the
-  // quoted scalar.
+  // What the node holds, for messages: "nothing", "a map", a short list of
+  // plain values as written ("[1, 2]"), "a list" (of maps or lists),
+  // "a list of N items" (a long one) or the quoted scalar.
   std::string describe() const;
 
  private:
