@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "animrt/core/input_file.hpp"
 #include "file_bytes.hpp"
 
 namespace animrt::seqnet {
@@ -201,7 +202,9 @@ std::vector<std::uint8_t> model_file_bytes(const ModelFile& m) {
 void write_model_file(const std::string& file, const ModelFile& model) {
   const std::vector<std::uint8_t> bytes = model_file_bytes(model);
   // Written beside and renamed, so that an interrupted save (a checkpoint
-  // during training) never leaves a half file under the name.
+  // during training) never leaves a half file under the name; the rename
+  // must not replace a device or a folder given as the file.
+  check_replaceable_file(file);
   const std::string partial = file + ".partial";
   {
     std::ofstream out(partial, std::ios::binary | std::ios::trunc);

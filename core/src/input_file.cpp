@@ -57,6 +57,13 @@ std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes
   return problem_of(st, max_bytes);
 }
 
+void check_replaceable_file(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return;  // nothing there (or the write will say why)
+  if (S_ISLNK(st.st_mode)) return;              // the rename replaces the link, not its target
+  if (std::string kind = kind_of(st.st_mode); !kind.empty()) fail(path, kind);
+}
+
 void check_input_file(const std::string& path, std::uintmax_t max_bytes) {
   if (std::string problem = input_file_problem(path, max_bytes); !problem.empty())
     fail(path, problem == kMissing ? errno_problem(ENOENT) : problem);

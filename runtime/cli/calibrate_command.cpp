@@ -20,6 +20,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/runtime/yaml_value_editor.hpp"
+#include "finite_range.hpp"
 #include "limp_figure.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
@@ -471,7 +472,7 @@ void add_calibrate_command(CLI::App& app) {
                 "it rests at the end, its direction stays as the file gives it");
   cmd->add_option("--seconds-per-joint", args.seconds_per_joint,
                   "time per joint in non-interactive mode")
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(FiniteRange(0.1, 3600.0));
   cmd->add_flag_callback(
       "--jog", [] { args.jog = 1; },
       "check each joint's direction by a small jog under a weak torque "
@@ -480,16 +481,16 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_flag_callback(
       "--no-jog", [] { args.jog = 0; }, "no direction jog, and no question");
   cmd->add_option("--jog-deg", args.jog_deg, "how far the jog goes (default 5)")
-      ->check(CLI::Range(0.5, 30.0));
+      ->check(FiniteRange(0.5, 30.0));
   cmd->add_option("--jog-percent", args.jog_percent,
                   "the jog's torque: this share of the servo's current limit (default 10)")
-      ->check(CLI::Range(1.0, 50.0));
+      ->check(FiniteRange(1.0, 50.0));
   cmd->add_flag("--yes", args.yes,
                 "agree beforehand to the moves calibrate would ask about: the homing search of "
                 "a CiA 402 drive on its switches (a joint with homing method 17-30)");
   cmd->add_option("--min-range-deg", args.min_range_deg,
                   "refuse a joint moved through less than this (default 2)")
-      ->check(CLI::Range(0.0, 360.0));
+      ->check(FiniteRange(0.0, 360.0));
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {
     try {

@@ -23,6 +23,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "evolve_pareto.hpp"
+#include "finite_range.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "walk_as_robot.hpp"
@@ -291,7 +292,7 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
   cmd->add_option("--dashboard-rate", args->dashboard_rate, "dashboard stream rate in Hz")
-      ->check(CLI::Range(0.5, 200.0));
+      ->check(FiniteRange(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--keep-serving", args->keep_serving,

@@ -14,6 +14,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "finite_range.hpp"
 #include "gait_command.hpp"
 #include "subcommand.hpp"
 #include "walk_as_robot.hpp"
@@ -131,9 +132,9 @@ void add_gait_measure_command(CLI::App& gait) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--perturb-deg", args->perturb_deg,
                   "each joint starts off its standing angle by up to this much")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(FiniteRange(0.0, 10.0));
   cmd->add_option("--settle", args->settle_s, "seconds standing before the walk")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(FiniteRange(0.0, 10.0));
   cmd->add_option("--warmup-cycles", args->warmup_cycles, "stride cycles walked, not measured")
       ->check(CLI::Range(0, 100));
   cmd->add_option("--measure-cycles", args->measure_cycles, "stride cycles measured")
@@ -141,11 +142,11 @@ void add_gait_measure_command(CLI::App& gait) {
   cmd->add_option("--balance-delay-ms", args->balance_delay_ms,
                   "the balance reflex reads the trunk's attitude this late (a robustness "
                   "measure; the fitness reads it at once)")
-      ->check(CLI::Range(0.0, 200.0));
+      ->check(FiniteRange(0.0, 200.0));
   cmd->add_option("--balance-period-ms", args->balance_period_ms,
                   "the balance reflex reads the trunk's attitude once every this long, as from "
                   "an IMU reporting at that rate (a measure; the fitness reads it every step)")
-      ->check(CLI::Range(0.0, 200.0));
+      ->check(FiniteRange(0.0, 200.0));
   cmd->add_option("--robot", args->robot,
                   "play the targets through this robot file's joint velocity, acceleration and "
                   "position limits at its loop rate, as `animrt run` does (its joints named as "

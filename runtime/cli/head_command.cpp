@@ -17,6 +17,7 @@
 #include "animrt/learn/head/evaluation.hpp"
 #include "animrt/learn/head/trainer.hpp"
 #include "animrt/learn/head_corpus/generator.hpp"
+#include "finite_range.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -150,11 +151,11 @@ void add_train_options(CLI::App* c, HeadArgs& a) {
   c->add_option("--iterations", a.iterations, "Baum-Welch iterations at most")
       ->check(CLI::Range(0, 200));
   c->add_option("--train-fraction", a.train_fraction, "share of the corpus for training")
-      ->check(CLI::Range(0.05, 1.0));
+      ->check(FiniteRange(0.05, 1.0));
   c->add_option("--shrink", a.shrink,
                 "output poses toward the mean pose: factor in [0, 1] (1: the paper), "
                 "negative: chosen on the training data")
-      ->check(CLI::Range(-1.0, 1.0));
+      ->check(FiniteRange(-1.0, 1.0));
   c->add_option("--seed", a.seed, "split seed");
   c->add_flag("--quiet", a.quiet, "no progress lines");
 }
@@ -192,7 +193,7 @@ void add_head_command(CLI::App& app) {
   s->add_option("IN", a->in, "audio file")->required();
   s->add_option("--out", a->out, "poses CSV (time_s, yaw_deg, pitch_deg, roll_deg)")->required();
   s->add_option("--noise-deg", a->noise_deg, "override the model's noise amplitude")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(FiniteRange(0.0, 10.0));
   set_subcommand_body(s, [a] { return run_synth(*a); });
 
   auto* e = head->add_subcommand("eval",

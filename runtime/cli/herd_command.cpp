@@ -21,6 +21,7 @@
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
+#include "finite_range.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -227,7 +228,7 @@ void add_herd_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("herd", "Run a herd of walking figures offline (flocks, crowds)");
   cmd->add_option("SCENE", args->scene, "scene file (YAML, docs/herd.md)")->required();
   cmd->add_option("--duration", args->duration, "seconds to simulate (default: the scene's)")
-      ->check(CLI::Range(0.001, 1e6));
+      ->check(FiniteRange(0.001, 1e6));
   cmd->add_option("--seed", args->seed, "random seed (overrides the scene's)");
   cmd->add_option("--out", args->out, "CSV of every agent at every output step");
   cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
@@ -240,10 +241,10 @@ void add_herd_command(CLI::App& app) {
                 "allow a --dashboard host that is not loopback");
   cmd->add_option("--dashboard-speed", args->dashboard_speed,
                   "with --dashboard: the pace, in multiples of real time")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(FiniteRange(0.01, 1000.0));
   cmd->add_option("--dashboard-rate", args->dashboard_rate,
                   "with --dashboard: states streamed per second")
-      ->check(CLI::Range(0.5, 200.0));
+      ->check(FiniteRange(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->dashboard_www, "folder of the dashboard's page");
   set_subcommand_body(cmd, [args] { return run_herd(*args); });
 }

@@ -35,6 +35,7 @@
 #include "data_dir.hpp"
 #include "doctor_command.hpp"
 #include "fault_injection.hpp"
+#include "finite_range.hpp"
 #include "record_command.hpp"
 #include "run_herd.hpp"
 #include "scan_command.hpp"
@@ -274,7 +275,7 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
   run->add_flag("--dashboard-remote", run_args.dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
   run->add_option("--dashboard-rate", run_args.dashboard_rate, "dashboard stream rate in Hz")
-      ->check(CLI::Range(0.5, 200.0));
+      ->check(animrt::cli::FiniteRange(0.5, 200.0));
   run->add_option("--dashboard-www", run_args.dashboard_www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
 

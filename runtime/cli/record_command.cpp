@@ -16,6 +16,7 @@
 #include "animrt/controllers/show/show_file.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
+#include "finite_range.hpp"
 #include "limp_figure.hpp"
 #include "sound_track_recorder.hpp"
 #include "stop_signals.hpp"
@@ -341,9 +342,9 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--tolerance-deg", args.tolerance_deg,
                   "how far the keys may stray from what was recorded (deg; prismatic joints: "
                   "this many mm)")
-      ->check(CLI::Range(0.0, 45.0));
+      ->check(FiniteRange(0.0, 45.0));
   cmd->add_option("--duration", args.duration_s, "seconds to record (0: until Ctrl-C)")
-      ->check(CLI::Range(0.0, 24.0 * 3600.0));
+      ->check(FiniteRange(0.0, 24.0 * 3600.0));
   cmd->add_option("--joint", args.joints, "record only this joint (repeatable)");
   cmd->add_flag("--audio", args.audio,
                 "record the microphone beside the motion as the show's sound track (SHOW.wav)");
@@ -362,7 +363,7 @@ void add_record_command(CLI::App& app) {
          "PERCENT: hold the figure by a weak torque, this share of each servo's current "
          "limit (Dynamixel current-based position mode; Feetech STS: its Torque Limit), so "
          "it does not sag while it is moved; the others stay limp (default 0: all limp)")
-      ->check(CLI::Range(0.0, 50.0));
+      ->check(FiniteRange(0.0, 50.0));
   args.ports.add_option(cmd);
   set_subcommand_body(cmd, [] {
     try {

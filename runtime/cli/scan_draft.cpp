@@ -11,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt::cli {
 namespace {
 
@@ -18,6 +20,7 @@ namespace fs = std::filesystem;
 using commission::FoundDevice;
 
 void write_file(const fs::path& path, const std::string& text) {
+  check_replaceable_file(path.string());  // renamed over: never over a device
   const fs::path tmp = path.string() + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

@@ -10,6 +10,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
 #include "data_dir.hpp"
+#include "finite_range.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -80,7 +81,7 @@ void add_seq_corpus_command(CLI::App& seq) {
   c->add_option("--gait", a->gaits, "gait file (repeatable; default: the model's gaits)");
   c->add_option("--froude", a->froude, "Froude numbers (default: around the gaits' own)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   c->add_option("--turn", a->turns,
                 "turn rates (rad/s) given to the gait through steer(); a gait that cannot be "
                 "steered walks straight, the index records what it achieved")
@@ -97,7 +98,7 @@ void add_seq_corpus_command(CLI::App& seq) {
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   c->add_option("--fps", a->fps, "frame rate (a whole number of physics steps per frame)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositiveNumber)
       ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress lines");
   set_subcommand_body(c, [a] { return run_seq_corpus(*a); });

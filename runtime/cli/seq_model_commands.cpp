@@ -20,6 +20,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/evaluation.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
+#include "finite_range.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -291,7 +292,7 @@ void add_seq_model_commands(CLI::App& seq) {
       ->add_option("--threshold", c->options.threshold,
                    "largest difference to merge at: RMS over the features, as a fraction of "
                    "each one's training range")
-      ->check(CLI::Range(1e-12, 10.0));
+      ->check(FiniteRange(1e-12, 10.0));
   complete->add_option("--retries", c->options.retries, "runs with random initial states")
       ->check(CLI::Range(0, 100000));
   complete->add_option("--seed", c->options.seed, "seed of the random initial states");
@@ -309,7 +310,7 @@ void add_seq_model_commands(CLI::App& seq) {
   evaluate->add_option("FEATURES", ev->data, "the feature file it was trained on")->required();
   auto* fraction =
       evaluate->add_option("--held-out", ev->options.held_out, "the trainer's held-out fraction")
-          ->check(CLI::Range(0.0, 1.0));
+          ->check(FiniteRange(0.0, 1.0));
   evaluate
       ->add_option("--held-out-clip", ev->options.held_out_clips,
                    "the clip the model was trained with held out whole (seq train "
@@ -319,7 +320,7 @@ void add_seq_model_commands(CLI::App& seq) {
       ->check(CLI::Range(1, 100000));
   evaluate
       ->add_option("--threshold", ev->options.completion.threshold, "completion: merge threshold")
-      ->check(CLI::Range(1e-12, 10.0));
+      ->check(FiniteRange(1e-12, 10.0));
   evaluate->add_option("--retries", ev->options.completion.retries, "completion: random retries")
       ->check(CLI::Range(0, 100000));
   evaluate

@@ -11,6 +11,7 @@
 #include "animrt/runtime/telemetry_replay.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "data_dir.hpp"
+#include "finite_range.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -101,7 +102,7 @@ void add_view_command(CLI::App& app) {
   cmd->add_flag("--dashboard-remote", args->remote,
                 "let the dashboard listen on an address other machines can reach");
   cmd->add_option("--dashboard-rate", args->rate, "stream rate in Hz")
-      ->check(CLI::Range(0.5, 200.0));
+      ->check(FiniteRange(0.5, 200.0));
   cmd->add_option("--dashboard-www", args->www, "folder of the dashboard's page")
       ->check(CLI::ExistingDirectory);
   set_subcommand_body(cmd, [args] { return run_view(*args); });

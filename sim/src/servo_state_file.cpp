@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "animrt/core/error.hpp"
+#include "animrt/core/input_file.hpp"
 
 namespace animrt::sim {
 namespace {
@@ -38,10 +39,11 @@ bool parse_hex(const std::string& text, std::vector<std::uint8_t>& out) {
 }  // namespace
 
 ServoStateFile::ServoStateFile(std::string path) : path_(std::move(path)) {
-  std::ifstream in(path_);  // none yet: an empty state
-  if (!in && std::filesystem::exists(path_)) {
-    throw DeviceError("servo state " + path_ + ": cannot read it");
-  }
+  // None yet: an empty state. Anything but a regular file is refused before
+  // it is read or replaced: the state is saved by renaming a new file over
+  // the path, which would replace a device such as /dev/zero with a file.
+  std::istringstream in;
+  if (input_file_problem(path_) != kFileMissing) in.str(read_input_file(path_));
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
@@ -58,7 +60,6 @@ ServoStateFile::ServoStateFile(std::string path) : path_(std::move(path)) {
     entry.family = family;
     entries_[{bus, static_cast<std::size_t>(index)}] = std::move(entry);
   }
-  in.close();
   write_locked();
 }
 

@@ -60,6 +60,21 @@ for bad in -1 nan inf 1e400 soon; do
   [[ $(echo "$out" | head -1) == "--duration: expected seconds from 0 (until Ctrl-C) to 31536000, found \"$bad\"" ]] ||
     fail "--duration $bad: unexpected message: $out"
 done
+# Every bounded number refuses NaN, which compares as neither below nor above
+# a bound (a serve with --duration nan ran until stopped).
+for args in "serve $root/configs/robots/animatronic.yaml --cues $root/configs/cues/animatronic.yaml --duration" \
+            "run $root/configs/robots/quadruped.yaml --dashboard-rate" \
+            "herd $root/configs/herd/flock.yaml --duration" \
+            "head synth $root/configs/head/model.txt $root/configs/head/utterance.wav --noise-deg"; do
+  for bad in nan -nan NaN; do
+    # shellcheck disable=SC2086  # the words of $args are the arguments
+    out=$(timeout 20 "$animrt" $args "$bad" 2>&1)
+    code=$?
+    option=${args##* }
+    [[ $code -eq 1 && $(echo "$out" | head -1) == "$option: Value $bad is not a number" ]] ||
+      fail "${args%% *} $option $bad: exit $code: $out"
+  done
+done
 # Any other parse error is a usage error too (CLI11's own codes are 100 and up).
 out=$("$animrt" run 2>&1)
 code=$?

@@ -59,6 +59,28 @@ TEST_F(InputFileTest, DirectoryFifoDeviceAndMissingFileEachHaveTheirMessage) {
   EXPECT_EQ(input_file_problem(path("none")), kFileMissing);
 }
 
+// An output saved by renaming a new file over its path may replace a
+// regular file, a link or nothing; never a FIFO, a device or a folder.
+TEST_F(InputFileTest, OnlyARegularFileALinkOrNothingMayBeReplacedByAnOutput) {
+  const auto refusal = [](const std::string& file) -> std::string {
+    try {
+      check_replaceable_file(file);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  std::ofstream(path("old.csv")) << "x\n";
+  ASSERT_EQ(::mkfifo(path("pipe").c_str(), 0600), 0);
+  fs::create_symlink(path("pipe"), path("link"));
+  EXPECT_EQ(refusal(path("old.csv")), "");
+  EXPECT_EQ(refusal(path("none.csv")), "");
+  EXPECT_EQ(refusal(path("link")), "");
+  EXPECT_EQ(refusal(path("pipe")), path("pipe") + ": is not a regular file (FIFO)");
+  EXPECT_EQ(refusal("/dev/null"), "/dev/null: is not a regular file (character device)");
+  EXPECT_EQ(refusal(dir_.string()), dir_.string() + ": is a directory");
+}
+
 TEST_F(InputFileTest, FileOverTheLimitIsRefusedBeforeReading) {
   std::ofstream(path("big.txt"), std::ios::binary) << std::string(3u << 20, 'y');
   EXPECT_EQ(error_of(path("big.txt"), std::uintmax_t{2} << 20),

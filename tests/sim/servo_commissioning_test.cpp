@@ -5,11 +5,13 @@
 // its lock is open.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "animrt/sim/dynamixel_sim_bus.hpp"
@@ -158,6 +160,31 @@ TEST(ServoCommissioning, StateFileWithABadLineNamesFileAndLine) {
     EXPECT_EQ(e.where().line, 3);
   }
   std::filesystem::remove(path);
+}
+
+// The state is saved by renaming a new file over its path: a path that is
+// not a regular file is refused at start, and left as it was (a device given
+// as the state, /dev/zero, was once replaced with a file).
+TEST(ServoCommissioning, AStatePathThatIsNotARegularFileIsRefusedAndLeftAlone) {
+  const std::string fifo = temp_path("fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string folder = temp_path("folder");
+  std::filesystem::create_directory(folder);
+  for (const auto& [path, problem] : {std::pair{fifo, std::string("is not a regular file (FIFO)")},
+                                      std::pair{folder, std::string("is a directory")}}) {
+    try {
+      sim::ServoStateFile state(path);
+      ADD_FAILURE() << "accepted " << path;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().file, path);
+      EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(path + ".tmp")) << path;
+  }
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_TRUE(std::filesystem::is_directory(folder));
+  std::filesystem::remove(fifo);
+  std::filesystem::remove(folder);
 }
 
 TEST(ServoCommissioning, FeetechEepromIsKeptOnlyWhileUnlocked) {

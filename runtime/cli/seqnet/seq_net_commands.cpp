@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "../finite_range.hpp"
 #include "../subcommand.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/training.hpp"
@@ -54,7 +55,7 @@ void add_seq_net_commands(CLI::App& app) {
   train->add_option("--stride", train_args->stride, "2: every other frame, for slow motion")
       ->check(CLI::Range(1, 16));
   train->add_option("--learning-rate", train_args->learning_rate, "Adam step size")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveNumber);
   train->add_option("--checkpoint-every", train_args->checkpoint_every, "iterations")
       ->check(CLI::Range(1, 100000000));
   train->add_option("--report-every", train_args->report_every, "iterations per progress line")
@@ -62,7 +63,7 @@ void add_seq_net_commands(CLI::App& app) {
   train
       ->add_option("--held-out-every", train_args->held_out_every,
                    "iterations between held-out completion lines (0: only at the end)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeNumber);
   train->add_option("--held-out-clip", train_args->held_out_clips,
                     "hold out this clip whole (feature file clip, or joint CSV) instead of a "
                     "block of every file; repeatable");
@@ -79,18 +80,18 @@ void add_seq_net_commands(CLI::App& app) {
   train->add_option("--dense-width", train_args->dense_width, "joint models: hidden layer width")
       ->check(CLI::Range(1, 4096));
   train->add_option("--kl-weight", train_args->kl_weight, "0 turns L_KL off (ablation)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(FiniteRange(0.0, 100.0));
   train->add_option("--l2-weight", train_args->l2_weight, "0 turns the L2 term off (ablation)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(FiniteRange(0.0, 100.0));
   train
       ->add_option("--placement-weight", train_args->placement_weight,
                    "weight of the placement numbers (where the body goes) in the loss, "
                    "against 1 for each deformation feature")
-      ->check(CLI::Range(1e-3, 1e4));
+      ->check(FiniteRange(1e-3, 1e4));
   train
       ->add_option("--clip-gradient", train_args->clip_gradient,
                    "scale all gradients together down to this L2 norm when longer (0: never)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(FiniteRange(0.0, 1e9));
   train->add_flag("!--unidirectional", train_args->bidirectional,
                   "forward chain only, no L_bidir (ablation)");
   set_subcommand_body(train, [train_args] { return run_train(*train_args); });

@@ -33,6 +33,12 @@ inline constexpr std::uintmax_t kMaxInflatedBytes = std::uintmax_t{64} << 20;  /
 std::string input_file_problem(const std::string& path,
                                std::uintmax_t max_bytes = kMaxInputFileBytes);
 
+// Throws InputError "PATH: PROBLEM" when something other than a regular
+// file is at `path` (a device, a FIFO, a folder): a file written beside it
+// and renamed over it, as outputs are saved, would replace it (as root, a
+// /dev/zero given as an output became a file). Nothing there is fine.
+void check_replaceable_file(const std::string& path);
+
 // Throws InputError "PATH: PROBLEM" when input_file_problem finds one.
 void check_input_file(const std::string& path, std::uintmax_t max_bytes = kMaxInputFileBytes);
 
