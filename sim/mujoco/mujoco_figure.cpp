@@ -62,6 +62,7 @@ MujocoFigure::MujocoFigure(const std::string& model_path,
     throw InputError(where, "model", model_path + " is not a valid MJCF model: " + message);
   }
   const mjModel* m = model_.get();
+  check_mujoco_timestep(*m, model_path);
   data_ = MujocoData(mj_makeData(m), mj_deleteData);
 
   for (const std::string& name : joint_names) {

@@ -2,8 +2,11 @@
 
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <string>
 
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
@@ -15,6 +18,28 @@ int MujocoModel::actuator_of(const std::string& joint) const {
     if (actuated_joints[i] == joint) return static_cast<int>(i);
   }
   return -1;
+}
+
+void check_mujoco_timestep(const mjModel& model, const std::string& path) {
+  // From 10 us (a run steps physics up to each cycle's time: a step much
+  // finer than that takes the run's time by itself) to 0.1 s.
+  constexpr double kMinStepS = 1e-5, kMaxStepS = 0.1;
+  const double step = model.opt.timestep;
+  if (step >= kMinStepS && step <= kMaxStepS) return;
+  // The line of the attribute, where the file has one.
+  int line = 0;
+  std::ifstream in(path);
+  std::string text;
+  for (int n = 1; std::getline(in, text); ++n) {
+    if (text.find("timestep") != std::string::npos) {
+      line = n;
+      break;
+    }
+  }
+  char found[32];
+  std::snprintf(found, sizeof found, "%g", step);
+  throw InputError({path, line, 0}, "option.timestep",
+                   std::string("expected a time step from 1e-05 to 0.1 s, found ") + found);
 }
 
 MujocoModel load_mujoco_model(const std::string& path) {
@@ -38,6 +63,7 @@ MujocoModel load_mujoco_model(const std::string& path) {
       raw, [](const mjModel* m) { mj_deleteModel(const_cast<mjModel*>(m)); });
   out.file = path;
   const mjModel* m = raw;
+  check_mujoco_timestep(*m, path);
   out.torso_body = mj_name2id(m, mjOBJ_BODY, "torso");
   if (out.torso_body < 0)
     throw InputError({path, 0, 0}, "torso", "the model needs a body named torso");

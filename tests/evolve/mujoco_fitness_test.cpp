@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +17,9 @@
 #include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/learn/evolve/phenotype.hpp"
 #include "animrt/learn/evolve/random.hpp"
+#include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "animrt/sim/mujoco/mujoco_model.hpp"
 #include "support/files.hpp"
 
 namespace animrt::evolve {
@@ -357,6 +360,35 @@ TEST(MujocoModel, BadModelsAreRefusedWithTheFileNamed) {
       << "<mujoco><worldbody><geom type=\"plane\" size=\"1 1 1\"/></worldbody></mujoco>";
   EXPECT_THROW(sim::load_mujoco_model(bad), InputError);
   EXPECT_THROW(sim::load_mujoco_model("/nonexistent/model.xml"), InputError);
+}
+
+// MuJoCo loads a model whose time step is 0 (or NaN, or tiny): a run that
+// steps physics up to each cycle's time then never got there, and a gait's
+// speed came out NaN. Both loaders refuse it at the attribute's line.
+TEST(MujocoModel, ATimeStepOutsideTenMicrosecondsToATenthIsRefusedAtItsLine) {
+  const std::string shipped = read_file(kConfigsDir + "/models/quadruped.xml");
+  const std::size_t at = shipped.find("timestep=\"0.002\"");
+  ASSERT_NE(at, std::string::npos);
+  const int line = 1 + static_cast<int>(std::count(shipped.begin(), shipped.begin() + at, '\n'));
+  const std::string file = ::testing::TempDir() + "/animrt_step_model.xml";
+  for (const char* step : {"0", "-0.002", "1e-9", "nan", "0.5"}) {
+    std::string text = shipped;
+    text.replace(at, 17, std::string("timestep=\"") + step + "\"");
+    write_file(file, text);
+    try {
+      sim::load_mujoco_model(file);
+      ADD_FAILURE() << "loaded timestep " << step;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().file, file) << step;
+      EXPECT_EQ(e.where().line, line) << step;
+      EXPECT_EQ(e.key(), "option.timestep") << step;
+    }
+    EXPECT_THROW(sim::MujocoFigure(file, {"lf_hip"}, Location{}), InputError) << step;
+  }
+  std::string text = shipped;
+  text.replace(at, 17, "timestep=\"0.001\"");
+  write_file(file, text);
+  EXPECT_NO_THROW(sim::load_mujoco_model(file));
 }
 
 }  // namespace

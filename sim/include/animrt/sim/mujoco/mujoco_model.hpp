@@ -31,6 +31,11 @@ struct MujocoModel {
 // missing or invalid model, or one that breaks the conventions above.
 MujocoModel load_mujoco_model(const std::string& path);
 
+// Throws InputError at the file's timestep attribute (option.timestep) when
+// the loaded model's step is outside 10 us to 0.1 s: MuJoCo accepts
+// timestep="0", and a run stepping physics up to a time never got there.
+void check_mujoco_timestep(const mjModel& model, const std::string& path);
+
 // A data block for `model`, freed with mj_deleteData.
 using MujocoData = std::unique_ptr<mjData, void (*)(mjData*)>;
 MujocoData make_mujoco_data(const MujocoModel& model);
