@@ -215,6 +215,7 @@ TelemetryRecording load_telemetry_mcap(const std::string& path) {
 }
 
 TelemetryRecording load_telemetry(const std::string& path) {
+  check_input_file(path, kMaxMediaFileBytes);  // before the peek: a FIFO would block it
   char head[sizeof mcap::kMagic] = {};
   std::ifstream in(path, std::ios::binary);
   in.read(head, sizeof head);

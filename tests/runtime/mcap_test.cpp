@@ -3,6 +3,8 @@
 // viewer reads it.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <fstream>
@@ -243,6 +245,21 @@ TEST(McapReplay, RefusesAnMcapWithoutJointStates) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/joint_states"), std::string::npos) << e.what();
   }
+}
+
+// A recording is checked before its first bytes are peeked at for the MCAP
+// magic: a FIFO (nothing writing to it) would block the open.
+TEST(McapReplay, ARecordingThatIsAFifoIsRefusedWithoutWaiting) {
+  const std::string path = ::testing::TempDir() + "replay_fifo.csv";
+  ::unlink(path.c_str());
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  try {
+    (void)load_telemetry(path);
+    ADD_FAILURE() << "loaded a FIFO";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": is not a regular file (FIFO)");
+  }
+  ::unlink(path.c_str());
 }
 
 }  // namespace
