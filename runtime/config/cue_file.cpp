@@ -135,7 +135,13 @@ CueStep make_step(const YamlNode& node, const std::string& cue_path, const Robot
   if (auto pose = node.find("pose")) layers.push_back(make_pose(*pose, robot));
   step.source =
       layers.size() == 1 ? std::move(layers.front()) : make_layered_source(std::move(layers));
-  if (auto d = node.find("duration_s")) step.duration_s = d->as_positive_double();
+  if (auto d = node.find("duration_s")) {
+    // At most what a show may last (11 days: longer than any cue plays
+    // unattended); a longer one is a typo, as good as never ending.
+    constexpr double kMaxStepS = 1e6;
+    step.duration_s = d->as_positive_double();
+    if (step.duration_s > kMaxStepS) d->fail("expected at most 1000000 s, found " + d->describe());
+  }
   return step;
 }
 

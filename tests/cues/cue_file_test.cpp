@@ -139,5 +139,24 @@ TEST(CueFile, AStepThatNeverEndsBeforeOthersIsRefused) {
   EXPECT_NE(error.find("never ends"), std::string::npos) << error;
 }
 
+// A step's duration is bounded as a show's is (1e6 s): 1e300 was accepted.
+TEST(CueFile, AStepLongerThanAShowMayLastIsRefusedAtItsDuration) {
+  const std::string path = write_cues("long.yaml",
+                                      "idle: rest\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 0}}}\n"
+                                      "  wait:\n"
+                                      "    play:\n"
+                                      "      - {pose: {neck_pan: 30}, duration_s: 1e300}\n");
+  EXPECT_EQ(load_error(path), path +
+                                  ":7:44: cues.wait.play[0].duration_s: expected at most 1000000 "
+                                  "s, found \"1e300\"");
+  const std::string fine = write_cues("day.yaml",
+                                      "idle: rest\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 0}, duration_s: 1e6}}\n");
+  EXPECT_EQ(load_error(fine), "");
+}
+
 }  // namespace
 }  // namespace animrt
