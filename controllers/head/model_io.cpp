@@ -2,6 +2,7 @@
 // order, so a damaged file is reported at the line where it stops making
 // sense.
 
+#include <Eigen/Cholesky>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -70,6 +71,15 @@ std::string read_model_file(const std::string& path) {
   return read_input_file(path);
 }
 
+// Logarithms of probabilities are at most 0 (a little above, for rounding
+// in the written digits).
+constexpr double kLogOne = 1e-9;
+constexpr const char* kLogProbabilityMessage = "log-probabilities must be at most 0";
+template <typename Values>
+bool log_probabilities(const Values& values) {
+  return (values.array() <= kLogOne).all();
+}
+
 class Reader {
  public:
   explicit Reader(const std::string& path) : path_(path), in_(read_model_file(path)) {}
@@ -101,6 +111,17 @@ class Reader {
            quote(tokens_.empty() ? std::string() : tokens_[0]));
     }
     pos_ = 1;
+  }
+  // After the last line: nothing but blank lines and comments.
+  void end_of_file() {
+    std::string text;
+    while (std::getline(in_, text)) {
+      ++line_no_;
+      if (text.find_first_not_of(" \t\r") != std::string::npos && text[0] != '#') {
+        throw InputError(Location{path_, line_no_, 0}, "end",
+                         "unexpected line after \"end\": " + quote(elide(text)));
+      }
+    }
   }
   std::string word() {
     if (pos_ >= tokens_.size()) fail("line ends too early");
@@ -316,9 +337,13 @@ HeadModel load_model(const std::string& path) {
   r.check(seed >= 0 && seed < 0x1p64 && seed == std::floor(seed),
           "seed: expected a whole number from 0 to 2^64 - 1");
   m.smoothing.seed = static_cast<std::uint64_t>(seed);
-  r.check(
-      m.smoothing.key_rate_hz > 0 && m.smoothing.output_rate_hz > 0 && m.smoothing.noise_deg >= 0,
-      "rates must be positive and noise_deg >= 0");
+  // The bounds of the head's own settings (head.noise_deg, the CLI's
+  // --noise-deg); rates up to what a cycle can use.
+  r.check(m.smoothing.key_rate_hz > 0 && m.smoothing.key_rate_hz <= 1000 &&
+              m.smoothing.output_rate_hz > 0 && m.smoothing.output_rate_hz <= 10000,
+          "rates must be above 0 and at most 1000 (key_rate_hz) and 10000 (output_rate_hz)");
+  r.check(m.smoothing.noise_deg >= 0 && m.smoothing.noise_deg <= 10,
+          "noise_deg must be from 0 to 10");
   r.done();
   r.line("shrink");
   r.check(r.word() == "factor", "expected \"factor\"");
@@ -362,7 +387,10 @@ HeadModel load_model(const std::string& path) {
     m.codebook.means.row(k) = r.nums(dim).transpose();
     r.check(r.word() == "cov", "expected \"cov\"");
     const Eigen::VectorXd c = r.nums(dim * dim);
-    m.codebook.covariances.push_back(Eigen::Map<const Eigen::MatrixXd>(c.data(), dim, dim));
+    const Eigen::MatrixXd cov = Eigen::Map<const Eigen::MatrixXd>(c.data(), dim, dim);
+    r.check(cov.isApprox(cov.transpose()) && cov.llt().info() == Eigen::Success,
+            "cov must be a symmetric positive-definite matrix");
+    m.codebook.covariances.push_back(cov);
     r.done();
   }
   for (int k = 0; k < K; ++k) {
@@ -379,15 +407,18 @@ HeadModel load_model(const std::string& path) {
     r.done();
     r.line("pi");
     h.log_pi = r.nums(S);
+    r.check(log_probabilities(h.log_pi), kLogProbabilityMessage);
     r.done();
     h.log_a.resize(S, S);
     for (int s = 0; s < S; ++s) {
       r.line("a");
       h.log_a.row(s) = r.nums(S).transpose();
+      r.check(log_probabilities(h.log_a.row(s)), kLogProbabilityMessage);
       r.done();
     }
     r.line("exit");
     h.log_exit = r.nums(S);
+    r.check(log_probabilities(h.log_exit), kLogProbabilityMessage);
     r.done();
     for (int s = 0; s < S; ++s) {
       GaussianMixture g;
@@ -397,6 +428,7 @@ HeadModel load_model(const std::string& path) {
       for (int c = 0; c < M; ++c) {
         r.line("mix");
         g.log_weights(c) = r.num();
+        r.check(g.log_weights(c) <= kLogOne, kLogProbabilityMessage);
         r.check(r.word() == "mean", "expected \"mean\"");
         g.means.row(c) = r.nums(kFeatureDim).transpose();
         r.check(r.word() == "var", "expected \"var\"");
@@ -411,15 +443,18 @@ HeadModel load_model(const std::string& path) {
   r.line("bigram");
   r.check(r.word() == "initial", "expected \"initial\"");
   m.bigram.log_initial = r.nums(K);
+  r.check(log_probabilities(m.bigram.log_initial), kLogProbabilityMessage);
   r.done();
   m.bigram.log_next.resize(K, K);
   for (int k = 0; k < K; ++k) {
     r.line("next");
     m.bigram.log_next.row(k) = r.nums(K).transpose();
+    r.check(log_probabilities(m.bigram.log_next.row(k)), kLogProbabilityMessage);
     r.done();
   }
   r.line("end");
   r.done();
+  r.end_of_file();
   return m;
 }
 

@@ -4,10 +4,12 @@
 #include <sndfile.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "animrt/controllers/head/audio.hpp"
@@ -48,6 +50,48 @@ TEST(ModelFileHardening, NulByteInsideANumberNamesFileAndLine) {
   EXPECT_EQ(error_of([&] { load_model(path); }),
             path + ":2:" + std::to_string(at - line2 + 1) +
                 ": features: NUL byte in the line (a corrupted or binary file?)");
+  std::filesystem::remove_all(dir);
+}
+
+// Values a model file cannot mean, each refused at its line: a smoothing
+// noise of 1e300 degrees (the poses came out near 1e308), a covariance
+// that is not positive definite, a log-probability above 0, and a line
+// after "end".
+TEST(ModelFileHardening, ValuesNoTrainedModelHasAreRefusedAtTheirLine) {
+  const std::string dir = test::temp_dir("badmodel");
+  const std::string shipped = read_all(std::string(ANIMRT_SOURCE_DIR) + "/configs/head/model.txt");
+  const auto line_of = [&](const std::string& start) {
+    const auto at = shipped.find("\n" + start);
+    return 2 + std::count(shipped.begin(), shipped.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  };
+  struct Case {
+    std::string from, to, start, message;
+  };
+  const std::vector<Case> cases = {
+      {"noise_deg 0.5", "noise_deg 1e300", "smoothing",
+       "smoothing: noise_deg must be from 0 to 10"},
+      {"cov 1.3899222431725102", "cov -1000", "cluster 0",
+       "cluster: cov must be a symmetric positive-definite matrix"},
+      {"a -0.069775388071348823", "a 5", "a -0.069775388071348823",
+       "a: log-probabilities must be at most 0"},
+  };
+  const std::string path = dir + "/model.txt";
+  for (const Case& c : cases) {
+    std::string text = shipped;
+    const auto at = text.find(c.from);
+    ASSERT_NE(at, std::string::npos) << c.from;
+    text.replace(at, c.from.size(), c.to);
+    std::ofstream(path, std::ios::binary) << text;
+    EXPECT_EQ(error_of([&] { load_model(path); }),
+              path + ":" + std::to_string(line_of(c.start)) + ": " + c.message);
+  }
+  std::ofstream(path, std::ios::binary) << shipped << "next 0 0\n";
+  const long lines = std::count(shipped.begin(), shipped.end(), '\n');
+  EXPECT_EQ(error_of([&] { load_model(path); }),
+            path + ":" + std::to_string(lines + 1) +
+                ": end: unexpected line after \"end\": \"next 0 0\"");
+  std::ofstream(path, std::ios::binary) << shipped << "\n# a note\n";
+  EXPECT_EQ(error_of([&] { load_model(path); }), "no error");
   std::filesystem::remove_all(dir);
 }
 
