@@ -33,8 +33,10 @@ Location location_of(const std::string& file, const YAML::Mark& mark) {
 class NodeCounter : public YAML::EventHandler {
  public:
   explicit NodeCounter(const std::string& file) : file_(file) {}
+  // Where the last document it met began.
+  const YAML::Mark& document_start() const { return document_; }
 
-  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentStart(const YAML::Mark& mark) override { document_ = mark; }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
@@ -63,6 +65,7 @@ class NodeCounter : public YAML::EventHandler {
 
   const std::string& file_;
   std::size_t nodes_ = 0;
+  YAML::Mark document_;
 };
 
 // Reads a string in place, without the copy an istringstream makes.
@@ -98,6 +101,12 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& file_
     YAML::Parser parser(in);
     NodeCounter counter(file_name);
     parser.HandleNextDocument(counter);
+    // yaml-cpp's Load reads the first document and ignores the rest.
+    if (parser.HandleNextDocument(counter)) {
+      throw InputError(location_of(file_name, counter.document_start()), "",
+                       "a second YAML document: a configuration file holds one (remove the "
+                       "\"---\" and what follows, or merge it into the first)");
+    }
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(location_of(file_name, e.mark), "", "YAML syntax error: " + e.msg);

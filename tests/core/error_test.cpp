@@ -93,6 +93,16 @@ TEST(YamlNode, AListFoundWhereAValueBelongsIsShownWhenShort) {
             "t.yaml:1:4: v: expected a string, found a list of 1 item");
 }
 
+// yaml-cpp reads the first document of a file and ignores the rest: a
+// second one is refused where it begins, not silently dropped.
+TEST(YamlNode, ASecondDocumentIsRefusedWhereItBegins) {
+  const auto error = [](const std::string& text) { return error_of(text, [](const YamlNode&) {}); };
+  EXPECT_EQ(error("name: a\n---\nname: b\n"),
+            "t.yaml:2:1: a second YAML document: a configuration file holds one (remove the "
+            "\"---\" and what follows, or merge it into the first)");
+  EXPECT_EQ(error("---\nname: a\n...\n"), "no error");
+}
+
 TEST(YamlNode, MissingKeyNamesTheFullPath) {
   auto msg = error_of("outer:\n  x: 1\n", [](const YamlNode& n) { (void)n.at("outer").at("y"); });
   EXPECT_EQ(msg, "t.yaml:2:3: outer.y: required key is missing");
