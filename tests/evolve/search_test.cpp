@@ -308,6 +308,17 @@ TEST(RunConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 3}]}\n"),
             "run.yaml:5:39: fitness.weights[0].from_generation: the first stage must start at "
             "generation 0");
+  // A stage whose weights are all 0 ranks every gait the same; no stage at all
+  // is not the defaults either.
+  EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 0, distance: 0, "
+                            "duty_factor: 0, stride_length: 0, energy: 0}]}\n"),
+            "run.yaml:5:21: fitness.weights[0]: every weight is 0: the stage would rank every "
+            "gait the same");
+  EXPECT_EQ(error_of(head + "fitness: {weights: []}\n"),
+            "run.yaml:5:20: fitness.weights: expected at least one stage (leave weights out for "
+            "the defaults)");
+  EXPECT_EQ(error_of(head + "fitness: {weights: [{from_generation: 0, distance: 0}]}\n"),
+            "no error");
   EXPECT_EQ(error_of(head + "search: {mapping: tree}\n"),
             "run.yaml:5:19: search.mapping: expected standard or structured, got 'tree'");
   EXPECT_EQ(parse_run_config(head + "search: {mapping: structured}\n", "run.yaml").search.mapping,

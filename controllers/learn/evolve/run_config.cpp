@@ -97,8 +97,14 @@ RunConfig from_root(const YamlNode& root) {
         st.weights.duty_factor = get_in(item, "duty_factor", 1, 0, 1e6);
         st.weights.stride_length = get_in(item, "stride_length", 1, 0, 1e6);
         st.weights.energy = get_in(item, "energy", 1, 0, 1e6);
+        if (st.weights.distance == 0 && st.weights.duty_factor == 0 &&
+            st.weights.stride_length == 0 && st.weights.energy == 0) {
+          item.fail("every weight is 0: the stage would rank every gait the same");
+        }
         c.weights.push_back(st);
       }
+      if (c.weights.empty())
+        ws->fail("expected at least one stage (leave weights out for the defaults)");
     }
     if (auto fr = f->find("freedom")) {
       int previous = -1;
