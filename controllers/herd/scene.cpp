@@ -84,6 +84,16 @@ Box box(const YamlNode& node) {
   return b;
 }
 
+// Whether any of the box lies on the ground: one wholly outside it does
+// nothing there, and is a typo (a wall at x = 1000 in a 40 m scene).
+bool overlaps(const Rect& ground, const Box& b) {
+  const double c = std::abs(std::cos(b.yaw_rad)), s = std::abs(std::sin(b.yaw_rad));
+  const double hx = 0.5 * (c * b.size.x + s * b.size.y);
+  const double hy = 0.5 * (s * b.size.x + c * b.size.y);
+  return b.center.x + hx > ground.xmin && b.center.x - hx < ground.xmax &&
+         b.center.y + hy > ground.ymin && b.center.y - hy < ground.ymax;
+}
+
 bool inside(const Rect& outer, const Rect& inner) {
   return inner.xmin >= outer.xmin && inner.xmax <= outer.xmax && inner.ymin >= outer.ymin &&
          inner.ymax <= outer.ymax;
@@ -199,6 +209,9 @@ HerdScene parse_herd_scene(const YamlNode& root) {
     for (const YamlNode& w : walls->items()) {
       w.allow_only({"center_m", "size_m", "yaw_deg"});
       scene.walls.push_back(box(w));
+      if (!overlaps(scene.bounds_m, scene.walls.back())) {
+        w.at("center_m").fail("the wall lies wholly outside bounds_m");
+      }
       scene.wall_where.push_back(w.location());
     }
   }
@@ -208,6 +221,9 @@ HerdScene parse_herd_scene(const YamlNode& root) {
       MovingObstacle m;
       scene.obstacle_where.push_back(o.location());
       m.footprint = box(o);
+      if (!overlaps(scene.bounds_m, m.footprint)) {
+        o.at("center_m").fail("the obstacle lies wholly outside bounds_m");
+      }
       if (auto p = o.find("period_s")) m.period_s = p->as_double_in(0.1, 1e6);
       if (auto d = o.find("down_fraction")) m.down_fraction = d->as_double_in(0.0, 1.0);
       if (auto p = o.find("phase_s")) m.phase_s = p->as_double_in(0.0, 1e6);

@@ -107,6 +107,34 @@ TEST(HerdScene, SpawnOutsideTheBounds) {
   EXPECT_NE(e.find("inside bounds_m"), std::string::npos) << e;
 }
 
+// A wall or moving obstacle wholly off the ground does nothing: refused at
+// its centre; one that reaches onto the ground (a boundary wall) is kept.
+TEST(HerdScene, AWallWhollyOutsideTheBoundsIsRefused) {
+  const std::string group =
+      "  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: [-18, -8, -14, 8],\n"
+      "     target_m: [16, 0], speed_mps: [0.05, 0.1]}\n";
+  std::string e = error_of("walls:\n  - {center_m: [1000, 0], size_m: [1, 4]}\n" + kHead + group);
+  EXPECT_NE(e.find("scene.yaml:2:16: walls[0].center_m: the wall lies wholly outside bounds_m"),
+            std::string::npos)
+      << e;
+  e = error_of("moving_obstacles:\n  - {center_m: [0, -30], size_m: [2, 2]}\n" + kHead + group);
+  EXPECT_NE(e.find("moving_obstacles[0].center_m: the obstacle lies wholly outside bounds_m"),
+            std::string::npos)
+      << e;
+  // Half on the ground; and turned 90 degrees so that its length reaches in.
+  EXPECT_EQ(error_of("walls:\n  - {center_m: [20, 0], size_m: [2, 4]}\n"
+                     "  - {center_m: [0, 13], size_m: [1, 8], yaw_deg: 0}\n" +
+                     kHead + group),
+            "");
+  EXPECT_NE(
+      error_of("walls:\n  - {center_m: [0, 13], size_m: [8, 1], yaw_deg: 0}\n" + kHead + group)
+          .find("wholly outside"),
+      std::string::npos);
+  EXPECT_EQ(
+      error_of("walls:\n  - {center_m: [0, 13], size_m: [8, 1], yaw_deg: 90}\n" + kHead + group),
+      "");
+}
+
 TEST(HerdScene, TargetOutsideTheBounds) {
   const std::string e =
       error_of(kHead +
