@@ -14,6 +14,7 @@
 
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
+#include "animrt/core/yaml_doc.hpp"
 #include "animrt/runtime/mcap_reader.hpp"
 
 namespace animrt {
@@ -97,7 +98,14 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
   const auto fail = [&](int column, const std::string& message) {
     throw InputError(Location{path, line_no, column}, "", message);
   };
-  if (!std::getline(in, line)) fail(0, "expected a telemetry CSV header, found an empty file");
+  // A file saved on Windows ends its lines with CR LF: the CR is no part
+  // of the last field (and invisible in a message quoting it).
+  const auto next_line = [&in, &line] {
+    if (!std::getline(in, line)) return false;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next_line()) fail(0, "expected a telemetry CSV header, found an empty file");
   ++line_no;
   const std::vector<std::string> header = split(line);
   // time_s, n commands, n measurements, then device health columns (5 per
@@ -137,7 +145,7 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
     }
   }
   const std::size_t width = header.size();
-  while (std::getline(in, line)) {
+  while (next_line()) {
     ++line_no;
     if (line.empty()) continue;
     const std::vector<std::string> fields = split(line);
@@ -153,10 +161,15 @@ TelemetryRecording load_telemetry_csv(const std::string& path) {
       if (ec != std::errc() || end != f.data() + f.size()) {
         fail(col, "expected a number, found " + quote(f));
       }
+      // The time and the joints' angles are drawn and replayed: finite.
+      if (i < 1 + 2 * n && !std::isfinite(values[i])) {
+        fail(col, "expected a finite number, found " + quote(f));
+      }
       col += static_cast<int>(f.size()) + 1;
     }
     if (!rec.t.empty() && !(values[0] >= rec.t.back())) {
-      fail(1, "time goes backwards (" + fields[0] + " after " + std::to_string(rec.t.back()) + ")");
+      fail(1, "time goes backwards (" + quote(fields[0]) + " after " + format_number(rec.t.back()) +
+                  ")");
     }
     rec.t.push_back(values[0]);
     rec.cmd.insert(rec.cmd.end(), values.begin() + 1, values.begin() + 1 + static_cast<long>(n));

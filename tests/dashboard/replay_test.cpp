@@ -51,7 +51,19 @@ TEST(Replay, ARecordingLoadsAndBadOnesAreErrorsAtTheirPlace) {
   EXPECT_EQ(error("width", "time_s,a_cmd_rad,a_meas_rad\n0,0\n"),
             ":2:1: expected 3 fields, found 2");
   EXPECT_EQ(error("back", "time_s,a_cmd_rad,a_meas_rad\n1,0,0\n0.5,0,0\n"),
-            ":3:1: time goes backwards (0.5 after 1.000000)");
+            ":3:1: time goes backwards (\"0.5\" after 1)");
+  EXPECT_EQ(error("nan_time", "time_s,a_cmd_rad,a_meas_rad\n0,0,0\nnan,0,0\n"),
+            ":3:1: expected a finite number, found \"nan\"");
+  EXPECT_EQ(error("inf_joint", "time_s,a_cmd_rad,a_meas_rad\n0,0,0\n0.1,0,-inf\n"),
+            ":3:7: expected a finite number, found \"-inf\"");
+  // Lines ended CR LF (saved on Windows) load as the same recording.
+  std::string crlf = kRecording;
+  for (std::size_t at = crlf.find('\n'); at != std::string::npos; at = crlf.find('\n', at + 2)) {
+    crlf.insert(at, "\r");
+  }
+  const TelemetryRecording windows = load_telemetry_csv(write_csv("crlf", crlf));
+  EXPECT_EQ(windows.joints, rec.joints);
+  EXPECT_EQ(windows.meas, rec.meas);
   EXPECT_EQ(error("header", "t,a,b\n"),
             ":1:1: expected the header time_s,<joint>_cmd_rad,...,<joint>_meas_rad,... of animrt "
             "run --telemetry, found \"t,a,b\"");
