@@ -15,8 +15,8 @@ namespace scene_ranges_test {
 // Line 1: bounds; line 2: a wall; line 3 onwards: figures and a group.
 std::string scene(const std::string& bounds, const std::string& wall,
                   const std::string& spawn = "[-5, -5, 5, 5]",
-                  const std::string& target = "[10, 0]") {
-  return "bounds_m: " + bounds + "\nwalls:\n  - {center_m: [0, 4], size_m: " + wall +
+                  const std::string& target = "[10, 0]", const std::string& wall_at = "[0, 4]") {
+  return "bounds_m: " + bounds + "\nwalls:\n  - {center_m: " + wall_at + ", size_m: " + wall +
          "}\nfigures:\n  pony: {robot: " + ANIMRT_SOURCE_DIR +
          "/configs/robots/quadruped.yaml}\n"
          "groups:\n  - {name: red, kind: crowd, figure: pony, count: 2, spawn_m: " +
@@ -42,7 +42,9 @@ TEST(SceneRanges, CoordinatesAndSizesJustPastTheirBoundsAreRefusedAtTheirPositio
       {scene("[-100, -100, 100, 100]", "[0.5, 200]"), ""},
       {scene("[-100, -100, 100.5, 100]", "[0.5, 6]"),
        "scene.yaml:1:11: bounds_m: expected an area at most 200 m a side, found 200.5 x 200 m"},
-      {scene("[800, 800, 1000, 1000]", "[0.5, 6]", "[850, 850, 860, 860]", "[900, 900]"), ""},
+      {scene("[800, 800, 1000, 1000]", "[0.5, 6]", "[850, 850, 860, 860]", "[900, 900]",
+             "[880, 880]"),
+       ""},
       {scene("[800, 800, 1000, 1000.5]", "[0.5, 6]"),
        "scene.yaml:1:28: bounds_m[3]: expected a coordinate from -1000 to 1000 m, found "
        "\"1000.5\""},
