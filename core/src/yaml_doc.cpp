@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -77,6 +79,55 @@ class TextBuffer : public std::streambuf {
   }
 };
 
+// YAML is UTF-8 text without control characters other than tab, LF and CR
+// (a BOM at the start is allowed). yaml-cpp takes any bytes, so a Latin-1
+// name or a binary file used to load or fail as something else; this names
+// the first byte that breaks the rule, at its line and column.
+void check_text(const std::string& text, const std::string& file) {
+  int line = 1, column = 1;
+  std::size_t i = 0;
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) i = 3;
+  while (i < text.size()) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    std::size_t length = 1;
+    std::uint32_t code = byte;
+    if (byte >= 0x80) {
+      length = byte >= 0xC2 && byte <= 0xDF   ? 2
+               : byte >= 0xE0 && byte <= 0xEF ? 3
+               : byte >= 0xF0 && byte <= 0xF4 ? 4
+                                              : 0;
+      bool valid = length > 0 && i + length <= text.size();
+      code = length == 2 ? byte & 0x1Fu : length == 3 ? byte & 0x0Fu : byte & 0x07u;
+      for (std::size_t k = 1; valid && k < length; ++k) {
+        const auto next = static_cast<unsigned char>(text[i + k]);
+        valid = (next & 0xC0) == 0x80;
+        code = (code << 6) | (next & 0x3Fu);
+      }
+      // Overlong forms, UTF-16 surrogates and code points past U+10FFFF.
+      valid = valid && !(length == 3 && code < 0x800) && !(length == 4 && code < 0x10000) &&
+              !(code >= 0xD800 && code <= 0xDFFF) && code <= 0x10FFFF;
+      if (!valid) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", byte);
+        throw InputError(Location{file, line, column}, "",
+                         std::string("not UTF-8 text (byte ") + hex + "): save the file as UTF-8");
+      }
+    } else if (byte < 0x20 && byte != '\t' && byte != '\n' && byte != '\r') {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", byte);
+      throw InputError(Location{file, line, column}, "",
+                       std::string("control character ") + hex + " (a binary or damaged file?)");
+    }
+    if (byte == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+    i += length;
+  }
+}
+
 }  // namespace
 
 YamlNode::YamlNode(std::shared_ptr<const std::string> file, YAML::Node node, std::string path,
@@ -94,6 +145,7 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& file_
                      "is " + std::to_string(text.size()) + " bytes, more than the " +
                          std::to_string(kMaxYamlFileBytes >> 20) + " MiB limit");
   }
+  check_text(text, file_name);
   YAML::Node root;
   try {
     TextBuffer buffer(text);

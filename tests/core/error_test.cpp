@@ -103,6 +103,28 @@ TEST(YamlNode, ASecondDocumentIsRefusedWhereItBegins) {
   EXPECT_EQ(error("---\nname: a\n...\n"), "no error");
 }
 
+// YAML is UTF-8 text: a Latin-1 byte, a broken sequence or a control
+// character (a binary file) is named at its line and column before parsing.
+TEST(YamlNode, BytesThatAreNotUtf8TextAreRefusedWhereTheyAre) {
+  const auto error = [](const std::string& text) { return error_of(text, [](const YamlNode&) {}); };
+  EXPECT_EQ(error("a: 1\nname: Zo\xEB\n"),
+            "t.yaml:2:9: not UTF-8 text (byte 0xEB): save the file as UTF-8");
+  EXPECT_EQ(error("name: \xC0\xAF\n"),
+            "t.yaml:1:7: not UTF-8 text (byte 0xC0): save the file as UTF-8");
+  EXPECT_EQ(error("name: \xED\xA0\x80\n"),  // a UTF-16 surrogate
+            "t.yaml:1:7: not UTF-8 text (byte 0xED): save the file as UTF-8");
+  EXPECT_EQ(error("name: \xE2\x82\n"),
+            "t.yaml:1:7: not UTF-8 text (byte 0xE2): save the file as UTF-8");
+  EXPECT_EQ(error(std::string("name: a\0b\n", 10)),
+            "t.yaml:1:8: control character 0x00 (a binary or damaged file?)");
+  EXPECT_EQ(error("\x01\x02\x03"),
+            "t.yaml:1:1: control character 0x01 (a binary or damaged file?)");
+  // Characters past the first byte count as one column each.
+  EXPECT_EQ(error("n\xC3\xA9: \xE2\x82\xAC\xF0\x9F\x90\xB4\xFF\n"),
+            "t.yaml:1:7: not UTF-8 text (byte 0xFF): save the file as UTF-8");
+  EXPECT_EQ(error("\xEF\xBB\xBFname: Zo\xC3\xAB \xF0\x9F\x90\xB4\r\nx: a\tb\n"), "no error");
+}
+
 TEST(YamlNode, MissingKeyNamesTheFullPath) {
   auto msg = error_of("outer:\n  x: 1\n", [](const YamlNode& n) { (void)n.at("outer").at("y"); });
   EXPECT_EQ(msg, "t.yaml:2:3: outer.y: required key is missing");
