@@ -85,6 +85,14 @@ class TextBuffer : public std::streambuf {
 // the first byte that breaks the rule, at its line and column.
 void check_text(const std::string& text, const std::string& file) {
   int line = 1, column = 1;
+  const auto hex = [](unsigned char byte) {
+    char digits[8];
+    std::snprintf(digits, sizeof digits, "0x%02X", byte);
+    return std::string(digits);
+  };
+  const auto fail = [&](const std::string& message) {
+    throw InputError(Location{file, line, column}, "", message);
+  };
   std::size_t i = 0;
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) i = 3;
   while (i < text.size()) {
@@ -106,17 +114,9 @@ void check_text(const std::string& text, const std::string& file) {
       // Overlong forms, UTF-16 surrogates and code points past U+10FFFF.
       valid = valid && !(length == 3 && code < 0x800) && !(length == 4 && code < 0x10000) &&
               !(code >= 0xD800 && code <= 0xDFFF) && code <= 0x10FFFF;
-      if (!valid) {
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "0x%02X", byte);
-        throw InputError(Location{file, line, column}, "",
-                         std::string("not UTF-8 text (byte ") + hex + "): save the file as UTF-8");
-      }
+      if (!valid) fail("not UTF-8 text (byte " + hex(byte) + "): save the file as UTF-8");
     } else if (byte < 0x20 && byte != '\t' && byte != '\n' && byte != '\r') {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "0x%02X", byte);
-      throw InputError(Location{file, line, column}, "",
-                       std::string("control character ") + hex + " (a binary or damaged file?)");
+      fail("control character " + hex(byte) + " (a binary or damaged file?)");
     }
     if (byte == '\n') {
       ++line;

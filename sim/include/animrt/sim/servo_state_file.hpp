@@ -27,8 +27,9 @@ class ServoStateFile {
  public:
   // Reads `path` if it exists (a missing file is an empty state) and writes
   // it back at once, so a path that cannot be written fails here; throws
-  // InputError naming the file and line of a line it cannot read,
-  // DeviceError when it cannot write.
+  // InputError naming the file when it is not a regular file (a device, a
+  // FIFO, a folder), and its line for a line it cannot read; DeviceError
+  // when it cannot write.
   explicit ServoStateFile(std::string path);
 
   const std::string& path() const { return path_; }
