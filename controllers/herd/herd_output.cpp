@@ -3,8 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
-#include <stdexcept>
+#include <sstream>
 
 #include "herd_groups.hpp"
 
@@ -141,11 +140,10 @@ void TrailRecorder::sample(const Herd& herd) {
   }
 }
 
-void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
+std::string TrailRecorder::svg(const Herd& herd) const {
   const HerdScene& scene = herd.scene();
   const Rect& r = scene.bounds_m;
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write the top view");
+  std::ostringstream out;
   const double w = (r.xmax - r.xmin) * kPixelsPerMetre, h = (r.ymax - r.ymin) * kPixelsPerMetre;
   out << fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" viewBox=\"0 0 "
@@ -210,7 +208,7 @@ void TrailRecorder::write_svg(const std::string& path, const Herd& herd) const {
   write_scale_bar(out, r);
   write_legend(out, scene, has_leader);
   out << "</svg>\n";
-  if (!out) throw std::runtime_error(path + ": cannot write the top view");
+  return out.str();
 }
 
 std::string format_order(const GroupMetrics& g) {

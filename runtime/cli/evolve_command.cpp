@@ -272,7 +272,7 @@ void add_evolve_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--threads", args->threads, "evaluation threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
-  cmd->add_option("--seed", args->seed, "random seed (overrides the run file)");
+  cmd->add_option("--seed", args->seed, "random seed (overrides the run file)")->check(kSeed);
   cmd->add_option("--population", args->population, "population size")
       ->check(CLI::Range(2, 1000000));
   cmd->add_option("--generations", args->generations,

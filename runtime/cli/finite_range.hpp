@@ -1,10 +1,13 @@
 #pragma once
-// CLI::Range for floating-point options, refusing NaN as well: CLI11's
+// Option checks CLI11's own miss. FiniteRange: CLI::Range for floating-point
+// options, refusing NaN as well: CLI11's
 // check compares the value with its bounds, and every comparison with NaN
 // is false, so "--duration nan" passed it (a serve then ran until stopped).
 
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -27,5 +30,25 @@ class FiniteRange : public CLI::Range {
 inline const FiniteRange kPositiveNumber(std::numeric_limits<double>::min(),
                                          std::numeric_limits<double>::max(), "POSITIVE");
 inline const FiniteRange kNonNegativeNumber(0.0, std::numeric_limits<double>::max(), "NONNEGATIVE");
+
+// Seeds: the integers a scene or run file's seed takes, 0 to 2^63 - 1. An
+// unsigned option alone reads "-1" as 2^64 - 1, and CLI::Range over int64
+// let 2^63 through.
+class SeedValidator : public CLI::Validator {
+ public:
+  SeedValidator() : CLI::Validator("SEED") {
+    func_ = [](std::string& input) -> std::string {
+      std::int64_t value = 0;
+      const char* end = input.data() + input.size();
+      const auto [stop, error] = std::from_chars(input.data(), end, value);
+      if (error != std::errc() || stop != end || value < 0) {
+        return "Value " + input + " is not a seed (an integer from 0 to " +
+               std::to_string(std::numeric_limits<std::int64_t>::max()) + ")";
+      }
+      return {};
+    };
+  }
+};
+inline const SeedValidator kSeed;
 
 }  // namespace animrt::cli

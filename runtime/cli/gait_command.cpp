@@ -175,7 +175,8 @@ void add_gait_command(CLI::App& app) {
       ->check(CLI::Range(1, 100));
   cmd->add_option("--turns", args->turns, "turn rates each way (fractions of the fastest)")
       ->check(CLI::Range(0, 20));
-  cmd->add_option("--seed", args->seed, "perturb the start pose (0: exact standing pose)");
+  cmd->add_option("--seed", args->seed, "perturb the start pose (0: exact standing pose)")
+      ->check(kSeed);
   set_subcommand_body(cmd, [args] { return run_calibrate(*args); });
   add_gait_measure_command(*gait);
 }

@@ -156,7 +156,7 @@ void add_train_options(CLI::App* c, HeadArgs& a) {
                 "output poses toward the mean pose: factor in [0, 1] (1: the paper), "
                 "negative: chosen on the training data")
       ->check(FiniteRange(-1.0, 1.0));
-  c->add_option("--seed", a.seed, "split seed");
+  c->add_option("--seed", a.seed, "split seed")->check(kSeed);
   c->add_flag("--quiet", a.quiet, "no progress lines");
 }
 
@@ -178,7 +178,7 @@ void add_head_command(CLI::App& app) {
   c->add_option("--out", a->out, "folder")->required();
   c->add_option("--utterances", a->utterances, "how many")->check(CLI::Range(1, 10000));
   c->add_option("--speakers", a->speakers, "speaker styles (1..4)")->check(CLI::Range(1, 4));
-  c->add_option("--seed", a->seed, "random seed");
+  c->add_option("--seed", a->seed, "random seed")->check(kSeed);
   c->add_flag("--quiet", a->quiet, "no progress lines");
   set_subcommand_body(c, [a] { return run_corpus(*a); });
 

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "finite_range.hpp"
+#include "output_file.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 
@@ -149,24 +151,43 @@ void step_herd(const HerdArgs& a, herd::Herd& herd, HerdDashboardServer* dashboa
   }
 }
 
-// The CSV closed, the trails and the summary written.
-void write_outputs(const HerdArgs& a, std::ofstream& csv, const herd::TrailRecorder& trails,
-                   const herd::Herd& herd, const herd::HerdMetrics& metrics, double wall_s) {
+// The files written at the end (the top view, the summary), opened before
+// the herd steps: a path that cannot be written is found before a long run.
+struct EndFiles {
+  OutputFile svg;
+  OutputFile summary;
+};
+
+void open_end_files(const HerdArgs& a, EndFiles& files) {
+  const auto open = [](const std::string& path, OutputFile& file, const char* what) {
+    if (path.empty() || file.open(path)) return;
+    throw std::runtime_error(path + ": cannot write the " + what + ": " +
+                             std::strerror(file.error));
+  };
+  open(a.svg, files.svg, "top view");
+  open(a.summary_json, files.summary, "summary");
+}
+
+// The CSV closed, the top view and the summary written.
+void write_outputs(const HerdArgs& a, std::ofstream& csv, EndFiles& files,
+                   const herd::TrailRecorder& trails, const herd::Herd& herd,
+                   const herd::HerdMetrics& metrics, double wall_s) {
   if (csv.is_open()) {
     csv.close();
     if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
     std::cout << "wrote " << a.out << '\n';
   }
-  if (!a.svg.empty()) {
-    trails.write_svg(a.svg, herd);
-    std::cout << "wrote " << a.svg << '\n';
-  }
-  if (!a.summary_json.empty()) {
-    std::ofstream j(a.summary_json);
-    j << to_json(metrics, wall_s).dump(2) << '\n';
-    if (!j) throw std::runtime_error(a.summary_json + ": cannot write the summary");
-    std::cout << "wrote " << a.summary_json << '\n';
-  }
+  const auto write = [](const std::string& path, OutputFile& file, const std::string& text,
+                        const char* what) {
+    if (!file.is_open()) return;
+    if (!file.write(text)) {
+      throw std::runtime_error(path + ": cannot write the " + what + ": " +
+                               std::strerror(file.error));
+    }
+    std::cout << "wrote " << path << '\n';
+  };
+  write(a.svg, files.svg, trails.svg(herd), "top view");
+  write(a.summary_json, files.summary, to_json(metrics, wall_s).dump(2) + '\n', "summary");
 }
 
 int run_herd(const HerdArgs& a) {
@@ -175,6 +196,8 @@ int run_herd(const HerdArgs& a) {
   const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
   if (!address.ok) return kExitUsage;
   const auto& dashboard_at = address.at;
+  EndFiles end_files;
+  open_end_files(a, end_files);
   herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
   const herd::HerdScene& s = herd.scene();
   std::unique_ptr<HerdDashboardServer> dashboard;
@@ -217,7 +240,7 @@ int run_herd(const HerdArgs& a) {
                 : signalled ? ", stopped by a signal"
                             : "")
             << '\n';
-  write_outputs(a, csv, trails, herd, metrics, wall_s);
+  write_outputs(a, csv, end_files, trails, herd, metrics, wall_s);
   return 0;
 }
 
@@ -229,7 +252,7 @@ void add_herd_command(CLI::App& app) {
   cmd->add_option("SCENE", args->scene, "scene file (YAML, docs/herd.md)")->required();
   cmd->add_option("--duration", args->duration, "seconds to simulate (default: the scene's)")
       ->check(FiniteRange(0.001, 1e6));
-  cmd->add_option("--seed", args->seed, "random seed (overrides the scene's)");
+  cmd->add_option("--seed", args->seed, "random seed (overrides the scene's)")->check(kSeed);
   cmd->add_option("--out", args->out, "CSV of every agent at every output step");
   cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
   cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON");

@@ -36,6 +36,7 @@
 #include "doctor_command.hpp"
 #include "fault_injection.hpp"
 #include "finite_range.hpp"
+#include "output_file.hpp"
 #include "record_command.hpp"
 #include "run_herd.hpp"
 #include "scan_command.hpp"
@@ -44,7 +45,6 @@
 #include "sim_command.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
-#include "summary_file.hpp"
 #include "tools_exec.hpp"
 #include "view_command.hpp"
 
@@ -189,7 +189,7 @@ int cmd_run(const RunArgs& args) {
   }
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
-  animrt::cli::SummaryFile summary_out;
+  animrt::cli::OutputFile summary_out;
   if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
     spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
                   std::strerror(summary_out.error));

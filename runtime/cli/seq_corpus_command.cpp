@@ -93,7 +93,7 @@ void add_seq_corpus_command(CLI::App& seq) {
   c->add_option("--vertices", a->vertices, "skin vertices, roughly")
       ->check(CLI::Range(100, 50000))
       ->capture_default_str();
-  c->add_option("--seed", a->seed, "first seed")->capture_default_str();
+  c->add_option("--seed", a->seed, "first seed")->capture_default_str()->check(kSeed);
   c->add_option("--seeds", a->seeds, "seeds per configuration")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();

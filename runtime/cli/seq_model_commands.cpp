@@ -268,8 +268,9 @@ void add_seq_model_commands(CLI::App& seq) {
       ->add_option("--out", g->out,
                    "mesh model: folder for frame_NNNN.obj; joint model: CSV file to write")
       ->required();
-  generate->add_option("--random-state", g->random_state,
-                       "draw the initial LSTM states from this seed");
+  generate
+      ->add_option("--random-state", g->random_state, "draw the initial LSTM states from this seed")
+      ->check(kSeed);
   set_subcommand_body(generate, [g] { return run_generate(*g); });
 
   auto c = std::make_shared<CompleteArgs>();
@@ -295,7 +296,8 @@ void add_seq_model_commands(CLI::App& seq) {
       ->check(FiniteRange(1e-12, 10.0));
   complete->add_option("--retries", c->options.retries, "runs with random initial states")
       ->check(CLI::Range(0, 100000));
-  complete->add_option("--seed", c->options.seed, "seed of the random initial states");
+  complete->add_option("--seed", c->options.seed, "seed of the random initial states")
+      ->check(kSeed);
   complete->add_flag("!--hand-over", c->options.blend,
                      "forward frames up to where the chains meet, backward frames after (the "
                      "paper) instead of blending the chains");

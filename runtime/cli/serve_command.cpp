@@ -20,13 +20,13 @@
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
 #include "finite_range.hpp"
+#include "output_file.hpp"
 #include "serve_dmx.hpp"
 #include "serve_sound.hpp"
 #include "serve_triggers.hpp"
 #include "service_notify.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
-#include "summary_file.hpp"
 
 namespace animrt::cli {
 namespace {
@@ -171,7 +171,7 @@ int serve(const ServeArgs& args) {
   }
   const DashboardAddress address = check_dashboard_address(args.dashboard, args.dashboard_remote);
   if (!address.ok) return kExitUsage;
-  SummaryFile summary_out;  // opened before anything moves
+  OutputFile summary_out;  // opened before anything moves
   if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
     spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
                   std::strerror(summary_out.error));

@@ -2,7 +2,8 @@
 # animrt herd's summary reports only what it measured: a Unity flock that
 # stands while its leader walks is reported as standing with
 # no order (text and JSON, with both speeds); a one-figure crowd that cannot
-# reach its goal in time has no pair distance, neighbour or time to goal.
+# reach its goal in time has no pair distance, neighbour or time to goal;
+# a summary or top view that cannot be written is refused before it steps.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -63,4 +64,15 @@ assert j["min_pair_distance_m"] is None and j["min_clearance_m"] is None
 assert g["order_mean"] is None and g["nearest_neighbour_mean_m"] is None
 assert g["arrivals"] == 0 and g["time_to_goal_mean_s"] is None and g["stuck"] == 0
 PY
+# The summary and the top view are written at the end, but a path that
+# cannot be written is refused before the herd takes a step, not after it.
+for opt in --summary-json --svg; do
+  what=summary; [[ $opt == --svg ]] && what="top view"
+  for path in "$tmp/missing/x" "$tmp"; do
+    out=$("$animrt" herd "$tmp/one.yaml" "$opt" "$path" --quiet 2>&1) &&
+      fail "herd $opt $path succeeded: $out"
+    [[ $out == *"$path: cannot write the $what: "* ]] || fail "herd $opt $path: $out"
+    [[ $out != *"min pair distance"* ]] || fail "herd $opt $path stepped the herd first: $out"
+  done
+done
 echo "herd_summary: ok"

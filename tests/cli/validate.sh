@@ -75,6 +75,24 @@ for args in "serve $root/configs/robots/animatronic.yaml --cues $root/configs/cu
       fail "${args%% *} $option $bad: exit $code: $out"
   done
 done
+# Seeds are 0 to 2^63 - 1, as in the files: an unsigned option alone took -1
+# as 2^64 - 1, and 2^63 passed a range over int64.
+max_seed=9223372036854775807
+for args in "herd $root/configs/herd/flock.yaml --seed" \
+            "evolve $root/configs/evolve/horse_concatenating.yaml --seed" \
+            "head corpus --out $tmp/corpus --seed" "seq corpus --out $tmp/corpus --seed" \
+            "seq complete $tmp/model --seed" "seq generate $tmp/model --out $tmp/x --random-state"; do
+  for bad in -1 9223372036854775808 1e3 0x10; do
+    # shellcheck disable=SC2086  # the words of $args are the arguments
+    out=$(timeout 20 "$animrt" $args "$bad" 2>&1)
+    code=$?
+    option=${args##* }
+    [[ $code -eq 1 && $(echo "$out" | head -1) == "$option: Value $bad is not a seed (an integer from 0 to $max_seed)" ]] ||
+      fail "${args%% *} $option $bad: exit $code: $out"
+  done
+done
+out=$("$animrt" herd "$root/configs/herd/gate.yaml" --quiet --duration 1 --seed $max_seed 2>&1) ||
+  fail "herd --seed $max_seed: $out"
 # Any other parse error is a usage error too (CLI11's own codes are 100 and up).
 out=$("$animrt" run 2>&1)
 code=$?

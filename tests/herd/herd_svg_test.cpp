@@ -6,7 +6,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "animrt/controllers/herd/herd.hpp"
@@ -42,11 +41,7 @@ TEST(HerdSvg, LegendScaleStartMarksAndLeaderPath) {
     herd.step();
     trails.sample(herd);
   }
-  const std::string svg_path = temp_path("svg_scene.svg");
-  trails.write_svg(svg_path, herd);
-  std::stringstream text;
-  text << std::ifstream(svg_path).rdbuf();
-  const std::string svg = text.str();
+  const std::string svg = trails.svg(herd);
   EXPECT_EQ(count(svg, "class=\"start\""), 7);   // one start mark per figure
   EXPECT_EQ(count(svg, "class=\"leader\""), 2);  // one leader path per flock
   EXPECT_EQ(count(svg, "<polyline"), 7);         // the trails, as before

@@ -44,7 +44,8 @@ void add_seq_net_commands(CLI::App& app) {
   train->add_option("--out", train_args->out, "model file (also OUT.ckpt and OUT.svg)")->required();
   train->add_option("--iterations", train_args->iterations, "total iterations")
       ->check(CLI::Range(1, 100000000));
-  train->add_option("--seed", train_args->seed, "seed for the split, the batches and the weights");
+  train->add_option("--seed", train_args->seed, "seed for the split, the batches and the weights")
+      ->check(kSeed);
   train->add_option("--threads", train_args->threads, "libtorch threads")
       ->check(CLI::Range(1, 256));
   train->add_option("--resume", train_args->resume, "continue from this checkpoint");

@@ -19,11 +19,10 @@ void write_csv_rows(std::ostream& out, const Herd& herd);
 class TrailRecorder {
  public:
   void sample(const Herd& herd);
-  // Throws std::runtime_error when the file cannot be written.
-  // The top view: walls, obstacles, each figure's trail from a start mark
+  // The top view as SVG text: walls, obstacles, each figure's trail from a start mark
   // (a square) to where it stands, targets (rings), each leader's path
   // (dashed), a legend of the groups and a scale bar.
-  void write_svg(const std::string& path, const Herd& herd) const;
+  std::string svg(const Herd& herd) const;
 
  private:
   std::vector<std::vector<Vec2>> trails_;         // per agent

@@ -1,4 +1,4 @@
-#include "summary_file.hpp"
+#include "output_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -7,17 +7,17 @@
 
 namespace animrt::cli {
 
-SummaryFile::~SummaryFile() {
+OutputFile::~OutputFile() {
   if (fd >= 0) ::close(fd);
 }
 
-bool SummaryFile::open(const std::string& path) {
+bool OutputFile::open(const std::string& path) {
   fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) error = errno;
   return fd >= 0;
 }
 
-bool SummaryFile::write(const std::string& text) {
+bool OutputFile::write(const std::string& text) {
   std::size_t done = 0;
   while (done < text.size()) {
     const ssize_t n = ::write(fd, text.data() + done, text.size() - done);

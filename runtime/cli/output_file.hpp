@@ -1,0 +1,24 @@
+#pragma once
+// A file written once at the end of a command's work (run's and serve's
+// --summary-json, herd's summary and top view): opened before the work starts
+// (before anything moves; a path that cannot be written is found then, not
+// after a long run), every failure (a full disk, /dev/full, a close that
+// fails) kept with its errno.
+
+#include <string>
+
+namespace animrt::cli {
+
+struct OutputFile {
+  int fd = -1;
+  int error = 0;
+  OutputFile() = default;
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  ~OutputFile();
+  bool is_open() const { return fd >= 0; }
+  bool open(const std::string& path);
+  bool write(const std::string& text);  // and close
+};
+
+}  // namespace animrt::cli
