@@ -3,6 +3,7 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/parser.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -30,11 +31,32 @@ Location location_of(const std::string& file, const YAML::Mark& mark) {
   return Location{file, mark.line + 1, mark.column + 1};
 }
 
-// Counts the nodes of the first document as the parser meets them and stops
-// at the first one past the limit, before any tree exists.
+// Where a quoted scalar that starts at `open` (its quote) ends, or npos.
+std::size_t closing_quote(const std::string& text, std::size_t open) {
+  const char quote = text[open];
+  for (std::size_t i = open + 1; i < text.size(); ++i) {
+    if (quote == '"' && text[i] == '\\') {
+      ++i;  // an escape: the next character is not the end
+    } else if (text[i] == quote) {
+      if (quote == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
+        ++i;  // '' is a quote inside a single-quoted value
+      } else {
+        return i;
+      }
+    }
+  }
+  return std::string::npos;
+}
+
+// Walks the first document as the parser meets it, before any tree exists:
+// stops at the first node past the limit, and at a quoted value that runs
+// over lines. YAML lets a quoted value go on to the lines below; none of our
+// values needs to, so one that does lacks its closing quote, and the file
+// would otherwise load as something else (the keys below it swallowed, then
+// reported missing).
 class NodeCounter : public YAML::EventHandler {
  public:
-  explicit NodeCounter(const std::string& file) : file_(file) {}
+  NodeCounter(const std::string& file, const std::string& text) : file_(file), text_(text) {}
   // Where the last document it met began.
   const YAML::Mark& document_start() const { return document_; }
 
@@ -45,6 +67,7 @@ class NodeCounter : public YAML::EventHandler {
   void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
                 const std::string&) override {
     count(mark);
+    check_quoted(mark);
   }
   void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
                        YAML::EmitterStyle::value) override {
@@ -65,7 +88,26 @@ class NodeCounter : public YAML::EventHandler {
                          " YAML nodes (values, lists and maps); a configuration needs far fewer");
   }
 
+  void check_quoted(const YAML::Mark& mark) const {
+    // The mark counts bytes after a byte order mark.
+    const std::size_t bom = text_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+    const auto open = static_cast<std::size_t>(mark.pos) + bom;
+    if (mark.pos < 0 || open >= text_.size() || (text_[open] != '"' && text_[open] != '\'')) return;
+    const std::size_t close = closing_quote(text_, open);
+    const auto end = close == std::string::npos ? text_.end() : text_.begin() + close;
+    const auto lines = std::count(text_.begin() + open, end, '\n');
+    if (lines == 0) return;
+    const std::string quote = text_[open] == '"' ? "\"" : "'";
+    throw InputError(location_of(file_, mark), "",
+                     close == std::string::npos
+                         ? "the quoted value has no closing " + quote
+                         : "the quoted value runs on to line " +
+                               std::to_string(mark.line + 1 + lines) + " (its closing " + quote +
+                               " missing?): write it on one line");
+  }
+
   const std::string& file_;
+  const std::string& text_;
   std::size_t nodes_ = 0;
   YAML::Mark document_;
 };
@@ -151,7 +193,7 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& file_
     TextBuffer buffer(text);
     std::istream in(&buffer);
     YAML::Parser parser(in);
-    NodeCounter counter(file_name);
+    NodeCounter counter(file_name, text);
     parser.HandleNextDocument(counter);
     // yaml-cpp's Load reads the first document and ignores the rest.
     if (parser.HandleNextDocument(counter)) {

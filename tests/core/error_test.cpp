@@ -103,6 +103,27 @@ TEST(YamlNode, ASecondDocumentIsRefusedWhereItBegins) {
   EXPECT_EQ(error("---\nname: a\n...\n"), "no error");
 }
 
+// A quoted value may run over lines in YAML; in a configuration that means a
+// missing closing quote, which swallowed the keys below it ("loop: required
+// key is missing"). It is named where the value opens.
+TEST(YamlNode, AQuotedValueWithoutItsClosingQuoteIsRefusedWhereItOpens) {
+  const auto error = [](const std::string& text) { return error_of(text, [](const YamlNode&) {}); };
+  EXPECT_EQ(error("name: \"head\nloop: {rate_hz: 100}\nnote: \"x\"\n"),
+            "t.yaml:1:7: the quoted value runs on to line 3 (its closing \" missing?): write it "
+            "on one line");
+  EXPECT_EQ(error("a: 1\nname: 'head\nloop: 2 # it's\n"),
+            "t.yaml:2:7: the quoted value runs on to line 3 (its closing ' missing?): write it on "
+            "one line");
+  EXPECT_EQ(error("a: [1, \"b]\n"), "t.yaml:1:8: the quoted value has no closing \"");
+  // After a byte order mark and a name in two-byte UTF-8, still its place.
+  EXPECT_EQ(error("\xEF\xBB\xBFn: Zo\xC3\xAB\nname: \"head\nx: \"\n"),
+            "t.yaml:2:7: the quoted value runs on to line 3 (its closing \" missing?): write it "
+            "on one line");
+  // Escaped and doubled quotes inside a value on one line, a block scalar
+  // over lines: loaded.
+  EXPECT_EQ(error("a: \"say \\\"hi\\\"\"\nb: 'it''s'\nc: |\n  two\n  lines\n"), "no error");
+}
+
 // YAML is UTF-8 text: a Latin-1 byte, a broken sequence or a control
 // character (a binary file) is named at its line and column before parsing.
 TEST(YamlNode, BytesThatAreNotUtf8TextAreRefusedWhereTheyAre) {
