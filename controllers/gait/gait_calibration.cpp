@@ -96,7 +96,8 @@ GaitCalibration parse_gait_calibration(const std::string& text, const std::strin
   if (cal.model_file.empty()) model.fail("expected the model file it walked on, found \"\"");
   cal.tolerance = root.at("tolerance").as_double_in(0.0, 1.0);
   const YamlNode points = root.at("points");
-  if (!points.is_sequence()) points.fail("expected a list of points, found " + points.describe());
+  if (!points.is_sequence() || points.items().empty())
+    points.fail("expected a list of points, found " + points.describe());
   for (const YamlNode& node : points.items()) {
     node.allow_only(
         {"speed_m_s", "turn_dps", "achieved_speed_m_s", "achieved_turn_dps", "fell", "usable"});

@@ -275,7 +275,15 @@ WalkResponse load_walk_response(const std::string& gait_path) {
   if (std::filesystem::exists(cal_path, ec)) {
     const GaitCalibration cal = load_gait_calibration(cal_path);
     check_calibration_references(cal, cal_path, gait_path);
-    return WalkResponse(*gait.steering, &cal);
+    WalkResponse walk(*gait.steering, &cal);
+    // A table without one usable straight walk would make a figure that
+    // stands: found here, not as "walks at most 0 m/s" in each scene.
+    if (walk.max_speed() <= 0.0) {
+      throw InputError(Location{cal_path, 0, 0}, "points",
+                       "no speed whose straight walk is usable (every one fell or missed the "
+                       "tolerance): calibrate the gait again (animrt gait calibrate)");
+    }
+    return walk;
   }
   return WalkResponse(*gait.steering);
 }

@@ -180,7 +180,9 @@ TEST(CalibrationRanges, TheTablesGaitAndModelReferencesAreChecked) {
   const std::string walk = f.write("walk.yaml", text);
   f.write("other.yaml", text);
   f.write("figure.xml", "<mujoco/>\n");
-  const std::string table = "tolerance: 0.15\npoints: []\n";
+  const std::string table =
+      "tolerance: 0.15\npoints:\n  - {speed_m_s: 0.1, turn_dps: 0, achieved_speed_m_s: 0.1, "
+      "achieved_turn_dps: 0, fell: false}\n";
   const std::string cal = calibration_path_for(walk);
 
   f.write("walk.calibration.yaml", "gait: walk.yaml\nmodel: figure.xml\n" + table);

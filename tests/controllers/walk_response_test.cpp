@@ -121,6 +121,9 @@ TEST(Calibration, BadFilesNameLineAndKey) {
   EXPECT_NE(turn_liar.find("points[0].usable"), std::string::npos) << turn_liar;
   const std::string tol = calibration_error("gait: w\nmodel: m\ntolerance: 2\npoints: []\n");
   EXPECT_NE(tol.find("c.yaml:3:12: tolerance"), std::string::npos) << tol;
+  // A table of no points calibrates nothing.
+  EXPECT_EQ(calibration_error(head.substr(0, head.size() - 1) + " []\n"),
+            "c.yaml:4:9: points: expected a list of points, found []");
   EXPECT_THROW(load_gait_calibration("/nonexistent/x.calibration.yaml"), InputError);
 }
 
@@ -295,6 +298,24 @@ TEST(WalkResponse, LoadsTheGaitAndItsCalibration) {
   const WalkResponse calibrated = load_walk_response(steer);
   EXPECT_EQ(calibrated.min_speed(), 0.1);
   EXPECT_NEAR(calibrated.max_turn(0.1), deg_to_rad(10.0), 1e-12);  // capped by the steering
+  // A table in which every walk fell leaves nothing to walk: refused at the
+  // table, not later as a figure that "walks at most 0 m/s".
+  GaitCalibration fallen = beside;
+  for (CalibrationPoint& p : fallen.points) {
+    p.fell = true;
+    p.usable = false;
+  }
+  write_gait_calibration(calibration_path_for(steer), fallen);
+  try {
+    (void)load_walk_response(steer);
+    ADD_FAILURE() << "a table without a usable walk loaded";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              calibration_path_for(steer) +
+                  ": points: no speed whose straight walk is usable (every one fell or missed "
+                  "the tolerance): calibrate the gait again (animrt gait calibrate)");
+  }
+  std::filesystem::remove(calibration_path_for(steer));
 }
 
 }  // namespace
