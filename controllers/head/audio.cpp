@@ -29,37 +29,39 @@ std::uint32_t le32(const unsigned char* p) {
          (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
 }
 
-// libsndfile quietly reads what is there when a WAV's data chunk is cut
-// short; a cut recording would then train on half an utterance. Walk the
-// RIFF chunks and compare the declared data size with the bytes present.
-void check_riff_length(const std::string& path) {
+}  // namespace
+
+std::string wav_truncation(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char header[12];
-  if (!in.read(reinterpret_cast<char*>(header), 12)) return;
+  if (!in.read(reinterpret_cast<char*>(header), 12)) return {};
   if (std::string(reinterpret_cast<char*>(header), 4) != "RIFF" ||
       std::string(reinterpret_cast<char*>(header) + 8, 4) != "WAVE") {
-    return;
+    return {};
   }
-  const auto file_size = static_cast<std::uint64_t>(std::filesystem::file_size(path));
+  std::error_code ec;
+  const auto file_size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
+  if (ec) return {};
   std::uint64_t pos = 12;
   unsigned char chunk[8];
   while (pos + 8 <= file_size) {
     in.seekg(static_cast<std::streamoff>(pos));
-    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return;
+    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return {};
     const std::string id(reinterpret_cast<char*>(chunk), 4);
     const std::uint64_t size = le32(chunk + 4);
     // Streaming writers leave 0 or 0xFFFFFFFF in the size; nothing to check.
     if (id == "data" && size != 0 && size != 0xFFFFFFFFu) {
       const std::uint64_t present = file_size - (pos + 8);
-      if (present < size) {
-        fail(path, "truncated WAV file: the data chunk declares " + std::to_string(size) +
-                       " bytes but only " + std::to_string(present) + " are present");
-      }
-      return;
+      if (present >= size) return {};
+      return "truncated WAV file: the data chunk declares " + std::to_string(size) +
+             " bytes but only " + std::to_string(present) + " are present";
     }
     pos += 8 + size + (size & 1);
   }
+  return {};
 }
+
+namespace {
 
 // Frames read and mixed at a time.
 constexpr sf_count_t kChunkFrames = 16384;
@@ -138,7 +140,8 @@ Audio load_audio(const std::string& path, int target_rate) {
   const std::uintmax_t file_size = fs::file_size(path, ec);
   if (file_size == 0) fail(path, "empty file (0 bytes), expected audio");
 
-  check_riff_length(path);  // before sf_open: a throw here leaves nothing open
+  // Before sf_open: a throw here leaves nothing open.
+  if (const std::string cut = wav_truncation(path); !cut.empty()) fail(path, cut);
   SF_INFO info{};
   SNDFILE* file = sf_open(path.c_str(), SFM_READ, &info);
   if (file == nullptr) {

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "animrt/controllers/head/audio.hpp"
 #include "animrt/controllers/seqnet/model_file.hpp"
 #include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/input_file.hpp"
@@ -265,6 +266,8 @@ ShowFile load_show_file(const std::string& path) {
         !problem.empty()) {
       file.fail("audio file " + quote_path(show.audio.file) + " " + problem);
     }
+    if (const std::string cut = head::wav_truncation(show.audio.file); !cut.empty())
+      file.fail("audio file " + quote_path(show.audio.file) + ": " + cut);
     SF_INFO info{};
     SNDFILE* sf = sf_open(show.audio.file.c_str(), SFM_READ, &info);
     if (sf == nullptr) {

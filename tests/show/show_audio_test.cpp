@@ -10,16 +10,17 @@
 #include <sndfile.h>
 
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
-#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "animrt/controllers/show/show_file.hpp"
 #include "animrt/controllers/show/show_playhead.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/run_monitor.hpp"
@@ -81,7 +82,7 @@ class RecordingSink final : public AudioSink {
     std::condition_variable changed;
     std::vector<std::vector<float>> blocks;
     std::size_t allowed = 0;
-    std::size_t flushed_at = 0;  // blocks written before the last flush
+    std::size_t flushed_at = 0;        // blocks written before the last flush
     std::vector<std::size_t> flushes;  // the block count at each flush
   };
   explicit RecordingSink(Shared& shared) : s_(shared) {}
@@ -345,6 +346,25 @@ TEST(ShowAudio, ATruncatedTrackIsAnErrorNamingTheFile) {
     EXPECT_NE(std::string(e.what()).find("truncated WAV file: the data chunk declares 3200 bytes"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// The show file's check (validate, and every command that loads the show)
+// finds the cut track at the show's line, as loading the track does.
+TEST(ShowAudio, ATruncatedTrackIsRefusedWhereTheShowNamesIt) {
+  const std::string show = write_show_with_audio("cut_show");
+  const std::string wav = ::testing::TempDir() + "/cut_show.wav";
+  EXPECT_NO_THROW(load_show_file(show));
+  std::filesystem::resize_file(wav, std::filesystem::file_size(wav) - 10);
+  try {
+    (void)load_show_file(show);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              show + ":1:15: audio.file: audio file \"" +
+                  (std::filesystem::path(show).parent_path() / "cut_show.wav").string() +
+                  "\": truncated WAV file: the data chunk declares 3200 "
+                  "bytes but only 3190 are present");
   }
 }
 

@@ -28,6 +28,11 @@ struct Audio {
 // samples.
 Audio load_audio(const std::string& path, int target_rate = 0);
 
+// What is wrong with a WAV file whose data chunk declares more bytes than
+// the file holds, or "" (also for a file that is not WAV). libsndfile
+// quietly reads what is there, so a cut recording would pass for a whole one.
+std::string wav_truncation(const std::string& path);
+
 // `fast`: a polyphase windowed-sinc filter for the rational ratio (what the
 // analysis uses; its features are tested to stay within a tolerance of
 // `medium`'s), libsamplerate's fastest sinc converter for ratios too
