@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 
 namespace animrt {
 namespace {
@@ -62,6 +63,48 @@ void check_replaceable_file(const std::string& path) {
   if (::lstat(path.c_str(), &st) != 0) return;  // nothing there (or the write will say why)
   if (S_ISLNK(st.st_mode)) return;              // the rename replaces the link, not its target
   if (std::string kind = kind_of(st.st_mode); !kind.empty()) fail(path, kind);
+}
+
+namespace {
+
+// The problem of the nearest existing one of `folder` and its parents: ""
+// when that is a folder (the missing rest can be made), or nothing exists.
+std::string first_existing_is_folder(std::filesystem::path folder) {
+  namespace fs = std::filesystem;
+  for (; !folder.empty(); folder = folder.parent_path()) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(folder, ec);
+    if (fs::exists(st)) {
+      return fs::is_directory(st) ? "" : "\"" + folder.string() + "\" is a file, not a folder";
+    }
+    if (folder == folder.parent_path()) break;
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string output_file_problem(const std::string& path, bool folder_made) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return "an empty path, expected a file to write";
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return "is a folder, expected a file to write";
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  if (folder_made) return first_existing_is_folder(folder);
+  const fs::file_status st = fs::status(folder, ec);
+  if (!fs::exists(st)) return "its folder \"" + folder.string() + "\" does not exist";
+  if (!fs::is_directory(st)) return "\"" + folder.string() + "\" is a file, not a folder";
+  return {};
+}
+
+std::string output_folder_problem(const std::string& path) {
+  if (path.empty()) return "an empty path, expected a folder";
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_directory(st))
+    return "is a file, expected a folder";
+  return first_existing_is_folder(path);
 }
 
 void check_input_file(const std::string& path, std::uintmax_t max_bytes) {

@@ -20,8 +20,8 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/runtime/yaml_value_editor.hpp"
-#include "finite_range.hpp"
 #include "limp_figure.hpp"
+#include "option_checks.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 

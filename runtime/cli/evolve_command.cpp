@@ -23,7 +23,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "evolve_pareto.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 #include "walk_as_robot.hpp"
@@ -205,6 +205,7 @@ int run_evolve(const EvolveArgs& a) {
     std::cerr << "--dashboard shows the single-objective search; it does not go with --pareto\n";
     return kExitUsage;
   }
+  if (!output_option_ok("--out", a.out, a.pareto ? kOutputFolder : kOutputFile)) return kExitUsage;
   // The dashboard's address is a usage error before any file is read.
   const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
   if (!address.ok) return kExitUsage;
@@ -279,8 +280,10 @@ void add_evolve_command(CLI::App& app) {
                   "generations to run, the initial one included (1: the initial population "
                   "only; the run file's search.generations counts those after it)")
       ->check(CLI::Range(1, 1000001));
-  cmd->add_option("--csv", args->csv, "per-generation statistics (default: OUT with .csv)");
-  cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)");
+  cmd->add_option("--csv", args->csv, "per-generation statistics (default: OUT with .csv)")
+      ->check(kOutputFile);
+  cmd->add_option("--plot", args->plot, "best/average fitness plot (default: OUT with .svg)")
+      ->check(kOutputFile);
   cmd->add_flag("--mpi", args->mpi, "spread evaluations over MPI ranks (launch with mpirun)");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
   cmd->add_flag("--pareto", args->pareto,

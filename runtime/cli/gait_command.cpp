@@ -17,6 +17,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/mujoco/mujoco_walk.hpp"
+#include "option_checks.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -170,7 +171,8 @@ void add_gait_command(CLI::App& app) {
   cmd->add_option("ROBOT", args->robot, "robot file (motion.type gait)")->required();
   cmd->add_option("--physics", args->physics, "MuJoCo MJCF model to walk on")->required();
   cmd->add_option("--gait", args->gait, "gait file to calibrate instead of the robot's");
-  cmd->add_option("--out", args->out, "calibration file (default: next to the gait)");
+  cmd->add_option("--out", args->out, "calibration file (default: next to the gait)")
+      ->check(kOutputFileMadeFolder);
   cmd->add_option("--speeds", args->speeds, "speeds from min to max Froude")
       ->check(CLI::Range(1, 100));
   cmd->add_option("--turns", args->turns, "turn rates each way (fractions of the fastest)")

@@ -14,8 +14,8 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/evolve/fitness.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
-#include "finite_range.hpp"
 #include "gait_command.hpp"
+#include "option_checks.hpp"
 #include "subcommand.hpp"
 #include "walk_as_robot.hpp"
 

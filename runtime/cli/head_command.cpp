@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -17,7 +18,8 @@
 #include "animrt/learn/head/evaluation.hpp"
 #include "animrt/learn/head/trainer.hpp"
 #include "animrt/learn/head_corpus/generator.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
+#include "output_file.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -116,6 +118,10 @@ int run_eval(const HeadArgs& a) {
 }
 
 int run_table(const HeadArgs& a) {
+  OutputFile out;  // opened before the hours of training, written at the end
+  if (!a.out.empty() && !out.open(a.out)) {
+    throw std::runtime_error("cannot write " + a.out + ": " + std::strerror(out.error));
+  }
   const auto split = split_corpus(list_corpus(a.corpus), a.train_fraction, a.seed);
   const FeatureConfig fc;
   const auto t0 = std::chrono::steady_clock::now();
@@ -134,7 +140,9 @@ int run_table(const HeadArgs& a) {
   });
   const std::string table = format_table(rows);
   std::cout << table;
-  if (!a.out.empty()) std::ofstream(a.out) << table;
+  if (out.is_open() && !out.write(table)) {
+    throw std::runtime_error("cannot write " + a.out + ": " + std::strerror(out.error));
+  }
   std::cerr << "took "
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
             << " s\n";
@@ -170,12 +178,12 @@ void add_head_command(CLI::App& app) {
 
   auto* f = head->add_subcommand("features", "Prosodic features of a WAV file as CSV");
   f->add_option("IN", a->in, "audio file")->required();
-  f->add_option("--out", a->out, "features CSV")->required();
+  f->add_option("--out", a->out, "features CSV")->required()->check(kOutputFile);
   set_subcommand_body(f, [a] { return run_features(*a); });
 
   auto* c = head->add_subcommand("corpus",
                                  "Generate a synthetic corpus (espeak-ng speech + head motion)");
-  c->add_option("--out", a->out, "folder")->required();
+  c->add_option("--out", a->out, "folder")->required()->check(kOutputFolder);
   c->add_option("--utterances", a->utterances, "how many")->check(CLI::Range(1, 10000));
   c->add_option("--speakers", a->speakers, "speaker styles (1..4)")->check(CLI::Range(1, 4));
   c->add_option("--seed", a->seed, "random seed")->check(kSeed);
@@ -184,14 +192,16 @@ void add_head_command(CLI::App& app) {
 
   auto* t = head->add_subcommand("train", "Train a model on the training split of a corpus");
   t->add_option("CORPUS", a->corpus, "corpus folder")->required();
-  t->add_option("--out", a->out, "model file")->required();
+  t->add_option("--out", a->out, "model file")->required()->check(kOutputFile);
   add_train_options(t, *a);
   set_subcommand_body(t, [a] { return run_train(*a); });
 
   auto* s = head->add_subcommand("synth", "Synthesize head poses for a WAV file");
   s->add_option("MODEL", a->model, "model file")->required();
   s->add_option("IN", a->in, "audio file")->required();
-  s->add_option("--out", a->out, "poses CSV (time_s, yaw_deg, pitch_deg, roll_deg)")->required();
+  s->add_option("--out", a->out, "poses CSV (time_s, yaw_deg, pitch_deg, roll_deg)")
+      ->required()
+      ->check(kOutputFile);
   s->add_option("--noise-deg", a->noise_deg, "override the model's noise amplitude")
       ->check(FiniteRange(0.0, 10.0));
   set_subcommand_body(s, [a] { return run_synth(*a); });
@@ -205,7 +215,7 @@ void add_head_command(CLI::App& app) {
   auto* tb = head->add_subcommand("table",
                                   "Train and evaluate the paper's eight configurations (Table 1)");
   tb->add_option("CORPUS", a->corpus, "corpus folder")->required();
-  tb->add_option("--out", a->out, "also write the table (markdown) here");
+  tb->add_option("--out", a->out, "also write the table (markdown) here")->check(kOutputFile);
   add_train_options(tb, *a);
   set_subcommand_body(tb, [a] { return run_table(*a); });
 }

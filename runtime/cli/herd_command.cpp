@@ -22,7 +22,7 @@
 #include "animrt/runtime/robot_config.hpp"
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "output_file.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"

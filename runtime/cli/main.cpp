@@ -35,7 +35,7 @@
 #include "data_dir.hpp"
 #include "doctor_command.hpp"
 #include "fault_injection.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "output_file.hpp"
 #include "record_command.hpp"
 #include "run_herd.hpp"
@@ -256,10 +256,12 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
   run->add_option("--duration", run_args.duration,
                   "seconds of motion, then ramp home (0 = until Ctrl-C)")
       ->check(duration_validator());
-  run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file");
+  run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file")
+      ->check(animrt::cli::kOutputFile);
   run->add_option("--record", run_args.record,
                   "record the run as MCAP to this file: joint states, events, loop statistics, "
-                  "device status (Foxglove, the mcap CLI, animrt view)");
+                  "device status (Foxglove, the mcap CLI, animrt view)")
+      ->check(animrt::cli::kOutputFile);
   run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON");
   run->add_flag("--lockstep", run_args.lockstep,
                 "simulated clock: run as fast as the devices answer (sim backend only)");

@@ -14,6 +14,7 @@
 #include "animrt/bridge/commission/modbus_scan.hpp"
 #include "animrt/bridge/commission/serial_scan.hpp"
 #include "animrt/core/error.hpp"
+#include "option_checks.hpp"
 #include "port_check.hpp"
 #include "scan_draft.hpp"
 #include "subcommand.hpp"
@@ -280,7 +281,8 @@ void add_scan_command(CLI::App& app) {
          "Modbus RTU parity: even (the default, as the standard's), odd or none")
       ->check(CLI::IsMember({"even", "odd", "none"}));
   cmd->add_option("--write-robot", args->write_robot,
-                  "draft a robot file from what was found (and a hold-still show beside it)");
+                  "draft a robot file from what was found (and a hold-still show beside it)")
+      ->check(kOutputFile);
   set_subcommand_body(cmd, [args] {
     try {
       return run_scan(*args);

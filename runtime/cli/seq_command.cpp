@@ -19,6 +19,7 @@
 #include "animrt/controllers/seqnet/placement.hpp"
 #include "animrt/controllers/seqnet/reconstruction.hpp"
 #include "animrt/core/error.hpp"
+#include "option_checks.hpp"
 #include "seq_model_commands.hpp"
 #include "seq_net_forward.hpp"
 #include "subcommand.hpp"
@@ -165,7 +166,7 @@ void add_seq_command(CLI::App& seq_group) {
                    "OBJ, MD2 or MD3 file (optionally .gz) or folder of OBJs; several become one "
                    "file with a clip per input")
       ->required();
-  features->add_option("--out", args->out, "feature file to write")->required();
+  features->add_option("--out", args->out, "feature file to write")->required()->check(kOutputFile);
   features->add_option("--clip", args->clip, "only this clip's frames");
   features->add_flag("--plain", args->plain,
                      "per-vertex fits only (no exact round-trip correction)");
@@ -178,7 +179,9 @@ void add_seq_command(CLI::App& seq_group) {
   });
   auto* reconstruct = seq->add_subcommand("reconstruct", "Mesh frames from a feature file");
   reconstruct->add_option("FEATURES", args->input, "feature file")->required();
-  reconstruct->add_option("--out", args->out, "folder for frame_NNNN.obj")->required();
+  reconstruct->add_option("--out", args->out, "folder for frame_NNNN.obj")
+      ->required()
+      ->check(kOutputFolder);
   set_subcommand_body(reconstruct, [args] { return run_reconstruct(*args); });
 
   add_seq_net_forwarders(*seq);

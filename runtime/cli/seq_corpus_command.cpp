@@ -10,7 +10,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seq_corpus/generator.hpp"
 #include "data_dir.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -73,7 +73,7 @@ void add_seq_corpus_command(CLI::App& seq) {
   auto a = std::make_shared<SeqCorpusArgs>();
   auto* c = seq.add_subcommand("corpus",
                                "Generate mesh sequences: a skinned model walking gaits on MuJoCo");
-  c->add_option("--out", a->out, "output folder")->required();
+  c->add_option("--out", a->out, "output folder")->required()->check(kOutputFolder);
   c->add_option("--model", a->model, "horse, quadruped (files under --configs) or MODEL.xml")
       ->capture_default_str();
   c->add_option("--configs", a->configs, "folder with models/ and gaits/ for a named model")

@@ -20,7 +20,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/evaluation.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "subcommand.hpp"
 
 namespace animrt::cli {
@@ -86,8 +86,15 @@ struct GenerateArgs {
   std::optional<std::uint64_t> random_state;
 };
 
+// A joint model writes a CSV file, a mesh model a folder of frames.
+bool out_ok(const seqnet::ModelFile& model, const std::string& out) {
+  return output_option_ok(
+      "--out", out, model.shape.kind == seqnet::ModelKind::joints ? kOutputFile : kOutputFolder);
+}
+
 int run_generate(const GenerateArgs& a) {
   const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
+  if (!out_ok(model, a.out)) return kExitUsage;
   if (model.shape.kind == seqnet::ModelKind::joints) {
     const seqnet::FrameMatrix initial = read_joint_frames(model, a.model, a.init, "--init", 1);
     if (initial.cols() >= model.shape.window) {
@@ -150,6 +157,7 @@ void print_report(const std::vector<seqnet::GapReport>& gaps, double threshold) 
 
 int run_complete(const CompleteArgs& a) {
   const seqnet::ModelFile model = seqnet::read_checked_model(a.model);
+  if (!out_ok(model, a.out)) return kExitUsage;
   seqnet::Completion c;
   if (model.shape.kind == seqnet::ModelKind::joints) {
     const seqnet::FrameMatrix keys = read_joint_frames(model, a.model, a.keys, "--keys", 2);

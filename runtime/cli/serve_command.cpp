@@ -19,7 +19,7 @@
 #include "dashboard_address.hpp"
 #include "data_dir.hpp"
 #include "fault_injection.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "output_file.hpp"
 #include "serve_dmx.hpp"
 #include "serve_sound.hpp"

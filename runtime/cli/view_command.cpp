@@ -11,7 +11,7 @@
 #include "animrt/runtime/telemetry_replay.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "data_dir.hpp"
-#include "finite_range.hpp"
+#include "option_checks.hpp"
 #include "stop_signals.hpp"
 #include "subcommand.hpp"
 

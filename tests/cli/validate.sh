@@ -93,6 +93,32 @@ for args in "herd $root/configs/herd/flock.yaml --seed" \
 done
 out=$("$animrt" herd "$root/configs/herd/gate.yaml" --quiet --duration 1 --seed $max_seed 2>&1) ||
   fail "herd --seed $max_seed: $out"
+# Output paths are checked when the command line is read, not after the work
+# (an evolution, a training, a run): a folder where a file goes, a missing
+# folder (where the command does not make it), a file where a folder goes.
+touch "$tmp/a_file"
+while IFS='|' read -r option path problem args; do
+  # shellcheck disable=SC2086  # the words of $args are the arguments
+  out=$(timeout 20 "$animrt" $args "$option" "$path" 2>&1)
+  code=$?
+  [[ $code -eq 1 && $(echo "$out" | head -1) == "$option: $path: $problem" ]] ||
+    fail "${args%% *} $option $path: exit $code: $out"
+done <<CASES
+--out|$tmp|is a folder, expected a file to write|evolve $root/configs/evolve/quadruped_sinusoidal.yaml
+--out|$tmp/none/g.yaml|its folder "$tmp/none" does not exist|evolve $root/configs/evolve/quadruped_sinusoidal.yaml
+--out|$tmp/a_file|is a file, expected a folder|evolve $root/configs/evolve/quadruped_sinusoidal.yaml --pareto
+--csv|$tmp|is a folder, expected a file to write|evolve $root/configs/evolve/quadruped_sinusoidal.yaml --out $tmp/g.yaml
+--plot|$tmp/none/p.svg|its folder "$tmp/none" does not exist|evolve $root/configs/evolve/quadruped_sinusoidal.yaml --out $tmp/g.yaml
+--out|$tmp/a_file/c.yaml|"$tmp/a_file" is a file, not a folder|gait calibrate $root/configs/robots/quadruped.yaml
+--out|$tmp/none/t.md|its folder "$tmp/none" does not exist|head table $root/configs/head
+--out|$tmp|is a folder, expected a file to write|head train --corpus $root/configs/head
+--out|$tmp/a_file|is a file, expected a folder|head corpus
+--out|$tmp/none/f.bin|its folder "$tmp/none" does not exist|seq features $tmp/clip
+--out|$tmp/a_file/frames|"$tmp/a_file" is a file, not a folder|seq reconstruct $tmp/f.bin $tmp/m.obj
+--telemetry|$tmp/none/t.csv|its folder "$tmp/none" does not exist|run $root/configs/robots/quadruped.yaml
+--record|$tmp|is a folder, expected a file to write|run $root/configs/robots/quadruped.yaml
+--write-robot|$tmp|is a folder, expected a file to write|scan --port $tmp/no_port
+CASES
 # Any other parse error is a usage error too (CLI11's own codes are 100 and up).
 out=$("$animrt" run 2>&1)
 code=$?

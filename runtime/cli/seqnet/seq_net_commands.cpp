@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "../finite_range.hpp"
+#include "../option_checks.hpp"
 #include "../subcommand.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/learn/seqnet/training.hpp"
@@ -41,7 +41,9 @@ void add_seq_net_commands(CLI::App& app) {
       ->add_option("DATA", train_args->data,
                    "one feature file (animrt seq features), or joint-angle CSVs")
       ->required();
-  train->add_option("--out", train_args->out, "model file (also OUT.ckpt and OUT.svg)")->required();
+  train->add_option("--out", train_args->out, "model file (also OUT.ckpt and OUT.svg)")
+      ->required()
+      ->check(kOutputFile);
   train->add_option("--iterations", train_args->iterations, "total iterations")
       ->check(CLI::Range(1, 100000000));
   train->add_option("--seed", train_args->seed, "seed for the split, the batches and the weights")

@@ -39,6 +39,17 @@ std::string input_file_problem(const std::string& path,
 // /dev/zero given as an output became a file). Nothing there is fine.
 void check_replaceable_file(const std::string& path);
 
+// What keeps a command from writing a file at `path`, or "": a folder there,
+// or no folder to hold it (`folder_made`: the command makes missing folders,
+// so only a file where a folder should be is a problem). Asked before the
+// work, so a bad path is not found after a long run.
+std::string output_file_problem(const std::string& path, bool folder_made = false);
+
+// What keeps a command from writing into a folder at `path` (making it when
+// it is missing), or "": a file there, or a file where one of its parents
+// should be.
+std::string output_folder_problem(const std::string& path);
+
 // Throws InputError "PATH: PROBLEM" when input_file_problem finds one.
 void check_input_file(const std::string& path, std::uintmax_t max_bytes = kMaxInputFileBytes);
 

@@ -1,0 +1,87 @@
+#pragma once
+// Option checks CLI11's own miss: numbers, seeds, output paths.
+
+#include <CLI/CLI.hpp>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <limits>
+#include <string>
+
+#include "animrt/core/input_file.hpp"
+
+namespace animrt::cli {
+
+// CLI::Range for floating-point options, refusing NaN as well: CLI11's check
+// compares the value with its bounds, and every comparison with NaN is
+// false, so "--duration nan" passed it (a serve then ran until stopped).
+class FiniteRange : public CLI::Range {
+ public:
+  FiniteRange(double min, double max, const std::string& name = {}) : CLI::Range(min, max, name) {
+    func_ = [in_range = func_](std::string& input) {
+      double value = 0.0;
+      if (CLI::detail::lexical_cast(input, value) && std::isnan(value)) {
+        return "Value " + input + " is not a number";
+      }
+      return in_range(input);
+    };
+  }
+};
+
+// CLI::PositiveNumber and CLI::NonNegativeNumber, refusing NaN.
+inline const FiniteRange kPositiveNumber(std::numeric_limits<double>::min(),
+                                         std::numeric_limits<double>::max(), "POSITIVE");
+inline const FiniteRange kNonNegativeNumber(0.0, std::numeric_limits<double>::max(), "NONNEGATIVE");
+
+// Seeds: the integers a scene or run file's seed takes, 0 to 2^63 - 1. An
+// unsigned option alone reads "-1" as 2^64 - 1, and CLI::Range over int64
+// let 2^63 through.
+class SeedValidator : public CLI::Validator {
+ public:
+  SeedValidator() : CLI::Validator("SEED") {
+    func_ = [](std::string& input) -> std::string {
+      std::int64_t value = 0;
+      const char* end = input.data() + input.size();
+      const auto [stop, error] = std::from_chars(input.data(), end, value);
+      if (error != std::errc() || stop != end || value < 0) {
+        return "Value " + input + " is not a seed (an integer from 0 to " +
+               std::to_string(std::numeric_limits<std::int64_t>::max()) + ")";
+      }
+      return {};
+    };
+  }
+};
+inline const SeedValidator kSeed;
+
+// Output paths, checked when the command line is read: a file that cannot
+// be written is found before the work (a search, a training, a run), not
+// after it. kOutputFile wants the folder to exist; kOutputFileMadeFolder
+// belongs to commands that make it; kOutputFolder to a folder written into.
+class OutputPathValidator : public CLI::Validator {
+ public:
+  enum class Kind { file, file_made_folder, folder };
+  explicit OutputPathValidator(Kind kind) : CLI::Validator(kind == Kind::folder ? "DIR" : "FILE") {
+    func_ = [kind](std::string& input) -> std::string {
+      const std::string problem = kind == Kind::folder
+                                      ? output_folder_problem(input)
+                                      : output_file_problem(input, kind == Kind::file_made_folder);
+      return problem.empty() ? problem : input + ": " + problem;
+    };
+  }
+};
+inline const OutputPathValidator kOutputFile(OutputPathValidator::Kind::file);
+inline const OutputPathValidator kOutputFileMadeFolder(OutputPathValidator::Kind::file_made_folder);
+inline const OutputPathValidator kOutputFolder(OutputPathValidator::Kind::folder);
+
+// The same check where an output's kind is known only after parsing (a file,
+// or with another option or model a folder): false, with the message CLI11
+// would print, when `path` will not do.
+inline bool output_option_ok(const std::string& option, std::string path,
+                             const OutputPathValidator& check) {
+  const std::string problem = check(path);
+  if (!problem.empty()) std::cerr << option << ": " << problem << '\n';
+  return problem.empty();
+}
+
+}  // namespace animrt::cli
