@@ -7,9 +7,16 @@
 #include <numeric>
 #include <utility>
 
+#include "animrt/core/yaml_doc.hpp"
 #include "file_bytes.hpp"
 
 namespace animrt::seqnet::detail {
+namespace {
+
+// The largest vertex coordinate a mesh may have, in its own units.
+constexpr double kMaxVertexCoordinate = 1e9;
+
+}  // namespace
 
 void merge_coincident(MeshSequence& sequence, const std::vector<int>& group) {
   const int v = sequence.vertex_count();
@@ -102,6 +109,12 @@ void validate_mesh(const MeshSequence& sequence, const std::string& file, bool p
                std::to_string(v));
     }
     if (!sequence.frames[f].allFinite()) fail(file, key, "a vertex position is not finite");
+    // Squared in the features, 1e308 overflowed to a round trip of NaN.
+    if (const double far = sequence.frames[f].cwiseAbs().maxCoeff(); far > kMaxVertexCoordinate) {
+      fail(file, key,
+           "a vertex coordinate of " + format_number(far) +
+               ", beyond 1e9 (a kilometre in micrometres; no mesh is that large)");
+    }
   }
   std::map<std::pair<int, int>, int> edge_use;
   for (std::size_t t = 0; t < sequence.triangles.size(); ++t) {

@@ -2,10 +2,13 @@
 
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
 #include <string>
 
 #include "animrt/core/error.hpp"
@@ -26,15 +29,29 @@ void check_mujoco_timestep(const mjModel& model, const std::string& path) {
   constexpr double kMinStepS = 1e-5, kMaxStepS = 0.1;
   const double step = model.opt.timestep;
   if (step >= kMinStepS && step <= kMaxStepS) return;
-  // The line of the attribute, where the file has one.
+  // The line of the attribute (timestep="..."), where the file has one,
+  // outside comments.
   int line = 0;
   std::ifstream in(path);
-  std::string text;
-  for (int n = 1; std::getline(in, text); ++n) {
-    if (text.find("timestep") != std::string::npos) {
-      line = n;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  static const std::regex attribute(R"((^|[\s])timestep\s*=)");
+  int n = 1;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t comment = text.find("<!--", at);
+    const std::size_t stop = comment == std::string::npos ? text.size() : comment;
+    std::smatch match;
+    const auto begin = text.begin() + static_cast<std::ptrdiff_t>(at);
+    const auto end = text.begin() + static_cast<std::ptrdiff_t>(stop);
+    if (std::regex_search(begin, end, match, attribute)) {
+      line = n + static_cast<int>(std::count(begin, match[0].first, '\n'));
       break;
     }
+    n += static_cast<int>(std::count(begin, end, '\n'));
+    if (comment == std::string::npos) break;
+    const std::size_t close = text.find("-->", comment + 4);
+    const std::size_t after = close == std::string::npos ? text.size() : close + 3;
+    n += static_cast<int>(std::count(end, text.begin() + static_cast<std::ptrdiff_t>(after), '\n'));
+    at = after;
   }
   char found[32];
   std::snprintf(found, sizeof found, "%g", step);

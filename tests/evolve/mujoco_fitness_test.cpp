@@ -385,6 +385,17 @@ TEST(MujocoModel, ATimeStepOutsideTenMicrosecondsToATenthIsRefusedAtItsLine) {
     }
     EXPECT_THROW(sim::MujocoFigure(file, {"lf_hip"}, Location{}), InputError) << step;
   }
+  // The word in a comment above it is not the attribute.
+  std::string commented = shipped;
+  commented.replace(at, 17, "timestep=\"0\"");
+  commented.insert(commented.find("<mujoco"), "<!-- timestep=\"0.002\" was\n  the timestep -->\n");
+  write_file(file, commented);
+  try {
+    sim::load_mujoco_model(file);
+    ADD_FAILURE() << "loaded timestep 0";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().line, line + 2);
+  }
   std::string text = shipped;
   text.replace(at, 17, "timestep=\"0.001\"");
   write_file(file, text);

@@ -312,9 +312,9 @@ TEST(Md3Reader, AClipOfNoFramesIsLeftOutAndAClipOutsideTheFileIsRefused) {
   EXPECT_EQ(s.clips.back().count, 2);
 
   seqtest::write_text(dir + "/animation.cfg", animation_cfg("6 2 0 10"));
-  EXPECT_EQ(error_of(model, read_md3),
-            dir + "/animation.cfg:27:1: LEGS_TURN: frames 4..5 are outside " + model +
-                "'s 4 frames");
+  EXPECT_EQ(
+      error_of(model, read_md3),
+      dir + "/animation.cfg:27:1: LEGS_TURN: frames 4..5 are outside " + model + "'s 4 frames");
   seqtest::write_text(dir + "/animation.cfg", animation_cfg("5 1 0 10"));
   const MeshSequence turn = read_md3(model);
   ASSERT_EQ(turn.clips.size(), 18u);
@@ -355,6 +355,14 @@ TEST(ObjReader, BadFacesNameLineAndColumn) {
   e = error_of(path, read_obj);
   EXPECT_NE(e.find("non-manifold"), std::string::npos) << e;
   EXPECT_NE(e.find("frame 0"), std::string::npos) << e;
+  // A coordinate no mesh has (1e308 made a round trip of NaN); 1e9 is kept.
+  seqtest::write_text(path, "v 0 0 0\nv 1e9 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(error_of(path, read_obj), "");
+  seqtest::write_text(path, "v 0 0 0\nv 1 0 0\nv 0 -1e308 0\nf 1 2 3\n");
+  EXPECT_EQ(error_of(path, read_obj),
+            path +
+                ": frame 0: a vertex coordinate of 1e+308, beyond 1e9 (a kilometre in "
+                "micrometres; no mesh is that large)");
 }
 
 // A key or initial frame is a pose of a model's mesh: a triangle it
