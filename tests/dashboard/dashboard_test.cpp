@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -466,6 +467,54 @@ TEST(Dashboard, AStreamClientThatNeverReadsDoesNotHoldUpTheLoop) {
   EXPECT_EQ(summary.overruns, 0u);
   EXPECT_EQ(summary.buses[0].late_cycles, 0u);
   EXPECT_EQ(run.monitor_->timing_dropped(), 0u);
+}
+
+// Resident memory of this process, in KiB.
+long resident_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+// A body far larger than any control takes (a stop's is empty, a cue's a
+// name) is not read into memory, with or without a length: the server stops
+// reading it, holds no copy, and the run and the dashboard go on. It was read
+// whole, without the token, until the request's deadline (gigabytes a
+// connection).
+TEST(Dashboard, ABodyLargerThanAnyControlIsNeitherReadNorHeld) {
+  DashboardRun run(60.0);
+  run.wait_state(in_motion);
+  const long before = resident_kib();
+  constexpr std::size_t kOffered = std::size_t{64} << 20;
+  for (const char* framing : {"Content-Length: 20000000000", "Transfer-Encoding: chunked"}) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(run.server_->port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    const bool chunked = std::string(framing).find("chunked") != std::string::npos;
+    std::string data =
+        "POST /api/stop HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(run.server_->port()) +
+        "\r\nContent-Type: application/json\r\n" + framing + "\r\n\r\n";
+    const std::string piece(65536, '0');
+    std::size_t sent = 0;
+    while (sent < kOffered) {
+      data += chunked ? "10000\r\n" + piece + "\r\n" : piece;
+      const ssize_t n = ::send(fd, data.data(), data.size(), MSG_NOSIGNAL);
+      if (n < 0) break;  // the server closed the connection
+      sent += static_cast<std::size_t>(n);
+      data.erase(0, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    EXPECT_LT(sent, kOffered) << framing << ": the server read the whole body";
+  }
+  EXPECT_LT(resident_kib() - before, 16 * 1024);
+  EXPECT_TRUE(in_motion(run.get("/api/state")));  // no stop taken, the dashboard answers
 }
 
 // Publishing to the dashboard and taking its controls adds no allocation to

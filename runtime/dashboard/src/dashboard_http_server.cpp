@@ -109,7 +109,10 @@ class DashboardHttpServer::ConnectionStream : public httplib::Stream {
   ConnectionStream(int sock, HttpClock::duration read_timeout, HttpClock::duration write_timeout)
       : sock_(sock), read_timeout_(read_timeout), write_timeout_(write_timeout) {}
 
-  void start_request() { deadline_ = HttpClock::now() + kRequestTimeout; }
+  void start_request() {
+    deadline_ = HttpClock::now() + kRequestTimeout;
+    received_ = 0;
+  }
   bool buffered() const { return begin_ < end_; }
   // A read failed: too late, silent, closed or broken. httplib answers such
   // a request 400 and would wait for the next; the connection ends instead.
@@ -129,8 +132,10 @@ class DashboardHttpServer::ConnectionStream : public httplib::Stream {
 
   ssize_t read(char* ptr, std::size_t size) override {
     if (!buffered()) {
-      // Late (the whole request is overdue) or silent for the read timeout.
-      if (HttpClock::now() >= deadline_ || !http_wait_for(sock_, POLLIN, read_wait())) {
+      // Late (the whole request is overdue), too long, or silent for the
+      // read timeout.
+      if (HttpClock::now() >= deadline_ || received_ > kMaxRequestBytes ||
+          !http_wait_for(sock_, POLLIN, read_wait())) {
         failed_ = true;
         return -1;
       }
@@ -143,6 +148,7 @@ class DashboardHttpServer::ConnectionStream : public httplib::Stream {
       }
       begin_ = 0;
       end_ = static_cast<std::size_t>(n);
+      received_ += end_;
     }
     const std::size_t n = std::min(size, end_ - begin_);
     std::memcpy(ptr, buffer_.data() + begin_, n);
@@ -175,6 +181,7 @@ class DashboardHttpServer::ConnectionStream : public httplib::Stream {
   int sock_;
   HttpClock::duration read_timeout_, write_timeout_;
   HttpClock::time_point deadline_ = HttpClock::now() + kRequestTimeout;
+  std::size_t received_ = 0;  // bytes of this request read from the socket
   std::array<char, 4096> buffer_{};
   std::size_t begin_ = 0, end_ = 0;
   bool failed_ = false;
@@ -182,6 +189,7 @@ class DashboardHttpServer::ConnectionStream : public httplib::Stream {
 
 DashboardHttpServer::DashboardHttpServer() {
   new_task_queue = [this] { return new ConnectionThreads(*this); };
+  set_payload_max_length(kMaxBody);
 }
 
 int DashboardHttpServer::connections() const {

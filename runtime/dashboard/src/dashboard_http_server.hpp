@@ -18,6 +18,13 @@
 // POST without Content-Length or Transfer-Encoding has an empty body
 // (RFC 9112 6.3), where httplib would read until the connection closes.
 // stop() wakes every open connection, so the server ends at once.
+//
+// A body is at most kMaxBody (the controls take a few bytes of JSON; a
+// longer Content-Length is answered 413), and a request at most
+// kMaxRequestBytes read from its socket, whatever it declares (httplib
+// enforces no limit on a chunked body): httplib reads a body before any
+// handler sees the request, so a client without the token held gigabytes
+// of memory per connection until its deadline.
 
 #include <httplib.h>
 
@@ -33,6 +40,8 @@ class DashboardHttpServer : public httplib::Server {
  public:
   static constexpr int kMaxConnections = 256;
   static constexpr std::chrono::milliseconds kRequestTimeout{2000};
+  static constexpr std::size_t kMaxBody = 64 * 1024;
+  static constexpr std::size_t kMaxRequestBytes = kMaxBody + 64 * 1024;  // + head, chunk sizes
 
   DashboardHttpServer();
 
