@@ -88,13 +88,17 @@ SacnSources::Verdict SacnSources::take(const SacnDmx& packet, double now_s) {
     return Verdict::not_output;
   }
   if (packet.start_code != 0) return Verdict::not_output;  // e.g. per-channel priorities
+  // Preview data is not live output (E1.31 6.2.6): it neither plays nor
+  // takes part in the priority among sources, so a preview at 200 does not
+  // silence the desk's live data at 100.
+  if (packet.preview) return Verdict::not_output;
   source->priority = packet.priority;
   source->seen_s = now_s;
   // The highest priority among live sources is output; equal ones take turns.
   for (const Source& s : sources_) {
     if (s.used && s.priority > packet.priority) return Verdict::lower_priority;
   }
-  return packet.preview ? Verdict::not_output : Verdict::output;
+  return Verdict::output;
 }
 
 std::string SacnReceiver::group(int universe) {

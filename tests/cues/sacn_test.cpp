@@ -109,6 +109,15 @@ TEST(Sacn, TheHighestPrioritySourceIsOutputUntilItIsLost) {
   EXPECT_EQ(sacn_take(sources, e131(1, {1}, 2, 180, 0x33, 0x40), 3.0), V::not_output);
   EXPECT_EQ(sacn_take(sources, e131(1, {1}, 4, 100, 0x11), 3.0), V::output);
   EXPECT_EQ(sacn_take(sources, e131(1, {1}, 5, 100, 0x11, 0x80), 3.0), V::not_output);
+  // Nor does preview data at a higher priority hold the live data back.
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 0, 200, 0x44, 0x80), 3.1), V::not_output);
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 6, 100, 0x11), 3.2), V::output);
+  // A source that goes from live to preview only is lost as if silent.
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 0, 190, 0x55), 4.0), V::output);
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 1, 190, 0x55, 0x80), 4.1), V::not_output);
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 7, 100, 0x11), 4.2), V::lower_priority);
+  EXPECT_EQ(sacn_take(sources, e131(1, {1}, 8, 100, 0x11), 4.0 + kSacnSourceLossS + 0.1),
+            V::output);
 }
 
 }  // namespace
