@@ -22,6 +22,7 @@
 
 #include "animrt/controllers/show/show_audio.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/runtime/cue_file.hpp"
 #include "animrt/runtime/dashboard.hpp"
 #include "animrt/runtime/emergency_stop.hpp"
 #include "animrt/runtime/figure.hpp"
@@ -76,7 +77,7 @@ void attach_legs(animrt::LoadedRobot& robot) {
                                                                        robot.config.model_where));
 }
 
-int cmd_validate(const std::string& path) {
+int cmd_validate(const std::string& path, const std::string& cues_path) {
   animrt::LoadedRobot robot = animrt::load_robot(path);
   load_figure(robot.config);
   attach_legs(robot);
@@ -91,6 +92,13 @@ int cmd_validate(const std::string& path) {
   for (const std::string& note : animrt::device_guard_notes(robot.config)) {
     std::cout << note << "\n";
   }
+  if (cues_path.empty()) return kExitOk;
+  // The cue file as serve loads it, against this robot's joints.
+  const animrt::LoadedCues cues = animrt::load_cues(cues_path, robot.config);
+  std::cout << cues_path << ": ok (" << cues.cues.size() << " cue"
+            << (cues.cues.size() == 1 ? "" : "s") << ", idle "
+            << cues.cues[static_cast<std::size_t>(cues.idle)].name << ")\n";
+  for (const std::string& warning : cues.warnings) std::cout << "warning: " << warning << "\n";
   return kExitOk;
 }
 
@@ -308,9 +316,11 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "animrt " ANIMRT_VERSION);
   app.option_defaults()->always_capture_default();  // every --help shows the defaults
 
-  std::string validate_path;
+  std::string validate_path, validate_cues;
   auto* validate = app.add_subcommand("validate", "Check a robot file and the files it names");
   validate->add_option("FILE", validate_path, "robot file (YAML)")->required();
+  validate->add_option("--cues", validate_cues,
+                       "also check this cue file (animrt serve's) against the robot");
 
   RunArgs run_args;
   auto* run = add_run_subcommand(app, run_args);
@@ -336,7 +346,7 @@ int main(int argc, char** argv) {
   }
   animrt::cli::install_stop_signals(g_controls);
   try {
-    if (*validate) return cmd_validate(validate_path);
+    if (*validate) return cmd_validate(validate_path, validate_cues);
     if (*run) return cmd_run(run_args);
   } catch (const animrt::InputError& e) {
     std::cerr << "error: " << e.what() << '\n';

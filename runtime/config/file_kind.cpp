@@ -14,10 +14,11 @@ struct FileKind {
   const char* name;
   const char* example;                   // a shipped file of the kind
   std::array<std::string_view, 4> keys;  // any one of them names the kind
+  const char* how_to_check = "";         // where animrt checks a file of the kind
 };
 
 // Keys no robot file has; the first kind that has one of them wins.
-constexpr std::array<FileKind, 6> kKinds{{
+constexpr std::array<FileKind, 7> kKinds{{
     {"a gait file",
      "configs/gaits/walk.yaml",
      {"stride_frequency_hz", "curves", "limbs", "steering"}},
@@ -32,6 +33,10 @@ constexpr std::array<FileKind, 6> kKinds{{
      "configs/modbus/linear_actuator.yaml",
      {"goal", "present", "enable", "unit"}},
     {"a show", "configs/shows/hello.yaml", {"duration_s", "tracks", "audio", ""}},
+    {"a cue file",
+     "configs/cues/animatronic.yaml",
+     {"cues", "idle", "crossfade_s", "artnet"},
+     "; check it with the robot that plays it: animrt validate ROBOT --cues FILE"},
 }};
 
 }  // namespace
@@ -44,7 +49,8 @@ std::string other_file_kind(const YamlNode& root) {
       if (!key.empty() && root.has(key)) seen += (seen.empty() ? "" : ", ") + std::string(key);
     }
     if (!seen.empty()) {
-      return std::string(kind.name) + " (it has " + seen + "; like " + kind.example + ")";
+      return std::string(kind.name) + " (it has " + seen + "; like " + kind.example + ")" +
+             kind.how_to_check;
     }
   }
   return "";
