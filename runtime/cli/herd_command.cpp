@@ -253,9 +253,11 @@ void add_herd_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration, "seconds to simulate (default: the scene's)")
       ->check(FiniteRange(0.001, 1e6));
   cmd->add_option("--seed", args->seed, "random seed (overrides the scene's)")->check(kSeed);
-  cmd->add_option("--out", args->out, "CSV of every agent at every output step");
-  cmd->add_option("--svg", args->svg, "top view with the trails (SVG)");
-  cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON");
+  cmd->add_option("--out", args->out, "CSV of every agent at every output step")
+      ->check(kOutputFile);
+  cmd->add_option("--svg", args->svg, "top view with the trails (SVG)")->check(kOutputFile);
+  cmd->add_option("--summary-json", args->summary_json, "write the metrics as JSON")
+      ->check(kOutputFile);
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
   cmd->add_option("--dashboard", args->dashboard,
                   "serve a live top view at HOST:PORT (port 0: a free one); the herd then walks "

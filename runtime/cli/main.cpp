@@ -270,7 +270,8 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
                   "record the run as MCAP to this file: joint states, events, loop statistics, "
                   "device status (Foxglove, the mcap CLI, animrt view)")
       ->check(animrt::cli::kOutputFile);
-  run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON");
+  run->add_option("--summary-json", run_args.summary_json, "write the run summary as JSON")
+      ->check(animrt::cli::kOutputFile);
   run->add_flag("--lockstep", run_args.lockstep,
                 "simulated clock: run as fast as the devices answer (sim backend only)");
   run->add_flag("--no-realtime", run_args.no_realtime, "do not request SCHED_FIFO or mlockall");

@@ -270,7 +270,8 @@ void add_serve_command(CLI::App& app) {
   cmd->add_flag("--dashboard-remote", args->dashboard_remote,
                 "let the dashboard listen on an address other machines can reach");
   cmd->add_option("--summary-json", args->summary_json,
-                  "write the run's summary and the cues' counts as JSON");
+                  "write the run's summary and the cues' counts as JSON")
+      ->check(kOutputFile);
   set_subcommand_body(cmd, [args]() -> int {
     try {
       return serve(*args);

@@ -66,13 +66,14 @@ assert g["arrivals"] == 0 and g["time_to_goal_mean_s"] is None and g["stuck"] ==
 PY
 # The summary and the top view are written at the end, but a path that
 # cannot be written is refused before the herd takes a step, not after it.
-for opt in --summary-json --svg; do
-  what=summary; [[ $opt == --svg ]] && what="top view"
-  for path in "$tmp/missing/x" "$tmp"; do
-    out=$("$animrt" herd "$tmp/one.yaml" "$opt" "$path" --quiet 2>&1) &&
-      fail "herd $opt $path succeeded: $out"
-    [[ $out == *"$path: cannot write the $what: "* ]] || fail "herd $opt $path: $out"
-    [[ $out != *"min pair distance"* ]] || fail "herd $opt $path stepped the herd first: $out"
-  done
+for opt in --summary-json --svg --out; do
+  out=$("$animrt" herd "$tmp/one.yaml" "$opt" "$tmp/missing/x" --quiet 2>&1) &&
+    fail "herd $opt in a missing folder succeeded: $out"
+  [[ $(echo "$out" | head -1) == "$opt: $tmp/missing/x: its folder \"$tmp/missing\" does not exist" ]] ||
+    fail "herd $opt in a missing folder: $out"
+  out=$("$animrt" herd "$tmp/one.yaml" "$opt" "$tmp" --quiet 2>&1) && fail "herd $opt $tmp succeeded"
+  [[ $(echo "$out" | head -1) == "$opt: $tmp: is a folder, expected a file to write" ]] ||
+    fail "herd $opt $tmp: $out"
+  [[ $out != *"min pair distance"* ]] || fail "herd $opt stepped the herd first: $out"
 done
 echo "herd_summary: ok"

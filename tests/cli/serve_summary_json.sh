@@ -24,7 +24,7 @@ PY
 out=$("$animrt" serve "$root/configs/robots/head.yaml" --cues "$root/configs/cues/head.yaml" \
   --lockstep --duration 1 --no-osc --no-artnet --summary-json "$tmp/no/such/dir/s.json" 2>&1)
 code=$?
-[[ $code -eq 1 && $out == *"--summary-json: cannot write $tmp/no/such/dir/s.json"* ]] ||
+[[ $code -eq 1 && $out == *"--summary-json: $tmp/no/such/dir/s.json: its folder \"$tmp/no/such/dir\" does not exist"* ]] ||
   fail "unwritable summary: exit $code: $out"
 [[ $out != *"start ramp"* && $out != *"cues started"* ]] || fail "it moved first: $out"
 echo ok
