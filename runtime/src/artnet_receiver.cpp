@@ -22,6 +22,11 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
   if (length < 2 || length > 512 || length % 2 != 0 || packet.size() != kHeader + length) {
     return ArtNetParse::malformed;
   }
+  // The Port-Address is 15 bits: a Net with its top bit set is no address
+  // (taken as 0x7f-masked, Net 0x80 played universe 0).
+  if ((packet[15] & 0x80) != 0) {
+    return ArtNetParse::malformed;
+  }
   out.universe = ((packet[15] & 0x7f) << 8) | packet[14];
   out.data = packet.subspan(kHeader, length);
   return ArtNetParse::dmx;

@@ -34,6 +34,10 @@ TEST(ArtNet, LengthsThatDisagreeAreMalformedAndOtherOpcodesAreNotDmx) {
   EXPECT_EQ(parse_artnet(art_dmx(0, std::vector<std::uint8_t>(514, 0), 514), dmx),
             ArtNetParse::malformed);
   EXPECT_EQ(parse_artnet(art_dmx(0, {}, 0), dmx), ArtNetParse::malformed);
+  // Net 0x80: outside the 15-bit Port-Address, not universe 0.
+  EXPECT_EQ(parse_artnet(art_dmx(0x8000, {1, 2}, 2), dmx), ArtNetParse::malformed);
+  EXPECT_EQ(parse_artnet(art_dmx(0x7fff, {1, 2}, 2), dmx), ArtNetParse::dmx);
+  EXPECT_EQ(dmx.universe, 0x7fff);
   auto poll = art_dmx(0, {1, 2}, 2);
   poll[9] = 0x20;  // ArtPoll
   EXPECT_EQ(parse_artnet(poll, dmx), ArtNetParse::other);
