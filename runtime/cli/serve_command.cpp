@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <memory>
@@ -52,8 +53,9 @@ struct ServeArgs {
 // Written by the signal handlers, OSC's /stop and the dashboard; read by the cycle.
 RunControls serve_controls;
 
-// What an OSC message asks: /cue/NAME, /stop, /pause (an argument 0
-// resumes), /resume. False for any other address.
+// What an OSC message asks: /cue/NAME, /stop, /pause (an argument 0 or
+// false resumes), /resume. False for any other address, and for a /pause
+// whose argument is NaN (counted as unknown).
 bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
                 CueRequests& requests) {
   const std::string& address = message.address;
@@ -62,6 +64,8 @@ bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
     return true;
   }
   if (address == "/pause") {
+    // No number pauses, 0 (or false) resumes; a NaN asks nothing.
+    if (!message.numbers.empty() && std::isnan(message.numbers.front())) return false;
     requests.pause(message.numbers.empty() || message.numbers.front() != 0.0);
     return true;
   }

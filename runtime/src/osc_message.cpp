@@ -48,7 +48,7 @@ class OscReader {
 };
 
 bool parse_argument(char tag, OscReader& in, OscMessage& message) {
-  std::uint32_t w = 0;
+  std::uint32_t w = 0, low = 0;
   std::string text;
   switch (tag) {
     case 'i':
@@ -66,8 +66,15 @@ bool parse_argument(char tag, OscReader& in, OscMessage& message) {
       if (!in.word(w) || w > 0x7fffffffu) return false;
       return in.skip((std::size_t{w} + 3) & ~std::size_t{3});
     case 'h':
-    case 't':
+      if (!in.word(w) || !in.word(low)) return false;
+      message.numbers.push_back(
+          static_cast<double>(static_cast<std::int64_t>((std::uint64_t{w} << 32) | low)));
+      return true;
     case 'd':
+      if (!in.word(w) || !in.word(low)) return false;
+      message.numbers.push_back(std::bit_cast<double>((std::uint64_t{w} << 32) | low));
+      return true;
+    case 't':
       return in.skip(8);
     case 'c':
     case 'r':
@@ -75,6 +82,8 @@ bool parse_argument(char tag, OscReader& in, OscMessage& message) {
       return in.skip(4);
     case 'T':
     case 'F':
+      message.numbers.push_back(tag == 'T' ? 1.0 : 0.0);
+      return true;
     case 'N':
     case 'I':
       return true;

@@ -43,6 +43,22 @@ TEST(Osc, AMessageWithIntAndFloatArguments) {
   EXPECT_EQ(out[0].numbers[1], 0.25);
 }
 
+// Booleans and 64-bit numbers are numbers too, in their places: a
+// controller that sends False to resume is heard as 0.
+TEST(Osc, BooleansAndSixtyFourBitNumbersAreNumbersInOrder) {
+  const double d = -2.5;
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &d, 8);
+  const Bytes packet =
+      message("/pause", ",FsThd",
+              {0x61000000u, 0xffffffffu, 0xfffffffdu, static_cast<std::uint32_t>(bits >> 32),
+               static_cast<std::uint32_t>(bits)});
+  std::vector<OscMessage> out;
+  ASSERT_TRUE(parse_osc_packet(packet, out));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].numbers, (std::vector<double>{0.0, 1.0, -3.0, -2.5}));
+}
+
 TEST(Osc, ABundleCarriesItsMessagesInOrder) {
   Bytes bundle;
   pad_string(bundle, "#bundle");

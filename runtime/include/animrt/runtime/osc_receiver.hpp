@@ -17,8 +17,10 @@
 namespace animrt {
 
 struct OscMessage {
-  std::string address;          // "/cue/hello"
-  std::vector<double> numbers;  // the int32 and float32 arguments, in order
+  std::string address;  // "/cue/hello"
+  // The numeric arguments in order: int32, float32, int64, float64, and the
+  // booleans T and F as 1 and 0 (a controller's "false" resumes a pause).
+  std::vector<double> numbers;
 };
 
 // Appends the messages of one packet (a message, or a bundle of them, nested
