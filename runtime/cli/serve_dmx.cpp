@@ -5,12 +5,18 @@
 namespace animrt::cli {
 namespace {
 
-// A channel's value asks for the cue with that `dmx` value.
-auto cue_selector(CueRequests& requests, const std::vector<int>& values) {
-  return [&requests, values](int value) {
+// A channel's value asks for the cue with that `dmx` value; a value other
+// than 0 that no cue has is counted in `no_cue`.
+auto cue_selector(CueRequests& requests, const std::vector<int>& values,
+                  std::atomic<std::uint64_t>& no_cue) {
+  return [&requests, values, &no_cue](int value) {
+    bool asked = false;
     for (std::size_t c = 0; c < values.size(); ++c) {
-      if (values[c] == value) requests.cue(static_cast<int>(c));
+      if (values[c] != value) continue;
+      requests.cue(static_cast<int>(c));
+      asked = true;
     }
+    if (!asked && value != 0) no_cue.fetch_add(1, std::memory_order_relaxed);
   };
 }
 
@@ -57,14 +63,15 @@ ServeDmx::ServeDmx(const DmxArgs& args, const LoadedCues& loaded, CueRequests& r
     drive_joints(artnet_joints_, loaded.artnet, motion, joints);
     artnet_ = std::make_unique<ArtNetReceiver>(
         args.artnet_bind, args.artnet_port, loaded.artnet.universe, loaded.artnet.channel,
-        cue_selector(requests, loaded.dmx_values), frame_sink(artnet_joints_.joints.get()));
+        cue_selector(requests, loaded.dmx_values, artnet_no_cue_),
+        frame_sink(artnet_joints_.joints.get()));
     print_listening("artnet", args.artnet_bind, artnet_->port(), loaded.artnet);
   }
   if (loaded.sacn.present && !args.no_sacn) {
     drive_joints(sacn_joints_, loaded.sacn, motion, joints);
     sacn_ = std::make_unique<SacnReceiver>(args.sacn_bind, args.sacn_port, args.sacn_multicast,
                                            loaded.sacn.universe, loaded.sacn.channel,
-                                           cue_selector(requests, loaded.dmx_values),
+                                           cue_selector(requests, loaded.dmx_values, sacn_no_cue_),
                                            frame_sink(sacn_joints_.joints.get()));
     print_listening("sacn", args.sacn_bind, sacn_->port(), loaded.sacn);
     if (args.sacn_multicast) {
@@ -89,12 +96,13 @@ void ServeDmx::report(std::ostream& out) const {
   if (artnet_) {
     out << "artnet: " << artnet_->packets() << " packets, " << artnet_->frames()
         << " frames of the cue universe, " << artnet_->malformed() << " malformed, "
-        << artnet_->ignored() << " ignored\n";
+        << artnet_->ignored() << " ignored, " << artnet_no_cue_.load()
+        << " values asking for no cue\n";
   }
   if (sacn_) {
     out << "sacn: " << sacn_->packets() << " packets, " << sacn_->frames() << " frames output, "
         << sacn_->malformed() << " malformed, " << sacn_->out_of_sequence() << " out of sequence, "
-        << sacn_->ignored() << " ignored\n";
+        << sacn_->ignored() << " ignored, " << sacn_no_cue_.load() << " values asking for no cue\n";
   }
   print_joints(out, "artnet", artnet_joints_.joints.get(), artnet_joints_.source);
   print_joints(out, "sacn", sacn_joints_.joints.get(), sacn_joints_.source);

@@ -3,6 +3,8 @@
 // selects cues, and the joints their channels drive (docs/show_control.md).
 
 #include <CLI/CLI.hpp>
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -45,6 +47,8 @@ class ServeDmx {
                     const std::vector<JointSpec>& joints);
 
   Input artnet_joints_, sacn_joints_;
+  // Values of the cue channel that no cue has (a desk patched wrong).
+  std::atomic<std::uint64_t> artnet_no_cue_{0}, sacn_no_cue_{0};
   std::unique_ptr<ArtNetReceiver> artnet_;  // after the inputs: their threads stop first
   std::unique_ptr<SacnReceiver> sacn_;
 };

@@ -42,6 +42,8 @@ send(artdmx([2, 0, 0], length=3, data_len=3))  # an odd length
 send(artdmx([2, 0])[:17])       # cut inside the header
 send(artdmx([0, 0]))            # zero: no cue
 time.sleep(0.2)
+send(artdmx([9, 0]))            # a value no cue has: counted
+time.sleep(0.2)
 send(artdmx([4, 0]))            # greet
 time.sleep(0.5)
 PY
@@ -51,7 +53,7 @@ out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "ended by stop request" <<<"$out" || fail "SIGTERM did not stop: $out"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"
-grep -qE "^artnet: 10 packets, 5 frames of the cue universe, 3 malformed, 2 ignored$" <<<"$out" ||
+grep -qE "^artnet: 11 packets, 6 frames of the cue universe, 3 malformed, 2 ignored, 1 values asking for no cue$" <<<"$out" ||
   fail "$(grep '^artnet' <<<"$out")"
 grep -qE "^cues started: sway [1-9][0-9]* hello 0 look_left 1 greet 1$" <<<"$out" ||
   fail "expected look_left and greet once: $(grep '^cues started' <<<"$out")"

@@ -99,7 +99,7 @@ wait_exit
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"
-grep -qE "^sacn: [0-9]+ packets, [0-9]+ frames output, 4 malformed, 1 out of sequence, 3 ignored$" <<<"$out" ||
+grep -qE "^sacn: [0-9]+ packets, [0-9]+ frames output, 4 malformed, 1 out of sequence, 3 ignored, 0 values asking for no cue$" <<<"$out" ||
   fail "$(grep '^sacn' <<<"$out")"
 grep -qE "^sacn joints: [0-9]+ frames, 1 times lost" <<<"$out" || fail "$(grep '^sacn joints' <<<"$out")"
 grep -qE "^artnet joints: [0-9]+ frames, 1 times lost" <<<"$out" || fail "$(grep '^artnet joints' <<<"$out")"
