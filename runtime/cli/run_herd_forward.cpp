@@ -9,7 +9,7 @@ namespace animrt::cli {
 
 void run_herd_here(const std::string& scene) {
   if (scene.empty()) return;
-  std::exit(exec_tools(remembered_argv()));
+  std::exit(exec_tools(remembered_argv(), "run --herd"));
 }
 
 std::unique_ptr<RunHerd> join_run_herd(const std::string&, const std::string&, const Figure&,

@@ -25,7 +25,7 @@ void set_subcommand_body(CLI::App* cmd, std::function<int()> body) {
 
 void hide_empty_defaults(CLI::App& app) {
   for (CLI::Option* option : app.get_options()) {
-    if (option->get_default_str() == "[]") option->default_str("");
+    if (option->get_default_str() == "[]" || option->get_required()) option->default_str("");
   }
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
     hide_empty_defaults(*sub);

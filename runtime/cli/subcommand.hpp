@@ -22,8 +22,9 @@ inline constexpr int kExitRecordLost = 6;
 void set_subcommand_body(CLI::App* cmd, std::function<int()> body);
 
 // --help shows every option's default (option_defaults()->always_capture_default()),
-// except an empty list's "[]", which says nothing: called once every command
-// is added.
+// except an empty list's "[]" and a required option's placeholder (servo's
+// "--id INT=-1 REQUIRED"), which say nothing: called once every command is
+// added.
 void hide_empty_defaults(CLI::App& app);
 
 }  // namespace animrt::cli

@@ -31,13 +31,15 @@ std::string tools_path() {
 void remember_argv(char** argv) { g_argv = argv; }
 char** remembered_argv() { return g_argv; }
 
-int exec_tools(char** argv) {
+int exec_tools(char** argv, const std::string& command_name) {
   const std::string tools = tools_path();
   std::cout.flush();
   std::cerr.flush();
   ::execv(tools.c_str(), argv);
   const int error = errno;
-  const std::string command = argv[1] != nullptr ? argv[1] : "";
+  const std::string command = !command_name.empty() ? command_name
+                              : argv[1] != nullptr  ? argv[1]
+                                                    : "";
   if (error == ENOENT) {
     std::cerr << "error: `animrt " << command
               << "` is one of the offline tools, which are not installed here (" << tools

@@ -35,5 +35,10 @@ for args in "evolve $root/configs/evolve/x.yaml" "seq corpus --help" \
   [[ $code == 1 ]] || fail "animrt $args without the tools: exit $code: $out"
   [[ $(wc -l <<<"$out") == 1 && $out == *"install the animrt-tools package"* ]] ||
     fail "animrt $args without the tools: $out"
+  # It names the command that needs the tools: `run --herd`, not `run`.
+  name=${args%% *}
+  [[ $args == *--herd* ]] && name="run --herd"
+  [[ $out == "error: \`animrt $name\` is one of the offline tools"* ]] ||
+    fail "animrt $args without the tools names another command: $out"
 done
 echo "ok"

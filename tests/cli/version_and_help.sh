@@ -19,6 +19,9 @@ out=$("$animrt" herd --help 2>&1) || fail "herd --help failed: $out"
 out=$("$animrt" seq corpus --help 2>&1) || fail "seq corpus --help failed: $out"
 [[ $out == *"--vertices "*"=1000"* ]] || fail "seq corpus --help shows no default vertices: $out"
 [[ $out != *"=[]"* ]] || fail "an empty list shown as a default: $out"
+# A required option has no default to show (servo's id was "INT=-1 REQUIRED").
+out=$("$animrt" servo --help 2>&1) || fail "servo --help failed: $out"
+[[ $out == *"--id INT REQUIRED"* ]] || fail "servo --help shows a default for the required id: $out"
 
 out=$("$animrt" seq train --help 2>&1) || fail "seq train --help failed: $out"
 [[ $out == *"Usage: animrt seq train "* ]] || fail "seq train --help names another program: $out"
