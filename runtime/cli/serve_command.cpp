@@ -225,7 +225,10 @@ int serve(const ServeArgs& args) {
     sound.start(t0);
     triggers.begin();
   };
-  options.on_motion_end = [&sound] { sound.stop(); };
+  options.on_motion_end = [&sound, &requests] {
+    sound.stop();
+    requests.close();  // what came later is not the run's
+  };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
   slow_exit_for_test();

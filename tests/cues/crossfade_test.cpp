@@ -317,5 +317,22 @@ TEST(CueRequests, ABurstOfTriggersNeitherAllocatesNorJumpsAndTheNewestWins) {
   }
 }
 
+// Once the motion has ended, requests are neither taken nor counted: the
+// summary file and the last lines, read at different times, agree.
+TEST(CueRequests, AfterCloseNothingIsTakenOrCounted) {
+  CueRequests requests;
+  requests.cue(2);
+  requests.pause(true);
+  requests.close();
+  requests.cue(1);
+  requests.pause(false);
+  int index = -1;
+  ASSERT_TRUE(requests.take(index));
+  EXPECT_EQ(index, 2);
+  EXPECT_FALSE(requests.take(index));
+  EXPECT_EQ(requests.posted(), 1u);
+  EXPECT_TRUE(requests.paused());
+}
+
 }  // namespace
 }  // namespace animrt

@@ -17,6 +17,7 @@ class CueRequests {
   // `at_s` > 0 asks for it from that time into the cue (a timecode that
   // re-synced into the middle of it).
   void cue(int index, double at_s = 0.0) {
+    if (closed_.load(std::memory_order_acquire)) return;
     const std::uint64_t seq = posted_.fetch_add(1, std::memory_order_relaxed) + 1;
     const std::uint32_t seq32 = static_cast<std::uint32_t>(seq);
     // The offset first, tagged with the request it belongs to.
@@ -27,7 +28,13 @@ class CueRequests {
     keep_newest(request_, (std::uint64_t{seq32} << 32) | static_cast<std::uint32_t>(index));
     paused_.store(false, std::memory_order_release);
   }
-  void pause(bool paused) { paused_.store(paused, std::memory_order_release); }
+  void pause(bool paused) {
+    if (!closed_.load(std::memory_order_acquire)) paused_.store(paused, std::memory_order_release);
+  }
+  // Any thread, once the motion has ended: later requests are neither taken
+  // nor counted, so the counts a run reports (its summary file, its last
+  // lines) are the same however long the receivers stay open.
+  void close() { closed_.store(true, std::memory_order_release); }
 
   // The cycle: true and `index` set when a request newer than the last one
   // taken is there; `at_s` its time into the cue.
@@ -75,6 +82,7 @@ class CueRequests {
   std::atomic<std::uint64_t> posted_{0};
   std::atomic<std::uint64_t> taken_{0};
   std::atomic<bool> paused_{false};
+  std::atomic<bool> closed_{false};
   std::uint64_t taken_seq_ = 0;  // the reader's own
   static_assert(std::atomic<std::uint64_t>::is_always_lock_free);
 };
