@@ -65,6 +65,25 @@ void check_replaceable_file(const std::string& path) {
   if (std::string kind = kind_of(st.st_mode); !kind.empty()) fail(path, kind);
 }
 
+int write_all(int fd, const void* data, std::size_t size, std::size_t* written) {
+  const auto* bytes = static_cast<const char*>(data);
+  std::size_t done = 0;
+  int error = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, bytes + done, size - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      error = n < 0 ? errno : EIO;
+      break;
+    }
+  }
+  if (written != nullptr) *written = done;
+  return error;
+}
+
 namespace {
 
 // The problem of the nearest existing one of `folder` and its parents: ""

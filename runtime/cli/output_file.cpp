@@ -5,6 +5,8 @@
 
 #include <cerrno>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt::cli {
 
 OutputFile::~OutputFile() {
@@ -18,18 +20,8 @@ bool OutputFile::open(const std::string& path) {
 }
 
 bool OutputFile::write(const std::string& text) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else {
-      error = n < 0 ? errno : EIO;
-      return false;
-    }
-  }
+  error = write_all(fd, text.data(), text.size());
+  if (error != 0) return false;
   const int closed = ::close(fd);
   fd = -1;
   if (closed != 0) error = errno;

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt {
 namespace {
 
@@ -271,19 +273,7 @@ void replace_file_contents(const std::string& path, const std::string& expected,
         {path, 0, 0}, "",
         "cannot write " + quote_path(tmp) + ": " + std::strerror(errno) + "; nothing was written");
   }
-  std::size_t done = 0;
-  int error = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else {
-      error = n < 0 ? errno : EIO;
-      break;
-    }
-  }
+  int error = write_all(fd, text.data(), text.size());
   if (error == 0 && ::fchmod(fd, st.st_mode & 07777) != 0) error = errno;
   if (error == 0 && ::fsync(fd) != 0) error = errno;
   if (::close(fd) != 0 && error == 0) error = errno;

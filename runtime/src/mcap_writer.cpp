@@ -14,6 +14,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt::mcap {
 namespace {
 
@@ -311,16 +313,7 @@ void Writer::emit(std::span<const std::uint8_t> bytes, bool data_section) {
   if (data_section) data_crc_ = crc32(bytes, data_crc_);
   if (error_ != 0) return;  // the file is cut short already: nothing after it is readable
   std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    error_ = n < 0 ? errno : EIO;
-    break;
-  }
+  error_ = write_all(fd_, bytes.data(), bytes.size(), &done);
   offset_ += done;
 }
 

@@ -10,6 +10,8 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "animrt/core/input_file.hpp"
+
 namespace animrt {
 namespace {
 
@@ -92,17 +94,7 @@ void TelemetryWriter::drain() {
 
 bool TelemetryWriter::flush_pending() {
   std::size_t done = 0;
-  int failed = 0;
-  while (done < pending_.size()) {
-    const ssize_t n = ::write(fd_, pending_.data() + done, pending_.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    failed = n < 0 ? errno : EIO;
-    break;
-  }
+  const int failed = write_all(fd_, pending_.data(), pending_.size(), &done);
   std::uint64_t whole = 0;
   while (whole < line_ends_.size() && line_ends_[whole] <= done) ++whole;
   written_.fetch_add(whole, std::memory_order_relaxed);

@@ -2,6 +2,7 @@
 
 #include "animrt/core/input_file.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -193,6 +194,47 @@ TEST(HeaderCount, CountsMustFitTheFileBeforeAnythingIsSized) {
                  "m.bin: header: the frames (1099511627776 x 8 bytes) is larger than the file "
                  "(80 bytes)");
   }
+}
+
+// Output paths are judged before a command's work: a folder where a file
+// goes, no folder to hold it, a file where a folder goes.
+TEST_F(InputFileTest, OutputPathsThatCannotBeWrittenAreNamedBeforeTheWork) {
+  const std::string file = path("f.txt");
+  std::ofstream(file) << "x";
+  EXPECT_EQ(output_file_problem(path("new.csv")), "");
+  EXPECT_EQ(output_file_problem(file), "");  // replaced
+  EXPECT_EQ(output_file_problem(dir_.string()), "is a folder, expected a file to write");
+  EXPECT_EQ(output_file_problem(path("no/x.csv")),
+            "its folder \"" + path("no") + "\" does not exist");
+  EXPECT_EQ(output_file_problem(path("no/x.csv"), true), "");  // the command makes it
+  EXPECT_EQ(output_file_problem(file + "/x.csv"), "\"" + file + "\" is a file, not a folder");
+  EXPECT_EQ(output_file_problem(file + "/a/x.csv", true),
+            "\"" + file + "\" is a file, not a folder");
+  EXPECT_EQ(output_file_problem("x.csv"), "");  // the working folder
+  EXPECT_EQ(output_folder_problem(path("out/a")), "");
+  EXPECT_EQ(output_folder_problem(dir_.string()), "");
+  EXPECT_EQ(output_folder_problem(file), "is a file, expected a folder");
+  EXPECT_EQ(output_folder_problem(file + "/a"), "\"" + file + "\" is a file, not a folder");
+}
+
+// Every byte is written, or the failing write's errno is returned with the
+// count that made it.
+TEST_F(InputFileTest, WriteAllWritesEverythingOrSaysWhyNot) {
+  const std::string file = path("w.bin");
+  const std::string text(200000, 'a');
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ASSERT_GE(fd, 0);
+  std::size_t written = 0;
+  EXPECT_EQ(write_all(fd, text.data(), text.size(), &written), 0);
+  EXPECT_EQ(written, text.size());
+  ::close(fd);
+  EXPECT_EQ(fs::file_size(file), text.size());
+  const int full = ::open("/dev/full", O_WRONLY);
+  ASSERT_GE(full, 0);
+  EXPECT_EQ(write_all(full, text.data(), text.size(), &written), ENOSPC);
+  EXPECT_EQ(written, 0u);
+  ::close(full);
+  EXPECT_EQ(write_all(-1, text.data(), 1), EBADF);
 }
 
 }  // namespace

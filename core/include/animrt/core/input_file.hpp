@@ -39,6 +39,11 @@ std::string input_file_problem(const std::string& path,
 // /dev/zero given as an output became a file). Nothing there is fine.
 void check_replaceable_file(const std::string& path);
 
+// Writes all `size` bytes at `data` to `fd`, again after EINTR and after a
+// short write. Returns 0, or the errno of the write that failed (EIO for one
+// that wrote nothing); `written`, when given, gets the bytes written.
+int write_all(int fd, const void* data, std::size_t size, std::size_t* written = nullptr);
+
 // What keeps a command from writing a file at `path`, or "": a folder there,
 // or no folder to hold it (`folder_made`: the command makes missing folders,
 // so only a file where a folder should be is a problem). Asked before the
