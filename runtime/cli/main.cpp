@@ -11,9 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
-#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -100,27 +98,6 @@ int cmd_validate(const std::string& path, const std::string& cues_path) {
             << cues.cues[static_cast<std::size_t>(cues.idle)].name << ")\n";
   for (const std::string& warning : cues.warnings) std::cout << "warning: " << warning << "\n";
   return kExitOk;
-}
-
-// Longest --duration accepted: a year, far past any show.
-constexpr double kMaxDurationS = 365.0 * 24 * 3600;
-
-// --duration: a finite number of seconds, 0 (until Ctrl-C) up to a year.
-// The message quotes the argument as given, not CLI11's conversion of it.
-CLI::Validator duration_validator() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double value = 0.0;
-        const char* end = text.data() + text.size();
-        const auto [stop, ec] = std::from_chars(text.data(), end, value);
-        const std::string expected = "expected seconds from 0 (until Ctrl-C) to " +
-                                     std::to_string(static_cast<long long>(kMaxDurationS)) +
-                                     ", found " + animrt::quote(text);
-        if (ec != std::errc() || stop != end || text.empty()) return expected;
-        if (!std::isfinite(value) || value < 0.0 || value > kMaxDurationS) return expected;
-        return "";
-      },
-      "SECONDS");
 }
 
 struct RunArgs {
@@ -263,7 +240,7 @@ CLI::App* add_run_subcommand(CLI::App& app, RunArgs& run_args) {
       ->capture_default_str();
   run->add_option("--duration", run_args.duration,
                   "seconds of motion, then ramp home (0 = until Ctrl-C)")
-      ->check(duration_validator());
+      ->check(animrt::cli::kRunDuration);
   run->add_option("--telemetry", run_args.telemetry, "write per-cycle CSV telemetry to this file")
       ->check(animrt::cli::kOutputFile);
   run->add_option("--record", run_args.record,

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
 
 namespace animrt::cli {
@@ -33,6 +34,28 @@ class FiniteRange : public CLI::Range {
 inline const FiniteRange kPositiveNumber(std::numeric_limits<double>::min(),
                                          std::numeric_limits<double>::max(), "POSITIVE");
 inline const FiniteRange kNonNegativeNumber(0.0, std::numeric_limits<double>::max(), "NONNEGATIVE");
+
+// run's and serve's --duration: a finite number of seconds, 0 (until
+// stopped) up to a year, far past any show. The message quotes the argument
+// as given, not CLI11's conversion of it.
+class RunDurationValidator : public CLI::Validator {
+ public:
+  static constexpr double kMaxS = 365.0 * 24 * 3600;
+  RunDurationValidator() : CLI::Validator("SECONDS") {
+    func_ = [](std::string& text) -> std::string {
+      double value = 0.0;
+      const char* end = text.data() + text.size();
+      const auto [stop, error] = std::from_chars(text.data(), end, value);
+      const std::string expected = "expected seconds from 0 (until stopped) to " +
+                                   std::to_string(static_cast<long long>(kMaxS)) + ", found " +
+                                   quote(text);
+      if (error != std::errc() || stop != end || text.empty()) return expected;
+      if (!std::isfinite(value) || value < 0.0 || value > kMaxS) return expected;
+      return {};
+    };
+  }
+};
+inline const RunDurationValidator kRunDuration;
 
 // Seeds: the integers a scene or run file's seed takes, 0 to 2^63 - 1. An
 // unsigned option alone reads "-1" as 2^64 - 1, and CLI::Range over int64

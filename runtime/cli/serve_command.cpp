@@ -260,7 +260,7 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "sim (simulated devices on ptys) or hardware")
       ->check(CLI::IsMember({"sim", "hardware"}));
   cmd->add_option("--duration", args->duration, "seconds, then ramp home (0 = until stopped)")
-      ->check(FiniteRange(0.0, 365.0 * 24 * 3600));
+      ->check(kRunDuration);
   cmd->add_flag("--lockstep", args->lockstep,
                 "simulated clock: run as fast as the devices answer (sim backend only)");
   cmd->add_flag("--no-realtime", args->no_realtime, "do not request SCHED_FIFO or mlockall");

@@ -52,18 +52,23 @@ line=$(grep -n 'file: /dev/zero' "$tmp/zero.yaml" | cut -d: -f1)
 [[ $code -eq 2 && $out == "error: $tmp/zero.yaml:$line:9: motion.file: \"/dev/zero\" is not a regular file (character device)" ]] ||
   fail "/dev/zero as motion file (exit $code): $out"
 
-# --duration: a finite number of seconds >= 0, else a usage error (exit 1).
-for bad in -1 nan inf 1e400 soon; do
-  out=$("$animrt" run "$root/configs/robots/quadruped.yaml" --duration "$bad" 2>&1)
-  code=$?
-  [[ $code -eq 1 ]] || fail "--duration $bad: exit $code, expected 1: $out"
-  [[ $(echo "$out" | head -1) == "--duration: expected seconds from 0 (until Ctrl-C) to 31536000, found \"$bad\"" ]] ||
-    fail "--duration $bad: unexpected message: $out"
+# --duration of run and serve: a finite number of seconds >= 0, else a
+# usage error (exit 1), in the same words (a serve with --duration nan ran
+# until stopped).
+for args in "run $root/configs/robots/quadruped.yaml" \
+            "serve $root/configs/robots/animatronic.yaml --cues $root/configs/cues/animatronic.yaml"; do
+  for bad in -1 nan -nan inf 1e400 soon; do
+    # shellcheck disable=SC2086  # the words of $args are the arguments
+    out=$(timeout 20 "$animrt" $args --duration "$bad" 2>&1)
+    code=$?
+    [[ $code -eq 1 ]] || fail "${args%% *} --duration $bad: exit $code, expected 1: $out"
+    [[ $(echo "$out" | head -1) == "--duration: expected seconds from 0 (until stopped) to 31536000, found \"$bad\"" ]] ||
+      fail "${args%% *} --duration $bad: unexpected message: $out"
+  done
 done
 # Every bounded number refuses NaN, which compares as neither below nor above
-# a bound (a serve with --duration nan ran until stopped).
-for args in "serve $root/configs/robots/animatronic.yaml --cues $root/configs/cues/animatronic.yaml --duration" \
-            "run $root/configs/robots/quadruped.yaml --dashboard-rate" \
+# a bound.
+for args in "run $root/configs/robots/quadruped.yaml --dashboard-rate" \
             "herd $root/configs/herd/flock.yaml --duration" \
             "head synth $root/configs/head/model.txt $root/configs/head/utterance.wav --noise-deg"; do
   for bad in nan -nan NaN; do
