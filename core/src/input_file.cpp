@@ -86,9 +86,10 @@ int write_all(int fd, const void* data, std::size_t size, std::size_t* written) 
 
 namespace {
 
-// The problem of the nearest existing one of `folder` and its parents: ""
-// when that is a folder (the missing rest can be made), or nothing exists.
-std::string first_existing_is_folder(std::filesystem::path folder) {
+// What is wrong with the nearest existing one of `folder` and its parents
+// as the place a folder is made in: "" when it is a folder (the missing rest
+// can be made) or nothing exists.
+std::string nearest_existing_parent_problem(std::filesystem::path folder) {
   namespace fs = std::filesystem;
   for (; !folder.empty(); folder = folder.parent_path()) {
     std::error_code ec;
@@ -103,15 +104,17 @@ std::string first_existing_is_folder(std::filesystem::path folder) {
 
 }  // namespace
 
-std::string output_file_problem(const std::string& path, bool folder_made) {
+std::string output_file_problem(const std::string& path) {
   namespace fs = std::filesystem;
   if (path.empty()) return "an empty path, expected a file to write";
   std::error_code ec;
   if (fs::is_directory(path, ec)) return "is a folder, expected a file to write";
   fs::path folder = fs::path(path).parent_path();
   if (folder.empty()) folder = ".";
-  if (folder_made) return first_existing_is_folder(folder);
   const fs::file_status st = fs::status(folder, ec);
+  // A folder that cannot be looked at (no permission) is not a missing one.
+  if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+    return "its folder \"" + folder.string() + "\": " + ec.message();
   if (!fs::exists(st)) return "its folder \"" + folder.string() + "\" does not exist";
   if (!fs::is_directory(st)) return "\"" + folder.string() + "\" is a file, not a folder";
   return {};
@@ -123,7 +126,7 @@ std::string output_folder_problem(const std::string& path) {
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (std::filesystem::exists(st) && !std::filesystem::is_directory(st))
     return "is a file, expected a folder";
-  return first_existing_is_folder(path);
+  return nearest_existing_parent_problem(path);
 }
 
 void check_input_file(const std::string& path, std::uintmax_t max_bytes) {

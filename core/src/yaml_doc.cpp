@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <streambuf>
@@ -49,14 +50,14 @@ std::size_t closing_quote(const std::string& text, std::size_t open) {
 }
 
 // Walks the first document as the parser meets it, before any tree exists:
-// stops at the first node past the limit, and at a quoted value that runs
-// over lines. YAML lets a quoted value go on to the lines below; none of our
-// values needs to, so one that does lacks its closing quote, and the file
-// would otherwise load as something else (the keys below it swallowed, then
-// reported missing).
-class NodeCounter : public YAML::EventHandler {
+// stops at the first node past the limit, and at a quoted value that runs on
+// over lines that read as keys. YAML lets a quoted value go on to the lines
+// below (a tool may fold a long one); one that takes in keys has lost its
+// closing quote, and the file would otherwise load as something else (the
+// keys swallowed, then reported missing).
+class DocumentChecks : public YAML::EventHandler {
  public:
-  NodeCounter(const std::string& file, const std::string& text) : file_(file), text_(text) {}
+  DocumentChecks(const std::string& file, const std::string& text) : file_(file), text_(text) {}
   // Where the last document it met began.
   const YAML::Mark& document_start() const { return document_; }
 
@@ -97,6 +98,9 @@ class NodeCounter : public YAML::EventHandler {
     const auto end = close == std::string::npos ? text_.end() : text_.begin() + close;
     const auto lines = std::count(text_.begin() + open, end, '\n');
     if (lines == 0) return;
+    // A value folded over lines by a tool that writes YAML (PyYAML wraps at
+    // 80 columns) is text; one that runs over keys has lost its quote.
+    if (close != std::string::npos && !swallows_a_key(open, close)) return;
     const std::string quote = text_[open] == '"' ? "\"" : "'";
     throw InputError(location_of(file_, mark), "",
                      close == std::string::npos
@@ -104,6 +108,19 @@ class NodeCounter : public YAML::EventHandler {
                          : "the quoted value runs on to line " +
                                std::to_string(mark.line + 1 + lines) + " (its closing " + quote +
                                " missing?): write it on one line");
+  }
+
+  // Whether a line after the first of text_[open, close) reads as a key
+  // ("name:", "- name:").
+  bool swallows_a_key(std::size_t open, std::size_t close) const {
+    static const std::regex key(R"(^[ \t]*(- +)?[A-Za-z_][A-Za-z0-9_.-]*:( |\t|$))");
+    for (std::size_t at = text_.find('\n', open); at < close; at = text_.find('\n', at + 1)) {
+      const std::size_t stop = std::min(close, text_.find('\n', at + 1));
+      if (std::regex_search(text_.begin() + static_cast<std::ptrdiff_t>(at + 1),
+                            text_.begin() + static_cast<std::ptrdiff_t>(stop), key))
+        return true;
+    }
+    return false;
   }
 
   const std::string& file_;
@@ -193,11 +210,11 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& file_
     TextBuffer buffer(text);
     std::istream in(&buffer);
     YAML::Parser parser(in);
-    NodeCounter counter(file_name, text);
-    parser.HandleNextDocument(counter);
+    DocumentChecks checks(file_name, text);
+    parser.HandleNextDocument(checks);
     // yaml-cpp's Load reads the first document and ignores the rest.
-    if (parser.HandleNextDocument(counter)) {
-      throw InputError(location_of(file_name, counter.document_start()), "",
+    if (parser.HandleNextDocument(checks)) {
+      throw InputError(location_of(file_name, checks.document_start()), "",
                        "a second YAML document: a configuration file holds one (remove the "
                        "\"---\" and what follows, or merge it into the first)");
     }

@@ -172,7 +172,7 @@ void add_gait_command(CLI::App& app) {
   cmd->add_option("--physics", args->physics, "MuJoCo MJCF model to walk on")->required();
   cmd->add_option("--gait", args->gait, "gait file to calibrate instead of the robot's");
   cmd->add_option("--out", args->out, "calibration file (default: next to the gait)")
-      ->check(kOutputFileMadeFolder);
+      ->check(kOutputFile);
   cmd->add_option("--speeds", args->speeds, "speeds from min to max Froude")
       ->check(CLI::Range(1, 100));
   cmd->add_option("--turns", args->turns, "turn rates each way (fractions of the fastest)")

@@ -196,9 +196,11 @@ int run_herd(const HerdArgs& a) {
   const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
   if (!address.ok) return kExitUsage;
   const auto& dashboard_at = address.at;
+  herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
+  // After the scene's gaits and calibrations load (a bad one leaves the last
+  // run's files as they were), before the herd steps.
   EndFiles end_files;
   open_end_files(a, end_files);
-  herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
   const herd::HerdScene& s = herd.scene();
   std::unique_ptr<HerdDashboardServer> dashboard;
   if (dashboard_at) dashboard = serve_dashboard(a, *dashboard_at, herd);

@@ -175,11 +175,7 @@ int cmd_run(const RunArgs& args) {
   // Opened before anything moves: a summary that cannot be written is found
   // now, not after the run.
   animrt::cli::OutputFile summary_out;
-  if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
-    spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
-                  std::strerror(summary_out.error));
-    return kExitUsage;
-  }
+  if (!animrt::cli::open_summary_json(summary_out, args.summary_json)) return kExitUsage;
   if (!run_args_go_together(args)) return kExitUsage;
 
   animrt::HardwareBackend hardware;

@@ -79,22 +79,20 @@ inline const SeedValidator kSeed;
 
 // Output paths, checked when the command line is read: a file that cannot
 // be written is found before the work (a search, a training, a run), not
-// after it. kOutputFile wants the folder to exist; kOutputFileMadeFolder
-// belongs to commands that make it; kOutputFolder to a folder written into.
+// after it. kOutputFile wants its folder to exist; kOutputFolder is a folder
+// written into (made when missing).
 class OutputPathValidator : public CLI::Validator {
  public:
-  enum class Kind { file, file_made_folder, folder };
+  enum class Kind { file, folder };
   explicit OutputPathValidator(Kind kind) : CLI::Validator(kind == Kind::folder ? "DIR" : "FILE") {
     func_ = [kind](std::string& input) -> std::string {
-      const std::string problem = kind == Kind::folder
-                                      ? output_folder_problem(input)
-                                      : output_file_problem(input, kind == Kind::file_made_folder);
+      const std::string problem =
+          kind == Kind::folder ? output_folder_problem(input) : output_file_problem(input);
       return problem.empty() ? problem : input + ": " + problem;
     };
   }
 };
 inline const OutputPathValidator kOutputFile(OutputPathValidator::Kind::file);
-inline const OutputPathValidator kOutputFileMadeFolder(OutputPathValidator::Kind::file_made_folder);
 inline const OutputPathValidator kOutputFolder(OutputPathValidator::Kind::folder);
 
 // The same check where an output's kind is known only after parsing (a file,

@@ -1,9 +1,12 @@
 #include "output_file.hpp"
 
 #include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
 
 #include "animrt/core/input_file.hpp"
 
@@ -14,18 +17,31 @@ OutputFile::~OutputFile() {
 }
 
 bool OutputFile::open(const std::string& path) {
-  fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  // Not emptied yet: a command that fails before its end (bad input, a
+  // stop) leaves the last run's file as it was.
+  fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
   if (fd < 0) error = errno;
   return fd >= 0;
 }
 
 bool OutputFile::write(const std::string& text) {
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::ftruncate(fd, 0) != 0) {
+    error = errno;
+    return false;
+  }
   error = write_all(fd, text.data(), text.size());
   if (error != 0) return false;
   const int closed = ::close(fd);
   fd = -1;
   if (closed != 0) error = errno;
   return closed == 0;
+}
+
+bool open_summary_json(OutputFile& file, const std::string& path) {
+  if (path.empty() || file.open(path)) return true;
+  spdlog::error("--summary-json: cannot write {}: {}", path, std::strerror(file.error));
+  return false;
 }
 
 }  // namespace animrt::cli

@@ -1,9 +1,10 @@
 #pragma once
 // A file written once at the end of a command's work (run's and serve's
-// --summary-json, herd's summary and top view): opened before the work starts
-// (before anything moves; a path that cannot be written is found then, not
-// after a long run), every failure (a full disk, /dev/full, a close that
-// fails) kept with its errno.
+// --summary-json, herd's summary and top view, head table's --out): opened
+// before the work starts (before anything moves; a path that cannot be
+// written is found then, not after a long run) and emptied only when it is
+// written, every failure (a full disk, /dev/full, a close that fails) kept
+// with its errno.
 
 #include <string>
 
@@ -20,5 +21,9 @@ struct OutputFile {
   bool open(const std::string& path);
   bool write(const std::string& text);  // and close
 };
+
+// run's and serve's --summary-json (none when `path` is empty): false, with
+// the error logged, when it cannot be opened.
+bool open_summary_json(OutputFile& file, const std::string& path);
 
 }  // namespace animrt::cli

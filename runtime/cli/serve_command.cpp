@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <iostream>
 #include <memory>
@@ -82,14 +83,20 @@ bool answer_osc(const OscMessage& message, const std::vector<std::string>& cues,
 }
 
 // What was played and what the triggers sent, after the run's summary.
-void print_cue_report(const CuePlayer& player, const CueRequests& requests, const OscReceiver* osc,
+// The cue requests' counts, read once for both reports.
+struct CueCounts {
+  std::uint64_t posted = 0;
+  std::uint64_t taken = 0;
+};
+
+void print_cue_report(const CuePlayer& player, const CueCounts& requests, const OscReceiver* osc,
                       const ServeDmx& dmx, const ServeTriggers& triggers) {
   std::cout << "cues started:";
   for (std::size_t c = 0; c < player.cues().size(); ++c) {
     std::cout << ' ' << player.cues()[c].name << ' ' << player.starts(static_cast<int>(c));
   }
   std::cout << '\n'
-            << "cue requests: " << requests.posted() << " posted, " << requests.taken()
+            << "cue requests: " << requests.posted << " posted, " << requests.taken
             << " taken by the cycle (the rest replaced by a newer one first), " << player.deferred()
             << " cycles waited for a crossfade to end\n";
   if (const TransitionWorker* worker = player.transition_worker()) {
@@ -113,15 +120,14 @@ void print_cue_report(const CuePlayer& player, const CueRequests& requests, cons
 
 // --summary-json: the run's summary and the cues' counts.
 std::string cue_summary_json(const RunSummary& summary, const CuePlayer& player,
-                             const CueRequests& requests) {
+                             const CueCounts& requests) {
   nlohmann::json j = to_json(summary);
   nlohmann::json started = nlohmann::json::object();
   for (std::size_t c = 0; c < player.cues().size(); ++c)
     started[player.cues()[c].name] = player.starts(static_cast<int>(c));
   j["cues_started"] = started;
-  j["cue_requests"] = {{"posted", requests.posted()},
-                       {"taken", requests.taken()},
-                       {"cycles_waited", player.deferred()}};
+  j["cue_requests"] = {
+      {"posted", requests.posted}, {"taken", requests.taken}, {"cycles_waited", player.deferred()}};
   if (const TransitionWorker* worker = player.transition_worker()) {
     j["learned_transitions"] = {
         {"played", player.learned_played()},
@@ -176,11 +182,7 @@ int serve(const ServeArgs& args) {
   const DashboardAddress address = check_dashboard_address(args.dashboard, args.dashboard_remote);
   if (!address.ok) return kExitUsage;
   OutputFile summary_out;  // opened before anything moves
-  if (!args.summary_json.empty() && !summary_out.open(args.summary_json)) {
-    spdlog::error("--summary-json: cannot write {}: {}", args.summary_json,
-                  std::strerror(summary_out.error));
-    return kExitUsage;
-  }
+  if (!open_summary_json(summary_out, args.summary_json)) return kExitUsage;
   LoadedRobot robot = load_robot(args.robot);
   // Every cue file and what it names is valid before any device starts.
   LoadedCues loaded = load_cues(args.cues, robot.config);
@@ -231,11 +233,14 @@ int serve(const ServeArgs& args) {
   };
   start_fault_injection();
   const RunSummary summary = figure.run(options);
+  // Closed at the motion's end; a request that passed the check just before
+  // may still count, so both reports read the counts once, here.
+  const CueCounts counts{requests.posted(), requests.taken()};
   slow_exit_for_test();
   const bool summary_written =
-      !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, requests));
+      !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, counts));
   std::cout << format_summary(summary);
-  print_cue_report(playing, requests, osc.get(), dmx, triggers);
+  print_cue_report(playing, counts, osc.get(), dmx, triggers);
   int code = summary.exit_code();
   if (!summary_written) {
     std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "

@@ -14,8 +14,8 @@ void add_tool_commands(CLI::App& app);
 
 // Replaces this process by animrt-tools with the same arguments. Returns
 // only when animrt-tools is not installed, with the exit code after one line
-// that says so, naming `command` ("run --herd"; default: argv[1]).
-int exec_tools(char** argv, const std::string& command = "");
+// that says so, naming `command_name` ("run --herd"; default: argv[1]).
+int exec_tools(char** argv, const std::string& command_name = "");
 
 // argv as main() got it, for exec_tools from a command's callback.
 void remember_argv(char** argv);

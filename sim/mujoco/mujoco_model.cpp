@@ -43,7 +43,7 @@ void check_mujoco_timestep(const mjModel& model, const std::string& path) {
     const auto begin = text.begin() + static_cast<std::ptrdiff_t>(at);
     const auto end = text.begin() + static_cast<std::ptrdiff_t>(stop);
     if (std::regex_search(begin, end, match, attribute)) {
-      line = n + static_cast<int>(std::count(begin, match[0].first, '\n'));
+      line = n + static_cast<int>(std::count(begin, match[1].second, '\n'));
       break;
     }
     n += static_cast<int>(std::count(begin, end, '\n'));

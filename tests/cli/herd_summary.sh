@@ -76,4 +76,18 @@ for opt in --summary-json --svg --out; do
     fail "herd $opt $tmp: $out"
   [[ $out != *"min pair distance"* ]] || fail "herd $opt stepped the herd first: $out"
 done
+# A scene whose figure cannot be loaded (its gait's calibration table holds
+# no points) leaves the last run's summary and top view as they were.
+mkdir "$tmp/gait"
+cp "$root/configs/gaits/herd_pony.yaml" "$tmp/gait/"
+printf 'gait: herd_pony.yaml\nmodel: %s\ntolerance: 0.15\npoints: []\n' \
+  "$root/configs/models/pony.xml" > "$tmp/gait/herd_pony.calibration.yaml"
+sed "s#$root/configs/gaits/herd_pony.yaml#$tmp/gait/herd_pony.yaml#" "$tmp/one.yaml" > "$tmp/bad_gait.yaml"
+echo "last run" > "$tmp/keep.json"
+echo "last run" > "$tmp/keep.svg"
+out=$("$animrt" herd "$tmp/bad_gait.yaml" --summary-json "$tmp/keep.json" --svg "$tmp/keep.svg" --quiet 2>&1) &&
+  fail "a figure without a calibrated walk was loaded: $out"
+[[ $out == *"points: expected a list of points, found []"* ]] || fail "bad calibration: $out"
+[[ $(cat "$tmp/keep.json") == "last run" && $(cat "$tmp/keep.svg") == "last run" ]] ||
+  fail "the last run's files were emptied by a run that never started"
 echo "herd_summary: ok"

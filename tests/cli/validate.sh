@@ -115,14 +115,15 @@ done <<CASES
 --csv|$tmp|is a folder, expected a file to write|evolve $root/configs/evolve/quadruped_sinusoidal.yaml --out $tmp/g.yaml
 --plot|$tmp/none/p.svg|its folder "$tmp/none" does not exist|evolve $root/configs/evolve/quadruped_sinusoidal.yaml --out $tmp/g.yaml
 --out|$tmp/a_file/c.yaml|"$tmp/a_file" is a file, not a folder|gait calibrate $root/configs/robots/quadruped.yaml
+--out|$tmp/none/c.yaml|its folder "$tmp/none" does not exist|gait calibrate $root/configs/robots/quadruped.yaml --physics $root/configs/models/quadruped.xml
 --out|$tmp/none/t.md|its folder "$tmp/none" does not exist|head table $root/configs/head
---out|$tmp|is a folder, expected a file to write|head train --corpus $root/configs/head
+--out|$tmp|is a folder, expected a file to write|head train $root/configs/head
 --out|$tmp/a_file|is a file, expected a folder|head corpus
 --out|$tmp/none/f.bin|its folder "$tmp/none" does not exist|seq features $tmp/clip
 --out|$tmp/a_file/frames|"$tmp/a_file" is a file, not a folder|seq reconstruct $tmp/f.bin $tmp/m.obj
 --telemetry|$tmp/none/t.csv|its folder "$tmp/none" does not exist|run $root/configs/robots/quadruped.yaml
 --record|$tmp|is a folder, expected a file to write|run $root/configs/robots/quadruped.yaml
---write-robot|$tmp|is a folder, expected a file to write|scan --port $tmp/no_port
+--write-robot|$tmp|is a folder, expected a file to write|scan $tmp/no_port
 CASES
 # Any other parse error is a usage error too (CLI11's own codes are 100 and up).
 out=$("$animrt" run 2>&1)

@@ -119,8 +119,11 @@ TEST(YamlNode, AQuotedValueWithoutItsClosingQuoteIsRefusedWhereItOpens) {
   EXPECT_EQ(error("\xEF\xBB\xBFn: Zo\xC3\xAB\nname: \"head\nx: \"\n"),
             "t.yaml:2:7: the quoted value runs on to line 3 (its closing \" missing?): write it "
             "on one line");
-  // Escaped and doubled quotes inside a value on one line, a block scalar
+  // A long value folded over lines (as PyYAML writes one at 80 columns),
+  // escaped and doubled quotes inside a value on one line, a block scalar
   // over lines: loaded.
+  EXPECT_EQ(error("note: 'a long note that says: the figure\n  nods twice'\nb: \"x\n  y\"\n"),
+            "no error");
   EXPECT_EQ(error("a: \"say \\\"hi\\\"\"\nb: 'it''s'\nc: |\n  two\n  lines\n"), "no error");
 }
 

@@ -206,11 +206,9 @@ TEST_F(InputFileTest, OutputPathsThatCannotBeWrittenAreNamedBeforeTheWork) {
   EXPECT_EQ(output_file_problem(dir_.string()), "is a folder, expected a file to write");
   EXPECT_EQ(output_file_problem(path("no/x.csv")),
             "its folder \"" + path("no") + "\" does not exist");
-  EXPECT_EQ(output_file_problem(path("no/x.csv"), true), "");  // the command makes it
   EXPECT_EQ(output_file_problem(file + "/x.csv"), "\"" + file + "\" is a file, not a folder");
-  EXPECT_EQ(output_file_problem(file + "/a/x.csv", true),
-            "\"" + file + "\" is a file, not a folder");
-  EXPECT_EQ(output_file_problem("x.csv"), "");  // the working folder
+  EXPECT_EQ(output_folder_problem(path("no/x/y")), "");  // made with its parents
+  EXPECT_EQ(output_file_problem("x.csv"), "");           // the working folder
   EXPECT_EQ(output_folder_problem(path("out/a")), "");
   EXPECT_EQ(output_folder_problem(dir_.string()), "");
   EXPECT_EQ(output_folder_problem(file), "is a file, expected a folder");

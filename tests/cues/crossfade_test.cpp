@@ -317,9 +317,9 @@ TEST(CueRequests, ABurstOfTriggersNeitherAllocatesNorJumpsAndTheNewestWins) {
   }
 }
 
-// Once the motion has ended, requests are neither taken nor counted: the
-// summary file and the last lines, read at different times, agree.
-TEST(CueRequests, AfterCloseNothingIsTakenOrCounted) {
+// Once the motion has ended, later requests are neither taken nor counted;
+// one posted before is still there to take.
+TEST(CueRequests, RequestsAfterCloseAreNeitherTakenNorCounted) {
   CueRequests requests;
   requests.cue(2);
   requests.pause(true);

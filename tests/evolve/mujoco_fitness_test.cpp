@@ -396,6 +396,16 @@ TEST(MujocoModel, ATimeStepOutsideTenMicrosecondsToATenthIsRefusedAtItsLine) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where().line, line + 2);
   }
+  // The attribute at the start of a line of its own.
+  std::string own_line = shipped;
+  own_line.replace(at, 17, "\ntimestep=\"0\"");
+  write_file(file, own_line);
+  try {
+    sim::load_mujoco_model(file);
+    ADD_FAILURE() << "loaded timestep 0";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().line, line + 1);
+  }
   std::string text = shipped;
   text.replace(at, 17, "timestep=\"0.001\"");
   write_file(file, text);

@@ -45,10 +45,9 @@ void check_replaceable_file(const std::string& path);
 int write_all(int fd, const void* data, std::size_t size, std::size_t* written = nullptr);
 
 // What keeps a command from writing a file at `path`, or "": a folder there,
-// or no folder to hold it (`folder_made`: the command makes missing folders,
-// so only a file where a folder should be is a problem). Asked before the
-// work, so a bad path is not found after a long run.
-std::string output_file_problem(const std::string& path, bool folder_made = false);
+// or no folder to hold it. Asked before the work, so a bad path is not found
+// after a long run.
+std::string output_file_problem(const std::string& path);
 
 // What keeps a command from writing into a folder at `path` (making it when
 // it is missing), or "": a file there, or a file where one of its parents

@@ -32,8 +32,7 @@ class CueRequests {
     if (!closed_.load(std::memory_order_acquire)) paused_.store(paused, std::memory_order_release);
   }
   // Any thread, once the motion has ended: later requests are neither taken
-  // nor counted, so the counts a run reports (its summary file, its last
-  // lines) are the same however long the receivers stay open.
+  // nor counted (the receivers stay open a while after it).
   void close() { closed_.store(true, std::memory_order_release); }
 
   // The cycle: true and `index` set when a request newer than the last one
