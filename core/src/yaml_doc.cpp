@@ -4,6 +4,7 @@
 #include <yaml-cpp/parser.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -12,10 +13,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <streambuf>
+#include <string_view>
 
 #include "animrt/core/input_file.hpp"
 
@@ -47,6 +48,29 @@ std::size_t closing_quote(const std::string& text, std::size_t open) {
     }
   }
   return std::string::npos;
+}
+
+// Whether `line` reads as a key: "name:" or "- name:", indented or not, with
+// a blank or the line's end after the colon.
+bool reads_as_key(std::string_view line) {
+  std::size_t i = line.find_first_not_of(" \t");
+  if (i == std::string_view::npos) return false;
+  if (line[i] == '-') {
+    const std::size_t item = line.find_first_not_of(' ', i + 1);
+    if (item == i + 1 || item == std::string_view::npos) return false;
+    i = item;
+  }
+  const auto letter = [](char c) {
+    return std::isalpha(static_cast<unsigned char>(c)) || c == '_';
+  };
+  if (!letter(line[i])) return false;
+  while (i < line.size() && (letter(line[i]) || std::isdigit(static_cast<unsigned char>(line[i])) ||
+                             line[i] == '.' || line[i] == '-')) {
+    ++i;
+  }
+  if (i == line.size() || line[i] != ':') return false;
+  ++i;
+  return i == line.size() || line[i] == ' ' || line[i] == '\t' || line[i] == '\r';
 }
 
 // Walks the first document as the parser meets it, before any tree exists:
@@ -110,15 +134,11 @@ class DocumentChecks : public YAML::EventHandler {
                                " missing?): write it on one line");
   }
 
-  // Whether a line after the first of text_[open, close) reads as a key
-  // ("name:", "- name:").
+  // Whether a line after the first of text_[open, close) reads as a key.
   bool swallows_a_key(std::size_t open, std::size_t close) const {
-    static const std::regex key(R"(^[ \t]*(- +)?[A-Za-z_][A-Za-z0-9_.-]*:( |\t|$))");
     for (std::size_t at = text_.find('\n', open); at < close; at = text_.find('\n', at + 1)) {
       const std::size_t stop = std::min(close, text_.find('\n', at + 1));
-      if (std::regex_search(text_.begin() + static_cast<std::ptrdiff_t>(at + 1),
-                            text_.begin() + static_cast<std::ptrdiff_t>(stop), key))
-        return true;
+      if (reads_as_key(std::string_view(text_).substr(at + 1, stop - at - 1))) return true;
     }
     return false;
   }

@@ -3,13 +3,14 @@
 #include "animrt/sim/mujoco/mujoco_model.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <string>
+#include <string_view>
 
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
@@ -23,6 +24,32 @@ int MujocoModel::actuator_of(const std::string& joint) const {
   return -1;
 }
 
+namespace {
+
+// The line (from 1) of the first attribute `name` (a blank before it, "="
+// after it and blanks between) outside XML comments, or 0.
+int attribute_line(const std::string& text, std::string_view name) {
+  std::size_t at = 0;
+  while ((at = text.find(name, at)) != std::string::npos) {
+    const std::size_t comment = text.rfind("<!--", at);
+    const std::size_t comment_end = comment == std::string::npos ? 0 : text.find("-->", comment);
+    const bool in_comment =
+        comment != std::string::npos && (comment_end == std::string::npos || comment_end > at);
+    std::size_t after = at + name.size();
+    while (after < text.size() && std::isspace(static_cast<unsigned char>(text[after]))) ++after;
+    const bool attribute = at > 0 && std::isspace(static_cast<unsigned char>(text[at - 1])) &&
+                           after < text.size() && text[after] == '=';
+    if (attribute && !in_comment) {
+      return 1 + static_cast<int>(std::count(text.begin(),
+                                             text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+    }
+    at += name.size();
+  }
+  return 0;
+}
+
+}  // namespace
+
 void check_mujoco_timestep(const mjModel& model, const std::string& path) {
   // From 10 us (a run steps physics up to each cycle's time: a step much
   // finer than that takes the run's time by itself) to 0.1 s.
@@ -31,28 +58,9 @@ void check_mujoco_timestep(const mjModel& model, const std::string& path) {
   if (step >= kMinStepS && step <= kMaxStepS) return;
   // The line of the attribute (timestep="..."), where the file has one,
   // outside comments.
-  int line = 0;
   std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  static const std::regex attribute(R"((^|[\s])timestep\s*=)");
-  int n = 1;
-  for (std::size_t at = 0; at < text.size();) {
-    const std::size_t comment = text.find("<!--", at);
-    const std::size_t stop = comment == std::string::npos ? text.size() : comment;
-    std::smatch match;
-    const auto begin = text.begin() + static_cast<std::ptrdiff_t>(at);
-    const auto end = text.begin() + static_cast<std::ptrdiff_t>(stop);
-    if (std::regex_search(begin, end, match, attribute)) {
-      line = n + static_cast<int>(std::count(begin, match[1].second, '\n'));
-      break;
-    }
-    n += static_cast<int>(std::count(begin, end, '\n'));
-    if (comment == std::string::npos) break;
-    const std::size_t close = text.find("-->", comment + 4);
-    const std::size_t after = close == std::string::npos ? text.size() : close + 3;
-    n += static_cast<int>(std::count(end, text.begin() + static_cast<std::ptrdiff_t>(after), '\n'));
-    at = after;
-  }
+  const int line = attribute_line(text, "timestep");
   char found[32];
   std::snprintf(found, sizeof found, "%g", step);
   throw InputError({path, line, 0}, "option.timestep",
