@@ -31,7 +31,7 @@ using std::chrono::milliseconds;
 
 // What the master asked, as a servo reads it.
 struct Request {
-  enum Kind { ping, read, write, sync_read, other } kind = other;
+  enum Kind { ping, read, write, sync_read, reboot, other } kind = other;
   std::uint8_t id = 0;
   std::uint16_t address = 0;
   std::uint16_t length = 0;
@@ -73,6 +73,9 @@ struct Dynamixel {
         out.kind = Request::write;
         out.address = u16(0);
         out.ids.assign(p.params.begin() + 2, p.params.end());  // the data written
+        break;
+      case dxl::inst::reboot:
+        out.kind = Request::reboot;
         break;
       case dxl::inst::sync_read:
         out.kind = Request::sync_read;
@@ -155,12 +158,25 @@ class ScheduledServos final : public ByteTransport {
   std::map<std::uint16_t, std::uint32_t> registers;  // what other addresses read
   std::vector<Request> requests;                     // every packet the master sent
   microseconds waited_since_last_answer{0};
+  // The answers to the next `late_requests` requests leave `late` after
+  // their request (a host too busy to carry the line's bytes in time).
+  int late_requests = 0;
+  microseconds late{0};
+  // A register added to what Present Position reads (Dynamixel's Homing
+  // Offset); none if 0. A unicast write to it lands in `registers`.
+  std::uint16_t offset_register = 0;
 
   void set_timeout(microseconds) override {}
   bool write(std::span<const std::uint8_t> bytes) override {
     Request r;
     if (!Family::parse(Bytes(bytes.begin(), bytes.end()), r)) return true;
     requests.push_back(r);
+    if (r.kind == Request::write && r.id != 0xFE && offset_register != 0 &&
+        r.address == offset_register && r.ids.size() == 4) {
+      std::uint32_t v = 0;
+      for (std::size_t i = 0; i < r.ids.size(); ++i) v |= std::uint32_t{r.ids[i]} << (8 * i);
+      registers[r.address] = v;
+    }
     std::vector<std::uint8_t> who;
     if (r.kind == Request::sync_read) {
       who = r.ids;
@@ -168,6 +184,10 @@ class ScheduledServos final : public ByteTransport {
       who.push_back(r.id);
     }
     auto at = Clock::now();
+    if (late_requests > 0 && !who.empty()) {
+      --late_requests;
+      at += late;
+    }
     bool first = true;
     for (std::uint8_t id : who) {
       at += gap;
@@ -175,7 +195,10 @@ class ScheduledServos final : public ByteTransport {
       Bytes data;
       if (r.kind == Request::read || r.kind == Request::sync_read) {
         std::uint32_t v = registers.count(r.address) != 0 ? registers[r.address] : 0;
-        if (r.address == Family::kPresent) v = static_cast<std::uint32_t>(ticks[id]);
+        if (r.address == Family::kPresent) {
+          v = static_cast<std::uint32_t>(ticks[id]) +
+              (offset_register != 0 ? registers[offset_register] : 0);
+        }
         data = low_first(v, r.length);
       }
       Bytes a = Family::status(id, error.count(id) != 0 ? error[id] : 0, data);
@@ -204,7 +227,11 @@ class ScheduledServos final : public ByteTransport {
     std::this_thread::sleep_for(wait);
     return 0;
   }
-  void discard_input() override { queue_.clear(); }
+  // What has arrived; answers still on their way come later.
+  void discard_input() override {
+    const auto now = Clock::now();
+    std::erase_if(queue_, [&](const Timed& t) { return t.at <= now; });
+  }
   const char* failure() const override { return nullptr; }
   int failure_errno() const override { return 0; }
   std::uint64_t write_failures() const override { return 0; }
@@ -406,6 +433,39 @@ TEST(DynamixelBusWatchdog, IsRearmedWhenNothingValidWasHeardForHalfItsTime) {
   cycles_for(milliseconds(50));
   EXPECT_EQ(bus.watchdog_rearms(), rearms);
   bus.deactivate();
+}
+
+TEST(DynamixelBusLateAnswers, ARetriedReadsLaterAnswerIsNotTakenForTheNextRead) {
+  // Every answer leaves 1.5 timeouts after its request: each try times out
+  // and the answer to the first comes during the second, whose own answer
+  // is still on its way when the next read is sent. set_home reads Present
+  // Position, then Homing Offset (both 4 bytes from the same id): taken for
+  // the Homing Offset, that later answer would make the home the shaft's
+  // 0 and the servo read 2048 + 2867 after the Reboot.
+  auto owned = std::make_unique<ScheduledServos<Dynamixel>>();
+  ScheduledServos<Dynamixel>& line = *owned;
+  BusConfig config;
+  config.name = "legs";
+  config.timeout_s = 0.030;
+  ActuatorBinding b;
+  b.joint = "knee";
+  b.device_id = 1;
+  b.ticks_per_rad = 16384 / (2 * std::numbers::pi);  // geared 4:1
+  b.zero_ticks = 2048;
+  dxl::DeviceOptions options;
+  options.multi_turn = true;
+  b.options = options;
+  config.actuators.push_back(b);
+  line.ticks[1] = 2867;  // within the shaft's first turn: a Reboot keeps the count
+  line.registers[dxl::xreg::operating_mode] = dxl::kExtendedPositionMode;
+  line.offset_register = dxl::xreg::homing_offset;
+  DynamixelBus bus(config, std::move(owned));
+  bus.configure();
+  // Torque off, Present Position, Homing Offset: each tried twice.
+  line.late_requests = 6;
+  line.late = microseconds(45'000);
+  EXPECT_EQ(bus.set_home(0, 2048), 2048);
+  EXPECT_EQ(static_cast<std::int32_t>(line.registers[dxl::xreg::homing_offset]), 2048 - 2867);
 }
 
 TEST(StatusBook, NamesTheBusAndItsDevices) {

@@ -41,9 +41,10 @@ start_sim "$robot"
 # The simulator's hand path takes each step after the servo has answered 5
 # reads of its position, so calibrate sees every step whatever the load
 # (the path is done after 60 reads: the first step at once, then 12 of 5;
-# --seconds-per-joint 5.0 is some 1000 reads at 200 Hz. With 2.0, the
-# sanitizer build beside the later tiers' builds once made only about 45
-# reads in the window: the home was taken on the path's ninth step).
+# --seconds-per-joint 5.0 is some 1000 reads at 200 Hz). On a loaded
+# machine the Homing Offset's reads are retried: a retried read's later
+# answer must not pass for the next read's (serial_servo_core_test,
+# DynamixelBusLateAnswers).
 steps='3000 6000 9000 12000 16384 13000 8000 4000 0 -2867 0 3000 6963'
 /usr/bin/python3 - "$tmp/ctl" "$steps" "$tmp/out.txt" "$animrt" calibrate "$robot" --port "legs=$pty" \
   --non-interactive --seconds-per-joint 5.0 --joint lf_knee <<'PY'

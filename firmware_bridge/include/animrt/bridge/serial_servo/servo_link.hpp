@@ -303,20 +303,29 @@ class Link {
   // desktop starting a browser) does not fail a lifecycle step, while a
   // silent device costs 7 timeouts in 3 tries. Within a Stopping scope each
   // try waits one timeout. An answer to an earlier try that comes during a
-  // later one is taken: it answers the same instruction (the answers to the
-  // other tries come with it, back to back, and the next transaction's
-  // begin() discards them; one that came later still, from the same id and
-  // of the length the next read wants, would pass for its answer).
+  // later one is taken: it answers the same instruction. The answers to the
+  // tries after it are then owed: a status packet names no instruction, so
+  // one that came during the device's next transaction would pass for its
+  // answer (a Present Position taken for the Homing Offset read next).
+  // That transaction first reads them away (begin()).
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length, int tries,
                  bool diagnostic = false) {
     Answer a = Answer::timeout;
     if (length == 0) return a;
-    for (int t = 0; t < tries; ++t) {
+    const Clock::time_point first = Clock::now();
+    int t = 0;
+    for (; t < tries; ++t) {
       ask(0, device);
       const int doubled = stopping_ ? 0 : std::min(t, 10);
       transact(length, 1, data_length, diagnostic, timeout_ * (std::int64_t{1} << doubled));
       a = answer_[0];
       if (a == Answer::ok || a == Answer::rejected) break;
+    }
+    if (t > 0 && t < tries) {
+      // A device that answers each try equally late answers the last one
+      // within as long again as the tries took so far.
+      const Clock::time_point now = Clock::now();
+      owed_ = {device, t, now + (now - first)};
     }
     return a;
   }
@@ -372,6 +381,12 @@ class Link {
       suspect_[s] = 0;
       book_.asked(asked_[s]);
     }
+    if (owed_.answers > 0 &&
+        std::find(asked_.begin(), asked_.begin() + static_cast<std::ptrdiff_t>(count),
+                  owed_.device) != asked_.begin() + static_cast<std::ptrdiff_t>(count)) {
+      read_away_owed();
+    }
+    owed_.answers = 0;
     // Late answers from an earlier transaction must not pass for this one's.
     transport_->discard_input();
     decoder_.reset();
@@ -459,6 +474,24 @@ class Link {
   }
 
  private:
+  // Waits for the answers a retried unicast left owed (until they came or
+  // their time is up) and drops them.
+  void read_away_owed() {
+    decoder_.reset();
+    rx_begin_ = rx_end_ = 0;
+    late_look_done_ = false;
+    Packet packet;
+    const std::uint8_t id = bus_ids_[owed_.device];
+    while (owed_.answers > 0) {
+      const Frame r = next_event(packet, owed_.until);
+      if (r == Frame::need_more) break;
+      if (r == Frame::packet && codec_.from_device(packet, {tx_.data(), sent_length_}) &&
+          codec_.id(packet) == id) {
+        --owed_.answers;
+      }
+    }
+  }
+
   // Pulls bytes until the decoder has something other than need_more, or
   // the deadline passed (and one last look found nothing).
   Frame next_event(Packet& packet, Clock::time_point deadline) {
@@ -542,6 +575,11 @@ class Link {
   std::size_t rx_begin_ = 0, rx_end_ = 0;
   bool late_look_done_ = false;
   bool stopping_ = false;  // within a Stopping scope
+  struct Owed {
+    std::size_t device = 0;
+    int answers = 0;  // answers to a retried unicast's later tries, still to come
+    Clock::time_point until{};
+  } owed_;
   typename Codec::Decoder decoder_;
 };
 
