@@ -13,18 +13,27 @@
 namespace animrt::cli {
 
 OutputFile::~OutputFile() {
-  if (fd >= 0) ::close(fd);
+  if (fd < 0) return;
+  ::close(fd);
+  if (!created_.empty()) ::unlink(created_.c_str());
 }
 
 bool OutputFile::open(const std::string& path) {
   // Not emptied yet: a command that fails before its end (bad input, a
-  // stop) leaves the last run's file as it was.
-  fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+  // stop) leaves the last run's file as it was, and no empty one where
+  // there was none.
+  fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd >= 0) {
+    created_ = path;
+    return true;
+  }
+  if (errno == EEXIST) fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
   if (fd < 0) error = errno;
   return fd >= 0;
 }
 
 bool OutputFile::write(const std::string& text) {
+  created_.clear();
   struct stat st {};
   if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::ftruncate(fd, 0) != 0) {
     error = errno;

@@ -4,7 +4,7 @@
 // before the work starts (before anything moves; a path that cannot be
 // written is found then, not after a long run) and emptied only when it is
 // written, every failure (a full disk, /dev/full, a close that fails) kept
-// with its errno.
+// with its errno. A file it created and never wrote is removed again.
 
 #include <string>
 
@@ -20,6 +20,9 @@ struct OutputFile {
   bool is_open() const { return fd >= 0; }
   bool open(const std::string& path);
   bool write(const std::string& text);  // and close
+
+ private:
+  std::string created_;  // the path, while a file this made is unwritten
 };
 
 // run's and serve's --summary-json (none when `path` is empty): false, with

@@ -90,4 +90,18 @@ out=$("$animrt" herd "$tmp/bad_gait.yaml" --summary-json "$tmp/keep.json" --svg 
 [[ $out == *"points: expected a list of points, found []"* ]] || fail "bad calibration: $out"
 [[ $(cat "$tmp/keep.json") == "last run" && $(cat "$tmp/keep.svg") == "last run" ]] ||
   fail "the last run's files were emptied by a run that never started"
+# A run that fails after its end files were opened (the dashboard's port
+# is taken) leaves no empty new file where there was none.
+/usr/bin/python3 -c '
+import socket, sys, time
+s = socket.socket(); s.bind(("127.0.0.1", 0)); s.listen()
+print(s.getsockname()[1], flush=True); time.sleep(30)' > "$tmp/port.txt" &
+holder=$!
+for _ in $(seq 50); do [[ -s $tmp/port.txt ]] && break; sleep 0.1; done
+port=$(cat "$tmp/port.txt")
+out=$("$animrt" herd "$tmp/one.yaml" --summary-json "$tmp/new.json" --svg "$tmp/new.svg" \
+  --dashboard "127.0.0.1:$port" --quiet 2>&1) && fail "a dashboard on a taken port: $out"
+kill "$holder" 2>/dev/null
+[[ ! -e $tmp/new.json && ! -e $tmp/new.svg ]] ||
+  fail "a run that failed left new files: $(ls "$tmp"); $out"
 echo "herd_summary: ok"
