@@ -158,11 +158,14 @@ struct EndFiles {
   OutputFile summary;
 };
 
+std::runtime_error cannot_write(const std::string& path, const OutputFile& file, const char* what) {
+  return std::runtime_error(path + ": cannot write the " + what + ": " + std::strerror(file.error));
+}
+
 void open_end_files(const HerdArgs& a, EndFiles& files) {
   const auto open = [](const std::string& path, OutputFile& file, const char* what) {
     if (path.empty() || file.open(path)) return;
-    throw std::runtime_error(path + ": cannot write the " + what + ": " +
-                             std::strerror(file.error));
+    throw cannot_write(path, file, what);
   };
   open(a.svg, files.svg, "top view");
   open(a.summary_json, files.summary, "summary");
@@ -180,10 +183,7 @@ void write_outputs(const HerdArgs& a, std::ofstream& csv, EndFiles& files,
   const auto write = [](const std::string& path, OutputFile& file, const std::string& text,
                         const char* what) {
     if (!file.is_open()) return;
-    if (!file.write(text)) {
-      throw std::runtime_error(path + ": cannot write the " + what + ": " +
-                               std::strerror(file.error));
-    }
+    if (!file.write(text)) throw cannot_write(path, file, what);
     std::cout << "wrote " << path << '\n';
   };
   write(a.svg, files.svg, trails.svg(herd), "top view");
