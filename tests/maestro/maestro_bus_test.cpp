@@ -6,9 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <any>
+#include <chrono>
 #include <cmath>
+#include <deque>
 #include <fstream>
+#include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "animrt/core/joint.hpp"
@@ -279,6 +283,109 @@ TEST(MaestroBus, ASerialTimeoutWhileTheOtherBusesCameUpRefusesTheRun) {
         << e.what();
   }
   EXPECT_EQ(r.sim->pulse(0), 0);  // switched off, not left to the board
+}
+
+// A board on a line whose answers leave on a script: the answer to burst
+// k (two bytes per Get Position, then two for Get Errors) comes in the
+// parts script[k] gives (a delay after the burst, a byte count); bursts
+// past the script are answered at once. It drops, as a line does, only
+// what has arrived.
+class ScriptedBoard final : public ByteTransport {
+ public:
+  using Clock = std::chrono::steady_clock;
+  std::map<int, std::uint16_t> pulse;   // per channel, quarter-us; 0: off
+  std::map<int, std::uint16_t> target;  // the last Set Target per channel
+  std::vector<std::vector<std::pair<std::chrono::microseconds, std::size_t>>> script;
+
+  void set_timeout(std::chrono::microseconds) override {}
+  bool write(std::span<const std::uint8_t> bytes) override {
+    std::vector<std::uint8_t> answer;
+    for (const std::uint8_t b : bytes) {
+      if (parser_.feed(b) != maestro::ParseResult::command) continue;
+      const maestro::Command& c = parser_.command();
+      std::uint8_t two[2];
+      if (c.command == maestro::cmd::get_position) {
+        maestro::encode_answer(pulse[c.channel], two);
+        answer.insert(answer.end(), two, two + 2);
+      } else if (c.command == maestro::cmd::get_errors) {
+        maestro::encode_answer(0, two);
+        answer.insert(answer.end(), two, two + 2);
+      } else if (c.command == maestro::cmd::set_target) {
+        target[c.channel] = c.value;
+      }
+    }
+    if (answer.empty()) return true;
+    const auto now = Clock::now();
+    std::size_t at = 0;
+    if (bursts_ < script.size()) {
+      for (const auto& [delay, count] : script[bursts_]) {
+        const std::size_t n = std::min(count, answer.size() - at);
+        queue_.push_back({now + delay, {answer.begin() + at, answer.begin() + at + n}});
+        at += n;
+      }
+    }
+    if (at < answer.size()) queue_.push_back({now, {answer.begin() + at, answer.end()}});
+    ++bursts_;
+    return true;
+  }
+  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds wait) override {
+    const auto until = Clock::now() + wait;
+    std::size_t n = 0;
+    for (;;) {
+      while (!queue_.empty() && queue_.front().at <= Clock::now() && n < buffer.size()) {
+        auto& part = queue_.front().bytes;
+        const std::size_t k = std::min(part.size(), buffer.size() - n);
+        std::copy(part.begin(), part.begin() + k, buffer.begin() + n);
+        n += k;
+        part.erase(part.begin(), part.begin() + k);
+        if (part.empty()) queue_.pop_front();
+      }
+      if (n > 0 || Clock::now() >= until) return n;
+      const auto next = queue_.empty() ? until : std::min(until, queue_.front().at);
+      std::this_thread::sleep_until(next);
+    }
+  }
+  void discard_input() override {
+    const auto now = Clock::now();
+    while (!queue_.empty() && queue_.front().at <= now) queue_.pop_front();
+  }
+  const char* failure() const override { return nullptr; }
+  int failure_errno() const override { return 0; }
+  std::uint64_t write_failures() const override { return 0; }
+  const std::string& port() const override { return port_; }
+
+ private:
+  struct Part {
+    Clock::time_point at;
+    std::vector<std::uint8_t> bytes;
+  };
+  maestro::Parser parser_;
+  std::deque<Part> queue_;
+  std::size_t bursts_ = 0;
+  std::string port_ = "scripted";
+};
+
+TEST(MaestroBus, AnAnswerThatCameInPartsIsNotShiftedOntoTheNextChannel) {
+  // eye_pan's channel is off (reads 0), eye_tilt's at 1750 us, the jaw's at
+  // 1600 us. The first burst's answer comes in part: eye_pan's two bytes at
+  // once, the other six 1.5 timeouts late, during the retry, ahead of the
+  // retry's own answer. Taken as the retry's, eye_tilt's 1750 us became
+  // eye_pan's position, and activate switched eye_pan on at 1750 us.
+  RobotConfig config = load(robot_text());
+  BusConfig& b = config.buses[0];
+  b.timeout_s = 0.03;
+  auto owned = std::make_unique<ScriptedBoard>();
+  ScriptedBoard& board = *owned;
+  board.pulse = {{0, 0}, {1, 7000}, {4, 6400}};
+  using std::chrono::microseconds;
+  board.script = {{{microseconds(0), 2}, {microseconds(45'000), 6}}, {{microseconds(20'000), 8}}};
+  MaestroBus bus(b, std::move(owned));
+  bus.configure();
+  bus.activate();
+  // eye_pan had no position: it starts at its neutral pulse (1500 us).
+  EXPECT_EQ(board.target[0], 6000);
+  EXPECT_EQ(board.target[1], 7000);
+  EXPECT_EQ(board.target[4], 6400);
 }
 
 }  // namespace

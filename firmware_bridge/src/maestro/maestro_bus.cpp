@@ -113,6 +113,20 @@ std::size_t MaestroBus::receive(std::size_t want, std::chrono::microseconds time
   return got;
 }
 
+void MaestroBus::read_away_owed() {
+  const bool line = transport_->follows_line();
+  while (owed_bytes_ > 0) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!line && now >= owed_until_) break;
+    const std::size_t n = transport_->read(
+        {rx_.data(), std::min(owed_bytes_, rx_.size())},
+        line ? timeout_ : std::chrono::ceil<std::chrono::microseconds>(owed_until_ - now));
+    if (n == 0 && (line || transport_->failure() != nullptr)) break;  // nothing will come
+    owed_bytes_ -= std::min(n, owed_bytes_);
+  }
+  owed_bytes_ = 0;
+}
+
 bool MaestroBus::poll_board(Board& board, bool count) {
   std::size_t length = 0;
   std::size_t asked = 0;
@@ -126,10 +140,22 @@ bool MaestroBus::poll_board(Board& board, bool count) {
   }
   length += maestro::encode_get_errors(board.address, {tx_.data() + length, tx_.size() - length});
   const std::size_t want = 2 * asked + 2;
-  // Late answers of an earlier burst must not pass for this one's.
+  // Late answers of an earlier burst must not pass for this one's: an
+  // answer is two bytes with no channel or board in them, and one that came
+  // in part before this burst and in part after would shift every value
+  // onto the next channel (a position taken for another channel's, then
+  // sent to it as its target at activate).
+  read_away_owed();
   transport_->discard_input();
+  const auto sent = std::chrono::steady_clock::now();
   send(length);
   const std::size_t got = receive(want, timeout_);
+  if (got < want) {
+    // The rest may still come, as late again as the wait was long.
+    const auto now = std::chrono::steady_clock::now();
+    owed_bytes_ = want - got;
+    owed_until_ = now + (now - sent);
+  }
 
   std::size_t slot = 0;
   for (std::size_t d : board.devices) {

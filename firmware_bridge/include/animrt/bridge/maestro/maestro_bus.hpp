@@ -102,6 +102,7 @@ class MaestroBus final : public ActuatorBus {
   // answers did not all arrive.
   bool poll_board(Board& board, bool count);
   std::size_t receive(std::size_t want, std::chrono::microseconds timeout);
+  void read_away_owed();
   void send(std::size_t length);
   std::uint16_t target_of(std::size_t device, double rad) const;
   std::string prefix() const { return book_.prefix(); }
@@ -119,6 +120,10 @@ class MaestroBus final : public ActuatorBus {
   std::vector<std::uint16_t> block_;    // scratch for Set Multiple Targets
   bool fresh_ = false;
   std::string timeout_warning_;
+  // The bytes a burst's answer still owed when it was given up: they carry
+  // no channel or board, so they are read away before the next burst.
+  std::size_t owed_bytes_ = 0;
+  std::chrono::steady_clock::time_point owed_until_{};
   std::array<std::uint8_t, 512> tx_{};
   std::array<std::uint8_t, 512> rx_{};
 };
