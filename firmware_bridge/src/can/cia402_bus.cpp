@@ -321,6 +321,15 @@ std::uint32_t Cia402Bus::sdo_exchange(std::size_t device, const can_frame& reque
       if (left.count() <= 0 && budget-- == 0) break;
       if (!transport_->receive(frame, std::max(left, std::chrono::microseconds(0)))) break;
       handle(frame);
+      // The answer to an earlier SDO of this drive whose try timed out and
+      // whose retry was answered first: it names another object, or another
+      // kind of transfer. Not this one's answer (nor its refusal); waited on.
+      const canopen::Sdo& a = sdo_answer_;
+      if (sdo_done_ && (a.index != index || a.subindex != sub ||
+                        (a.kind != canopen::SdoKind::abort && a.kind != expected))) {
+        book_.stray(device);
+        sdo_done_ = false;
+      }
     }
     sdo_slot_ = -1;
     if (!sdo_done_) continue;
@@ -331,7 +340,7 @@ std::uint32_t Cia402Bus::sdo_exchange(std::size_t device, const can_frame& reque
     }
     // Uploads are expedited only: a segmented answer is not understood.
     const bool expedited_if_upload = expected != canopen::SdoKind::upload_response || a.expedited;
-    if (a.kind != expected || !expedited_if_upload || a.index != index || a.subindex != sub) {
+    if (!expedited_if_upload) {
       book_.stray(device);
       throw DeviceError(prefix() + describe(device) + ": " + what + ": unexpected answer");
     }
