@@ -287,6 +287,24 @@ TEST(ModbusBus, OnALockstepLineAnAnswerLaterThanTheTimeoutIsNoTimeout) {
   EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, 0u);
 }
 
+TEST(ModbusBus, OnARealRtuLineARetriedReadsLateAnswerIsNotTakenForAnother) {
+  // Slave 1's first answer leaves 1.5 timeouts late: configure's read of it
+  // times out, the repeat takes that answer, and the repeat's own answer
+  // comes while the host asks slave 2, then activate writes slave 1. An
+  // RTU answer names no register: taken for the next request's, it failed
+  // request after request (activate: "cannot enable slave 1").
+  Rig r("modbus-rtu");
+  r.sim->set_device_answer_delay(1, 300'000'000, 1);
+  ASSERT_NO_THROW(r.bus->configure());
+  ASSERT_NO_THROW(r.bus->activate());
+  const std::vector<double> goal{deg_to_rad(5), deg_to_rad(-2)};
+  const std::vector<double> pos = r.step(goal, 50);
+  EXPECT_NEAR(pos[0], goal[0], 1e-3);
+  EXPECT_NEAR(pos[1], goal[1], 2e-4 / 0.1);
+  EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
+  EXPECT_EQ(r.bus->devices()[1].health, DeviceHealth::ok);
+}
+
 TEST(ModbusBus, IllegalAddressIsExceptionTwoAtBringUp) {
   // The runtime thinks slave 1 is a linear actuator; the drive has the rotary map.
   ManualClock clock;

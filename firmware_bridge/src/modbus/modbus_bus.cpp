@@ -42,13 +42,16 @@ std::string exception_name(int code) {
 
 // Simulated RTU drives on a lockstep clock say when they have answered all
 // they will (modbus_requests.hpp); TCP and hardware have no such line.
-LockstepLine* line_of(const BusConfig& config, const ModbusBusOptions& options) {
-  return options.tcp ? nullptr : config.lockstep_line.get();
-}
 
 }  // namespace
 
-ModbusBus::ModbusBus(BusConfig config) : config_(std::move(config)) {
+modbus_requests::Line ModbusBus::line() const {
+  if (options_.tcp) return {};  // the transaction id tells answers apart
+  return {config_.lockstep_line.get(), config_.lockstep_line ? nullptr : late_.get()};
+}
+
+ModbusBus::ModbusBus(BusConfig config)
+    : config_(std::move(config)), late_(std::make_unique<modbus_requests::LateAnswers>()) {
   const std::string bus = "bus " + config_.name + ": ";
   if (const auto* o = std::any_cast<ModbusBusOptions>(&config_.options)) options_ = *o;
   const std::size_t n = config_.actuators.size();
@@ -290,9 +293,8 @@ bool ModbusBus::read_slave(Slave& slave, bool count) {
     if (!connected_) return false;
     modbus_set_slave(ctx_, slave.id);
     ++requests_;
-    const int rc = modbus_requests::read_registers(ctx_, line_of(config_, options_), slave.id,
-                                                   r.table == modbus::Table::input, r.begin,
-                                                   r.count, r.words.data());
+    const int rc = modbus_requests::read_registers(
+        ctx_, line(), slave.id, r.table == modbus::Table::input, r.begin, r.count, r.words.data());
     if (rc != r.count) {
       const int error = rc < 0 ? errno : EMBMDATA;
       if (count) {
@@ -365,9 +367,8 @@ void ModbusBus::read_health_round_robin() {
       if (!connected_) return;
       modbus_set_slave(ctx_, s.id);
       ++requests_;
-      const int rc = modbus_requests::read_registers(ctx_, line_of(config_, options_), s.id,
-                                                     r.table == modbus::Table::input, r.begin,
-                                                     r.count, r.words.data());
+      const int rc = modbus_requests::read_registers(
+          ctx_, line(), s.id, r.table == modbus::Table::input, r.begin, r.count, r.words.data());
       if (rc != r.count) {
         for (std::size_t d : s.devices) kept_health_[d] = book_[d].health;
         fail_slave(s, rc < 0 ? errno : EMBMDATA);
@@ -400,8 +401,8 @@ bool ModbusBus::write_slave(Slave& slave) {
     if (!connected_) return false;
     modbus_set_slave(ctx_, slave.id);
     ++requests_;
-    if (modbus_requests::write_registers(ctx_, line_of(config_, options_), slave.id, w.begin,
-                                         w.count, w.words.data()) != w.count) {
+    if (modbus_requests::write_registers(ctx_, line(), slave.id, w.begin, w.count,
+                                         w.words.data()) != w.count) {
       fail_slave(slave, errno);
       return false;
     }
@@ -415,8 +416,7 @@ bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
     if (!e.configured) continue;
     modbus_set_slave(ctx_, slave.id);
     const std::uint16_t value = on ? e.on : e.off;
-    const int rc = modbus_requests::write_single(ctx_, line_of(config_, options_), slave.id, e.coil,
-                                                 e.address, value);
+    const int rc = modbus_requests::write_single(ctx_, line(), slave.id, e.coil, e.address, value);
     if (rc != 1) {
       *error = errno;
       return false;
@@ -431,8 +431,7 @@ bool ModbusBus::set_watchdog(Slave& slave, bool on, int* error) {
     if (!w.configured || joints_[d].watchdog_counts == 0) continue;
     modbus_set_slave(ctx_, slave.id);
     const auto counts = static_cast<std::uint16_t>(on ? joints_[d].watchdog_counts : 0);
-    if (modbus_requests::write_single(ctx_, line_of(config_, options_), slave.id, false, w.address,
-                                      counts) != 1) {
+    if (modbus_requests::write_single(ctx_, line(), slave.id, false, w.address, counts) != 1) {
       *error = errno;
       return false;
     }
@@ -551,8 +550,7 @@ void ModbusBus::switch_off_pending() {
       if (!e.configured || !connected_) continue;
       modbus_set_slave(ctx_, s.id);
       ++requests_;
-      const int rc = modbus_requests::write_single(ctx_, line_of(config_, options_), s.id, e.coil,
-                                                   e.address, e.off);
+      const int rc = modbus_requests::write_single(ctx_, line(), s.id, e.coil, e.address, e.off);
       if (rc != 1 && classify(errno) == Failure::connection && options_.tcp) disconnect();
     }
   }

@@ -3,8 +3,10 @@
 #include <modbus.h>
 #include <poll.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <thread>
 
 namespace animrt::modbus_requests {
 namespace {
@@ -74,14 +76,52 @@ void put16(std::uint8_t* p, int v) {
 
 int get16(const std::uint8_t* p) { return (p[0] << 8) | p[1]; }
 
+// A libmodbus call on a real line, with late answers waited out (RTU).
+template <class Call>
+int on_real_line(modbus_t* ctx, Line line, int slave, const LateAnswers::Request& request,
+                 Call&& call) {
+  if (line.late == nullptr) return call();
+  line.late->before(ctx, slave, request);
+  const auto sent = LateAnswers::Clock::now();
+  const int rc = call();
+  const int error = errno;
+  line.late->after(rc, slave, request, sent);
+  errno = error;
+  return rc;
+}
+
 }  // namespace
 
-int read_registers(modbus_t* ctx, LockstepLine* line, int slave, bool input, int address, int count,
+void LateAnswers::before(modbus_t* ctx, int slave, const Request& request) {
+  Owed& o = owed_[static_cast<std::size_t>(slave & 0xFF)];
+  if (!o.due || o.request == request) return;
+  std::this_thread::sleep_until(o.until);
+  modbus_flush(ctx);
+  o.due = false;
+}
+
+void LateAnswers::after(int rc, int slave, const Request& request, Clock::time_point sent) {
+  Owed& o = owed_[static_cast<std::size_t>(slave & 0xFF)];
+  const bool answered = rc >= 0 || (errno >= MODBUS_ENOBASE && errno <= MODBUS_ENOBASE + 0xFF);
+  // Answered after a repeat given up: that answer may have been the one
+  // owed, and this request's own is owed now.
+  if (answered && !(o.due && o.request == request)) return;
+  const auto now = Clock::now();
+  o.until = o.due ? std::max(o.until, now + (now - sent)) : now + (now - sent);
+  o.due = true;
+  o.request = request;
+}
+
+int read_registers(modbus_t* ctx, Line line, int slave, bool input, int address, int count,
                    std::uint16_t* dest) {
-  if (line == nullptr) {
-    return input ? modbus_read_input_registers(ctx, address, count, dest)
-                 : modbus_read_registers(ctx, address, count, dest);
+  if (line.lockstep == nullptr) {
+    const int function = input ? MODBUS_FC_READ_INPUT_REGISTERS : MODBUS_FC_READ_HOLDING_REGISTERS;
+    return on_real_line(ctx, line, slave, {function, address, count}, [&] {
+      return input ? modbus_read_input_registers(ctx, address, count, dest)
+                   : modbus_read_registers(ctx, address, count, dest);
+    });
   }
+  LockstepLine* lockstep = line.lockstep;
   if (count < 1 || count > MODBUS_MAX_READ_REGISTERS) {
     errno = EMBMDATA;
     return -1;
@@ -92,7 +132,7 @@ int read_registers(modbus_t* ctx, LockstepLine* line, int slave, bool input, int
   put16(req + 2, address);
   put16(req + 4, count);
   std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
-  const int rc = exchange(ctx, *line, req, sizeof req, rsp);
+  const int rc = exchange(ctx, *lockstep, req, sizeof req, rsp);
   // Slave, function, byte count, the registers, CRC.
   if (!answer_ok(req, rsp, rc, 3 + 2 * count + 2)) return -1;
   if (rsp[2] != 2 * count) {
@@ -103,9 +143,12 @@ int read_registers(modbus_t* ctx, LockstepLine* line, int slave, bool input, int
   return count;
 }
 
-int write_registers(modbus_t* ctx, LockstepLine* line, int slave, int address, int count,
+int write_registers(modbus_t* ctx, Line line, int slave, int address, int count,
                     const std::uint16_t* src) {
-  if (line == nullptr) return modbus_write_registers(ctx, address, count, src);
+  if (line.lockstep == nullptr) {
+    return on_real_line(ctx, line, slave, {MODBUS_FC_WRITE_MULTIPLE_REGISTERS, address, count},
+                        [&] { return modbus_write_registers(ctx, address, count, src); });
+  }
   if (count < 1 || count > MODBUS_MAX_WRITE_REGISTERS) {
     errno = EMBMDATA;
     return -1;
@@ -117,7 +160,7 @@ int write_registers(modbus_t* ctx, LockstepLine* line, int slave, int address, i
   req[6] = static_cast<std::uint8_t>(2 * count);
   for (int i = 0; i < count; ++i) put16(req + 7 + 2 * i, src[i]);
   std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
-  const int rc = exchange(ctx, *line, req, 7 + 2 * count, rsp);
+  const int rc = exchange(ctx, *line.lockstep, req, 7 + 2 * count, rsp);
   // Slave, function, address, quantity, CRC.
   if (!answer_ok(req, rsp, rc, 8)) return -1;
   if (get16(rsp + 2) != address || get16(rsp + 4) != count) {
@@ -127,11 +170,13 @@ int write_registers(modbus_t* ctx, LockstepLine* line, int slave, int address, i
   return count;
 }
 
-int write_single(modbus_t* ctx, LockstepLine* line, int slave, bool coil, int address,
-                 std::uint16_t value) {
-  if (line == nullptr) {
-    return coil ? modbus_write_bit(ctx, address, value != 0 ? 1 : 0)
-                : modbus_write_register(ctx, address, value);
+int write_single(modbus_t* ctx, Line line, int slave, bool coil, int address, std::uint16_t value) {
+  if (line.lockstep == nullptr) {
+    const int function = coil ? MODBUS_FC_WRITE_SINGLE_COIL : MODBUS_FC_WRITE_SINGLE_REGISTER;
+    return on_real_line(ctx, line, slave, {function, address, 1}, [&] {
+      return coil ? modbus_write_bit(ctx, address, value != 0 ? 1 : 0)
+                  : modbus_write_register(ctx, address, value);
+    });
   }
   const int word = coil ? (value != 0 ? 0xFF00 : 0) : value;
   std::uint8_t req[6] = {static_cast<std::uint8_t>(slave),
@@ -140,7 +185,7 @@ int write_single(modbus_t* ctx, LockstepLine* line, int slave, bool coil, int ad
   put16(req + 2, address);
   put16(req + 4, word);
   std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
-  const int rc = exchange(ctx, *line, req, sizeof req, rsp);
+  const int rc = exchange(ctx, *line.lockstep, req, sizeof req, rsp);
   // The request echoed, and the CRC.
   if (!answer_ok(req, rsp, rc, 8)) return -1;
   if (get16(rsp + 2) != address || get16(rsp + 4) != word) {

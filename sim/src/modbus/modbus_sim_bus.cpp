@@ -54,6 +54,10 @@ struct ModbusSimBus::Drive {
   std::vector<Joint> joints;
   modbus_mapping_t* mapping = nullptr;
   bool responding = true;
+  // Its next `late_answers` answers (-1: all) leave `late_us` later than
+  // the return delay, as from a drive busy with other work.
+  int late_answers = 0;
+  int late_us = 0;
   std::uint16_t faults = 0;
   std::uint16_t fault_code = 0;  // the health section's fault code (injected)
   // The firmware's own overtemperature trip: output off, latched until a
@@ -328,7 +332,11 @@ void ModbusSimBus::handle(const std::uint8_t* req, int length, int offset) {
       }
     }
   }
-  const int delay = config_.sim.return_delay_us;
+  int delay = config_.sim.return_delay_us;
+  if (d->late_answers != 0) {
+    delay += d->late_us;
+    if (d->late_answers > 0) --d->late_answers;
+  }
   if (bad_value) {
     sleep_us(delay);
     wrote(modbus_reply_exception(ctx_, req, MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE));
@@ -511,6 +519,16 @@ void ModbusSimBus::serve_rtu() {
 
 void ModbusSimBus::wrote(int bytes) {
   if (line_ && bytes > 0) line_->device_wrote(static_cast<std::size_t>(bytes));
+}
+
+void ModbusSimBus::set_device_answer_delay(int device_id, Nanos delay_ns, int answers) {
+  std::lock_guard lock(mutex_);
+  Drive* d = drive(device_id);
+  if (!d)
+    throw std::out_of_range("no slave " + std::to_string(device_id) + " on simulated bus '" +
+                            elide(config_.name) + "'");
+  d->late_us = static_cast<int>(delay_ns / 1000);
+  d->late_answers = delay_ns > 0 ? answers : 0;
 }
 
 void ModbusSimBus::set_device_responding(int device_id, bool responding) {

@@ -37,8 +37,8 @@ class SimulatedBus {
   virtual void set_device_hardware_error(int device_id, std::uint8_t error_bits) = 0;
   // Fault injection: the device's next `answers` answers (every one while
   // answers < 0) leave `delay_ns` of real time late; 0 switches it off.
-  // Throws std::logic_error where the devices do not model it (only the
-  // Dynamixel servos do).
+  // Throws std::logic_error where the devices do not model it (the
+  // Dynamixel servos, the CAN drives and motors and the Modbus drives do).
   virtual void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) {
     (void)device_id;
     (void)delay_ns;

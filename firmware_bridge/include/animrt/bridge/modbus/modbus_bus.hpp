@@ -47,6 +47,11 @@ struct _modbus;
 
 namespace animrt {
 
+namespace modbus_requests {
+class LateAnswers;
+struct Line;
+}  // namespace modbus_requests
+
 // BusConfig::options of a modbus-tcp or modbus-rtu bus.
 struct ModbusBusOptions {
   bool tcp = true;
@@ -114,6 +119,7 @@ class ModbusBus final : public ActuatorBus {
   std::uint64_t requests() const { return requests_; }
 
  private:
+  modbus_requests::Line line() const;
   struct Read {
     modbus::Table table;
     int begin = 0, count = 0;
@@ -176,6 +182,7 @@ class ModbusBus final : public ActuatorBus {
   std::vector<DeviceHealth> kept_health_;  // round_robin: a lost health read keeps these
   std::size_t health_next_ = 0;            // round_robin: the slave read next
   _modbus* ctx_ = nullptr;
+  std::unique_ptr<modbus_requests::LateAnswers> late_;
   bool connected_ = false;
   bool fresh_ = false;
   std::chrono::steady_clock::time_point next_attempt_{};

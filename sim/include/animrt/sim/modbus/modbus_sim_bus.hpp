@@ -69,6 +69,7 @@ class ModbusSimBus final : public SimulatedBus {
   void stop() override;
   std::string raise_priority(int priority) override { return set_fifo_priority(thread_, priority); }
   // device_id = slave id. A drive that is not responding ignores requests.
+  void set_device_answer_delay(int device_id, Nanos delay_ns, int answers = -1) override;
   void set_device_responding(int device_id, bool responding) override;
   // Sets bits in the drive's status register (and disables its motors).
   void set_device_hardware_error(int device_id, std::uint8_t error_bits) override;
