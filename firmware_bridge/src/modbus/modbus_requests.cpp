@@ -102,10 +102,15 @@ void LateAnswers::before(modbus_t* ctx, int slave, const Request& request) {
 
 void LateAnswers::after(int rc, int slave, const Request& request, Clock::time_point sent) {
   Owed& o = owed_[static_cast<std::size_t>(slave & 0xFF)];
-  const bool answered = rc >= 0 || (errno >= MODBUS_ENOBASE && errno <= MODBUS_ENOBASE + 0xFF);
+  // No answer in time, or one not usable as this request's (damaged, or
+  // another's): this request's own may still come. An exception is an
+  // answer; a connection error leaves nothing to wait for.
+  const bool given_up =
+      rc < 0 && (errno == ETIMEDOUT || errno == EMBBADCRC || errno == EMBBADDATA ||
+                 errno == EMBBADEXC || errno == EMBBADSLAVE);
   // Answered after a repeat given up: that answer may have been the one
   // owed, and this request's own is owed now.
-  if (answered && !(o.due && o.request == request)) return;
+  if (!given_up && !(o.due && o.request == request)) return;
   const auto now = Clock::now();
   o.until = o.due ? std::max(o.until, now + (now - sent)) : now + (now - sent);
   o.due = true;
