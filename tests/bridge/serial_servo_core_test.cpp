@@ -436,9 +436,10 @@ TEST(DynamixelBusWatchdog, IsRearmedWhenNothingValidWasHeardForHalfItsTime) {
 }
 
 TEST(DynamixelBusLateAnswers, ARetriedReadsLaterAnswerIsNotTakenForTheNextRead) {
-  // Every answer leaves 1.5 timeouts after its request: each try times out
-  // and the answer to the first comes during the second, whose own answer
-  // is still on its way when the next read is sent. set_home reads Present
+  // Every answer leaves 2 timeouts after its request: each try times out
+  // and the answer to the first comes during the second (half way through
+  // its wait of 2 timeouts), whose own answer is still on its way when the
+  // next read is sent. set_home reads Present
   // Position, then Homing Offset (both 4 bytes from the same id): taken for
   // the Homing Offset, that later answer would make the home the shaft's
   // 0 and the servo read 2048 + 2867 after the Reboot.
@@ -446,7 +447,7 @@ TEST(DynamixelBusLateAnswers, ARetriedReadsLaterAnswerIsNotTakenForTheNextRead) 
   ScheduledServos<Dynamixel>& line = *owned;
   BusConfig config;
   config.name = "legs";
-  config.timeout_s = 0.030;
+  config.timeout_s = 0.040;
   ActuatorBinding b;
   b.joint = "knee";
   b.device_id = 1;
@@ -463,7 +464,7 @@ TEST(DynamixelBusLateAnswers, ARetriedReadsLaterAnswerIsNotTakenForTheNextRead) 
   bus.configure();
   // Torque off, Present Position, Homing Offset: each tried twice.
   line.late_requests = 6;
-  line.late = microseconds(45'000);
+  line.late = microseconds(80'000);
   EXPECT_EQ(bus.set_home(0, 2048), 2048);
   EXPECT_EQ(static_cast<std::int32_t>(line.registers[dxl::xreg::homing_offset]), 2048 - 2867);
 }

@@ -304,10 +304,12 @@ class Link {
   // silent device costs 7 timeouts in 3 tries. Within a Stopping scope each
   // try waits one timeout. An answer to an earlier try that comes during a
   // later one is taken: it answers the same instruction. The answers to the
-  // tries after it are then owed: a status packet names no instruction, so
-  // one that came during the device's next transaction would pass for its
-  // answer (a Present Position taken for the Homing Offset read next).
-  // That transaction first reads them away (begin()).
+  // tries after it may still be on their way: a status packet names no
+  // instruction, so one that came during the device's next transaction
+  // would pass for its answer (a Present Position taken for the Homing
+  // Offset read next). They are read away here, within as long again as
+  // the tries took (one timeout within a Stopping scope); the cycle's own
+  // transactions are never retried, so never wait for them.
   Answer unicast(std::size_t device, std::size_t length, std::size_t data_length, int tries,
                  bool diagnostic = false) {
     Answer a = Answer::timeout;
@@ -322,10 +324,8 @@ class Link {
       if (a == Answer::ok || a == Answer::rejected) break;
     }
     if (t > 0 && t < tries) {
-      // A device that answers each try equally late answers the last one
-      // within as long again as the tries took so far.
       const Clock::time_point now = Clock::now();
-      owed_ = {device, t, now + (now - first)};
+      read_away(device, t, stopping_ ? now + timeout_ : now + (now - first));
     }
     return a;
   }
@@ -381,12 +381,6 @@ class Link {
       suspect_[s] = 0;
       book_.asked(asked_[s]);
     }
-    if (owed_.answers > 0 &&
-        std::find(asked_.begin(), asked_.begin() + static_cast<std::ptrdiff_t>(count),
-                  owed_.device) != asked_.begin() + static_cast<std::ptrdiff_t>(count)) {
-      read_away_owed();
-    }
-    owed_.answers = 0;
     // Late answers from an earlier transaction must not pass for this one's.
     transport_->discard_input();
     decoder_.reset();
@@ -474,22 +468,22 @@ class Link {
   }
 
  private:
-  // Waits for the answers a retried unicast left owed (until they came or
-  // their time is up) and drops them.
-  void read_away_owed() {
-    decoder_.reset();
-    rx_begin_ = rx_end_ = 0;
+  // Reads up to `answers` status packets of `device` (the answers to a
+  // unicast's later tries) until `until`, and drops them.
+  void read_away(std::size_t device, int answers, Clock::time_point until) {
     late_look_done_ = false;
     Packet packet;
-    const std::uint8_t id = bus_ids_[owed_.device];
-    while (owed_.answers > 0) {
-      const Frame r = next_event(packet, owed_.until);
+    const std::uint8_t id = bus_ids_[device];
+    while (answers > 0) {
+      const Frame r = next_event(packet, until);
       if (r == Frame::need_more) break;
       if (r == Frame::packet && codec_.from_device(packet, {tx_.data(), sent_length_}) &&
           codec_.id(packet) == id) {
-        --owed_.answers;
+        --answers;
       }
     }
+    decoder_.reset();
+    rx_begin_ = rx_end_ = 0;
   }
 
   // Pulls bytes until the decoder has something other than need_more, or
@@ -575,11 +569,6 @@ class Link {
   std::size_t rx_begin_ = 0, rx_end_ = 0;
   bool late_look_done_ = false;
   bool stopping_ = false;  // within a Stopping scope
-  struct Owed {
-    std::size_t device = 0;
-    int answers = 0;  // answers to a retried unicast's later tries, still to come
-    Clock::time_point until{};
-  } owed_;
   typename Codec::Decoder decoder_;
 };
 
