@@ -45,9 +45,9 @@ std::string exception_name(int code) {
 
 }  // namespace
 
-modbus_requests::Line ModbusBus::line() const {
+modbus_requests::Line ModbusBus::line(bool urgent) const {
   if (options_.tcp) return {};  // the transaction id tells answers apart
-  return {config_.lockstep_line.get(), config_.lockstep_line ? nullptr : late_.get()};
+  return {config_.lockstep_line.get(), config_.lockstep_line ? nullptr : late_.get(), urgent};
 }
 
 ModbusBus::ModbusBus(BusConfig config)
@@ -416,7 +416,8 @@ bool ModbusBus::set_enable(Slave& slave, bool on, int* error) {
     if (!e.configured) continue;
     modbus_set_slave(ctx_, slave.id);
     const std::uint16_t value = on ? e.on : e.off;
-    const int rc = modbus_requests::write_single(ctx_, line(), slave.id, e.coil, e.address, value);
+    const int rc =
+        modbus_requests::write_single(ctx_, line(!on), slave.id, e.coil, e.address, value);
     if (rc != 1) {
       *error = errno;
       return false;
@@ -550,7 +551,8 @@ void ModbusBus::switch_off_pending() {
       if (!e.configured || !connected_) continue;
       modbus_set_slave(ctx_, s.id);
       ++requests_;
-      const int rc = modbus_requests::write_single(ctx_, line(), s.id, e.coil, e.address, e.off);
+      const int rc =
+          modbus_requests::write_single(ctx_, line(true), s.id, e.coil, e.address, e.off);
       if (rc != 1 && classify(errno) == Failure::connection && options_.tcp) disconnect();
     }
   }

@@ -81,7 +81,7 @@ template <class Call>
 int on_real_line(modbus_t* ctx, Line line, int slave, const LateAnswers::Request& request,
                  Call&& call) {
   if (line.late == nullptr) return call();
-  line.late->before(ctx, slave, request);
+  if (!line.urgent) line.late->before(ctx, slave, request);
   const auto sent = LateAnswers::Clock::now();
   const int rc = call();
   const int error = errno;

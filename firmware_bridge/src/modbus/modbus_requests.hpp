@@ -55,6 +55,9 @@ class LateAnswers {
 struct Line {
   LockstepLine* lockstep = nullptr;
   LateAnswers* late = nullptr;
+  // Sent without waiting for a late answer (a switch-off: the drive acts on
+  // the request whatever answer the host then reads).
+  bool urgent = false;
 };
 
 // Read Holding Registers (input = false) or Read Input Registers.

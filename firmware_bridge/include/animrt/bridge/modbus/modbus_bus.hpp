@@ -119,7 +119,8 @@ class ModbusBus final : public ActuatorBus {
   std::uint64_t requests() const { return requests_; }
 
  private:
-  modbus_requests::Line line() const;
+  // `urgent`: a switch-off, sent without waiting out a late answer.
+  modbus_requests::Line line(bool urgent = false) const;
   struct Read {
     modbus::Table table;
     int begin = 0, count = 0;
