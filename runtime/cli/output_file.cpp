@@ -14,8 +14,15 @@ namespace animrt::cli {
 
 OutputFile::~OutputFile() {
   if (fd < 0) return;
+  // Removed only while the path still names the empty file this made: not
+  // one another run has written or put there since.
+  struct stat open_st {
+  }, path_st{};
+  const bool ours = !created_.empty() && ::fstat(fd, &open_st) == 0 && open_st.st_size == 0 &&
+                    ::lstat(created_.c_str(), &path_st) == 0 && path_st.st_dev == open_st.st_dev &&
+                    path_st.st_ino == open_st.st_ino;
+  if (ours) ::unlink(created_.c_str());
   ::close(fd);
-  if (!created_.empty()) ::unlink(created_.c_str());
 }
 
 bool OutputFile::open(const std::string& path) {

@@ -99,9 +99,13 @@ print(s.getsockname()[1], flush=True); time.sleep(30)' > "$tmp/port.txt" &
 holder=$!
 for _ in $(seq 50); do [[ -s $tmp/port.txt ]] && break; sleep 0.1; done
 port=$(cat "$tmp/port.txt")
+[[ -n $port ]] || { kill "$holder"; fail "no port to hold"; }
 out=$("$animrt" herd "$tmp/one.yaml" --summary-json "$tmp/new.json" --svg "$tmp/new.svg" \
-  --dashboard "127.0.0.1:$port" --quiet 2>&1) && fail "a dashboard on a taken port: $out"
+  --dashboard "127.0.0.1:$port" --quiet 2>&1)
+code=$?
 kill "$holder" 2>/dev/null
+[[ $code -ne 0 && $out == *"cannot listen on 127.0.0.1:$port"* ]] ||
+  fail "a dashboard on a taken port: exit $code: $out"
 [[ ! -e $tmp/new.json && ! -e $tmp/new.svg ]] ||
   fail "a run that failed left new files: $(ls "$tmp"); $out"
 echo "herd_summary: ok"
