@@ -115,14 +115,9 @@ std::size_t MaestroBus::receive(std::size_t want, std::chrono::microseconds time
 
 void MaestroBus::read_away_owed() {
   const bool line = transport_->follows_line();
-  while (owed_bytes_ > 0) {
-    const auto now = std::chrono::steady_clock::now();
-    if (!line && now >= owed_until_) break;
-    const std::size_t n = transport_->read(
-        {rx_.data(), std::min(owed_bytes_, rx_.size())},
-        line ? timeout_ : std::chrono::ceil<std::chrono::microseconds>(owed_until_ - now));
-    if (n == 0 && (line || transport_->failure() != nullptr)) break;  // nothing will come
-    owed_bytes_ -= std::min(n, owed_bytes_);
+  const auto left = std::chrono::ceil<std::chrono::microseconds>(owed_until_ - steady_clock::now());
+  if (owed_bytes_ > 0 && (line || left.count() > 0)) {
+    receive(std::min(owed_bytes_, rx_.size()), line ? timeout_ : left);
   }
   owed_bytes_ = 0;
 }
@@ -147,12 +142,12 @@ bool MaestroBus::poll_board(Board& board, bool count) {
   // sent to it as its target at activate).
   read_away_owed();
   transport_->discard_input();
-  const auto sent = std::chrono::steady_clock::now();
+  const auto sent = steady_clock::now();
   send(length);
   const std::size_t got = receive(want, timeout_);
   if (got < want) {
     // The rest may still come, as late again as the wait was long.
-    const auto now = std::chrono::steady_clock::now();
+    const auto now = steady_clock::now();
     owed_bytes_ = want - got;
     owed_until_ = now + (now - sent);
   }

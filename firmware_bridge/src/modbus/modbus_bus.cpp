@@ -40,11 +40,11 @@ std::string exception_name(int code) {
   }
 }
 
-// Simulated RTU drives on a lockstep clock say when they have answered all
-// they will (modbus_requests.hpp); TCP and hardware have no such line.
-
 }  // namespace
 
+// Simulated RTU drives on a lockstep clock say when they have answered all
+// they will; on a real RTU line late answers are waited out
+// (modbus_requests.hpp).
 modbus_requests::Line ModbusBus::line(bool urgent) const {
   if (options_.tcp) return {};  // the transaction id tells answers apart
   return {config_.lockstep_line.get(), config_.lockstep_line ? nullptr : late_.get(), urgent};

@@ -126,7 +126,6 @@ int read_registers(modbus_t* ctx, Line line, int slave, bool input, int address,
                    : modbus_read_registers(ctx, address, count, dest);
     });
   }
-  LockstepLine* lockstep = line.lockstep;
   if (count < 1 || count > MODBUS_MAX_READ_REGISTERS) {
     errno = EMBMDATA;
     return -1;
@@ -137,7 +136,7 @@ int read_registers(modbus_t* ctx, Line line, int slave, bool input, int address,
   put16(req + 2, address);
   put16(req + 4, count);
   std::uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
-  const int rc = exchange(ctx, *lockstep, req, sizeof req, rsp);
+  const int rc = exchange(ctx, *line.lockstep, req, sizeof req, rsp);
   // Slave, function, byte count, the registers, CRC.
   if (!answer_ok(req, rsp, rc, 3 + 2 * count + 2)) return -1;
   if (rsp[2] != 2 * count) {

@@ -5,7 +5,8 @@
 // written whatever they answer, and an answer that is not there then is
 // missing at once, where libmodbus would wait its response timeout on the
 // wall clock; the answer that is there is read and checked here as
-// libmodbus checks it. Without a line: libmodbus's own calls, unchanged.
+// libmodbus checks it. Without a line: libmodbus's own calls, with a late
+// answer waited out first on RTU (LateAnswers).
 //
 // Each returns what the libmodbus call it stands for returns: the number of
 // registers or bits, or -1 with errno set (ETIMEDOUT for a missing answer,
