@@ -146,6 +146,7 @@ void DynamixelSimBus::serve() {
                  line::feed(dxl::LinkCodec{}, decoder_, bytes, decode_counts_,
                             [&](const dxl::Packet& packet) { handle(packet, arrival); });
                  stray_bytes_ = decoder_.stray_bytes();
+                 received_bytes_ += bytes.size();
                },
                [this] { return decoder_.buffered() > 0; },
                [this] {
@@ -335,6 +336,7 @@ double DynamixelSimBus::device_position(int device_id) const {
 
 DynamixelSimStats DynamixelSimBus::stats() const {
   DynamixelSimStats s;
+  s.received_bytes = received_bytes_;
   s.packets = packets_;
   s.answers = answers_sent_;
   s.crc_errors = decode_counts_.bad_checks;

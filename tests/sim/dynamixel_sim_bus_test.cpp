@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <thread>
 #include <vector>
 
 #include "animrt/core/error.hpp"
@@ -65,6 +66,20 @@ class DynamixelSimBusTest : public ::testing::Test {
   }
 
   test::Status transact(const Bytes& instruction) { return client_->transact(instruction); }
+
+  // Sends `bytes` and returns once the servos' side has read them: on a
+  // loaded machine its thread may not run for longer than any silence a
+  // test leaves, and would read what was sent apart as one burst.
+  void send_and_wait_read(const Bytes& bytes) {
+    const std::uint64_t before = bus_->stats().received_bytes;
+    client_->send(bytes);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (bus_->stats().received_bytes < before + bytes.size() &&
+           std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_EQ(bus_->stats().received_bytes, before + bytes.size());
+  }
 
   std::int32_t read_i32(std::uint8_t id, std::uint16_t address) {
     const auto s = transact(test::read(id, address, 4));
@@ -333,11 +348,11 @@ TEST_F(DynamixelSimBusTest, UnknownIdGetsNoAnswer) {
 TEST_F(DynamixelSimBusTest, StrayBytesSplitAndBackToBackPackets) {
   const Bytes p = test::ping(2);
   Bytes noise = {0x00, 0x42, 0xFF, 0x13};
-  client_->send(noise);
-  client_->send(Bytes(p.begin(), p.begin() + 4));
+  send_and_wait_read(noise);
+  send_and_wait_read(Bytes(p.begin(), p.begin() + 4));
   EXPECT_TRUE(client_->silent(std::chrono::milliseconds(30)));
   // After that silence the firmware dropped the half packet: its rest is junk.
-  client_->send(Bytes(p.begin() + 4, p.end()));
+  send_and_wait_read(Bytes(p.begin() + 4, p.end()));
   EXPECT_TRUE(client_->silent(std::chrono::milliseconds(30)));
   EXPECT_EQ(bus_->stats().partial_packet_bytes, 4u);
 
@@ -355,7 +370,7 @@ TEST_F(DynamixelSimBusTest, StrayBytesSplitAndBackToBackPackets) {
 
 TEST_F(DynamixelSimBusTest, HeaderClaimingALongLengthDoesNotSwallowWhatFollowsASilence) {
   // Header, id 1, LEN 0x00FF, then nothing more of that packet.
-  client_->send({0xFF, 0xFF, 0xFD, 0x00, 0x01, 0xFF, 0x00, 0x02});
+  send_and_wait_read({0xFF, 0xFF, 0xFD, 0x00, 0x01, 0xFF, 0x00, 0x02});
   EXPECT_TRUE(client_->silent(std::chrono::milliseconds(50)));
   const auto s = transact(test::ping(2));
   EXPECT_EQ(s.id, 2);

@@ -53,6 +53,7 @@
 namespace animrt::sim {
 
 struct DynamixelSimStats {
+  std::uint64_t received_bytes = 0;        // bytes read from the line and handled
   std::uint64_t packets = 0;               // instruction packets handled (any id)
   std::uint64_t answers = 0;               // status packets sent
   std::uint64_t crc_errors = 0;            // packets dropped for a bad CRC (never answered)
@@ -142,6 +143,7 @@ class DynamixelSimBus final : public SimulatedBus {
 
   std::thread thread_;
   std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> received_bytes_{0};
   std::atomic<std::uint64_t> packets_{0};
   std::atomic<std::uint64_t> answers_sent_{0};
   line::DecodeCounts decode_counts_;
