@@ -12,7 +12,6 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -213,16 +212,10 @@ int cmd_run(const RunArgs& args) {
   animrt::cli::start_fault_injection();
   animrt::RunSummary summary = figure.run(options);
   if (herd) herd->stop();
-  const bool summary_written =
-      !summary_out.is_open() || summary_out.write(animrt::to_json(summary).dump(2) + '\n');
   std::cout << animrt::format_summary(summary);
   if (herd) std::cout << herd->report() << '\n';
-  int code = summary.exit_code();
-  if (!summary_written) {
-    std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "
-              << std::strerror(summary_out.error) << '\n';
-    if (code == kExitOk) code = animrt::cli::kExitRecordLost;
-  }
+  const int code = animrt::cli::write_summary_json(
+      summary_out, args.summary_json, animrt::to_json(summary).dump(2) + '\n', summary.exit_code());
   std::cout << std::flush;
   return code;
 }

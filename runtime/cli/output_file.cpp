@@ -7,8 +7,10 @@
 
 #include <cerrno>
 #include <cstring>
+#include <iostream>
 
 #include "animrt/core/input_file.hpp"
+#include "subcommand.hpp"
 
 namespace animrt::cli {
 
@@ -58,6 +60,14 @@ bool open_summary_json(OutputFile& file, const std::string& path) {
   if (path.empty() || file.open(path)) return true;
   spdlog::error("--summary-json: cannot write {}: {}", path, std::strerror(file.error));
   return false;
+}
+
+int write_summary_json(OutputFile& file, const std::string& path, const std::string& json,
+                       int code) {
+  if (!file.is_open() || file.write(json)) return code;
+  std::cout << "RECORD LOST summary JSON: could not be written to " << path << ": "
+            << std::strerror(file.error) << '\n';
+  return code == kExitOk ? kExitRecordLost : code;
 }
 
 }  // namespace animrt::cli

@@ -28,5 +28,10 @@ struct OutputFile {
 // run's and serve's --summary-json (none when `path` is empty): false, with
 // the error logged, when it cannot be opened.
 bool open_summary_json(OutputFile& file, const std::string& path);
+// Writes `json` to run's or serve's --summary-json if one is open; when it
+// cannot be written, prints the RECORD LOST line and turns a clean exit
+// `code` into kExitRecordLost. Returns the exit code.
+int write_summary_json(OutputFile& file, const std::string& path, const std::string& json,
+                       int code);
 
 }  // namespace animrt::cli

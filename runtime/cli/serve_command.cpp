@@ -237,16 +237,11 @@ int serve(const ServeArgs& args) {
   // may still count, so both reports read the counts once, here.
   const CueCounts counts{requests.posted(), requests.taken()};
   slow_exit_for_test();
-  const bool summary_written =
-      !summary_out.is_open() || summary_out.write(cue_summary_json(summary, playing, counts));
   std::cout << format_summary(summary);
   print_cue_report(playing, counts, osc.get(), dmx, triggers);
-  int code = summary.exit_code();
-  if (!summary_written) {
-    std::cout << "RECORD LOST summary JSON: could not be written to " << args.summary_json << ": "
-              << std::strerror(summary_out.error) << '\n';
-    if (code == kExitOk) code = kExitRecordLost;
-  }
+  const int code =
+      write_summary_json(summary_out, args.summary_json, cue_summary_json(summary, playing, counts),
+                         summary.exit_code());
   std::cout << std::flush;
   // The watchdog is fed up to here: the figure was released, and writing
   // the summary may take seconds on a loaded machine.

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # animrt serve --summary-json: the run's summary and the cues' counts as
 # JSON (a lockstep serve of the head with its cues, idling),
-# and a file that cannot be written refused before anything moves.
+# a file that cannot be written refused before anything moves, and one
+# that fails when written (a full disk) reported as a lost record, exit 6.
 set -uo pipefail
 animrt=$1
 root=$2
@@ -27,4 +28,11 @@ code=$?
 [[ $code -eq 1 && $out == *"--summary-json: $tmp/no/such/dir/s.json: its folder \"$tmp/no/such/dir\" does not exist"* ]] ||
   fail "unwritable summary: exit $code: $out"
 [[ $out != *"start ramp"* && $out != *"cues started"* ]] || fail "it moved first: $out"
+
+out=$("$animrt" serve "$root/configs/robots/head.yaml" --cues "$root/configs/cues/head.yaml" \
+  --lockstep --duration 1 --no-osc --no-artnet --summary-json /dev/full 2>&1)
+code=$?
+[[ $code -eq 6 ]] || fail "summary JSON to /dev/full: exit $code, expected 6: $out"
+grep -q "^RECORD LOST summary JSON: could not be written to /dev/full: No space left on device$" \
+  <<< "$out" || fail "summary JSON to /dev/full: $out"
 echo ok
