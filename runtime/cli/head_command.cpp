@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <iostream>
 #include <memory>
 #include <set>
@@ -119,7 +118,7 @@ int run_eval(const HeadArgs& a) {
 int run_table(const HeadArgs& a) {
   OutputFile out;  // opened before the hours of training, written at the end
   if (!a.out.empty() && !out.open(a.out)) {
-    throw std::runtime_error("cannot write " + a.out + ": " + std::strerror(out.error));
+    throw cannot_write("--out", a.out, out.error);
   }
   const auto split = split_corpus(list_corpus(a.corpus), a.train_fraction, a.seed);
   const FeatureConfig fc;
@@ -140,7 +139,7 @@ int run_table(const HeadArgs& a) {
   const std::string table = format_table(rows);
   std::cout << table;
   if (out.is_open() && !out.write(table)) {
-    throw std::runtime_error("cannot write " + a.out + ": " + std::strerror(out.error));
+    throw cannot_write("--out", a.out, out.error);
   }
   std::cerr << "took "
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()

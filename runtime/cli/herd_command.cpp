@@ -3,9 +3,9 @@
 
 #include "herd_command.hpp"
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -158,17 +158,13 @@ struct EndFiles {
   OutputFile summary;
 };
 
-std::runtime_error cannot_write(const std::string& path, const OutputFile& file, const char* what) {
-  return std::runtime_error(path + ": cannot write the " + what + ": " + std::strerror(file.error));
-}
-
 void open_end_files(const HerdArgs& a, EndFiles& files) {
-  const auto open = [](const std::string& path, OutputFile& file, const char* what) {
+  const auto open = [](const std::string& path, OutputFile& file, const char* option) {
     if (path.empty() || file.open(path)) return;
-    throw cannot_write(path, file, what);
+    throw cannot_write(option, path, file.error);
   };
-  open(a.svg, files.svg, "top view");
-  open(a.summary_json, files.summary, "summary");
+  open(a.svg, files.svg, "--svg");
+  open(a.summary_json, files.summary, "--summary-json");
 }
 
 // The CSV closed, the top view and the summary written.
@@ -177,17 +173,17 @@ void write_outputs(const HerdArgs& a, std::ofstream& csv, EndFiles& files,
                    const herd::HerdMetrics& metrics, double wall_s) {
   if (csv.is_open()) {
     csv.close();
-    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    if (!csv) throw cannot_write("--out", a.out, errno);
     std::cout << "wrote " << a.out << '\n';
   }
   const auto write = [](const std::string& path, OutputFile& file, const std::string& text,
-                        const char* what) {
+                        const char* option) {
     if (!file.is_open()) return;
-    if (!file.write(text)) throw cannot_write(path, file, what);
+    if (!file.write(text)) throw cannot_write(option, path, file.error);
     std::cout << "wrote " << path << '\n';
   };
-  write(a.svg, files.svg, trails.svg(herd), "top view");
-  write(a.summary_json, files.summary, to_json(metrics, wall_s).dump(2) + '\n', "summary");
+  write(a.svg, files.svg, trails.svg(herd), "--svg");
+  write(a.summary_json, files.summary, to_json(metrics, wall_s).dump(2) + '\n', "--summary-json");
 }
 
 int run_herd(const HerdArgs& a) {
@@ -213,7 +209,7 @@ int run_herd(const HerdArgs& a) {
   std::ofstream csv;
   if (!a.out.empty()) {
     csv.open(a.out);
-    if (!csv) throw std::runtime_error(a.out + ": cannot write the herd CSV");
+    if (!csv) throw cannot_write("--out", a.out, errno);
     herd::write_csv_header(csv);
   }
   herd::TrailRecorder trails;

@@ -56,9 +56,14 @@ bool OutputFile::write(const std::string& text) {
   return closed == 0;
 }
 
+std::runtime_error cannot_write(const std::string& option, const std::string& path, int error) {
+  const std::string why = error != 0 ? std::string(": ") + std::strerror(error) : "";
+  return std::runtime_error(option + ": cannot write " + path + why);
+}
+
 bool open_summary_json(OutputFile& file, const std::string& path) {
   if (path.empty() || file.open(path)) return true;
-  spdlog::error("--summary-json: cannot write {}: {}", path, std::strerror(file.error));
+  spdlog::error("{}", cannot_write("--summary-json", path, file.error).what());
   return false;
 }
 

@@ -6,6 +6,7 @@
 // written, every failure (a full disk, /dev/full, a close that fails) kept
 // with its errno. A file it created and never wrote is removed again.
 
+#include <stdexcept>
 #include <string>
 
 namespace animrt::cli {
@@ -24,6 +25,10 @@ struct OutputFile {
  private:
   std::string created_;  // the path, while a file this made is unwritten
 };
+
+// How every command says an output file failed: "--svg: cannot write
+// PATH: No space left on device" (without the reason when `error` is 0).
+std::runtime_error cannot_write(const std::string& option, const std::string& path, int error);
 
 // run's and serve's --summary-json (none when `path` is empty): false, with
 // the error logged, when it cannot be opened.

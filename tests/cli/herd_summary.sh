@@ -76,6 +76,14 @@ for opt in --summary-json --svg --out; do
     fail "herd $opt $tmp: $out"
   [[ $out != *"min pair distance"* ]] || fail "herd $opt stepped the herd first: $out"
 done
+# One written when the run is over that fails (a full disk) names its
+# option, its path and why, as every command's output files do.
+for opt in --summary-json --svg --out; do
+  out=$("$animrt" herd "$tmp/one.yaml" "$opt" /dev/full --quiet 2>&1) &&
+    fail "herd $opt /dev/full succeeded: $out"
+  [[ $out == *"$opt: cannot write /dev/full: No space left on device"* ]] ||
+    fail "herd $opt /dev/full: $out"
+done
 # A scene whose figure cannot be loaded (its gait's calibration table holds
 # no points) leaves the last run's summary and top view as they were.
 mkdir "$tmp/gait"
