@@ -44,7 +44,9 @@ def read(port, dev, address, length):
 
 
 def main():
-    port = serial.Serial(sys.argv[1], 1000000, timeout=0.5)
+    # A read returns once its answer is in; the long timeout is for a loaded
+    # machine that holds the simulated servos off the CPU.
+    port = serial.Serial(sys.argv[1], 1000000, timeout=5)
     ids = range(int(sys.argv[2]), int(sys.argv[3]) + 1)
     delay = float(sys.argv[4]) if len(sys.argv) > 4 else 0.2
     first = {}

@@ -16,6 +16,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -28,6 +29,7 @@
 #include "animrt/learn/evolve/evaluator.hpp"
 #include "animrt/sim/mujoco/mujoco_figure.hpp"
 #include "animrt/sim/mujoco/mujoco_gait_sim.hpp"
+#include "support/eventually.hpp"
 #include "support/files.hpp"
 
 namespace animrt {
@@ -239,9 +241,11 @@ TEST(EvolveDashboard, TheSnapshotHasTheGenerationsInOrderAndTheBestGaitPlays) {
     }
   };
   check_frame(state);
-  std::this_thread::sleep_for(std::chrono::duration<double>(period / 4));
-  const json later = rig.get("/api/state");
-  EXPECT_NE(later["playback"]["t_s"], state["playback"]["t_s"]);
+  json later;
+  EXPECT_TRUE(test::eventually([&] {
+    later = rig.get("/api/state");
+    return later["playback"]["t_s"] != state["playback"]["t_s"];
+  }));
   check_frame(later);
 
   // The tail of the curves for a page that has the rest.
@@ -306,6 +310,7 @@ TEST(EvolveDashboard, AStopWithTheTokenEndsTheRunAfterTheCurrentGeneration) {
 
   // A client on the stream gets the last state, ended and stopped.
   json last;
+  std::atomic<bool> connected{false};
   std::thread client([&] {
     httplib::Client c("127.0.0.1", rig.server->port());
     c.set_read_timeout(10, 0);
@@ -316,10 +321,12 @@ TEST(EvolveDashboard, AStopWithTheTokenEndsTheRunAfterTheCurrentGeneration) {
         last = json::parse(buffer.substr(6, end - 6));
         buffer.erase(0, end + 2);
       }
+      connected = true;
       return true;
     });
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  // Finished once the client is on the stream, however late its thread runs.
+  EXPECT_TRUE(test::eventually([&] { return connected.load(); }));
   rig.server->finish(result.stopped);
   client.join();
   ASSERT_TRUE(last.is_object());

@@ -25,6 +25,7 @@
 #include "animrt/runtime/robot_config.hpp"
 #include "animrt/sim/dynamixel_servo.hpp"
 #include "animrt/sim/modbus/modbus_sim_bus.hpp"
+#include "support/eventually.hpp"
 
 namespace animrt {
 namespace {
@@ -359,13 +360,16 @@ TEST(ModbusBus, RtuFrameCutOffBySilenceDoesNotSwallowTheNextRequest) {
   const int fd = ::open(r.sim->endpoint().c_str(), O_RDWR | O_NOCTTY);
   ASSERT_GE(fd, 0);
   const std::uint8_t cut[4] = {0x01, 0x03, 0x00, 0x10};
+  const std::uint64_t dropped = r.sim->stats().dropped;
   ASSERT_EQ(::write(fd, cut, sizeof cut), 4);
-  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  // Until the simulated slaves saw the silence after it (their thread may
+  // not run for a while on a loaded machine).
+  ASSERT_TRUE(test::eventually([&] { return r.sim->stats().dropped == dropped + 4; }));
   const std::uint64_t timeouts = r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts;
   r.step({0.0, 0.0}, 3);
   EXPECT_EQ(r.bus->devices()[0].timeouts + r.bus->devices()[1].timeouts, timeouts);
   EXPECT_EQ(r.bus->devices()[0].health, DeviceHealth::ok);
-  EXPECT_GE(r.sim->stats().dropped, 4u);
+  EXPECT_EQ(r.sim->stats().dropped, dropped + 4);
   ::close(fd);
 }
 

@@ -169,15 +169,16 @@ TEST(DynamixelBusFastRead, CycleNeverAllocates) {
   EXPECT_EQ(rig.bus->devices()[3].timeouts, 0u);
 }
 
-// 12 servos, each answer 30 ms after the one before, timeout 100 ms: the
-// twelve answers of a Sync Read (or slices of a Fast Sync Read) take 360 ms,
-// far more than one timeout; since the timeout is per answer, neither times
-// out (with one deadline for the whole read, ten of them would).
+// 12 servos, each answer 50 ms after the one before, timeout 400 ms: the
+// twelve answers of a Sync Read (or slices of a Fast Sync Read) take 600 ms,
+// more than one timeout; since the timeout is per answer, neither times out
+// (with one deadline for the whole read, the last four would). Each answer
+// has 350 ms to spare for a machine too loaded to run the simulator.
 void twelve_late_answers(dxl::FastRead mode) {
-  Rig rig(bus_of(12, 46, mode, 0.1));
+  Rig rig(bus_of(12, 46, mode, 0.4));
   rig.bus->configure();
   EXPECT_EQ(rig.bus->fast_read_active(), mode == dxl::FastRead::on);
-  for (int id = 1; id <= 12; ++id) rig.sim.set_device_answer_delay(id, 30'000'000);
+  for (int id = 1; id <= 12; ++id) rig.sim.set_device_answer_delay(id, 50'000'000);
   std::vector<double> q(12, 0.0);
   rig.bus->read(q);
   for (const DeviceStatus& st : rig.bus->devices()) {

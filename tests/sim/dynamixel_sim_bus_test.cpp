@@ -10,11 +10,11 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
-#include <thread>
 #include <vector>
 
 #include "animrt/core/error.hpp"
 #include "sim/pty_client.hpp"
+#include "support/eventually.hpp"
 
 namespace animrt {
 namespace {
@@ -73,12 +73,8 @@ class DynamixelSimBusTest : public ::testing::Test {
   void send_and_wait_read(const Bytes& bytes) {
     const std::uint64_t before = bus_->stats().received_bytes;
     client_->send(bytes);
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (bus_->stats().received_bytes < before + bytes.size() &&
-           std::chrono::steady_clock::now() < give_up) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    ASSERT_EQ(bus_->stats().received_bytes, before + bytes.size());
+    ASSERT_TRUE(
+        test::eventually([&] { return bus_->stats().received_bytes == before + bytes.size(); }));
   }
 
   std::int32_t read_i32(std::uint8_t id, std::uint16_t address) {
@@ -326,13 +322,13 @@ TEST_F(DynamixelSimBusTest, TorqueOffMeansNoMotion) {
 TEST_F(DynamixelSimBusTest, BadCrcIsIgnoredAndCounted) {
   Bytes bad = test::ping(1);
   bad.back() ^= 0x5A;
-  client_->send(bad);
+  send_and_wait_read(bad);
   EXPECT_TRUE(client_->silent());
   EXPECT_EQ(bus_->stats().crc_errors, 1u);
   // A corrupted write changes nothing.
   Bytes bad_write = test::write(1, xreg::led, {1});
   bad_write[9] ^= 0x01;
-  client_->send(bad_write);
+  send_and_wait_read(bad_write);
   EXPECT_TRUE(client_->silent());
   EXPECT_EQ(bus_->stats().crc_errors, 2u);
   EXPECT_EQ(read_u8(1, xreg::led), 0);
@@ -533,7 +529,8 @@ TEST_F(DynamixelSimBusTest, NonRespondingDeviceIsSilent) {
   const std::uint8_t ids[] = {1, 2, 3};
   const std::size_t n = dxl::encode_sync_read(xreg::present_position, 4, ids, buf);
   client_->send(Bytes(buf.begin(), buf.begin() + n));
-  auto answers = client_->read_status(3, std::chrono::milliseconds(200));
+  auto answers = client_->read_status(2);
+  EXPECT_TRUE(client_->silent(std::chrono::milliseconds(200)));
   ASSERT_EQ(answers.size(), 2u);
   EXPECT_EQ(answers[0].id, 1);
   EXPECT_EQ(answers[1].id, 3);

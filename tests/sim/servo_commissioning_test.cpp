@@ -123,7 +123,8 @@ TEST(ServoCommissioning, FactoryStartupIsId1At57600WithOneServoPluggedIn) {
   }
   test::PtyClient line(sim.endpoint(), 57600);
   line.send(test::ping(dxl::kBroadcastId));
-  EXPECT_EQ(line.read_status(3, std::chrono::milliseconds(300)).size(), 1u);  // one plugged in
+  EXPECT_EQ(line.read_status(1).size(), 1u);
+  EXPECT_TRUE(line.silent(std::chrono::milliseconds(300)));  // one plugged in
   EXPECT_EQ(read_u8(line, 1, xreg::return_delay_time), 250);
 }
 

@@ -17,6 +17,7 @@
 #include "animrt/sim/feetech/feetech_sim_bus.hpp"
 #include "animrt/sim/serial_line.hpp"
 #include "sim/pty_client.hpp"
+#include "support/eventually.hpp"
 
 namespace animrt {
 namespace {
@@ -42,12 +43,31 @@ BusConfig dynamixel_bus(std::vector<int> ids, int baud) {
 
 constexpr auto kQuiet = std::chrono::milliseconds(150);
 
+// Sends `bytes` and returns once the simulated servos have handled a packet
+// more than `sim` had (heard or not): a change of the line's baud or of the
+// servos plugged in must come after it, however late their thread runs.
+template <class Sim>
+void send_handled(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
+  const std::uint64_t before = sim.stats().packets;
+  line.send(bytes);
+  ASSERT_TRUE(test::eventually([&] { return sim.stats().packets > before; }));
+}
+
+// Sends `bytes` and reads what the servos answer once they have sent it.
+template <class Sim>
+Bytes answers_to(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
+  const std::uint64_t before = sim.stats().answers;
+  line.send(bytes);
+  EXPECT_TRUE(test::eventually([&] { return sim.stats().answers > before; }));
+  return line.read_raw(64, kQuiet);
+}
+
 TEST(ServoLine, ServoHearsOnlyItsOwnBaud) {
   ManualClock clock{0};
   sim::DynamixelSimBus sim(dynamixel_bus({3}, 1'000'000), clock);
   sim.start();
   test::PtyClient line(sim.endpoint(), 57600);
-  line.send(test::ping(3));
+  send_handled(line, sim, test::ping(3));
   EXPECT_TRUE(line.silent(kQuiet));
   line.set_baud(1'000'000);
   EXPECT_EQ(line.transact(test::ping(3)).id, 3);
@@ -60,7 +80,7 @@ TEST(ServoLine, NewBaudRateTakesEffectAfterTheAnswer) {
   test::PtyClient line(sim.endpoint(), 1'000'000);
   // Baud Rate 1 (57600): the status packet still comes at 1 Mbaud.
   EXPECT_EQ(line.transact(test::write(3, xreg::baud_rate, {1})).error, 0);
-  line.send(test::ping(3));
+  send_handled(line, sim, test::ping(3));
   EXPECT_TRUE(line.silent(kQuiet));
   line.set_baud(57600);
   EXPECT_EQ(line.transact(test::ping(3)).id, 3);
@@ -92,8 +112,7 @@ TEST(ServoLine, ServosSharingAnIdCollide) {
   test::PtyClient line(sim.endpoint(), 57600);
   EXPECT_EQ(line.transact(test::ping(1)).id, 1);  // one new servo: a clean answer
   sim.set_device_plugged(1, true);                // a second one, also ID 1
-  line.send(test::ping(1));
-  const Bytes wire = line.read_raw(64, kQuiet);
+  const Bytes wire = answers_to(line, sim, test::ping(1));
   EXPECT_GE(wire.size(), 14u);  // something came back...
   dxl::Decoder decoder;
   decoder.feed(wire);
@@ -103,14 +122,17 @@ TEST(ServoLine, ServosSharingAnIdCollide) {
     EXPECT_NE(r, dxl::DecodeResult::packet) << "a clean packet out of a collision";
   }
   // ...and a broadcast ping gets no clean answer from ID 1 either.
-  line.send(test::ping(dxl::kBroadcastId));
-  EXPECT_TRUE(line.read_status(1, kQuiet).empty());
+  const Bytes broadcast = answers_to(line, sim, test::ping(dxl::kBroadcastId));
+  decoder.feed(broadcast);
+  while ((r = decoder.next(p)) != dxl::DecodeResult::need_more) {
+    EXPECT_FALSE(r == dxl::DecodeResult::packet && p.id == 1) << "a clean answer of ID 1";
+  }
   // Given an ID of its own (the other unplugged), each answers cleanly again.
   sim.set_device_plugged(1, false);
   EXPECT_EQ(line.transact(test::write(1, xreg::id, {2})).id, 2);
   sim.set_device_plugged(1, true);
   line.send(test::ping(dxl::kBroadcastId));
-  const auto both = line.read_status(2, std::chrono::milliseconds(500));
+  const auto both = line.read_status(2);
   ASSERT_EQ(both.size(), 2u);
   EXPECT_EQ(both[0].id, 1);
   EXPECT_EQ(both[1].id, 2);
@@ -131,14 +153,13 @@ TEST(ServoLine, FeetechServosHearTheirBaudAndCollide) {
   sim.start();
   const Bytes ping1 = {0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB};
   test::PtyClient line(sim.endpoint(), 500'000);
-  line.send(ping1);
+  send_handled(line, sim, ping1);
   EXPECT_TRUE(line.silent(kQuiet));
   line.set_baud(1'000'000);
   line.send(ping1);
   EXPECT_EQ(line.read_raw(6), Bytes({0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC}));
   sim.set_device_plugged(1, true);
-  line.send(ping1);
-  const Bytes wire = line.read_raw(16, kQuiet);
+  const Bytes wire = answers_to(line, sim, ping1);
   EXPECT_EQ(wire.size(), 7u);  // two 6-byte packets, the second a byte behind
   EXPECT_NE(wire, Bytes({0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC}));
 }

@@ -472,6 +472,8 @@ void ModbusSimBus::serve_rtu() {
   const int master = pty_->master();
   // Silence that ends a cut frame: 3.5 characters, at least a few ms here.
   const int gap_ms = 5;
+  const MonotonicClock wall;
+  Nanos last_byte = 0;
   while (!stop_.load()) {
     pollfd fds[2] = {{master, POLLIN, 0}, {wake_->read_fd(), POLLIN, 0}};
     const int r = ::poll(fds, 2, have > 0 ? gap_ms : -1);
@@ -480,17 +482,20 @@ void ModbusSimBus::serve_rtu() {
       break;
     }
     if (fds[1].revents != 0) break;
-    if (r == 0) {  // silence inside a frame: drop it
+    // Silence inside a frame drops it; so does one this thread slept
+    // through (the bytes that came after it start a new frame).
+    if (have > 0 && (r == 0 || wall.now() - last_byte > Nanos{gap_ms} * 1'000'000)) {
       dropped_ += have;
       have = 0;
-      continue;
     }
+    if (r == 0) continue;
     if (!(fds[0].revents & POLLIN)) {
       ::poll(&fds[1], 1, 10);
       continue;
     }
     const ssize_t n = ::read(master, buf.data() + have, buf.size() - have);
     if (n <= 0) continue;
+    last_byte = wall.now();
     have += static_cast<std::size_t>(n);
     for (;;) {
       const int want = modbus_frame::rtu_length(buf.data(), have);
