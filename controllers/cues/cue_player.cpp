@@ -321,7 +321,7 @@ void CuePlayer::enter(int cue, int step, bool asked, double at_s) const {
     pending_.deadline = last_t_ + kLearnedWaitS;
     pending_.wall_deadline =
         std::chrono::steady_clock::now() +
-        std::chrono::nanoseconds(static_cast<std::int64_t>(kLearnedWaitS * 1e9));
+        std::chrono::nanoseconds(static_cast<std::int64_t>(kLockstepLearnedWaitS * 1e9));
   }
   pending_.active = true;
   pending_.cue = cue;

@@ -102,7 +102,7 @@ void print_cue_report(const CuePlayer& player, const CueCounts& requests, const 
   if (const TransitionWorker* worker = player.transition_worker()) {
     std::cout << "learned transitions: " << player.learned_played() << " played, "
               << player.learned_late() << " crossfaded (not computed within "
-              << kLearnedWaitS * 1000.0 << " ms), " << player.learned_unusable()
+              << player.learned_wait_s() * 1000.0 << " ms), " << player.learned_unusable()
               << " crossfaded (unusable), compute " << worker->max_compute().count() / 1000
               << " us at most\n";
   }

@@ -381,7 +381,9 @@ TEST(DynamixelBusWatchdog, IsRearmedWhenNothingValidWasHeardForHalfItsTime) {
   // re-arms it by broadcast, and stops once answers come again.
   auto owned = std::make_unique<ScheduledServos<Dynamixel>>();
   ScheduledServos<Dynamixel>& line = *owned;
-  constexpr std::uint8_t kUnits = 10;  // 200 ms
+  // 1 s: a test thread held off the CPU for a while in the answered phases
+  // must not look like a silence of half of it.
+  constexpr std::uint8_t kUnits = 50;
   BusConfig config;
   config.name = "guarded";
   config.timeout_s = 0.002;
@@ -419,18 +421,18 @@ TEST(DynamixelBusWatchdog, IsRearmedWhenNothingValidWasHeardForHalfItsTime) {
     }
   };
   // Answers every cycle for longer than half the guard: nothing to re-arm.
-  cycles_for(milliseconds(150));
+  cycles_for(milliseconds(700));
   EXPECT_EQ(bus.watchdog_rearms(), 0u);
   // Sent every cycle, never answered, for longer than half the guard.
   line.silent = {1, 2};
-  cycles_for(milliseconds(150));
+  cycles_for(milliseconds(700));
   EXPECT_GE(bus.watchdog_rearms(), 1u);
   EXPECT_EQ(rearm_broadcasts() - armed, static_cast<int>(bus.watchdog_rearms()));
   // Heard again: no more re-arming.
   line.silent.clear();
   bus.read(q);
   const std::uint64_t rearms = bus.watchdog_rearms();
-  cycles_for(milliseconds(50));
+  cycles_for(milliseconds(300));
   EXPECT_EQ(bus.watchdog_rearms(), rearms);
   bus.deactivate();
 }

@@ -33,9 +33,11 @@ constexpr Nanos kMs = 1'000'000;
 constexpr canid_t kNode = 23;
 constexpr double kCountsPerDeg = 100.0;
 constexpr int kWatchdogMs = 100;
+constexpr int kHostHeartbeatMs = Cia402Bus::host_heartbeat_ms(kWatchdogMs);
 
 // The host's transport, which can die: from then on it sends nothing and
-// its receive() blocks until released (then finds nothing).
+// its receive() blocks until released (then finds nothing). It notes when
+// the host last sent its heartbeat.
 class MortalTransport final : public CanFrameTransport {
  public:
   explicit MortalTransport(std::unique_ptr<CanFrameTransport> inner) : inner_(std::move(inner)) {}
@@ -43,7 +45,9 @@ class MortalTransport final : public CanFrameTransport {
   void set_filters(std::span<const can_filter> filters) override { inner_->set_filters(filters); }
   bool send(const can_frame& frame) override {
     std::lock_guard lock(mutex_);
-    return dead_ || inner_->send(frame);
+    if (dead_) return true;
+    if ((frame.can_id & CAN_SFF_MASK & ~canid_t{0x7F}) == 0x700) last_heartbeat_ = inner_->now();
+    return inner_->send(frame);
   }
   bool receive(can_frame& frame, std::chrono::microseconds timeout) override {
     if (!dead_.load()) return inner_->receive(frame, timeout);
@@ -59,9 +63,19 @@ class MortalTransport final : public CanFrameTransport {
     dead_ = true;
   }
   void release() { released_ = true; }
+  // Whether a clock at `now` is within two of the host's heartbeat periods
+  // of its last heartbeat (or it sent none yet): the test's clock runs on
+  // only while the host's thread keeps up, however long a loaded machine
+  // holds it off the CPU, so the drive never misses a heartbeat the host
+  // would have sent.
+  bool keeping_up(Nanos now) const {
+    const Nanos last = last_heartbeat_.load();
+    return last < 0 || now < last + 2 * kHostHeartbeatMs * kMs;
+  }
 
  private:
   std::unique_ptr<CanFrameTransport> inner_;
+  std::atomic<Nanos> last_heartbeat_{-1};
   std::mutex mutex_;
   std::atomic<bool> dead_{false};
   std::atomic<bool> released_{false};
@@ -175,7 +189,7 @@ TEST(Cia402HomingGuard, AHostThatDiesMidSearchLeavesTheDriveFaultedAndStopped) {
   std::atomic<bool> pacing{true};
   std::thread pacer([&] {
     while (pacing.load()) {
-      clock.advance(kMs);
+      if (host_link.keeping_up(clock.now())) clock.advance(kMs);
       std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
   });
@@ -228,13 +242,15 @@ TEST(Cia402HomingGuard, AHomingThatEndsLeavesNoGuardArmed) {
   sim::CanSimBus sim(drive_side, clock, sim::CanSimAttach::in_process);
   sim.start();
   Wire wire{VirtualCanBus::named("homing_guard_clean")->attach(), -1e9, false, 0};
-  Cia402Bus bus(config, open_can(config.port));
+  auto transport = std::make_unique<MortalTransport>(open_can(config.port));
+  const MortalTransport& host_link = *transport;
+  Cia402Bus bus(config, std::move(transport));
   bus.configure();
   bus.deactivate();
   std::atomic<bool> pacing{true};
   std::thread pacer([&] {
     while (pacing.load()) {
-      clock.advance(kMs);
+      if (host_link.keeping_up(clock.now())) clock.advance(kMs);
       std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
   });

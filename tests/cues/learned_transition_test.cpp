@@ -206,7 +206,10 @@ TEST(LearnedTransition, AModelTooSlowFallsBackToTheCrossfadeWithinTheBound) {
   for (bool lockstep : {false, true}) {
     Rig rig(true, true, lockstep);
     Rig plain(true, false, lockstep);
-    rig.player.transition_worker()->set_delay(std::chrono::milliseconds(200));
+    // Longer than the bound (in wall time on a lockstep clock).
+    const double bound_s = lockstep ? kLockstepLearnedWaitS : kLearnedWaitS;
+    rig.player.transition_worker()->set_delay(
+        std::chrono::milliseconds(static_cast<int>(bound_s * 1000) + 100));
     for (int i = 0; i < 30; ++i) rig.step(), plain.step();
     rig.requests.cue(1);
     // Real time: the figure plays on for the bound (10 cycles), then crossfades.

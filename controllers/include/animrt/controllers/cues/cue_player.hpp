@@ -80,6 +80,10 @@ inline constexpr double kCrossfadeLimitShare = 0.3;
 // How long a learned in-between may take to compute, from the first
 // request it answers: then the cue crossfades in instead (counted).
 inline constexpr double kLearnedWaitS = 0.1;
+// The same on a lockstep clock, in wall time: the figure's time stands while
+// the cycle waits, so a machine too loaded to compute the in-between within
+// kLearnedWaitS does not change the run; only a model far too slow does.
+inline constexpr double kLockstepLearnedWaitS = 2.0;
 // The share of a learned transition at each end over which the played
 // targets ease from the crossfade to the model's frames and back.
 inline constexpr double kLearnedEaseShare = 0.25;
@@ -113,10 +117,12 @@ class CuePlayer final : public MotionSource {
   double last_crossfade_s() const { return last_fade_.load(std::memory_order_relaxed); }
 
   // Learned transitions: played, fallen back to the crossfade because the
-  // in-between was not ready within kLearnedWaitS, or because it could not
-  // be used (not finite, more frames than planned for).
+  // in-between was not ready within learned_wait_s(), or because it could
+  // not be used (not finite, more frames than planned for).
   std::uint64_t learned_played() const { return learned_played_.load(std::memory_order_relaxed); }
   std::uint64_t learned_late() const { return learned_late_.load(std::memory_order_relaxed); }
+  // kLearnedWaitS, or kLockstepLearnedWaitS (wall time) on a lockstep clock.
+  double learned_wait_s() const { return lockstep_ ? kLockstepLearnedWaitS : kLearnedWaitS; }
   std::uint64_t learned_unusable() const {
     return learned_unusable_.load(std::memory_order_relaxed);
   }
@@ -194,7 +200,7 @@ class CuePlayer final : public MotionSource {
   std::unique_ptr<TransitionWorker> worker_;
   std::vector<int> model_of_cue_;  // the worker's model index, -1 crossfade
   // On a lockstep clock (not real time) the cycle waits for an in-between,
-  // up to kLearnedWaitS of wall time, so that a run is repeatable.
+  // up to kLockstepLearnedWaitS of wall time, so that a run is repeatable.
   bool lockstep_ = false;
   mutable Pending pending_;
   mutable std::atomic<std::uint64_t> learned_played_{0}, learned_late_{0}, learned_unusable_{0};

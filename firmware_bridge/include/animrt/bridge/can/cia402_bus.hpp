@@ -56,7 +56,7 @@ class Cia402Bus final : public ActuatorBus {
 
   // The host's heartbeat period for a consumer time: a quarter of it, so
   // that a late cycle or two still leaves a heartbeat inside the window.
-  static int host_heartbeat_ms(int device_watchdog_ms) {
+  static constexpr int host_heartbeat_ms(int device_watchdog_ms) {
     return std::max(1, device_watchdog_ms / 4);
   }
   // 1016h sub-index 1: bits 23-16 the producer's node id, 15-0 the time in ms.
