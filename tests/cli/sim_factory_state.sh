@@ -52,9 +52,13 @@ fast = serial.Serial(sys.argv[1], 1000000, timeout=0.3)
 fast.write(packet(1, 0x01))  # a new servo does not hear 1 Mbaud
 assert fast.read(14) == b""
 fast.close()
-port = serial.Serial(sys.argv[1], 57600, timeout=0.5)
+# Reads return once their answer is in: the long timeout is for a loaded machine.
+port = serial.Serial(sys.argv[1], 57600, timeout=5)
 port.write(packet(0xFE, 0x01))  # broadcast ping: one new servo plugged in
-assert len(port.read(28)) == 14
+assert len(port.read(14)) == 14
+port.timeout = 0.3
+assert port.read(14) == b""  # and only one
+port.timeout = 5
 port.write(packet(1, 0x03, bytes([7, 0, 1])))  # Write ID = 1 ... to 1 (nothing changes)
 assert len(port.read(11)) == 11
 port.write(packet(1, 0x03, bytes([7, 0, 21])))  # ID = 21

@@ -21,7 +21,9 @@
 namespace animrt {
 namespace {
 
-BusConfig arm(ft::Series series, std::initializer_list<int> ids, double timeout_s = 0.05) {
+// The timeout leaves a loaded machine room to run the simulated servos'
+// thread: answers come at once, so only a silent servo waits it out.
+BusConfig arm(ft::Series series, std::initializer_list<int> ids, double timeout_s = 0.3) {
   BusConfig config;
   config.name = "arm";
   config.protocol = series == ft::Series::sts ? "feetech_sts" : "feetech_scs";
@@ -136,10 +138,10 @@ TEST(FeetechBusOnSim, ServoKeepsGoalsInsideTheJointLimitsTheBusWrote) {
     auto line = open_serial(f.sim.endpoint(), 1'000'000);
     std::array<std::uint8_t, ft::kMaxPacket> tx{};
     std::array<std::uint8_t, 32> rx{};
-    // Collects `n` answer bytes (or what came within half a second).
+    // Collects `n` answer bytes (or what came within five seconds).
     const auto answer = [&](std::size_t n) {
       std::size_t got = 0;
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
       while (got < n && std::chrono::steady_clock::now() < deadline) {
         got += line->read(std::span(rx).subspan(got, n - got), std::chrono::milliseconds(50));
       }
@@ -260,7 +262,7 @@ TEST(FeetechBusOnSim, ScsSilentServoCostsOnlyItsOwnRead) {
 }
 
 TEST(FeetechBusOnSim, ConfigureNamesTheServoThatDoesNotAnswer) {
-  Fixture f(arm(ft::Series::sts, {1, 2}, 0.01), ft::Series::sts);
+  Fixture f(arm(ft::Series::sts, {1, 2}, 0.1), ft::Series::sts);
   f.sim.set_device_responding(2, false);
   try {
     f.bus.configure();
