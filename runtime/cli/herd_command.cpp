@@ -172,6 +172,7 @@ void write_outputs(const HerdArgs& a, std::ofstream& csv, EndFiles& files,
                    const herd::TrailRecorder& trails, const herd::Herd& herd,
                    const herd::HerdMetrics& metrics, double wall_s) {
   if (csv.is_open()) {
+    errno = 0;  // what the flush at close sets, if it fails
     csv.close();
     if (!csv) throw cannot_write("--out", a.out, errno);
     std::cout << "wrote " << a.out << '\n';
@@ -208,6 +209,7 @@ int run_herd(const HerdArgs& a) {
   }
   std::ofstream csv;
   if (!a.out.empty()) {
+    errno = 0;
     csv.open(a.out);
     if (!csv) throw cannot_write("--out", a.out, errno);
     herd::write_csv_header(csv);

@@ -171,7 +171,6 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
     keeper_.save(firmware_);
     if (!hand_paths_.empty()) follow_hand_paths(now);
   }
-  if (packet.instruction != dxl::inst::status) ++packets_;
 
   if (!config_.sim.wire_time) {
     for (const Answers::Answer& a : answers_.list) {
@@ -190,6 +189,8 @@ void DynamixelSimBus::handle(const dxl::Packet& packet, Nanos arrival) {
     send_paced();
   }
   answers_sent_ += answers_.list.size();
+  // Counted once answered: a client that sees the count sees the answers too.
+  if (packet.instruction != dxl::inst::status) ++packets_;
 }
 
 void DynamixelSimBus::send_paced() {

@@ -209,7 +209,7 @@ TEST(LearnedTransition, AModelTooSlowFallsBackToTheCrossfadeWithinTheBound) {
     // Longer than the bound (in wall time on a lockstep clock).
     const double bound_s = lockstep ? kLockstepLearnedWaitS : kLearnedWaitS;
     rig.player.transition_worker()->set_delay(
-        std::chrono::milliseconds(static_cast<int>(bound_s * 1000) + 100));
+        std::chrono::milliseconds(static_cast<int>(bound_s * 1000) + 1000));
     for (int i = 0; i < 30; ++i) rig.step(), plain.step();
     rig.requests.cue(1);
     // Real time: the figure plays on for the bound (10 cycles), then crossfades.

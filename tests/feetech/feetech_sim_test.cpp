@@ -66,9 +66,11 @@ Bytes unanswered(ByteTransport& line, const sim::FeetechSimBus& sim, const Bytes
     return s.packets + s.bad_checksums + s.malformed;
   };
   const std::uint64_t before = taken();
+  const std::uint64_t answers = sim.stats().answers;
   line.discard_input();
   line.write(request);
   EXPECT_TRUE(test::eventually([&] { return taken() > before; }));
+  EXPECT_EQ(sim.stats().answers, answers);
   return collect(line, 1, 50ms);
 }
 

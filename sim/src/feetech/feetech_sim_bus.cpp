@@ -75,7 +75,6 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
     board_.handle(packet, now, answers_, any_baud_ ? 0 : line::line_baud(pty_.master()));
     keeper_.save(board_);
   }
-  ++packets_;
   if (!config_.sim.wire_time) {
     for (const FeetechAnswers::Answer& a : answers_.list) send(answers_.packet(a));
   } else {
@@ -88,6 +87,7 @@ void FeetechSimBus::handle(const ft::Packet& packet, Nanos arrival) {
     bus_free_ = t;
   }
   answers_sent_ += answers_.list.size();
+  ++packets_;  // once answered: a client that sees the count sees the answers too
 }
 
 Nanos FeetechSimBus::wire_ns(std::size_t bytes) const { return line::wire_ns(bytes, config_.baud); }
