@@ -50,6 +50,12 @@ MotionCommand steer_figure(const Figure& figure, const Agent& agent, Vec2 desire
   return walk.command_for(want);
 }
 
+double turning_radius(const Figure& figure) {
+  const WalkResponse& walk = figure.walk;
+  const double turn = walk.max_turn(walk.min_speed());
+  return walk.spot_turn() > 0.0 || !(turn > 0.0) ? 0.0 : walk.min_speed() / turn;
+}
+
 MotionCommand turn_clear(const Figure& figure, const Agent& agent, Vec2 desired, Vec2 toward) {
   const double spot = figure.walk.spot_turn();
   if (!(spot > 0.0) || norm2(toward) <= 0.0 || norm2(desired) <= 0.0) return {};

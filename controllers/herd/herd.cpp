@@ -63,6 +63,7 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
   for (const FigureSpec& spec : scene_.figures) {
     const std::string gait = spec.gait.empty() ? gait_of_robot(spec.robot) : spec.gait;
     figures_.push_back(Figure{spec.name, spec.radius_m, load_walk_response(gait)});
+    turning_radius_.push_back(turning_radius(figures_.back()));
   }
   double max_radius = 0.0;
   for (const Figure& f : figures_) max_radius = std::max(max_radius, f.radius_m);
@@ -164,6 +165,25 @@ void Herd::keep_out_of_walls(Agent& agent) const {
   agent.position.y = std::clamp(agent.position.y, b.ymin + agent.radius, b.ymax - agent.radius);
 }
 
+double Herd::turning_of(int agent) const {
+  const Agent& a = agents_[static_cast<std::size_t>(agent)];
+  if (scene_.groups[static_cast<std::size_t>(a.group)].kind != GroupKind::crowd) return -1.0;
+  return turning_radius_[static_cast<std::size_t>(figure_of_[static_cast<std::size_t>(agent)])];
+}
+
+namespace {
+
+// How much nearer a figure with `turning` radius, at `a`, comes to a point
+// `to_other` away while it walks its tightest turn until it faces past it.
+double turn_room(double turning, const Agent& a, Vec2 to_other) {
+  const double dist = norm(to_other);
+  if (turning <= 0.0 || dist <= 0.0) return 0.0;
+  const double c = dot(heading_vector(a.heading), to_other) / dist;
+  return c > 0.0 ? turning * (1.0 - std::sqrt(std::max(0.0, 1.0 - c * c))) : 0.0;
+}
+
+}  // namespace
+
 void Herd::step() {
   const double dt = scene_.step_s;
   // The crowd moves the obstacles itself (before it plans); without one,
@@ -172,8 +192,9 @@ void Herd::step() {
   for (auto& g : groups_) g->steering().steer(t_, dt, agents_, desired_);
   double reach = 0.0;  // farthest a figure can come toward another in one step
   for (std::size_t i = 0; i < agents_.size(); ++i) {
-    const Figure& f = figures_[static_cast<std::size_t>(figure_of_[i])];
-    reach = std::max(reach, 2 * f.radius_m + 2 * f.walk.max_speed() * dt);
+    const std::size_t f = static_cast<std::size_t>(figure_of_[i]);
+    reach = std::max(reach, 2 * figures_[f].radius_m + 2 * figures_[f].walk.max_speed() * dt +
+                                2 * turning_radius_[f]);
   }
   grid_.build(std::span<const Agent>(agents_), std::max(reach, 1e-3));
   for (std::size_t i = 0; i < agents_.size(); ++i) {
@@ -186,20 +207,36 @@ void Herd::step() {
     // figure at its surface (crowds steer around them before).
     keep_out_of_walls(next);
     // Figures are solid: the last guard, whatever the steering asked, is a
-    // figure that stops rather than step into another.
+    // figure that stops rather than step into another. A crowd figure that
+    // turns only while it walks stops short of that by the room it and the
+    // one it faces need to walk their turns away: at contact every step of
+    // such a turn closes on the other, and neither could ever leave.
+    const bool crowd = turning_of(static_cast<int>(i)) >= 0.0;
+    const double turning = std::max(turning_of(static_cast<int>(i)), 0.0);
     bool blocked = false;
     Vec2 toward;  // unit vectors to the figures it would step into
     grid_.for_each_near(static_cast<int>(i), reach, [&](int j, double) {
       const Agent& other = agents_[static_cast<std::size_t>(j)];
       const double contact = next.radius + other.radius;
+      const double other_turning = crowd ? std::max(turning_of(j), 0.0) : 0.0;
+      const double near = contact + turning + other_turning;
       // Clear of contact by far more than rounding: no need of the exact
       // distances (most neighbours of the query are).
-      if (norm2(next.position - other.position) > contact * contact * (1 + 1e-9)) return;
-      const double before = norm(agents_[i].position - other.position);
-      const double after = norm(next.position - other.position);
-      if (after < contact && after < before) {
+      if (norm2(next.position - other.position) > near * near * (1 + 1e-9)) return;
+      const Vec2 from_before = other.position - agents_[i].position;
+      const Vec2 from_after = other.position - next.position;
+      const double before = norm(from_before);
+      const double after = norm(from_after);
+      // Walking the turn away at its fastest keeps the clearance as it is;
+      // so does the other's, if it must turn too.
+      const double clear_before = before - contact - turn_room(turning, agents_[i], from_before) -
+                                  turn_room(other_turning, other, -from_before);
+      const double clear_after = after - contact - turn_room(turning, next, from_after) -
+                                 turn_room(other_turning, other, -from_after);
+      if ((after < contact && after < before) ||
+          (clear_after < 0.0 && clear_after < clear_before - 1e-6)) {
         blocked = true;
-        if (before > 0.0) toward += (other.position - agents_[i].position) / before;
+        if (before > 0.0) toward += from_before / before;
       }
     });
     if (blocked) {
@@ -207,9 +244,7 @@ void Herd::step() {
       // It stands; a flock's figure turns on the spot out of the way where
       // it can (in place: the drift of such a turn is ignored here). A
       // crowd plans around its neighbours and unsticks by its own rule.
-      const bool flock =
-          scene_.groups[static_cast<std::size_t>(agents_[i].group)].kind != GroupKind::crowd;
-      commands_[i] = flock ? turn_clear(figure, agents_[i], desired_[i], toward) : MotionCommand{};
+      commands_[i] = crowd ? MotionCommand{} : turn_clear(figure, agents_[i], desired_[i], toward);
       const Vec2 at = agents_[i].position;
       walk_figure(figure, commands_[i], dt, agents_[i]);
       agents_[i].position = at;

@@ -18,6 +18,11 @@ struct Figure {
   WalkResponse walk;
 };
 
+// The radius of the tightest circle a figure that turns only while it
+// walks can walk (its slowest walk at that walk's fastest turn); 0 for one
+// that turns on the spot or not at all.
+double turning_radius(const Figure& figure);
+
 // Seconds in which a figure means to close its heading error (the turn it
 // asks for is error / this, within its limits).
 inline constexpr double kHeadingTimeConstant_s = 0.3;

@@ -85,7 +85,10 @@ class Herd {
 
   HerdScene scene_;
   std::vector<Figure> figures_;
-  std::vector<int> figure_of_;  // per agent
+  std::vector<int> figure_of_;          // per agent
+  std::vector<double> turning_radius_;  // per figure (figure.hpp)
+  // A crowd figure's turning radius (0: it turns on the spot); -1 for a flock's.
+  double turning_of(int agent) const;
   std::vector<Agent> agents_;
   std::vector<std::string> names_;
   std::vector<Vec2> desired_;
