@@ -30,14 +30,18 @@ HerdMetrics run(Herd& herd) {
   return herd.metrics();
 }
 
+// Both layouts of the crossing: the teams head on through shared gaps, and
+// each through a gap of its own.
 TEST(HerdScenes, CrossingTeamsArriveWithoutTouching) {
-  Herd herd(load_herd_scene(scene_path("crossing.yaml")), gait_of);
-  const HerdMetrics m = run(herd);
-  EXPECT_EQ(m.collisions, 0) << "min clearance " << m.min_clearance_m;
-  ASSERT_EQ(m.groups.size(), 2u);
-  for (const GroupMetrics& g : m.groups) {
-    EXPECT_EQ(g.arrivals, g.agents) << g.name;
-    EXPECT_LE(g.time_ratio_max, 2.0) << g.name;
+  for (const char* scene : {"crossing.yaml", "crossing_own_gaps.yaml"}) {
+    Herd herd(load_herd_scene(scene_path(scene)), gait_of);
+    const HerdMetrics m = run(herd);
+    EXPECT_EQ(m.collisions, 0) << scene << ": min clearance " << m.min_clearance_m;
+    ASSERT_EQ(m.groups.size(), 2u);
+    for (const GroupMetrics& g : m.groups) {
+      EXPECT_EQ(g.arrivals, g.agents) << scene << ": " << g.name;
+      EXPECT_LE(g.time_ratio_max, 2.0) << scene << ": " << g.name;
+    }
   }
 }
 
