@@ -227,12 +227,14 @@ void Herd::step() {
       const Vec2 from_after = other.position - next.position;
       const double before = norm(from_before);
       const double after = norm(from_after);
-      // Walking the turn away at its fastest keeps the clearance as it is;
-      // so does the other's, if it must turn too.
-      const double clear_before = before - contact - turn_room(turning, agents_[i], from_before) -
-                                  turn_room(other_turning, other, -from_before);
-      const double clear_after = after - contact - turn_room(turning, next, from_after) -
-                                 turn_room(other_turning, other, -from_after);
+      // Walking the turn away at its fastest keeps the clearance as it is.
+      // The other's room (if it must turn too) is taken as it was: a step
+      // across its nose changes it, and would stop a figure turning clear.
+      const double other_room = turn_room(other_turning, other, -from_before);
+      const double clear_before =
+          before - contact - turn_room(turning, agents_[i], from_before) - other_room;
+      const double clear_after =
+          after - contact - turn_room(turning, next, from_after) - other_room;
       if ((after < contact && after < before) ||
           (clear_after < 0.0 && clear_after < clear_before - 1e-6)) {
         blocked = true;

@@ -71,10 +71,9 @@ class DynamixelSimBusTest : public ::testing::Test {
   // loaded machine its thread may not run for longer than any silence a
   // test leaves, and would read what was sent apart as one burst.
   void send_and_wait_read(const Bytes& bytes) {
-    const std::uint64_t before = bus_->stats().received_bytes;
     client_->send(bytes);
     ASSERT_TRUE(
-        test::eventually([&] { return bus_->stats().received_bytes == before + bytes.size(); }));
+        test::eventually([&] { return bus_->stats().received_bytes == client_->bytes_sent(); }));
   }
 
   std::int32_t read_i32(std::uint8_t id, std::uint16_t address) {

@@ -61,7 +61,11 @@ class PtyClient {
       const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
       if (n > 0) done += static_cast<std::size_t>(n);
     }
+    bytes_sent_ += bytes.size();
   }
+  // Every byte sent so far: a simulator that has read and handled as many
+  // (its received_bytes) has answered all of them.
+  std::uint64_t bytes_sent() const { return bytes_sent_; }
 
   // Raw bytes until `count` bytes arrived or `timeout` passed.
   Bytes read_raw(std::size_t count, std::chrono::milliseconds timeout = kTimeout) {
@@ -138,6 +142,7 @@ class PtyClient {
   }
 
   int fd_ = -1;
+  std::uint64_t bytes_sent_ = 0;
   dxl::Decoder decoder_;
 };
 

@@ -43,23 +43,30 @@ BusConfig dynamixel_bus(std::vector<int> ids, int baud) {
 
 constexpr auto kQuiet = std::chrono::milliseconds(150);
 
+// Until the simulated servos have read and handled every byte sent (and so
+// sent every answer): a change of the line's baud or of the servos plugged
+// in must come after that, however late their thread runs.
+template <class Sim>
+void settle(const test::PtyClient& line, const Sim& sim) {
+  ASSERT_TRUE(test::eventually([&] { return sim.stats().received_bytes == line.bytes_sent(); }));
+}
+
 // Sends `bytes`, a packet no servo should hear, and checks that none
-// answered once the simulated servos have taken it: a change of the line's
-// baud must come after that, however late their thread runs.
+// answered it.
 template <class Sim>
 void send_unheard(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
-  const auto before = sim.stats();
+  settle(line, sim);
+  const std::uint64_t answers = sim.stats().answers;
   line.send(bytes);
-  ASSERT_TRUE(test::eventually([&] { return sim.stats().packets > before.packets; }));
-  EXPECT_EQ(sim.stats().answers, before.answers);
+  settle(line, sim);
+  EXPECT_EQ(sim.stats().answers, answers);
 }
 
 // Sends `bytes` and reads what the servos answer once they have sent it.
 template <class Sim>
 Bytes answers_to(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
-  const std::uint64_t before = sim.stats().answers;
   line.send(bytes);
-  EXPECT_TRUE(test::eventually([&] { return sim.stats().answers > before; }));
+  settle(line, sim);
   return line.read_raw(64, kQuiet);
 }
 

@@ -56,6 +56,7 @@ void FeetechSimBus::serve() {
               {[this](std::span<const std::uint8_t> bytes, Nanos arrival) {
                  line::feed(ft::LinkCodec{}, decoder_, bytes, decode_counts_,
                             [&](const ft::Packet& packet) { handle(packet, arrival); });
+                 received_bytes_ += bytes.size();
                },
                [this] { return decoder_.buffered() > 0; },
                [this] {
@@ -181,6 +182,7 @@ std::int32_t FeetechSimBus::device_last_goal(int device_id) const {
 
 FeetechSimStats FeetechSimBus::stats() const {
   FeetechSimStats s;
+  s.received_bytes = received_bytes_;
   s.packets = packets_;
   s.answers = answers_sent_;
   s.bad_checksums = decode_counts_.bad_checks;

@@ -34,9 +34,10 @@
 namespace animrt::sim {
 
 struct FeetechSimStats {
-  std::uint64_t packets = 0;        // instruction packets handled
-  std::uint64_t answers = 0;        // status packets sent
-  std::uint64_t bad_checksums = 0;  // packets dropped, never answered
+  std::uint64_t received_bytes = 0;  // bytes read from the line and handled
+  std::uint64_t packets = 0;         // instruction packets handled
+  std::uint64_t answers = 0;         // status packets sent
+  std::uint64_t bad_checksums = 0;   // packets dropped, never answered
   std::uint64_t malformed = 0;
   std::uint64_t partial_packet_bytes = 0;
 };
@@ -99,6 +100,7 @@ class FeetechSimBus final : public SimulatedBus {
 
   std::thread thread_;
   std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> received_bytes_{0};
   std::atomic<std::uint64_t> packets_{0};
   std::atomic<std::uint64_t> answers_sent_{0};
   line::DecodeCounts decode_counts_;
