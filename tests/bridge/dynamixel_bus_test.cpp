@@ -249,7 +249,9 @@ BusConfig make_config(const std::string& port) {
   c.name = "legs";
   c.protocol = "dynamixel2";
   c.port = port;
-  c.timeout_s = 0.05;  // generous: the machine may be loaded
+  // Generous: a loaded machine may hold the fake servos' thread off the CPU
+  // for tens of milliseconds, and a cycle's read is not retried.
+  c.timeout_s = 0.2;
   // These devices speak plain Sync Read only (Fast Sync Read: tests/sim).
   dxl::BusOptions options;
   options.fast_read = dxl::FastRead::off;

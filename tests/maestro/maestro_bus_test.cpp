@@ -76,7 +76,7 @@ struct Rig {
   explicit Rig(const std::string& bus_extra = "") {
     config = load(robot_text(bus_extra));
     BusConfig& b = config.buses[0];
-    b.timeout_s = 0.05;
+    b.timeout_s = 0.2;  // a loaded machine may hold the simulated board off the CPU a while
     sim = std::make_unique<sim::MaestroSimBus>(b, clock);
     sim->start();
     b.port = sim->endpoint();
