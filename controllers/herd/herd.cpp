@@ -211,8 +211,9 @@ void Herd::step() {
     // turns only while it walks stops short of that by the room it and the
     // one it faces need to walk their turns away: at contact every step of
     // such a turn closes on the other, and neither could ever leave.
-    const bool crowd = turning_of(static_cast<int>(i)) >= 0.0;
-    const double turning = std::max(turning_of(static_cast<int>(i)), 0.0);
+    const double own_turning = turning_of(static_cast<int>(i));
+    const bool crowd = own_turning >= 0.0;
+    const double turning = std::max(own_turning, 0.0);
     bool blocked = false;
     Vec2 toward;  // unit vectors to the figures it would step into
     grid_.for_each_near(static_cast<int>(i), reach, [&](int j, double) {
