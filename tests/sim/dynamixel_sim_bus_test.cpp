@@ -14,7 +14,6 @@
 
 #include "animrt/core/error.hpp"
 #include "sim/pty_client.hpp"
-#include "support/eventually.hpp"
 
 namespace animrt {
 namespace {
@@ -72,8 +71,7 @@ class DynamixelSimBusTest : public ::testing::Test {
   // test leaves, and would read what was sent apart as one burst.
   void send_and_wait_read(const Bytes& bytes) {
     client_->send(bytes);
-    ASSERT_TRUE(
-        test::eventually([&] { return bus_->stats().received_bytes == client_->bytes_sent(); }));
+    ASSERT_TRUE(test::handled_all(*client_, *bus_));
   }
 
   std::int32_t read_i32(std::uint8_t id, std::uint16_t address) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "animrt/bridge/dynamixel/protocol2.hpp"
+#include "support/eventually.hpp"
 
 namespace animrt::test {
 
@@ -167,6 +168,15 @@ inline Bytes write_u32(std::uint8_t id, std::uint16_t address, std::uint32_t val
 inline Bytes packet(std::uint8_t id, std::uint8_t instruction, const Bytes& params) {
   std::array<std::uint8_t, dxl::kMaxPacket> buf{};
   return Bytes(buf.begin(), buf.begin() + dxl::encode_packet(id, instruction, params, buf));
+}
+
+// Whether `sim` (a simulated serial-servo bus) has read and handled every
+// byte `client` sent, and so sent every answer to them, within eventually()'s
+// limit: what a test waits for before a silence or a change of the line,
+// however late a loaded machine runs the simulator's thread.
+template <class Sim>
+bool handled_all(const PtyClient& client, const Sim& sim) {
+  return eventually([&] { return sim.stats().received_bytes == client.bytes_sent(); });
 }
 
 }  // namespace animrt::test

@@ -17,7 +17,6 @@
 #include "animrt/sim/feetech/feetech_sim_bus.hpp"
 #include "animrt/sim/serial_line.hpp"
 #include "sim/pty_client.hpp"
-#include "support/eventually.hpp"
 
 namespace animrt {
 namespace {
@@ -43,22 +42,14 @@ BusConfig dynamixel_bus(std::vector<int> ids, int baud) {
 
 constexpr auto kQuiet = std::chrono::milliseconds(150);
 
-// Until the simulated servos have read and handled every byte sent (and so
-// sent every answer): a change of the line's baud or of the servos plugged
-// in must come after that, however late their thread runs.
-template <class Sim>
-void settle(const test::PtyClient& line, const Sim& sim) {
-  ASSERT_TRUE(test::eventually([&] { return sim.stats().received_bytes == line.bytes_sent(); }));
-}
-
 // Sends `bytes`, a packet no servo should hear, and checks that none
 // answered it.
 template <class Sim>
 void send_unheard(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
-  settle(line, sim);
+  ASSERT_TRUE(test::handled_all(line, sim));
   const std::uint64_t answers = sim.stats().answers;
   line.send(bytes);
-  settle(line, sim);
+  ASSERT_TRUE(test::handled_all(line, sim));
   EXPECT_EQ(sim.stats().answers, answers);
 }
 
@@ -66,7 +57,7 @@ void send_unheard(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
 template <class Sim>
 Bytes answers_to(test::PtyClient& line, const Sim& sim, const Bytes& bytes) {
   line.send(bytes);
-  settle(line, sim);
+  EXPECT_TRUE(test::handled_all(line, sim));
   return line.read_raw(64, kQuiet);
 }
 
