@@ -80,6 +80,7 @@ JointCsv read_joint_csv(const std::string& file) {
     std::vector<double> joints;
     for (std::size_t c : use) joints.push_back(row[c]);
     t.rows.push_back(std::move(joints));
+    t.lines.push_back(number);
   }
   if (names.empty()) fail(file, 0, 0, "", "empty file: no header line");
   return t;

@@ -18,6 +18,7 @@
 #include "animrt/controllers/seqnet/mesh_io.hpp"
 #include "animrt/controllers/seqnet/output_check.hpp"
 #include "animrt/core/error.hpp"
+#include "animrt/core/yaml_doc.hpp"
 #include "animrt/learn/seqnet/evaluation.hpp"
 #include "animrt/learn/seqnet/held_out.hpp"
 #include "option_checks.hpp"
@@ -57,6 +58,21 @@ seqnet::FrameMatrix read_joint_frames(const seqnet::ModelFile& model, const std:
     throw InputError(Location{files[0], 0, 0}, option,
                      std::to_string(csv.rows.size()) + " rows, at least " +
                          std::to_string(at_least) + " needed");
+  }
+  // A pose far outside what the model was trained on is not one it can
+  // continue or join: its output there means nothing (and 1e300 rad came
+  // back as a written frame). One range's width beyond either end is
+  // allowed for keys a little past the training data.
+  for (std::size_t r = 0; r < csv.rows.size(); ++r) {
+    for (std::size_t j = 0; j < csv.joints.size(); ++j) {
+      const double lo = model.low[j], hi = model.high[j], width = hi - lo;
+      const double v = csv.rows[r][j];
+      if (v >= lo - width && v <= hi + width) continue;
+      throw InputError(Location{files[0], csv.lines[r], 0}, csv.joints[j],
+                       format_number(v) + " is far outside the range " + model_path +
+                           " was trained on (" + format_number(lo) + " to " + format_number(hi) +
+                           "; a pose at most the range's width beyond it is taken)");
+    }
   }
   seqnet::FrameMatrix frames(static_cast<Eigen::Index>(csv.joints.size()),
                              static_cast<Eigen::Index>(csv.rows.size()));

@@ -72,6 +72,19 @@ out=$("$animrt" seq complete "$tmp/m.model" --keys "$tmp/one.csv" --gap 4 --out 
 code=$?
 [[ $code -eq 2 && $out == *"$tmp/one.csv: --keys: 1 rows, at least 2 needed"* ]] || fail "one key: exit $code: $out"
 
+# A key or an initial frame far outside the model's training range is
+# refused at its line before anything is written (1e300 came back as a
+# generated file's first row).
+printf 'time_s,hip,knee\n# a comment\n0,0.25,-0.125\n1,1e300,0.3\n' > "$tmp/far.csv"
+for cmd in "complete --gap 4 --keys" "generate --init"; do
+  rm -f "$tmp/far_out.csv"
+  out=$("$animrt" seq ${cmd%% *} "$tmp/m.model" ${cmd#* } "$tmp/far.csv" --out "$tmp/far_out.csv" 2>&1)
+  code=$?
+  [[ $code -eq 2 && $out == "error: $tmp/far.csv:4: hip: 1e+300 is far outside the range $tmp/m.model was trained on ("* ]] ||
+    fail "$cmd, a 1e300 angle: exit $code: $out"
+  [[ $(echo "$out" | wc -l) -eq 1 && ! -e $tmp/far_out.csv ]] || fail "$cmd, a 1e300 angle: $out"
+done
+
 # A 6 x 6 plate bending to and fro, 30 OBJ frames; keys 0, 10 and 20.
 write_plate "$tmp/plate"
 "$animrt" seq features "$tmp/plate" --out "$tmp/plate.bin" >/dev/null || fail "features of the plate"

@@ -15,6 +15,7 @@ bool is_joint_column(const std::string& name);
 struct JointCsv {
   std::vector<std::string> joints;         // joint columns, in file order
   std::vector<std::vector<double>> rows;   // per row, the joint columns' values
+  std::vector<int> lines;                  // per row, its line in the file
 };
 
 // Throws InputError naming file, line, column and key for a file that
