@@ -19,7 +19,12 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
   if (opcode != kOpDmx) return ArtNetParse::other;
   if (packet.size() < kHeader) return ArtNetParse::malformed;
   const std::size_t length = (std::size_t{packet[16]} << 8) | packet[17];
-  if (length < 2 || length > 512 || length % 2 != 0 || packet.size() != kHeader + length) {
+  // Art-Net asks senders for an even length, but desks and scripts that
+  // send an odd number of channels exist: taken, with or without the
+  // padding byte that makes the data even.
+  const std::size_t carried = packet.size() - kHeader;
+  const bool padded = length % 2 == 1 && carried == length + 1;
+  if (length < 1 || length > 512 || (carried != length && !padded)) {
     return ArtNetParse::malformed;
   }
   // The Port-Address is 15 bits: a Net with its top bit set is no address

@@ -17,7 +17,7 @@ start_serve "$root/configs/robots/animatronic.yaml" --cues "$root/configs/cues/a
   fail "no Art-Net line: '$line'"
 /usr/bin/python3 - "${BASH_REMATCH[1]}" <<'PY' || fail "the sender failed"
 # ArtDmx: ID "Art-Net\0", OpCode 0x5000 little-endian, ProtVerHi 0, ProtVerLo
-# 14, Sequence, Physical, SubUni, Net, Length big-endian (even, 2-512), Data.
+# 14, Sequence, Physical, SubUni, Net, Length big-endian (1-512, even as a sender should), Data.
 import socket, struct, sys, time
 sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 target = ("127.0.0.1", int(sys.argv[1]))
@@ -38,7 +38,7 @@ time.sleep(0.5)
 send(artdmx([2], universe=1))   # another universe: ignored
 send(b"Art-Net\0" + struct.pack("<H", 0x2000) + bytes([0, 14, 0, 0]))  # ArtPoll: ignored
 send(artdmx([2, 0], length=4))  # says 4 channels, carries 2
-send(artdmx([2, 0, 0], length=3, data_len=3))  # an odd length
+send(artdmx([2, 0, 0, 0, 0], length=3))  # says 3 channels, carries 6
 send(artdmx([2, 0])[:17])       # cut inside the header
 send(artdmx([0, 0]))            # zero: no cue
 time.sleep(0.2)

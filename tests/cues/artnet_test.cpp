@@ -27,10 +27,25 @@ TEST(ArtNet, ArtDmxCarriesItsUniverseAndChannels) {
   EXPECT_EQ(dmx.data[3], 6);
 }
 
+// Art-Net asks a sender for an even length; an odd one (a script sending
+// three channels), with or without a padding byte, still carries them.
+TEST(ArtNet, AnOddLengthCarriesItsChannels) {
+  ArtDmx dmx;
+  ASSERT_EQ(parse_artnet(art_dmx(5, {9, 8, 7}, 3), dmx), ArtNetParse::dmx);
+  EXPECT_EQ(dmx.universe, 5);
+  ASSERT_EQ(dmx.data.size(), 3u);
+  EXPECT_EQ(dmx.data[2], 7);
+  ASSERT_EQ(parse_artnet(art_dmx(0, {42, 0}, 1), dmx), ArtNetParse::dmx);
+  ASSERT_EQ(dmx.data.size(), 1u);
+  EXPECT_EQ(dmx.data[0], 42);
+  EXPECT_EQ(parse_artnet(art_dmx(0, {42, 0, 0}, 1), dmx), ArtNetParse::malformed);
+}
+
 TEST(ArtNet, LengthsThatDisagreeAreMalformedAndOtherOpcodesAreNotDmx) {
   ArtDmx dmx;
   EXPECT_EQ(parse_artnet(art_dmx(0, {1, 2}, 4), dmx), ArtNetParse::malformed);
-  EXPECT_EQ(parse_artnet(art_dmx(0, {1, 2, 3}, 3), dmx), ArtNetParse::malformed);
+  EXPECT_EQ(parse_artnet(art_dmx(0, {1, 2, 3}, 2), dmx), ArtNetParse::malformed);
+  EXPECT_EQ(parse_artnet(art_dmx(0, {1, 2, 3, 4}, 2), dmx), ArtNetParse::malformed);
   EXPECT_EQ(parse_artnet(art_dmx(0, std::vector<std::uint8_t>(514, 0), 514), dmx),
             ArtNetParse::malformed);
   EXPECT_EQ(parse_artnet(art_dmx(0, {}, 0), dmx), ArtNetParse::malformed);
