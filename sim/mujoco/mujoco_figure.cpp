@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "animrt/core/input_file.hpp"
+#include "animrt/sim/mujoco/mujoco_model.hpp"
 
 namespace animrt::sim {
 namespace {
@@ -54,10 +55,9 @@ MujocoFigure::MujocoFigure(const std::string& model_path,
       !problem.empty()) {
     throw InputError(where, "model", model_path + " " + problem);
   }
-  char error[1024] = "";
-  model_.reset(mj_loadXML(model_path.c_str(), nullptr, error, sizeof error));
+  std::string message;
+  model_.reset(read_mjcf(model_path, message));
   if (!model_) {
-    std::string message = error;
     std::replace(message.begin(), message.end(), '\n', ' ');
     throw InputError(where, "model", model_path + " is not a valid MJCF model: " + message);
   }

@@ -4,13 +4,17 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "animrt/core/error.hpp"
 #include "animrt/core/input_file.hpp"
@@ -48,6 +52,123 @@ int attribute_line(const std::string& text, std::string_view name) {
   return 0;
 }
 
+// An attribute value token that reads whole as a number that is not finite
+// ("nan", "inf", "-Infinity"): MuJoCo loads some of them with a warning of
+// its own, and the physics then computes NaN.
+bool non_finite_token(std::string_view token) {
+  const std::string t(token);
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  return end == t.c_str() + t.size() && !t.empty() && !std::isfinite(v);
+}
+
+// The first attribute outside comments whose value holds a non-finite
+// number: its line and column (from 1), "element.attribute" and the token.
+struct NonFinite {
+  int line = 0, column = 0;
+  std::string attribute, token;
+};
+
+std::optional<NonFinite> first_non_finite(const std::string& text) {
+  int line = 1;
+  std::size_t line_start = 0;
+  bool in_tag = false;
+  std::string element;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      line_start = i + 1;
+      continue;
+    }
+    if (!in_tag && text.compare(i, 4, "<!--") == 0) {
+      const std::size_t end = text.find("-->", i + 4);
+      const std::size_t stop = end == std::string::npos ? text.size() : end + 3;
+      for (std::size_t k = i; k < stop; ++k) {
+        if (text[k] == '\n') {
+          ++line;
+          line_start = k + 1;
+        }
+      }
+      i = stop - 1;
+      continue;
+    }
+    if (text[i] == '<') {
+      in_tag = true;
+      std::size_t e = i + 1;
+      while (e < text.size() && !std::isspace(static_cast<unsigned char>(text[e])) &&
+             text[e] != '>' && text[e] != '/') {
+        ++e;
+      }
+      element = text.substr(i + 1, e - i - 1);
+    }
+    if (text[i] == '>') in_tag = false;
+    if (!in_tag || text[i] != '=') continue;
+    std::size_t q = i + 1;
+    while (q < text.size() && std::isspace(static_cast<unsigned char>(text[q]))) ++q;
+    if (q >= text.size() || (text[q] != '"' && text[q] != '\'')) continue;
+    const std::size_t close = text.find(text[q], q + 1);
+    if (close == std::string::npos) return std::nullopt;  // MuJoCo's parser says where
+    std::size_t name_end = i;
+    while (name_end > 0 && std::isspace(static_cast<unsigned char>(text[name_end - 1]))) --name_end;
+    std::size_t name_start = name_end;
+    while (name_start > 0 && !std::isspace(static_cast<unsigned char>(text[name_start - 1])) &&
+           text[name_start - 1] != '<') {
+      --name_start;
+    }
+    const std::string_view value(text.data() + q + 1, close - q - 1);
+    std::size_t t = 0;
+    while (t < value.size()) {
+      while (t < value.size() && std::isspace(static_cast<unsigned char>(value[t]))) ++t;
+      std::size_t e = t;
+      while (e < value.size() && !std::isspace(static_cast<unsigned char>(value[e]))) ++e;
+      if (e > t && non_finite_token(value.substr(t, e - t))) {
+        NonFinite f;
+        f.line = line;
+        f.column = static_cast<int>(q + 2 + t - line_start);
+        f.attribute = element + "." + text.substr(name_start, name_end - name_start);
+        f.token = std::string(value.substr(t, e - t));
+        return f;
+      }
+      t = e;
+    }
+    // A value that spans lines moves the line count on.
+    for (std::size_t k = q; k < close; ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        line_start = k + 1;
+      }
+    }
+    i = close;
+  }
+  return std::nullopt;
+}
+
+// MuJoCo writes its own warnings (to the terminal and a MUJOCO_LOG.TXT in
+// the working folder); while a model loads they are kept and told as ours.
+thread_local std::vector<std::string>* load_warnings = nullptr;
+
+void keep_warning(const char* message) {
+  if (load_warnings != nullptr) load_warnings->emplace_back(message);
+}
+
+class KeptWarnings {
+ public:
+  KeptWarnings() : previous_(mju_user_warning) {
+    load_warnings = &list;
+    mju_user_warning = keep_warning;
+  }
+  ~KeptWarnings() {
+    mju_user_warning = previous_;
+    load_warnings = nullptr;
+  }
+  KeptWarnings(const KeptWarnings&) = delete;
+  KeptWarnings& operator=(const KeptWarnings&) = delete;
+  std::vector<std::string> list;
+
+ private:
+  void (*previous_)(const char*);
+};
+
 }  // namespace
 
 void check_mujoco_timestep(const mjModel& model, const std::string& path) {
@@ -67,10 +188,28 @@ void check_mujoco_timestep(const mjModel& model, const std::string& path) {
                    std::string("expected a time step from 1e-05 to 0.1 s, found ") + found);
 }
 
+mjModel* read_mjcf(const std::string& path, std::string& error) {
+  if (const auto bad = first_non_finite(read_input_file(path, kMaxMediaFileBytes))) {
+    throw InputError({path, bad->line, bad->column}, bad->attribute,
+                     "expected finite numbers, found " + bad->token);
+  }
+  char text[1024] = "";
+  mjModel* model = nullptr;
+  {
+    KeptWarnings warnings;
+    model = mj_loadXML(path.c_str(), nullptr, text, sizeof text);
+    for (const std::string& w : warnings.list) {
+      std::cerr << "warning: " << path << ": " << w << '\n';
+    }
+  }
+  error = text;
+  return model;
+}
+
 MujocoModel load_mujoco_model(const std::string& path) {
   check_input_file(path, kMaxMediaFileBytes);
-  char error[1024] = "";
-  mjModel* raw = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+  std::string error;
+  mjModel* raw = read_mjcf(path, error);
   if (!raw) {
     std::string message = error;
     // MuJoCo's parser errors say "... line N ..."; take N for the location.

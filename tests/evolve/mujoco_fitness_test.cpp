@@ -412,5 +412,42 @@ TEST(MujocoModel, ATimeStepOutsideTenMicrosecondsToATenthIsRefusedAtItsLine) {
   EXPECT_NO_THROW(sim::load_mujoco_model(file));
 }
 
+// MuJoCo takes size="nan ..." with a warning of its own on the terminal
+// (and a MUJOCO_LOG.TXT in the working folder), then fails or simulates
+// NaN; both loaders refuse a non-finite number at its line and attribute.
+TEST(MujocoModel, ANonFiniteNumberIsRefusedAtItsLineAndAttribute) {
+  const std::string shipped = read_file(kConfigsDir + "/models/quadruped.xml");
+  const std::size_t at = shipped.find("<geom", shipped.find("<body"));
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t size_at = shipped.find("size=\"", at);
+  ASSERT_LT(size_at, shipped.find('>', at));
+  const int line = 1 + static_cast<int>(std::count(shipped.begin(), shipped.begin() + at, '\n'));
+  const std::string file = ::testing::TempDir() + "/animrt_nan_model.xml";
+  for (const char* bad : {"nan", "-inf", "Infinity"}) {
+    std::string text = shipped;
+    text.insert(size_at + 6, std::string("0.01 ") + bad + " ");
+    write_file(file, text);
+    ::testing::internal::CaptureStderr();
+    ::testing::internal::CaptureStdout();
+    try {
+      sim::load_mujoco_model(file);
+      ADD_FAILURE() << "loaded " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().line, line) << bad;
+      EXPECT_EQ(e.key(), "geom.size") << bad;
+      EXPECT_NE(std::string(e.what()).find(std::string("found ") + bad), std::string::npos)
+          << e.what();
+    }
+    EXPECT_THROW(sim::MujocoFigure(file, {"lf_hip"}, Location{}), InputError) << bad;
+    EXPECT_EQ(::testing::internal::GetCapturedStdout(), "") << bad;
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << bad;
+  }
+  // In a comment it is no attribute.
+  std::string commented = shipped;
+  commented.insert(commented.find("<mujoco"), "<!-- size=\"nan\" -->\n");
+  write_file(file, commented);
+  EXPECT_NO_THROW(sim::load_mujoco_model(file));
+}
+
 }  // namespace
 }  // namespace animrt::evolve

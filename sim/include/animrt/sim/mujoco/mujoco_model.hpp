@@ -31,6 +31,13 @@ struct MujocoModel {
 // missing or invalid model, or one that breaks the conventions above.
 MujocoModel load_mujoco_model(const std::string& path);
 
+// MuJoCo's mj_loadXML of `path`, after refusing (InputError at its line
+// and attribute) a number in the file that is not finite, which MuJoCo
+// takes with a warning and simulates as NaN. MuJoCo's own warnings go to
+// standard error as "warning: PATH: ..." (not to the terminal and a
+// MUJOCO_LOG.TXT by themselves). Null with MuJoCo's error in `error`.
+mjModel* read_mjcf(const std::string& path, std::string& error);
+
 // Throws InputError at the file's timestep attribute (option.timestep) when
 // the loaded model's step is outside 10 us to 0.1 s: MuJoCo accepts
 // timestep="0", and a run stepping physics up to a time never got there.
