@@ -1,6 +1,7 @@
 #include "animrt/runtime/cue_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -44,6 +45,21 @@ std::string resolve(const YamlNode& file, const std::string& cue_path) {
   return path.string();
 }
 
+// A joint position as a cue file writes it (degrees; metres for a prismatic
+// joint), in SI and within the joint's limits. The limits are kept in SI
+// and 60 deg reads back as 59.99999999999999: a value at a limit as the
+// robot file writes it passes by a rounding margin and is held to it.
+double position_within_limits(const YamlNode& value, const JointSpec& joint) {
+  const bool metres = joint.type == JointType::prismatic;
+  const auto as_written = [metres](double si) { return metres ? si : rad_to_deg(si); };
+  const double lo = as_written(joint.limits.min_position);
+  const double hi = as_written(joint.limits.max_position);
+  const double margin = 1e-9 * std::max({1.0, std::abs(lo), std::abs(hi)});
+  const double given = value.as_double_in(lo - margin, hi + margin);
+  return std::clamp(metres ? given : deg_to_rad(given), joint.limits.min_position,
+                    joint.limits.max_position);
+}
+
 std::unique_ptr<MotionSource> make_pose(const YamlNode& node, const RobotConfig& robot) {
   std::vector<std::pair<int, double>> pose;
   for (const auto& [name, value] : node.entries()) {
@@ -52,12 +68,8 @@ std::unique_ptr<MotionSource> make_pose(const YamlNode& node, const RobotConfig&
       if (robot.joints[j].name == name) index = static_cast<int>(j);
     }
     if (index < 0) value.fail("no joint " + quote(name) + " in robot " + robot.name);
-    const JointSpec& joint = robot.joints[static_cast<std::size_t>(index)];
-    const bool metres = joint.type == JointType::prismatic;
-    const double lo = metres ? joint.limits.min_position : rad_to_deg(joint.limits.min_position);
-    const double hi = metres ? joint.limits.max_position : rad_to_deg(joint.limits.max_position);
-    const double given = value.as_double_in(lo, hi);
-    pose.emplace_back(index, metres ? given : deg_to_rad(given));
+    pose.emplace_back(index,
+                      position_within_limits(value, robot.joints[static_cast<std::size_t>(index)]));
   }
   if (pose.empty()) node.fail("expected joint: degrees pairs, found none");
   return make_pose_source(std::move(pose));
@@ -352,15 +364,8 @@ DmxJoint make_dmx_joint(const std::string& name, const YamlNode& node, const Rob
     if (!range->is_sequence() || ends.size() != 2) {
       range->fail("expected [at level 0, at full], found " + range->describe());
     }
-    const bool metres = joint.type == JointType::prismatic;
-    const double lo = metres ? joint.limits.min_position : rad_to_deg(joint.limits.min_position);
-    const double hi = metres ? joint.limits.max_position : rad_to_deg(joint.limits.max_position);
-    dmx.min = ends[0].as_double_in(lo, hi);
-    dmx.max = ends[1].as_double_in(lo, hi);
-    if (!metres) {
-      dmx.min = deg_to_rad(dmx.min);
-      dmx.max = deg_to_rad(dmx.max);
-    }
+    dmx.min = position_within_limits(ends[0], joint);
+    dmx.max = position_within_limits(ends[1], joint);
   }
   return dmx;
 }

@@ -64,6 +64,35 @@ TEST(CueFile, EveryShippedCueFileLoadsForItsRobot) {
   EXPECT_EQ(files, 2);
 }
 
+// The robot file's limits are kept in radians and 60 deg reads back as
+// 59.99999999999999: a pose or a DMX range at a limit as written is
+// taken (and held to it), one past it refused.
+TEST(CueFile, APoseOrADmxRangeAtAJointsLimitIsTaken) {
+  const RobotConfig robot = animatronic();
+  const std::string at_limits =
+      write_cues("at_limits.yaml",
+                 "idle: rest\n"
+                 "artnet: {universe: 0, joints: {neck_pan: {channel: 4, range: [-60, 60]}}}\n"
+                 "cues:\n"
+                 "  rest: {play: {pose: {neck_pan: 60, neck_tilt: -20, eye_pan: -30}}}\n"
+                 "  far: {play: {pose: {neck_pan: -60, neck_tilt: 25}}}\n");
+  ASSERT_EQ(load_error(at_limits), "");
+  const LoadedCues loaded = load_cues(at_limits, robot);
+  ASSERT_EQ(loaded.artnet.joints.size(), 1u);
+  const JointLimits& pan =
+      robot.joints[static_cast<std::size_t>(loaded.artnet.joints[0].joint)].limits;
+  EXPECT_EQ(loaded.artnet.joints[0].min, pan.min_position);
+  EXPECT_EQ(loaded.artnet.joints[0].max, pan.max_position);
+  const std::string past = write_cues("past_limit.yaml",
+                                      "idle: rest\n"
+                                      "cues:\n"
+                                      "  rest: {play: {pose: {neck_pan: 60.001}}}\n");
+  EXPECT_NE(load_error(past).find(":4:34: cues.rest.play.pose.neck_pan: expected a number from -60 "
+                                  "to 60, found \"60.001\""),
+            std::string::npos)
+      << load_error(past);
+}
+
 TEST(CueFile, ACueNamingAMissingShowNamesFileLineAndKey) {
   const std::string path = write_cues("missing.yaml",
                                       "idle: rest\n"
