@@ -39,7 +39,14 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
                              std::span<const char> arrived, std::span<const double> max_speed) {
   const std::size_t n = agents.size();
   ++steps_;
+  // Speeds and directions are the figures' own motion since the last
+  // sample, not the speed their gaits were asked for: a figure pressed
+  // against a wall or stopped by the contact guard walks nowhere.
+  const double since = t - last_t_;
   last_t_ = t;
+  const auto motion = [&](std::size_t i) {
+    return since > 0.0 ? (agents[i].position - tracks_[i].last) / since : Vec2{};
+  };
   double max_radius = 0.0;
   for (const Agent& a : agents) max_radius = std::max(max_radius, a.radius);
 
@@ -115,10 +122,12 @@ void MetricsRecorder::sample(double t, std::span<const Agent> agents,
                              ? max_speed[static_cast<std::size_t>(i)]
                              : 0.0;
       const double floor = top > 0 ? kMovingFraction * top : kMovingFloor_mps;
-      all_speed += std::abs(a.speed);
-      if (std::abs(a.speed) > floor) {
-        sum_v += a.velocity();
-        sum_speed += std::abs(a.speed);
+      const Vec2 v = motion(static_cast<std::size_t>(i));
+      const double speed = norm(v);
+      all_speed += speed;
+      if (speed > floor) {
+        sum_v += v;
+        sum_speed += speed;
         ++moving;
       }
       centre += a.position;

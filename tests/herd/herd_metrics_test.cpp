@@ -34,6 +34,12 @@ struct Fixture {
         max_speed(agents.size(), 0.1) {}
 };
 
+// Each figure walks what its speed and heading say for dt: the metrics
+// read a figure's motion from its positions.
+void walk(std::vector<Agent>& agents, double dt) {
+  for (Agent& a : agents) a.position += a.velocity() * dt;
+}
+
 std::vector<GroupInfo> one_group(int n, std::optional<Vec2> target = {}) {
   GroupInfo g{"g", "crowd", {}, target};
   for (int i = 0; i < n; ++i) g.members.push_back(i);
@@ -91,8 +97,10 @@ TEST(HerdMetrics, OrderParameterAfterSettling) {
   MetricsRecorder a(one_group(3), aligned.agents, 1.0);
   MetricsRecorder b(one_group(2), opposed.agents, 1.0);
   for (double t : {0.0, 0.5, 1.0, 1.5}) {
-    a.sample(t, aligned.agents, aligned.leaders, aligned.arrived, aligned.max_speed);
-    b.sample(t, opposed.agents, opposed.leaders, opposed.arrived, opposed.max_speed);
+    walk(aligned.agents, 0.5);
+    walk(opposed.agents, 0.5);
+    a.sample(t + 0.5, aligned.agents, aligned.leaders, aligned.arrived, aligned.max_speed);
+    b.sample(t + 0.5, opposed.agents, opposed.leaders, opposed.arrived, opposed.max_speed);
   }
   EXPECT_NEAR(a.finish().groups[0].order_mean, 1.0, 1e-12);
   EXPECT_NEAR(b.finish().groups[0].order_mean, 0.0, 1e-12);
@@ -132,6 +140,26 @@ TEST(HerdMetrics, AFlockThatStandsWhileItsLeaderWalksIsStandingNotOrdered) {
   EXPECT_EQ(text.find("order"), std::string::npos) << text;
 }
 
+// Figures whose gaits walk 0.1 m/s into a wall that holds them where they
+// are: the speed they were asked is no motion. They stand, and have no
+// order, while their leader walks on.
+TEST(HerdMetrics, AFlockPressedAgainstAWallIsStanding) {
+  std::vector<Agent> agents;
+  for (int i = 0; i < 6; ++i) agents.push_back(at(0, i, 0.0, 0.1));
+  Fixture f(agents, 1);
+  f.max_speed.assign(agents.size(), 0.12);
+  MetricsRecorder r({GroupInfo{"f", "unity", {0, 1, 2, 3, 4, 5}, {}}}, f.agents, 2.0);
+  for (int k = 1; k <= 200; ++k) {
+    const double t = 0.1 * k;
+    f.leaders[0] = Vec2{10 + 0.11 * t, 0};
+    r.sample(t, f.agents, f.leaders, f.arrived, f.max_speed);
+  }
+  const GroupMetrics g = r.finish().groups[0];
+  EXPECT_TRUE(g.standing);
+  EXPECT_EQ(g.order_steps, 0);
+  EXPECT_EQ(g.speed_mean_mps, 0.0);
+}
+
 TEST(HerdMetrics, TheSummaryCountsKnots) {
   HerdMetrics m;
   m.knots = 3;
@@ -154,7 +182,8 @@ TEST(HerdMetrics, OrderCountsOnlyMovingFigures) {
   // have no direction to disagree with.
   Fixture f({at(0, 0, 0, 0.1), at(2, 0, 0, 0.1), at(4, 0, M_PI, 0.001), at(6, 0, M_PI, 0.001)}, 1);
   MetricsRecorder r(one_group(4), f.agents, 0.0);
-  r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
+  walk(f.agents, 0.1);
+  r.sample(0.1, f.agents, f.leaders, f.arrived, f.max_speed);
   const GroupMetrics g = r.finish().groups[0];
   EXPECT_EQ(g.order_steps, 1);
   EXPECT_NEAR(g.order_mean, 1.0, 1e-12);
@@ -199,7 +228,8 @@ TEST(HerdMetrics, ArrivalTimesPathsAndStuckFigures) {
 TEST(HerdMetrics, OneFigureHasNoPairDistanceNorNeighbour) {
   Fixture f({at(0, 0, 0, 0.1)}, 1);
   MetricsRecorder r(one_group(1), f.agents, 0.0);
-  r.sample(0.0, f.agents, f.leaders, f.arrived, f.max_speed);
+  walk(f.agents, 0.1);
+  r.sample(0.1, f.agents, f.leaders, f.arrived, f.max_speed);
   const HerdMetrics m = r.finish();
   EXPECT_FALSE(m.has_pair);
   EXPECT_FALSE(m.groups[0].has_pair);

@@ -24,11 +24,13 @@ struct GroupMetrics {
   double min_pair_distance_m = 0.0;  // centre distance, over pairs touching this group that came
                                      // within two figure widths (has_pair false: none did)
   bool has_pair = false;
+  // Velocities v are each figure's displacement since the previous sample
+  // over the time between (what it walked, not what its gait was asked).
   double order_mean = 0.0;      // |sum v| / (N mean |v|) over moving members, mean over steps after
                                 // settling with at least two moving
   double order_min = 0.0;       // its minimum over those steps
   long order_steps = 0;         // steps the order was measured in (0: not measured)
-  double speed_mean_mps = 0.0;  // mean |speed| of all members, over steps after settling
+  double speed_mean_mps = 0.0;  // mean |v| of all members, over steps after settling
   double leader_speed_mean_mps = -1.0;  // flocks: the leader's, over the same steps (-1: none)
   bool standing = false;  // mean speed under a tenth of the leader's: order means nothing
   double nearest_neighbour_mean_m = 0.0;  // within the group, mean over steps
