@@ -633,6 +633,10 @@ void CrowdGroup::make_slots(double radius) {
         under_obstacle = true;
     }
     if (under_obstacle) continue;
+    // Not in a narrow passage or before its mouth: a team gathered there
+    // stands in the way of every figure that must pass (and of its own
+    // waiting for it).
+    if (crowd_.passages_ && crowd_.passages_->in_way(q, radius)) continue;
     // Only slots reached from the target roughly in a straight line: not
     // behind a wall.
     const auto len = w.path_length(t, q);

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 
 #include "animrt/controllers/herd/nav_world.hpp"
 
@@ -257,6 +259,68 @@ std::vector<Passage> find_passages(std::span<const Box> walls, double max_width)
   return out;
 }
 
+std::vector<PassageChain> find_chains(
+    std::span<const Passage> passages, double link_m,
+    const std::function<std::optional<double>(Vec2, Vec2)>& distance) {
+  // Mouth 2k + 0 is passage k's mouth along its axis, 2k + 1 against it.
+  const std::size_t n = passages.size();
+  const auto mouth = [&](std::size_t m) {
+    const Passage& p = passages[m / 2];
+    return p.centre + p.axis * ((m % 2 == 0 ? 1.0 : -1.0) * p.half_length);
+  };
+  const auto out_of = [&](std::size_t m) {  // the way out of the passage through mouth m
+    return passages[m / 2].axis * (m % 2 == 0 ? 1.0 : -1.0);
+  };
+  std::vector<std::vector<std::size_t>> links(2 * n);
+  for (std::size_t a = 0; a < 2 * n; ++a) {
+    for (std::size_t b = a + 1; b < 2 * n; ++b) {
+      if (a / 2 == b / 2) continue;
+      const Vec2 gap = mouth(b) - mouth(a);
+      // Each mouth faces the other: out of one is on toward the other
+      // (gaps side by side in one wall face the same way, and do not link).
+      const double along = norm(gap) * 0.1;
+      if (dot(gap, out_of(a)) <= along || dot(gap * -1.0, out_of(b)) <= along) continue;
+      const auto d = distance(mouth(a), mouth(b));
+      if (d && *d <= link_m) {
+        links[a].push_back(b);
+        links[b].push_back(a);
+      }
+    }
+  }
+  // A mouth faced by more than one other (a junction) links none.
+  const auto link_of = [&](std::size_t m) -> long {
+    if (links[m].size() != 1) return -1;
+    const std::size_t o = links[m][0];
+    return links[o].size() == 1 ? static_cast<long>(o) : -1;
+  };
+  std::vector<char> taken(n, 0);
+  std::vector<PassageChain> chains;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (taken[k]) continue;
+    // Walk back to one end of k's chain (a ring has none: it stays at k).
+    std::size_t start = k, from = 2 * k + 1;  // entering `start` through mouth `from`
+    for (std::size_t steps = 0; steps < n; ++steps) {
+      const long back = link_of(from);
+      if (back < 0 || static_cast<std::size_t>(back) / 2 == k) break;
+      start = static_cast<std::size_t>(back) / 2;
+      from = static_cast<std::size_t>(back) ^ 1U;
+    }
+    PassageChain c;
+    std::size_t at = start, in = from;
+    for (std::size_t steps = 0; steps < n && !taken[at]; ++steps) {
+      taken[at] = 1;
+      c.members.push_back(static_cast<int>(at));
+      c.orient.push_back(in % 2 == 1 ? 1 : -1);  // in through its minus mouth: along its axis
+      const long next = link_of(in ^ 1U);
+      if (next < 0) break;
+      at = static_cast<std::size_t>(next) / 2;
+      in = static_cast<std::size_t>(next);
+    }
+    chains.push_back(std::move(c));
+  }
+  return chains;
+}
+
 PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, PassageParams params,
                            const NavWorld* world)
     : passages_(find_passages(walls, params.max_width_radii * avoid_radius)),
@@ -264,6 +328,14 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
       params_(params),
       world_(world) {
   for (const Box& b : walls) walls_.push_back(extent_of(b));
+  chains_ = find_chains(passages_, params_.approach_m, [this](Vec2 a, Vec2 b) {
+    return world_ ? world_->path_length(a, b) : std::optional<double>(norm(b - a));
+  });
+  chain_of_.assign(passages_.size(), 0);
+  for (std::size_t c = 0; c < chains_.size(); ++c) {
+    for (const int m : chains_[c].members)
+      chain_of_[static_cast<std::size_t>(m)] = static_cast<int>(c);
+  }
   places_.resize(passages_.size());
   for (std::size_t k = 0; k < passages_.size(); ++k) {
     for (const int dir : {1, -1}) {
@@ -271,6 +343,16 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
         places_[k][place_slot(dir, side)] = find_wait_place(passages_[k], dir, side);
     }
   }
+}
+
+bool PassageRules::in_way(Vec2 q, double radius) const {
+  for (const Passage& p : passages_) {
+    const Vec2 d = q - p.centre, across{-p.axis.y, p.axis.x};
+    if (std::abs(dot(d, p.axis)) <= p.half_length + params_.close_m &&
+        std::abs(dot(d, across)) <= p.half_width + radius)
+      return true;
+  }
+  return false;
 }
 
 bool PassageRules::sees(const Passage& p, Vec2 pos) const {
@@ -301,8 +383,17 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
   round_way_.resize(agents.size() * passages_.size(), 0);
   round_to_.resize(agents.size() * passages_.size(), 0.0);
   round_next_.resize(agents.size() * passages_.size(), 0.0);
+  dir_of_.assign(agents.size() * passages_.size(), 0);
+  round_of_.assign(agents.size() * passages_.size(), 0);
+  near_.assign(agents.size() * passages_.size(), 0);
+  ahead_.assign(agents.size() * passages_.size(), 0);
+  chain_way_.resize(agents.size() * chains_.size(), 0);
+  counts_.resize(passages_.size());
   for (std::size_t k = 0; k < passages_.size(); ++k)
-    update_one(t, static_cast<int>(k), passages_[k], agents, target, active);
+    counts_[k] = count_one(t, static_cast<int>(k), passages_[k], agents, target, active);
+  for (std::size_t c = 0; c < chains_.size(); ++c) take_turns(t, static_cast<int>(c), agents);
+  for (std::size_t k = 0; k < passages_.size(); ++k)
+    hold_one(static_cast<int>(k), passages_[k], agents, target);
   // A figure keeps its place in a queue only while it stays queued.
   for (char& q : queued_) q = q == 2 ? 1 : 0;
 }
@@ -310,10 +401,11 @@ void PassageRules::update(double t, std::span<const Agent> agents, std::span<con
 int PassageRules::single_file(const Passage& p, std::span<const Agent> agents) const {
   if (p.owner == 0 || p.half_width >= 2.0 * avoid_radius_) return -1;
   const Vec2 mouth = p.centre - p.axis * (p.owner * p.half_length);
+  const auto index = static_cast<std::size_t>(&p - passages_.data());
   int next = -1;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < agents.size(); ++i) {
-    if (dir_of_[i] != p.owner) continue;
+    if (dir_of_[i * passages_.size() + index] != p.owner) continue;
     const double s = dot(agents[i].position - p.centre, p.axis) * p.owner;
     if (s >= -p.half_length) continue;  // in the passage already
     const double d = norm(agents[i].position - mouth);
@@ -325,27 +417,26 @@ int PassageRules::single_file(const Passage& p, std::span<const Agent> agents) c
   return next;
 }
 
-void PassageRules::update_one(double t, int index, Passage& p, std::span<const Agent> agents,
-                              std::span<const Vec2> target, const std::vector<bool>& active) {
+PassageRules::Count PassageRules::count_one(double t, int index, const Passage& p,
+                                            std::span<const Agent> agents,
+                                            std::span<const Vec2> target,
+                                            const std::vector<bool>& active) {
   const Vec2 u = p.axis, across{-u.y, u.x};
   const double hl = p.half_length, hw = p.half_width;
   const double reach = hl + params_.approach_m;
-  int want[2] = {0, 0}, in[2] = {0, 0};  // asking for the passage, and near its mouth
-  double nearest[2] = {std::numeric_limits<double>::infinity(),
-                       std::numeric_limits<double>::infinity()};
-  std::vector<signed char>& dir_of = dir_of_;
-  dir_of.assign(agents.size(), 0);
+  Count c;
+  c.nearest[0] = c.nearest[1] = std::numeric_limits<double>::infinity();
   const std::size_t np = passages_.size();
-  round_of_.assign(agents.size(), 0);
   for (std::size_t i = 0; i < agents.size(); ++i) {
-    signed char& known = way_[i * np + static_cast<std::size_t>(index)];
+    const std::size_t at = i * np + static_cast<std::size_t>(index);
+    signed char& known = way_[at];
     const Vec2 d = agents[i].position - p.centre;
     const double along = dot(d, u);
     const double side = std::abs(dot(d, across));
     if (!active[i] || std::abs(along) > std::max(reach, hl + params_.clear_m) ||
         side > hw + params_.approach_m) {
       known = 0;
-      round_way_[i * np + static_cast<std::size_t>(index)] = 0;
+      round_way_[at] = 0;
       continue;
     }
     // Only a figure that sees the passage from where it stands asks for
@@ -353,24 +444,24 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     // it, or not there yet). One the passage holds keeps asking while it
     // walks to its place.
     const bool in_it = std::abs(along) <= hl && side <= hw + agents[i].radius;
-    signed char& round = round_way_[i * np + static_cast<std::size_t>(index)];
+    signed char& round = round_way_[at];
     if (!in_it && (was_held_by_[i] != index || was_stood_by_[i] == index) &&
         !sees(p, agents[i].position)) {
       known = 0;
       // Round a wall's end from the passage, its way through it: on its
       // way the figure comes round the corner into the other way's way
       // out, so while that way has the passage it waits where it is.
-      const std::size_t at = i * np + static_cast<std::size_t>(index);
       if (round == 0 && t >= round_next_[at]) {
         round = way_round(p, agents[i].position, target[i], round_to_[at]);
         if (round == 0) round_next_[at] = t + 1.0;  // not near yet: asked again in a second
       }
       if (round == 0 || round == kNotThrough) continue;
       const int k = round > 0 ? 0 : 1;
-      dir_of[i] = round;
-      round_of_[i] = 1;
-      ++want[k];
-      nearest[k] = std::min(nearest[k], round_to_[at] + hl);
+      dir_of_[at] = round;
+      round_of_[at] = 1;
+      ahead_[at] = 1;
+      ++c.want[k];
+      c.nearest[k] = std::min(c.nearest[k], round_to_[at] + hl);
       continue;
     }
     round = 0;
@@ -383,40 +474,104 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
       continue;
     }
     const int k = dir > 0 ? 0 : 1;
-    dir_of[i] = static_cast<signed char>(dir);
-    ++want[k];
+    dir_of_[at] = static_cast<signed char>(dir);
+    ahead_[at] = s <= hl ? 1 : 0;
+    ++c.want[k];
     // Out of the far mouth, a figure no longer holds up a swap of the
     // passage: the other way, standing at that mouth, may be what it must
     // walk round.
-    if (s >= -(hl + params_.close_m) && s <= hl) ++in[k];
-    nearest[k] = std::min(nearest[k], -s);
+    if (s >= -(hl + params_.close_m) && s <= hl) {
+      ++c.in[k];
+      near_[at] = 1;
+    }
+    c.nearest[k] = std::min(c.nearest[k], -s);
   }
-  if (p.owner == 0) {
-    if (want[0] + want[1] > 0) p.owner = nearest[0] <= nearest[1] ? 1 : -1;
-    p.waiting_since = -1.0;
-    p.closing = false;
-  } else if (want[idx(p.owner)] == 0) {
-    p.owner = want[idx(-p.owner)] > 0 ? -p.owner : 0;
-    p.waiting_since = -1.0;
-    p.closing = false;
-  } else if (want[idx(-p.owner)] > 0) {
-    if (p.waiting_since < 0.0) p.waiting_since = t;
-    if (t - p.waiting_since >= params_.max_hold_s) p.closing = true;
-    if (p.closing && in[idx(p.owner)] == 0) {
-      p.owner = -p.owner;
-      p.waiting_since = -1.0;
-      p.closing = false;
+  return c;
+}
+
+void PassageRules::take_turns(double t, int chain, std::span<const Agent> agents) {
+  PassageChain& ch = chains_[static_cast<std::size_t>(chain)];
+  int want[2] = {0, 0}, in[2] = {0, 0};
+  double nearest[2] = {std::numeric_limits<double>::infinity(),
+                       std::numeric_limits<double>::infinity()};
+  for (std::size_t m = 0; m < ch.members.size(); ++m) {
+    const Count& c = counts_[static_cast<std::size_t>(ch.members[m])];
+    for (const int way : {1, -1}) {
+      const int k = idx(way * ch.orient[m]);
+      want[k] += c.want[idx(way)];
+      in[k] += c.in[idx(way)];
+      nearest[k] = std::min(nearest[k], c.nearest[idx(way)]);
+    }
+  }
+  if (ch.members.size() > 1) {
+    // A figure that came near one of the chain's passages (and so goes on
+    // through it whatever the turn) is in the chain until it asks for none
+    // of them: between two, it is still on its way through, and a swap
+    // then would meet it head on in the next.
+    const std::size_t np = passages_.size();
+    for (std::size_t i = 0; i < agents.size(); ++i) {
+      signed char& way = chain_way_[i * chains_.size() + static_cast<std::size_t>(chain)];
+      bool asks = false, ahead = false;
+      for (std::size_t m = 0; m < ch.members.size(); ++m) {
+        const std::size_t at = i * np + static_cast<std::size_t>(ch.members[m]);
+        if (dir_of_[at] == 0) continue;
+        asks = true;
+        ahead = ahead || ahead_[at];
+        if (near_[at]) way = static_cast<signed char>(dir_of_[at] * ch.orient[m]);
+      }
+      if (!asks) way = 0;
+      // Out of the chain's last passage, it no longer holds up a swap.
+      if (way != 0 && ahead) ++in[idx(way)];
+    }
+  }
+  if (ch.owner == 0) {
+    if (want[0] + want[1] > 0) ch.owner = nearest[0] <= nearest[1] ? 1 : -1;
+    ch.waiting_since = -1.0;
+    ch.closing = false;
+  } else if (want[idx(ch.owner)] == 0) {
+    ch.owner = want[idx(-ch.owner)] > 0 ? -ch.owner : 0;
+    ch.waiting_since = -1.0;
+    ch.closing = false;
+  } else if (want[idx(-ch.owner)] > 0) {
+    if (ch.waiting_since < 0.0) ch.waiting_since = t;
+    if (t - ch.waiting_since >= params_.max_hold_s) ch.closing = true;
+    if (ch.closing && in[idx(ch.owner)] == 0) {
+      ch.owner = -ch.owner;
+      ch.waiting_since = -1.0;
+      ch.closing = false;
     }
   } else {
-    p.waiting_since = -1.0;
-    p.closing = false;
+    ch.waiting_since = -1.0;
+    ch.closing = false;
   }
+  for (std::size_t m = 0; m < ch.members.size(); ++m) {
+    Passage& p = passages_[static_cast<std::size_t>(ch.members[m])];
+    p.owner = ch.owner * ch.orient[m];
+    p.waiting_since = ch.waiting_since;
+    p.closing = ch.closing;
+  }
+}
+
+void PassageRules::hold_one(int index, const Passage& p, std::span<const Agent> agents,
+                            std::span<const Vec2> target) {
+  const Vec2 u = p.axis, across{-u.y, u.x};
+  const double hl = p.half_length, hw = p.half_width;
+  const std::size_t np = passages_.size();
+  const int chain = chain_of_[static_cast<std::size_t>(index)];
+  const PassageChain& ch = chains_[static_cast<std::size_t>(chain)];
+  const auto member = std::find(ch.members.begin(), ch.members.end(), index) - ch.members.begin();
   const int next = single_file(p, agents);
   for (std::size_t i = 0; i < agents.size(); ++i) {
-    const int dir = dir_of[i];
+    const std::size_t at = i * np + static_cast<std::size_t>(index);
+    const int dir = dir_of_[at];
     if (dir == 0 || held_[i]) continue;
-    if (round_of_[i]) {
-      if (dir == p.owner && !p.closing) continue;
+    // A figure through a passage before this one in its chain is on its
+    // way through the chain: closing, it goes on, as one near the mouth.
+    const bool in_chain =
+        ch.members.size() > 1 && chain_way_[i * chains_.size() + static_cast<std::size_t>(chain)] ==
+                                     dir * ch.orient[static_cast<std::size_t>(member)];
+    if (round_of_[at]) {
+      if (dir == p.owner && (!p.closing || in_chain)) continue;
       // One already at the corner goes on: stood there, it would stand in
       // the way out it was to keep clear of.
       if (was_stood_by_[i] != index &&
@@ -437,7 +592,7 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     const bool inside = s >= -hl && side <= hw + agents[i].radius;
     // Closing, the owner's figures already near the mouth go on: stopped in
     // a stream, touching, they could not turn out of its way.
-    const bool near = s >= -(hl + params_.close_m);
+    const bool near = s >= -(hl + params_.close_m) || in_chain;
     const bool wait = (dir != p.owner && !inside) || (dir == p.owner && p.closing && !near);
     if (!wait) {
       // One lane: the owner's figures near the mouth stand where they are
@@ -459,8 +614,8 @@ void PassageRules::update_one(double t, int index, Passage& p, std::span<const A
     // room (choose_side).
     held_[i] = 1;
     held_by_[i] = index;
-    const int on =
-        p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)] : choose_side(index, dir, agents, target);
+    const int on = p.wait_side[idx(dir)] != 0 ? p.wait_side[idx(dir)]
+                                              : choose_side(index, dir, agents, target);
     hold_[i] = wait_place(index, dir, on);
   }
 }
@@ -551,7 +706,8 @@ int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
   if (!world_) return 1;
   int other = -1;
   for (std::size_t i = 0; i < agents.size() && other < 0; ++i) {
-    if (dir_of_[i] == -dir) other = static_cast<int>(i);
+    if (dir_of_[i * passages_.size() + static_cast<std::size_t>(index)] == -dir)
+      other = static_cast<int>(i);
   }
   // A side with no clear place (its place snapped to the mesh's edge, as
   // where the passage lies near the scene's edge: there its crowd would
@@ -559,7 +715,7 @@ int PassageRules::choose_side(int index, int dir, std::span<const Agent> agents,
   const auto& places = places_[static_cast<std::size_t>(index)];
   const auto clearer = [&](int side) {
     return !places[place_slot(dir, side)].clear && places[place_slot(dir, -side)].clear ? -side
-                                                                                      : side;
+                                                                                        : side;
   };
   if (other < 0) return clearer(1);  // decided once the other way is there
   const Vec2 goal = target[static_cast<std::size_t>(other)];

@@ -8,7 +8,7 @@ animrt=$1
 root=$2
 shift 2
 scenes=("$@")
-[ ${#scenes[@]} -gt 0 ] || scenes=(counterflow gate crossing crossing_own_gaps maze)
+[ ${#scenes[@]} -gt 0 ] || scenes=(counterflow gate crossing crossing_own_gaps maze corridor baffles)
 for scene in "${scenes[@]}"; do
   for seed in 1 2 3 4 5; do
     echo "== $scene seed $seed"

@@ -10,7 +10,7 @@ first=$3
 last=$4
 shift 4
 scenes=("$@")
-[ ${#scenes[@]} -gt 0 ] || scenes=(counterflow gate crossing crossing_own_gaps maze)
+[ ${#scenes[@]} -gt 0 ] || scenes=(counterflow gate crossing crossing_own_gaps maze corridor baffles)
 runs=$(mktemp)
 trap 'rm -f "$runs"' EXIT
 for scene in "${scenes[@]}"; do

@@ -9,6 +9,8 @@
 // and when the last of them is through, ownership swaps.
 
 #include <array>
+#include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -60,6 +62,21 @@ struct Passage {
   int wait_side[2] = {0, 0};
 };
 
+// Passages in a row (a narrow corridor that turns, gaps close one after
+// another) take turns as one: a figure out of one is straight away asking
+// for the next, with no room between to wait aside, and two ways that
+// each held one of them stood nose to nose between them for good. A
+// chain's passages follow each other mouth to mouth, each far mouth
+// facing the next one's near mouth within approach_m; a mouth that more
+// passages face (a junction) links none.
+struct PassageChain {
+  std::vector<int> members;  // passages, in order along the chain
+  std::vector<int> orient;   // per member: its way (+1, -1) when the chain's way is +1
+  int owner = 0;             // the chain's way: +1, -1, or 0 free
+  double waiting_since = -1.0;
+  bool closing = false;
+};
+
 // A wall as the passage finder measures it: its corners (counter-clockwise)
 // and its extent along its own two axes.
 struct WallExtent {
@@ -74,6 +91,13 @@ struct WallExtent {
 // max_width: for two parallel walls their whole overlap, for slanted ones
 // the stretch round the narrowest point (its half_width is there).
 std::vector<Passage> find_passages(std::span<const Box> walls, double max_width);
+
+// The chains of `passages` (every passage is in one; most in one of their
+// own): mouths linked where `distance` between them (by the mesh, or
+// straight) is at most link_m and each faces the other.
+std::vector<PassageChain> find_chains(
+    std::span<const Passage> passages, double link_m,
+    const std::function<std::optional<double>(Vec2, Vec2)>& distance);
 
 class PassageRules {
  public:
@@ -90,11 +114,27 @@ class PassageRules {
   bool held(int i) const { return held_[static_cast<std::size_t>(i)] != 0; }
   Vec2 hold_point(int i) const { return hold_[static_cast<std::size_t>(i)]; }
   std::span<const Passage> passages() const { return passages_; }
+  std::span<const PassageChain> chains() const { return chains_; }
+  // Whether a figure of `radius` at q stands in a passage or in front of
+  // one of its mouths (within close_m of it, as wide as the passage):
+  // where those who pass walk.
+  bool in_way(Vec2 q, double radius) const;
   bool empty() const { return passages_.empty(); }
 
  private:
-  void update_one(double t, int index, Passage& p, std::span<const Agent> agents,
+  // Who asks for passage `index` (and how near), per way.
+  struct Count {
+    int want[2] = {0, 0};  // asking for the passage
+    int in[2] = {0, 0};    // near its mouth or in it
+    double nearest[2] = {0.0, 0.0};
+  };
+  Count count_one(double t, int index, const Passage& p, std::span<const Agent> agents,
                   std::span<const Vec2> target, const std::vector<bool>& active);
+  // Whose turn it is at a chain (its passages take it on).
+  void take_turns(double t, int chain, std::span<const Agent> agents);
+  // Holds the figures passage `index` makes wait, and says where.
+  void hold_one(int index, const Passage& p, std::span<const Agent> agents,
+                std::span<const Vec2> target);
 
   // In a passage one figure wide, the owner's figure outside it that is
   // nearest its mouth (the next to go in); -1 for a wider one.
@@ -126,6 +166,9 @@ class PassageRules {
   int choose_side(int index, int dir, std::span<const Agent> agents, std::span<const Vec2> target);
 
   std::vector<Passage> passages_;
+  std::vector<PassageChain> chains_;
+  std::vector<int> chain_of_;  // per passage
+  std::vector<Count> counts_;  // per passage, this update
   std::vector<WallExtent> walls_;
   std::vector<std::array<WaitPlace, 4>> places_;  // per passage (place_slot in passage.cpp)
   double avoid_radius_;
@@ -141,17 +184,25 @@ class PassageRules {
   std::vector<Vec2> stand_at_;
   // Per agent and passage: the way through of a figure round a corner
   // from it (0: not decided, 2: not through), its path to the mouth, and
-  // when to ask again while it is not near; per agent, round a corner from
-  // the passage at hand.
+  // when to ask again while it is not near.
   std::vector<signed char> round_way_;
   std::vector<double> round_to_;
   std::vector<double> round_next_;
-  std::vector<char> round_of_;
   // Per agent and passage: its way through, decided as it comes near
   // (0: not yet, 2: not through), kept while it stays near.
   std::vector<signed char> way_;
-  // Per agent: its direction (+1, -1) while it asks for the passage at hand, else 0.
+  // Per agent and passage: its direction (+1, -1) while it asks for the
+  // passage, else 0; whether it asks from round a corner; whether it is
+  // near the mouth or in the passage (it goes on through when it closes);
+  // whether it is not yet out of the far mouth.
   std::vector<signed char> dir_of_;
+  std::vector<char> round_of_;
+  std::vector<char> near_;
+  std::vector<char> ahead_;
+  // Per agent and chain of more than one passage: the chain's way it took
+  // near one of its passages (0: none), kept while it asks for any of
+  // them, so a figure between two of them still counts as in the chain.
+  std::vector<signed char> chain_way_;
   // Per agent: queued at a one-lane mouth (1 since the last update, 2 this
   // one), and where it stands in the queue.
   std::vector<char> queued_;
