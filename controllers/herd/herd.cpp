@@ -49,6 +49,24 @@ std::string occupants(const HerdScene& scene, std::span<const Agent> placed, con
   return out;
 }
 
+// A figure's walk from its gait file; the gait's error is told at the
+// scene's figure (the file at fault may be named in several scenes).
+WalkResponse walk_of(const FigureSpec& spec, const std::string& gait) {
+  try {
+    return load_walk_response(gait);
+  } catch (const InputError& e) {
+    // A robot file's own keys, met in a gait file: the figure names its
+    // robot as a gait.
+    const bool robot_file = spec.robot.empty() && (e.key() == "loop" || e.key() == "buses" ||
+                                                   e.key() == "motion" || e.key() == "safety");
+    throw InputError(
+        spec.where, "figures." + spec.name + (spec.robot.empty() ? ".gait" : ".robot"),
+        std::string(e.what()) + (robot_file ? " (a robot file? give it as robot:, its gait is the "
+                                              "figure's)"
+                                            : ""));
+  }
+}
+
 }  // namespace
 
 bool overlaps_box(const Box& box, Vec2 p, double radius) {
@@ -62,7 +80,7 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
   if (seed) scene_.seed = *seed;
   for (const FigureSpec& spec : scene_.figures) {
     const std::string gait = spec.gait.empty() ? gait_of_robot(spec.robot) : spec.gait;
-    figures_.push_back(Figure{spec.name, spec.radius_m, load_walk_response(gait)});
+    figures_.push_back(Figure{spec.name, spec.radius_m, walk_of(spec, gait)});
     turning_radius_.push_back(turning_radius(figures_.back()));
   }
   double max_radius = 0.0;

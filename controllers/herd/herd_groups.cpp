@@ -18,6 +18,10 @@
 namespace animrt::herd {
 namespace {
 
+// How far from the walkable ground a target may lie: as far as a path
+// search snaps its ends (NavWorld::has_path).
+constexpr double kTargetSnapM = 0.3;
+
 // One parameter of a kind: its key, where it goes, its range.
 struct Param {
   const char* key;
@@ -204,6 +208,22 @@ std::vector<std::unique_ptr<HerdGroup>> make_groups(const HerdScene& scene,
                          "figure '" + elide(f.name) + "' walks at most " +
                              format_number(f.walk.max_speed()) +
                              " m/s (its gait's steering range)");
+      }
+      // A target off the walkable ground (in a wall, or nearer a wall or
+      // the ground's edge than a figure's centre comes) is no place to
+      // walk to, whatever the spawn area.
+      if (!nav->nearest_on_mesh(p.target, kTargetSnapM)) {
+        const std::string place = nav->in_wall(p.target, 0.0)
+                                      ? "inside a wall"
+                                      : "off the walkable ground (too near a wall or the "
+                                        "ground's edge for a figure's centre)";
+        const auto nearest = nav->nearest_on_mesh(p.target, 1e3);
+        throw InputError(
+            spec.target_where, "groups[" + std::to_string(g) + "].target_m",
+            "the target is " + place +
+                (nearest ? "; the nearest walkable point is [" + format_number(nearest->x + 0.0) +
+                               ", " + format_number(nearest->y + 0.0) + "]"
+                         : std::string()));
       }
       for (int i : members[g]) {
         if (!nav->has_path(agents[static_cast<std::size_t>(i)].position, p.target)) {
