@@ -584,11 +584,10 @@ void CrowdGroup::find_lanes(std::span<const Agent> agents) {
 }
 
 void CrowdGroup::mark_lane_slots() {
-  if (lanes_.empty()) return;
   // Not the first slot (at the target): the gathering can always begin.
   for (const int open : open_) {
     const auto s = static_cast<std::size_t>(open);
-    if (s > 0) in_lane_[s] = in_lane(slots_[s]) ? 1 : 0;
+    if (s > 0) in_lane_[s] = in_way_[s] || (!lanes_.empty() && in_lane(slots_[s])) ? 1 : 0;
   }
 }
 
@@ -633,15 +632,19 @@ void CrowdGroup::make_slots(double radius) {
         under_obstacle = true;
     }
     if (under_obstacle) continue;
-    // Not in a narrow passage or before its mouth: a team gathered there
-    // stands in the way of every figure that must pass (and of its own
-    // waiting for it).
-    if (crowd_.passages_ && crowd_.passages_->in_way(q, radius)) continue;
     // Only slots reached from the target roughly in a straight line: not
     // behind a wall.
     const auto len = w.path_length(t, q);
     if (!len || *len > d + s) continue;
     slots_.push_back(q);
+  }
+  // No member gathers in a narrow passage or before its mouths: gathered
+  // there, a team stands in the way of every figure that must pass. The
+  // slots stay in the lattice, never taken (like slots in a lane), so the
+  // gathering's reach is what it would be without the passage.
+  in_way_.assign(slots_.size(), 0);
+  for (std::size_t k = 0; k < slots_.size(); ++k) {
+    if (crowd_.passages_ && crowd_.passages_->in_way(slots_[k], radius)) in_way_[k] = 1;
   }
   slot_taken_.assign(slots_.size(), false);
   frontier_.assign(slots_.size(), false);

@@ -348,7 +348,7 @@ PassageRules::PassageRules(std::span<const Box> walls, double avoid_radius, Pass
 bool PassageRules::in_way(Vec2 q, double radius) const {
   for (const Passage& p : passages_) {
     const Vec2 d = q - p.centre, across{-p.axis.y, p.axis.x};
-    if (std::abs(dot(d, p.axis)) <= p.half_length + params_.close_m &&
+    if (std::abs(dot(d, p.axis)) <= p.half_length + 2.0 * radius &&
         std::abs(dot(d, across)) <= p.half_width + radius)
       return true;
   }

@@ -172,8 +172,8 @@ class Crowd {
   std::vector<int> wall_decided_;
   std::vector<int> wall_drop_;       // per moving wall: drops seen, counting this one
   std::vector<char> wall_was_down_;  // per moving wall: down at the last step
-  struct WallGap {     // per moving wall, from its footprint
-    Vec2 across, along;  // unit axes through its thin and along its long side
+  struct WallGap {                   // per moving wall, from its footprint
+    Vec2 across, along;              // unit axes through its thin and along its long side
     double depth = 0.0, half = 0.0;  // half its thickness and half its length
     bool closes_gap = false;         // both ends meet a static wall or the ground's edge
   };
@@ -227,7 +227,8 @@ class CrowdGroup final : public GroupSteering {
   // near the target toward its target.
   void find_lanes(std::span<const Agent> agents);
   bool in_lane(Vec2 q) const;
-  // Marks the open slots (but the first) that lie in a lane in in_lane_.
+  // Marks the open slots (but the first) that lie in a lane or a
+  // passage's way in in_lane_.
   void mark_lane_slots();
   void take_slot(std::size_t slot);  // keeps open_ and taken_ with slot_taken_
   void free_slot(std::size_t slot);
@@ -259,7 +260,8 @@ class CrowdGroup final : public GroupSteering {
     double length = 0.0, half_width = 0.0;
   };
   std::vector<Lane> lanes_;
-  std::vector<char> in_lane_;  // per slot: open and in a lane this step
+  std::vector<char> in_lane_;  // per slot: open and in a lane (or in_way_) this step
+  std::vector<char> in_way_;   // per slot: in a narrow passage's way (never taken)
   double assign_distance_ = 0.0;
   double spacing_ = 0.0;
 };

@@ -115,9 +115,9 @@ class PassageRules {
   Vec2 hold_point(int i) const { return hold_[static_cast<std::size_t>(i)]; }
   std::span<const Passage> passages() const { return passages_; }
   std::span<const PassageChain> chains() const { return chains_; }
-  // Whether a figure of `radius` at q stands in a passage or in front of
-  // one of its mouths (within close_m of it, as wide as the passage):
-  // where those who pass walk.
+  // Whether a figure of `radius` at q stands in a passage or before one of
+  // its mouths (within close_m, as wide as the passage): where every
+  // figure that passes walks.
   bool in_way(Vec2 q, double radius) const;
   bool empty() const { return passages_.empty(); }
 
