@@ -26,6 +26,15 @@ namespace {
 
 constexpr Nanos kNever = std::numeric_limits<Nanos>::max();
 
+// The jaw's energy: RMS of a window about its mean, from the window's sum
+// and sum of squares. A DC offset (a cheap microphone's) or any constant
+// signal is no speech and leaves the jaw closed.
+double window_rms(double sum, double sum_sq, std::size_t n) {
+  const double count = static_cast<double>(n);
+  const double mean = sum / count;
+  return std::sqrt(std::max(0.0, sum_sq / count - mean * mean));
+}
+
 struct Drive {
   int joint = -1;
   double gain = 1.0, offset_deg = 0.0, lo = 0.0, hi = 0.0;  // lo/hi in rad
@@ -155,12 +164,13 @@ class HeadSource final : public MotionSource {
   // the newest one), so the jaw never leads the sound.
   double file_energy(double t) const {
     const auto last = static_cast<std::int64_t>(std::floor(t * audio_.sample_rate));
-    double sum = 0.0;
+    double sum = 0.0, sum_sq = 0.0;
     for (std::size_t k = 0; k < jaw_window_; ++k) {
       const double v = stream_sample(last - static_cast<std::int64_t>(k));
-      sum += v * v;
+      sum += v;
+      sum_sq += v * v;
     }
-    return std::sqrt(sum / static_cast<double>(jaw_window_));
+    return window_rms(sum, sum_sq, jaw_window_);
   }
 
   // Fills `block` with the stream's block j; false past the end of a sound
@@ -218,10 +228,12 @@ class HeadSource final : public MotionSource {
       recent_[recent_at_] = v;
       recent_at_ = (recent_at_ + 1) % recent_.size();
     }
-    double sum = 0.0;
-    for (const float v : recent_) sum += static_cast<double>(v) * v;
-    live_energy_.store(std::sqrt(sum / static_cast<double>(recent_.size())),
-                       std::memory_order_release);
+    double sum = 0.0, sum_sq = 0.0;
+    for (const float v : recent_) {
+      sum += v;
+      sum_sq += static_cast<double>(v) * v;
+    }
+    live_energy_.store(window_rms(sum, sum_sq, recent_.size()), std::memory_order_release);
   }
 
   // Reader thread (live input): each block's energy for the jaw, then the

@@ -1,5 +1,5 @@
-// Pitch through aubio's YIN family, RMS energy on the same window, spline
-// fill of unvoiced F0, regression derivatives.
+// Pitch through aubio's YIN family, RMS energy about the mean on the same
+// window, spline fill of unvoiced F0, regression derivatives.
 
 #include "animrt/controllers/head/prosody.hpp"
 
@@ -20,6 +20,23 @@ double f0_semitones(double f0_hz) {
 double energy_db(double rms) {
   return rms > 0 ? std::max(kEnergyFloorDb, 20.0 * std::log10(rms)) : kEnergyFloorDb;
 }
+
+namespace {
+
+// RMS of samples about their mean.
+double rms_about_mean(std::span<const float> x) {
+  const auto count = static_cast<double>(x.size());
+  double sum = 0.0;
+  for (const float v : x) sum += v;
+  const double mean = sum / count;
+  double sum_sq = 0.0;
+  for (const float v : x) sum_sq += (v - mean) * (v - mean);
+  return std::sqrt(sum_sq / count);
+}
+
+double level_db(double rms) { return rms > 0 ? 20.0 * std::log10(rms) : -200.0; }
+
+}  // namespace
 
 int FeatureConfig::hop_samples() const {
   return static_cast<int>(std::lround(sample_rate / frame_rate_hz));
@@ -72,7 +89,9 @@ PitchEnergyTracker::PitchEnergyTracker(const FeatureConfig& config)
                             static_cast<uint_t>(m.hop), static_cast<uint_t>(config.sample_rate));
   if (m.pitch == nullptr) throw std::runtime_error("aubio: cannot create pitch detector");
   aubio_pitch_set_unit(m.pitch, "Hz");
-  aubio_pitch_set_silence(m.pitch, static_cast<smpl_t>(config.silence_db));
+  // aubio's own silence gate measures the newest hop with its DC offset;
+  // push() gates the same hop about its mean instead, so aubio's never acts.
+  aubio_pitch_set_silence(m.pitch, -200);
   m.in = new_fvec(static_cast<uint_t>(m.hop));
   m.out = new_fvec(1);
   m.ring.assign(static_cast<std::size_t>(m.window), 0.0f);
@@ -105,14 +124,18 @@ void PitchEnergyTracker::push(std::span<const float> samples, std::vector<RawFra
     // Until a whole window has arrived the analysis sees leading zeros.
     if (m.total < static_cast<std::uint64_t>(m.window)) continue;
     RawFrame f;
-    double sum = 0.0;
-    for (float v : m.ring) sum += static_cast<double>(v) * v;
-    f.energy = std::sqrt(sum / static_cast<double>(m.ring.size()));
+    // Levels about the mean: a DC offset (a cheap microphone's) is no
+    // speech, and would lift silence's energy and pass the level gates.
+    // YIN's difference function ignores a constant already.
+    f.energy = rms_about_mean(m.ring);
+    const double hop_rms = rms_about_mean(std::span<const float>(m.in->data, hop));
     f.confidence = aubio_pitch_get_confidence(m.pitch);
     const double hz = m.out->data[0];
-    const double level_db = f.energy > 0 ? 20.0 * std::log10(f.energy) : -200.0;
+    // Voiced: a pitch in range, aubio's confidence, and both the window and
+    // its newest hop (where aubio gates) above the silence level.
     f.voiced = hz >= m.config.f0_min_hz && hz <= m.config.f0_max_hz &&
-               f.confidence >= m.config.voicing_threshold && level_db > m.config.silence_db;
+               f.confidence >= m.config.voicing_threshold &&
+               level_db(f.energy) > m.config.silence_db && level_db(hop_rms) >= m.config.silence_db;
     f.f0_hz = f.voiced ? hz : 0.0;
     frames.push_back(f);
   }

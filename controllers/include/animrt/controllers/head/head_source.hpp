@@ -5,8 +5,9 @@
 // clamped to the joint limits) and the speech energy opens the jaw.
 //
 // Timing. The jaw and the head poses take two paths: the jaw follows the
-// speech energy (RMS over jaw.window_s, from the samples themselves), the
-// neck follows the slower HMM pipeline of the streaming synthesizer.
+// speech energy (RMS about the mean over jaw.window_s, from the samples
+// themselves: a DC offset does not open it), the neck follows the slower
+// HMM pipeline of the streaming synthesizer.
 //   - A sound file (`audio`) is known ahead: the worker feeds the
 //     synthesizer its worst-case latency ahead of the run's clock, so motion
 //     time t shows the head pose of audio time t, and the jaw opens with the

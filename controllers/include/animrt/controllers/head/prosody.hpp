@@ -53,7 +53,7 @@ struct FeatureConfig {
 // One analysis window's raw measurements.
 struct RawFrame {
   double f0_hz = 0.0;   // 0 when unvoiced
-  double energy = 0.0;  // RMS of the window
+  double energy = 0.0;  // RMS of the window about its mean (DC removed)
   double confidence = 0.0;
   bool voiced = false;
 };
