@@ -52,7 +52,11 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
     capture->fail("give either audio (a file) or capture (a live ALSA device), not both");
   if (!audio && !capture)
     node.fail("missing key \"audio\" (a WAV file) or \"capture\" (an ALSA device)");
-  if (audio) c.audio = resolve_file(*audio, robot_path);
+  if (audio) {
+    c.audio = resolve_file(*audio, robot_path);
+    c.audio_where = audio->location();
+    c.audio_key = audio->path();
+  }
   if (capture) {
     c.capture = capture->as_string();
     if (c.capture.empty()) capture->fail("expected an ALSA device name, found \"\"");

@@ -411,13 +411,25 @@ Drive bind_joint(const std::string& name, const Location& where, const std::stri
 
 }  // namespace
 
+Audio load_head_audio(const HeadMotionConfig& c) {
+  try {
+    return load_audio(c.audio);
+  } catch (const InputError& e) {
+    // The audio's own error names only the WAV; say which file and key chose
+    // it (a config built in code has none).
+    if (c.audio_where.file.empty()) throw;
+    throw InputError(c.audio_where, c.audio_key,
+                     "audio file " + quote_path(c.audio) + ": " + e.message());
+  }
+}
+
 std::unique_ptr<MotionSource> make_head_source(const HeadMotionConfig& c,
                                                std::span<const JointSpec> joints) {
   HeadModel model = load_model(c.model);
   if (c.noise_deg) model.smoothing.noise_deg = *c.noise_deg;
   Audio audio;
   if (!c.audio.empty()) {
-    audio = load_audio(c.audio);
+    audio = load_head_audio(c);
   } else {
     audio.sample_rate = model.features.sample_rate;
   }

@@ -109,7 +109,7 @@ std::unique_ptr<MotionSource> make_head(const YamlNode& node, const std::string&
   auto config = std::make_shared<head::HeadMotionConfig>(head::parse_head_motion(node, cue_path));
   const bool file = config->capture.empty() && !config->live;
   config->precomputed = file;
-  if (file && !config->repeat) duration_s = head::load_audio(config->audio).duration_s();
+  if (file && !config->repeat) duration_s = head::load_head_audio(*config).duration_s();
   MotionConfig motion;
   motion.type = "head";
   motion.head = config;

@@ -21,7 +21,9 @@ namespace {
 
 const std::string kRoot = ANIMRT_SOURCE_DIR;
 
-std::string head_cues(const std::string& extra = "") {
+std::string head_cues(const std::string& extra = "",
+                      const std::string& audio = kRoot + "/configs/head/utterance.wav",
+                      bool repeat = false) {
   const std::string path = ::testing::TempDir() + "/head_cues.yaml";
   std::ofstream(path) << "idle: rest\n"
                          "crossfade_s: 0.3\n"
@@ -35,9 +37,7 @@ std::string head_cues(const std::string& extra = "") {
                       << kRoot
                       << "/configs/head/model.txt\n"
                          "        audio: "
-                      << kRoot
-                      << "/configs/head/utterance.wav\n"
-                         "        repeat: false\n"
+                      << audio << "\n        repeat: " << (repeat ? "true" : "false") << "\n"
                       << extra
                       << "        axes: {yaw: {joint: neck_yaw}, pitch: {joint: neck_pitch}}\n"
                          "        jaw: {joint: jaw, closed_deg: 0, open_deg: 20}\n";
@@ -113,6 +113,28 @@ TEST(HeadCue, ABadHeadStepNamesTheCueFileLineAndKey) {
     const std::string what = e.what();
     EXPECT_NE(what.find("head_cues.yaml:12"), std::string::npos) << what;
     EXPECT_NE(what.find("smoothing"), std::string::npos) << what;
+  }
+}
+
+// A bad sound is an error at the cue file's line and key that name it, with
+// the sound's own problem (it used to name only the WAV), whether the step
+// plays for the sound's length or repeats it.
+TEST(HeadCue, ABadSoundNamesTheCueFileLineAndKey) {
+  const RobotConfig robot = load_robot_config(kRoot + "/configs/robots/head.yaml");
+  const std::string wav = ::testing::TempDir() + "/head_cue_text.wav";
+  std::ofstream(wav) << "hello this is not audio\n";
+  for (const bool repeat : {false, true}) {
+    const std::string cues = head_cues("", wav, repeat);
+    try {
+      load_cues(cues, robot);
+      FAIL() << "loaded, repeat " << repeat;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().file, cues);
+      EXPECT_EQ(e.where().line, 10);
+      EXPECT_EQ(e.key(), "cues.talk.play.head.audio");
+      const std::string want = "audio file \"" + wav + "\": not a readable audio file";
+      EXPECT_EQ(e.message().substr(0, want.size()), want) << e.what();
+    }
   }
 }
 

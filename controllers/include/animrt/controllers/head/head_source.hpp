@@ -47,6 +47,7 @@
 #include <span>
 #include <string>
 
+#include "animrt/controllers/head/audio.hpp"
 #include "animrt/controllers/motion_source.hpp"
 #include "animrt/core/error.hpp"
 #include "animrt/core/joint.hpp"
@@ -69,8 +70,10 @@ struct HeadJawMap {
 };
 
 struct HeadMotionConfig {
-  std::string model;    // resolved path
-  std::string audio;    // resolved path, or empty with capture
+  std::string model;     // resolved path
+  std::string audio;     // resolved path, or empty with capture
+  Location audio_where;  // where the robot or cue file names `audio`, and its key
+  std::string audio_key;
   std::string capture;  // live input (audio_input.hpp: ALSA device or pipe:PATH), or empty
   bool live = false;    // play `audio` as if captured live: no look-ahead
   bool precomputed = false;
@@ -90,6 +93,10 @@ struct HeadMotionConfig {
 // Reads the motion node of a robot file (type: head); paths are resolved
 // against the robot file's folder and must exist. InputError on any problem.
 HeadMotionConfig parse_head_motion(const YamlNode& motion, const std::string& robot_path);
+
+// The motion's sound file. A problem with it is an InputError at the line
+// and key of the robot or cue file that names it, with the problem's text.
+Audio load_head_audio(const HeadMotionConfig& config);
 
 // Loads the model and audio (InputError naming the file on any problem) and
 // binds the axes to the robot's joints by name.
