@@ -130,7 +130,72 @@ std::string frame_count_problem(const SF_INFO& info, std::uintmax_t file_size) {
   return "";
 }
 
+// The frames of an open file, mixed to mono as they are read in chunks,
+// appended to `out` (or only looked at when it is null).
+struct MonoRead {
+  sf_count_t frames = 0;      // frames read
+  sf_count_t nonfinite = -1;  // the first frame whose mix is not a finite number, or -1
+};
+
+MonoRead read_mono(SNDFILE* file, const SF_INFO& info, std::vector<float>* out) {
+  const auto channels = static_cast<std::size_t>(info.channels);
+  std::vector<float> chunk(kChunkFrames * channels);
+  MonoRead r;
+  while (r.frames < info.frames) {
+    const sf_count_t want = std::min<sf_count_t>(kChunkFrames, info.frames - r.frames);
+    const sf_count_t n = sf_readf_float(file, chunk.data(), want);
+    if (n <= 0) break;
+    for (sf_count_t f = 0; f < n; ++f) {
+      float sum = 0.0f;
+      for (std::size_t c = 0; c < channels; ++c)
+        sum += chunk[static_cast<std::size_t>(f) * channels + c];
+      const float mono = sum / static_cast<float>(channels);
+      if (!std::isfinite(mono)) {
+        r.nonfinite = r.frames + f;
+        return r;
+      }
+      if (out) out->push_back(mono);
+    }
+    r.frames += n;
+  }
+  return r;
+}
+
+std::string nonfinite_problem(sf_count_t frame, int rate) {
+  return "sample " + std::to_string(frame) + " (at " +
+         format_number(static_cast<double>(frame) / rate) +
+         " s) is not a finite number (NaN or infinity)";
+}
+
+// Integer encodings (PCM, u-law, A-law; FLAC's subformats are PCM) cannot
+// hold a sample that is not a finite number.
+bool integer_samples(int format) {
+  switch (format & SF_FORMAT_SUBMASK) {
+    case SF_FORMAT_PCM_S8:
+    case SF_FORMAT_PCM_U8:
+    case SF_FORMAT_PCM_16:
+    case SF_FORMAT_PCM_24:
+    case SF_FORMAT_PCM_32:
+    case SF_FORMAT_ULAW:
+    case SF_FORMAT_ALAW:
+      return true;
+    default:
+      return false;
+  }
+}
+
 }  // namespace
+
+std::string audio_nonfinite_sample(const std::string& path) {
+  SF_INFO info{};
+  SNDFILE* file = sf_open(path.c_str(), SFM_READ, &info);
+  if (file == nullptr) return {};
+  MonoRead r;
+  if (info.frames > 0 && info.channels > 0 && info.samplerate > 0 && !integer_samples(info.format))
+    r = read_mono(file, info, nullptr);
+  sf_close(file);
+  return r.nonfinite >= 0 ? nonfinite_problem(r.nonfinite, info.samplerate) : std::string();
+}
 
 Audio load_audio(const std::string& path, int target_rate) {
   namespace fs = std::filesystem;
@@ -174,33 +239,12 @@ Audio load_audio(const std::string& path, int target_rate) {
   audio.sample_rate = info.samplerate;
   audio.samples.reserve(static_cast<std::size_t>(
       std::min<sf_count_t>(info.frames, static_cast<sf_count_t>(file_size))));
-  const auto channels = static_cast<std::size_t>(info.channels);
-  std::vector<float> chunk(kChunkFrames * channels);
-  sf_count_t got = 0;
-  while (got < info.frames) {
-    const sf_count_t want = std::min<sf_count_t>(kChunkFrames, info.frames - got);
-    const sf_count_t n = sf_readf_float(file, chunk.data(), want);
-    if (n <= 0) break;
-    for (sf_count_t f = 0; f < n; ++f) {
-      float sum = 0.0f;
-      for (std::size_t c = 0; c < channels; ++c)
-        sum += chunk[static_cast<std::size_t>(f) * channels + c];
-      const float mono = sum / static_cast<float>(channels);
-      if (!std::isfinite(mono)) {
-        sf_close(file);
-        const auto i = static_cast<double>(got + f);
-        fail(path, "sample " + std::to_string(got + f) + " (at " +
-                       format_number(i / info.samplerate) +
-                       " s) is not a finite number (NaN or infinity)");
-      }
-      audio.samples.push_back(mono);
-    }
-    got += n;
-  }
+  const MonoRead read = read_mono(file, info, &audio.samples);
   sf_close(file);
-  if (got != info.frames) {
+  if (read.nonfinite >= 0) fail(path, nonfinite_problem(read.nonfinite, info.samplerate));
+  if (read.frames != info.frames) {
     fail(path, "truncated audio file: expected " + std::to_string(info.frames) + " frames, read " +
-                   std::to_string(got));
+                   std::to_string(read.frames));
   }
   if (target_rate > 0) {
     try {

@@ -284,6 +284,9 @@ ShowFile load_show_file(const std::string& path) {
                 std::to_string(kMinShowAudioRate) + ".." + std::to_string(kMaxShowAudioRate) +
                 " Hz");
     }
+    // The run's loader refuses a NaN or infinite sample; validate must too.
+    if (const std::string bad = head::audio_nonfinite_sample(show.audio.file); !bad.empty())
+      file.fail("audio file " + quote_path(show.audio.file) + ": " + bad);
     show.audio.sample_rate = info.samplerate;
     show.audio.channels = info.channels;
     show.audio.length_s = static_cast<double>(info.frames) / info.samplerate;

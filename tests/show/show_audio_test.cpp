@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -365,6 +366,39 @@ TEST(ShowAudio, ATruncatedTrackIsRefusedWhereTheShowNamesIt) {
                   (std::filesystem::path(show).parent_path() / "cut_show.wav").string() +
                   "\": truncated WAV file: the data chunk declares 3200 "
                   "bytes but only 3190 are present");
+  }
+}
+
+// A float track with a NaN or an infinite sample: validate (and every
+// command that loads the show) refuses it at the show's line, as the run's
+// loader of the track does, with the sample's problem.
+TEST(ShowAudio, ATrackWithANonFiniteSampleIsRefusedWhereTheShowNamesIt) {
+  const std::string dir = ::testing::TempDir();
+  for (const float bad :
+       {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    const std::string wav = dir + "/nan_show.wav";
+    SF_INFO info{};
+    info.samplerate = 8000;
+    info.channels = 1;
+    info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+    SNDFILE* f = sf_open(wav.c_str(), SFM_WRITE, &info);
+    ASSERT_NE(f, nullptr);
+    std::vector<float> samples(800, 0.25f);
+    samples[100] = bad;
+    sf_writef_float(f, samples.data(), 800);
+    sf_close(f);
+    const std::string show = dir + "/nan_show.yaml";
+    std::ofstream(show) << "audio: {file: nan_show.wav}\n"
+                        << "joints:\n  jaw: {keys: [[0, 1]]}\n";
+    try {
+      (void)load_show_file(show);
+      FAIL() << "expected an InputError for " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                show + ":1:15: audio.file: audio file \"" +
+                    (std::filesystem::path(show).parent_path() / "nan_show.wav").string() +
+                    "\": sample 100 (at 0.0125 s) is not a finite number (NaN or infinity)");
+    }
   }
 }
 

@@ -33,6 +33,12 @@ Audio load_audio(const std::string& path, int target_rate = 0);
 // quietly reads what is there, so a cut recording would pass for a whole one.
 std::string wav_truncation(const std::string& path);
 
+// What is wrong with the first sample of an audio file that is not a finite
+// number (NaN or infinity) once mixed to mono, as load_audio says it, or ""
+// (also for a file libsndfile does not open). Reads the whole file unless
+// its encoding is an integer one, which cannot hold such a sample.
+std::string audio_nonfinite_sample(const std::string& path);
+
 // `fast`: a polyphase windowed-sinc filter for the rational ratio (what the
 // analysis uses; its features are tested to stay within a tolerance of
 // `medium`'s), libsamplerate's fastest sinc converter for ratios too
