@@ -19,7 +19,12 @@ namespace {
 }  // namespace
 
 bool is_joint_column(const std::string& name) {
-  return name != "time_s" && name.rfind("torso_", 0) != 0;
+  // The corpus's pose of the body, not joints; a joint may be named
+  // torso_lean (the animatronic's is).
+  for (const char* pose : {"time_s", "torso_x", "torso_y", "torso_z", "torso_yaw"}) {
+    if (name == pose) return false;
+  }
+  return true;
 }
 
 JointCsv read_joint_csv(const std::string& file) {
@@ -29,7 +34,9 @@ JointCsv read_joint_csv(const std::string& file) {
   std::vector<std::size_t> use;
   std::string line;
   int number = 0;
-  for (std::size_t at = 0; at < text.size();) {
+  // A spreadsheet's "CSV UTF-8" starts with a byte order mark: not part of
+  // the first column's name.
+  for (std::size_t at = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0; at < text.size();) {
     std::size_t end = text.find('\n', at);
     if (end == std::string::npos) end = text.size();
     line.assign(text, at, end - at);
@@ -42,8 +49,12 @@ JointCsv read_joint_csv(const std::string& file) {
     std::size_t start = 0;
     while (true) {
       const std::size_t comma = line.find(',', start);
-      cells.push_back(line.substr(start, comma == std::string::npos ? comma : comma - start));
-      columns.push_back(static_cast<int>(start) + 1);
+      // Blanks round a cell (", " between cells) are no part of it.
+      std::size_t from = start, to = comma == std::string::npos ? line.size() : comma;
+      while (from < to && (line[from] == ' ' || line[from] == '\t')) ++from;
+      while (to > from && (line[to - 1] == ' ' || line[to - 1] == '\t')) --to;
+      cells.push_back(line.substr(from, to - from));
+      columns.push_back(static_cast<int>(from) + 1);
       if (comma == std::string::npos) break;
       start = comma + 1;
     }

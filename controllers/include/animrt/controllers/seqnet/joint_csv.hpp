@@ -1,8 +1,8 @@
 #pragma once
 // Joint-angle CSVs of the sequence network (training data, initial frames
 // and keys, generated and completed frames): a header row, then one row per
-// frame. Every column but time_s and the torso_* columns is a joint, so the
-// corpus's NAME.csv files and telemetry CSVs work as they are.
+// frame. Every column but time_s and the corpus's torso_x, torso_y, torso_z
+// and torso_yaw is a joint, so the corpus's NAME.csv files work as they are.
 
 #include <Eigen/Core>
 #include <string>
