@@ -449,6 +449,13 @@ LoadedCues load_cues(const std::string& path, const RobotConfig& robot) {
                  quote(tc->as_string()));
       }
       if (!loaded.ltc) tc->fail("a timecode start needs an `ltc:` section (its frame rate)");
+      // One frame starts one cue, as one DMX value or MIDI message asks for one.
+      for (const TimecodeCue& other : loaded.timecode_cues) {
+        if (std::abs(other.start_s - *start) < 0.5 / loaded.ltc_fps) {
+          tc->fail("cue " + loaded.cues[static_cast<std::size_t>(other.cue)].name +
+                   " starts at this timecode too");
+        }
+      }
       loaded.timecode_cues.push_back({*start, static_cast<int>(loaded.cues.size() - 1)});
     }
     if (auto midi = node.find("midi")) read_midi_binding(*midi, loaded);

@@ -15,6 +15,9 @@ robot="$root/configs/robots/animatronic.yaml"
 
 bad_cues $'idle: rest\nltc: {fps: 25}\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, timecode: "00:00:00:25"}' \
   4 cues.rest.timecode
+# One frame starts one cue (two cues on it were both taken).
+bad_cues $'idle: rest\nltc: {fps: 25}\ncues:\n  rest: {play: {pose: {eye_pan: 0}}, timecode: "00:00:01:00"}\n  b: {play: {pose: {eye_pan: 5}}, timecode: "00:00:01:00"}' \
+  5 cues.b.timecode
 
 PYTHONPATH="$root/tests/cli" /usr/bin/python3 - "$tmp/ltc.wav" <<'PY' || fail "the LTC writer"
 import sys
