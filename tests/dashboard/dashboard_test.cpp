@@ -373,12 +373,33 @@ TEST(Dashboard, SteeringReachesASteerableGaitAndIsRefusedOtherwise) {
   {
     DashboardRun run(0.0);
     run.wait_state(in_motion);
+    const json range = run.get("/api/info")["motion"];
+    const double top = range["speed_mps"][1].get<double>();
+    const double leftmost = range["turn_rps"][0].get<double>();
+    ASSERT_GT(top, 0.0);
+    ASSERT_LT(leftmost, 0.0);
     EXPECT_EQ(run.post("/api/steer", {{"speed_mps", 0.1}}), 400);
-    EXPECT_EQ(run.post("/api/steer", {{"speed_mps", 0.1}, {"turn_rps", 0.2}}), 200);
+    EXPECT_EQ(run.post("/api/steer", {{"speed_mps", top / 2}, {"turn_rps", leftmost / 2}}), 200);
     const json steered =
         run.wait_state([](const json& s) { return !s["motion"]["speed_mps"].is_null(); });
-    EXPECT_DOUBLE_EQ(steered["motion"]["speed_mps"].get<double>(), 0.1);
-    EXPECT_DOUBLE_EQ(steered["motion"]["turn_rps"].get<double>(), 0.2);
+    EXPECT_DOUBLE_EQ(steered["motion"]["speed_mps"].get<double>(), top / 2);
+    EXPECT_DOUBLE_EQ(steered["motion"]["turn_rps"].get<double>(), leftmost / 2);
+    // Beyond the range /api/info gives, held to its ends: the answer and
+    // the state say what the figure is asked (1e308 was shown as asked).
+    json answer;
+    EXPECT_EQ(
+        run.post("/api/steer", {{"speed_mps", 1e308}, {"turn_rps", -1e308}}, std::nullopt, &answer),
+        200);
+    EXPECT_EQ(answer["speed_mps"].get<double>(), top);
+    EXPECT_EQ(answer["turn_rps"].get<double>(), leftmost);
+    run.wait_state([&](const json& s) {
+      return s["motion"]["speed_mps"].get<double>() == top &&
+             s["motion"]["turn_rps"].get<double>() == leftmost;
+    });
+    EXPECT_EQ(
+        run.post("/api/steer", {{"speed_mps", -1.0}, {"turn_rps", 0.0}}, std::nullopt, &answer),
+        200);
+    EXPECT_EQ(answer["speed_mps"].get<double>(), 0.0);
   }
   DashboardRun run(0.0, /*steerable=*/false);
   run.wait_state(in_motion);

@@ -521,8 +521,14 @@ struct DashboardServer::Impl {
       if (!speed || !turn) {
         return error(res, 400, "expected \"speed_mps\" and \"turn_rps\": finite numbers");
       }
-      controls.steer.post(MotionCommand{*speed, *turn});
-      answer(res, 200, {{"ok", true}});
+      // Held to the range /api/info gives (the gait would hold it there
+      // too), so the state and the answer say what the figure is asked.
+      const double max_turn = setup.steering->max_turn_rad_s;
+      const MotionCommand held{std::clamp(*speed, 0.0, setup.steering->max_speed_m_s()),
+                               std::clamp(*turn, -max_turn, max_turn)};
+      controls.steer.post(held);
+      answer(res, 200,
+             {{"ok", true}, {"speed_mps", held.speed_m_s}, {"turn_rps", held.turn_rad_s}});
     });
   }
 
