@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "animrt/controllers/herd/crowd.hpp"
@@ -67,6 +68,28 @@ WalkResponse walk_of(const FigureSpec& spec, const std::string& gait) {
   }
 }
 
+// "" when the figure's gait turns; else the warning that it cannot. Its
+// turns are read where its walk can go: every walking speed (sampled) and
+// on the spot.
+std::string cannot_turn(const FigureSpec& spec, const WalkResponse& walk) {
+  constexpr double kLeastTurnRadS = 1.0 * M_PI / 180.0;  // under 1 deg/s: a drift's size
+  constexpr int kSpeeds = 16;
+  double best = walk.spot_turn();
+  for (int k = 0; k <= kSpeeds; ++k) {
+    const double v = walk.min_speed() + (walk.max_speed() - walk.min_speed()) * k / kSpeeds;
+    best = std::max(best, walk.max_turn(v));
+  }
+  if (best >= kLeastTurnRadS) return "";
+  char turn[32];
+  std::snprintf(turn, sizeof turn, "%.2f", best * 180.0 / M_PI);
+  const InputError said(spec.where, "figures." + spec.name,
+                        std::string("its gait turns at most ") + turn +
+                            " deg/s (no usable turning walk in its calibration, no turn on the "
+                            "spot): it cannot steer toward a target nor mend its drift (animrt "
+                            "gait calibrate, docs/gait.md)");
+  return std::string("warning: ") + said.what();
+}
+
 }  // namespace
 
 bool overlaps_box(const Box& box, Vec2 p, double radius) {
@@ -82,6 +105,11 @@ Herd::Herd(HerdScene scene, const GaitOfRobot& gait_of_robot, std::optional<std:
     const std::string gait = spec.gait.empty() ? gait_of_robot(spec.robot) : spec.gait;
     figures_.push_back(Figure{spec.name, spec.radius_m, walk_of(spec, gait)});
     turning_radius_.push_back(turning_radius(figures_.back()));
+    const bool used = std::any_of(scene_.groups.begin(), scene_.groups.end(),
+                                  [&](const GroupSpec& g) { return g.figure == spec.name; });
+    if (const std::string w = used ? cannot_turn(spec, figures_.back().walk) : ""; !w.empty()) {
+      warnings_.push_back(w);
+    }
   }
   double max_radius = 0.0;
   for (const Figure& f : figures_) max_radius = std::max(max_radius, f.radius_m);

@@ -194,6 +194,7 @@ int run_herd(const HerdArgs& a) {
   if (!address.ok) return kExitUsage;
   const auto& dashboard_at = address.at;
   herd::Herd herd(std::move(scene), gait_of_robot, a.seed);
+  for (const std::string& w : herd.warnings()) std::cerr << w << '\n';
   // After the scene's gaits and calibrations load (a bad one leaves the last
   // run's files as they were), before the herd steps.
   EndFiles end_files;

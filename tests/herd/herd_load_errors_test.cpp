@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "animrt/controllers/herd/herd.hpp"
 
@@ -69,6 +70,34 @@ TEST(HerdLoadErrors, ARobotFileGivenAsAGaitIsSaidToBeOne) {
   const std::string e = build_error("f: {gait: " + kRoot + "/configs/robots/pony.yaml}", "[0, 0]");
   EXPECT_NE(e.find("figures.f.gait: "), std::string::npos) << e;
   EXPECT_NE(e.find("(a robot file? give it as robot:"), std::string::npos) << e;
+}
+
+// The warnings of a herd of one team of `figure`, which reaches its target.
+std::vector<std::string> warnings_of(const std::string& figure) {
+  const std::string text =
+      "bounds_m: [-10, -10, 10, 10]\n"
+      "duration_s: 10\n"
+      "figures:\n"
+      "  " +
+      figure +
+      "\n"
+      "groups:\n"
+      "  - {name: t, kind: crowd, figure: f, count: 1, spawn_m: [-8, -2, -6, 2],\n"
+      "     target_m: [0, 0], speed_mps: [0.07, 0.07]}\n";
+  Herd herd(parse_herd_scene(YamlNode::load_string(text, "scene.yaml")),
+            [](const std::string&) { return std::string(); });
+  return herd.warnings();
+}
+
+// The demo quadruped's calibration has no usable turning walk: it walked
+// off its way for good (0 of 1 home 18 m straight ahead) without a word.
+TEST(HerdLoadErrors, AFigureWhoseGaitCannotTurnIsWarnedOf) {
+  const std::vector<std::string> w =
+      warnings_of("f: {gait: " + kRoot + "/configs/gaits/walk.yaml, radius_m: 0.2}");
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].rfind("warning: scene.yaml:4:6: figures.f: its gait turns at most 0.", 0), 0u)
+      << w[0];
+  EXPECT_TRUE(warnings_of(kPony).empty());
 }
 
 }  // namespace

@@ -54,6 +54,10 @@ class Herd {
   Herd& operator=(const Herd&) = delete;
 
   const HerdScene& scene() const { return scene_; }
+  // What the scene may not do as meant, one line each naming the scene's
+  // line and key: a figure whose gait cannot turn (no usable turning walk
+  // and no turn on the spot) cannot steer to a target nor mend its drift.
+  const std::vector<std::string>& warnings() const { return warnings_; }
   double time() const { return t_; }
   std::span<const Agent> agents() const { return agents_; }
   std::span<const MotionCommand> commands() const { return commands_; }
@@ -84,6 +88,7 @@ class Herd {
   void keep_out_of_walls(Agent& agent) const;
 
   HerdScene scene_;
+  std::vector<std::string> warnings_;
   std::vector<Figure> figures_;
   std::vector<int> figure_of_;          // per agent
   std::vector<double> turning_radius_;  // per figure (figure.hpp)
