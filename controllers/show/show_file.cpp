@@ -145,8 +145,9 @@ void load_learned(const YamlNode& root, ShowFile& show, const std::filesystem::p
       throw InputError(key.where, "joints." + first.joint + ".keys",
                        "learned keys are at least two frames apart, so the model has a frame "
                        "to fill: " +
-                           format_number(t0) + " s to " + format_number(t1) +
-                           " s is one frame of frame_s " + format_number(frame) + " s");
+                           format_number(t0) + " s to " + format_number(t1) + " s is " +
+                           (std::round(frames) == 1.0 ? "one frame" : "no frame") + " of frame_s " +
+                           format_number(frame) + " s");
     }
   };
   for (std::size_t k = 0; k + 1 < first.keys.size(); ++k) {
@@ -245,6 +246,20 @@ ShowFile load_show_file(const std::string& path) {
   }
   if (show.loop && !(show.duration_s > 0.0))
     root.at("loop").fail("a looping show needs a duration > 0");
+  // Looping, a key at duration_s and one at 0 are the same instant of the
+  // next pass: with other values the joint would jump there every pass.
+  for (const ShowTrack& track : show.tracks) {
+    if (!show.loop || track.keys.size() < 2) continue;
+    const ShowKey& first = track.keys.front();
+    const ShowKey& end = track.keys.back();
+    if (first.t == 0.0 && end.t == show.duration_s && end.value != first.value) {
+      throw InputError(end.where, "joints." + track.joint + ".keys",
+                       "the key at " + format_number(end.t) + " s (" + format_number(end.value) +
+                           ") and the first at 0 s (" + format_number(first.value) +
+                           ") are one instant of the loop: the joint would jump there each "
+                           "pass; give them one value, or end the keys before duration_s");
+    }
+  }
 
   load_learned(root, show, folder);
 
