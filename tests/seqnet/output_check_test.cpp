@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -91,7 +92,8 @@ TEST_F(ModelOutput, GenerateAndCompleteRefuseAnOverflowingModelAndWriteNothing) 
 }
 
 // A sound model fed a key far outside its range (finite in the CSV, beyond
-// float range once normalised) computes inf: refused, nothing written.
+// float range once normalised) computed inf: such a key is refused at its
+// line before the model runs, and nothing is written.
 TEST_F(ModelOutput, GenerateAndCompleteNeverWriteANonFiniteNumber) {
   const std::string model = path("small.model");
   write_model_file(model, test::tiny_joint_model(0.1F));
@@ -102,14 +104,15 @@ TEST_F(ModelOutput, GenerateAndCompleteNeverWriteANonFiniteNumber) {
                         path("gen.csv"),
                     err);
   EXPECT_EQ(code, 2) << err;
-  EXPECT_NE(err.find(model + ": output: the model computed a non-finite value"), std::string::npos)
+  EXPECT_NE(err.find(path("init.csv") + ":2: hip: 1e+300 is far outside the range"),
+            std::string::npos)
       << err;
   EXPECT_FALSE(fs::exists(path("gen.csv")));
   code = animrt("seq complete " + model + " --keys " + path("keys.csv") + " --gap 3 --out " +
                     path("done.csv"),
                 err);
   EXPECT_EQ(code, 2) << err;
-  EXPECT_NE(err.find("non-finite"), std::string::npos) << err;
+  EXPECT_NE(err.find(path("keys.csv") + ":2: hip:"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(path("done.csv")));
 
   // The same model from keys in its range writes finite rows.
@@ -119,6 +122,23 @@ TEST_F(ModelOutput, GenerateAndCompleteNeverWriteANonFiniteNumber) {
       err);
   EXPECT_EQ(code, 0) << err;
   EXPECT_TRUE(fs::exists(path("done.csv")));
+}
+
+// The last guard before a file is written: a frame the model computed that
+// is not finite is refused, naming the joint and the frame.
+TEST_F(ModelOutput, ANonFiniteFrameIsRefusedNamingItsJointAndFrame) {
+  FrameMatrix frames(2, 3);
+  frames << 0.1, 0.2, 0.3, 0.4, std::numeric_limits<double>::quiet_NaN(), 0.6;
+  try {
+    require_finite_frames(frames, "m.model", {"hip", "knee"});
+    ADD_FAILURE() << "a NaN frame was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "m.model: output: the model computed a non-finite value (nan) for knee at frame 1; "
+              "nothing was written");
+  }
+  frames(1, 1) = 0.5;
+  EXPECT_NO_THROW(require_finite_frames(frames, "m.model", {"hip", "knee"}));
 }
 
 }  // namespace output_check_test
