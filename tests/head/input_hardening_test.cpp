@@ -18,6 +18,7 @@
 #include "animrt/learn/head/corpus.hpp"
 #include "head_test_util.hpp"
 #include "support/hostile_files.hpp"
+#include "support/wav_file.hpp"
 
 namespace animrt::head {
 namespace {
@@ -121,16 +122,9 @@ TEST_F(WavHardening, NanAndInfiniteSamplesAreRejectedWithTheFileNamed) {
   for (float bad :
        {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
     const std::string path = dir_ + "/float.wav";
-    SF_INFO info{};
-    info.samplerate = 16000;
-    info.channels = 1;
-    info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
-    SNDFILE* sf = sf_open(path.c_str(), SFM_WRITE, &info);
-    ASSERT_NE(sf, nullptr);
     std::vector<float> samples(1600, 0.1f);
     samples[400] = bad;
-    sf_writef_float(sf, samples.data(), static_cast<sf_count_t>(samples.size()));
-    sf_close(sf);
+    ASSERT_TRUE(write_float_wav(path, samples, 16000));
     EXPECT_EQ(error_of([&] { load_audio(path); }),
               path + ": sample 400 (at 0.025 s) is not a finite number (NaN or infinity)");
   }

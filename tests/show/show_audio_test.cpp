@@ -26,6 +26,7 @@
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/run_monitor.hpp"
 #include "support/sim_rig.hpp"
+#include "support/wav_file.hpp"
 
 namespace animrt {
 namespace {
@@ -376,17 +377,9 @@ TEST(ShowAudio, ATrackWithANonFiniteSampleIsRefusedWhereTheShowNamesIt) {
   const std::string dir = ::testing::TempDir();
   for (const float bad :
        {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
-    const std::string wav = dir + "/nan_show.wav";
-    SF_INFO info{};
-    info.samplerate = 8000;
-    info.channels = 1;
-    info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
-    SNDFILE* f = sf_open(wav.c_str(), SFM_WRITE, &info);
-    ASSERT_NE(f, nullptr);
     std::vector<float> samples(800, 0.25f);
     samples[100] = bad;
-    sf_writef_float(f, samples.data(), 800);
-    sf_close(f);
+    ASSERT_TRUE(write_float_wav(dir + "/nan_show.wav", samples, 8000));
     const std::string show = dir + "/nan_show.yaml";
     std::ofstream(show) << "audio: {file: nan_show.wav}\n"
                         << "joints:\n  jaw: {keys: [[0, 1]]}\n";
