@@ -30,12 +30,14 @@ TEST(ArtNet, ArtDmxCarriesItsUniverseAndChannels) {
 // Art-Net asks a sender for an even length; an odd one (a script sending
 // three channels), with or without a padding byte, still carries them.
 TEST(ArtNet, AnOddLengthCarriesItsChannels) {
-  ArtDmx dmx;
-  ASSERT_EQ(parse_artnet(art_dmx(5, {9, 8, 7}, 3), dmx), ArtNetParse::dmx);
+  ArtDmx dmx;  // its data is a view into the packet: the packets outlive it
+  const auto three = art_dmx(5, {9, 8, 7}, 3);
+  ASSERT_EQ(parse_artnet(three, dmx), ArtNetParse::dmx);
   EXPECT_EQ(dmx.universe, 5);
   ASSERT_EQ(dmx.data.size(), 3u);
   EXPECT_EQ(dmx.data[2], 7);
-  ASSERT_EQ(parse_artnet(art_dmx(0, {42, 0}, 1), dmx), ArtNetParse::dmx);
+  const auto padded = art_dmx(0, {42, 0}, 1);
+  ASSERT_EQ(parse_artnet(padded, dmx), ArtNetParse::dmx);
   ASSERT_EQ(dmx.data.size(), 1u);
   EXPECT_EQ(dmx.data[0], 42);
   EXPECT_EQ(parse_artnet(art_dmx(0, {42, 0, 0}, 1), dmx), ArtNetParse::malformed);
