@@ -638,7 +638,7 @@ void CrowdGroup::make_slots(double radius) {
     if (!len || *len > d + s) continue;
     slots_.push_back(q);
   }
-  // No member gathers in a narrow passage or before its mouths: gathered
+  // No member gathers in a narrow passage or its doorways: gathered
   // there, a team stands in the way of every figure that must pass. The
   // slots stay in the lattice, never taken (like slots in a lane), so the
   // gathering's reach is what it would be without the passage.

@@ -115,9 +115,9 @@ class PassageRules {
   Vec2 hold_point(int i) const { return hold_[static_cast<std::size_t>(i)]; }
   std::span<const Passage> passages() const { return passages_; }
   std::span<const PassageChain> chains() const { return chains_; }
-  // Whether a figure of `radius` at q stands in a passage or before one of
-  // its mouths (within close_m, as wide as the passage): where every
-  // figure that passes walks.
+  // Whether a figure of `radius` at q stands in a passage or in one of its
+  // doorways (less than a figure's width out of a mouth, as wide as the
+  // passage): where every figure that passes must walk.
   bool in_way(Vec2 q, double radius) const;
   bool empty() const { return passages_.empty(); }
 
