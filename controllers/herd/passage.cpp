@@ -547,8 +547,6 @@ void PassageRules::take_turns(double t, int chain, std::span<const Agent> agents
   for (std::size_t m = 0; m < ch.members.size(); ++m) {
     Passage& p = passages_[static_cast<std::size_t>(ch.members[m])];
     p.owner = ch.owner * ch.orient[m];
-    p.waiting_since = ch.waiting_since;
-    p.closing = ch.closing;
   }
 }
 
@@ -571,7 +569,7 @@ void PassageRules::hold_one(int index, const Passage& p, std::span<const Agent> 
         ch.members.size() > 1 && chain_way_[i * chains_.size() + static_cast<std::size_t>(chain)] ==
                                      dir * ch.orient[static_cast<std::size_t>(member)];
     if (round_of_[at]) {
-      if (dir == p.owner && (!p.closing || in_chain)) continue;
+      if (dir == p.owner && (!ch.closing || in_chain)) continue;
       // One already at the corner goes on: stood there, it would stand in
       // the way out it was to keep clear of.
       if (was_stood_by_[i] != index &&
@@ -593,7 +591,7 @@ void PassageRules::hold_one(int index, const Passage& p, std::span<const Agent> 
     // Closing, the owner's figures already near the mouth go on: stopped in
     // a stream, touching, they could not turn out of its way.
     const bool near = s >= -(hl + params_.close_m) || in_chain;
-    const bool wait = (dir != p.owner && !inside) || (dir == p.owner && p.closing && !near);
+    const bool wait = (dir != p.owner && !inside) || (dir == p.owner && ch.closing && !near);
     if (!wait) {
       // One lane: the owner's figures near the mouth stand where they are
       // and go in one at a time, nearest first; several pressing into it

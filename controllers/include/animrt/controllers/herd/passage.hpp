@@ -54,9 +54,7 @@ struct Passage {
   Vec2 axis;  // through the passage (unit)
   double half_width = 0.0;
   double half_length = 0.0;
-  int owner = 0;                // +1: along axis, -1: against it, 0: free
-  double waiting_since = -1.0;  // when the other way began to wait, or -1
-  bool closing = false;         // the owner admits no one new
+  int owner = 0;  // +1: along axis, -1: against it, 0: free (its chain's way, PassageChain)
   // Per way (+1, -1): the side its figures wait on, +1 right, -1 left, 0
   // not decided yet.
   int wait_side[2] = {0, 0};
@@ -70,11 +68,11 @@ struct Passage {
 // facing the next one's near mouth within approach_m; a mouth that more
 // passages face (a junction) links none.
 struct PassageChain {
-  std::vector<int> members;  // passages, in order along the chain
-  std::vector<int> orient;   // per member: its way (+1, -1) when the chain's way is +1
-  int owner = 0;             // the chain's way: +1, -1, or 0 free
-  double waiting_since = -1.0;
-  bool closing = false;
+  std::vector<int> members;     // passages, in order along the chain
+  std::vector<int> orient;      // per member: its way (+1, -1) when the chain's way is +1
+  int owner = 0;                // the chain's way: +1, -1, or 0 free
+  double waiting_since = -1.0;  // when the other way began to wait, or -1
+  bool closing = false;         // the owner admits no one new
 };
 
 // A wall as the passage finder measures it: its corners (counter-clockwise)
