@@ -232,5 +232,35 @@ TEST(CommissionSetup, TwoServosAnsweringAsOneIdAreRefused) {
   }
 }
 
+// A servo storing its new ID stays silent a while (a busy EEPROM, a loaded
+// host): the read back asks again rather than report the change as failed.
+TEST(CommissionSetup, ANewIdReadBackWaitsForALateServo) {
+  std::uint8_t id = 1;
+  int silent_reads = 12;  // far more than three asks
+  auto open = [&](int) {
+    auto line = std::make_unique<ScriptedLine>();
+    line->reply = [&](const Bytes& request) -> Bytes {
+      if (request[4] != id) return {};
+      const std::uint8_t instruction = request[7];
+      if (instruction == dxl::inst::ping) return kStatusId1;
+      const std::uint16_t address = static_cast<std::uint16_t>(request[8] | request[9] << 8);
+      if (instruction == dxl::inst::write && address == dxl::xreg::id) {
+        id = request[10];
+        return {};  // the status would come from the new id: none
+      }
+      if (instruction != dxl::inst::read) return {};
+      if (id != 1 && silent_reads-- > 0) return {};
+      const Bytes table = control_table(id);
+      const std::uint16_t length = static_cast<std::uint16_t>(request[10] | request[11] << 8);
+      return dxl_status(id, Bytes(table.begin() + address, table.begin() + address + length));
+    };
+    return std::unique_ptr<ByteTransport>(std::move(line));
+  };
+  ServoSetup servo(Family::dynamixel2, open, 1, 57600, std::chrono::microseconds(1000));
+  const std::string said = servo.set_id(5);
+  EXPECT_NE(said.find("id 1 -> 5 (read back)"), std::string::npos) << said;
+  EXPECT_LT(silent_reads, 0);
+}
+
 }  // namespace
 }  // namespace animrt::commission

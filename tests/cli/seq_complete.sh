@@ -13,7 +13,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-if ldd "$animrt" | grep -q torch; then fail "animrt links libtorch: $(ldd "$animrt" | grep torch)"; fi
+libs=$(ldd "$animrt") || fail "ldd $animrt"
+[[ $libs == *torch* ]] && fail "animrt links libtorch: $(grep torch <<< "$libs")"
 
 source "$(dirname "$0")/seq_data.bash"
 write_walk_csv "$tmp/walk.csv"

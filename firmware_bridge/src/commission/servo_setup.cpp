@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <thread>
 
 #include "animrt/bridge/commission/serial_scan.hpp"
@@ -20,6 +21,10 @@ namespace freg = ft::reg;
 
 // A servo restarts within about a second after Reboot or Factory Reset.
 constexpr auto kRestartWait = std::chrono::milliseconds(2000);
+// A read is asked again while silent, at least three times and for this
+// long: a servo busy storing EEPROM, or a loaded host, answers late, and a
+// read back that gives up early reports a change as failed that was made.
+constexpr auto kReadWindow = std::chrono::milliseconds(500);
 // Factory Reset parameter: everything except ID and Baud Rate.
 constexpr std::uint8_t kResetKeepIdAndBaud = 0x02;
 
@@ -100,7 +105,9 @@ void ServoSetup::require_torque_off() {
 std::vector<std::uint8_t> ServoSetup::read(int id, std::uint16_t address, std::uint16_t length,
                                            const std::string& what) {
   std::optional<std::vector<std::uint8_t>> data;
-  for (int attempt = 0; attempt < 3 && !data; ++attempt) {
+  const auto until = std::chrono::steady_clock::now() + kReadWindow;
+  for (int attempt = 0; !data && (attempt < 3 || std::chrono::steady_clock::now() < until);
+       ++attempt) {
     data = family_ == Family::dynamixel2
                ? dxl_detail::read(*line_, static_cast<std::uint8_t>(id), address, length, baud_,
                                   timeout_)
