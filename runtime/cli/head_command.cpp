@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <set>
+#include <string>
 
 #include "animrt/controllers/head/model.hpp"
 #include "animrt/controllers/head/synthesis.hpp"
@@ -47,8 +49,19 @@ TrainOptions train_options(const HeadArgs& a) {
   return o;
 }
 
+// A sound shorter than one analysis window gives no frame, so no pose:
+// said, rather than an empty file written as if all went well.
+void require_frames(const std::string& path, std::size_t frames, const FeatureConfig& config) {
+  if (frames > 0) return;
+  throw InputError(Location{path, 0, 0}, "",
+                   "the sound is shorter than one analysis window (" +
+                       std::to_string(std::lround(config.window_s * 1000)) +
+                       " ms), so it gives no head motion");
+}
+
 int run_features(const HeadArgs& a) {
   const FeatureTrack t = extract_features_file(a.in, FeatureConfig{});
+  require_frames(a.in, t.size(), FeatureConfig{});
   write_features_csv(a.out, t);
   std::size_t voiced = 0;
   for (const auto& f : t.raw) voiced += f.voiced ? 1 : 0;
@@ -84,6 +97,7 @@ int run_synth(const HeadArgs& a) {
   HeadModel model = load_model(a.model);
   if (a.noise_deg >= 0) model.smoothing.noise_deg = a.noise_deg;
   const PoseTrack poses = synthesize(model, load_audio(a.in, model.features.sample_rate));
+  require_frames(a.in, poses.size(), model.features);
   write_euler_csv(a.out, poses);
   std::cout << "wrote " << a.out << ": " << poses.size() << " poses at "
             << model.smoothing.output_rate_hz << " Hz\n";

@@ -9,12 +9,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "animrt/controllers/head/head_source.hpp"
 #include "animrt/controllers/head/pose_io.hpp"
 #include "animrt/controllers/head/prosody.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/wav_file.hpp"
 
 namespace animrt::head {
 namespace {
@@ -62,6 +66,36 @@ TEST(HeadCli, CorpusTrainSynthEvalFeatures) {
                 "/configs/head/utterance.wav --out " + d + "/x.csv"),
             2);
   EXPECT_EQ(run(kBin + " head features " + d + "/bad.txt --out " + d + "/x.csv"), 2);
+  std::filesystem::remove_all(d);
+}
+
+// A sound shorter than one analysis window (25 ms) gives no pose: synth and
+// features say so (exit 2) and write nothing, rather than an empty file
+// with exit 0. One window's worth is enough for a frame.
+TEST(HeadCli, ASoundShorterThanOneWindowIsRefused) {
+  const std::string d = tmp("short");
+  for (const std::size_t samples : {std::size_t{1}, std::size_t{480}}) {  // 24 kHz: 20 ms
+    ASSERT_TRUE(write_float_wav(d + "/short.wav", std::vector<float>(samples, 0.1f), 24000));
+    for (const std::string& command :
+         {" head synth " + kSrc + "/configs/head/model.txt " + d + "/short.wav --out " + d +
+              "/p.csv",
+          " head features " + d + "/short.wav --out " + d + "/p.csv"}) {
+      EXPECT_EQ(std::system((kBin + command + " > " + d + "/said.txt 2>&1").c_str()), 2 << 8)
+          << command << " with " << samples << " samples";
+      std::ifstream said_file(d + "/said.txt");
+      const std::string said((std::istreambuf_iterator<char>(said_file)),
+                             std::istreambuf_iterator<char>());
+      EXPECT_NE(said.find(d + "/short.wav: the sound is shorter than one analysis window (25 ms)"),
+                std::string::npos)
+          << said;
+      EXPECT_FALSE(std::filesystem::exists(d + "/p.csv")) << command;
+    }
+  }
+  ASSERT_TRUE(write_float_wav(d + "/short.wav", std::vector<float>(600, 0.1f), 24000));
+  EXPECT_EQ(run(kBin + " head synth " + kSrc + "/configs/head/model.txt " + d +
+                "/short.wav --out " + d + "/p.csv"),
+            0);
+  EXPECT_GE(load_euler_csv(d + "/p.csv").size(), 1u);
   std::filesystem::remove_all(d);
 }
 
