@@ -108,6 +108,20 @@ std::string output_file_problem(const std::string& path) {
   namespace fs = std::filesystem;
   if (path.empty()) return "an empty path, expected a file to write";
   std::error_code ec;
+  // A link is written through: judged by what it points to, so a dangling
+  // link into a missing folder is named here, not after the work.
+  if (fs::is_symlink(fs::symlink_status(path, ec))) {
+    const fs::file_status target = fs::status(path, ec);
+    if (ec == std::errc::too_many_symbolic_link_levels)
+      return "is a link that cannot be followed: " + ec.message();
+    if (!fs::exists(target)) {
+      fs::path to = fs::read_symlink(path, ec);
+      if (ec) return "is a link that cannot be read: " + ec.message();
+      if (to.is_relative()) to = fs::path(path).parent_path() / to;
+      const std::string problem = output_file_problem(to.string());
+      if (!problem.empty()) return "is a link to \"" + to.string() + "\": " + problem;
+    }
+  }
   if (fs::is_directory(path, ec)) return "is a folder, expected a file to write";
   fs::path folder = fs::path(path).parent_path();
   if (folder.empty()) folder = ".";

@@ -213,6 +213,22 @@ TEST_F(InputFileTest, OutputPathsThatCannotBeWrittenAreNamedBeforeTheWork) {
   EXPECT_EQ(output_folder_problem(dir_.string()), "");
   EXPECT_EQ(output_folder_problem(file), "is a file, expected a folder");
   EXPECT_EQ(output_folder_problem(file + "/a"), "\"" + file + "\" is a file, not a folder");
+  // Links are judged by what they point to: a dangling one into a missing
+  // folder (absolute or relative to the link), one that loops.
+  std::filesystem::create_symlink(path("no/x.csv"), path("dangling"));
+  EXPECT_EQ(output_file_problem(path("dangling")), "is a link to \"" + path("no/x.csv") +
+                                                       "\": its folder \"" + path("no") +
+                                                       "\" does not exist");
+  std::filesystem::create_symlink("no/y.csv", path("relative"));
+  EXPECT_EQ(output_file_problem(path("relative")), "is a link to \"" + path("no/y.csv") +
+                                                       "\": its folder \"" + path("no") +
+                                                       "\" does not exist");
+  std::filesystem::create_symlink("new_target.csv", path("to_new"));
+  EXPECT_EQ(output_file_problem(path("to_new")), "");  // the link makes a new file
+  std::filesystem::create_symlink(path("loop_b"), path("loop_a"));
+  std::filesystem::create_symlink(path("loop_a"), path("loop_b"));
+  EXPECT_EQ(output_file_problem(path("loop_a")).rfind("is a link that cannot be followed: ", 0), 0u)
+      << output_file_problem(path("loop_a"));
 }
 
 // Every byte is written, or the failing write's errno is returned with the
