@@ -26,8 +26,10 @@ std::string resolve_file(const YamlNode& node, const std::string& robot_path) {
 HeadAxisMap parse_axis(const YamlNode& n) {
   n.allow_only({"joint", "sign", "scale", "offset_deg"});
   HeadAxisMap a;
-  a.where = n.location();
-  a.joint = n.at("joint").as_string();
+  const YamlNode joint = n.at("joint");
+  a.where = joint.location();
+  a.key = joint.path();
+  a.joint = joint.as_string();
   if (auto s = n.find("sign")) {
     a.sign = s->as_double();
     if (a.sign != 1.0 && a.sign != -1.0) s->fail("expected 1 or -1, found " + s->describe());
@@ -91,8 +93,10 @@ HeadMotionConfig parse_head_motion(const YamlNode& node, const std::string& robo
   if (auto a = axes.find("roll")) c.roll = parse_axis(*a);
   if (auto j = node.find("jaw")) {
     j->allow_only({"joint", "closed_deg", "open_deg", "energy_floor", "energy_full", "window_s"});
-    c.jaw.where = j->location();
-    c.jaw.joint = j->at("joint").as_string();
+    const YamlNode joint = j->at("joint");
+    c.jaw.where = joint.location();
+    c.jaw.key = joint.path();
+    c.jaw.joint = joint.as_string();
     if (auto d = j->find("closed_deg")) c.jaw.closed_deg = d->as_double_in(-360.0, 360.0);
     if (auto d = j->find("open_deg")) c.jaw.open_deg = d->as_double_in(-360.0, 360.0);
     if (auto e = j->find("energy_floor")) c.jaw.energy_floor = e->as_double_in(0.0, 1.0);

@@ -435,14 +435,12 @@ std::unique_ptr<MotionSource> make_head_source(const HeadMotionConfig& c,
   }
   Drive axes[3];
   const HeadAxisMap* maps[3] = {&c.yaw, &c.pitch, &c.roll};
-  const char* keys[3] = {"motion.axes.yaw.joint", "motion.axes.pitch.joint",
-                         "motion.axes.roll.joint"};
   for (int k = 0; k < 3; ++k) {
-    axes[k] = bind_joint(maps[k]->joint, maps[k]->where, keys[k], joints);
+    axes[k] = bind_joint(maps[k]->joint, maps[k]->where, maps[k]->key, joints);
     axes[k].gain = maps[k]->sign * maps[k]->scale;
     axes[k].offset_deg = maps[k]->offset_deg;
   }
-  const Drive jaw = bind_joint(c.jaw.joint, c.jaw.where, "motion.jaw.joint", joints);
+  const Drive jaw = bind_joint(c.jaw.joint, c.jaw.where, c.jaw.key, joints);
   return std::make_unique<HeadSource>(c, std::move(model), std::move(audio), axes, jaw, c.jaw);
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "animrt/controllers/cues/cue_player.hpp"
@@ -113,6 +114,36 @@ TEST(HeadCue, ABadHeadStepNamesTheCueFileLineAndKey) {
     const std::string what = e.what();
     EXPECT_NE(what.find("head_cues.yaml:12"), std::string::npos) << what;
     EXPECT_NE(what.find("smoothing"), std::string::npos) << what;
+  }
+}
+
+// A head axis or jaw bound to a joint the robot lacks is named at the cue
+// file's line and key (the binding used to be reported with the robot
+// file's keys, motion.axes...).
+TEST(HeadCue, AnUnknownJointIsNamedAtTheCueFilesKey) {
+  const RobotConfig robot = load_robot_config(kRoot + "/configs/robots/head.yaml");
+  const std::string good = head_cues();
+  std::ifstream in(good);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  struct Case {
+    std::string from, to, where, key;
+  };
+  for (const Case& c :
+       {Case{"pitch: {joint: neck_pitch}", "pitch: {joint: neck_tilt}", "head_cues.yaml:12:",
+             ": cues.talk.play.head.axes.pitch.joint: no joint named 'neck_tilt'"},
+        Case{"jaw: {joint: jaw,", "jaw: {joint: mouth,",
+             "head_cues.yaml:13:", ": cues.talk.play.head.jaw.joint: no joint named 'mouth'"}}) {
+    std::string bad = text;
+    bad.replace(bad.find(c.from), c.from.size(), c.to);
+    std::ofstream(good) << bad;
+    try {
+      load_cues(good, robot);
+      ADD_FAILURE() << "loaded with " << c.to;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.where), std::string::npos) << what;
+      EXPECT_NE(what.find(c.key), std::string::npos) << what;
+    }
   }
 }
 

@@ -58,7 +58,8 @@ namespace animrt::head {
 struct HeadAxisMap {
   std::string joint;  // empty: axis not driven
   double sign = 1.0, scale = 1.0, offset_deg = 0.0;
-  Location where;
+  Location where;   // the `joint` key in the robot or cue file
+  std::string key;  // its path there
 };
 
 struct HeadJawMap {
@@ -66,7 +67,8 @@ struct HeadJawMap {
   double closed_deg = 0.0, open_deg = 20.0;
   double energy_floor = 0.01, energy_full = 0.12;  // RMS energy: closed below, fully open above
   double window_s = 0.02;                          // the RMS window, ending at the newest sample
-  Location where;
+  Location where;                                  // the `joint` key in the robot or cue file
+  std::string key;                                 // its path there
 };
 
 struct HeadMotionConfig {
