@@ -77,6 +77,23 @@ class SeedValidator : public CLI::Validator {
 };
 inline const SeedValidator kSeed;
 
+// A whole number, all of the argument: CLI11 reads an empty argument as 0
+// for an integer option (`servo ... set-id ""` gave a servo id 0).
+class IntegerValidator : public CLI::Validator {
+ public:
+  IntegerValidator() : CLI::Validator("INT") {
+    func_ = [](std::string& input) -> std::string {
+      long long value = 0;
+      const char* end = input.data() + input.size();
+      const auto [stop, error] = std::from_chars(input.data(), end, value);
+      if (input.empty() || error != std::errc() || stop != end)
+        return "Value " + quote(input) + " is not a whole number";
+      return {};
+    };
+  }
+};
+inline const IntegerValidator kInteger;
+
 // Output paths, checked when the command line is read: a file that cannot
 // be written is found before the work (a search, a training, a run), not
 // after it. kOutputFile wants its folder to exist; kOutputFolder is a folder

@@ -6,6 +6,7 @@
 
 #include "animrt/bridge/commission/servo_setup.hpp"
 #include "animrt/core/error.hpp"
+#include "option_checks.hpp"
 #include "port_check.hpp"
 #include "subcommand.hpp"
 
@@ -77,10 +78,12 @@ void add_servo_command(CLI::App& app) {
   cmd->add_option("--protocol", args->protocol, "dynamixel2 or feetech")
       ->required()
       ->check(CLI::IsMember({"dynamixel2", "feetech"}));
-  cmd->add_option("--id", args->id, "the servo's id now")->required();
+  cmd->add_option("--id", args->id, "the servo's id now")->required()->check(kInteger);
   cmd->add_option("--baud", args->baud,
                   "the servo's baud rate now (default the factory's: 57600 Dynamixel, 1000000 "
-                  "Feetech)");
+                  "Feetech)")
+      ->check(kInteger)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--timeout-ms", args->timeout_ms, "wait for one answer (default 20)")
       ->check(CLI::Range(1, 1000));
   cmd->require_subcommand(1);
@@ -96,14 +99,14 @@ void add_servo_command(CLI::App& app) {
     };
   };
   auto* set_id = cmd->add_subcommand("set-id", "give the servo a new id (read back at it)");
-  set_id->add_option("ID", args->value, "new id")->required();
+  set_id->add_option("ID", args->value, "new id")->required()->check(kInteger);
   set_subcommand_body(set_id, body("set-id"));
   auto* set_baud =
       cmd->add_subcommand("set-baud", "change its baud rate (read back at the new one)");
-  set_baud->add_option("BAUD", args->value, "new baud rate")->required();
+  set_baud->add_option("BAUD", args->value, "new baud rate")->required()->check(kInteger);
   set_subcommand_body(set_baud, body("set-baud"));
   auto* delay = cmd->add_subcommand("set-return-delay", "its Return Delay Time, in microseconds");
-  delay->add_option("US", args->value, "microseconds, even, 0..508")->required();
+  delay->add_option("US", args->value, "microseconds, even, 0..508")->required()->check(kInteger);
   set_subcommand_body(delay, body("set-return-delay"));
   auto* mode = cmd->add_subcommand("set-mode", "its operating mode");
   mode->add_option("MODE", args->mode,
@@ -112,8 +115,12 @@ void add_servo_command(CLI::App& app) {
       ->required();
   set_subcommand_body(mode, body("set-mode"));
   auto* limits = cmd->add_subcommand("set-limits", "its own position limits, in ticks");
-  limits->add_option("MIN", args->min_ticks, "lowest position (ticks)")->required();
-  limits->add_option("MAX", args->max_ticks, "highest position (ticks)")->required();
+  limits->add_option("MIN", args->min_ticks, "lowest position (ticks)")
+      ->required()
+      ->check(kInteger);
+  limits->add_option("MAX", args->max_ticks, "highest position (ticks)")
+      ->required()
+      ->check(kInteger);
   set_subcommand_body(limits, body("set-limits"));
   auto* reboot = cmd->add_subcommand("reboot", "restart the servo (Dynamixel)");
   set_subcommand_body(reboot, body("reboot"));

@@ -308,25 +308,29 @@ BusConfig parse_bus(const std::string& name, const YamlNode& node, const YamlNod
   return bus;
 }
 
-// sim.switches of a drive the bus does not have would simulate nothing: the
-// id is almost always a typo. After the joints, which bind the drives.
-void check_switch_ids(const YamlNode& buses, const RobotConfig& config) {
+// sim.switches or sim.inject of a device the bus does not have would
+// simulate nothing (an injected fault that never comes: a test of nothing):
+// the id is almost always a typo. After the joints, which bind the devices.
+void check_sim_ids(const YamlNode& buses, const RobotConfig& config) {
   for (const BusConfig& bus : config.buses) {
     const auto sim = buses.at(bus.name).find("sim");
-    const auto switches = sim ? sim->find("switches") : std::nullopt;
-    if (!switches) continue;
+    if (!sim) continue;
     std::string ids;
     for (const ActuatorBinding& a : bus.actuators) {
       ids += (ids.empty() ? "" : ", ") + std::to_string(a.device_id);
     }
-    for (const YamlNode& item : switches->items()) {
-      const YamlNode id = item.at("id");
-      const auto n = id.as_int();
-      const bool bound = std::any_of(bus.actuators.begin(), bus.actuators.end(),
-                                     [&](const ActuatorBinding& a) { return a.device_id == n; });
-      if (!bound) {
-        id.fail("no drive on bus " + bus.name + " has id " + std::to_string(n) +
-                " (its drives: " + ids + ")");
+    for (const char* key : {"switches", "inject"}) {
+      const auto list = sim->find(key);
+      if (!list) continue;
+      for (const YamlNode& item : list->items()) {
+        const YamlNode id = item.at("id");
+        const auto n = id.as_int();
+        const bool bound = std::any_of(bus.actuators.begin(), bus.actuators.end(),
+                                       [&](const ActuatorBinding& a) { return a.device_id == n; });
+        if (!bound) {
+          id.fail("no device on bus " + bus.name + " has id " + std::to_string(n) +
+                  " (its devices: " + ids + ")");
+        }
       }
     }
   }
@@ -640,7 +644,7 @@ RobotConfig load_robot_config(const std::string& path) {
   check_bus_timeouts(buses, config, safety);
   parse_joints(root.at("joints"), config);
   config.joints_where = key_location(root, "joints");
-  check_switch_ids(buses, config);
+  check_sim_ids(buses, config);
   check_bus_load(loop.at("rate_hz"), config);
   // A bus without devices is almost always a typo in some actuator.bus, and
   // opening its port would fail or grab a line for nothing.

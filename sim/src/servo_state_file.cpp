@@ -57,17 +57,38 @@ ServoStateFile::ServoStateFile(std::string path) : path_(std::move(path)) {
                        "expected 'BUS INDEX FAMILY HEX', found \"" + elide(line) + "\"");
     }
     entry.family = family;
+    entry.line = number;
     entries_[{bus, static_cast<std::size_t>(index)}] = std::move(entry);
   }
-  write_locked();
+  write_locked(false);
 }
 
 std::vector<std::uint8_t> ServoStateFile::find(const std::string& bus, std::size_t index,
-                                               std::string_view family) const {
+                                               const ServoFamily& family) const {
   std::lock_guard lock(mutex_);
   const auto it = entries_.find({bus, index});
-  if (it == entries_.end() || it->second.family != family) return {};
-  return it->second.bytes;
+  if (it == entries_.end()) return {};
+  const Entry& e = it->second;
+  const auto fail = [&](const std::string& problem) {
+    throw InputError(Location{path_, e.line, 0}, "servo",
+                     "bus " + bus + " servo " + std::to_string(index) + ": " + problem);
+  };
+  if (e.family != family.name) {
+    fail("is a " + std::string(family.name) + ", found the EEPROM of a " + elide(e.family));
+  }
+  if (e.bytes.size() != family.eeprom_end) {
+    fail("expected " + std::to_string(family.eeprom_end) + " bytes of EEPROM, found " +
+         std::to_string(e.bytes.size()));
+  }
+  // 0xFE is the broadcast id, 0xFF none.
+  if (const int id = e.bytes[family.id_address]; id >= 0xFE) {
+    fail("id " + std::to_string(id) + " is no servo's (expected 0..253)");
+  }
+  if (const int code = e.bytes[family.baud_address];
+      baud_of(family, e.bytes[family.baud_address]) == 0) {
+    fail("Baud Rate " + std::to_string(code) + " names no baud rate");
+  }
+  return e.bytes;
 }
 
 void ServoStateFile::put(const std::string& bus, std::size_t index, std::string_view family,
@@ -76,10 +97,11 @@ void ServoStateFile::put(const std::string& bus, std::size_t index, std::string_
   Entry& e = entries_[{bus, index}];
   e.family = std::string(family);
   e.bytes.assign(eeprom.begin(), eeprom.end());
-  write_locked();
+  e.line = 0;
+  write_locked(true);
 }
 
-void ServoStateFile::write_locked() const {
+void ServoStateFile::write_locked(bool replace) const {
   const std::string temp = path_ + ".tmp";
   {
     std::ofstream out(temp, std::ios::trunc);
@@ -92,6 +114,10 @@ void ServoStateFile::write_locked() const {
     }
     out.flush();
     if (!out) throw DeviceError("servo state " + path_ + ": cannot write " + temp);
+  }
+  if (!replace) {
+    std::remove(temp.c_str());
+    return;
   }
   if (std::rename(temp.c_str(), path_.c_str()) != 0) {
     throw DeviceError("servo state " + path_ + ": rename: " + std::strerror(errno));

@@ -134,8 +134,8 @@ TEST(Cia402HomingConfig, SwitchesOfADriveTheBusLacksAreRefused) {
     const std::string what = e.what();
     EXPECT_NE(what.find("cia402_homing.yaml:" + std::to_string(line) + ":"), std::string::npos)
         << what;
-    EXPECT_NE(what.find("hip_drive.sim.switches[1].id: no drive on bus hip_drive has id 33 "
-                        "(its drives: 32)"),
+    EXPECT_NE(what.find("hip_drive.sim.switches[1].id: no device on bus hip_drive has id 33 "
+                        "(its devices: 32)"),
               std::string::npos)
         << what;
   }

@@ -35,6 +35,22 @@ found() {
   awk 'NR > 1 && $2 == "dynamixel2" {print $3 ":" $4}' "$tmp/scan.txt" | sort | tr '\n' ' '
 }
 
+# Refused before anything is written, the new servo left as it was: a rate
+# the line cannot be set to (a pty takes only the standard rates: the servo
+# would be stranded there), an empty id (it was read as 0), and a second
+# servo answering as the same id.
+out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 1 set-baud 4500000 2>&1)
+[[ $? -eq 3 && $out == *"cannot be set to 4500000 baud"*"nothing was written"* ]] \
+  || fail "set-baud to a rate the pty cannot take: $out"
+out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 1 set-id "" 2>&1)
+[[ $? -eq 1 && $out == *'Value "" is not a whole number'* ]] || fail "set-id \"\": $out"
+[[ $(ctl "plug legs 1") == ok* ]] || fail "plug legs 1 beside legs 0"
+out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 1 set-id 2 2>&1)
+[[ $? -eq 3 && $out == *"several servos answer as this id"* ]] || fail "two at id 1: $out"
+[[ $(ctl "unplug legs 1") == ok* ]] || fail "unplug legs 1"
+reply=$(ctl "get legs 1")
+[[ $reply == *" id=1 baud=57600" ]] || fail "the refusals changed the servo: $reply"
+
 for index in $(seq 0 11); do
   id=$((index + 2))  # id 1 stays free for the next new servo
   if ((index > 0)); then

@@ -1013,6 +1013,11 @@ TEST_F(RobotConfigTest, BadHealthKeysNameTheirPlace) {
                "        - {id: 1, at_s: 2, temperature_c: 80, blocked: true}\n");
   EXPECT_EQ(error_of(text), at("9:11: buses.b.sim.inject[0]: expected exactly one of "
                                "temperature_c, blocked, supply_v, hardware_error, found 2"));
+  // A fault injected into a servo the bus does not have would never come.
+  text.replace(text.find("{id: 1, at_s: 2, temperature_c: 80, blocked: true}"), 50,
+               "{id: 9, at_s: 2, temperature_c: 80}");
+  EXPECT_EQ(error_of(text), at("9:16: buses.b.sim.inject[0].id: no device on bus b has id 9 (its "
+                               "devices: 1)"));
 }
 
 TEST(RobotConfigWatchdog, MustCoverTwoLoopPeriods) {

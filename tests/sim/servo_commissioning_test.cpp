@@ -140,7 +140,7 @@ TEST(ServoCommissioning, StateFileKeepsEepromAcrossRestarts) {
     EXPECT_EQ(line.transact(test::write(1, xreg::id, {7})).error, 0);
     // Saved on change, before the simulator stops.
     sim::ServoStateFile saved(path);
-    EXPECT_EQ(saved.find("legs", 0, "dynamixel2").at(xreg::id), 7);
+    EXPECT_EQ(saved.find("legs", 0, sim::kDynamixelX).at(xreg::id), 7);
   }
   sim::ServoStateFile state(path);
   sim::DynamixelSimBus sim(config, clock, nullptr, ServoStartup{true, &state});
@@ -159,6 +159,50 @@ TEST(ServoCommissioning, StateFileWithABadLineNamesFileAndLine) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where().file, path);
     EXPECT_EQ(e.where().line, 3);
+  }
+  std::filesystem::remove(path);
+}
+
+// An entry that fits no servo of its bus is named at its line when the
+// simulator starts (it came up at its defaults, and the file was then
+// saved without what it had been given), and the file is left as written.
+TEST(ServoCommissioning, AStateEntryThatFitsNoServoIsNamedAtItsLine) {
+  const std::string path = temp_path("misfit");
+  const BusConfig config = dynamixel_bus({3});
+  ManualClock clock{0};
+  std::string table(2 * sim::kDynamixelX.eeprom_end, '0');
+  const auto with = [&](std::size_t address, const char* hex) {
+    std::string t = table;
+    t.replace(2 * address, 2, hex);
+    return t;
+  };
+  const std::string good = with(sim::kDynamixelX.baud_address, "01");
+  for (const auto& [line, problem] :
+       {std::pair{"legs 0 feetech_sts " + good, std::string("is a dynamixel2, found the EEPROM "
+                                                            "of a feetech_sts")},
+        std::pair{"legs 0 dynamixel2 " + good + "00",
+                  std::string("expected " + std::to_string(sim::kDynamixelX.eeprom_end) +
+                              " bytes of EEPROM")},
+        std::pair{"legs 0 dynamixel2 " + with(sim::kDynamixelX.baud_address, "ff"),
+                  std::string("Baud Rate 255 names no baud rate")},
+        std::pair{"legs 0 dynamixel2 " + good.substr(0, 2 * sim::kDynamixelX.id_address) + "ff" +
+                      good.substr(2 * sim::kDynamixelX.id_address + 2),
+                  std::string("id 255 is no servo's")}}) {
+    const std::string text = "# state\n" + line + "\n";
+    std::ofstream(path) << text;
+    sim::ServoStateFile state(path);
+    try {
+      sim::DynamixelSimBus sim(config, clock, nullptr, ServoStartup{false, &state});
+      sim.start();
+      ADD_FAILURE() << "started with " << line;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().file, path);
+      EXPECT_EQ(e.where().line, 2);
+      EXPECT_NE(std::string(e.what()).find("bus legs servo 0: " + problem), std::string::npos)
+          << e.what();
+    }
+    std::ifstream in(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), text);
   }
   std::filesystem::remove(path);
 }
@@ -218,8 +262,8 @@ TEST(ServoCommissioning, FeetechEepromIsKeptOnlyWhileUnlocked) {
     sim.set_device_plugged(0, true);  // a power cycle
   }
   sim::ServoStateFile state(path);
-  EXPECT_EQ(state.find("arm", 0, "feetech_sts").at(ft::reg::id), 5);
-  EXPECT_EQ(state.find("arm", 0, "feetech_sts").at(ft::reg::return_delay), 0);
+  EXPECT_EQ(state.find("arm", 0, sim::kFeetechSts).at(ft::reg::id), 5);
+  EXPECT_EQ(state.find("arm", 0, sim::kFeetechSts).at(ft::reg::return_delay), 0);
   sim::FeetechSimBus sim(config, ft::Series::sts, clock, ServoStartup{false, &state});
   EXPECT_EQ(sim.servo_readout(1).id, 5);
   std::filesystem::remove(path);

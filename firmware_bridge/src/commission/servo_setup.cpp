@@ -55,6 +55,9 @@ ServoSetup::ServoSetup(Family family, Open open, int id, int baud, microseconds 
     throw DeviceError("--id " + std::to_string(id_) + ": expected 0.." + std::to_string(max_id));
   }
   line_ = open_(baud_);
+  if (!carries_baud(line_->port(), baud_)) {
+    fail("a pseudo-terminal cannot be set to this rate (it takes only the standard ones)");
+  }
   check_answers(id_);
   if (family_ == Family::feetech) {
     const auto table = ft_detail::read(*line_, static_cast<std::uint8_t>(id_), 0,
@@ -78,8 +81,12 @@ void ServoSetup::check_answers(int id) {
   // A late answer is no absent servo: ask up to three times while silent.
   for (int attempt = 0; attempt < 3 && answers == 0; ++attempt) {
     if (family_ == Family::dynamixel2) {
-      dxl_detail::instruct(*line_, static_cast<std::uint8_t>(id), dxl::inst::ping, {}, baud_,
-                           timeout_, &answers);
+      // Two servos answering at once garble each other: bytes that are no
+      // clean packet, as the scan counts them.
+      const auto s = dxl_detail::ping(*line_, static_cast<std::uint8_t>(id), baud_, timeout_);
+      for (const auto& p : s.packets) answers += p.id == id ? 1 : 0;
+      damaged = s.damaged > 0 || s.stray > 0;
+      if (damaged) ++answers;
     } else {
       const auto s = ft_detail::transact(*line_, static_cast<std::uint8_t>(id), ft::inst::ping, {},
                                          6, baud_, timeout_);
@@ -181,8 +188,8 @@ std::string ServoSetup::set_id(int new_id) {
   {
     int answers = 0;
     if (family_ == Family::dynamixel2) {
-      dxl_detail::instruct(*line_, static_cast<std::uint8_t>(new_id), dxl::inst::ping, {}, baud_,
-                           timeout_, &answers);
+      const auto s = dxl_detail::ping(*line_, static_cast<std::uint8_t>(new_id), baud_, timeout_);
+      answers = static_cast<int>(s.packets.size()) + s.damaged + (s.stray > 0 ? 1 : 0);
     } else {
       const auto s = ft_detail::transact(*line_, static_cast<std::uint8_t>(new_id), ft::inst::ping,
                                          {}, 6, baud_, timeout_);
@@ -204,6 +211,19 @@ std::string ServoSetup::set_baud(int new_baud) {
   if (index < 0) fail("baud " + std::to_string(new_baud) + " is not one of " + baud_list(bauds));
   if (new_baud == baud_) return where() + ": baud rate is already " + std::to_string(new_baud);
   require_torque_off();
+  // The line must reach the servo at its new rate, or the servo is
+  // stranded there: tried before anything is written.
+  const std::string cannot = "the line cannot be set to " + std::to_string(new_baud) + " baud";
+  if (!carries_baud(line_->port(), new_baud))
+    fail(cannot + " (a pseudo-terminal takes only the standard rates); nothing was written");
+  line_.reset();
+  try {
+    open_(new_baud).reset();
+  } catch (const std::exception& e) {
+    line_ = open_(baud_);
+    fail(cannot + " (" + e.what() + "); nothing was written");
+  }
+  line_ = open_(baud_);
   const std::uint8_t value = static_cast<std::uint8_t>(index);
   lock_eeprom(id_, false);
   write(family_ == Family::dynamixel2 ? xreg::baud_rate : freg::baud_rate, {&value, 1},

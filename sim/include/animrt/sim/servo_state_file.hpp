@@ -26,17 +26,22 @@ namespace animrt::sim {
 class ServoStateFile {
  public:
   // Reads `path` if it exists (a missing file is an empty state) and writes
-  // it back at once, so a path that cannot be written fails here; throws
+  // its content to the file's temporary neighbour at once, so a path that
+  // cannot be written fails here (the file itself is replaced only when a
+  // servo's EEPROM changes, so errors name its lines as the user wrote them); throws
   // InputError naming the file when it is not a regular file (a device, a
   // FIFO, a folder), and its line for a line it cannot read; DeviceError
   // when it cannot write.
   explicit ServoStateFile(std::string path);
 
   const std::string& path() const { return path_; }
-  // What servo `index` of bus `bus` kept, if its family is `family`; empty
-  // otherwise.
+  // What servo `index` of bus `bus` kept: empty when the file holds nothing
+  // for it. InputError at the entry's line when it is of another family, not
+  // the family's EEPROM size, or holds an id or baud rate no servo can have
+  // (the servo would come up at its defaults or unreachable, and the id and
+  // baud rate it was given be lost when the file is next saved).
   std::vector<std::uint8_t> find(const std::string& bus, std::size_t index,
-                                 std::string_view family) const;
+                                 const ServoFamily& family) const;
   // Records a servo's EEPROM and rewrites the file; throws DeviceError if the
   // file cannot be written.
   void put(const std::string& bus, std::size_t index, std::string_view family,
@@ -46,8 +51,11 @@ class ServoStateFile {
   struct Entry {
     std::string family;
     std::vector<std::uint8_t> bytes;
+    int line = 0;  // in the file as read; 0 once written by us
   };
-  void write_locked() const;
+  // Writes the entries to the temporary file, and renames it over the path
+  // when `replace`.
+  void write_locked(bool replace) const;
 
   std::string path_;
   mutable std::mutex mutex_;
@@ -72,7 +80,7 @@ class ServoStartupKeeper {
         s.set_plugged(i == 0, now);  // the user plugs in one new servo at a time
       }
       if (file_ != nullptr) {
-        const std::vector<std::uint8_t> kept = file_->find(bus_, i, s.eeprom().family().name);
+        const std::vector<std::uint8_t> kept = file_->find(bus_, i, s.eeprom().family());
         if (!kept.empty()) s.restore_eeprom(kept, now);
       }
       saved_.push_back(s.eeprom().changes());
