@@ -38,7 +38,7 @@ void ServeTriggers::report(std::ostream& out) const {
   if (ltc_) {
     out << "ltc: " << ltc_->frames() << " frames, " << ltc_->jumps() << " jumps (re-synced), "
         << ltc_->dropouts() << " dropouts (freewheeled), " << ltc_->losses() << " lost, "
-        << ltc_->cues_asked() << " cues asked\n";
+        << ltc_->malformed() << " malformed, " << ltc_->cues_asked() << " cues asked\n";
   }
   if (midi_) {
     out << "midi: " << midi_->messages() << " messages, " << midi_->triggers() << " triggers, "

@@ -3,6 +3,7 @@
 #include <ltc.h>
 #include <time.h>
 
+#include <cmath>
 #include <optional>
 
 #include "animrt/controllers/head/alsa_audio.hpp"
@@ -99,6 +100,12 @@ void LtcReceiver::decode(const float* samples, std::size_t count) {
   while (ltc_decoder_read(in.decoder, &frame) > 0) {
     SMPTETimecode time{};
     ltc_frame_to_time(&time, &frame.ltc, 0);
+    // A time no clock shows (hour 24, second 60, a frame number at or past
+    // the rate) is noise or a misset generator: counted, never chased.
+    if (time.hours > 23 || time.mins > 59 || time.secs > 59 || time.frame >= std::ceil(fps_)) {
+      malformed_.fetch_add(1);
+      continue;
+    }
     const double tc = time.hours * 3600.0 + time.mins * 60.0 + time.secs + time.frame / fps_;
     // From its start: the decoder reports the end of the last frame before
     // a silence only when the signal comes back.

@@ -46,7 +46,7 @@ code=$?
 out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out $(cat "$tmp/err.txt")"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"
-grep -qE "^ltc: (49|50) frames, 1 jumps \(re-synced\), 2 dropouts \(freewheeled\), 1 lost, 3 cues asked$" \
+grep -qE "^ltc: (49|50) frames, 1 jumps \(re-synced\), 2 dropouts \(freewheeled\), 1 lost, 0 malformed, 3 cues asked$" \
   <<<"$out" || fail "$(grep '^ltc' <<<"$out")"
 grep -qE "^cues started: rest 1 a 1 b 1 c 1 d 0$" <<<"$out" || fail "$(grep '^cues started' <<<"$out")"
 echo "ok: serve chases LTC"

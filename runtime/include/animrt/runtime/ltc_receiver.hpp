@@ -39,6 +39,8 @@ class LtcReceiver {
   std::uint64_t jumps() const { return jumps_.load(); }
   std::uint64_t dropouts() const { return dropouts_.load(); }
   std::uint64_t losses() const { return losses_.load(); }
+  // Frames whose time no clock shows (dropped).
+  std::uint64_t malformed() const { return malformed_.load(); }
   std::uint64_t cues_asked() const { return asked_.load(); }
 
  private:
@@ -52,7 +54,8 @@ class LtcReceiver {
   Handler handler_;
   std::atomic<bool> running_{true};
   std::atomic<bool> begun_{false};
-  std::atomic<std::uint64_t> frames_{0}, jumps_{0}, dropouts_{0}, losses_{0}, asked_{0};
+  std::atomic<std::uint64_t> frames_{0}, jumps_{0}, dropouts_{0}, losses_{0}, malformed_{0},
+      asked_{0};
   std::thread thread_;
 };
 
