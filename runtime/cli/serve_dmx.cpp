@@ -96,8 +96,8 @@ void ServeDmx::report(std::ostream& out) const {
   if (artnet_) {
     out << "artnet: " << artnet_->packets() << " packets, " << artnet_->frames()
         << " frames of the cue universe, " << artnet_->malformed() << " malformed, "
-        << artnet_->ignored() << " ignored, " << artnet_no_cue_.load()
-        << " values asking for no cue\n";
+        << artnet_->out_of_sequence() << " out of sequence, " << artnet_->ignored() << " ignored, "
+        << artnet_no_cue_.load() << " values asking for no cue\n";
   }
   if (sacn_) {
     out << "sacn: " << sacn_->packets() << " packets, " << sacn_->frames() << " frames output, "

@@ -1,5 +1,6 @@
 #include "animrt/runtime/artnet_receiver.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 namespace animrt {
@@ -18,6 +19,8 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
   const std::uint16_t opcode = static_cast<std::uint16_t>(packet[8] | (packet[9] << 8));
   if (opcode != kOpDmx) return ArtNetParse::other;
   if (packet.size() < kHeader) return ArtNetParse::malformed;
+  // Art-Net 4 asks receivers to ignore versions before 14.
+  if (((packet[10] << 8) | packet[11]) < 14) return ArtNetParse::malformed;
   const std::size_t length = (std::size_t{packet[16]} << 8) | packet[17];
   // Art-Net asks senders for an even length, but desks and scripts that
   // send an odd number of channels exist: taken, with or without the
@@ -33,8 +36,44 @@ ArtNetParse parse_artnet(std::span<const std::uint8_t> packet, ArtDmx& out) {
     return ArtNetParse::malformed;
   }
   out.universe = ((packet[15] & 0x7f) << 8) | packet[14];
+  out.sequence = packet[12];
   out.data = packet.subspan(kHeader, length);
   return ArtNetParse::dmx;
+}
+
+ArtNetSources::Verdict ArtNetSources::take(const UdpSender& from, const ArtDmx& dmx, double now_s) {
+  Source* source = nullptr;
+  Source* free = nullptr;
+  for (Source& s : sources_) {
+    if (s.used && now_s - s.seen_s > kForgetS) s.used = false;
+    if (s.used && s.address == from.address) source = &s;
+    if (!s.used && free == nullptr) free = &s;
+  }
+  if (source == nullptr) {
+    if (free == nullptr) return Verdict::third_source;
+    *free = Source{from.address, {}, 0, 0, now_s, true};
+    source = free;
+  } else if (dmx.sequence != 0 && source->sequence != 0) {
+    // 1 to 19 behind the source's last came late, overtaken on the way (a
+    // sender's counter runs 1-255 and wraps past 0). The same number again
+    // is a sender that does not count: taken.
+    int behind = source->sequence - dmx.sequence;
+    if (behind < 0) behind += 255;
+    if (behind >= 1 && behind < 20) return Verdict::out_of_sequence;
+  }
+  source->sequence = dmx.sequence;
+  source->seen_s = now_s;
+  source->length = dmx.data.size();
+  std::copy(dmx.data.begin(), dmx.data.end(), source->levels.begin());
+  std::fill(source->levels.begin() + static_cast<long>(dmx.data.size()), source->levels.end(), 0);
+  merged_length_ = 0;
+  merged_.fill(0);
+  for (const Source& s : sources_) {
+    if (!s.used) continue;
+    merged_length_ = std::max(merged_length_, s.length);
+    for (std::size_t c = 0; c < s.length; ++c) merged_[c] = std::max(merged_[c], s.levels[c]);
+  }
+  return Verdict::output;
 }
 
 ArtNetReceiver::ArtNetReceiver(const std::string& host, int port, int universe, int channel,
@@ -42,9 +81,11 @@ ArtNetReceiver::ArtNetReceiver(const std::string& host, int port, int universe, 
     : universe_(universe),
       watch_(channel, std::move(handler), std::move(frames)),
       udp_("Art-Net", host, port,
-           [this](std::span<const std::uint8_t> datagram) { take(datagram); }) {}
+           [this](std::span<const std::uint8_t> datagram, const UdpSender& from) {
+             take(datagram, from);
+           }) {}
 
-void ArtNetReceiver::take(std::span<const std::uint8_t> datagram) {
+void ArtNetReceiver::take(std::span<const std::uint8_t> datagram, const UdpSender& from) {
   ArtDmx dmx;
   const ArtNetParse parsed = parse_artnet(datagram, dmx);
   if (parsed == ArtNetParse::malformed) {
@@ -55,7 +96,13 @@ void ArtNetReceiver::take(std::span<const std::uint8_t> datagram) {
     ignored_.fetch_add(1);
     return;
   }
-  watch_.take(dmx.data);
+  const double now_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
+  const ArtNetSources::Verdict verdict = sources_.take(from, dmx, now_s);
+  if (verdict == ArtNetSources::Verdict::out_of_sequence) out_of_sequence_.fetch_add(1);
+  if (verdict == ArtNetSources::Verdict::third_source) ignored_.fetch_add(1);
+  if (verdict != ArtNetSources::Verdict::output) return;
+  watch_.take(sources_.merged());
 }
 
 }  // namespace animrt

@@ -4,7 +4,8 @@ namespace animrt {
 
 OscReceiver::OscReceiver(const std::string& host, int port, Handler handler)
     : handler_(std::move(handler)),
-      udp_("OSC", host, port, [this](std::span<const std::uint8_t> datagram) { take(datagram); }) {}
+      udp_("OSC", host, port,
+           [this](std::span<const std::uint8_t> datagram, const UdpSender&) { take(datagram); }) {}
 
 void OscReceiver::take(std::span<const std::uint8_t> datagram) {
   messages_buffer_.clear();

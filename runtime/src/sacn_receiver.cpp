@@ -109,7 +109,10 @@ std::string SacnReceiver::group(int universe) {
 SacnReceiver::SacnReceiver(const std::string& host, int port, bool multicast, int universe,
                            int channel, Handler handler, FrameHandler frames)
     : universe_(universe), watch_(channel, std::move(handler), std::move(frames)) {
-  auto take = [this](std::span<const std::uint8_t> datagram) { this->take(datagram); };
+  // Sources are told apart by their CID, not their address.
+  auto take = [this](std::span<const std::uint8_t> datagram, const UdpSender&) {
+    this->take(datagram);
+  };
   UdpOptions shared;
   shared.reuse_address = multicast;
   unicast_ = std::make_unique<UdpReceiver>("sACN", host, port, take, shared);

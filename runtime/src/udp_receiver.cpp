@@ -105,12 +105,26 @@ void UdpReceiver::receive() {
   while (running_.load()) {
     pollfd p{fd_, POLLIN, 0};
     if (::poll(&p, 1, kPollMs) <= 0) continue;
-    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+    sockaddr_storage peer{};
+    socklen_t peer_size = sizeof peer;
+    const ssize_t n = ::recvfrom(fd_, buffer.data(), buffer.size(), MSG_TRUNC,
+                                 reinterpret_cast<sockaddr*>(&peer), &peer_size);
     if (n < 0) continue;
     datagrams_.fetch_add(1);
+    UdpSender from;
+    if (peer.ss_family == AF_INET) {
+      const auto& in = reinterpret_cast<const sockaddr_in&>(peer);
+      std::memcpy(from.address.data(), &in.sin_addr, 4);
+      from.port = ntohs(in.sin_port);
+    } else if (peer.ss_family == AF_INET6) {
+      const auto& in6 = reinterpret_cast<const sockaddr_in6&>(peer);
+      std::memcpy(from.address.data(), &in6.sin6_addr, 16);
+      from.port = ntohs(in6.sin6_port);
+    }
     const auto size = static_cast<std::size_t>(n);
     handler_(size > buffer.size() ? std::span<const std::uint8_t>()
-                                  : std::span<const std::uint8_t>(buffer.data(), size));
+                                  : std::span<const std::uint8_t>(buffer.data(), size),
+             from);
   }
 }
 

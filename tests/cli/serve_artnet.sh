@@ -46,6 +46,16 @@ send(artdmx([9, 0]))            # a value no cue has: counted
 time.sleep(0.2)
 send(artdmx([4, 0]))            # greet
 time.sleep(0.5)
+old = artdmx([2, 0])
+send(old[:10] + bytes([0, 0]) + old[12:])  # protocol version 0: dropped
+# A second desk asking for hello while the first still holds greet: merged,
+# the higher level wins (greet stays).
+second = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+second.bind(("127.0.0.2", 0))
+for _ in range(3):
+    second.sendto(artdmx([2, 0]), target)
+    time.sleep(0.05)
+time.sleep(0.3)
 PY
 kill -TERM $pid
 wait_exit
@@ -53,7 +63,7 @@ out=$(cat "$tmp/out.txt")
 [[ $code == 0 ]] || fail "exit $code: $out"
 grep -q "ended by stop request" <<<"$out" || fail "SIGTERM did not stop: $out"
 grep -q "deactivate: torque off" "$tmp/err.txt" || fail "no torque off: $(cat "$tmp/err.txt")"
-grep -qE "^artnet: 11 packets, 6 frames of the cue universe, 3 malformed, 2 ignored, 1 values asking for no cue$" <<<"$out" ||
+grep -qE "^artnet: 15 packets, 9 frames of the cue universe, 4 malformed, 0 out of sequence, 2 ignored, 1 values asking for no cue$" <<<"$out" ||
   fail "$(grep '^artnet' <<<"$out")"
 grep -qE "^cues started: sway [1-9][0-9]* hello 0 look_left 1 greet 1$" <<<"$out" ||
   fail "expected look_left and greet once: $(grep '^cues started' <<<"$out")"

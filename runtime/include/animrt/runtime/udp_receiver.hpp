@@ -3,6 +3,7 @@
 // is handed to a handler on that thread. Show-control triggers (OSC,
 // Art-Net) arrive this way.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -18,10 +19,19 @@ struct UdpOptions {
   std::string interface;       // the address of the interface to join it on
 };
 
+// Where a datagram came from: the sender's IP address (IPv4 in the first
+// four bytes) and port.
+struct UdpSender {
+  std::array<std::uint8_t, 16> address{};
+  std::uint16_t port = 0;
+  bool operator==(const UdpSender&) const = default;
+};
+
 class UdpReceiver {
  public:
   // A datagram longer than the largest UDP payload comes as an empty span.
-  using Handler = std::function<void(std::span<const std::uint8_t> datagram)>;
+  using Handler =
+      std::function<void(std::span<const std::uint8_t> datagram, const UdpSender& from)>;
 
   // Binds UDP `host`:`port` (port 0: a free one). Throws std::runtime_error
   // naming `what` and the address when it cannot.
