@@ -366,6 +366,11 @@ DmxJoint make_dmx_joint(const std::string& name, const YamlNode& node, const Rob
     }
     dmx.min = position_within_limits(ends[0], joint);
     dmx.max = position_within_limits(ends[1], joint);
+    if (dmx.min == dmx.max) {
+      range->fail(
+          "both ends are one position, so the fader would not move the joint; expected "
+          "[at level 0, at full]");
+    }
   }
   return dmx;
 }

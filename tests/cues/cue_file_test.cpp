@@ -93,6 +93,25 @@ TEST(CueFile, APoseOrADmxRangeAtAJointsLimitIsTaken) {
       << load_error(past);
 }
 
+// A DMX joint's range of one position would leave the fader moving
+// nothing: refused at the range, as written or as its limit holds it.
+TEST(CueFile, ADmxRangeOfOnePositionIsRefused) {
+  for (const char* range : {"[10, 10]", "[60, 60]", "[10.0, 1e1]"}) {
+    const std::string path = write_cues(
+        "one_position.yaml", std::string("idle: rest\n"
+                                         "artnet: {universe: 0, joints: {neck_pan: {channel: 4, "
+                                         "range: ") +
+                                 range +
+                                 "}}}\n"
+                                 "cues:\n"
+                                 "  rest: {play: {pose: {neck_pan: 0}}}\n");
+    EXPECT_NE(load_error(path).find(":3:62: artnet.joints.neck_pan.range: both ends are one "
+                                    "position"),
+              std::string::npos)
+        << range << ": " << load_error(path);
+  }
+}
+
 TEST(CueFile, ACueNamingAMissingShowNamesFileLineAndKey) {
   const std::string path = write_cues("missing.yaml",
                                       "idle: rest\n"
