@@ -135,6 +135,14 @@ int put_draft_joints(std::ostream& y, std::ostream& keys, const commission::Scan
     // Rounded inwards: a limit past what the servo's own limits allow is refused.
     const double min_deg = std::ceil((*d.min_limit - zero) * 3600.0 / tpr) / 10.0;
     const double max_deg = std::floor((*d.max_limit - zero) * 3600.0 / tpr) / 10.0;
+    if (!(max_deg > min_deg)) {
+      // Limits a tenth of a degree apart or crossed (or a Feetech's 0 and
+      // 0, wheel mode): no joint a robot file takes.
+      y << "  # left out: id " << d.id << " (" << d.model << "): its limit registers ("
+        << *d.min_limit << " and " << *d.max_limit
+        << " ticks) leave no travel; set them with `animrt servo ... set-limits` and scan again\n";
+      continue;
+    }
     const std::string name = "id" + std::to_string(d.id);
     y << "  " << name << ":   # " << d.model;
     if (d.position) y << ", at " << *d.position << " ticks when scanned";
@@ -180,6 +188,10 @@ int write_robot_draft(const std::string& path, const std::string& port,
   put_draft_bus(y, port, found, groups, best);
   std::ostringstream keys;
   const int joints = put_draft_joints(y, keys, found, protocol, baud);
+  if (joints == 0) {
+    throw std::runtime_error(
+        "--write-robot: no servo's limit registers leave it any travel; nothing to draft");
+  }
   y << "\n# Holds every joint at its home pose: replace with the figure's motion.\n"
     << "motion:\n  type: show\n  file: " << show.filename().string() << "\n";
 

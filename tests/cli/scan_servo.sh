@@ -80,6 +80,15 @@ out=$(servo21 factory-reset --yes) && [[ $out == *"factory reset (id and baud ra
 scan > "$tmp/scan4.txt" 2>&1
 grep -q "  21  " "$tmp/scan4.txt" && ! grep -q "operating mode" "$tmp/scan4.txt" \
   || fail "after the reset: $(cat "$tmp/scan4.txt")"
+# Limits that leave no travel (a tick apart): the servo is left out of the
+# draft, saying why, and the draft still validates.
+out=$(servo21 set-limits 2048 2049) || fail "set-limits 2048 2049: $out"
+scan --write-robot "$tmp/draft5.yaml" > "$tmp/scan5.txt" 2>&1 || fail "draft5: $(cat "$tmp/scan5.txt")"
+grep -q "# left out: id 21 .* leave no travel" "$tmp/draft5.yaml" && ! grep -q "^  id21:" "$tmp/draft5.yaml" \
+  || fail "draft5: $(cat "$tmp/draft5.yaml")"
+"$animrt" validate "$tmp/draft5.yaml" > "$tmp/validate5.txt" 2>&1 \
+  || fail "draft5 does not validate: $(cat "$tmp/validate5.txt")"
+grep -q "ok (11 joints" "$tmp/validate5.txt" || fail "draft5: $(cat "$tmp/validate5.txt")"
 out=$(servo21 set-mode walking)
 [[ $? -eq 3 && $out == *"unknown mode 'walking': expected one of current, velocity, position"* ]] \
   || fail "bad mode: $out"
