@@ -235,6 +235,26 @@ struct CycleStages {
         double& last_ok = s.last_ok_[b][d];
         if (!io.fresh && t - last_ok <= late_bus_grace(watchdog) + kTimeEps) continue;
         const DeviceHealth health = io.fresh ? io.health[d] : DeviceHealth::timeout;
+        // A device's own error flag (Dynamixel's Alert, a drive's fault
+        // state) is its error bits: with `error_bits: warn` or `ignore` it
+        // answered, and is not faulted for it (one that switched itself off
+        // is found by its following error). Warned here only when its bits
+        // are not read (health off); read, the health check warns.
+        const HealthLimits::Bits bits = model.buses[b].health_of(d).error_bits;
+        if (health == DeviceHealth::hardware_error && bits != HealthLimits::Bits::fault) {
+          last_ok = t;
+          auto& warned = s.health_track_[b][d].warned;
+          const auto bit =
+              static_cast<std::uint8_t>(1u << static_cast<unsigned>(HealthCheck::error_bits));
+          const bool read = d < io.readings.size() && io.readings[d].has_error_bits;
+          if (bits == HealthLimits::Bits::warn && !read && !(warned & bit)) {
+            warned |= bit;
+            ++s.health_stats_[b][d].warnings;
+            s.emit(CycleEvent{EventKind::health_warning, t, model.buses[b].joint[d], b, d,
+                              DeviceHealth::ok, -1.0, HealthCheck::error_bits});
+          }
+          continue;
+        }
         if (health == DeviceHealth::ok) {
           last_ok = t;
         } else if (health == DeviceHealth::hardware_error || t - last_ok > watchdog + kTimeEps) {

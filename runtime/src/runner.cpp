@@ -61,6 +61,7 @@ std::string describe_health(const HealthLimits& lim, const CycleEvent& e,
           "stall: current {:.2f} A (limit {:g} A) for {:g} s while the joint did not follow",
           e.value, lim.stall_current_a, lim.stall_time_s);
     case HealthCheck::error_bits:
+      if (e.value < 0.0) return "the device reports a hardware error (its error bits are not read)";
       return fmt::format("device error bits 0x{:02X}{}", static_cast<unsigned>(e.value),
                          error_text.empty() ? "" : " (" + error_text + ")");
     case HealthCheck::none:
@@ -73,7 +74,7 @@ std::string describe_health(const HealthLimits& lim, const CycleEvent& e,
 std::string health_text(const RobotModel& m, const std::vector<std::unique_ptr<ActuatorBus>>& buses,
                         const CycleEvent& e) {
   const std::string words =
-      e.check == HealthCheck::error_bits
+      e.check == HealthCheck::error_bits && e.value >= 0.0
           ? buses[e.bus]->error_words(e.device, static_cast<std::uint32_t>(e.value))
           : std::string();
   return describe_health(m.buses[e.bus].health_of(e.device), e, words);

@@ -62,4 +62,22 @@ sed 's/temperature_fault_c: 70/temperature_fault_c: 50/' "$tmp/robots/hot.yaml" 
   > "$tmp/out2.txt" 2> "$tmp/err2.txt" && fail "a fault limit below the warning was accepted"
 grep -Eq "bad.yaml:[0-9]+:[0-9]+: safety.health.temperature_fault_c: expected more than temperature_warn_c \(60\)" \
   "$tmp/err2.txt" "$tmp/out2.txt" || fail "no located error: $(cat "$tmp/err2.txt" "$tmp/out2.txt")"
+# A servo's hardware error (its Alert bit) under `error_bits: warn`, its
+# bits not read (health off): warned of once, the run plays on (exit 0).
+/usr/bin/python3 - "$root/configs/robots/quadruped.yaml" "$tmp/robots/alert.yaml" <<'PY'
+import sys
+text = open(sys.argv[1]).read()
+text = text.replace("  stop_ramp_s: 2.0 ", "  stop_ramp_s: 0.5 \n  health: {error_bits: warn}\n  #", 1)
+text = text.replace("  start_ramp_s: 2.0 ", "  start_ramp_s: 0.5 \n  #", 1)
+text = text.replace("      return_delay_us: 0 ",
+                    "      inject:\n        - {id: 3, at_s: 1.0, hardware_error: 1}\n      return_delay_us: 0 ", 1)
+assert "error_bits: warn" in text and "hardware_error" in text
+open(sys.argv[2], "w").write(text)
+PY
+"$animrt" run "$tmp/robots/alert.yaml" --backend sim --lockstep --duration 2 --no-realtime \
+  > "$tmp/out3.txt" 2> "$tmp/err3.txt"
+code=$?
+[[ $code == 0 ]] || fail "error_bits warn: exit $code: $(cat "$tmp/out3.txt" "$tmp/err3.txt")"
+[[ $(grep -c "^WARNING bus legs id 3 (lf_ankle): the device reports a hardware error (its error bits are not read)" "$tmp/out3.txt") == 1 ]] \
+  || fail "error_bits warn: $(cat "$tmp/out3.txt")"
 echo OK

@@ -263,6 +263,33 @@ TEST(Cycle, AHardwareErrorFaultsTheDeviceAtOnce) {
   EXPECT_EQ(bench.state.phase(), Phase::stop_ramp);
 }
 
+// The device's own error flag is its error bits: with `error_bits: warn`
+// it is warned of once (its bits not being read) and plays on; with
+// `ignore` nothing is said. Neither faults it.
+TEST(Cycle, AHardwareErrorUnderErrorBitsWarnOrIgnoreIsNoFault) {
+  for (const auto bits : {HealthLimits::Bits::warn, HealthLimits::Bits::ignore}) {
+    Bench bench(two_bus_model());
+    bench.model.buses[0].health.error_bits = bits;
+    bench.begin();
+    bench.run_until(Phase::motion);
+    bench.health[0][1] = DeviceHealth::hardware_error;
+    for (int i = 0; i < 50; ++i) bench.cycle();
+    EXPECT_EQ(bench.first(EventKind::device_fault), nullptr);
+    EXPECT_EQ(bench.state.phase(), Phase::motion);
+    const CycleEvent* warning = bench.first(EventKind::health_warning);
+    if (bits == HealthLimits::Bits::warn) {
+      ASSERT_NE(warning, nullptr);
+      EXPECT_EQ(warning->check, HealthCheck::error_bits);
+      EXPECT_EQ(warning->device, 1u);
+      int warnings = 0;
+      for (const CycleEvent& e : bench.events) warnings += e.kind == EventKind::health_warning;
+      EXPECT_EQ(warnings, 1);  // once per episode
+    } else {
+      EXPECT_EQ(warning, nullptr);
+    }
+  }
+}
+
 TEST(Cycle, ABusThatNeverComesBackIsFaultedOnlyAfterTenWatchdogs) {
   Bench bench(two_bus_model());
   bench.model.safety.watchdog_timeout_s = 0.1;
