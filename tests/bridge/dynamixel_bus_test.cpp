@@ -509,7 +509,9 @@ TEST_F(DynamixelBusTest, ActivateRefusesADeviceInHardwareError) {
   EXPECT_EQ(error_of([&] { bus_.activate(); }),
             "bus legs (" + fake_.port() +
                 "): cannot write goal position of id 3 (lf_ankle): device reports a hardware "
-                "error (hardware error status 0x24: overheating, overload)");
+                "error (hardware error status 0x24: overheating, overload); once its cause is "
+                "gone, a power cycle or `animrt servo " +
+                fake_.port() + " --protocol dynamixel2 --id 3 --baud 1000000 reboot` clears it");
   EXPECT_EQ(fake_.servo(1).torque, 0);
   EXPECT_EQ(fake_.servo(2).torque, 0);
 }

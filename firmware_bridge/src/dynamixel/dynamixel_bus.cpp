@@ -410,8 +410,15 @@ void DynamixelBus::activate() {
       if (a == Answer::ok && (link_.book()[i].last_error_byte & dxl::kAlertBit) == 0) return;
       // A servo in hardware error shutdown would stay limp: refuse to start.
       if (a == Answer::ok) read_pending_hardware_status();
+      // The Alert stays until the servo restarts: say how, once its cause is gone.
+      const std::string reboot =
+          a == Answer::ok ? "; once its cause is gone, a power cycle or `animrt servo " +
+                                config_.port + " --protocol dynamixel2 --id " +
+                                std::to_string(config_.actuators[i].device_id) + " --baud " +
+                                std::to_string(config_.baud) + " reboot` clears it"
+                          : std::string();
       const std::string message =
-          prefix() + "cannot " + action + " of " + describe(i) + ": " + failure(i, a);
+          prefix() + "cannot " + action + " of " + describe(i) + ": " + failure(i, a) + reboot;
       deactivate();
       throw DeviceError(message);
     };
