@@ -27,6 +27,7 @@ assert post("/api/cue", {"cue": "nothere"}) == 400
 assert post("/api/cue", {"cue": "hello"}, with_token=False) == 401
 assert post("/api/cue", {"pause": True}) == 200
 assert post("/api/cue", {"pause": "yes"}) == 400
+assert post("/api/cue", {"cue": "hello", "pause": True}) == 400  # which one is meant?
 time.sleep(0.5)
 assert post("/api/stop", {}) == 200
 PY

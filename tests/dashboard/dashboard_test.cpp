@@ -104,6 +104,16 @@ class DashboardRun {
     if (answer) *answer = json::parse(res->body, nullptr, false);
     return res->status;
   }
+  // POSTs `body` as it is (with the token); the status, and the answer's error.
+  int post_raw(const std::string& path, const std::string& body, std::string* error) const {
+    httplib::Headers headers{{"Authorization", "Bearer " + server_->token()}};
+    auto res = client().Post(path.c_str(), headers, body, "application/json");
+    EXPECT_TRUE(res);
+    if (!res) return -1;
+    const json answer = json::parse(res->body, nullptr, false);
+    if (error && answer.is_object() && answer.contains("error")) *error = answer["error"];
+    return res->status;
+  }
   // Polls /api/state until `pred` holds (or fails the test after kPatience).
   json wait_state(const std::function<bool(const json&)>& pred) const {
     const auto give_up = std::chrono::steady_clock::now() + kPatience;
@@ -311,6 +321,32 @@ TEST(Dashboard, AControlWithoutTheTokenIsRefusedAndChangesNothing) {
   EXPECT_FALSE(run.done_.load());
   // The token as a query parameter works as the header does.
   EXPECT_EQ(run.post("/api/stop", json::object(), run.server_->token()), 200);
+  EXPECT_EQ(run.finish().end_reason, EndReason::signal);
+}
+
+// A control's body that is no one JSON object is refused saying what is
+// wrong: a key given twice (it was taken as its last value), the parser's
+// own words (a number past a double's range and a lone surrogate were both
+// "expected a JSON object"), an array. Nothing changes.
+TEST(Dashboard, ABodyThatIsNoOneObjectIsRefusedSayingWhy) {
+  DashboardRun run(0.0);
+  run.wait_state(in_motion);
+  std::string error;
+  EXPECT_EQ(run.post_raw("/api/manual", R"({"on": true, "on": false})", &error), 400);
+  EXPECT_EQ(error, "the key \"on\" is given twice");
+  EXPECT_EQ(run.post_raw("/api/manual", R"({"on": {"a": 1, "a": 2}})", &error), 400);
+  EXPECT_EQ(error, "the key \"a\" is given twice");
+  EXPECT_EQ(run.post_raw("/api/manual", R"({"a": {"on": 1}, "on": true})", &error), 200);
+  EXPECT_EQ(run.post_raw("/api/manual", R"({"on": false})", &error), 200);
+  EXPECT_EQ(run.post_raw("/api/steer", R"({"speed_mps": 1e999})", &error), 400);
+  EXPECT_EQ(error.rfind("the body is no JSON: ", 0), 0u) << error;
+  EXPECT_NE(error.find("1e999"), std::string::npos) << error;
+  EXPECT_EQ(run.post_raw("/api/steer", R"({"joint": "\ud800"})", &error), 400);
+  EXPECT_NE(error.find("surrogate"), std::string::npos) << error;
+  EXPECT_EQ(run.post_raw("/api/stop", "[1]", &error), 400);
+  EXPECT_EQ(error, "expected a JSON object as the body");
+  EXPECT_FALSE(run.controls_.stop.load());
+  EXPECT_EQ(run.post("/api/stop", json::object()), 200);
   EXPECT_EQ(run.finish().end_reason, EndReason::signal);
 }
 

@@ -476,6 +476,9 @@ struct DashboardServer::Impl {
       if (!setup.cue) return error(res, 409, "the figure plays no cues (animrt serve does)");
       const auto cue = body.find("cue");
       const auto pause = body.find("pause");
+      if (cue != body.end() && pause != body.end()) {
+        return error(res, 400, "give either \"cue\" or \"pause\", not both");
+      }
       if (cue != body.end() && cue->is_string()) {
         if (!setup.cue(cue->get<std::string>())) {
           return error(res, 400, "no cue named " + cue->dump());
@@ -566,10 +569,10 @@ struct DashboardServer::Impl {
   void route_seek(httplib::Server& server) {
     server.Post("/api/seek", [this](const httplib::Request& req, httplib::Response& res) {
       if (!setup.replay || !setup.seek) return error(res, 409, "not a replay");
-      const json body = json::parse(req.body, nullptr, false);
-      if (body.is_discarded() || !body.is_object()) {
-        return error(res, 400, "expected a JSON object as the body");
-      }
+      std::string problem;
+      const std::optional<json> parsed = DashboardCore::object_body(req.body, problem);
+      if (!parsed) return error(res, 400, problem);
+      const json& body = *parsed;
       const auto t = number(body, "t_s");
       if (!t) return error(res, 400, "expected \"t_s\": a finite number of seconds");
       const auto playing = body.find("playing");

@@ -15,8 +15,11 @@
 #include <chrono>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <random>
+#include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "animrt/core/error.hpp"
 #include "animrt/runtime/dashboard.hpp"
@@ -185,15 +188,51 @@ void DashboardCore::error(httplib::Response& res, int status, const std::string&
   answer(res, status, {{"ok", false}, {"error", message}});
 }
 
+std::optional<json> DashboardCore::object_body(const std::string& text, std::string& problem) {
+  if (text.empty()) return json::object();
+  // Keys seen in each object open around the parser (a key given twice
+  // would otherwise be taken as its last value, silently).
+  std::vector<std::set<std::string>> open;
+  std::string twice;
+  const json::parser_callback_t watch = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) open.emplace_back();
+    if (event == json::parse_event_t::object_end && !open.empty()) open.pop_back();
+    if (event == json::parse_event_t::key && !open.empty() && twice.empty() &&
+        !open.back().insert(parsed.get<std::string>()).second) {
+      twice = parsed.get<std::string>();
+    }
+    return true;
+  };
+  json body;
+  try {
+    body = json::parse(text, watch);
+  } catch (const json::exception& e) {
+    // A parse error or a number past a double's range, without the
+    // library's "[json.exception.KIND.N] " prefix.
+    const std::string what = e.what();
+    const auto end = what.find("] ");
+    problem = "the body is no JSON: " + (end == std::string::npos ? what : what.substr(end + 2));
+    return std::nullopt;
+  }
+  if (!twice.empty()) {
+    problem = "the key " + json(twice).dump() + " is given twice";
+    return std::nullopt;
+  }
+  if (!body.is_object()) {
+    problem = "expected a JSON object as the body";
+    return std::nullopt;
+  }
+  return body;
+}
+
 void DashboardCore::control(const std::string& path,
                             std::function<void(const json&, httplib::Response&)> act) {
   server_.Post(path, [this, act](const httplib::Request& req, httplib::Response& res) {
     if (!authorized(req)) return error(res, 401, "a valid token is needed for controls");
-    json body = req.body.empty() ? json::object() : json::parse(req.body, nullptr, false);
-    if (body.is_discarded() || !body.is_object()) {
-      return error(res, 400, "expected a JSON object as the body");
-    }
-    act(body, res);
+    std::string problem;
+    const std::optional<json> body = object_body(req.body, problem);
+    if (!body) return error(res, 400, problem);
+    act(*body, res);
   });
 }
 

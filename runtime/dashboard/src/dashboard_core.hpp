@@ -20,6 +20,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -88,6 +89,10 @@ class DashboardCore {
   // JSON answers: `body` with `status`; an error as {"ok": false, "error"}.
   static void answer(httplib::Response& res, int status, const nlohmann::json& body);
   static void error(httplib::Response& res, int status, const std::string& message);
+  // A request's body as a JSON object ({} when empty); nullopt, with what is
+  // wrong in `problem` (the parser's words, a key given twice, not an
+  // object), otherwise.
+  static std::optional<nlohmann::json> object_body(const std::string& text, std::string& problem);
   // POST `path`: 401 without the token, 400 unless the body is empty or a
   // JSON object, then `act` with the body ({} when empty).
   void control(const std::string& path,
