@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "animrt/bridge/commission/servo_setup.hpp"
 #include "animrt/core/error.hpp"
@@ -40,6 +41,18 @@ int run_servo(const ServoArgs& args, const std::string& action) {
   const Family family = args.protocol == "dynamixel2" ? Family::dynamixel2 : Family::feetech;
   // Factory rates: Dynamixel X 57600, Feetech STS/SCS 1 Mbaud.
   const int baud = args.baud > 0 ? args.baud : (family == Family::dynamixel2 ? 57600 : 1'000'000);
+  // What the command line alone shows wrong is said before the line is
+  // opened (an absent servo's "no answer" would hide it).
+  const int max_id = ServoSetup::max_id(family);
+  using Id = std::pair<const char*, int>;
+  for (const auto& [what, id] :
+       {Id{"--id", args.id}, Id{"set-id: the new id", action == "set-id" ? args.value : 0}}) {
+    if (id < 0 || id > max_id) {
+      std::cerr << "error: " << what << " " << id << " is outside 0.." << max_id << " ("
+                << args.protocol << ")\n";
+      return kExitUsage;
+    }
+  }
   // A port that is no serial port is told so first (open_serial says why).
   open_serial(args.port, 57600).reset();
   if (const std::string busy = port_busy(args.port); !busy.empty()) {

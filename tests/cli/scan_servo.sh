@@ -54,6 +54,13 @@ out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 21 --baud 1000000 set-id
 out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 99 --baud 1000000 set-id 98 2>&1)
 [[ $? -eq 3 && $(wc -l <<< "$out") -eq 1 && $out == *"id 99"*"no answer to a ping"* ]] \
   || fail "absent servo: $out"
+# An id out of range is told before the line is asked anything (it was
+# "no answer to a ping" for an absent servo).
+out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 99 --baud 1000000 set-id 1000 2>&1)
+[[ $? -eq 1 && $out == "error: set-id: the new id 1000 is outside 0..252 (dynamixel2)" ]] \
+  || fail "new id out of range: $out"
+out=$("$animrt" servo "$pty" --protocol dynamixel2 --id 253 --baud 1000000 reboot 2>&1)
+[[ $? -eq 1 && $out == "error: --id 253 is outside 0..252 (dynamixel2)" ]] || fail "--id 253: $out"
 # A factory reset is not done unconfirmed.
 out=$(echo n | "$animrt" servo "$pty" --protocol dynamixel2 --id 21 --baud 1000000 factory-reset 2>&1)
 [[ $? -ne 0 && $out == *"factory reset not confirmed"* ]] || fail "unconfirmed reset: $out"

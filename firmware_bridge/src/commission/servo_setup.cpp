@@ -50,9 +50,9 @@ std::string baud_list(const std::vector<int>& bauds) {
 
 ServoSetup::ServoSetup(Family family, Open open, int id, int baud, microseconds timeout)
     : family_(family), open_(std::move(open)), id_(id), baud_(baud), timeout_(timeout) {
-  const int max_id = family_ == Family::dynamixel2 ? 252 : ft::kMaxDeviceId;
-  if (id_ < 0 || id_ > max_id) {
-    throw DeviceError("--id " + std::to_string(id_) + ": expected 0.." + std::to_string(max_id));
+  if (id_ < 0 || id_ > max_id(family_)) {
+    throw DeviceError("--id " + std::to_string(id_) + ": expected 0.." +
+                      std::to_string(max_id(family_)));
   }
   line_ = open_(baud_);
   if (!carries_baud(line_->port(), baud_)) {
@@ -67,6 +67,10 @@ ServoSetup::ServoSetup(Family family, Open open, int id, int baud, microseconds 
 }
 
 bool ServoSetup::sts() const { return family_ == Family::feetech && !scs_; }
+
+int ServoSetup::max_id(Family family) {
+  return family == Family::dynamixel2 ? 252 : ft::kMaxDeviceId;
+}
 
 std::string ServoSetup::where() const {
   return std::string(family_ == Family::dynamixel2 ? "dynamixel2" : "feetech") + " id " +
@@ -178,9 +182,8 @@ void ServoSetup::write_verified(std::uint16_t address, std::span<const std::uint
 }
 
 std::string ServoSetup::set_id(int new_id) {
-  const int max_id = family_ == Family::dynamixel2 ? 252 : ft::kMaxDeviceId;
-  if (new_id < 0 || new_id > max_id) {
-    fail("new id " + std::to_string(new_id) + " is outside 0.." + std::to_string(max_id));
+  if (new_id < 0 || new_id > max_id(family_)) {
+    fail("new id " + std::to_string(new_id) + " is outside 0.." + std::to_string(max_id(family_)));
   }
   if (new_id == id_) return where() + ": id is already " + std::to_string(new_id);
   require_torque_off();

@@ -38,6 +38,8 @@ class ServoSetup {
 
   // Names set_mode takes, for this family.
   std::string mode_names() const;
+  // The highest id a servo of `family` takes (0 is the lowest).
+  static int max_id(Family family);
 
  private:
   std::string where() const;  // "<protocol> id N at B baud on PORT"
