@@ -81,7 +81,8 @@ inline const SeedValidator kSeed;
 // for an integer option (`servo ... set-id ""` gave a servo id 0).
 class IntegerValidator : public CLI::Validator {
  public:
-  IntegerValidator() : CLI::Validator("INT") {
+  // No name of its own: the option's type already reads INT in --help.
+  IntegerValidator() : CLI::Validator("") {
     func_ = [](std::string& input) -> std::string {
       long long value = 0;
       const char* end = input.data() + input.size();

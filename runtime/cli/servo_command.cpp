@@ -44,6 +44,10 @@ int run_servo(const ServoArgs& args, const std::string& action) {
   // What the command line alone shows wrong is said before the line is
   // opened (an absent servo's "no answer" would hide it).
   const int max_id = ServoSetup::max_id(family);
+  if (args.baud < 0) {
+    std::cerr << "error: --baud " << args.baud << ": expected a baud rate\n";
+    return kExitUsage;
+  }
   using Id = std::pair<const char*, int>;
   for (const auto& [what, id] :
        {Id{"--id", args.id}, Id{"set-id: the new id", action == "set-id" ? args.value : 0}}) {
@@ -95,8 +99,7 @@ void add_servo_command(CLI::App& app) {
   cmd->add_option("--baud", args->baud,
                   "the servo's baud rate now (default the factory's: 57600 Dynamixel, 1000000 "
                   "Feetech)")
-      ->check(kInteger)
-      ->check(CLI::PositiveNumber);
+      ->check(kInteger);
   cmd->add_option("--timeout-ms", args->timeout_ms, "wait for one answer (default 20)")
       ->check(CLI::Range(1, 1000));
   cmd->require_subcommand(1);
