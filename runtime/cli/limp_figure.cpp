@@ -23,6 +23,13 @@ void apply_ports(const std::vector<std::string>& entries, RobotConfig& config) {
       throw std::invalid_argument("--port " + quote(entry) + ": expected BUS=PATH");
     }
     const std::string name = entry.substr(0, eq);
+    for (const std::string& earlier : entries) {
+      if (&earlier == &entry) break;
+      if (earlier.compare(0, eq + 1, entry, 0, eq + 1) == 0) {
+        throw std::invalid_argument("--port " + quote(entry) + ": bus " + quote(name) +
+                                    " is given a port twice (also " + quote(earlier) + ")");
+      }
+    }
     bool found = false;
     for (BusConfig& bus : config.buses) {
       if (bus.name == name) {

@@ -135,6 +135,13 @@ code=$?
    $(wc -l <<< "$out") -eq 1 ]] || fail "unknown joint (exit $code): $out"
 cmp -s "$robot" "$tmp/before.yaml" || fail "file changed after an unknown joint"
 
+# One bus given two ports: refused, naming both (the last one was taken).
+out=$("$animrt" calibrate "$robot" --non-interactive --port "legs=$pty" --port "legs=/dev/ttyUSB7" \
+  --joint lf_knee 2>&1)
+code=$?
+[[ $code -eq 1 && $out == *"--port \"legs=/dev/ttyUSB7\": bus \"legs\" is given a port twice (also \"legs=$pty\")"* ]] \
+  || fail "a bus given two ports (exit $code): $out"
+
 # A read-only file: one line, exit 2, untouched.
 chmod 444 "$robot"
 calibrate '{"lf_knee": [2, 1800, 2400, 2000]}' "$tmp/ro.txt" --non-interactive --joint lf_knee --seconds-per-joint 0.7
