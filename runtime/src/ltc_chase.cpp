@@ -9,6 +9,8 @@ namespace {
 
 constexpr double kJumpFrames = 1.5;
 constexpr double kDropoutFrames = 2.5;
+// Timecode counts the hours of a day: after 23:59:59 comes 00:00:00.
+constexpr double kDayS = 24 * 3600.0;
 
 }  // namespace
 
@@ -25,7 +27,8 @@ void LtcChase::frame(double timecode_s, double end_s) {
   const double at_end = timecode_s + frame_s_;
   if (locked_) {
     const double expected = anchor_tc_ + (end_s - anchor_at_);
-    if (std::abs(at_end - expected) > kJumpFrames * frame_s_) {
+    // Across midnight the timecode runs on: compared within a day.
+    if (std::abs(std::remainder(at_end - expected, kDayS)) > kJumpFrames * frame_s_) {
       ++jumps_;
       resync_ = true;
     }
@@ -56,17 +59,23 @@ int LtcChase::advance(double now_s) {
     position_.reset();
     return -1;
   }
-  const double now_tc = anchor_tc_ + silent;
+  const double now_tc = std::fmod(anchor_tc_ + silent, kDayS);
   int entry = -1;
   if (resync_ || !position_) {
     entry = playing_at(now_tc);
     resync_ = false;
+  } else if (now_tc < *position_ - kDayS / 2) {
+    // Past midnight: the cues from the day's start, else the last of the
+    // day before.
+    entry = due(-1.0, now_tc);
+    if (entry < 0) entry = due(*position_, kDayS);
   } else {
     entry = due(*position_, now_tc);
   }
   position_ = now_tc;
   if (entry < 0) return -1;
   offset_ = now_tc - cues_[static_cast<std::size_t>(entry)].start_s;
+  if (offset_ < 0.0) offset_ += kDayS;
   return cues_[static_cast<std::size_t>(entry)].cue;
 }
 

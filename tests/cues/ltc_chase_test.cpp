@@ -53,6 +53,24 @@ TEST(LtcChase, CuesComeAsTheTimecodeCrossesThemAndAJumpReSyncs) {
   EXPECT_EQ(chase.frames(), 53u);
 }
 
+// Time-of-day timecode runs past midnight into the next day: no jump, and
+// the cues on either side of midnight come as it crosses them.
+TEST(LtcChase, MidnightIsNoJump) {
+  const double day = 24 * 3600.0;
+  LtcChase chase(25, 0.5, {{0.0, 1}, {0.2, 2}, {day - 0.2, 3}});
+  // Locked at 23:59:59:15: cue 2 is the one playing (since 00:00:00:05);
+  // cue 3 as the timecode crosses 23:59:59:20.
+  EXPECT_EQ(ltc_play(chase, day - 0.4, 0.0, 5), (std::vector<int>{2, 3}));
+  std::vector<int> asked = ltc_play(chase, day - 0.2, 0.2, 5);   // 23:59:59:20 .. 24
+  const std::vector<int> after = ltc_play(chase, 0.0, 0.4, 10);  // 00:00:00:00 ..
+  asked.insert(asked.end(), after.begin(), after.end());
+  EXPECT_EQ(asked, (std::vector<int>{1, 2}));
+  EXPECT_EQ(chase.jumps(), 0u);
+  EXPECT_NEAR(*chase.timecode(), 0.4, 1e-9);
+  // Cue 2 was asked for as the timecode crossed 0.2 s: a frame past it at most.
+  EXPECT_GE(chase.cue_offset(), 0.0);
+}
+
 TEST(LtcChase, TimecodesAreCheckedAgainstTheFrameRate) {
   EXPECT_DOUBLE_EQ(*parse_timecode("01:02:03:12", 25), 3723.48);
   EXPECT_DOUBLE_EQ(*parse_timecode("00:00:01;29", 30), 1.0 + 29.0 / 30);
