@@ -147,11 +147,19 @@ void print_header(const evolve::RunConfig& config, const evolve::ModelInfo& info
   std::cout << std::flush;
 }
 
+// The history's CSV and plot: as given, else beside --out.
+std::string history_csv(const EvolveArgs& a) {
+  return a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
+}
+std::string history_plot(const EvolveArgs& a) {
+  return a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
+}
+
 // The history (CSV and plot) and the best gait written, the best reported.
 int write_results(const EvolveArgs& a, const evolve::RunConfig& config,
                   const evolve::SearchResult& result, EvolveDashboardServer* dashboard) {
-  const std::string csv = a.csv.empty() ? with_extension(a.out, ".csv") : a.csv;
-  const std::string plot = a.plot.empty() ? with_extension(a.out, ".svg") : a.plot;
+  const std::string csv = history_csv(a);
+  const std::string plot = history_plot(a);
   evolve::write_history_csv(result.history, csv);
   evolve::write_history_svg(result.history, config.name, plot);
   const auto& best = result.best;
@@ -206,6 +214,14 @@ int run_evolve(const EvolveArgs& a) {
     return kExitUsage;
   }
   if (!output_option_ok("--out", a.out, a.pareto ? kOutputFolder : kOutputFile)) return kExitUsage;
+  // The files written beside the gait too, before the search (a folder in
+  // the way lost the search's gait after it).
+  if (!a.pareto &&
+      (!output_option_ok(a.csv.empty() ? "--out's .csv" : "--csv", history_csv(a), kOutputFile) ||
+       !output_option_ok(a.plot.empty() ? "--out's .svg" : "--plot", history_plot(a),
+                         kOutputFile))) {
+    return kExitUsage;
+  }
   // The dashboard's address is a usage error before any file is read.
   const DashboardAddress address = check_dashboard_address(a.dashboard, a.dashboard_remote);
   if (!address.ok) return kExitUsage;

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "animrt/controllers/gait/froude.hpp"
 #include "animrt/controllers/gait/gait_file.hpp"
@@ -116,6 +117,12 @@ int run_calibrate(const CalibrateArgs& a) {
 
   GaitCalibration cal;
   const std::string out = a.out.empty() ? calibration_path_for(gait_path) : a.out;
+  // Checked before the walks (--out itself when the command line was read;
+  // the default beside the gait only now, once the gait is known).
+  if (const std::string problem = output_file_problem(out); !problem.empty()) {
+    throw std::invalid_argument("the calibration file " + out + ": " + problem +
+                                " (give another with --out)");
+  }
   cal.gait_file = relative_to(gait_path, out);
   cal.model_file = relative_to(a.physics, out);
   std::printf("calibrating %s on %s: %d speeds x %d turn rates\n", gait_path.c_str(),

@@ -125,6 +125,18 @@ done <<CASES
 --record|$tmp|is a folder, expected a file to write|run $root/configs/robots/quadruped.yaml
 --write-robot|$tmp|is a folder, expected a file to write|scan $tmp/no_port
 CASES
+# The files written beside an output are checked before the work too (a
+# folder where evolve's plot goes lost the search's gait after it; one where
+# a gait's calibration goes, the whole grid walked).
+mkdir -p "$tmp/ev/g.svg" "$tmp/gc/pony.calibration.yaml"
+out=$(timeout 20 "$animrt" evolve "$root/configs/evolve/quadruped_sinusoidal.yaml" --out "$tmp/ev/g.yaml" 2>&1)
+[[ $? -eq 1 && $out == "--out's .svg: $tmp/ev/g.svg: is a folder, expected a file to write" && ! -e $tmp/ev/g.csv ]] ||
+  fail "evolve with its plot's path a folder: $out"
+cp "$root/configs/gaits/pony.yaml" "$tmp/gc/"
+out=$(cd "$tmp/gc" && timeout 20 "$animrt" gait calibrate "$root/configs/robots/pony.yaml" \
+  --physics "$root/configs/models/pony.xml" --gait pony.yaml 2>&1)
+[[ $? -eq 1 && $out == *"the calibration file pony.calibration.yaml: is a folder, expected a file to write (give another with --out)" ]] ||
+  fail "gait calibrate with its default output a folder: $out"
 # Any other parse error is a usage error too (CLI11's own codes are 100 and up).
 out=$("$animrt" run 2>&1)
 code=$?
