@@ -59,33 +59,15 @@ std::string shortest_exact(double v) {
   return std::string(buf, end);
 }
 
-// The loop evaluates a curve at the strides walked so far, less a limb's
-// phase: from t = -1 on, and past 2^24 strides only after months of walking.
-constexpr int kLongRunDoublings = 24;
-
-// Throws if the compiled curve is not finite somewhere on [0, 1), or at
-// the times a long walk reaches (a curve such as 0*sin(1e306*t) is finite
-// over one stride and not a few hundred strides on).
+// Throws if the compiled curve is not finite somewhere on [0, 1).
 void check_finite(const Expression& curve, const std::function<void(const std::string&)>& fail) {
-  const auto value_text = [](double v) {
-    return std::isnan(v) ? std::string("nan") : shortest_exact(v);
-  };
   for (int i = 0; i < kFiniteSamples; ++i) {
     const double t = static_cast<double>(i) / kFiniteSamples;  // exact binary fractions
     const double v = curve.eval(t);
     if (!std::isfinite(v)) {
       fail("curve is not finite at t = " + shortest_exact(t) + " stride cycles (value " +
-           value_text(v) + "); it must be finite over the whole stride");
-    }
-  }
-  for (int k = -1; k <= kLongRunDoublings; ++k) {
-    for (const double part : {0.0, 0.25, 0.5, 0.75}) {
-      const double t = (k < 0 ? -1.0 : std::ldexp(1.0, k)) + part;
-      const double v = curve.eval(t);
-      if (!std::isfinite(v)) {
-        fail("curve is not finite at t = " + shortest_exact(t) + " stride cycles (value " +
-             value_text(v) + "), which a walk reaches; it must stay finite as the stride repeats");
-      }
+           (std::isnan(v) ? std::string("nan") : shortest_exact(v)) +
+           "); it must be finite over the whole stride");
     }
   }
 }
